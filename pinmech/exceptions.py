@@ -1,0 +1,113 @@
+"""Errors raised by pinmech: one base class, one named subclass per failure.
+
+Every error keeps the offending numbers as attributes and puts them in its message,
+so the CLI can print one line and a script can inspect what went wrong.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+class PinmechError(Exception):
+    """Base class of every error pinmech raises on purpose."""
+
+    exit_code = 2
+
+
+class ModelError(PinmechError):
+    """A URDF file or one of its `<constraint>` elements is malformed or inconsistent."""
+
+    exit_code = 3
+
+    def __init__(self, message: str, *, path: str | None = None, element: str | None = None):
+        where = ", ".join(x for x in (path, element) if x)
+        super().__init__(f"{where}: {message}" if where else message)
+        self.path = path
+        self.element = element
+
+
+class SceneError(PinmechError):
+    """A scene or hand-value file is malformed, or names something the model lacks."""
+
+    exit_code = 4
+
+    def __init__(self, message: str, *, path: str | None = None, key: str | None = None):
+        where = ", ".join(x for x in (path, key) if x)
+        super().__init__(f"{where}: {message}" if where else message)
+        self.path = path
+        self.key = key
+
+
+class UnitError(SceneError):
+    """A quantity is written with an unknown unit, or a unit of the wrong dimension."""
+
+
+class FrameNotFound(SceneError):
+    """A joint, link, point or frame name is not in the model."""
+
+    def __init__(self, kind: str, name: str, known: list[str], *, path: str | None = None):
+        listed = ", ".join(known[:20]) + (", ..." if len(known) > 20 else "")
+        super().__init__(f"unknown {kind} '{name}' (the model has: {listed})", path=path)
+        self.kind = kind
+        self.name = name
+        self.known = known
+
+
+class MobilityError(PinmechError):
+    """The drivers do not match the mechanism's mobility (degrees of freedom)."""
+
+    exit_code = 5
+
+    def __init__(self, message: str, *, mobility: int, drivers: int):
+        super().__init__(message)
+        self.mobility = mobility
+        self.drivers = drivers
+
+
+class LoopClosureError(PinmechError):
+    """Newton could not close the loops: the pose is out of reach for these dimensions.
+
+    Attributes:
+        residual: closure residual reached (dimensionless, position rows divided by the
+            mechanism's length scale).
+        iterations: Newton iterations spent.
+        partial: the last iterate (configuration vector), for inspection.
+    """
+
+    exit_code = 6
+
+    def __init__(self, message: str, *, residual: float, iterations: int, partial: Any = None):
+        super().__init__(message)
+        self.residual = residual
+        self.iterations = iterations
+        self.partial = partial
+
+
+class SingularPoseError(PinmechError):
+    """A Jacobian is singular (or too ill-conditioned) at the pose: rates are undefined.
+
+    Attributes:
+        condition: condition number of the Jacobian (inf at an exact singularity).
+        sigma_min: its smallest singular value.
+    """
+
+    exit_code = 7
+
+    def __init__(self, message: str, *, condition: float, sigma_min: float, partial: Any = None):
+        super().__init__(message)
+        self.condition = condition
+        self.sigma_min = sigma_min
+        self.partial = partial
+
+
+class TaskError(PinmechError):
+    """An end-effector rate task is inconsistent or over-determined."""
+
+    exit_code = 8
+
+
+class CheckMismatch(PinmechError):
+    """Hand values disagree with pinmech (raised by the CLI after printing the table)."""
+
+    exit_code = 1

@@ -1,0 +1,424 @@
+"""URDF + `<constraint>` loop cuts -> a Pinocchio model with named points and closures.
+
+URDF describes a tree. A closed loop is cut at one joint, and the cut is declared in the
+same file with the `<constraint>` element proposed for URDF (ros/urdfdom#264):
+
+    <constraint name="C" type="revolute|prismatic|spherical|fixed">
+      <parent link="ground"/> <parent_origin xyz="0.05 0 0" rpy="0 0 0"/> <parent_axis xyz="0 0 1"/>
+      <child link="link3"/>   <child_origin xyz="0 0 0" rpy="0 0 0"/>     <child_axis xyz="0 0 1"/>
+    </constraint>
+
+Pinocchio ignores the element; this module reads it, adds one frame per side of the cut,
+and finds which constraint rows are independent (a planar loop loses its out-of-plane
+rows). Named points are massless leaf links hung on fixed joints.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from pinmech.closures import CUT_TYPES, Closure
+from pinmech.exceptions import FrameNotFound, ModelError
+
+#: Singular values below this fraction of the largest mark a row as structurally zero.
+STRUCTURAL_RANK_TOL = 1e-9
+_SAMPLES = 4
+
+
+@dataclass(frozen=True)
+class JointInfo:
+    """A one-degree-of-freedom (or other) joint of the model, as a user names it.
+
+    Attributes:
+        kind: "revolute", "continuous" (stored as cos/sin), "prismatic" or "other".
+        idx_q, idx_v: first index in the configuration and velocity vectors.
+    """
+
+    name: str
+    id: int
+    kind: str
+    idx_q: int
+    idx_v: int
+    nq: int
+    nv: int
+    parent_link: str
+    child_link: str
+    axis: np.ndarray  # in the joint frame
+
+    @property
+    def is_angular(self) -> bool:
+        return self.kind in ("revolute", "continuous")
+
+
+@dataclass
+class Mechanism:
+    """A Pinocchio model with the user's names: joints, links, points and loop closures.
+
+    Build one with `Mechanism.from_urdf`. It owns no solver state: solvers create their own
+    `pin.Data` once and keep it across poses.
+
+    Attributes:
+        model: the (possibly reduced) Pinocchio model, with one extra frame per cut side.
+        closures: the loop cuts, with their independent rows.
+        joints: name -> JointInfo of every joint that moves.
+        links: name -> Pinocchio BODY frame id, for every link that is not a point.
+        points: name -> frame id of every named point.
+        length_scale: size of the mechanism [m]; position tolerances are relative to it.
+        plane_normal: unit normal of the motion plane for a planar mechanism, else None.
+        locked: joints locked out of the model, with their values (SI).
+    """
+
+    model: pin.Model
+    closures: list[Closure]
+    joints: dict[str, JointInfo]
+    links: dict[str, int]
+    points: dict[str, int]
+    length_scale: float
+    plane_normal: np.ndarray | None
+    source: str = "<model>"
+    locked: dict[str, float] = field(default_factory=dict)
+
+    # ---------------------------------------------------------------- construction
+    @classmethod
+    def from_urdf(
+        cls,
+        path: str | Path,
+        *,
+        locked: dict[str, float] | None = None,
+        package_dirs: list[str] | None = None,
+    ) -> Mechanism:
+        """Load a URDF with its `<constraint>` loop cuts.
+
+        Args:
+            path: the URDF file.
+            locked: joints to lock out of the model, name -> value (rad or m). The others
+                keep their degrees of freedom. Locked joints cost nothing at solve time.
+            package_dirs: unused for kinematics (no meshes are loaded here); kept for
+                symmetry with the drawing code.
+
+        Raises:
+            ModelError: malformed XML or URDF, or a malformed `<constraint>`.
+            FrameNotFound: a locked joint that is not in the model.
+        """
+        path = Path(path)
+        source = str(path)
+        root = _parse_xml(path)
+        try:
+            full = pin.buildModelFromUrdf(source)
+        except (ValueError, RuntimeError) as exc:
+            raise ModelError(f"Pinocchio cannot build the model: {exc}", path=source) from exc
+        model = _lock_joints(full, locked or {}, source)
+        links_xml = _link_names(root)
+        point_names = _point_links(root)
+        joint_links = {
+            j.get("name"): (j.find("parent").get("link"), j.find("child").get("link"))
+            for j in root.findall("joint")
+            if j.find("parent") is not None and j.find("child") is not None
+        }
+        cuts = [_parse_constraint(c, model, links_xml, source) for c in root.findall("constraint")]
+        mech = cls(
+            model=model,
+            closures=[],
+            joints=_joint_infos(model, joint_links),
+            links={n: _body_frame(model, n) for n in links_xml if n not in point_names and model.existBodyName(n)},
+            points={n: _body_frame(model, n) for n in point_names if model.existBodyName(n)},
+            length_scale=1.0,
+            plane_normal=None,
+            source=source,
+            locked=dict(locked or {}),
+        )
+        mech.length_scale = _length_scale(model)
+        mech.closures = [_make_closure(model, c, mech.length_scale) for c in cuts]
+        _reduce_rows(mech)
+        mech.plane_normal = _plane_normal(mech)
+        return mech
+
+    # ---------------------------------------------------------------- look-ups
+    def joint(self, name: str) -> JointInfo:
+        """The joint called `name`; FrameNotFound lists the known ones otherwise."""
+        try:
+            return self.joints[name]
+        except KeyError:
+            raise FrameNotFound("joint", name, list(self.joints), path=self.source) from None
+
+    def frame_id(self, name: str) -> int:
+        """Frame id of a point, a link, or any other frame of the model, by name."""
+        if name in self.points:
+            return self.points[name]
+        if name in self.links:
+            return self.links[name]
+        if self.model.existFrame(name):
+            return self.model.getFrameId(name)
+        known = list(self.points) + list(self.links)
+        raise FrameNotFound("point or frame", name, known, path=self.source)
+
+    def link_of_frame(self, frame: int) -> str:
+        """Name of the link a frame is attached to (the body of its parent joint)."""
+        joint = self.model.frames[frame].parentJoint
+        for name, fid in self.links.items():
+            if self.model.frames[fid].parentJoint == joint:
+                return name
+        return self.model.names[joint]
+
+    @property
+    def constraint_rows(self) -> int:
+        """Number of independent loop-closure equations."""
+        return sum(c.rows for c in self.closures)
+
+    @property
+    def mobility(self) -> int:
+        """Degrees of freedom left once every loop is closed (Gruebler, from ranks)."""
+        return self.model.nv - self.constraint_rows
+
+    def neutral(self) -> np.ndarray:
+        """The model's neutral configuration (all joint coordinates zero)."""
+        return pin.neutral(self.model)
+
+    def set_coordinate(self, q: np.ndarray, name: str, value: float) -> None:
+        """Write a joint's coordinate (angle [rad] or length [m]) into q, in place."""
+        j = self.joint(name)
+        if j.kind == "continuous":
+            q[j.idx_q : j.idx_q + 2] = (np.cos(value), np.sin(value))
+        elif j.nq == 1:
+            q[j.idx_q] = value
+        else:
+            raise ModelError(f"joint '{name}' has {j.nq} coordinates; give it a full configuration", path=self.source)
+
+    def coordinate(self, q: np.ndarray, name: str) -> float:
+        """A one-dof joint's coordinate (angle in (-pi, pi] for a continuous joint)."""
+        j = self.joint(name)
+        if j.kind == "continuous":
+            return float(np.arctan2(q[j.idx_q + 1], q[j.idx_q]))
+        return float(q[j.idx_q])
+
+
+# -------------------------------------------------------------------- XML reading
+def _parse_xml(path: Path) -> ET.Element:
+    if not path.is_file():
+        raise ModelError("no such URDF file", path=str(path))
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise ModelError(f"malformed XML: {exc}", path=str(path)) from exc
+    if root.tag != "robot":
+        raise ModelError(f"root element is <{root.tag}>, expected <robot>", path=str(path))
+    return root
+
+
+def _link_names(root: ET.Element) -> list[str]:
+    return [link.get("name") for link in root.findall("link")]
+
+
+def _point_links(root: ET.Element) -> list[str]:
+    """Massless leaf links hung on fixed joints: the URDF's named points."""
+    parents = {j.find("parent").get("link") for j in root.findall("joint") if j.find("parent") is not None}
+    fixed_children = {
+        j.find("child").get("link")
+        for j in root.findall("joint")
+        if j.get("type") == "fixed" and j.find("child") is not None
+    }
+    empty = {
+        link.get("name")
+        for link in root.findall("link")
+        if not any(link.find(tag) is not None for tag in ("inertial", "visual", "collision"))
+    }
+    return [n for n in _link_names(root) if n in fixed_children and n in empty and n not in parents]
+
+
+def _vector(element: ET.Element | None, attr: str, default: str, where: str, source: str) -> np.ndarray:
+    text = default if element is None else element.get(attr, default)
+    try:
+        values = np.array([float(x) for x in text.split()])
+    except ValueError:
+        raise ModelError(f"{attr}=\"{text}\" is not three numbers", path=source, element=where) from None
+    if values.shape != (3,) or not np.all(np.isfinite(values)):
+        raise ModelError(f"{attr}=\"{text}\" is not three finite numbers", path=source, element=where)
+    return values
+
+
+@dataclass(frozen=True)
+class _Cut:
+    name: str
+    cut_type: str
+    parent_link: str
+    child_link: str
+    parent_origin: pin.SE3
+    child_origin: pin.SE3
+    parent_axis: np.ndarray
+    child_axis: np.ndarray
+    source: str
+
+
+def _parse_constraint(el: ET.Element, model: pin.Model, links: list[str], source: str) -> _Cut:
+    name = el.get("name") or "<unnamed>"
+    where = f"<constraint name=\"{name}\">"
+    cut_type = el.get("type")
+    if cut_type not in CUT_TYPES:
+        raise ModelError(f"type=\"{cut_type}\" is not one of {', '.join(CUT_TYPES)}", path=source, element=where)
+    sides = {}
+    for side in ("parent", "child"):
+        link_el = el.find(side)
+        link = None if link_el is None else link_el.get("link")
+        if link is None:
+            raise ModelError(f"missing <{side} link=\"...\"/>", path=source, element=where)
+        if link not in links:
+            raise ModelError(f"<{side} link=\"{link}\"/> names no link of the model", path=source, element=where)
+        origin = el.find(f"{side}_origin")
+        xyz = _vector(origin, "xyz", "0 0 0", where, source)
+        rpy = _vector(origin, "rpy", "0 0 0", where, source)
+        axis = _vector(el.find(f"{side}_axis"), "xyz", "0 0 1", where, source)
+        norm = np.linalg.norm(axis)
+        if norm == 0:
+            raise ModelError(f"<{side}_axis xyz=\"0 0 0\"/> is not a direction", path=source, element=where)
+        sides[side] = (link, pin.SE3(pin.rpy.rpyToMatrix(rpy), xyz), axis / norm)
+    return _Cut(name, cut_type, sides["parent"][0], sides["child"][0], sides["parent"][1], sides["child"][1],
+                sides["parent"][2], sides["child"][2], source)
+
+
+# -------------------------------------------------------------------- model building
+def _lock_joints(model: pin.Model, locked: dict[str, float], source: str) -> pin.Model:
+    if not locked:
+        return model
+    q_ref = pin.neutral(model)
+    ids = []
+    for name, value in locked.items():
+        if not model.existJointName(name):
+            raise FrameNotFound("joint to lock", name, [n for n in model.names[1:]], path=source)
+        jid = model.getJointId(name)
+        joint = model.joints[jid]
+        if joint.nq == 2 and joint.nv == 1:
+            q_ref[joint.idx_q : joint.idx_q + 2] = (np.cos(value), np.sin(value))
+        elif joint.nq == 1:
+            q_ref[joint.idx_q] = value
+        else:
+            raise ModelError(f"joint '{name}' has {joint.nq} coordinates and cannot be locked by one value", path=source)
+        ids.append(jid)
+    return pin.buildReducedModel(model, ids, q_ref)
+
+
+def _joint_kind(joint: pin.JointModel) -> str:
+    short = joint.shortname()
+    if joint.nv != 1:
+        return "other"
+    if joint.nq == 2:
+        return "continuous"
+    if "Prismatic" in short or short.startswith("JointModelP"):
+        return "prismatic"
+    if "Revolute" in short or short.startswith("JointModelR"):
+        return "revolute"
+    return "other"
+
+
+def _joint_axis(joint: pin.JointModel) -> np.ndarray:
+    """Unit axis of a one-dof joint in its own frame (motion subspace)."""
+    if joint.nv != 1:
+        return np.zeros(3)
+    data = joint.createData()
+    q = np.zeros(joint.nq)
+    if joint.nq == 2:
+        q[0] = 1.0
+    joint.calc(data, q)
+    S = np.array(data.S).reshape(6, 1)[:, 0]
+    part = S[3:] if np.linalg.norm(S[3:]) > 0 else S[:3]
+    return part / np.linalg.norm(part)
+
+
+def _joint_infos(model: pin.Model, joint_links: dict[str, tuple[str, str]]) -> dict[str, JointInfo]:
+    infos = {}
+    for jid in range(1, model.njoints):
+        joint, name = model.joints[jid], model.names[jid]
+        parent, child = joint_links.get(name, (model.names[model.parents[jid]], name))
+        infos[name] = JointInfo(name, jid, _joint_kind(joint), joint.idx_q, joint.idx_v, joint.nq, joint.nv,
+                                parent, child, _joint_axis(joint))
+    return infos
+
+
+def _body_frame(model: pin.Model, link: str) -> int:
+    return model.getFrameId(link, pin.FrameType.BODY)
+
+
+def _length_scale(model: pin.Model) -> float:
+    """Diagonal of the box around every frame origin at the neutral configuration [m]."""
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, pin.neutral(model))
+    pts = np.array([f.translation for f in data.oMf])
+    size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))) if len(pts) else 0.0
+    return size if size > 0 else 1.0
+
+
+def _make_closure(model: pin.Model, cut: _Cut, length_scale: float) -> Closure:
+    frame_ids = []
+    for side, link, origin in (("parent", cut.parent_link, cut.parent_origin), ("child", cut.child_link, cut.child_origin)):
+        body_id = _body_frame(model, link)
+        body = model.frames[body_id]
+        frame = pin.Frame(f"{cut.name}__{side}", body.parentJoint, body_id, body.placement * origin,
+                          pin.FrameType.OP_FRAME)
+        frame_ids.append(model.addFrame(frame, False))
+    return Closure(cut.name, cut.cut_type, frame_ids[0], frame_ids[1], cut.parent_axis, cut.child_axis,
+                   parent_link=cut.parent_link, child_link=cut.child_link, length_scale=length_scale)
+
+
+def _sample_configurations(model: pin.Model, count: int) -> list[np.ndarray]:
+    rng = np.random.default_rng(20261122)
+    q0 = pin.neutral(model)
+    return [pin.integrate(model, q0, rng.normal(size=model.nv)) for _ in range(count)]
+
+
+def _reduce_rows(mech: Mechanism) -> None:
+    """Give each closure a constant basis of the rows that do not vanish identically."""
+    if not mech.closures:
+        return
+    model = mech.model
+    data = model.createData()
+    samples = _sample_configurations(model, _SAMPLES)
+    stacks: list[list[np.ndarray]] = [[] for _ in mech.closures]
+    for q in samples:
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        for stack, closure in zip(stacks, mech.closures):
+            stack.append(closure.selected @ closure.relative_jacobian6(model, data))
+    for stack, closure in zip(stacks, mech.closures):
+        U, s, _ = np.linalg.svd(np.hstack(stack), full_matrices=False)
+        rank = int(np.sum(s > STRUCTURAL_RANK_TOL * max(s[0], 1e-300))) if s.size else 0
+        closure.basis = _readable_basis(U[:, :rank])
+
+
+def _readable_basis(U: np.ndarray) -> np.ndarray:
+    """Rows of the identity when they span the same space as U's columns, else U^T.
+
+    A planar revolute cut then keeps "x" and "y" rather than two mixed combinations,
+    so its residual reads in the cut frame's own axes.
+    """
+    inside = np.linalg.norm(U.T, axis=0) > 1 - 1e-12  # identity rows lying in span(U)
+    if int(inside.sum()) == U.shape[1]:
+        return np.eye(U.shape[0])[inside]
+    return U.T.copy()
+
+
+def _plane_normal(mech: Mechanism) -> np.ndarray | None:
+    """The common normal of a planar mechanism: every link turns about it, none moves along it."""
+    model = mech.model
+    if model.nv == 0:
+        return None
+    data = model.createData()
+    angular, linear = [], []
+    for q in _sample_configurations(model, 3):
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        for fid in range(model.nframes):
+            J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+            angular.append(J[3:])
+            linear.append(J[:3])
+    U, s, _ = np.linalg.svd(np.hstack(angular))
+    if s[0] == 0 or (len(s) > 1 and s[1] > STRUCTURAL_RANK_TOL * s[0]):
+        return None
+    normal = U[:, 0] * np.sign(U[np.argmax(np.abs(U[:, 0])), 0])
+    lin = np.hstack(linear)
+    if np.linalg.norm(normal @ lin) > STRUCTURAL_RANK_TOL * max(np.linalg.norm(lin), 1e-300):
+        return None
+    return normal

@@ -1,0 +1,211 @@
+"""What a hand calculation reports, read off Pinocchio at a solved (q, v, a).
+
+Positions, velocities and classical accelerations of named points; angular velocities
+and accelerations of links; joint coordinates and rates; and for every prismatic joint
+the relative (slider) velocity, acceleration and the Coriolis term 2 w_parent x v_rel.
+All vectors are in the world frame, SI units.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from pinmech.exceptions import FrameNotFound
+from pinmech.mechanism import Mechanism
+
+_LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+
+@dataclass(frozen=True)
+class PointMotion:
+    """Position [m], velocity [m/s] and classical acceleration [m/s^2] of a point, world frame."""
+
+    position: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    link: str
+
+
+@dataclass(frozen=True)
+class LinkMotion:
+    """Orientation, angular velocity [rad/s] and angular acceleration [rad/s^2] of a link.
+
+    `angle` is the rotation about the mechanism's plane normal [rad] (planar mechanisms
+    only, else None): the angle of the link's x axis, as a textbook's phi.
+    """
+
+    rotation: np.ndarray
+    angular_velocity: np.ndarray
+    angular_acceleration: np.ndarray
+    angle: float | None
+
+
+@dataclass(frozen=True)
+class JointMotion:
+    """Coordinate [rad or m], rate and acceleration of a one-dof joint."""
+
+    q: float
+    v: float
+    a: float
+    kind: str
+
+
+@dataclass(frozen=True)
+class SliderMotion:
+    """Motion of a prismatic joint's child relative to its parent, world frame.
+
+    Attributes:
+        relative_velocity: velocity of the child's point relative to the parent [m/s].
+        relative_acceleration: its acceleration seen from the parent [m/s^2].
+        coriolis_acceleration: 2 w_parent x v_rel [m/s^2].
+    """
+
+    parent: str
+    child: str
+    relative_velocity: np.ndarray
+    relative_acceleration: np.ndarray
+    coriolis_acceleration: np.ndarray
+
+
+@dataclass(frozen=True)
+class CoincidentPoint:
+    """A point of `link` that coincides with the named point `at` at this instant (e.g. B3)."""
+
+    name: str
+    at: str
+    link: str
+
+
+@dataclass(frozen=True)
+class Motion:
+    """Everything a report shows about one solved pose."""
+
+    joints: dict[str, JointMotion]
+    links: dict[str, LinkMotion]
+    points: dict[str, PointMotion]
+    sliders: dict[str, SliderMotion]
+
+
+def evaluate_motion(
+    mechanism: Mechanism,
+    data: pin.Data,
+    q: np.ndarray,
+    v: np.ndarray,
+    a: np.ndarray,
+    *,
+    points: Iterable[str] | None = None,
+    coincident: Iterable[CoincidentPoint] = (),
+    links: Iterable[str] | None = None,
+) -> Motion:
+    """Evaluate joints, links, points and sliders at (q, v, a).
+
+    Args:
+        mechanism: the model.
+        data: a `pin.Data` of the model to work in (overwritten).
+        points: named points or frames to report (default: all the URDF's points).
+        coincident: points of a link coinciding with a named point (e.g. B3 on link 3).
+        links: links to report (default: all that move).
+    """
+    model = mechanism.model
+    pin.forwardKinematics(model, data, q, v, a)
+    pin.updateFramePlacements(model, data)
+    link_names = list(links) if links is not None else _moving_links(mechanism)
+    link_motion = {n: _link_motion(mechanism, data, n) for n in link_names}
+    point_names = list(points) if points is not None else list(mechanism.points)
+    coincident = list(coincident)
+    point_motion = {}
+    for name in point_names:
+        match = [c for c in coincident if c.name == name]
+        point_motion[name] = _coincident(mechanism, data, match[0]) if match else _point(mechanism, data, name)
+    for c in coincident:
+        point_motion.setdefault(c.name, _coincident(mechanism, data, c))
+    return Motion(
+        joints={n: JointMotion(mechanism.coordinate(q, n), float(v[j.idx_v]), float(a[j.idx_v]), j.kind)
+                for n, j in mechanism.joints.items() if j.nv == 1},
+        links=link_motion,
+        points=point_motion,
+        sliders={n: _slider(mechanism, data, n, float(v[j.idx_v]), float(a[j.idx_v]))
+                 for n, j in mechanism.joints.items() if j.kind == "prismatic"},
+    )
+
+
+def _moving_links(mechanism: Mechanism) -> list[str]:
+    model = mechanism.model
+    return [n for n, fid in mechanism.links.items() if model.frames[fid].parentJoint != 0]
+
+
+def _point(mechanism: Mechanism, data: pin.Data, name: str) -> PointMotion:
+    fid = mechanism.frame_id(name)
+    model = mechanism.model
+    return PointMotion(
+        position=data.oMf[fid].translation.copy(),
+        velocity=pin.getFrameVelocity(model, data, fid, _LWA).linear.copy(),
+        acceleration=pin.getFrameClassicalAcceleration(model, data, fid, _LWA).linear.copy(),
+        link=mechanism.link_of_frame(fid),
+    )
+
+
+def _link_motion(mechanism: Mechanism, data: pin.Data, name: str) -> LinkMotion:
+    if name not in mechanism.links:
+        raise FrameNotFound("link", name, list(mechanism.links), path=mechanism.source)
+    fid = mechanism.links[name]
+    model = mechanism.model
+    rotation = data.oMf[fid].rotation.copy()
+    return LinkMotion(
+        rotation=rotation,
+        angular_velocity=pin.getFrameVelocity(model, data, fid, _LWA).angular.copy(),
+        angular_acceleration=pin.getFrameAcceleration(model, data, fid, _LWA).angular.copy(),
+        angle=_plane_angle(rotation, mechanism.plane_normal),
+    )
+
+
+def _plane_angle(rotation: np.ndarray, normal: np.ndarray | None) -> float | None:
+    """Angle of the link's x axis about the plane normal, measured from the world x axis."""
+    if normal is None:
+        return None
+    x_axis = rotation[:, 0]
+    ref = np.array([1.0, 0.0, 0.0]) if abs(normal[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    ref = ref - normal * (normal @ ref)
+    ref /= np.linalg.norm(ref)
+    return float(np.arctan2(normal @ np.cross(ref, x_axis), ref @ x_axis))
+
+
+def _coincident(mechanism: Mechanism, data: pin.Data, c: CoincidentPoint) -> PointMotion:
+    """Motion of the material point of `c.link` that sits at point `c.at` now (rigid-body formulas)."""
+    if c.link not in mechanism.links:
+        raise FrameNotFound("link", c.link, list(mechanism.links), path=mechanism.source)
+    model = mechanism.model
+    fid = mechanism.links[c.link]
+    at = data.oMf[mechanism.frame_id(c.at)].translation.copy()
+    origin = data.oMf[fid].translation
+    vel = pin.getFrameVelocity(model, data, fid, _LWA)
+    acc = pin.getFrameClassicalAcceleration(model, data, fid, _LWA)
+    spatial_acc = pin.getFrameAcceleration(model, data, fid, _LWA)
+    r = at - origin
+    w, alpha = vel.angular, spatial_acc.angular
+    return PointMotion(
+        position=at,
+        velocity=vel.linear + np.cross(w, r),
+        acceleration=acc.linear + np.cross(alpha, r) + np.cross(w, np.cross(w, r)),
+        link=c.link,
+    )
+
+
+def _slider(mechanism: Mechanism, data: pin.Data, name: str, rate: float, accel: float) -> SliderMotion:
+    joint = mechanism.joint(name)
+    model = mechanism.model
+    axis_world = data.oMi[joint.id].rotation @ joint.axis
+    parent_joint = model.parents[joint.id]
+    omega_parent = data.oMi[parent_joint].rotation @ data.v[parent_joint].angular
+    v_rel = rate * axis_world
+    return SliderMotion(
+        parent=joint.parent_link,
+        child=joint.child_link,
+        relative_velocity=v_rel,
+        relative_acceleration=accel * axis_world,
+        coriolis_acceleration=2.0 * np.cross(omega_parent, v_rel),
+    )

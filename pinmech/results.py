@@ -1,0 +1,65 @@
+"""Result objects that carry their own accuracy, so a caller can tell when not to trust them."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Accuracy:
+    """How well a solution satisfies its equations.
+
+    Attributes:
+        residual: largest closure (or task) position error, dimensionless: position rows
+            are divided by the mechanism's length scale [m], orientation rows are [rad].
+        iterations: Newton iterations spent on the position (0 when none were needed).
+        condition: 2-norm condition number of the Jacobian solved for the rates.
+        sigma_min: smallest singular value of that Jacobian (dimensionless rows).
+        velocity_residual: max |J q_dot| of the velocity equations, per second.
+        acceleration_residual: max |J q_ddot + Jdot q_dot| of the acceleration equations.
+    """
+
+    residual: float
+    iterations: int
+    condition: float
+    sigma_min: float
+    velocity_residual: float = 0.0
+    acceleration_residual: float = 0.0
+
+    def is_accurate(self, tol: float = 1e-9, max_condition: float = 1e8) -> bool:
+        """True when the position residual is below `tol` and the Jacobian is well conditioned."""
+        return self.residual <= tol and self.condition <= max_condition
+
+    def as_dict(self) -> dict[str, float | int]:
+        return {
+            "closure_residual": self.residual,
+            "newton_iterations": self.iterations,
+            "condition_number": self.condition,
+            "sigma_min": self.sigma_min,
+            "velocity_residual": self.velocity_residual,
+            "acceleration_residual": self.acceleration_residual,
+        }
+
+
+@dataclass(frozen=True)
+class LoopSolution:
+    """Joint positions, velocities and accelerations of a closed mechanism (SI units).
+
+    Attributes:
+        q: configuration vector of the Pinocchio model (continuous joints as cos/sin).
+        v: joint velocities [rad/s or m/s], one per degree of freedom.
+        a: joint accelerations [rad/s^2 or m/s^2].
+        accuracy: residuals, iterations and conditioning of this solve.
+    """
+
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    accuracy: Accuracy
+    drivers: tuple[str, ...] = field(default=())
+
+    def is_closed(self, tol: float = 1e-9) -> bool:
+        """True when every loop closes to `tol` (relative to the mechanism's size)."""
+        return self.accuracy.residual <= tol
