@@ -198,6 +198,12 @@ class Mechanism:
 
 
 # -------------------------------------------------------------------- XML reading
+def urdf_joint_types(path: str | Path) -> dict[str, str]:
+    """Joint name -> URDF joint type ("revolute", "prismatic", ...), read from the XML."""
+    root = _parse_xml(Path(path))
+    return {j.get("name"): j.get("type") for j in root.findall("joint")}
+
+
 def _parse_xml(path: Path) -> ET.Element:
     if not path.is_file():
         raise ModelError("no such URDF file", path=str(path))

@@ -1,0 +1,128 @@
+"""A scene, solved: model loaded, loops closed, rates found, motion read off.
+
+This is the one function the CLI's `solve` and a user's script share:
+
+    analysis = pinmech.analyse(pinmech.Scene.load("models/scenes/r_rtr.toml"))
+    analysis.motion.points["D"].velocity   # [m/s], world frame
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from pinmech.exceptions import FrameNotFound, ModelError, SceneError
+from pinmech.mechanism import Mechanism, urdf_joint_types
+from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
+from pinmech.results import LoopSolution
+from pinmech.scene import Scene
+from pinmech.solve_loops import LoopSolver
+
+
+@dataclass(frozen=True)
+class Drivers:
+    """Driver joints and their coordinate [rad or m], rate and acceleration, in SI."""
+
+    names: tuple[str, ...]
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """Everything `pinmech solve` reports for one scene."""
+
+    scene: Scene
+    mechanism: Mechanism
+    drivers: Drivers
+    solution: LoopSolution
+    motion: Motion
+    extra: dict[str, Any] | None = None
+
+
+def load_mechanism(scene: Scene) -> Mechanism:
+    """The scene's URDF as a Mechanism, with the scene's `[lock]` joints locked out."""
+    if not scene.urdf.is_file():
+        raise ModelError(f"the scene's urdf = \"{scene.raw['urdf']}\" is not a file", path=str(scene.path))
+    types = urdf_joint_types(scene.urdf)
+    locked = {}
+    for name, value in scene.section("lock").items():
+        kind = "length" if types.get(name) == "prismatic" else "angle"
+        locked[name] = scene.quantity(value, kind, "lock", name)
+    return Mechanism.from_urdf(scene.urdf, locked=locked)
+
+
+def _scene_joint(scene: Scene, mechanism: Mechanism, name: str, key: str):
+    """A joint the scene names, or FrameNotFound naming the scene file and key."""
+    if name not in mechanism.joints:
+        raise FrameNotFound(f"joint (in [{key}])", name, list(mechanism.joints), path=str(scene.path))
+    return mechanism.joints[name]
+
+
+def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
+    """The `[drivers]` table in SI units, checked against the model's joints."""
+    table = scene.driver_table()
+    names, values = [], []
+    for name, spec in table.items():
+        if name in mechanism.locked:
+            raise SceneError(f"joint '{name}' is both driven and locked", path=str(scene.path), key=f"drivers.{name}")
+        joint = _scene_joint(scene, mechanism, name, "drivers")
+        row = [0.0, 0.0, 0.0]
+        given = [False, False, False]
+        for key, value in spec.items():
+            order = Scene.driver_order(key)
+            if given[order]:
+                raise SceneError(f"{key} repeats another key of the same order", path=str(scene.path), key=f"drivers.{name}")
+            row[order] = scene.joint_quantity(value, joint.kind, order, "drivers", name, key)
+            given[order] = True
+        if not given[0]:
+            raise SceneError("missing its angle (or position)", path=str(scene.path), key=f"drivers.{name}")
+        names.append(name)
+        values.append(row)
+    arr = np.array(values, dtype=float).reshape(-1, 3)
+    return Drivers(tuple(names), arr[:, 0].copy(), arr[:, 1].copy(), arr[:, 2].copy())
+
+
+def scene_guess(scene: Scene, mechanism: Mechanism) -> np.ndarray:
+    """Starting configuration from `[guess]`: it picks the assembly branch."""
+    q = mechanism.neutral()
+    for name, value in scene.section("guess").items():
+        joint = _scene_joint(scene, mechanism, name, "guess")
+        mechanism.set_coordinate(q, name, scene.joint_quantity(value, joint.kind, 0, "guess", name))
+    return q
+
+
+def coincident_points(scene: Scene) -> list[CoincidentPoint]:
+    """`[points.NAME] at = "B", link = "link3"`: points of a link under another point."""
+    out = []
+    for name, spec in scene.section("points").items():
+        if not isinstance(spec, dict) or set(spec) != {"at", "link"}:
+            raise SceneError("a coincident point needs exactly at = \"POINT\" and link = \"LINK\"",
+                             path=str(scene.path), key=f"points.{name}")
+        out.append(CoincidentPoint(name, str(spec["at"]), str(spec["link"])))
+    return out
+
+
+def report_lists(scene: Scene) -> tuple[list[str] | None, list[str] | None]:
+    """Points and links the scene asks to report (None: all)."""
+    report = scene.section("report")
+    unknown = set(report) - {"points", "links"}
+    if unknown:
+        raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))} in [report]; known: points, links",
+                         path=str(scene.path), key="report")
+    return report.get("points"), report.get("links")
+
+
+def analyse(scene: Scene) -> Analysis:
+    """Load, close the loops, solve the rates and read off the motion of a scene."""
+    mechanism = load_mechanism(scene)
+    drivers = scene_drivers(scene, mechanism)
+    solver = LoopSolver(mechanism, drivers.names, **scene.solver_options())
+    solution = solver.solve(drivers.q, drivers.v, drivers.a, guess=scene_guess(scene, mechanism))
+    points, links = report_lists(scene)
+    motion = evaluate_motion(mechanism, solver.data, solution.q, solution.v, solution.a,
+                             points=points, links=links, coincident=coincident_points(scene))
+    return Analysis(scene, mechanism, drivers, solution, motion)

@@ -1,0 +1,200 @@
+"""Hand values against pinmech: one verdict per printed quantity.
+
+A hand file (TOML) lists values as they were printed, as strings so that their printed
+precision is kept:
+
+    scene = "r_rtr.toml"
+    [[value]]
+    label = "v_D (text)"
+    quantity = "points.D.velocity"     # a path into `pinmech solve --json`
+    hand = ["0.386", "-0.282"]         # x, y as printed
+    unit = "m/s"
+
+A printed value is an interval: "0.386" means [0.3855, 0.3865]. Verdicts:
+    ok        within half a unit of the last printed digit: correctly rounded;
+    rounding  within `slack` units: truncated, or carried rounding of the hand work's
+              own rounded intermediate values; right at the printed precision;
+    MISMATCH  further off: the print (or the model) is wrong.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass
+from decimal import Decimal, InvalidOperation
+from pathlib import Path
+from typing import Any
+
+from pinmech.exceptions import SceneError
+from pinmech.units import to_si
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+#: How many units of the last printed digit count as "rounding" rather than a mismatch.
+DEFAULT_SLACK = 2.0
+_COMPONENTS = {"x": 0, "y": 1, "z": 2}
+_KINDS = {
+    "position": "length",
+    "velocity": "velocity",
+    "acceleration": "acceleration",
+    "relative_velocity": "velocity",
+    "relative_acceleration": "acceleration",
+    "coriolis_acceleration": "acceleration",
+    "angle": "angle",
+    "angular_velocity": "angular_velocity",
+    "angular_acceleration": "angular_acceleration",
+}
+
+
+@dataclass(frozen=True)
+class HandValue:
+    """One printed number: its label, where it lives in the result, and its precision."""
+
+    label: str
+    quantity: str
+    component: int | None
+    printed: str
+    unit: str
+    kind: str
+
+    @property
+    def value(self) -> float:
+        return float(self.printed)
+
+    @property
+    def ulp(self) -> float:
+        """One unit of the last printed digit, in the hand unit."""
+        exponent = Decimal(self.printed).as_tuple().exponent
+        return 10.0 ** int(exponent)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Hand value, pinmech value (in the hand unit), difference and verdict."""
+
+    hand: HandValue
+    computed: float
+    difference: float
+    verdict: str
+
+
+@dataclass(frozen=True)
+class HandFile:
+    path: Path
+    scene: Path
+    source: str
+    values: list[HandValue]
+
+
+def load_hand_file(path: str | Path) -> HandFile:
+    """Read a hand-value file; its scene path is relative to the file's folder.
+
+    Raises:
+        SceneError: malformed TOML, a value that is not a printed number, an unknown unit.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise SceneError("no such hand-value file", path=str(path))
+    try:
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"malformed TOML: {exc}", path=str(path)) from exc
+    if not isinstance(raw.get("scene"), str):
+        raise SceneError("missing scene = \"scene.toml\"", path=str(path), key="scene")
+    values = []
+    for i, entry in enumerate(raw.get("value", [])):
+        values.extend(_hand_values(entry, f"value[{i}]", str(path)))
+    return HandFile(path, (path.parent / raw["scene"]).resolve(), str(raw.get("source", "")), values)
+
+
+def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue]:
+    for key in ("quantity", "hand", "unit"):
+        if key not in entry:
+            raise SceneError(f"missing {key}", path=path, key=where)
+    quantity = str(entry["quantity"])
+    hand = entry["hand"] if isinstance(entry["hand"], list) else [entry["hand"]]
+    base, component = _split_component(quantity)
+    kind = _kind_of(base, str(entry.get("kind", "")), path, where)
+    label = str(entry.get("label", quantity))
+    out = []
+    for i, printed in enumerate(hand):
+        if not isinstance(printed, str):
+            raise SceneError(f"hand value {printed!r} must be a string as printed (e.g. \"0.386\")", path=path, key=where)
+        try:
+            Decimal(printed)
+            float(printed)
+        except (InvalidOperation, ValueError):
+            raise SceneError(f"hand value {printed!r} is not a number", path=path, key=where) from None
+        comp = component if component is not None else (i if len(hand) > 1 else None)
+        suffix = "" if len(hand) == 1 else f" {'xyz'[i]}"
+        out.append(HandValue(label + suffix, base, comp, printed.strip(), str(entry["unit"]), kind))
+    to_si(f"1 {out[0].unit}", kind, where=f"{where}.unit")  # unknown or wrong unit fails here
+    return out
+
+
+def _split_component(quantity: str) -> tuple[str, int | None]:
+    head, _, last = quantity.rpartition(".")
+    if last in _COMPONENTS:
+        return head, _COMPONENTS[last]
+    return quantity, None
+
+
+def _kind_of(path: str, declared: str, file: str, where: str) -> str:
+    if declared:
+        return declared
+    last = path.rsplit(".", 1)[-1]
+    if last in _KINDS:
+        return _KINDS[last]
+    raise SceneError(f"cannot tell the kind of {path!r}: add kind = \"angle\" (or length, velocity, ...)",
+                     path=file, key=where)
+
+
+def lookup(result: dict[str, Any], quantity: str, component: int | None, *, where: str = "") -> float:
+    """A number of a `pinmech solve --json` result, by dotted path and component."""
+    node: Any = result
+    for part in quantity.split("."):
+        if not isinstance(node, dict) or part not in node:
+            known = ", ".join(node) if isinstance(node, dict) else "nothing"
+            raise SceneError(f"{quantity!r}: no '{part}' in the result (has {known})", key=where)
+        node = node[part]
+    if isinstance(node, list):
+        if component is None:
+            raise SceneError(f"{quantity!r} is a vector: add .x, .y or .z, or give a list of hand values", key=where)
+        return float(node[component])
+    return float(node)
+
+
+def compare(result: dict[str, Any], values: list[HandValue], slack: float = DEFAULT_SLACK) -> list[Verdict]:
+    """Verdicts of hand values against a result, in the hand values' units."""
+    out = []
+    for hv in values:
+        factor = to_si(f"1 {hv.unit}", hv.kind)
+        computed = lookup(result, hv.quantity, hv.component, where=hv.label) / factor
+        diff = hv.value - computed
+        units = abs(diff) / hv.ulp
+        verdict = "ok" if units <= 0.5 + 1e-9 else "rounding" if units <= slack else "MISMATCH"
+        out.append(Verdict(hv, computed, diff, verdict))
+    return out
+
+
+def format_verdicts(verdicts: list[Verdict]) -> str:
+    """A table: label, hand value, pinmech value, difference (in last-digit units), verdict."""
+    rows = [("quantity", "hand", "pinmech", "difference", "verdict")]
+    for v in verdicts:
+        digits = max(0, -int(math.floor(math.log10(v.hand.ulp)))) + 3
+        rows.append((
+            v.hand.label,
+            f"{v.hand.printed} {v.hand.unit}",
+            f"{v.computed:.{digits}f}",
+            f"{v.difference:+.2g} ({abs(v.difference) / v.hand.ulp:.2g} digit)",
+            v.verdict,
+        ))
+    widths = [max(len(r[i]) for r in rows) for i in range(5)]
+    lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+    counts = {k: sum(v.verdict == k for v in verdicts) for k in ("ok", "rounding", "MISMATCH")}
+    lines.append(f"{counts['ok']} ok, {counts['rounding']} within rounding, {counts['MISMATCH']} mismatch")
+    return "\n".join(lines)

@@ -1,0 +1,117 @@
+"""The `pinmech` command: one plain function per subcommand, `main(argv)` for tests.
+
+Exit codes: 0 success; 1 hand values mismatch (`check`); 2 usage or other pinmech error;
+3 bad URDF; 4 bad scene or hand file (unknown name, unit, key); 5 drivers do not match
+the mobility; 6 a loop cannot close; 7 singular pose; 8 inconsistent task.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+
+from pinmech import __version__  # noqa: F401  (re-exported for --version)
+from pinmech.exceptions import PinmechError
+
+
+def _add_scene_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("scene", help="scene file (TOML), e.g. models/scenes/r_rtr.toml")
+    parser.add_argument(
+        "--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+        help="override a scene value, e.g. --set 'drivers.A.angle=\"45 deg\"' (repeatable)",
+    )
+    parser.add_argument("--angle", help="shortcut: the (single) driver's angle or position, e.g. '45 deg'")
+    parser.add_argument("--speed", help="shortcut: the driver's speed, e.g. '-50 rpm' or '2 rad/s'")
+    parser.add_argument("--acceleration", help="shortcut: the driver's acceleration, e.g. '1 rad/s^2'")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser, with one sub-parser per subcommand."""
+    parser = argparse.ArgumentParser(
+        prog="pinmech",
+        description="Kinematics of mechanisms and robot arms from URDF, on Pinocchio.",
+        epilog="Exit codes: 0 ok, 1 check mismatch, 2 error, 3 URDF, 4 scene, 5 mobility, "
+        "6 loop cannot close, 7 singular pose, 8 task.",
+    )
+    parser.add_argument("--version", action="version", version=f"pinmech {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    solve = sub.add_parser("solve", help="solve a scene and print the report (or JSON)")
+    _add_scene_arguments(solve)
+    solve.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of text")
+    solve.set_defaults(func=cmd_solve)
+
+    check = sub.add_parser("check", help="compare hand-calculated values with pinmech")
+    check.add_argument("hand_file", help="hand-value file (TOML), e.g. models/scenes/r_rtr.hand.toml")
+    check.add_argument("--slack", type=float, default=None,
+                       help="units of the last printed digit still called rounding (default 2)")
+    check.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                       help="override a value of the hand file's scene")
+    check.set_defaults(func=cmd_check)
+    return parser
+
+
+def _scene(args: argparse.Namespace):
+    from pinmech.scene import Scene
+
+    overrides = list(args.overrides)
+    shortcuts = {"angle": args.angle, "speed": args.speed, "acceleration": args.acceleration}
+    if any(shortcuts.values()):
+        scene = Scene.load(args.scene)
+        drivers = list(scene.section("drivers"))
+        if len(drivers) != 1:
+            raise PinmechError(f"--angle/--speed/--acceleration need a single driver; {args.scene} has "
+                               f"{len(drivers)}: use --set drivers.NAME.angle=...")
+        name = drivers[0]
+        spec = scene.section("drivers")[name]
+        keys = {"angle": "position" if "position" in spec else "angle",
+                "speed": "velocity" if "velocity" in spec else "speed", "acceleration": "acceleration"}
+        overrides += [f'drivers.{name}.{keys[k]}="{v}"' for k, v in shortcuts.items() if v]
+    return Scene.load(args.scene, overrides)
+
+
+def cmd_solve(args: argparse.Namespace) -> int:
+    """`pinmech solve SCENE`: the textbook-ordered report, or `--json`."""
+    from pinmech.analysis import analyse
+    from pinmech.report import to_json, to_text
+
+    analysis = analyse(_scene(args))
+    print(to_json(analysis) if args.json else to_text(analysis), end="" if not args.json else "\n")
+    return 0
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """`pinmech check HAND_FILE`: hand values against pinmech, non-zero exit on a mismatch."""
+    from pinmech.analysis import analyse
+    from pinmech.check import DEFAULT_SLACK, compare, format_verdicts, load_hand_file
+    from pinmech.report import to_dict
+    from pinmech.scene import Scene
+
+    hand = load_hand_file(args.hand_file)
+    analysis = analyse(Scene.load(hand.scene, args.overrides))
+    verdicts = compare(to_dict(analysis), hand.values, args.slack if args.slack is not None else DEFAULT_SLACK)
+    print(f"{hand.source or hand.path}  vs  pinmech on {hand.scene.name}")
+    print(format_verdicts(verdicts))
+    return 1 if any(v.verdict == "MISMATCH" for v in verdicts) else 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; every pinmech error becomes one line on stderr and its exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except PinmechError as exc:
+        print(f"pinmech: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except ImportError as exc:
+        print(f"pinmech: error: {exc}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # `pinmech sweep ... | head`
+        return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,168 @@
+"""Reports of a solved scene: readable text in the textbook's order, and JSON in SI units."""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+import numpy as np
+
+from pinmech.analysis import Analysis
+from pinmech.motion import Motion
+
+
+def _vec(x: np.ndarray) -> list[float]:
+    return [float(c) for c in np.asarray(x).reshape(-1)]
+
+
+def motion_dict(motion: Motion) -> dict[str, Any]:
+    """The `joints`, `links`, `points` and `sliders` sections (SI, world frame)."""
+    links = {}
+    for name, link in motion.links.items():
+        entry: dict[str, Any] = {
+            "angular_velocity": _vec(link.angular_velocity),
+            "angular_acceleration": _vec(link.angular_acceleration),
+        }
+        if link.angle is not None:
+            entry["angle"] = link.angle
+        links[name] = entry
+    return {
+        "joints": {n: {"q": j.q, "v": j.v, "a": j.a, "type": j.kind} for n, j in motion.joints.items()},
+        "links": links,
+        "points": {
+            n: {"position": _vec(p.position), "velocity": _vec(p.velocity), "acceleration": _vec(p.acceleration),
+                "link": p.link}
+            for n, p in motion.points.items()
+        },
+        "sliders": {
+            n: {
+                "parent": s.parent,
+                "child": s.child,
+                "relative_velocity": _vec(s.relative_velocity),
+                "relative_acceleration": _vec(s.relative_acceleration),
+                "coriolis_acceleration": _vec(s.coriolis_acceleration),
+            }
+            for n, s in motion.sliders.items()
+        },
+    }
+
+
+def to_dict(analysis: Analysis) -> dict[str, Any]:
+    """One JSON-ready object for a solved scene (SI units, vectors [x, y, z] in the world frame)."""
+    out: dict[str, Any] = {
+        "title": analysis.scene.title,
+        "scene": str(analysis.scene.path),
+        "urdf": str(analysis.mechanism.source),
+        "units": "SI: m, rad, s; vectors [x, y, z] in the world frame",
+        "drivers": {
+            n: {"q": float(q), "v": float(v), "a": float(a)}
+            for n, q, v, a in zip(analysis.drivers.names, analysis.drivers.q, analysis.drivers.v, analysis.drivers.a)
+        },
+    }
+    out.update(motion_dict(analysis.motion))
+    out["accuracy"] = analysis.solution.accuracy.as_dict()
+    if analysis.extra:
+        out.update(analysis.extra)
+    return out
+
+
+def to_json(analysis: Analysis) -> str:
+    """`to_dict` as indented JSON text (non-finite numbers become null)."""
+    return json.dumps(_finite(to_dict(analysis)), indent=2)
+
+
+def _finite(x: Any) -> Any:
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    if isinstance(x, dict):
+        return {k: _finite(v) for k, v in x.items()}
+    if isinstance(x, list):
+        return [_finite(v) for v in x]
+    return x
+
+
+# ---------------------------------------------------------------------- text
+def _num(x: float) -> str:
+    return f"{x: .6g}"
+
+
+class _Text:
+    """Formats vectors as (x, y) for a mechanism moving in the world xy plane, else (x, y, z)."""
+
+    def __init__(self, analysis: Analysis) -> None:
+        normal = analysis.mechanism.plane_normal
+        self.planar_z = normal is not None and abs(abs(normal[2]) - 1.0) < 1e-12
+        self.lines: list[str] = []
+
+    def vec(self, x: np.ndarray, unit: str) -> str:
+        parts = x[:2] if self.planar_z else x
+        return "(" + ", ".join(_num(c) for c in parts) + f") {unit}"
+
+    def spin(self, w: np.ndarray, unit: str) -> str:
+        return f"{_num(w[2])} {unit} (k)" if self.planar_z else self.vec(w, unit)
+
+    def head(self, title: str) -> None:
+        self.lines += ["", title, "-" * len(title)]
+
+    def row(self, name: str, *cells: str) -> None:
+        self.lines.append(f"  {name:<10} " + "   ".join(cells))
+
+
+def to_text(analysis: Analysis) -> str:
+    """A readable report in the textbook's order: positions, angles, link rates, points, sliders."""
+    m = analysis.motion
+    t = _Text(analysis)
+    drivers = ", ".join(f"{n} = {_angle_or_length(analysis, n, q)}" for n, q in zip(analysis.drivers.names, analysis.drivers.q))
+    t.lines += [f"{analysis.scene.title}", f"model {analysis.mechanism.source}", f"drivers: {drivers}"]
+    t.head("Positions")
+    for name, p in m.points.items():
+        t.row(name, t.vec(p.position, "m"), f"on {p.link}")
+    if any(link.angle is not None for link in m.links.values()):
+        t.head("Link angles (x axis from world x)")
+        for name, link in m.links.items():
+            if link.angle is not None:
+                t.row(name, f"phi = {_num(math.degrees(link.angle))} deg = {_num(link.angle)} rad")
+    t.head("Angular velocities and accelerations")
+    for name, link in m.links.items():
+        t.row(name, "omega = " + t.spin(link.angular_velocity, "rad/s"), "alpha = " + t.spin(link.angular_acceleration, "rad/s^2"))
+    t.head("Velocities of points")
+    for name, p in m.points.items():
+        t.row(name, "v = " + t.vec(p.velocity, "m/s"), f"|v| = {_num(float(np.linalg.norm(p.velocity)))} m/s")
+    t.head("Accelerations of points")
+    for name, p in m.points.items():
+        t.row(name, "a = " + t.vec(p.acceleration, "m/s^2"), f"|a| = {_num(float(np.linalg.norm(p.acceleration)))} m/s^2")
+    if m.sliders:
+        t.head("Sliders (child relative to parent)")
+        for name, s in m.sliders.items():
+            t.row(name, f"{s.child} on {s.parent}")
+            t.row("", "v_rel = " + t.vec(s.relative_velocity, "m/s"))
+            t.row("", "a_rel = " + t.vec(s.relative_acceleration, "m/s^2"))
+            t.row("", "a_cor = 2 omega x v_rel = " + t.vec(s.coriolis_acceleration, "m/s^2"))
+    t.head("Joints")
+    for name, j in m.joints.items():
+        t.row(name, *_joint_cells(j.kind, j.q, j.v, j.a))
+    acc = analysis.solution.accuracy
+    t.head("Accuracy")
+    t.lines.append(
+        f"  closure residual {acc.residual:.2g} (of the mechanism size {analysis.mechanism.length_scale:.4g} m), "
+        f"{acc.iterations} Newton iterations, condition number {acc.condition:.4g}"
+    )
+    for line in (analysis.extra or {}).get("_text", []):
+        t.lines.append(line)
+    return "\n".join(t.lines) + "\n"
+
+
+def _angle_or_length(analysis: Analysis, name: str, q: float) -> str:
+    joint = analysis.mechanism.joint(name)
+    return f"{math.degrees(q):.6g} deg" if joint.is_angular else f"{q:.6g} m"
+
+
+def _joint_cells(kind: str, q: float, v: float, a: float) -> list[str]:
+    if kind == "prismatic":
+        return [f"q = {_num(q)} m", f"v = {_num(v)} m/s", f"a = {_num(a)} m/s^2"]
+    return [
+        f"q = {_num(math.degrees(q))} deg",
+        f"v = {_num(v)} rad/s ({_num(v * 30 / math.pi)} rpm)",
+        f"a = {_num(a)} rad/s^2",
+    ]

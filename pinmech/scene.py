@@ -1,0 +1,151 @@
+"""TOML scene files: which URDF, which drivers with which values, which branch, what to report.
+
+A scene keeps quantities as the user wrote them ("30 deg", "-50 rpm", "150 mm") and
+converts them to SI only once the model is known (a driver's unit depends on its joint
+type). See the README section "Scene files" for the format.
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from pinmech.exceptions import SceneError
+from pinmech.units import JOINT_KINDS, to_si
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+#: Top-level keys a scene may have; other modules (tasks, sweeps) register theirs here.
+KNOWN_KEYS = {"title", "urdf", "drivers", "guess", "lock", "points", "report", "solver", "task", "sweep", "draw"}
+_DRIVER_KEYS = {"angle": 0, "position": 0, "speed": 1, "velocity": 1, "acceleration": 2}
+
+
+@dataclass
+class Scene:
+    """A parsed scene: raw values as written, plus where they came from.
+
+    Attributes:
+        path: the scene file (relative paths inside it are relative to its folder).
+        raw: the TOML content, after command-line overrides.
+    """
+
+    path: Path
+    raw: dict[str, Any] = field(default_factory=dict)
+
+    # -------------------------------------------------------------- loading
+    @classmethod
+    def load(cls, path: str | Path, overrides: list[str] | None = None) -> Scene:
+        """Read a scene file and apply `KEY=VALUE` overrides (dotted keys).
+
+        Raises:
+            SceneError: missing file, malformed TOML, unknown keys, bad override.
+        """
+        path = Path(path)
+        if not path.is_file():
+            raise SceneError("no such scene file", path=str(path))
+        try:
+            raw = tomllib.loads(path.read_text(encoding="utf-8"))
+        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+            raise SceneError(f"malformed TOML: {exc}", path=str(path)) from exc
+        scene = cls(path=path, raw=raw)
+        for item in overrides or []:
+            scene.override(item)
+        scene._validate()
+        return scene
+
+    def override(self, item: str) -> None:
+        """Apply one `dotted.key=value` override; the value is read as TOML, else as a string."""
+        key, sep, text = item.partition("=")
+        if not sep or not key.strip():
+            raise SceneError(f"override {item!r} is not KEY=VALUE (e.g. drivers.A.angle='45 deg')", path=str(self.path))
+        try:
+            value = tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = text.strip().strip("'\"")
+        node = self.raw
+        parts = key.strip().split(".")
+        for part in parts[:-1]:
+            node = node.setdefault(part, {})
+            if not isinstance(node, dict):
+                raise SceneError(f"cannot set {key}: {part} is not a table", path=str(self.path), key=key)
+        node[parts[-1]] = value
+
+    def _validate(self) -> None:
+        unknown = set(self.raw) - KNOWN_KEYS
+        if unknown:
+            raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(KNOWN_KEYS))}",
+                             path=str(self.path))
+        if "urdf" not in self.raw or not isinstance(self.raw["urdf"], str):
+            raise SceneError("missing urdf = \"path/to/model.urdf\"", path=str(self.path), key="urdf")
+        for name in ("drivers", "guess", "lock", "points", "report", "solver"):
+            if name in self.raw and not isinstance(self.raw[name], dict):
+                raise SceneError(f"[{name}] must be a table", path=str(self.path), key=name)
+
+    # -------------------------------------------------------------- accessors
+    @property
+    def title(self) -> str:
+        return str(self.raw.get("title", self.path.stem))
+
+    @property
+    def urdf(self) -> Path:
+        """The URDF file, resolved relative to the scene's folder."""
+        return (self.path.parent / self.raw["urdf"]).resolve()
+
+    def where(self, *keys: str) -> str:
+        return ".".join(keys)
+
+    def section(self, name: str) -> dict[str, Any]:
+        value = self.raw.get(name, {})
+        if not isinstance(value, dict):
+            raise SceneError(f"[{name}] must be a table", path=str(self.path), key=name)
+        return value
+
+    def quantity(self, value: Any, kind: str, *keys: str) -> float:
+        """A quantity of this scene in SI, with file and key in any error."""
+        try:
+            return to_si(value, kind, where=self.where(*keys))
+        except SceneError as exc:
+            exc.path = str(self.path)
+            raise SceneError(str(exc), path=str(self.path)) from exc
+
+    def joint_quantity(self, value: Any, joint_kind: str, order: int, *keys: str) -> float:
+        """A joint coordinate (order 0), rate (1) or acceleration (2) in SI."""
+        kinds = JOINT_KINDS["prismatic" if joint_kind == "prismatic" else "revolute"]
+        return self.quantity(value, kinds[order], *keys)
+
+    def driver_table(self) -> dict[str, dict[str, Any]]:
+        """name -> {"angle"/"position", "speed"/"velocity", "acceleration"} as written."""
+        drivers = self.section("drivers")
+        for name, spec in drivers.items():
+            if not isinstance(spec, dict):
+                raise SceneError(f"[drivers.{name}] must be a table with angle/speed/acceleration",
+                                 path=str(self.path), key=f"drivers.{name}")
+            unknown = set(spec) - set(_DRIVER_KEYS)
+            if unknown:
+                raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))}; use angle (or position), "
+                                 "speed (or velocity), acceleration", path=str(self.path), key=f"drivers.{name}")
+        return drivers
+
+    @staticmethod
+    def driver_order(key: str) -> int:
+        return _DRIVER_KEYS[key]
+
+    def solver_options(self) -> dict[str, float | int]:
+        """`[solver]` settings: tol, max_iterations, max_condition (numbers)."""
+        options = self.section("solver")
+        allowed = {"tol": float, "max_iterations": int, "max_condition": float}
+        out: dict[str, float | int] = {}
+        for key, value in options.items():
+            if key not in allowed:
+                raise SceneError(f"unknown solver option {key}; known: {', '.join(allowed)}",
+                                 path=str(self.path), key=f"solver.{key}")
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+                raise SceneError(f"solver.{key} must be a positive number, got {value!r}",
+                                 path=str(self.path), key=f"solver.{key}")
+            out[key] = allowed[key](value)
+        return out
