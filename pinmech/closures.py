@@ -138,6 +138,23 @@ class Closure:
         angular = R_T @ (J_C[3:] - J_P[3:])
         return np.vstack([linear, angular])
 
+    def residual_jacobian(self, model: pin.Model, data: pin.Data) -> np.ndarray:
+        """(rows, nv) exact derivative of `residual` at any q, closed or not (for Newton).
+
+        Position rows are those of `jacobian`; orientation rows carry the derivative of
+        their error measure (a_P x R a_C, or log3 R), which equals the velocity rows only
+        once the loop is closed.
+        """
+        J6 = self.relative_jacobian6(model, data)
+        if self.cut_type != "spherical":
+            M_P, M_C = data.oMf[self.parent_frame], data.oMf[self.child_frame]
+            R_rel = M_P.rotation.T @ M_C.rotation
+            if self.cut_type == "revolute":
+                J6[3:] = -pin.skew(self.axis) @ pin.skew(R_rel @ self.child_axis) @ J6[3:]
+            else:
+                J6[3:] = pin.Jlog3(R_rel) @ R_rel.T @ J6[3:]
+        return self.basis @ (self._select @ (self._scale()[:, None] * J6))
+
     def jacobian(self, model: pin.Model, data: pin.Data) -> np.ndarray:
         """(rows, nv) constraint Jacobian of the independent rows (dimensionless rows)."""
         return self.basis @ (self._select @ (self._scale()[:, None] * self.relative_jacobian6(model, data)))

@@ -106,6 +106,9 @@ class LoopSolver:
             return np.zeros((0, self.model.nv))
         return np.vstack([c.jacobian(self.model, self.data) for c in closures])
 
+    def _residual_jacobian(self) -> np.ndarray:
+        return np.vstack([c.residual_jacobian(self.model, self.data) for c in self.mechanism.closures])
+
     def _drift(self) -> np.ndarray:
         closures = self.mechanism.closures
         if not closures:
@@ -138,7 +141,7 @@ class LoopSolver:
         while norm > self.tol:
             if iterations >= self.max_iterations:
                 break
-            J_dep = self._jacobian()[:, self._dep_v]
+            J_dep = self._residual_jacobian()[:, self._dep_v]
             step, *_ = np.linalg.lstsq(J_dep, -r, rcond=None)
             q, r, norm, ok = self._line_search(q, step, norm)
             iterations += 1

@@ -1,0 +1,92 @@
+"""Small mechanisms written as URDF strings, for tests that need more than the bundled models."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+_LINK = '<link name="{name}"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+
+
+def _links(*names: str) -> str:
+    return "\n".join(_LINK.format(name=n) for n in names)
+
+
+def four_bar_urdf(a: float = 0.04, b: float = 0.12, c: float = 0.08, d: float = 0.10) -> str:
+    """Planar four-bar: crank a at O2 = (0,0), coupler b, rocker c at O4 = (d,0); cut at B."""
+    return f"""<?xml version="1.0"?>
+<robot name="four_bar">
+  <link name="ground"/>
+  {_links("crank", "coupler", "rocker")}
+  <joint name="O2" type="continuous"><parent link="ground"/><child link="crank"/><axis xyz="0 0 1"/></joint>
+  <joint name="A" type="continuous"><parent link="crank"/><child link="coupler"/>
+    <origin xyz="{a} 0 0"/><axis xyz="0 0 1"/></joint>
+  <joint name="O4" type="continuous"><parent link="ground"/><child link="rocker"/>
+    <origin xyz="{d} 0 0"/><axis xyz="0 0 1"/></joint>
+  <constraint name="B" type="revolute">
+    <parent link="coupler"/> <parent_origin xyz="{b} 0 0"/> <parent_axis xyz="0 0 1"/>
+    <child link="rocker"/> <child_origin xyz="{c} 0 0"/> <child_axis xyz="0 0 1"/>
+  </constraint>
+  <link name="P"/>
+  <joint name="point_P" type="fixed"><parent link="coupler"/><child link="P"/><origin xyz="{b / 2} 0.02 0"/></joint>
+</robot>
+"""
+
+
+def spatial_rsur_urdf() -> str:
+    """A spatial RSUR loop: crank about z, universal joint, rocker about x, spherical cut.
+
+    Joint freedoms 1 + 2 + 1 = 4, a spherical cut removes 3: mobility 1, spatial.
+    """
+    return f"""<?xml version="1.0"?>
+<robot name="rsur">
+  <link name="ground"/>
+  {_links("crank", "u_cross", "coupler", "rocker")}
+  <joint name="R1" type="revolute"><parent link="ground"/><child link="crank"/>
+    <axis xyz="0 0 1"/><limit lower="-10" upper="10" effort="1" velocity="1"/></joint>
+  <joint name="U1" type="revolute"><parent link="crank"/><child link="u_cross"/>
+    <origin xyz="0.05 0 0"/><axis xyz="0 0 1"/><limit lower="-10" upper="10" effort="1" velocity="1"/></joint>
+  <joint name="U2" type="revolute"><parent link="u_cross"/><child link="coupler"/>
+    <axis xyz="0 1 0"/><limit lower="-10" upper="10" effort="1" velocity="1"/></joint>
+  <joint name="R4" type="revolute"><parent link="ground"/><child link="rocker"/>
+    <origin xyz="0.10 0.12 0.03"/><axis xyz="1 0 0"/><limit lower="-10" upper="10" effort="1" velocity="1"/></joint>
+  <constraint name="S" type="spherical">
+    <parent link="coupler"/> <parent_origin xyz="0.15 0 0"/>
+    <child link="rocker"/> <child_origin xyz="0 0 0.08"/>
+  </constraint>
+</robot>
+"""
+
+
+def spatial_rsur_revolute_cut_urdf() -> str:
+    """The same RSUR loop cut at the rocker's pivot instead (a revolute cut: 5 rows).
+
+    The spherical joint is three revolute joints in the tree: 1 + 2 + 3 = 6 freedoms,
+    minus 5 rows: mobility 1. Its angular rows exercise the revolute cut's axis rows.
+    """
+    limit = '<limit lower="-10" upper="10" effort="1" velocity="1"/>'
+    return f"""<?xml version="1.0"?>
+<robot name="rsur_cut_at_R4">
+  <link name="ground"/>
+  {_links("crank", "u_cross", "coupler", "s1", "s2", "rocker")}
+  <joint name="R1" type="revolute"><parent link="ground"/><child link="crank"/>
+    <axis xyz="0 0 1"/>{limit}</joint>
+  <joint name="U1" type="revolute"><parent link="crank"/><child link="u_cross"/>
+    <origin xyz="0.05 0 0"/><axis xyz="0 0 1"/>{limit}</joint>
+  <joint name="U2" type="revolute"><parent link="u_cross"/><child link="coupler"/>
+    <axis xyz="0 1 0"/>{limit}</joint>
+  <joint name="Sx" type="revolute"><parent link="coupler"/><child link="s1"/>
+    <origin xyz="0.15 0 0"/><axis xyz="1 0 0"/>{limit}</joint>
+  <joint name="Sy" type="revolute"><parent link="s1"/><child link="s2"/><axis xyz="0 1 0"/>{limit}</joint>
+  <joint name="Sz" type="revolute"><parent link="s2"/><child link="rocker"/><axis xyz="0 0 1"/>{limit}</joint>
+  <constraint name="R4" type="revolute">
+    <parent link="ground"/> <parent_origin xyz="0.10 0.12 0.03"/> <parent_axis xyz="1 0 0"/>
+    <child link="rocker"/> <child_origin xyz="0 0 -0.08"/> <child_axis xyz="1 0 0"/>
+  </constraint>
+</robot>
+"""
+
+
+def write(tmp_path: Path, name: str, text: str) -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
