@@ -109,9 +109,8 @@ class Scene:
         """A quantity of this scene in SI, with file and key in any error."""
         try:
             return to_si(value, kind, where=self.where(*keys))
-        except SceneError as exc:
-            exc.path = str(self.path)
-            raise SceneError(str(exc), path=str(self.path)) from exc
+        except SceneError as exc:  # UnitError stays a UnitError, now naming the file
+            raise type(exc)(str(exc), path=str(self.path)) from exc
 
     def joint_quantity(self, value: Any, joint_kind: str, order: int, *keys: str) -> float:
         """A joint coordinate (order 0), rate (1) or acceleration (2) in SI."""

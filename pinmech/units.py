@@ -85,14 +85,14 @@ def to_si(value: Any, kind: str, *, where: str = "") -> float:
         # on an angle unit (rad, deg, rev, rpm, ...) in the expression.
         if "radian" not in str(quantity.to_root_units().units):
             raise UnitError(
-                f"{value!r} has no angle unit: write e.g. '{_example(kind)}' for a {kind.replace('_', ' ')}",
+                f"{value!r} has no angle unit, so it is not an {kind.replace('_', ' ')} (use e.g. {_example(kind)})",
                 key=where,
             )
     try:
         number = float(quantity.to(si).magnitude)
     except Exception as exc:
         raise UnitError(
-            f"{value!r} is not a {kind.replace('_', ' ')} (expected units like {_example(kind)})",
+            f"{value!r} is not a {kind.replace('_', ' ')} (use e.g. {_example(kind)})",
             key=where,
         ) from exc
     if not math.isfinite(number):
