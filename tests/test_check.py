@@ -1,0 +1,96 @@
+"""`pinmech check`: where the printed R-RTR solution is right, where it rounds, where it is wrong.
+
+The expectations below were established from the mathematics, not from pinmech: the
+text's v_D = 0.386 i - 0.282 j is the velocity of B3 (omega_3 x CB), copied where
+omega_3 x CD was meant; its program prints vD = (0.935792, -0.685048), which is
+omega_3 x (r_D - r_C) = -7.7316 k x (0.088604, 0.121035). Its other three-decimal
+values are truncated rather than rounded, hence "rounding" (within 1 unit of the last
+digit) where a correctly rounded print would be "ok".
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from pinmech import SceneError, analyse, compare, load_hand_file, to_dict
+from pinmech.check import HandValue, format_verdicts
+from pinmech.scene import Scene
+
+
+@pytest.fixture(scope="module")
+def verdicts(request):
+    from tests.conftest import SCENES
+
+    hand = load_hand_file(SCENES / "r_rtr.hand.toml")
+    return {v.hand.label: v for v in compare(to_dict(analyse(Scene.load(hand.scene))), hand.values)}
+
+
+def test_the_program_output_is_right_to_its_last_printed_digit(verdicts):
+    program = {k: v for k, v in verdicts.items() if k.startswith("program:")}
+    assert len(program) == 27
+    assert {v.verdict for v in program.values()} == {"ok"}
+
+
+def test_the_text_velocity_of_d_is_the_velocity_of_b3(verdicts):
+    assert verdicts["text: v_D3 = v_D4 x"].verdict == "MISMATCH"
+    assert verdicts["text: v_D3 = v_D4 y"].verdict == "MISMATCH"
+    # ... and the printed numbers are those of B3, to their printed precision:
+    assert verdicts["text: v_D3 = v_D4 x"].hand.value == pytest.approx(verdicts["program: vB3 x"].computed, abs=0.001)
+    assert verdicts["text: v_D3 = v_D4 y"].hand.value == pytest.approx(verdicts["program: vB3 y"].computed, abs=0.001)
+
+
+def test_the_other_text_values_hold_at_their_printed_precision(verdicts):
+    text = {k: v for k, v in verdicts.items() if k.startswith("text:") or k.startswith("text eq")}
+    wrong = sorted(k for k, v in text.items() if v.verdict == "MISMATCH")
+    assert wrong == ["text: v_D3 = v_D4 x", "text: v_D3 = v_D4 y"]
+    # truncated, not rounded: x_B = 0.0866 printed 0.086, omega_3 = -7.7316 printed -7.731
+    assert verdicts["text eq. (3): r_B x"].verdict == "rounding"
+    assert verdicts["text: omega_3 = omega_2"].verdict == "rounding"
+    assert verdicts["text: alpha_3 = alpha_2"].verdict == "ok"
+
+
+def test_a_printed_value_is_an_interval_of_half_a_last_digit():
+    hv = HandValue("x", "points.B.position", 0, "0.386", "m", "length")
+    assert hv.ulp == pytest.approx(0.001)
+    [verdict] = compare({"points": {"B": {"position": [0.3864, 0, 0]}}}, [hv])
+    assert verdict.verdict == "ok"
+    [verdict] = compare({"points": {"B": {"position": [0.3869, 0, 0]}}}, [hv])
+    assert verdict.verdict == "rounding"
+    [verdict] = compare({"points": {"B": {"position": [0.3890, 0, 0]}}}, [hv])
+    assert verdict.verdict == "MISMATCH"
+
+
+def test_hand_units_are_converted():
+    hv = HandValue("phi", "links.l.angle", None, "90.0", "deg", "angle")
+    [verdict] = compare({"links": {"l": {"angle": 1.5707963267948966}}}, [hv])
+    assert verdict.verdict == "ok" and verdict.computed == pytest.approx(90.0)
+
+
+def test_table_counts(verdicts):
+    table = format_verdicts(list(verdicts.values()))
+    assert table.splitlines()[-1] == "35 ok, 11 within rounding, 2 mismatch"
+
+
+@pytest.mark.parametrize(
+    "body, message",
+    [
+        ('scene = "x.toml"\n[[value]]\nquantity = "points.D.velocity"\nhand = [0.386]\nunit = "m/s"\n', "must be a string"),
+        ('scene = "x.toml"\n[[value]]\nquantity = "points.D.velocity"\nhand = ["abc"]\nunit = "m/s"\n', "is not a number"),
+        ('scene = "x.toml"\n[[value]]\nquantity = "points.D.velocity"\nhand = ["1"]\nunit = "blorps/s"\n', "cannot read"),
+        ('scene = "x.toml"\n[[value]]\nquantity = "points.D.weird"\nhand = ["1"]\nunit = "m"\n', "cannot tell the kind"),
+        ('scene = "x.toml"\n[[value]]\nhand = ["1"]\nunit = "m"\n', "missing quantity"),
+        ('[[value]]\n', "missing scene"),
+        ('scene = [\n', "malformed TOML"),
+    ],
+)
+def test_bad_hand_files(tmp_path, body, message):
+    path = tmp_path / "h.toml"
+    path.write_text(body)
+    with pytest.raises(SceneError, match=message):
+        load_hand_file(path)
+
+
+def test_an_unknown_quantity_path_names_what_exists():
+    hv = HandValue("x", "points.Q.position", 0, "1.0", "m", "length")
+    with pytest.raises(SceneError, match=r"no 'Q' in the result \(has B\)"):
+        compare({"points": {"B": {"position": [1, 0, 0]}}}, [hv])
