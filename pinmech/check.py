@@ -181,6 +181,13 @@ def compare(result: dict[str, Any], values: list[HandValue], slack: float = DEFA
     return out
 
 
+def _difference(v: Verdict) -> str:
+    """The difference, and how many units of the last printed digit it is."""
+    if abs(v.difference) < 1e-9 * v.hand.ulp:
+        return "0"
+    return f"{v.difference:+.2g} ({abs(v.difference) / v.hand.ulp:.2g} digit)"
+
+
 def format_verdicts(verdicts: list[Verdict]) -> str:
     """A table: label, hand value, pinmech value, difference (in last-digit units), verdict."""
     rows = [("quantity", "hand", "pinmech", "difference", "verdict")]
@@ -190,7 +197,7 @@ def format_verdicts(verdicts: list[Verdict]) -> str:
             v.hand.label,
             f"{v.hand.printed} {v.hand.unit}",
             f"{v.computed:.{digits}f}",
-            f"{v.difference:+.2g} ({abs(v.difference) / v.hand.ulp:.2g} digit)",
+            _difference(v),
             v.verdict,
         ))
     widths = [max(len(r[i]) for r in rows) for i in range(5)]
