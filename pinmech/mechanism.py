@@ -15,6 +15,9 @@ rows). Named points are massless leaf links hung on fixed joints.
 
 from __future__ import annotations
 
+import os
+import sys
+import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -108,10 +111,7 @@ class Mechanism:
         path = Path(path)
         source = str(path)
         root = _parse_xml(path)
-        try:
-            full = pin.buildModelFromUrdf(source)
-        except (ValueError, RuntimeError) as exc:
-            raise ModelError(f"Pinocchio cannot build the model: {exc}", path=source) from exc
+        full = _build_model(source)
         model = _lock_joints(full, locked or {}, source)
         links_xml = _link_names(root)
         point_names = _point_links(root)
@@ -287,6 +287,26 @@ def _parse_constraint(el: ET.Element, model: pin.Model, links: list[str], source
 
 
 # -------------------------------------------------------------------- model building
+def _build_model(source: str) -> pin.Model:
+    """pin.buildModelFromUrdf, with urdfdom's own stderr chatter folded into the error."""
+    with tempfile.TemporaryFile(mode="w+b") as sink:
+        saved = os.dup(2)
+        try:
+            sys.stderr.flush()
+            os.dup2(sink.fileno(), 2)
+            try:
+                return pin.buildModelFromUrdf(source)
+            except (ValueError, RuntimeError) as exc:
+                error = exc
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+        sink.seek(0)
+        said = " ".join(sink.read().decode(errors="replace").split())
+    detail = f" ({said})" if said else ""
+    raise ModelError(f"Pinocchio cannot build the model: {error}{detail}", path=source) from error
+
+
 def _lock_joints(model: pin.Model, locked: dict[str, float], source: str) -> pin.Model:
     if not locked:
         return model
