@@ -32,6 +32,25 @@ def four_bar_urdf(a: float = 0.04, b: float = 0.12, c: float = 0.08, d: float = 
 """
 
 
+def slider_crank_prismatic_cut_urdf(r: float = 0.05, l: float = 0.15, e: float = 0.01) -> str:
+    """Offset slider-crank cut at its slider: a planar prismatic cut (2 rows: offset and turn)."""
+    return f"""<?xml version="1.0"?>
+<robot name="slider_crank_cut_at_slider">
+  <link name="ground"/>
+  {_links("crank", "rod", "block")}
+  <joint name="O" type="continuous"><parent link="ground"/><child link="crank"/><axis xyz="0 0 1"/></joint>
+  <joint name="A" type="continuous"><parent link="crank"/><child link="rod"/>
+    <origin xyz="{r} 0 0"/><axis xyz="0 0 1"/></joint>
+  <joint name="B" type="continuous"><parent link="rod"/><child link="block"/>
+    <origin xyz="{l} 0 0"/><axis xyz="0 0 1"/></joint>
+  <constraint name="slide" type="prismatic">
+    <parent link="ground"/> <parent_origin xyz="0 {e} 0"/> <parent_axis xyz="1 0 0"/>
+    <child link="block"/> <child_origin xyz="0 0 0"/> <child_axis xyz="1 0 0"/>
+  </constraint>
+</robot>
+"""
+
+
 def spatial_rsur_urdf() -> str:
     """A spatial RSUR loop: crank about z, universal joint, rocker about x, spherical cut.
 

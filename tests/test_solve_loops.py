@@ -21,7 +21,13 @@ from pinmech import (
     ModelError,
     SingularPoseError,
 )
-from tests._mechanisms import four_bar_urdf, spatial_rsur_revolute_cut_urdf, spatial_rsur_urdf, write
+from tests._mechanisms import (
+    four_bar_urdf,
+    slider_crank_prismatic_cut_urdf,
+    spatial_rsur_revolute_cut_urdf,
+    spatial_rsur_urdf,
+    write,
+)
 
 H = 1e-6
 RTOL = 1e-7
@@ -43,6 +49,14 @@ def _four_bar(models_dir, tmp_path):
     return mech, "O2", guess
 
 
+def _slider_crank(models_dir, tmp_path):
+    mech = Mechanism.from_urdf(write(tmp_path, "sc.urdf", slider_crank_prismatic_cut_urdf()))
+    guess = mech.neutral()
+    mech.set_coordinate(guess, "A", -0.3)
+    mech.set_coordinate(guess, "B", 0.3)
+    return mech, "O", guess
+
+
 def _rsur(models_dir, tmp_path):
     return Mechanism.from_urdf(write(tmp_path, "rsur.urdf", spatial_rsur_urdf())), "R1", None
 
@@ -51,7 +65,7 @@ def _rsur_cut_at_r4(models_dir, tmp_path):
     return Mechanism.from_urdf(write(tmp_path, "rsur4.urdf", spatial_rsur_revolute_cut_urdf())), "R1", None
 
 
-MECHANISMS = [_r_rtr, _four_bar, _rsur, _rsur_cut_at_r4]
+MECHANISMS = [_r_rtr, _four_bar, _slider_crank, _rsur, _rsur_cut_at_r4]
 
 
 @pytest.mark.parametrize("build", MECHANISMS, ids=lambda f: f.__name__.strip("_"))
@@ -80,6 +94,23 @@ def test_solution_vouches_for_itself(build, models_dir, tmp_path):
     assert solution.accuracy.velocity_residual < 1e-12
     assert solution.accuracy.acceleration_residual < 1e-12
     assert 1 <= solution.accuracy.condition < 1e3
+
+
+def test_a_planar_prismatic_cut_gives_two_rows(tmp_path):
+    mech = Mechanism.from_urdf(write(tmp_path, "sc.urdf", slider_crank_prismatic_cut_urdf()))
+    assert mech.closures[0].rows == 2 and mech.mobility == 1
+
+
+def test_slider_crank_slider_position_matches_the_triangle(tmp_path):
+    """x_B = r cos(theta) + sqrt(l^2 - (e - r sin(theta))^2) for the offset slider-crank."""
+    r, l, e, theta = 0.05, 0.15, 0.01, 0.7
+    mech, driver, guess = _slider_crank(None, tmp_path)
+    sol = LoopSolver(mech, [driver]).solve([theta], guess=guess)
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, sol.q)
+    block = data.oMf[mech.links["block"]].translation
+    np.testing.assert_allclose(block[:2], [r * np.cos(theta) + np.sqrt(l**2 - (e - r * np.sin(theta)) ** 2), e],
+                               rtol=1e-13, atol=1e-15)
 
 
 def test_where_the_loop_is_cut_does_not_change_the_motion(tmp_path):
