@@ -192,7 +192,7 @@ def format_verdicts(verdicts: list[Verdict]) -> str:
     """A table: label, hand value, pinmech value, difference (in last-digit units), verdict."""
     rows = [("quantity", "hand", "pinmech", "difference", "verdict")]
     for v in verdicts:
-        digits = max(0, -int(math.floor(math.log10(v.hand.ulp)))) + 3
+        digits = max(0, -math.floor(math.log10(v.hand.ulp))) + 3
         rows.append((
             v.hand.label,
             f"{v.hand.printed} {v.hand.unit}",

@@ -8,11 +8,10 @@ the mobility; 6 a loop cannot close; 7 singular pose; 8 inconsistent task.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from collections.abc import Sequence
 
-from pinmech import __version__  # noqa: F401  (re-exported for --version)
+from pinmech import __version__
 from pinmech.exceptions import PinmechError
 
 

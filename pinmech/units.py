@@ -80,14 +80,13 @@ def to_si(value: Any, kind: str, *, where: str = "") -> float:
             f"{value!r} has no unit: write it as '{value} {_example(kind)}' ({kind.replace('_', ' ')})",
             key=where,
         )
-    if kind.startswith("angle") or kind.startswith("angular"):
-        # pint treats the radian as dimensionless: "1 Hz" would pass as 1 rad/s. Insist
-        # on an angle unit (rad, deg, rev, rpm, ...) in the expression.
-        if "radian" not in str(quantity.to_root_units().units):
-            raise UnitError(
-                f"{value!r} has no angle unit, so it is not an {kind.replace('_', ' ')} (use e.g. {_example(kind)})",
-                key=where,
-            )
+    # pint treats the radian as dimensionless: "1 Hz" would pass as 1 rad/s. Insist on an
+    # angle unit (rad, deg, rev, rpm, ...) in the expression of an angular quantity.
+    if kind.startswith(("angle", "angular")) and "radian" not in str(quantity.to_root_units().units):
+        raise UnitError(
+            f"{value!r} has no angle unit, so it is not an {kind.replace('_', ' ')} (use e.g. {_example(kind)})",
+            key=where,
+        )
     try:
         number = float(quantity.to(si).magnitude)
     except Exception as exc:
