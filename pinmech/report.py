@@ -84,7 +84,7 @@ def _finite(x: Any) -> Any:
 
 # ---------------------------------------------------------------------- text
 def _num(x: float) -> str:
-    return f"{x: .6g}"
+    return f"{x + 0.0: .6g}"  # + 0.0 turns -0.0 into 0.0
 
 
 class _Text:
@@ -97,7 +97,9 @@ class _Text:
 
     def vec(self, x: np.ndarray, unit: str) -> str:
         parts = x[:2] if self.planar_z else x
-        return "(" + ", ".join(_num(c) for c in parts) + f") {unit}"
+        # Components below 1e-12 of the vector's size are rounding noise (cos 90 deg = 6e-17).
+        floor = 1e-12 * float(np.max(np.abs(x), initial=0.0))
+        return "(" + ", ".join(_num(c if abs(c) > floor else 0.0) for c in parts) + f") {unit}"
 
     def spin(self, w: np.ndarray, unit: str) -> str:
         return f"{_num(w[2])} {unit} (k)" if self.planar_z else self.vec(w, unit)
