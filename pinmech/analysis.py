@@ -50,9 +50,31 @@ def load_mechanism(scene: Scene) -> Mechanism:
     types = urdf_joint_types(scene.urdf)
     locked = {}
     for name, value in scene.section("lock").items():
-        kind = "length" if types.get(name) == "prismatic" else "angle"
-        locked[name] = scene.quantity(value, kind, "lock", name)
+        locked[name] = scene.quantity(value, _kind(types, name), "lock", name)
+    if "move" in scene.raw:
+        locked.update(_locked_by_move(scene, types, locked))
     return Mechanism.from_urdf(scene.urdf, locked=locked)
+
+
+def _kind(types: dict[str, str], name: str) -> str:
+    return "length" if types.get(name) == "prismatic" else "angle"
+
+
+def _locked_by_move(scene: Scene, types: dict[str, str], locked: dict[str, float]) -> dict[str, float]:
+    """`move = [...]`: every other one-dof joint is locked at its `[pose]` value (else 0)."""
+    move = scene.raw["move"]
+    if not isinstance(move, list) or not all(isinstance(n, str) for n in move):
+        raise SceneError("move must be a list of joint names", path=str(scene.path), key="move")
+    movable = [n for n, t in types.items() if t in ("revolute", "continuous", "prismatic")]
+    for name in move:
+        if name not in movable:
+            raise FrameNotFound("joint (in move)", name, movable, path=str(scene.path))
+    pose = scene.section("pose")
+    return {
+        name: scene.quantity(pose[name], _kind(types, name), "pose", name) if name in pose else 0.0
+        for name in movable
+        if name not in move and name not in locked
+    }
 
 
 def _scene_joint(scene: Scene, mechanism: Mechanism, name: str, key: str):
@@ -117,7 +139,14 @@ def report_lists(scene: Scene) -> tuple[list[str] | None, list[str] | None]:
 
 
 def analyse(scene: Scene) -> Analysis:
-    """Load, close the loops, solve the rates and read off the motion of a scene."""
+    """Load, close the loops, solve the rates and read off the motion of a scene.
+
+    A scene with `[[task]]` entries is an end-effector rate problem (see `analyse_task`).
+    """
+    if "task" in scene.raw:
+        from pinmech.analysis_task import analyse_task
+
+        return analyse_task(scene)
     mechanism = load_mechanism(scene)
     drivers = scene_drivers(scene, mechanism)
     solver = LoopSolver(mechanism, drivers.names, **scene.solver_options())

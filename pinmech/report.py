@@ -63,7 +63,7 @@ def to_dict(analysis: Analysis) -> dict[str, Any]:
     out.update(motion_dict(analysis.motion))
     out["accuracy"] = analysis.solution.accuracy.as_dict()
     if analysis.extra:
-        out.update(analysis.extra)
+        out.update({k: v for k, v in analysis.extra.items() if not k.startswith("_")})
     return out
 
 
@@ -116,7 +116,8 @@ def to_text(analysis: Analysis) -> str:
     m = analysis.motion
     t = _Text(analysis)
     drivers = ", ".join(f"{n} = {_angle_or_length(analysis, n, q)}" for n, q in zip(analysis.drivers.names, analysis.drivers.q))
-    t.lines += [f"{analysis.scene.title}", f"model {analysis.mechanism.source}", f"drivers: {drivers}"]
+    label = "pose" if analysis.extra and "task" in analysis.extra else "drivers"
+    t.lines += [f"{analysis.scene.title}", f"model {analysis.mechanism.source}", f"{label}: {drivers}"]
     t.head("Positions")
     for name, p in m.points.items():
         t.row(name, t.vec(p.position, "m"), f"on {p.link}")

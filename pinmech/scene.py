@@ -21,7 +21,10 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 #: Top-level keys a scene may have; other modules (tasks, sweeps) register theirs here.
-KNOWN_KEYS = {"title", "urdf", "drivers", "guess", "lock", "points", "report", "solver", "task", "sweep", "draw"}
+KNOWN_KEYS = {
+    "title", "urdf", "robot", "drivers", "guess", "pose", "move", "lock", "points", "report", "solver",
+    "task", "rates", "sweep", "draw",
+}
 _DRIVER_KEYS = {"angle": 0, "position": 0, "speed": 1, "velocity": 1, "acceleration": 2}
 
 
@@ -80,9 +83,12 @@ class Scene:
         if unknown:
             raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(KNOWN_KEYS))}",
                              path=str(self.path))
-        if "urdf" not in self.raw or not isinstance(self.raw["urdf"], str):
-            raise SceneError("missing urdf = \"path/to/model.urdf\"", path=str(self.path), key="urdf")
-        for name in ("drivers", "guess", "lock", "points", "report", "solver"):
+        has_urdf = isinstance(self.raw.get("urdf"), str)
+        has_robot = isinstance(self.raw.get("robot"), str)
+        if has_urdf == has_robot:
+            raise SceneError("give exactly one of urdf = \"path/to/model.urdf\" or robot = \"ur5\" "
+                             "(an example-robot-data name)", path=str(self.path), key="urdf")
+        for name in ("drivers", "guess", "pose", "lock", "points", "report", "solver", "rates"):
             if name in self.raw and not isinstance(self.raw[name], dict):
                 raise SceneError(f"[{name}] must be a table", path=str(self.path), key=name)
 
@@ -93,7 +99,11 @@ class Scene:
 
     @property
     def urdf(self) -> Path:
-        """The URDF file, resolved relative to the scene's folder."""
+        """The URDF file: resolved relative to the scene's folder, or an example-robot-data model's."""
+        if "robot" in self.raw:
+            from pinmech.robots import robot_urdf
+
+            return robot_urdf(self.raw["robot"], where=str(self.path))
         return (self.path.parent / self.raw["urdf"]).resolve()
 
     def where(self, *keys: str) -> str:

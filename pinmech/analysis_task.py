@@ -1,0 +1,160 @@
+"""A task scene, solved: pose set (loops closed), task rates solved, motion read off.
+
+    [pose]                    # joint coordinates (on a closed loop: as many as the mobility)
+    A = "50 deg"
+    [[task]]
+    frame = "D"               # a point, link or frame
+    components = ["x", "y"]   # of x, y, z, wx, wy, wz
+    reference = "world"       # or "local"
+    velocity = ["1 m/s", "0 m/s"]
+    acceleration = ["0 m/s^2", "0 m/s^2"]
+    [rates]
+    method = "exact"          # or "least_squares", "damped"
+    damping = 1e-3
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from pinmech.analysis import Analysis, Drivers, coincident_points, load_mechanism, report_lists, scene_guess
+from pinmech.exceptions import FrameNotFound, SceneError
+from pinmech.mechanism import Mechanism
+from pinmech.motion import evaluate_motion
+from pinmech.results import Accuracy, LoopSolution
+from pinmech.scene import Scene
+from pinmech.solve_loops import LoopSolver
+from pinmech.solve_rates import COMPONENTS, RateSolution, RateSolver, Task
+
+_ORDER_KINDS = {True: ("angular_velocity", "angular_acceleration"), False: ("velocity", "acceleration")}
+
+
+def scene_tasks(scene: Scene) -> list[Task]:
+    """The `[[task]]` entries, in SI units."""
+    entries = scene.raw["task"]
+    if not isinstance(entries, list) or not entries:
+        raise SceneError("task must be an array of tables: [[task]]", path=str(scene.path), key="task")
+    return [_task(scene, entry, i) for i, entry in enumerate(entries)]
+
+
+def _task(scene: Scene, entry: Any, i: int) -> Task:
+    where = f"task[{i}]"
+    if not isinstance(entry, dict):
+        raise SceneError("must be a table", path=str(scene.path), key=where)
+    unknown = set(entry) - {"frame", "components", "velocity", "acceleration", "reference"}
+    missing = {"frame", "components", "velocity"} - set(entry)
+    if unknown or missing:
+        raise SceneError(f"unknown keys {sorted(unknown)} / missing keys {sorted(missing)}; a task has frame, "
+                         "components, velocity, acceleration (optional) and reference (optional)",
+                         path=str(scene.path), key=where)
+    comps = entry["components"]
+    if not isinstance(comps, list) or not all(c in COMPONENTS for c in comps):
+        raise SceneError(f"components {comps!r} must be a list of {', '.join(COMPONENTS)}",
+                         path=str(scene.path), key=f"{where}.components")
+    values = {}
+    for order, key in enumerate(("velocity", "acceleration")):
+        given = entry.get(key, [0] * len(comps))
+        if not isinstance(given, list) or len(given) != len(comps):
+            raise SceneError(f"{key} needs one quantity per component ({len(comps)})",
+                             path=str(scene.path), key=f"{where}.{key}")
+        values[key] = np.array([
+            scene.quantity(x, _ORDER_KINDS[c.startswith("w")][order], where, key, c) for x, c in zip(given, comps)
+        ])
+    return Task(str(entry["frame"]), tuple(comps), values["velocity"], values["acceleration"],
+                str(entry.get("reference", "world")))
+
+
+def scene_pose(scene: Scene, mechanism: Mechanism) -> tuple[np.ndarray, list[str], np.ndarray]:
+    """Configuration from `[guess]` then `[pose]`; also the pose joints and their values (SI)."""
+    q = scene_guess(scene, mechanism)
+    names, values = [], []
+    for name, value in scene.section("pose").items():
+        if name in mechanism.locked:
+            continue
+        if name not in mechanism.joints:
+            raise FrameNotFound("joint (in [pose])", name, list(mechanism.joints), path=str(scene.path))
+        joint = mechanism.joints[name]
+        x = scene.joint_quantity(value, joint.kind, 0, "pose", name)
+        mechanism.set_coordinate(q, name, x)
+        names.append(name)
+        values.append(x)
+    return q, names, np.array(values)
+
+
+def _rate_options(scene: Scene) -> dict[str, Any]:
+    options = scene.section("rates")
+    unknown = set(options) - {"method", "damping", "max_condition"}
+    if unknown:
+        raise SceneError(f"unknown key(s) {sorted(unknown)}; known: method, damping, max_condition",
+                         path=str(scene.path), key="rates")
+    return dict(options)
+
+
+def analyse_task(scene: Scene) -> Analysis:
+    """Set the pose (closing loops with the pose joints held), then solve the task's rates."""
+    mechanism = load_mechanism(scene)
+    q, names, values = scene_pose(scene, mechanism)
+    residual, iterations = 0.0, 0
+    if mechanism.closures:
+        solver = LoopSolver(mechanism, names, **scene.solver_options())
+        q, iterations, residual = solver.close(q, values)
+    rates = RateSolver(mechanism, scene_tasks(scene), **_rate_options(scene))
+    rs = rates.solve(q)
+    accuracy = Accuracy(residual, iterations, rs.condition, rs.sigma_min,
+                        max(rs.closure_velocity_residual, rs.velocity_error),
+                        max(rs.closure_acceleration_residual, rs.acceleration_error))
+    solution = LoopSolution(q=q, v=rs.v, a=rs.a, accuracy=accuracy, drivers=tuple(names))
+    points, links = report_lists(scene)
+    if points is None:
+        points = list(dict.fromkeys(list(mechanism.points) + [t.frame for t in rates.tasks
+                                                                if t.frame not in mechanism.links]))
+    motion = evaluate_motion(mechanism, rates.data, q, rs.v, rs.a, points=points, links=links,
+                             coincident=coincident_points(scene))
+    idx = [mechanism.joint(n).idx_v for n in names]
+    drivers = Drivers(tuple(names), values, rs.v[idx], rs.a[idx])
+    return Analysis(scene, mechanism, drivers, solution, motion, extra=task_sections(rates.tasks, rs))
+
+
+def task_sections(tasks: tuple[Task, ...], rs: RateSolution) -> dict[str, Any]:
+    """The JSON `task` section (requested and achieved) and the report's task lines."""
+    rows, lines, k = [], [], 0
+    for task in tasks:
+        for comp in task.components:
+            angular = comp.startswith("w")
+            rows.append({
+                "frame": task.frame, "component": comp, "reference": task.reference,
+                "requested_velocity": float(rs.requested_velocity[k]),
+                "achieved_velocity": float(rs.achieved_velocity[k]),
+                "requested_acceleration": float(rs.requested_acceleration[k]),
+                "achieved_acceleration": float(rs.achieved_acceleration[k]),
+            })
+            unit_v, unit_a = ("rad/s", "rad/s^2") if angular else ("m/s", "m/s^2")
+            lines.append(
+                f"  {task.frame:<10} {comp:<3} ({task.reference})  velocity asked {rs.requested_velocity[k]: .6g} "
+                f"got {rs.achieved_velocity[k]: .6g} {unit_v};  acceleration asked "
+                f"{rs.requested_acceleration[k]: .6g} got {rs.achieved_acceleration[k]: .6g} {unit_a}"
+            )
+            k += 1
+    note = {
+        "exact": "square task, solved exactly",
+        "minimum_norm": f"redundant task: minimum-norm solution, null space of dimension {rs.nullspace_dim}",
+        "least_squares": "over-determined task: least-squares solution (see the asked/got differences)",
+        "damped": "damped least squares: the motion achieved may differ from the one asked",
+    }[rs.method]
+    header = ["", "Task (end-effector rate problem)", "--------------------------------",
+              f"  method: {rs.method} ({note}); condition number {rs.condition:.4g}, "
+              f"smallest singular value {rs.sigma_min:.4g}"]
+    return {
+        "task": {
+            "method": rs.method,
+            "nullspace_dim": rs.nullspace_dim,
+            "condition_number": rs.condition,
+            "sigma_min": rs.sigma_min,
+            "velocity_error": rs.velocity_error,
+            "acceleration_error": rs.acceleration_error,
+            "rows": rows,
+        },
+        "_text": header + lines,
+    }
