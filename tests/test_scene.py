@@ -47,7 +47,7 @@ def test_the_branch_is_chosen_by_the_guess(r_rtr_scene):
         ('urdf = "../r_rtr.urdf"\n[drivers.A]\nspeed = "1 rpm"\n', SceneError, "missing its angle"),
         ('urdf = "../r_rtr.urdf"\n[drivers.A]\nangle = "1 deg"\nturbo = 1\n', SceneError, "unknown key"),
         ('urdf = "../r_rtr.urdf"\ncolour = "red"\n', SceneError, r"unknown key\(s\) colour"),
-        ('[drivers.A]\nangle = "1 deg"\n', SceneError, "missing urdf"),
+        ('[drivers.A]\nangle = "1 deg"\n', SceneError, "give exactly one of urdf"),
         ('urdf = "../r_rtr.urdf"\n[drivers.A\n', SceneError, "malformed TOML"),
         ('urdf = "../missing.urdf"\n[drivers.A]\nangle = "1 deg"\n', ModelError, "is not a file"),
         ('urdf = "../r_rtr.urdf"\n[solver]\ntol = -1\n', SceneError, "positive number"),
