@@ -440,7 +440,7 @@ def _plane_normal(mech: Mechanism) -> np.ndarray | None:
             J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
             angular.append(J[3:])
             linear.append(J[:3])
-    U, s, _ = np.linalg.svd(np.hstack(angular))
+    U, s, _ = np.linalg.svd(np.hstack(angular), full_matrices=False)  # 3 x (frames * nv): U only
     if s[0] == 0 or (len(s) > 1 and s[1] > STRUCTURAL_RANK_TOL * s[0]):
         return None
     normal = U[:, 0] * np.sign(U[np.argmax(np.abs(U[:, 0])), 0])
