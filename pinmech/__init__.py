@@ -19,6 +19,7 @@ from pinmech.exceptions import (
     PinmechError,
     SceneError,
     SingularPoseError,
+    SweepError,
     TaskError,
     UnitError,
 )
@@ -52,6 +53,7 @@ __all__ = [
     "Scene",
     "SceneError",
     "SingularPoseError",
+    "SweepError",
     "TaskError",
     "UnitError",
     "__version__",

@@ -19,7 +19,14 @@ from typing import Any
 
 import numpy as np
 
-from pinmech.analysis import Analysis, Drivers, coincident_points, load_mechanism, report_lists, scene_guess
+from pinmech.analysis import (
+    Analysis,
+    Drivers,
+    coincident_points,
+    load_mechanism,
+    report_lists,
+    scene_guess,
+)
 from pinmech.exceptions import FrameNotFound, SceneError
 from pinmech.mechanism import Mechanism
 from pinmech.motion import evaluate_motion
@@ -144,8 +151,8 @@ def task_sections(tasks: tuple[Task, ...], rs: RateSolution) -> dict[str, Any]:
         "damped": "damped least squares: the motion achieved may differ from the one asked",
     }[rs.method]
     header = ["", "Task (end-effector rate problem)", "--------------------------------",
-              f"  method: {rs.method} ({note}); condition number {rs.condition:.4g}, "
-              f"smallest singular value {rs.sigma_min:.4g}"]
+              (f"  method: {rs.method} ({note}); condition number {rs.condition:.4g}, "
+              f"smallest singular value {rs.sigma_min:.4g}")]
     return {
         "task": {
             "method": rs.method,

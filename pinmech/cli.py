@@ -42,6 +42,21 @@ def build_parser() -> argparse.ArgumentParser:
     solve.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of text")
     solve.set_defaults(func=cmd_solve)
 
+    sweep = sub.add_parser("sweep", help="sweep a driver through a cycle: CSV, JSON and plots")
+    _add_scene_arguments(sweep)
+    sweep.add_argument("--driver", help="the driver to sweep (default: the scene's first)")
+    sweep.add_argument("--from", dest="start", help="first value, e.g. '0 deg' (default: the scene's)")
+    sweep.add_argument("--to", dest="stop", help="last value, e.g. '360 deg' (default: one turn on)")
+    sweep.add_argument("--steps", type=int, default=361, help="number of poses, both ends included (default 361)")
+    sweep.add_argument("--csv", dest="csv_path", help="write the CSV here (default: standard output)")
+    sweep.add_argument("--json", dest="json_path", help="also write the poses as JSON lines here")
+    sweep.add_argument("--plot", dest="plot_path", help="also draw a figure here (PNG, PDF, SVG; pinmech[plot])")
+    sweep.add_argument("--links", nargs="*", help="links to plot (default: all moving but the driver's)")
+    sweep.add_argument("--points", nargs="*", help="points to plot (default: all moving points)")
+    sweep.add_argument("--skip-failures", action="store_true",
+                       help="report a pose that cannot close as a row with its error instead of stopping")
+    sweep.set_defaults(func=cmd_sweep)
+
     check = sub.add_parser("check", help="compare hand-calculated values with pinmech")
     check.add_argument("hand_file", help="hand-value file (TOML), e.g. models/scenes/r_rtr.hand.toml")
     check.add_argument("--slack", type=float, default=None,
@@ -79,6 +94,64 @@ def cmd_solve(args: argparse.Namespace) -> int:
     analysis = analyse(_scene(args))
     print(to_json(analysis) if args.json else to_text(analysis), end="" if not args.json else "\n")
     return 0
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    """`pinmech sweep SCENE`: every pose of a cycle, streamed as CSV (and JSON lines, a plot)."""
+    import numpy as np
+
+    from pinmech.sweep import Sweep, write_csv
+
+    if args.steps < 2:
+        raise PinmechError(f"--steps must be at least 2, got {args.steps}")
+    scene = _scene(args)
+    sweep = Sweep.from_scene(scene, args.driver)
+    kind = "angle" if sweep.is_angular else "length"
+    start = scene.quantity(args.start, kind, "--from") if args.start else sweep.start
+    stop = scene.quantity(args.stop, kind, "--to") if args.stop else start + (sweep.default_values(2)[1] - sweep.start)
+    values = np.linspace(start, stop, args.steps)
+    poses = _progress(sweep.poses(values, skip_failures=args.skip_failures), args.steps)
+    if args.plot_path or args.json_path:
+        poses = list(poses)
+    if args.csv_path:
+        with open(args.csv_path, "w", newline="", encoding="utf-8") as stream:
+            count = write_csv(sweep, poses, stream)
+        print(f"{count} poses written to {args.csv_path}", file=sys.stderr)
+    elif not args.plot_path and not args.json_path:
+        write_csv(sweep, poses, sys.stdout)
+    if args.json_path:
+        _write_json_lines(sweep, poses, args.json_path)
+    if args.plot_path:
+        from pinmech.plot import plot_sweep
+
+        plot_sweep(sweep, poses, args.plot_path, links=args.links, points=args.points)
+        print(f"figure written to {args.plot_path}", file=sys.stderr)
+    return 0
+
+
+def _progress(poses, total: int):
+    """A progress bar on a terminal (tqdm, if installed); nothing when piped."""
+    if not sys.stderr.isatty():
+        return poses
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return poses
+    return tqdm(poses, total=total, unit="pose", file=sys.stderr)
+
+
+def _write_json_lines(sweep, poses, path: str) -> None:
+    import json
+
+    from pinmech.report import motion_dict
+
+    with open(path, "w", encoding="utf-8") as stream:
+        for pose in poses:
+            entry = {"index": pose.index, sweep.driver: pose.value, "error": pose.error}
+            if pose.motion is not None:
+                entry.update(motion_dict(pose.motion))
+                entry["accuracy"] = pose.accuracy.as_dict()
+            stream.write(json.dumps(entry) + "\n")
 
 
 def cmd_check(args: argparse.Namespace) -> int:

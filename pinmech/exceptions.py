@@ -111,3 +111,20 @@ class CheckMismatch(PinmechError):
     """Hand values disagree with pinmech (raised by the CLI after printing the table)."""
 
     exit_code = 1
+
+
+class SweepError(PinmechError):
+    """A pose of a sweep failed: names the driver value and carries the original error.
+
+    Attributes:
+        driver: the swept joint.
+        value: its coordinate at the failing pose [rad or m].
+        cause: the LoopClosureError or SingularPoseError raised there.
+    """
+
+    def __init__(self, message: str, *, driver: str, value: float, cause: PinmechError):
+        super().__init__(message)
+        self.driver = driver
+        self.value = value
+        self.cause = cause
+        self.exit_code = cause.exit_code
