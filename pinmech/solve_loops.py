@@ -24,6 +24,16 @@ DEFAULT_TOL = 1e-13
 DEFAULT_MAX_CONDITION = 1e10
 
 
+def _newton_step(J: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Newton step: a plain solve when J is square (cheap), else least squares."""
+    if J.shape[0] == J.shape[1]:
+        try:
+            return np.linalg.solve(J, -r)
+        except np.linalg.LinAlgError:
+            return np.full(J.shape[1], np.nan)
+    return np.linalg.lstsq(J, -r, rcond=None)[0]
+
+
 class LoopSolver:
     """Solves one mechanism pose after pose, keeping Pinocchio `Data` and buffers alive.
 
@@ -142,29 +152,46 @@ class LoopSolver:
             if iterations >= self.max_iterations:
                 break
             J_dep = self._residual_jacobian()[:, self._dep_v]
-            step, *_ = np.linalg.lstsq(J_dep, -r, rcond=None)
-            q, r, norm, ok = self._line_search(q, step, norm)
+            q, r, norm, ok = self._newton_update(q, J_dep, r, norm)
             iterations += 1
             if not ok:
                 break
-        if norm > self.tol or self._full_residual() > max(self.tol, 1e-12) * 10:
+        full = self._full_residual()
+        if norm > self.tol or full > max(self.tol, 1e-12) * 10:
             self._raise_not_closed(q, norm, iterations, driver_q)
-        return q, iterations, float(max(norm, self._full_residual()))
+        return q, iterations, float(max(norm, full))
+
+    def _newton_update(self, q: np.ndarray, J_dep: np.ndarray, r: np.ndarray,
+                       norm: float) -> tuple[np.ndarray, np.ndarray, float, bool]:
+        """A full Newton step when it lowers the residual (the usual case near a solution);
+        else a minimum-norm least-squares step, halved until the residual decreases."""
+        step = _newton_step(J_dep, r)
+        if np.all(np.isfinite(step)):
+            trial = self._move(q, step)
+            r_trial = self._residual(trial)
+            trial_norm = float(np.max(np.abs(r_trial), initial=0.0))
+            if trial_norm < norm:
+                return trial, r_trial, trial_norm, True
+            self._residual(q)
+        step = np.linalg.lstsq(J_dep, -r, rcond=None)[0]
+        return self._line_search(q, step, norm)
+
+    def _move(self, q: np.ndarray, step: np.ndarray) -> np.ndarray:
+        self._step[:] = 0.0
+        self._step[self._dep_v] = step
+        return pin.integrate(self.model, q, self._step)
 
     def _line_search(self, q: np.ndarray, step: np.ndarray, norm: float) -> tuple[np.ndarray, np.ndarray, float, bool]:
         """Backtracking: halve the Newton step until the residual decreases."""
         alpha = 1.0
         for _ in range(30):
-            self._step[:] = 0.0
-            self._step[self._dep_v] = alpha * step
-            trial = pin.integrate(self.model, q, self._step)
+            trial = self._move(q, alpha * step)
             r = self._residual(trial)
             trial_norm = np.max(np.abs(r), initial=0.0)
             if trial_norm < norm:
                 return trial, r, float(trial_norm), True
             alpha *= 0.5
-        self._residual(q)  # restore data at q
-        return q, self._residual(q), norm, False
+        return q, self._residual(q), norm, False  # data back at q
 
     def _raise_not_closed(self, q: np.ndarray, norm: float, iterations: int, driver_q: Sequence[float]) -> None:
         drivers = ", ".join(f"{n} = {v:.6g}" for n, v in zip(self.drivers, driver_q))
@@ -178,13 +205,19 @@ class LoopSolver:
             partial=q,
         )
 
-    def rates(self, q: np.ndarray, driver_v: Sequence[float], driver_a: Sequence[float]) -> tuple[np.ndarray, np.ndarray, Accuracy]:
+    def rates(self, q: np.ndarray, driver_v: Sequence[float], driver_a: Sequence[float], *,
+              at_q: bool = False) -> tuple[np.ndarray, np.ndarray, Accuracy]:
         """Velocities and accelerations at a closed configuration q.
+
+        Args:
+            at_q: the solver's data already holds q's placements and Jacobians (as `close`
+                leaves them), so they are not computed again.
 
         Raises:
             SingularPoseError: the dependent-joint constraint Jacobian is singular.
         """
-        self._residual(q)
+        if not at_q:
+            self._residual(q)
         J = self._jacobian()
         J_dep = J[:, self._dep_v]
         sigma = np.linalg.svd(J_dep, compute_uv=False) if J_dep.size else np.ones(1)
@@ -239,7 +272,7 @@ class LoopSolver:
             raise ModelError(f"guess must be {self.model.nq} finite numbers, got shape {q0.shape}",
                              path=self.mechanism.source)
         q, iterations, residual = self.close(q0, dq)
-        v, a, acc = self.rates(q, dv, da)
+        v, a, acc = self.rates(q, dv, da, at_q=True)
         accuracy = Accuracy(residual, iterations, acc.condition, acc.sigma_min,
                             acc.velocity_residual, acc.acceleration_residual)
         return LoopSolution(q=q, v=v, a=a, accuracy=accuracy, drivers=self.drivers)
