@@ -125,7 +125,7 @@ class Closure:
             angular = np.zeros(3)
         else:
             angular = pin.log3(R_rel)
-        return np.r_[linear, angular]
+        return np.concatenate((linear, angular))
 
     def full_residual(self, data: pin.Data) -> np.ndarray:
         """All selected rows of the scaled pose error, reduced or not (dimensionless)."""
