@@ -55,6 +55,12 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--points", nargs="*", help="points to plot (default: all moving points)")
     sweep.add_argument("--skip-failures", action="store_true",
                        help="report a pose that cannot close as a row with its error instead of stopping")
+    sweep.add_argument("--no-predictor", action="store_true",
+                       help="start each pose from the previous one as it is, not moved along its rates")
+    sweep.add_argument("--cold-start", action="store_true",
+                       help="start every pose from the scene's guess (slower; may change branch)")
+    sweep.add_argument("--tol", type=float, help="closure tolerance, relative to the mechanism's size "
+                       "(default 1e-13; 1e-6 is faster and good to about 1e-6)")
     sweep.set_defaults(func=cmd_sweep)
 
     check = sub.add_parser("check", help="compare hand-calculated values with pinmech")
@@ -110,7 +116,13 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     start = scene.quantity(args.start, kind, "--from") if args.start else sweep.start
     stop = scene.quantity(args.stop, kind, "--to") if args.stop else start + (sweep.default_values(2)[1] - sweep.start)
     values = np.linspace(start, stop, args.steps)
-    poses = _progress(sweep.poses(values, skip_failures=args.skip_failures), args.steps)
+    if args.tol is not None:
+        if not args.tol > 0:
+            raise PinmechError(f"--tol must be positive, got {args.tol}")
+        sweep.solver.tol = args.tol
+    poses = sweep.poses(values, skip_failures=args.skip_failures, warm_start=not args.cold_start,
+                        predictor=not (args.no_predictor or args.cold_start))
+    poses = _progress(poses, args.steps)
     if args.plot_path or args.json_path:
         poses = list(poses)
     if args.csv_path:

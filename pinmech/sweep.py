@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import IO
 
 import numpy as np
+import pinocchio as pin
 
 from pinmech.analysis import (
     coincident_points,
@@ -78,8 +79,18 @@ class Sweep:
         span = 2 * math.pi if self.is_angular else self.mechanism.length_scale
         return np.linspace(self.start, self.start + span, steps)
 
-    def poses(self, values: Iterable[float], *, skip_failures: bool = False) -> Iterator[SweepPose]:
+    def poses(self, values: Iterable[float], *, skip_failures: bool = False, warm_start: bool = True,
+              predictor: bool = True) -> Iterator[SweepPose]:
         """Solve the poses one after the other, each from the previous one (lazy).
+
+        Args:
+            skip_failures: keep a failing pose as a row with its error instead of stopping.
+            warm_start: start Newton from the previous pose (default; keeps the branch).
+                False starts every pose from the scene's guess: slower, and may jump branch.
+            predictor: (default) start from the previous pose moved along its own rates
+                and accelerations (q + v dt + a dt^2 / 2 on the manifold, dt = step / driver
+                speed): fewer Newton iterations, and the last one lands at rounding level
+                (see scripts/benchmark_sweep.py). Falls back to the warm start at zero speed.
 
         Raises:
             SweepError: a pose where the loop cannot close or the Jacobian is singular,
@@ -91,8 +102,15 @@ class Sweep:
         guess = scene_guess(self.scene, self.mechanism)
         points, links = report_lists(self.scene)
         coincident = coincident_points(self.scene)
+        start_guess, previous = guess, None
+        model = self.mechanism.model
         for index, value in enumerate(values):
             q_drv[k] = value
+            if predictor and previous is not None and v_drv[k] != 0:
+                dt = (value - previous[0]) / v_drv[k]
+                guess = pin.integrate(model, previous[1].q, previous[1].v * dt + 0.5 * previous[1].a * dt * dt)
+            elif not warm_start:
+                guess = start_guess
             try:
                 sol = self.solver.solve(q_drv, v_drv, a_drv, guess=guess)
             except (LoopClosureError, SingularPoseError) as exc:
@@ -102,7 +120,7 @@ class Sweep:
                                      value=float(value), cause=exc) from exc
                 yield SweepPose(index, float(value), None, None, f"{type(exc).__name__}: {exc}")
                 continue
-            guess = sol.q
+            guess, previous = sol.q, (value, sol)
             motion = evaluate_motion(self.mechanism, self.solver.data, sol.q, sol.v, sol.a,
                                      points=points, links=links, coincident=coincident)
             yield SweepPose(index, float(value), motion, sol.accuracy)
