@@ -7,7 +7,22 @@ import importlib
 import pytest
 
 
-@pytest.mark.parametrize("name", ["r_rtr_example"])
-def test_worked_example_runs(name, capsys):
-    importlib.import_module(name).main()
+@pytest.mark.parametrize(
+    "name, argv",
+    [
+        ("r_rtr_example", None),
+        ("closed_form", None),
+        ("benchmark_sweep", ["--poses", "40", "--repeats", "1"]),
+        ("sweep_memory", ["--poses", "200"]),
+    ],
+)
+def test_script_runs(name, argv, capsys):
+    module = importlib.import_module(name)
+    module.main() if argv is None else module.main(argv)
     assert capsys.readouterr().out
+
+
+def test_reduced_models_script_runs(capsys):
+    pytest.importorskip("example_robot_data", reason='needs pip install "pinmech[robots]"')
+    importlib.import_module("reduced_models").main()
+    assert "talos_left_arm.toml" in capsys.readouterr().out

@@ -114,3 +114,13 @@ def test_cli_failure_exit_code_names_the_angle(tmp_path, models_dir, capsys):
     scene = _singular_scene(tmp_path, models_dir)
     assert main(["sweep", str(scene.path), "--from", "-20 deg", "--to", "20 deg", "--steps", "5"]) == 7
     assert "sweep stopped at A = 0 deg" in capsys.readouterr().err
+
+
+def test_start_options_agree_on_the_exact_solution(sweep):
+    """Predictor, plain warm start and cold start all converge to the same closed poses."""
+    values = sweep.default_values(73)
+    runs = [list(sweep.poses(values, predictor=p, warm_start=w)) for p, w in ((True, True), (False, True), (False, False))]
+    ref = np.array([p.motion.points["D"].acceleration for p in runs[0]])
+    for other in runs[1:]:
+        got = np.array([p.motion.points["D"].acceleration for p in other])
+        np.testing.assert_allclose(got, ref, rtol=0, atol=1e-11 * np.abs(ref).max())
