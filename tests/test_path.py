@@ -1,0 +1,68 @@
+"""Path mode: text 17.110's task integrated in time. D must follow x0 + (1 m/s) t; the
+second-order step q (+) (v dt + a dt^2/2) makes the drift shrink like dt^2."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from pinmech import Scene, TaskError
+from pinmech.analysis import load_mechanism
+from pinmech.analysis_task import scene_pose, scene_tasks
+from pinmech.cli import main
+from pinmech.path import follow_path
+
+
+@pytest.fixture(scope="module")
+def arm_task():
+    from tests.conftest import SCENES
+
+    scene = Scene.load(SCENES / "planar_arm.toml")
+    mech = load_mechanism(scene)
+    q0, _, _ = scene_pose(scene, mech)
+    return mech, scene_tasks(scene), q0
+
+
+def _drift(arm_task, step, gain=0.0):
+    mech, tasks, q0 = arm_task
+    return max(p.drift for p in follow_path(mech, tasks, q0, duration=0.08, step=step, gain=gain))
+
+
+def test_drift_shrinks_like_the_step_squared(arm_task):
+    coarse, fine = _drift(arm_task, 1e-2), _drift(arm_task, 1e-3)
+    assert 50 < coarse / fine < 200  # ~ (10)^2 for a second-order scheme
+    assert fine < 1e-5
+
+
+def test_feedback_reduces_the_drift(arm_task):
+    assert _drift(arm_task, 1e-3, gain=50.0) < 0.7 * _drift(arm_task, 1e-3)
+
+
+def test_cd_stays_vertical_and_d_on_its_line(arm_task):
+    mech, tasks, q0 = arm_task
+    data = mech.model.createData()
+    last = list(follow_path(mech, tasks, q0, duration=0.05, step=1e-4))[-1]
+    pin.framesForwardKinematics(mech.model, data, last.q)
+    d = data.oMf[mech.frame_id("D")].translation
+    x0 = 0.3 * np.cos(np.radians(50)) + 0.3 * np.cos(np.radians(15))
+    np.testing.assert_allclose(d[:2], [x0 + 0.05, 0.3 * np.sin(np.radians(50)) - 0.3 * np.sin(np.radians(15)) - 0.17],
+                               atol=1e-7)
+    R = data.oMf[mech.links["CD"]].rotation
+    np.testing.assert_allclose(R[:, 0], [0, -1, 0], atol=1e-9)  # CD still points straight down
+
+
+def test_leaving_the_workspace_is_an_error(arm_task):
+    mech, tasks, q0 = arm_task
+    with pytest.raises(TaskError, match=r"at t = 0\.09\d* s the path is"):
+        list(follow_path(mech, tasks, q0, duration=0.3, step=1e-3))
+
+
+def test_cli_path_csv(scenes_dir, tmp_path, capsys):
+    out = tmp_path / "path.csv"
+    assert main(["path", str(scenes_dir / "planar_arm.toml"), "--duration", "20 ms", "--step", "1 ms",
+                 "--csv", str(out)]) == 0
+    lines = out.read_text().splitlines()
+    assert lines[0].startswith("t [s],A.q [deg],A.v [rad/s]") and len(lines) == 22
+    assert "largest drift" in capsys.readouterr().err
+    assert main(["path", str(scenes_dir / "planar_arm.toml"), "--duration", "1 s", "--step", "2 s"]) == 2
