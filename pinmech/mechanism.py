@@ -175,6 +175,19 @@ class Mechanism:
         """Degrees of freedom left once every loop is closed (Gruebler, from ranks)."""
         return self.model.nv - self.constraint_rows
 
+    def velocity_scale(self) -> np.ndarray:
+        """Per degree of freedom: the length scale for prismatic joints, 1 for the others.
+
+        Multiplying Jacobian columns by it makes them dimensionless (a slide of one
+        mechanism size weighs as a turn of one radian), so condition numbers do not depend
+        on the units or the size of the mechanism.
+        """
+        scale = np.ones(self.model.nv)
+        for joint in self.joints.values():
+            if joint.kind == "prismatic":
+                scale[joint.idx_v] = self.length_scale
+        return scale
+
     def neutral(self) -> np.ndarray:
         """The model's neutral configuration (all joint coordinates zero)."""
         return pin.neutral(self.model)

@@ -28,6 +28,16 @@ class Accuracy:
     velocity_residual: float = 0.0
     acceleration_residual: float = 0.0
 
+    @property
+    def error_estimate(self) -> float:
+        """Relative error to expect of accelerations, about 1e-13 x condition^2.
+
+        An empirical law, measured as poses approach a singularity (tests/test_singular.py:
+        an R-RTR whose guide passes through its pivot, a four-bar at its limit position).
+        Velocities are better than this, positions better still.
+        """
+        return 1e-13 * self.condition**2
+
     def is_accurate(self, tol: float = 1e-9, max_condition: float = 1e8) -> bool:
         """True when the position residual is below `tol` and the Jacobian is well conditioned."""
         return self.residual <= tol and self.condition <= max_condition
@@ -40,6 +50,7 @@ class Accuracy:
             "sigma_min": self.sigma_min,
             "velocity_residual": self.velocity_residual,
             "acceleration_residual": self.acceleration_residual,
+            "estimated_relative_error": self.error_estimate,
         }
 
 

@@ -20,8 +20,10 @@ from pinmech.results import Accuracy, LoopSolution
 
 #: Default closure tolerance (dimensionless: metres per metre of mechanism, or radians).
 DEFAULT_TOL = 1e-13
-#: Default largest condition number accepted before a pose is called singular.
-DEFAULT_MAX_CONDITION = 1e10
+#: Default largest condition number accepted before a pose is called singular. Near a
+#: singularity accelerations lose accuracy like 1e-13 x condition^2 (tests/test_singular.py),
+#: so 1e5 keeps every answer pinmech gives to about 1e-3 relative or better.
+DEFAULT_MAX_CONDITION = 1e5
 
 
 def _newton_step(J: np.ndarray, r: np.ndarray) -> np.ndarray:
@@ -69,6 +71,7 @@ class LoopSolver:
         self._dep_v = np.setdiff1d(np.arange(self.model.nv), self._drv_v)
         self._check_mobility()
         self._step = np.zeros(self.model.nv)
+        self._dep_scale = mechanism.velocity_scale()[self._dep_v]  # dimensionless columns
         self._zero_a = np.zeros(self.model.nv)
 
     # ------------------------------------------------------------------ set-up
@@ -220,7 +223,7 @@ class LoopSolver:
             self._residual(q)
         J = self._jacobian()
         J_dep = J[:, self._dep_v]
-        sigma = np.linalg.svd(J_dep, compute_uv=False) if J_dep.size else np.ones(1)
+        sigma = np.linalg.svd(J_dep * self._dep_scale, compute_uv=False) if J_dep.size else np.ones(1)
         condition = float(sigma[0] / sigma[-1]) if sigma[-1] > 0 else float("inf")
         if condition > self.max_condition:
             raise SingularPoseError(

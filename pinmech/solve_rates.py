@@ -188,7 +188,7 @@ class RateSolver:
         J, _, n_c = self._stack(q, zero)
         m, n = J.shape
         rhs_v = np.r_[np.zeros(n_c), self.x_dot]
-        sigma = np.linalg.svd(J, compute_uv=False)
+        sigma = np.linalg.svd(self._dimensionless(J, n_c), compute_uv=False)
         rank_sigma = sigma[: min(m, n)]
         condition = float(rank_sigma[0] / rank_sigma[-1]) if rank_sigma[-1] > 0 else float("inf")
         method = self._method(m, n, condition, q, rank_sigma)
@@ -205,6 +205,14 @@ class RateSolver:
             closure_velocity_residual=float(np.max(np.abs(achieved_v[:n_c]), initial=0.0)),
             closure_acceleration_residual=float(np.max(np.abs(achieved_a[:n_c]), initial=0.0)),
         )
+
+    def _dimensionless(self, J: np.ndarray, n_closure: int) -> np.ndarray:
+        """J with linear task rows divided by the mechanism's size and prismatic columns
+        multiplied by it, so its condition number does not depend on units or size."""
+        rows = [1.0] * n_closure
+        for task in self.tasks:
+            rows += [1.0 / self.mechanism.length_scale if c in "xyz" else 1.0 for c in task.components]
+        return np.asarray(rows)[:, None] * J * self.mechanism.velocity_scale()
 
     def _method(self, m: int, n: int, condition: float, q: np.ndarray, sigma: np.ndarray) -> str:
         if self.method == "damped":
