@@ -150,7 +150,7 @@ def to_text(analysis: Analysis) -> str:
     t.lines.append(
         f"  closure residual {acc.residual:.2g} (of the mechanism size {analysis.mechanism.length_scale:.4g} m), "
         f"{acc.iterations} Newton iterations, condition number {acc.condition:.4g} "
-        f"(accelerations good to about {max(acc.error_estimate, 1e-15):.0e} relative)"
+        f"(worst-case acceleration error about {max(acc.error_estimate, 1e-15):.0e} relative)"
     )
     for line in (analysis.extra or {}).get("_text", []):
         t.lines.append(line)

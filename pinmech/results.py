@@ -30,13 +30,13 @@ class Accuracy:
 
     @property
     def error_estimate(self) -> float:
-        """Relative error to expect of accelerations, about 1e-13 x condition^2.
+        """Worst relative error to expect of accelerations: machine epsilon x condition^3.
 
-        An empirical law, measured as poses approach a singularity (tests/test_singular.py:
-        an R-RTR whose guide passes through its pivot, a four-bar at its limit position).
-        Velocities are better than this, positions better still.
+        An empirical bound, measured as poses approach a singularity (tests/test_singular.py:
+        an R-RTR whose guide passes through its pivot, a four-bar at its limit position, a
+        planar arm stretched). Velocities are better than this, positions better still.
         """
-        return 1e-13 * self.condition**2
+        return 2.2e-16 * self.condition**3
 
     def is_accurate(self, tol: float = 1e-9, max_condition: float = 1e8) -> bool:
         """True when the position residual is below `tol` and the Jacobian is well conditioned."""

@@ -21,9 +21,9 @@ from pinmech.results import Accuracy, LoopSolution
 #: Default closure tolerance (dimensionless: metres per metre of mechanism, or radians).
 DEFAULT_TOL = 1e-13
 #: Default largest condition number accepted before a pose is called singular. Near a
-#: singularity accelerations lose accuracy like 1e-13 x condition^2 (tests/test_singular.py),
-#: so 1e5 keeps every answer pinmech gives to about 1e-3 relative or better.
-DEFAULT_MAX_CONDITION = 1e5
+#: singularity accelerations lose accuracy like eps x condition^3 (tests/test_singular.py),
+#: so 1e4 keeps every acceleration pinmech gives to about 2e-4 relative or better.
+DEFAULT_MAX_CONDITION = 1e4
 
 
 def _newton_step(J: np.ndarray, r: np.ndarray) -> np.ndarray:
