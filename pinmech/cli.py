@@ -74,6 +74,29 @@ def build_parser() -> argparse.ArgumentParser:
                       help="override a scene value (repeatable)")
     path.set_defaults(func=cmd_path)
 
+    snap = sub.add_parser("snapshot", help="save the solved pose as an offline meshcat HTML page (pinmech[viz])")
+    _add_scene_arguments(snap)
+    snap.add_argument("-o", "--output", required=True, help="the HTML file to write")
+    snap.add_argument("--arrows", nargs="*", default=[], metavar="POINT.QUANTITY",
+                      help="vectors to draw, e.g. D.velocity D.acceleration (scaled to fit)")
+    snap.add_argument("--no-grid", action="store_true", help="hide meshcat's grid and axes")
+    snap.set_defaults(func=cmd_snapshot)
+
+    anim = sub.add_parser("animate", help="save a driver cycle as an offline meshcat animation (pinmech[viz])")
+    _add_scene_arguments(anim)
+    anim.add_argument("-o", "--output", required=True, help="the HTML file to write")
+    anim.add_argument("--from", dest="start", help="first driver value (default: the scene's)")
+    anim.add_argument("--to", dest="stop", help="last driver value (default: one turn on)")
+    anim.add_argument("--steps", type=int, default=91, help="frames (default 91)")
+    anim.add_argument("--fps", type=int, default=30, help="frames per second (default 30)")
+    anim.add_argument("--skip-failures", action="store_true", help="leave out poses that cannot close")
+    anim.add_argument("--no-grid", action="store_true", help="hide meshcat's grid and axes")
+    anim.set_defaults(func=cmd_animate)
+
+    live = sub.add_parser("view", help="show the solved pose in a live meshcat server (a browser tab)")
+    _add_scene_arguments(live)
+    live.set_defaults(func=cmd_view)
+
     check = sub.add_parser("check", help="compare hand-calculated values with pinmech")
     check.add_argument("hand_file", help="hand-value file (TOML), e.g. models/scenes/r_rtr.hand.toml")
     check.add_argument("--slack", type=float, default=None,
@@ -215,6 +238,71 @@ def cmd_path(args: argparse.Namespace) -> int:
             stream.close()
     print(f"largest drift of the path from the one asked: {worst:.3e} m", file=sys.stderr)
     return 0
+
+
+_ARROW_COLOURS = {"velocity": (0.1, 0.2, 0.9), "acceleration": (0.9, 0.5, 0.0)}
+
+
+def cmd_snapshot(args: argparse.Namespace) -> int:
+    """`pinmech snapshot SCENE -o FILE.html`: the solved pose, framed, with points and arrows."""
+    from pinmech.analysis import analyse
+    from pinmech.draw import Arrow, snapshot_html
+
+    analysis = analyse(_scene(args))
+    points = {n: p.position for n, p in analysis.motion.points.items()}
+    arrows = []
+    for spec in args.arrows:
+        name, _, quantity = spec.rpartition(".")
+        if name not in analysis.motion.points or quantity not in _ARROW_COLOURS:
+            raise PinmechError(f"--arrows {spec}: expected POINT.velocity or POINT.acceleration with a reported "
+                               f"point ({', '.join(analysis.motion.points)})")
+        point = analysis.motion.points[name]
+        arrows.append(Arrow(point.position, getattr(point, quantity), _ARROW_COLOURS[quantity], spec))
+    html = snapshot_html(analysis.mechanism, analysis.solution.q, points=points, arrows=arrows,
+                         show_grid=not args.no_grid)
+    _write(args.output, html)
+    return 0
+
+
+def cmd_animate(args: argparse.Namespace) -> int:
+    """`pinmech animate SCENE -o FILE.html`: a driver cycle, each frame a solved, closed pose."""
+    import numpy as np
+
+    from pinmech.draw import animation_html
+    from pinmech.sweep import Sweep
+
+    scene = _scene(args)
+    sweep = Sweep.from_scene(scene)
+    kind = "angle" if sweep.is_angular else "length"
+    start = scene.quantity(args.start, kind, "--from") if args.start else sweep.start
+    stop = scene.quantity(args.stop, kind, "--to") if args.stop else start + (sweep.default_values(2)[1] - sweep.start)
+    if args.steps < 2:
+        raise PinmechError(f"--steps must be at least 2, got {args.steps}")
+    qs = []
+    for pose in sweep.poses(np.linspace(start, stop, args.steps), skip_failures=args.skip_failures):
+        if pose.motion is not None:
+            qs.append(sweep.last_q.copy())
+    if not qs:
+        raise PinmechError("no pose of the range could be closed")
+    _write(args.output, animation_html(sweep.mechanism, qs, fps=args.fps, show_grid=not args.no_grid))
+    return 0
+
+
+def cmd_view(args: argparse.Namespace) -> int:
+    """`pinmech view SCENE`: the solved pose in a live meshcat server; prints its URL."""
+    from pinmech.analysis import analyse
+    from pinmech.draw import live_view
+
+    analysis = analyse(_scene(args))
+    print(live_view(analysis.mechanism, analysis.solution.q))
+    input("press Enter to stop the viewer\n")
+    return 0
+
+
+def _write(path: str, html: str) -> None:
+    with open(path, "w", encoding="utf-8") as stream:
+        stream.write(html)
+    print(f"wrote {path} ({len(html) // 1024} KB, offline: open it in any browser)", file=sys.stderr)
 
 
 def cmd_check(args: argparse.Namespace) -> int:

@@ -56,6 +56,7 @@ class Sweep:
     solver: LoopSolver
     driver: str
     start: float
+    last_q: np.ndarray | None = None  # configuration of the last pose solved (for drawing)
 
     @classmethod
     def from_scene(cls, scene: Scene, driver: str | None = None) -> Sweep:
@@ -121,6 +122,7 @@ class Sweep:
                 yield SweepPose(index, float(value), None, None, f"{type(exc).__name__}: {exc}")
                 continue
             guess, previous = sol.q, (value, sol)
+            self.last_q = sol.q
             motion = evaluate_motion(self.mechanism, self.solver.data, sol.q, sol.v, sol.a,
                                      points=points, links=links, coincident=coincident)
             yield SweepPose(index, float(value), motion, sol.accuracy)
