@@ -8,6 +8,7 @@ the mobility; 6 a loop cannot close; 7 singular pose; 8 inconsistent task.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 from collections.abc import Sequence
 
@@ -218,8 +219,9 @@ def cmd_path(args: argparse.Namespace) -> int:
     mechanism = load_mechanism(scene)
     q0, _, _ = scene_pose(scene, mechanism)
     joints = [j for j in mechanism.joints.values() if j.nv == 1]
-    stream = open(args.csv_path, "w", newline="", encoding="utf-8") if args.csv_path else sys.stdout
-    try:
+    with contextlib.ExitStack() as stack:
+        stream = stack.enter_context(open(args.csv_path, "w", newline="", encoding="utf-8")) \
+            if args.csv_path else sys.stdout
         writer = csv.writer(stream)
         units = [("deg", "rad/s", "rad/s^2") if j.is_angular else ("m", "m/s", "m/s^2") for j in joints]
         writer.writerow(["t [s]"] + [f"{j.name}.{x} [{u}]" for j, us in zip(joints, units)
@@ -233,9 +235,6 @@ def cmd_path(args: argparse.Namespace) -> int:
                           f"{point.a[j.idx_v]:.12g}"]
             writer.writerow(cells + [f"{point.drift:.3e}"])
             worst = max(worst, point.drift)
-    finally:
-        if args.csv_path:
-            stream.close()
     print(f"largest drift of the path from the one asked: {worst:.3e} m", file=sys.stderr)
     return 0
 

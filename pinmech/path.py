@@ -53,7 +53,7 @@ def follow_path(mechanism: Mechanism, tasks: list[Task], q0: np.ndarray, *, dura
     pin.framesForwardKinematics(model, data, q0)
     start = [data.oMf[f].translation.copy() for f in frames]
     q, t = np.array(q0, dtype=float), 0.0
-    steps = int(round(duration / step))
+    steps = round(duration / step)
     for k in range(steps + 1):
         t = k * step
         pin.framesForwardKinematics(model, data, q)
