@@ -26,3 +26,13 @@ def test_reduced_models_script_runs(capsys):
     pytest.importorskip("example_robot_data", reason='needs pip install "pinmech[robots]"')
     importlib.import_module("reduced_models").main()
     assert "talos_left_arm.toml" in capsys.readouterr().out
+
+
+def test_render_snapshots_script_runs(tmp_path, monkeypatch, capsys):
+    pytest.importorskip("meshcat", reason='needs pip install "pinmech[viz]"')
+    module = importlib.import_module("render_snapshots")
+    monkeypatch.setattr(module, "IMAGES", tmp_path)
+    monkeypatch.setattr(module, "SCENES", {"r_rtr": []})
+    module.main()
+    out = capsys.readouterr().out
+    assert "needs Debian's chromium" in out or (tmp_path / "r_rtr.png").stat().st_size > 1000
