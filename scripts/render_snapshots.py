@@ -44,7 +44,7 @@ def main() -> None:
             png = IMAGES / f"{name}.png"
             subprocess.run([chromium, *FLAGS, f"--user-data-dir={tmp}/profile", f"--screenshot={png}", html.as_uri()],
                            capture_output=True, timeout=120, check=True)
-            print(f"wrote {png.relative_to(ROOT)}")
+            print(f"wrote {png}")
 
 
 if __name__ == "__main__":
