@@ -24,9 +24,9 @@ import numpy as np
 import pinocchio as pin
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import closed_form  # noqa: E402
+import closed_form
 
-import pinmech  # noqa: E402
+import pinmech
 
 ROOT = Path(__file__).resolve().parents[1]
 OMEGA1 = -50 * np.pi / 30
@@ -129,7 +129,6 @@ def run_floor(phis):
         pin.getFrameClassicalAcceleration(model, data, fp, LWA)
         pin.getFrameClassicalAcceleration(model, data, fc, LWA)
         pin.getFrameClassicalAcceleration(model, data, fd, LWA)
-    return None
 
 
 def run_closed_form(phis):

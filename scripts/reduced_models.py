@@ -45,7 +45,7 @@ def measure(scene_name: str) -> list[dict]:
         mech = load_mechanism(sc)
         q, _, _ = scene_pose(sc, mech)
         solver = RateSolver(mech, scene_tasks(sc))
-        solve = _median_time(lambda: solver.solve(q), 200)
+        solve = _median_time(lambda solver=solver, q=q: solver.solve(q), 200)
         rows.append({"model": label, "nq": mech.model.nq, "nv": mech.model.nv, "joints": mech.model.njoints - 1,
                      "frames": mech.model.nframes, "load_ms": 1e3 * load, "solve_us": 1e6 * solve,
                      "method": solver.solve(q).method})
