@@ -15,6 +15,7 @@ Run: python scripts/benchmark_sweep.py [--poses 3600] [--repeats 5] [--out bench
 from __future__ import annotations
 
 import argparse
+import functools
 import statistics
 import sys
 import time
@@ -33,7 +34,9 @@ OMEGA1 = -50 * np.pi / 30
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
+@functools.lru_cache(maxsize=None)
 def _setup(tol: float = 1e-13):
+    """Model, solver and branch guess, built once per tolerance: loading is not timed per pose."""
     mech = pinmech.Mechanism.from_urdf(ROOT / "models" / "r_rtr.urdf")
     solver = pinmech.LoopSolver(mech, ["A"], tol=tol)
     guess = mech.neutral()
@@ -170,6 +173,7 @@ def main(argv=None) -> None:
     parser.add_argument("--poses", type=int, default=3600)
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--out", default=None, help="also write the markdown table here")
+    parser.add_argument("--plot", default=None, help="also draw time against error here (PNG; pinmech[plot])")
     args = parser.parse_args(argv)
     phis = np.radians(30) + np.linspace(0, 2 * np.pi, args.poses, endpoint=False)
     reference = run_closed_form(phis)
@@ -205,6 +209,36 @@ def main(argv=None) -> None:
     print(paths)
     if args.out:
         Path(args.out).write_text(table + "\n\n" + paths + "\n", encoding="utf-8")
+    if args.plot:
+        plot_trade(rows, args.plot)
+
+
+def plot_trade(rows, path: str) -> None:
+    """Time per pose against the acceleration error, one marker per setting (log-log)."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print('the plot needs matplotlib: pip install "pinmech[plot]"')
+        return
+    fig, ax = plt.subplots(figsize=(11, 5))
+    for name, t, errs in rows:
+        if errs[2] == "":
+            ax.axvline(1e6 * t, color="0.5", linestyle=":", label=name)
+            continue
+        ax.scatter(1e6 * t, max(errs[2], 1e-17), s=50, label=name)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("time per pose [us]")
+    ax.set_ylabel("largest relative error of a_D over the cycle")
+    ax.set_title(f"R-RTR cycle: speed against accuracy (median of repeats, this machine)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(1.02, 0.0))
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    print(f"figure written to {path}")
 
 
 if __name__ == "__main__":
