@@ -56,6 +56,7 @@ class Sweep:
     solver: LoopSolver
     driver: str
     start: float
+    drivers: Drivers
     last_q: np.ndarray | None = None  # configuration of the last pose solved (for drawing)
 
     @classmethod
@@ -67,9 +68,7 @@ class Sweep:
             raise SceneError(f"'{name}' is not a driver of the scene ({', '.join(drivers.names)})",
                              path=str(scene.path), key="drivers")
         solver = LoopSolver(mechanism, drivers.names, **scene.solver_options())
-        sweep = cls(scene, mechanism, solver, name, float(drivers.q[drivers.names.index(name)]))
-        sweep._drivers = drivers
-        return sweep
+        return cls(scene, mechanism, solver, name, float(drivers.q[drivers.names.index(name)]), drivers)
 
     @property
     def is_angular(self) -> bool:
@@ -97,7 +96,7 @@ class Sweep:
             SweepError: a pose where the loop cannot close or the Jacobian is singular,
                 naming the driver value, unless `skip_failures` (then the row says why).
         """
-        d = self._drivers
+        d = self.drivers
         k = d.names.index(self.driver)
         q_drv, v_drv, a_drv = d.q.copy(), d.v.copy(), d.a.copy()
         guess = scene_guess(self.scene, self.mechanism)
