@@ -17,6 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.analysis import (
+    Drivers,
     coincident_points,
     load_mechanism,
     report_lists,
