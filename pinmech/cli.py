@@ -294,7 +294,10 @@ def cmd_view(args: argparse.Namespace) -> int:
 
     analysis = analyse(_scene(args))
     print(live_view(analysis.mechanism, analysis.solution.q))
-    input("press Enter to stop the viewer\n")
+    try:
+        input("press Enter to stop the viewer\n")
+    except (EOFError, KeyboardInterrupt):  # no terminal, or Ctrl-C: stop quietly
+        pass
     return 0
 
 

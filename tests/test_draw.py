@@ -85,3 +85,10 @@ def test_arrows_are_scaled_per_kind():
 
     arrows = [Arrow(np.zeros(3), np.array([1.0, 0, 0]), (0, 0, 1)), Arrow(np.zeros(3), np.array([10.0, 0, 0]), (1, 0, 0))]
     assert len({a.color for a in arrows}) == 2
+
+
+def test_live_viewer_serves_on_loopback(scenes_dir, monkeypatch, capsys):
+    """`pinmech view` starts meshcat's server on this machine and prints its URL."""
+    monkeypatch.setattr("builtins.input", lambda prompt="": "")
+    assert main(["view", str(scenes_dir / "r_rtr.toml")]) == 0
+    assert "http://127.0.0.1:" in capsys.readouterr().out
