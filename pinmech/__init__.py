@@ -26,9 +26,10 @@ from pinmech.exceptions import (
 from pinmech.mechanism import JointInfo, Mechanism
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.report import to_dict, to_json, to_text
-from pinmech.results import Accuracy, LoopSolution
+from pinmech.results import Accuracy, LoopSolution, RateSolution
 from pinmech.scene import Scene
 from pinmech.solve_loops import LoopSolver
+from pinmech.solve_rates import RateSolver, Task
 from pinmech.units import to_si
 
 __version__ = "0.1.0"
@@ -50,10 +51,13 @@ __all__ = [
     "ModelError",
     "Motion",
     "PinmechError",
+    "RateSolution",
+    "RateSolver",
     "Scene",
     "SceneError",
     "SingularPoseError",
     "SweepError",
+    "Task",
     "TaskError",
     "UnitError",
     "__version__",

@@ -30,10 +30,10 @@ from pinmech.analysis import (
 from pinmech.exceptions import FrameNotFound, SceneError
 from pinmech.mechanism import Mechanism
 from pinmech.motion import evaluate_motion
-from pinmech.results import Accuracy, LoopSolution
+from pinmech.results import Accuracy, LoopSolution, RateSolution
 from pinmech.scene import Scene
 from pinmech.solve_loops import LoopSolver
-from pinmech.solve_rates import COMPONENTS, RateSolution, RateSolver, Task
+from pinmech.solve_rates import COMPONENTS, RateSolver, Task
 
 _ORDER_KINDS = {True: ("angular_velocity", "angular_acceleration"), False: ("velocity", "acceleration")}
 
@@ -69,8 +69,20 @@ def _task(scene: Scene, entry: Any, i: int) -> Task:
         values[key] = np.array([
             scene.quantity(x, _ORDER_KINDS[c.startswith("w")][order], where, key, c) for x, c in zip(given, comps)
         ])
-    return Task(str(entry["frame"]), tuple(comps), values["velocity"], values["acceleration"],
-                str(entry.get("reference", "world")))
+    reference = entry.get("reference", "world")
+    if reference not in ("world", "local"):
+        raise SceneError(f"reference must be \"world\" or \"local\" (the frame's own axes), got {reference!r}",
+                         path=str(scene.path), key=f"{where}.reference")
+    return Task(str(entry["frame"]), tuple(comps), values["velocity"], values["acceleration"], reference)
+
+
+def _check_frames(scene: Scene, mechanism: Mechanism, tasks: list[Task]) -> None:
+    """Every task frame is in the model, else FrameNotFound naming the scene and the task."""
+    for i, task in enumerate(tasks):
+        try:
+            mechanism.frame_id(task.frame)
+        except FrameNotFound as exc:
+            raise FrameNotFound(f"frame (in task[{i}])", task.frame, exc.known, path=str(scene.path)) from None
 
 
 def scene_pose(scene: Scene, mechanism: Mechanism) -> tuple[np.ndarray, list[str], np.ndarray]:
@@ -107,7 +119,9 @@ def analyse_task(scene: Scene) -> Analysis:
     if mechanism.closures:
         solver = LoopSolver(mechanism, names, **scene.solver_options())
         q, iterations, residual = solver.close(q, values)
-    rates = RateSolver(mechanism, scene_tasks(scene), **_rate_options(scene))
+    tasks = scene_tasks(scene)
+    _check_frames(scene, mechanism, tasks)
+    rates = RateSolver(mechanism, tasks, **_rate_options(scene))
     rs = rates.solve(q)
     accuracy = Accuracy(residual, iterations, rs.condition, rs.sigma_min,
                         max(rs.closure_velocity_residual, rs.velocity_error),
@@ -121,41 +135,69 @@ def analyse_task(scene: Scene) -> Analysis:
                              coincident=coincident_points(scene))
     idx = [mechanism.joint(n).idx_v for n in names]
     drivers = Drivers(tuple(names), values, rs.v[idx], rs.a[idx])
-    return Analysis(scene, mechanism, drivers, solution, motion, extra=task_sections(rates.tasks, rs))
+    extra = task_sections(rates.tasks, rs, noise_floors(mechanism, rs))
+    return Analysis(scene, mechanism, drivers, solution, motion, extra=extra)
 
 
-def task_sections(tasks: tuple[Task, ...], rs: RateSolution) -> dict[str, Any]:
+def noise_floors(mechanism: Mechanism, rs: RateSolution) -> dict[str, float]:
+    """Below these, a task row's value is rounding noise (for the text report only): 1e-12
+    of the size of the terms that cancel in J q_dot and J q_ddot + Jdot q_dot."""
+    L = mechanism.length_scale
+    v = float(np.max(np.abs(rs.v), initial=0.0))
+    a = float(np.max(np.abs(rs.a), initial=0.0))
+    asked_v = float(np.max(np.abs(rs.requested_velocity), initial=0.0))
+    asked_a = float(np.max(np.abs(rs.requested_acceleration), initial=0.0))
+    return {
+        "m/s": 1e-12 * max(asked_v, L * v),
+        "m/s^2": 1e-12 * max(asked_a, L * a, L * v * v),
+        "rad/s": 1e-12 * max(asked_v, v),
+        "rad/s^2": 1e-12 * max(asked_a, a, v * v),
+    }
+
+
+_NOTES = {
+    "exact": "square task, solved exactly",
+    "minimum_norm": "redundant task: the minimum-norm joint rates, null space of dimension {null}",
+    "least_squares": "least squares, as asked: the rows cannot all hold, see asked vs got",
+    "damped": "damped least squares, as asked: the motion got may differ from the one asked",
+}
+
+
+def task_sections(tasks: tuple[Task, ...], rs: RateSolution,
+                  floors: dict[str, float] | None = None) -> dict[str, Any]:
     """The JSON `task` section (requested and achieved) and the report's task lines."""
+    floors = floors or {}
+    width = max(len(t.frame) for t in tasks)
     rows, lines, k = [], [], 0
     for task in tasks:
         for comp in task.components:
-            angular = comp.startswith("w")
-            rows.append({
+            unit_v, unit_a = ("rad/s", "rad/s^2") if comp.startswith("w") else ("m/s", "m/s^2")
+            row = {
                 "frame": task.frame, "component": comp, "reference": task.reference,
                 "requested_velocity": float(rs.requested_velocity[k]),
                 "achieved_velocity": float(rs.achieved_velocity[k]),
                 "requested_acceleration": float(rs.requested_acceleration[k]),
                 "achieved_acceleration": float(rs.achieved_acceleration[k]),
-            })
-            unit_v, unit_a = ("rad/s", "rad/s^2") if angular else ("m/s", "m/s^2")
+            }
+            rows.append(row)
+            got_v = _shown(row["achieved_velocity"], floors.get(unit_v, 0.0))
+            got_a = _shown(row["achieved_acceleration"], floors.get(unit_a, 0.0))
             lines.append(
-                f"  {task.frame:<10} {comp:<3} ({task.reference})  velocity asked {rs.requested_velocity[k]: .6g} "
-                f"got {rs.achieved_velocity[k]: .6g} {unit_v};  acceleration asked "
-                f"{rs.requested_acceleration[k]: .6g} got {rs.achieved_acceleration[k]: .6g} {unit_a}"
+                f"  {task.frame:<{width}} {comp:<2} ({task.reference})  velocity asked "
+                f"{row['requested_velocity']: .6g} got {got_v} {unit_v};  acceleration asked "
+                f"{row['requested_acceleration']: .6g} got {got_a} {unit_a}"
             )
             k += 1
-    note = {
-        "exact": "square task, solved exactly",
-        "minimum_norm": f"redundant task: minimum-norm solution, null space of dimension {rs.nullspace_dim}",
-        "least_squares": "over-determined task: least-squares solution (see the asked/got differences)",
-        "damped": "damped least squares: the motion achieved may differ from the one asked",
-    }[rs.method]
+    note = _NOTES[rs.method].format(null=rs.nullspace_dim)
     header = ["", "Task (end-effector rate problem)", "--------------------------------",
-              (f"  method: {rs.method} ({note}); condition number {rs.condition:.4g}, "
-              f"smallest singular value {rs.sigma_min:.4g}")]
+              f"  method: {rs.method} ({note})",
+              (f"  condition number {rs.condition:.4g}, smallest singular value {rs.sigma_min:.4g} "
+               f"(dimensionless); largest |asked - got|: velocity {rs.velocity_error:.3g}, "
+               f"acceleration {rs.acceleration_error:.3g}")]
     return {
         "task": {
             "method": rs.method,
+            "rank": rs.rank,
             "nullspace_dim": rs.nullspace_dim,
             "condition_number": rs.condition,
             "sigma_min": rs.sigma_min,
@@ -165,3 +207,7 @@ def task_sections(tasks: tuple[Task, ...], rs: RateSolution) -> dict[str, Any]:
         },
         "_text": header + lines,
     }
+
+
+def _shown(x: float, floor: float) -> str:
+    return f"{(x if abs(x) > floor else 0.0) + 0.0: .6g}"

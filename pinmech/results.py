@@ -74,3 +74,62 @@ class LoopSolution:
     def is_closed(self, tol: float = 1e-9) -> bool:
         """True when every loop closes to `tol` (relative to the mechanism's size)."""
         return self.accuracy.residual <= tol
+
+
+@dataclass(frozen=True)
+class RateSolution:
+    """Joint rates and accelerations that realise a task, with their own accuracy.
+
+    The velocity rows are J q_dot = x_dot and the acceleration rows J q_ddot + Jdot q_dot
+    = x_ddot, where x_ddot is the CLASSICAL acceleration (d^2 p/dt^2 of a frame origin;
+    angular rows: the angular acceleration). Loop-closure rows, if any, hold on top.
+
+    Attributes:
+        v: joint velocities [rad/s or m/s], all of the model's freedoms.
+        a: joint accelerations [rad/s^2 or m/s^2].
+        method: "exact" (square, full rank), "minimum_norm" (more joints than rows: the
+            smallest |q_dot| that does the task), "least_squares" (asked for: rows that
+            cannot all hold, the closest motion in the least-squares sense) or "damped"
+            (asked for: damped least squares, the motion achieved may differ from the asked).
+        condition: condition number of the stacked Jacobian (closure + task rows), rows
+            and columns made dimensionless by the mechanism's size; over its rank.
+        sigma_min: its smallest singular value (over its rank), dimensionless.
+        nullspace_dim: joint freedoms the task leaves free (0 for a square task).
+        rank: rank of the stacked Jacobian (closure rows included).
+        requested_velocity, achieved_velocity: task rows, asked and obtained (J v)
+            [m/s or rad/s].
+        requested_acceleration, achieved_acceleration: task rows, asked and obtained
+            (J a + Jdot v) [m/s^2 or rad/s^2].
+        closure_velocity_residual, closure_acceleration_residual: largest |row| of the
+            loop-closure equations at the solution (0 on an open chain).
+    """
+
+    v: np.ndarray
+    a: np.ndarray
+    method: str
+    condition: float
+    sigma_min: float
+    nullspace_dim: int
+    requested_velocity: np.ndarray
+    achieved_velocity: np.ndarray
+    requested_acceleration: np.ndarray
+    achieved_acceleration: np.ndarray
+    closure_velocity_residual: float = 0.0
+    closure_acceleration_residual: float = 0.0
+    rank: int = -1
+
+    @property
+    def velocity_error(self) -> float:
+        """Largest |asked - achieved| over the velocity rows [m/s or rad/s]."""
+        return float(np.max(np.abs(self.requested_velocity - self.achieved_velocity), initial=0.0))
+
+    @property
+    def acceleration_error(self) -> float:
+        """Largest |asked - achieved| over the acceleration rows [m/s^2 or rad/s^2]."""
+        return float(np.max(np.abs(self.requested_acceleration - self.achieved_acceleration), initial=0.0))
+
+    def is_exact(self, tol: float = 1e-9) -> bool:
+        """True when the achieved motion equals the asked one to `tol` (relative, floor 1)."""
+        scale_v = max(1.0, float(np.max(np.abs(self.requested_velocity), initial=0.0)))
+        scale_a = max(1.0, float(np.max(np.abs(self.requested_acceleration), initial=0.0)))
+        return self.velocity_error <= tol * scale_v and self.acceleration_error <= tol * scale_a

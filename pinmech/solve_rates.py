@@ -1,21 +1,26 @@
 """End-effector rate problems: which joint rates and accelerations give a wanted motion.
 
-A task prescribes, for some frames, components of the velocity and the CLASSICAL
-acceleration (the second time derivative of the frame origin's position; angular rows
-are the angular velocity and acceleration, the same in both conventions):
+A task prescribes, for some frames, components of the velocity and of the CLASSICAL
+acceleration (the second time derivative of the frame origin's position, not
+Pinocchio's spatial acceleration; angular rows are the angular velocity and
+acceleration, the same in both conventions):
 
     J q_dot = x_dot,        J q_ddot = x_ddot - Jdot q_dot
 
-where J stacks the selected rows of each frame's Jacobian (`pin.getFrameJacobian`,
-LOCAL_WORLD_ALIGNED: origin velocity in world axes), and Jdot q_dot is the frame's
-classical acceleration at zero joint acceleration (`pin.getFrameClassicalAcceleration`).
-"local" rows are the same vectors expressed in the frame's own axes at this instant.
-On a closed-loop mechanism the loop-closure rows (J_c q_dot = 0, J_c q_ddot = -drift)
-are stacked above the task rows and always hold exactly.
+J stacks the selected rows of each frame's Jacobian (`pin.getFrameJacobian`,
+LOCAL_WORLD_ALIGNED: origin velocity and angular velocity in world axes). Jdot q_dot is
+the frame's classical acceleration at zero joint acceleration
+(`pin.getFrameClassicalAcceleration` after `forwardKinematics(q, q_dot, 0)`), which is
+d/dt(J) q_dot of the classical rows without forming Jdot. "local" rows are the same
+vectors in the frame's own axes at this instant. On a closed-loop mechanism the
+loop-closure rows (J_c q_dot = 0, J_c q_ddot = -drift) are stacked above the task rows
+and hold exactly: the loop is closed first (LoopSolver), then the rates are solved.
 
-Methods: "exact" (square, full rank), minimum-norm for redundant tasks (automatic, with
-the null-space dimension reported), "least_squares" (opt-in, for over-determined tasks,
-reports the residual), "damped" (opt-in damped least squares, reports asked vs achieved).
+Methods: "exact" (square, full rank); minimum-norm for redundant tasks (automatic, with
+the null-space dimension reported); "least_squares" (opt-in: over-determined or
+inconsistent rows, reports asked vs achieved); "damped" (opt-in damped least squares,
+(J^T J + lambda^2 I)^-1 J^T, reports asked vs achieved). Without an opt-in, a task whose
+rows cannot all hold is a TaskError and a singular pose a SingularPoseError.
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ import pinocchio as pin
 
 from pinmech.exceptions import SingularPoseError, TaskError
 from pinmech.mechanism import Mechanism
+from pinmech.results import RateSolution
 from pinmech.solve_loops import DEFAULT_MAX_CONDITION
 
 COMPONENTS = ("x", "y", "z", "wx", "wy", "wz")
@@ -70,48 +76,11 @@ class Task:
         return np.array([COMPONENTS.index(c) for c in self.components])
 
 
-@dataclass(frozen=True)
-class RateSolution:
-    """Joint rates and accelerations that realise a task, with their accuracy.
 
-    Attributes:
-        v, a: joint velocities and accelerations (all of the model's freedoms).
-        method: "exact", "minimum_norm", "least_squares" or "damped".
-        condition: condition number of the stacked Jacobian (closure + task rows).
-        sigma_min: its smallest singular value.
-        nullspace_dim: freedoms the task leaves free (0 for a square task).
-        requested_velocity, achieved_velocity, requested_acceleration,
-        achieved_acceleration: the task rows, asked and obtained (J v, J a + Jdot v).
-    """
 
-    v: np.ndarray
-    a: np.ndarray
-    method: str
-    condition: float
-    sigma_min: float
-    nullspace_dim: int
-    requested_velocity: np.ndarray
-    achieved_velocity: np.ndarray
-    requested_acceleration: np.ndarray
-    achieved_acceleration: np.ndarray
-    closure_velocity_residual: float = 0.0
-    closure_acceleration_residual: float = 0.0
-
-    @property
-    def velocity_error(self) -> float:
-        """Largest |asked - achieved| over the velocity rows."""
-        return float(np.max(np.abs(self.requested_velocity - self.achieved_velocity), initial=0.0))
-
-    @property
-    def acceleration_error(self) -> float:
-        """Largest |asked - achieved| over the acceleration rows."""
-        return float(np.max(np.abs(self.requested_acceleration - self.achieved_acceleration), initial=0.0))
-
-    def is_exact(self, tol: float = 1e-9) -> bool:
-        """True when the achieved motion equals the asked one to `tol` (relative)."""
-        scale_v = max(1.0, float(np.max(np.abs(self.requested_velocity), initial=0.0)))
-        scale_a = max(1.0, float(np.max(np.abs(self.requested_acceleration), initial=0.0)))
-        return self.velocity_error <= tol * scale_v and self.acceleration_error <= tol * scale_a
+#: Singular values below this fraction of the largest, at every sampled pose, are zero.
+STRUCTURAL_RANK_TOL = 1e-9
+_SAMPLES = 3
 
 
 class RateSolver:
@@ -121,10 +90,16 @@ class RateSolver:
         mechanism: the model (its loop closures, if any, are always enforced).
         tasks: the prescribed frame motions.
         method: "exact" (default: square or redundant tasks; redundant ones get the
-            minimum-norm solution), "least_squares" (also accepts over-determined
-            tasks), or "damped" (damped least squares with `damping`).
-        damping: lambda of the damped least squares, in the Jacobian's units.
-        max_condition: above this the pose is singular (SingularPoseError) unless damped.
+            minimum-norm solution), "least_squares" (also accepts over-determined or
+            inconsistent tasks: the least-squares motion, asked vs achieved reported),
+            or "damped" (damped least squares with `damping`, also at singular poses).
+        damping: lambda of the damped least squares, in the Jacobian's units (SI).
+        max_condition: above this condition number (dimensionless) the pose is singular
+            (SingularPoseError) unless the method is "damped".
+
+    Raises:
+        TaskError: unknown method, or no task.
+        FrameNotFound: a task names a frame the model lacks.
     """
 
     def __init__(self, mechanism: Mechanism, tasks: Sequence[Task], *, method: str = "exact",
@@ -133,6 +108,8 @@ class RateSolver:
             raise TaskError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
         if not tasks:
             raise TaskError("no task given: add a [[task]] with frame, components, velocity, acceleration")
+        if not (np.isfinite(damping) and damping > 0):
+            raise TaskError(f"damping must be a positive number, got {damping!r}")
         self.mechanism = mechanism
         self.model = mechanism.model
         self.data = self.model.createData()
@@ -143,103 +120,174 @@ class RateSolver:
         self.max_condition = max_condition
         self.x_dot = np.concatenate([t.velocity for t in self.tasks])
         self.x_ddot = np.concatenate([t.acceleration for t in self.tasks])
-
-    # ------------------------------------------------------------------ rows
-    def _task_rows(self) -> tuple[np.ndarray, np.ndarray]:
-        """Stacked task Jacobian and its drift Jdot v (needs kinematics at (q, v, 0))."""
-        J_rows, drift_rows = [], []
-        for task, fid in zip(self.tasks, self.frames):
-            J6 = pin.getFrameJacobian(self.model, self.data, fid, _LWA)
-            acc = pin.getFrameClassicalAcceleration(self.model, self.data, fid, _LWA)
-            d6 = np.r_[acc.linear, acc.angular]
-            if task.reference == "local":
-                R_T = self.data.oMf[fid].rotation.T
-                J6 = np.vstack([R_T @ J6[:3], R_T @ J6[3:]])
-                d6 = np.r_[R_T @ d6[:3], R_T @ d6[3:]]
-            J_rows.append(J6[task.rows])
-            drift_rows.append(d6[task.rows])
-        return np.vstack(J_rows), np.concatenate(drift_rows)
-
-    def _closure_rows(self) -> tuple[np.ndarray, np.ndarray]:
-        closures = self.mechanism.closures
-        if not closures:
-            return np.zeros((0, self.model.nv)), np.zeros(0)
-        J = np.vstack([c.jacobian(self.model, self.data) for c in closures])
-        drift = np.concatenate([c.drift(self.model, self.data) for c in closures])
-        return J, drift
-
-    def _stack(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
-        pin.computeJointJacobians(self.model, self.data, q)
-        pin.forwardKinematics(self.model, self.data, q, v, np.zeros(self.model.nv))
-        pin.updateFramePlacements(self.model, self.data)
-        J_c, d_c = self._closure_rows()
-        J_t, d_t = self._task_rows()
-        return np.vstack([J_c, J_t]), np.concatenate([d_c, d_t]), J_c.shape[0]
+        self.row_names = [f"{t.frame}.{c}" for t in self.tasks for c in t.components]
+        self._row_scale = np.array([1.0 / mechanism.length_scale if c in "xyz" else 1.0
+                                    for t in self.tasks for c in t.components])
+        self._generic: tuple[int, np.ndarray, list[int]] | None = None  # rank, rows, dependent rows
 
     # ------------------------------------------------------------------ solve
-    def solve(self, q: np.ndarray) -> RateSolution:
+    def solve(self, q: np.ndarray, velocity: np.ndarray | None = None,
+              acceleration: np.ndarray | None = None) -> RateSolution:
         """Joint rates and accelerations at configuration q (loops already closed).
 
+        Args:
+            q: configuration of the model.
+            velocity, acceleration: the task rows' values for this call, in task order
+                (default: the tasks' own) [m/s, rad/s; m/s^2, rad/s^2].
+
         Raises:
-            TaskError: an over-determined or inconsistent task without method "least_squares".
-            SingularPoseError: a singular stacked Jacobian, unless method is "damped".
+            TaskError: an over-determined task, or rows that cannot hold together at any
+                pose (a zero row, a row repeated), unless method is "least_squares".
+            SingularPoseError: the stacked Jacobian is singular at q, unless "damped".
         """
-        zero = np.zeros(self.model.nv)
-        J, _, n_c = self._stack(q, zero)
+        x_dot = self._values(velocity, self.x_dot, "velocity")
+        x_ddot = self._values(acceleration, self.x_ddot, "acceleration")
+        J, n_c = self._jacobian(self.data, q)
         m, n = J.shape
-        rhs_v = np.r_[np.zeros(n_c), self.x_dot]
         sigma = np.linalg.svd(self._dimensionless(J, n_c), compute_uv=False)
-        rank_sigma = sigma[: min(m, n)]
-        condition = float(rank_sigma[0] / rank_sigma[-1]) if rank_sigma[-1] > 0 else float("inf")
-        method = self._method(m, n, condition, q, rank_sigma)
-        v = self._apply(J, rhs_v, method)
-        J, drift, _ = self._stack(q, v)
-        a = self._apply(J, np.r_[np.zeros(n_c), self.x_ddot] - drift, method)
-        achieved_v = J @ v
-        achieved_a = J @ a + drift
+        rank = min(m, n)
+        if rank and not sigma[rank - 1] > sigma[0] / self.max_condition:
+            rank = min(rank, self._structural_rank()[0])  # only poses that look singular pay
+        sigma_min = float(sigma[rank - 1]) if rank else 0.0
+        condition = float(sigma[0] / sigma_min) if sigma_min > 0 else float("inf")
+        method = self._method(m, n, rank, condition, sigma_min, q)
+        v = self._apply(J, np.r_[np.zeros(n_c), x_dot], method, rank)
+        drift = self._drift(q, v, n_c)
+        a = self._apply(J, np.r_[np.zeros(n_c), x_ddot] - drift, method, rank)
+        achieved_v, achieved_a = J @ v, J @ a + drift
         return RateSolution(
-            v=v, a=a, method=method, condition=condition, sigma_min=float(rank_sigma[-1]),
-            nullspace_dim=max(n - m, 0),
-            requested_velocity=self.x_dot.copy(), achieved_velocity=achieved_v[n_c:],
-            requested_acceleration=self.x_ddot.copy(), achieved_acceleration=achieved_a[n_c:],
+            v=v, a=a, method=method, condition=condition, sigma_min=sigma_min,
+            nullspace_dim=n - rank, rank=rank,
+            requested_velocity=x_dot.copy(), achieved_velocity=achieved_v[n_c:],
+            requested_acceleration=x_ddot.copy(), achieved_acceleration=achieved_a[n_c:],
             closure_velocity_residual=float(np.max(np.abs(achieved_v[:n_c]), initial=0.0)),
             closure_acceleration_residual=float(np.max(np.abs(achieved_a[:n_c]), initial=0.0)),
         )
 
+    def _values(self, given: np.ndarray | None, default: np.ndarray, name: str) -> np.ndarray:
+        if given is None:
+            return default
+        values = np.asarray(given, dtype=float)
+        if values.shape != default.shape or not np.all(np.isfinite(values)):
+            raise TaskError(f"{name} needs {default.size} finite values (rows {', '.join(self.row_names)}), "
+                            f"got {given!r}")
+        return values
+
+    # ------------------------------------------------------------------ rows
+    def _jacobian(self, data: pin.Data, q: np.ndarray) -> tuple[np.ndarray, int]:
+        """Closure rows stacked over task rows at q, and the number of closure rows."""
+        pin.computeJointJacobians(self.model, data, q)
+        pin.updateFramePlacements(self.model, data)
+        rows = [c.jacobian(self.model, data) for c in self.mechanism.closures]
+        n_c = sum(r.shape[0] for r in rows)
+        for task, fid in zip(self.tasks, self.frames):
+            J6 = pin.getFrameJacobian(self.model, data, fid, _LWA)
+            if task.reference == "local":
+                R_T = data.oMf[fid].rotation.T
+                J6 = np.vstack([R_T @ J6[:3], R_T @ J6[3:]])
+            rows.append(J6[task.rows])
+        return np.vstack(rows), n_c
+
+    def _drift(self, q: np.ndarray, v: np.ndarray, n_c: int) -> np.ndarray:
+        """Jdot v of every row: closure drift, then the task frames' classical acceleration
+        at zero joint acceleration (same q as the Jacobian: data.J stays valid)."""
+        pin.forwardKinematics(self.model, self.data, q, v, np.zeros(self.model.nv))
+        pin.updateFramePlacements(self.model, self.data)
+        parts = [c.drift(self.model, self.data) for c in self.mechanism.closures]
+        for task, fid in zip(self.tasks, self.frames):
+            acc = pin.getFrameClassicalAcceleration(self.model, self.data, fid, _LWA)
+            linear, angular = acc.linear, acc.angular
+            if task.reference == "local":
+                R_T = self.data.oMf[fid].rotation.T
+                linear, angular = R_T @ linear, R_T @ angular
+            parts.append(np.r_[linear, angular][task.rows])
+        return np.concatenate(parts) if parts else np.zeros(n_c)
+
     def _dimensionless(self, J: np.ndarray, n_closure: int) -> np.ndarray:
         """J with linear task rows divided by the mechanism's size and prismatic columns
         multiplied by it, so its condition number does not depend on units or size."""
-        rows = [1.0] * n_closure
-        for task in self.tasks:
-            rows += [1.0 / self.mechanism.length_scale if c in "xyz" else 1.0 for c in task.components]
-        return np.asarray(rows)[:, None] * J * self.mechanism.velocity_scale()
+        rows = np.r_[np.ones(n_closure), self._row_scale]
+        return rows[:, None] * J * self.mechanism.velocity_scale()
 
-    def _method(self, m: int, n: int, condition: float, q: np.ndarray, sigma: np.ndarray) -> str:
+    def _structural_rank(self) -> tuple[int, np.ndarray, list[int]]:
+        """Rank of the stacked Jacobian at random poses (the highest found), its task rows
+        there (dimensionless, structural zeros exact) and the task rows that depend on the
+        rows before them: a deficiency no pose can cure. Computed once, and only when a
+        pose looks singular, so well-posed tasks never pay for it."""
+        if self._generic is None:
+            data = self.model.createData()
+            rng = np.random.default_rng(20261122)
+            best = None
+            for _ in range(_SAMPLES):
+                q = pin.integrate(self.model, pin.neutral(self.model), rng.normal(size=self.model.nv))
+                J, n_c = self._jacobian(data, q)
+                Jd = self._dimensionless(J, n_c)
+                r = _rank(Jd)
+                if best is None or r > best[0]:
+                    best = (r, Jd, n_c)
+            rank, Jd, n_c = best
+            kept: list[int] = list(range(n_c))
+            dependent = []
+            for i in range(n_c, Jd.shape[0]):
+                if _rank(Jd[kept + [i]]) > len(kept):
+                    kept.append(i)
+                else:
+                    dependent.append(i - n_c)
+            task_rows = Jd[n_c:].copy()
+            task_rows[np.abs(task_rows) <= STRUCTURAL_RANK_TOL * np.max(np.abs(Jd))] = 0.0
+            self._generic = (rank, task_rows, dependent)
+        return self._generic
+
+    # ------------------------------------------------------------------ method
+    def _method(self, m: int, n: int, rank: int, condition: float, sigma_min: float, q: np.ndarray) -> str:
         if self.method == "damped":
             return "damped"
-        if m > n and self.method != "least_squares":
-            raise TaskError(
-                f"{self.mechanism.source}: the task has {m} equations (closures included) for {n} joint "
-                "freedoms: over-determined; drop components or ask for method = \"least_squares\""
-            )
+        if rank < m and self.method != "least_squares":
+            raise self._inconsistent(m, n)
         if condition > self.max_condition:
-            pose = ", ".join(f"{name} = {self.mechanism.coordinate(q, name):.6g}"
-                             for name, j in self.mechanism.joints.items() if j.nv == 1)
             raise SingularPoseError(
-                f"{self.mechanism.source}: the task Jacobian is singular at {pose} (condition number "
-                f"{condition:.3g} > {self.max_condition:.3g}, smallest singular value {sigma[-1]:.3g}); "
+                f"{self.mechanism.source}: the task Jacobian is singular at {self._pose(q)} (condition number "
+                f"{condition:.3g} > {self.max_condition:.3g}, smallest singular value {sigma_min:.3g}); "
                 "ask for method = \"damped\" to get the closest achievable motion",
-                condition=condition, sigma_min=float(sigma[-1]), partial=q,
+                condition=condition, sigma_min=sigma_min, partial=q,
             )
-        if m > n:
+        if rank < m:
             return "least_squares"
         return "exact" if m == n else "minimum_norm"
 
-    def _apply(self, J: np.ndarray, rhs: np.ndarray, method: str) -> np.ndarray:
+    def _inconsistent(self, m: int, n: int) -> TaskError:
+        hint = "or ask for method = \"least_squares\" (the closest motion, asked vs achieved reported)"
+        if m > n:
+            return TaskError(f"{self.mechanism.source}: the task has {m} equations (closures included) for {n} "
+                             f"joint freedoms: over-determined; drop components {hint}")
+        J, dependent = self._structural_rank()[1:]
+        zero = [self.row_names[i] for i in dependent if not np.any(J[i])]
+        repeated = [self.row_names[i] for i in dependent if np.any(J[i])]
+        said = []
+        if zero:
+            said.append(f"no joint of the model gives {', '.join(zero)} at any pose")
+        if repeated:
+            said.append(f"{', '.join(repeated)} repeat{'s' if len(repeated) == 1 else ''} a combination of "
+                        "the rows before at every pose")
+        return TaskError(f"{self.mechanism.source}: the task cannot be met as asked: {'; '.join(said)}; "
+                         f"drop those rows {hint}")
+
+    def _pose(self, q: np.ndarray) -> str:
+        values = ", ".join(f"{name} = {self.mechanism.coordinate(q, name):.6g}"
+                           for name, j in self.mechanism.joints.items() if j.nv == 1)
+        return f"{values} (rad, m)"
+
+    def _apply(self, J: np.ndarray, rhs: np.ndarray, method: str, rank: int) -> np.ndarray:
         if method == "exact":
             return np.linalg.solve(J, rhs)
         if method == "damped":
-            lam2 = self.damping**2
-            return J.T @ np.linalg.solve(J @ J.T + lam2 * np.eye(J.shape[0]), rhs)
-        x, *_ = np.linalg.lstsq(J, rhs, rcond=None)  # minimum-norm or least-squares
-        return x
+            return J.T @ np.linalg.solve(J @ J.T + self.damping**2 * np.eye(J.shape[0]), rhs)
+        if rank == min(J.shape):
+            return np.linalg.lstsq(J, rhs, rcond=None)[0]  # minimum-norm or least-squares
+        U, s, Vt = np.linalg.svd(J, full_matrices=False)  # rank-deficient: truncated pseudo-inverse
+        return Vt[:rank].T @ ((U[:, :rank].T @ rhs) / s[:rank])
+
+
+def _rank(J: np.ndarray) -> int:
+    s = np.linalg.svd(J, compute_uv=False)
+    return int(np.sum(s > STRUCTURAL_RANK_TOL * s[0])) if s.size and s[0] > 0 else 0
