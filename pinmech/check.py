@@ -196,7 +196,7 @@ def format_verdicts(verdicts: list[Verdict]) -> str:
         rows.append((
             v.hand.label,
             f"{v.hand.printed} {v.hand.unit}",
-            f"{v.computed:.{digits}f}",
+            f"{round(v.computed, digits) + 0.0:.{digits}f}",  # + 0.0: no "-0.00000"
             _difference(v),
             v.verdict,
         ))

@@ -94,12 +94,23 @@ class _Text:
         normal = analysis.mechanism.plane_normal
         self.planar_z = normal is not None and abs(abs(normal[2]) - 1.0) < 1e-12
         self.lines: list[str] = []
+        # Per unit, the largest point vector reported: what rounding noise is measured against.
+        points = analysis.motion.points.values()
+        self.sizes = {
+            unit: max((float(np.max(np.abs(getattr(p, attr)), initial=0.0)) for p in points), default=0.0)
+            for unit, attr in (("m", "position"), ("m/s", "velocity"), ("m/s^2", "acceleration"))
+        }
 
     def vec(self, x: np.ndarray, unit: str) -> str:
         parts = x[:2] if self.planar_z else x
-        # Components below 1e-12 of the vector's size are rounding noise (cos 90 deg = 6e-17).
-        floor = 1e-12 * float(np.max(np.abs(x), initial=0.0))
+        # Components below 1e-12 of the vector's size, or of the largest point vector of the
+        # same unit, are rounding noise (cos 90 deg = 6e-17; a_D = 0 computed as 9e-16).
+        floor = 1e-12 * max(float(np.max(np.abs(x), initial=0.0)), self.sizes.get(unit, 0.0))
         return "(" + ", ".join(_num(c if abs(c) > floor else 0.0) for c in parts) + f") {unit}"
+
+    def norm(self, x: np.ndarray, unit: str) -> str:
+        size = float(np.linalg.norm(x))
+        return f"{_num(size if size > 1e-12 * self.sizes.get(unit, 0.0) else 0.0)} {unit}"
 
     def spin(self, w: np.ndarray, unit: str) -> str:
         return f"{_num(w[2])} {unit} (k)" if self.planar_z else self.vec(w, unit)
@@ -131,10 +142,10 @@ def to_text(analysis: Analysis) -> str:
         t.row(name, "omega = " + t.spin(link.angular_velocity, "rad/s"), "alpha = " + t.spin(link.angular_acceleration, "rad/s^2"))
     t.head("Velocities of points")
     for name, p in m.points.items():
-        t.row(name, "v = " + t.vec(p.velocity, "m/s"), f"|v| = {_num(float(np.linalg.norm(p.velocity)))} m/s")
+        t.row(name, "v = " + t.vec(p.velocity, "m/s"), "|v| = " + t.norm(p.velocity, "m/s"))
     t.head("Accelerations of points")
     for name, p in m.points.items():
-        t.row(name, "a = " + t.vec(p.acceleration, "m/s^2"), f"|a| = {_num(float(np.linalg.norm(p.acceleration)))} m/s^2")
+        t.row(name, "a = " + t.vec(p.acceleration, "m/s^2"), "|a| = " + t.norm(p.acceleration, "m/s^2"))
     if m.sliders:
         t.head("Sliders (child relative to parent)")
         for name, s in m.sliders.items():
