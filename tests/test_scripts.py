@@ -22,12 +22,6 @@ def test_script_runs(name, argv, capsys):
     assert capsys.readouterr().out
 
 
-def test_reduced_models_script_runs(capsys):
-    pytest.importorskip("example_robot_data", reason='needs pip install "pinmech[robots]"')
-    importlib.import_module("reduced_models").main()
-    assert "talos_left_arm.toml" in capsys.readouterr().out
-
-
 def test_render_snapshots_script_runs(tmp_path, monkeypatch, capsys):
     pytest.importorskip("meshcat", reason='needs pip install "pinmech[viz]"')
     module = importlib.import_module("render_snapshots")
