@@ -1,195 +1,259 @@
-"""End-effector rate problems: text 17.110 against its closed form, real arms by finite
-differences, minimum-norm and damped solutions against numpy's pseudo-inverse, errors."""
+"""The task-space rate solver: J q_dot = x_dot and J q_ddot = x_ddot - Jdot q_dot.
+
+Text 17.110's arm against its closed form; minimum-norm and damped answers against numpy's
+pseudo-inverse on the same Jacobian; singular poses, over-determined and inconsistent
+tasks; a task on the closed R-RTR loop against the R-RTR's closed form.
+"""
 
 from __future__ import annotations
 
+import closed_form
 import numpy as np
 import pinocchio as pin
 import pytest
 
-import closed_form
-from pinmech import Mechanism, Scene, SingularPoseError, TaskError, analyse, compare, load_hand_file, to_dict
-from pinmech.analysis import load_mechanism
-from pinmech.analysis_task import scene_pose, scene_tasks
-from pinmech.solve_rates import RateSolver, Task
+from pinmech import (
+    FrameNotFound,
+    LoopSolver,
+    Mechanism,
+    RateSolver,
+    SingularPoseError,
+    Task,
+    TaskError,
+)
+from tests.conftest import MODELS
 
 DEG = np.pi / 180
+R_ARM = (0.3, 0.3, 0.17)
+_LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
 @pytest.fixture(scope="module")
 def arm():
-    from tests.conftest import MODELS
-
     return Mechanism.from_urdf(MODELS / "planar_arm.urdf")
 
 
-def _arm_tasks(vD=(1.0, 0.0), aD=(0.0, 0.0)):
+def arm_tasks(vD=(1.0, 0.0), aD=(0.0, 0.0)) -> list[Task]:
+    """Text 17.110: D moves at vD with classical acceleration aD, CD does not turn."""
     return [Task("D", ("x", "y"), np.array(vD), np.array(aD)), Task("CD", ("wz",), np.zeros(1), np.zeros(1))]
 
 
-def _arm_q(arm, angles_deg):
+def arm_q(arm, angles_deg) -> np.ndarray:
     q = arm.neutral()
     for name, angle in zip("ABC", angles_deg):
         arm.set_coordinate(q, name, angle * DEG)
     return q
 
 
-def test_text_17_110_against_the_closed_form(arm):
-    """Cramer's rule on the text's two equations (written without Pinocchio), 1e-10 relative."""
-    sol = RateSolver(arm, _arm_tasks()).solve(_arm_q(arm, (50, -65, -75)))
-    cf = closed_form.planar_arm_rates(50 * DEG, -15 * DEG, -90 * DEG, 0.3, 0.3, 0.17, np.array([1.0, 0.0]), np.zeros(2))
-    assert sol.method == "exact" and sol.nullspace_dim == 0
+def frame_jacobian(mech, q, frame) -> np.ndarray:
+    data = mech.model.createData()
+    pin.computeJointJacobians(mech.model, data, q)
+    pin.updateFramePlacements(mech.model, data)
+    return pin.getFrameJacobian(mech.model, data, mech.frame_id(frame), _LWA)
+
+
+# --------------------------------------------------------------------- text 17.110
+def test_text_17_110_against_cramers_rule(arm):
+    """The text's two equations solved by Cramer's rule without Pinocchio, 1e-10 relative."""
+    sol = RateSolver(arm, arm_tasks()).solve(arm_q(arm, (50, -65, -75)))
+    cf = closed_form.planar_arm_rates(50 * DEG, -15 * DEG, -90 * DEG, *R_ARM, np.array([1.0, 0.0]), np.zeros(2))
+    assert sol.method == "exact" and sol.nullspace_dim == 0 and sol.rank == 3
+    np.testing.assert_allclose(sol.v, cf.q_dot, rtol=1e-10)
+    np.testing.assert_allclose(sol.a, cf.q_ddot, rtol=1e-10)
+    assert sol.is_exact(1e-12)
+
+
+def test_any_motion_of_D_against_cramers_rule(arm):
+    """Another pose and a non-zero acceleration of D, to 1e-10."""
+    sol = RateSolver(arm, arm_tasks((0.3, -0.2), (1.0, 2.0))).solve(arm_q(arm, (20, 40, -150)))
+    cf = closed_form.planar_arm_rates(20 * DEG, 60 * DEG, -90 * DEG, *R_ARM, np.array([0.3, -0.2]),
+                                      np.array([1.0, 2.0]))
     np.testing.assert_allclose(sol.v, cf.q_dot, rtol=1e-10)
     np.testing.assert_allclose(sol.a, cf.q_ddot, rtol=1e-10)
 
 
-def test_text_17_110_printed_answers(scenes_dir):
-    """The four printed rates hold to 2 figures; the text's v_C line (sign slip) does not."""
-    hand = load_hand_file(scenes_dir / "planar_arm.hand.toml")
-    verdicts = {v.hand.label: v.verdict for v in compare(to_dict(analyse(Scene.load(hand.scene))), hand.values)}
-    assert verdicts == {
-        "text: theta1_dot (omega_AB)": "ok",
-        "text: omega_BC = -theta2_dot": "ok",
-        "text: theta1_ddot (alpha_AB)": "ok",
-        "text: alpha_BC = -theta2_ddot": "ok",
-        "text's v_C line, i term, at its own rates": "MISMATCH",
-    }
+def test_task_values_can_change_per_call(arm):
+    """One solver, new asked values: the same answer as a solver built for them."""
+    q = arm_q(arm, (50, -65, -75))
+    solver = RateSolver(arm, arm_tasks())
+    sol = solver.solve(q, velocity=[0.3, -0.2, 0.0], acceleration=[1.0, 2.0, 0.0])
+    ref = RateSolver(arm, arm_tasks((0.3, -0.2), (1.0, 2.0))).solve(q)
+    np.testing.assert_allclose(sol.v, ref.v, rtol=1e-14)
+    np.testing.assert_allclose(sol.a, ref.a, rtol=1e-14)
+    with pytest.raises(TaskError, match=r"velocity needs 3 finite values \(rows D.x, D.y, CD.wz\)"):
+        solver.solve(q, velocity=[1.0, 0.0])
 
 
-def _end_effector_fd(mech, frame, q, v, a, h=1e-5):
-    """Velocity and classical acceleration of a frame by central differences along
-    q(t) = q + t v + t^2/2 a on the manifold. h = 1e-5: truncation ~ h^2 |x'''| ~ 1e-10,
-    rounding ~ eps / h^2 ~ 1e-6 for the second difference, so acceleration rtol ~ 1e-5."""
-    model, data = mech.model, mech.model.createData()
-    fid = mech.frame_id(frame)
-
-    def pos(t):
-        pin.framesForwardKinematics(model, data, pin.integrate(model, q, t * v + 0.5 * t * t * a))
-        return data.oMf[fid].translation.copy()
-
-    p_m, p_0, p_p = pos(-h), pos(0.0), pos(h)
-    return (p_p - p_m) / (2 * h), (p_p - 2 * p_0 + p_m) / h**2
+def test_local_rows_are_the_world_rows_turned_into_the_frame(arm):
+    """CD points straight down: its local x is world -y, local y is world x."""
+    q = arm_q(arm, (50, -65, -75))
+    world = RateSolver(arm, arm_tasks((0.4, -0.7), (1.5, 0.5))).solve(q)
+    local = RateSolver(arm, [Task("D", ("x", "y"), np.array([0.7, 0.4]), np.array([-0.5, 1.5]), "local"),
+                             Task("CD", ("wz",), np.zeros(1), np.zeros(1))]).solve(q)
+    np.testing.assert_allclose(local.v, world.v, rtol=1e-12)
+    np.testing.assert_allclose(local.a, world.a, rtol=1e-12)
 
 
-def test_planar_arm_motion_by_finite_differences(arm):
-    q = _arm_q(arm, (50, -65, -75))
-    sol = RateSolver(arm, _arm_tasks(aD=(0.5, -2.0))).solve(q)
-    vel, acc = _end_effector_fd(arm, "D", q, sol.v, sol.a)
-    np.testing.assert_allclose(vel[:2], [1.0, 0.0], atol=1e-8)
-    np.testing.assert_allclose(acc[:2], [0.5, -2.0], atol=2e-4)
-
-
-@pytest.mark.parametrize("scene, frame", [("ur5.toml", "tool0"), ("panda.toml", "panda_hand_tcp"),
-                                          ("talos_left_arm.toml", "gripper_left_base_link")])
-def test_real_arms_by_finite_differences(scenes_dir, scene, frame):
-    pytest.importorskip("example_robot_data", reason='needs pip install "pinmech[robots]"')
-    sc = Scene.load(scenes_dir / scene)
-    mech = load_mechanism(sc)
-    q, _, _ = scene_pose(sc, mech)
-    tasks = scene_tasks(sc)
-    tasks[0] = Task(frame, tasks[0].components, tasks[0].velocity, np.array([0.2, 0.0, 0.1, 0.0, 0.0, 0.0]))
-    sol = RateSolver(mech, tasks).solve(q)
-    vel, acc = _end_effector_fd(mech, frame, q, sol.v, sol.a)
-    np.testing.assert_allclose(vel, tasks[0].velocity[:3], atol=1e-8)
-    np.testing.assert_allclose(acc, tasks[0].acceleration[:3], atol=2e-4)
-
-
-def test_talos_scene_models_one_arm_only(scenes_dir):
-    pytest.importorskip("example_robot_data", reason='needs pip install "pinmech[robots]"')
-    sc = Scene.load(scenes_dir / "talos_left_arm.toml")
-    mech = load_mechanism(sc)
-    assert mech.model.nv == 7 and set(mech.joints) == {f"arm_left_{i}_joint" for i in range(1, 8)}
-    assert mech.locked["torso_2_joint"] == pytest.approx(10 * DEG)
-
-
-def test_redundant_task_is_minimum_norm(scenes_dir):
-    """Panda: 7 joints, 6 rows; the answer is numpy's pseudo-inverse solution."""
-    pytest.importorskip("example_robot_data", reason='needs pip install "pinmech[robots]"')
-    sc = Scene.load(scenes_dir / "panda.toml")
-    mech = load_mechanism(sc)
-    q, _, _ = scene_pose(sc, mech)
-    solver = RateSolver(mech, scene_tasks(sc))
+# --------------------------------------------------------------------- redundant and damped
+def test_redundant_task_is_numpys_minimum_norm(arm):
+    """D's velocity only: 2 rows, 3 joints; the answer is pinv(J) x_dot, null space 1,
+    and the accelerations are pinv(J) (x_ddot - Jdot q_dot)."""
+    q = arm_q(arm, (50, -65, -75))
+    solver = RateSolver(arm, [Task("D", ("x", "y"), np.array([1.0, 0.0]), np.array([0.5, -1.0]))])
     sol = solver.solve(q)
-    data = mech.model.createData()
-    pin.computeJointJacobians(mech.model, data, q)
-    pin.updateFramePlacements(mech.model, data)
-    J = pin.getFrameJacobian(mech.model, data, mech.frame_id("panda_hand_tcp"), pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
-    assert sol.method == "minimum_norm" and sol.nullspace_dim == 1
-    np.testing.assert_allclose(sol.v, np.linalg.pinv(J) @ solver.x_dot, rtol=1e-10, atol=1e-12)
+    J = frame_jacobian(arm, q, "D")[:2]
+    assert sol.method == "minimum_norm" and sol.nullspace_dim == 1 and sol.rank == 2
+    np.testing.assert_allclose(sol.v, np.linalg.pinv(J) @ [1.0, 0.0], rtol=1e-12)
+    jdot_v = sol.achieved_acceleration - J @ sol.a  # the drift the solver used
+    np.testing.assert_allclose(sol.a, np.linalg.pinv(J) @ ([0.5, -1.0] - jdot_v), rtol=1e-12)
+    assert sol.is_exact(1e-12)
 
 
 def test_damped_least_squares_is_the_regularised_pseudo_inverse(arm):
-    q = _arm_q(arm, (50, -65, -75))
+    """(J^T J + lambda^2 I)^-1 J^T x_dot, on the Jacobian numpy gets from Pinocchio."""
+    q = arm_q(arm, (50, -65, -75))
     lam = 0.05
-    solver = RateSolver(arm, _arm_tasks(), method="damped", damping=lam)
-    sol = solver.solve(q)
-    J = solver._stack(q, np.zeros(3))[0]
-    expected = np.linalg.solve(J.T @ J + lam**2 * np.eye(3), J.T @ solver.x_dot)
+    sol = RateSolver(arm, arm_tasks(), method="damped", damping=lam).solve(q)
+    J = np.vstack([frame_jacobian(arm, q, "D")[:2], frame_jacobian(arm, q, "CD")[5:]])
+    expected = np.linalg.solve(J.T @ J + lam**2 * np.eye(3), J.T @ [1.0, 0.0, 0.0])
     np.testing.assert_allclose(sol.v, expected, rtol=1e-12)
-    assert sol.method == "damped" and sol.velocity_error > 0  # it says how far it is from the asked motion
+    assert sol.method == "damped" and not sol.is_exact()
+    np.testing.assert_allclose(sol.achieved_velocity, J @ sol.v, rtol=1e-12)  # what it reports achieving
+    assert sol.velocity_error == pytest.approx(np.max(np.abs(J @ sol.v - [1.0, 0.0, 0.0])))
 
 
+# --------------------------------------------------------------------- singular poses
 @pytest.mark.parametrize("bend", [0.0, 180.0])
 def test_stretched_or_folded_arm_is_singular(arm, bend):
     """B = 0 (stretched) or 180 deg (folded back): D cannot move along the arm's line."""
-    with pytest.raises(SingularPoseError, match=r"task Jacobian is singular at A = 0\.5, B = ") as info:
-        RateSolver(arm, _arm_tasks()).solve(_arm_q(arm, (0.5 / DEG, bend, -30)))
-    assert info.value.sigma_min < 1e-9
+    with pytest.raises(SingularPoseError, match=r"task Jacobian is singular at A = 0\.5, B = .* \(rad, m\)") as info:
+        RateSolver(arm, arm_tasks()).solve(arm_q(arm, (0.5 / DEG, bend, -30)))
+    assert info.value.sigma_min < 1e-9 and info.value.condition > 1e4
+    np.testing.assert_allclose(info.value.partial, arm_q(arm, (0.5 / DEG, bend, -30)))
 
 
 def test_damped_solution_at_the_singular_pose_reports_its_error(arm):
     """Stretched along x, D can move along x only by turning CD, which the task forbids:
-    the damped answer is finite, and the report shows it misses most of the 1 m/s asked."""
-    q = _arm_q(arm, (0.0, 0.0, -90))
-    sol = RateSolver(arm, _arm_tasks(), method="damped", damping=1e-2).solve(q)
-    assert np.all(np.isfinite(sol.v)) and not sol.is_exact()
+    the damped answer is finite and the report shows it misses most of the 1 m/s asked."""
+    sol = RateSolver(arm, arm_tasks(), method="damped", damping=1e-2).solve(arm_q(arm, (0, 0, -90)))
+    assert np.all(np.isfinite(sol.v)) and np.all(np.isfinite(sol.a)) and not sol.is_exact()
     assert sol.velocity_error > 0.5
-    np.testing.assert_allclose(sol.requested_velocity - sol.achieved_velocity,
-                               [1.0 - sol.achieved_velocity[0], -sol.achieved_velocity[1], -sol.achieved_velocity[2]])
+    np.testing.assert_allclose(sol.requested_velocity, [1.0, 0.0, 0.0])
 
 
-def test_over_determined_task(arm):
-    tasks = [Task("D", ("x", "y", "wz"), np.ones(3), np.zeros(3)), Task("C", ("x",), np.ones(1), np.zeros(1))]
+# --------------------------------------------------------------------- tasks that cannot hold
+def test_over_determined_task_is_an_error_or_least_squares(arm):
+    q = arm_q(arm, (50, -65, -75))
+    tasks = [Task("D", ("x", "y", "wz"), np.array([1.0, 0.0, 0.0]), np.zeros(3)),
+             Task("C", ("x",), np.array([2.0]), np.zeros(1))]
     with pytest.raises(TaskError, match="4 equations .* for 3 joint freedoms: over-determined"):
-        RateSolver(arm, tasks).solve(_arm_q(arm, (50, -65, -75)))
-    sol = RateSolver(arm, tasks, method="least_squares").solve(_arm_q(arm, (50, -65, -75)))
-    assert sol.method == "least_squares" and sol.velocity_error > 0
+        RateSolver(arm, tasks).solve(q)
+    sol = RateSolver(arm, tasks, method="least_squares").solve(q)
+    J = np.vstack([frame_jacobian(arm, q, "D")[[0, 1, 5]], frame_jacobian(arm, q, "C")[:1]])
+    np.testing.assert_allclose(sol.v, np.linalg.lstsq(J, [1.0, 0.0, 0.0, 2.0], rcond=None)[0], rtol=1e-12)
+    assert sol.method == "least_squares" and sol.rank == 3 and sol.nullspace_dim == 0
+    np.testing.assert_allclose(sol.achieved_velocity, J @ sol.v, rtol=1e-12)  # what the report shows
+    assert sol.velocity_error == pytest.approx(np.max(np.abs(J @ sol.v - [1.0, 0.0, 0.0, 2.0])))
+    assert sol.velocity_error > 0.1  # v_D - v_C = omega_CD x CD: 1 m/s apart needs CD to turn, wz = 0 forbids it
 
 
-def test_task_on_a_closed_loop_obeys_the_loop(models_dir):
-    """R-RTR: ask D's x velocity; the crank rate found reproduces it and the loop stays closed."""
-    from pinmech import LoopSolver
+def test_a_motion_no_joint_gives_is_an_inconsistent_task(arm):
+    """The planar arm cannot move D along z: a TaskError naming the row, not a singular pose."""
+    tasks = [Task("D", ("x", "y", "z"), np.array([1.0, 0.0, 0.1]), np.zeros(3))]
+    with pytest.raises(TaskError, match=r"no joint of the model gives D\.z at any pose"):
+        RateSolver(arm, tasks).solve(arm_q(arm, (50, -65, -75)))
+    sol = RateSolver(arm, tasks, method="least_squares").solve(arm_q(arm, (50, -65, -75)))
+    assert sol.method == "least_squares" and sol.rank == 2 and sol.nullspace_dim == 1
+    np.testing.assert_allclose(sol.achieved_velocity, [1.0, 0.0, 0.0], atol=1e-12)
+    assert sol.velocity_error == pytest.approx(0.1)  # the z asked, reported as missed
 
+
+def test_a_row_prescribed_twice_is_an_inconsistent_task(arm):
+    """D is fixed on CD: D's wz and CD's wz are one row. Asking them different is impossible."""
+    tasks = [Task("D", ("x", "wz"), np.array([1.0, 0.0]), np.zeros(2)), Task("CD", ("wz",), np.ones(1), np.zeros(1))]
+    with pytest.raises(TaskError, match=r"CD\.wz repeats a combination of the rows before at every pose"):
+        RateSolver(arm, tasks).solve(arm_q(arm, (50, -65, -75)))
+    sol = RateSolver(arm, tasks, method="least_squares").solve(arm_q(arm, (50, -65, -75)))
+    np.testing.assert_allclose(sol.achieved_velocity, [1.0, 0.5, 0.5], rtol=1e-12)  # halfway
+
+
+def test_the_rank_check_does_not_mistake_a_singular_pose_for_the_task(arm):
+    """At the stretched pose the rank drops, but not at other poses: a SingularPoseError."""
+    solver = RateSolver(arm, arm_tasks())
+    with pytest.raises(SingularPoseError):
+        solver.solve(arm_q(arm, (0, 0, -90)))
+    assert solver.solve(arm_q(arm, (50, -65, -75))).method == "exact"  # same solver, fine pose
+
+
+# --------------------------------------------------------------------- closed loops
+def test_task_on_the_r_rtr_loop_against_its_closed_form(models_dir):
+    """No driver speed: D must move at 1 m/s along x with no x acceleration. The closed form
+    is linear in the crank's rates, v_D = omega1 dD/dphi, a_D = a_D(omega1, 0) + alpha1 dD/dphi,
+    so omega1 = 1 / (dD/dphi)_x and alpha1 = -a_D,x(omega1, 0) / (dD/dphi)_x."""
     mech = Mechanism.from_urdf(models_dir / "r_rtr.urdf")
     guess = mech.neutral()
-    mech.set_coordinate(guess, "B", 0.35)
+    mech.set_coordinate(guess, "B", 20 * DEG)
     mech.set_coordinate(guess, "B_slider", -0.06)
-    solver = LoopSolver(mech, ["A"])
-    q, _, _ = solver.close(guess, [np.radians(30)])
-    sol = RateSolver(mech, [Task("D", ("x",), np.array([0.935792321]), np.array([-1.0766009]))]).solve(q)
-    # The textbook pose at -50 rpm gives v_D,x = 0.935792 and a_D,x = -1.0766: the crank must be at -50 rpm
-    np.testing.assert_allclose(sol.v[mech.joint("A").idx_v], -50 * np.pi / 30, rtol=1e-8)
-    assert sol.closure_velocity_residual < 1e-12 and sol.closure_acceleration_residual < 1e-10
+    q, _, _ = LoopSolver(mech, ["A"]).close(guess, [30 * DEG])
+    sol = RateSolver(mech, [Task("D", ("x",), np.array([1.0]), np.array([0.0]))]).solve(q)
+
+    dD = closed_form.r_rtr(30 * DEG, 1.0, 0.0).vD[0]
+    omega1 = 1.0 / dD
+    alpha1 = -closed_form.r_rtr(30 * DEG, omega1, 0.0).aD[0] / dD
+    A = mech.joint("A").idx_v
+    np.testing.assert_allclose([sol.v[A], sol.a[A]], [omega1, alpha1], rtol=1e-10)
+    assert sol.method == "exact" and sol.rank == mech.model.nv
+    assert sol.closure_velocity_residual < 1e-13 and sol.closure_acceleration_residual < 1e-12
 
 
+# --------------------------------------------------------------------- malformed input
 @pytest.mark.parametrize(
     "kwargs, message",
     [
-        (dict(frame="D", components=("q",), velocity=np.zeros(1), acceleration=np.zeros(1)), "must be distinct names"),
-        (dict(frame="D", components=("x", "x"), velocity=np.zeros(2), acceleration=np.zeros(2)), "must be distinct"),
-        (dict(frame="D", components=("x",), velocity=np.zeros(2), acceleration=np.zeros(1)), "needs 1 finite"),
-        (dict(frame="D", components=("x",), velocity=np.array([np.nan]), acceleration=np.zeros(1)), "finite"),
-        (dict(frame="D", components=("x",), velocity=np.zeros(1), acceleration=np.zeros(1), reference="tool"),
-         "reference must be"),
+        ({"components": ("q",), "velocity": np.zeros(1), "acceleration": np.zeros(1)}, "must be distinct names"),
+        ({"components": ("vx",), "velocity": np.zeros(1), "acceleration": np.zeros(1)}, "among x, y, z, wx, wy, wz"),
+        ({"components": ("x", "x"), "velocity": np.zeros(2), "acceleration": np.zeros(2)}, "must be distinct"),
+        ({"components": (), "velocity": np.zeros(0), "acceleration": np.zeros(0)}, "must be distinct"),
+        ({"components": ("x",), "velocity": np.zeros(2), "acceleration": np.zeros(1)}, "velocity needs 1 finite"),
+        ({"components": ("x",), "velocity": np.array([np.nan]), "acceleration": np.zeros(1)}, "finite"),
+        ({"components": ("x",), "velocity": np.zeros(1), "acceleration": np.array([np.inf])}, "acceleration needs"),
+        ({"components": ("x",), "velocity": np.zeros(1), "acceleration": np.zeros(1), "reference": "tool"},
+         "reference must be 'world' or 'local'"),
     ],
 )
 def test_malformed_tasks(kwargs, message):
     with pytest.raises(TaskError, match=message):
-        Task(**kwargs)
+        Task("D", **kwargs)
 
 
-def test_unknown_task_frame(arm):
-    from pinmech import FrameNotFound
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        ({"method": "pinv"}, "method must be one of exact, least_squares, damped"),
+        ({"method": "damped", "damping": -1.0}, "damping must be a positive number"),
+        ({"method": "damped", "damping": float("nan")}, "damping must be a positive number"),
+    ],
+)
+def test_bad_solver_options(arm, options, message):
+    with pytest.raises(TaskError, match=message):
+        RateSolver(arm, arm_tasks(), **options)
 
+
+def test_no_task_and_unknown_frame(arm):
+    with pytest.raises(TaskError, match=r"no task given"):
+        RateSolver(arm, [])
     with pytest.raises(FrameNotFound, match="unknown point or frame 'E'"):
         RateSolver(arm, [Task("E", ("x",), np.zeros(1), np.zeros(1))])
+
+
+def test_r_rtr_task_scene(scenes_dir):
+    """models/scenes/r_rtr_task.toml: the pose sets only the crank; the loop is closed, then
+    D's one task row gives the crank rate of the closed form (-53.4307 rpm)."""
+    from pinmech import Scene, analyse
+
+    analysis = analyse(Scene.load(scenes_dir / "r_rtr_task.toml"))
+    dD = closed_form.r_rtr(30 * DEG, 1.0, 0.0).vD[0]
+    np.testing.assert_allclose(analysis.drivers.v, [1.0 / dD], rtol=1e-10)
+    assert analysis.drivers.v[0] * 30 / np.pi == pytest.approx(-53.4307, abs=5e-5)
+    np.testing.assert_allclose(analysis.motion.points["D"].velocity[0], 1.0, rtol=1e-12)
+    assert analysis.solution.accuracy.residual < 1e-13 and analysis.extra["task"]["method"] == "exact"
