@@ -14,7 +14,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from pinmech import Mechanism, RateSolver, Scene, SceneError, Task, analyse, load_mechanism
+from pinmech import Mechanism, ModelError, RateSolver, Scene, SceneError, Task, analyse, load_mechanism
 from pinmech.analysis_task import scene_pose, scene_tasks
 from pinmech.cli import main
 from tests.conftest import SCENES
@@ -112,7 +112,7 @@ def test_a_free_flyer_root_rebuilds_the_loaders_model():
     sizes = (robot.model.nq, robot.model.nv, robot.model.njoints, robot.model.nframes)
     assert (mech.model.nq, mech.model.nv, mech.model.njoints, mech.model.nframes) == sizes == (39, 38, 34, 121)
     assert mech.joints["root_joint"].kind == "other"
-    with pytest.raises(Exception, match="root_joint must be None or one of free_flyer"):
+    with pytest.raises(ModelError, match="root_joint must be None or one of free_flyer, got 'planar'"):
         Mechanism.from_urdf(scene.urdf, root_joint="planar")
 
 
