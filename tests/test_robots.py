@@ -14,7 +14,16 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from pinmech import Mechanism, ModelError, RateSolver, Scene, SceneError, Task, analyse, load_mechanism
+from pinmech import (
+    Mechanism,
+    ModelError,
+    RateSolver,
+    Scene,
+    SceneError,
+    Task,
+    analyse,
+    load_mechanism,
+)
 from pinmech.analysis_task import scene_pose, scene_tasks
 from pinmech.cli import main
 from tests.conftest import SCENES
