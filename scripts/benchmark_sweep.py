@@ -34,7 +34,7 @@ OMEGA1 = -50 * np.pi / 30
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _setup(tol: float = 1e-13):
     """Model, solver and branch guess, built once per tolerance: loading is not timed per pose."""
     mech = pinmech.Mechanism.from_urdf(ROOT / "models" / "r_rtr.urdf")
@@ -233,7 +233,7 @@ def plot_trade(rows, path: str) -> None:
     ax.set_yscale("log")
     ax.set_xlabel("time per pose [us]")
     ax.set_ylabel("largest relative error of a_D over the cycle")
-    ax.set_title(f"R-RTR cycle: speed against accuracy (median of repeats, this machine)")
+    ax.set_title("R-RTR cycle: speed against accuracy (median of repeats, this machine)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(1.02, 0.0))
     fig.tight_layout()
