@@ -13,7 +13,7 @@ Only world-frame linear rows are tracked for drift; angular rows are integrated 
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
@@ -54,10 +54,11 @@ def follow_path(mechanism: Mechanism, tasks: list[Task], q0: np.ndarray, *, dura
     start = [data.oMf[f].translation.copy() for f in frames]
     q, t = np.array(q0, dtype=float), 0.0
     steps = round(duration / step)
+    solver = RateSolver(mechanism, tasks, **solver_options)  # one solver; new task values each step
     for k in range(steps + 1):
         t = k * step
         pin.framesForwardKinematics(model, data, q)
-        drift, live = 0.0, []
+        drift, velocities = 0.0, []
         for task, fid, rows, x0 in zip(tasks, frames, linear, start):
             comps = [("xyz".index(task.components[i]), i) for i in rows]
             target = {c: x0[c] + task.velocity[i] * t + 0.5 * task.acceleration[i] * t * t for c, i in comps}
@@ -68,13 +69,14 @@ def follow_path(mechanism: Mechanism, tasks: list[Task], q0: np.ndarray, *, dura
                 velocity = velocity.copy()
                 for c, i in comps:
                     velocity[i] += gain * error[c]
-            live.append(replace(task, velocity=velocity))
+            velocities.append(velocity)
         if drift > max_drift * mechanism.length_scale:
             raise TaskError(
                 f"{mechanism.source}: at t = {t:.6g} s the path is {drift:.3g} m from the one asked "
                 f"(more than {max_drift:g} of the mechanism's size): the task leaves the workspace or "
                 "passes a singularity; shorten --duration or the --step"
             )
-        solution = RateSolver(mechanism, live, **solver_options).solve(q)
+        solution = solver.solve(q, velocity=np.concatenate(velocities),
+                                acceleration=np.concatenate([task.acceleration for task in tasks]))
         yield PathPoint(t, q.copy(), solution.v, solution.a, drift)
         q = pin.integrate(model, q, solution.v * step + 0.5 * solution.a * step * step)
