@@ -91,12 +91,16 @@ def to_si(value: Any, kind: str, *, where: str = "") -> float:
         number = float(quantity.to(si).magnitude)
     except Exception as exc:
         raise UnitError(
-            f"{value!r} is not a {kind.replace('_', ' ')} (use e.g. {_example(kind)})",
+            f"{value!r} is not {_article(kind)} {kind.replace('_', ' ')} (use e.g. {_example(kind)})",
             key=where,
         ) from exc
     if not math.isfinite(number):
         raise UnitError(f"{value!r} is not a finite number", key=where)
     return number
+
+
+def _article(kind: str) -> str:
+    return "an" if kind[0] in "aeiou" else "a"
 
 
 def _example(kind: str) -> str:
