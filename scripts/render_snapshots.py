@@ -1,30 +1,131 @@
-"""Regenerate the README's pictures: each bundled mechanism's snapshot, as headless
-chromium draws the offline meshcat page (the same route as the browser tests).
+"""Regenerate the README's pictures of the bundled mechanisms: each pose drawn by
+`pinmech.draw` as an offline meshcat page, then photographed by headless chromium, the same
+route as the browser tests (tests/browser.py).
 
-Run: python scripts/render_snapshots.py      (needs pinmech[viz] and Debian's chromium)
+- `docs/images/r_rtr.png`: the R-RTR of Problem Chapter I.9 at crank angle 30 deg, crank
+  at -50 rpm without angular acceleration: velocity (blue) and acceleration (orange) of D.
+- `docs/images/planar_arm.png`: the 3R arm of text 17.110 at (50, -65, -75) deg, D moving
+  at 1 m/s along x while CD does not turn: velocities of B, C and D (one scale).
+
+Poses and rates come from the independent closed forms in scripts/closed_form.py; the models
+are built from the URDF files directly.
+
+Run: python scripts/render_snapshots.py   (needs pinmech[viz] and Debian's chromium)
 """
 
 from __future__ import annotations
 
+import math
 import shutil
 import subprocess
+import sys
 import tempfile
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 IMAGES = ROOT / "docs" / "images"
-SCENES = {
-    "r_rtr": ["--arrows", "D.velocity", "D.acceleration"],
-    "planar_arm": ["--arrows", "D.velocity"],
-    "four_bar": ["--arrows", "P.velocity"],
-    "slider_crank": [],
-}
-FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader", "--disable-quic",
-         "--no-first-run", "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         "--virtual-time-budget=3000", "--window-size=800,600"]
+MODELS = ROOT / "models"
+SCENES = {"r_rtr": ["v_D", "a_D"], "planar_arm": ["v_B", "v_C", "v_D"]}  # picture: arrows drawn
+FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--enable-unsafe-swiftshader",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--virtual-time-budget=3000",
+    "--window-size=800,600",
+]  # as tests/browser.py
+BLUE, ORANGE = (0.1, 0.2, 0.9), (0.9, 0.5, 0.0)
+Z = np.array([0.0, 0.0, 1.0])
+
+
+def _xyz(v: np.ndarray) -> np.ndarray:
+    """A planar vector (x, y) as a spatial one (x, y, 0)."""
+    return np.array([v[0], v[1], 0.0])
+
+
+def r_rtr_drawing() -> tuple[np.ndarray, dict, list]:
+    """The R-RTR's configuration, named points [m] and arrows at crank angle 30 deg."""
+    from closed_form import r_rtr
+
+    from pinmech.draw import Arrow
+
+    theta = math.radians(30.0)
+    r = r_rtr(theta, -50.0 * math.pi / 30.0, 0.0)  # -50 rpm, no crank acceleration
+    q_B = float(r.phi3) - theta
+    q = np.array([math.cos(theta), math.sin(theta), math.cos(q_B), math.sin(q_B), -float(r.s)])
+    points = {"A": np.zeros(3), "B": _xyz(r.B), "C": np.array([0.05, 0.0, 0.0]), "D": _xyz(r.D)}
+    arrows = [
+        Arrow(points["D"], _xyz(r.vD), BLUE, "v_D", "m/s"),
+        Arrow(points["D"], _xyz(r.aD), ORANGE, "a_D", "m/s^2"),
+    ]
+    return q, points, arrows
+
+
+def planar_arm_drawing() -> tuple[np.ndarray, dict, list]:
+    """The 3R arm's configuration, named points [m] and point velocities of text 17.110."""
+    from closed_form import planar_arm_rates
+
+    from pinmech.draw import Arrow
+
+    q = np.radians([50.0, -65.0, -75.0])
+    th1, th_BC, th_CD = np.cumsum(q)
+    rates = planar_arm_rates(th1, th_BC, th_CD, 0.30, 0.30, 0.17, vD=[1.0, 0.0], aD=[0.0, 0.0])
+    e1, e2 = np.array([math.cos(th1), math.sin(th1)]), np.array([math.cos(th_BC), math.sin(th_BC)])
+    B, C = 0.30 * e1, 0.30 * e1 + 0.30 * e2
+    vB = float(rates.omega_AB) * 0.30 * np.array([-e1[1], e1[0]])
+    vC = vB + float(rates.omega_BC) * 0.30 * np.array([-e2[1], e2[0]])
+    points = {"A": np.zeros(3), "B": _xyz(B), "C": _xyz(C), "D": _xyz(rates.D)}
+    arrows = [
+        Arrow(points["B"], _xyz(vB), BLUE, "v_B", "m/s"),
+        Arrow(points["C"], _xyz(vC), BLUE, "v_C", "m/s"),
+        Arrow(points["D"], np.array([1.0, 0.0, 0.0]), BLUE, "v_D", "m/s"),
+    ]
+    return q, points, arrows
+
+
+DRAWINGS = {"r_rtr": r_rtr_drawing, "planar_arm": planar_arm_drawing}
+
+
+def page(name: str, arrow_labels: list[str]) -> str:
+    """The offline page of one bundled mechanism, with the arrows named in `arrow_labels`."""
+    import pinocchio as pin
+
+    from pinmech.draw import load_visuals, snapshot_html
+
+    urdf = MODELS / f"{name}.urdf"
+    model = pin.buildModelFromUrdf(str(urdf))
+    q, points, arrows = DRAWINGS[name]()
+    arrows = [a for a in arrows if a.label in arrow_labels]
+    return snapshot_html(
+        model,
+        load_visuals(urdf, model),
+        q,
+        points=points,
+        arrows=arrows,
+        plane_normal=Z,
+        title=name,
+    )
+
+
+def photograph(chromium: str, html: Path, png: Path, profile: Path) -> None:
+    """Headless chromium's screenshot of a page (800 x 600 pixels)."""
+    subprocess.run(
+        [chromium, *FLAGS, f"--user-data-dir={profile}", f"--screenshot={png}", html.as_uri()],
+        capture_output=True,
+        timeout=120,
+        check=True,
+    )
 
 
 def main() -> None:
+    """Write docs/images/NAME.png for every picture in SCENES."""
     chromium = shutil.which("chromium")
     if chromium is None:
         print("this script needs Debian's chromium: apt-get install chromium")
@@ -34,17 +135,14 @@ def main() -> None:
     except ImportError:
         print('this script needs meshcat: pip install "pinmech[viz]"')
         return
-    from pinmech.cli import main as pinmech
-
+    sys.path.insert(0, str(Path(__file__).resolve().parent))  # closed_form.py, beside this file
     IMAGES.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
-        for name, extra in SCENES.items():
+        for name, arrow_labels in SCENES.items():
             html = Path(tmp) / f"{name}.html"
-            pinmech(["snapshot", str(ROOT / "models" / "scenes" / f"{name}.toml"), "-o", str(html), "--no-grid", *extra])
-            png = IMAGES / f"{name}.png"
-            subprocess.run([chromium, *FLAGS, f"--user-data-dir={tmp}/profile", f"--screenshot={png}", html.as_uri()],
-                           capture_output=True, timeout=120, check=True)
-            print(f"wrote {png}")
+            html.write_text(page(name, arrow_labels), encoding="utf-8")
+            photograph(chromium, html, IMAGES / f"{name}.png", Path(tmp) / "profile")
+            print(f"wrote {IMAGES / f'{name}.png'}")
 
 
 if __name__ == "__main__":

@@ -1,8 +1,16 @@
-"""A real browser for page tests: headless Debian chromium takes a screenshot of a saved
-HTML file, and the pixels say whether the mechanism is drawn and framed."""
+"""A real browser for page tests: Debian's chromium, headless, takes a screenshot of a saved
+HTML file, and the pixels say whether something is drawn, how much of the view it spans and
+whether a colour is there.
+
+The command line that works here (chromium 156, no GPU, no network, root):
+software WebGL through SwiftShader (`--enable-unsafe-swiftshader`; `--use-gl=swiftshader`
+gives a blank page), no background networking, and a virtual time budget that lets the
+page draw and then exits (a budget of 0 or 100 ms hangs, so a subprocess timeout guards).
+"""
 
 from __future__ import annotations
 
+import colorsys
 import os
 import shutil
 import subprocess
@@ -12,50 +20,124 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-# Flags for a closed network: no sandbox (root), no GPU (software WebGL via SwiftShader),
-# no background networking; a virtual time budget lets the page draw, then exit.
-FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader", "--disable-quic",
-         "--no-first-run", "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         "--virtual-time-budget=3000", "--window-size=800,600"]
+CHROMIUM = shutil.which("chromium")
+FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--enable-unsafe-swiftshader",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--window-size=800,600",
+]
+BUDGET_MS = 3000  # virtual time for the page to load and draw [ms]
+TIMEOUT_S = 90  # wall-clock limit of one screenshot [s]
+BACKGROUND = 0.9  # a pixel with every channel above this is the white page
+UI_BOXES = (
+    (slice(0, 30), slice(-260, None)),  # meshcat's "Open Controls" bar, top right
+    (slice(-24, None), slice(None)),
+)  # pinmech's legend line, at the bottom
 
 
 def require_browser() -> str:
-    """The chromium executable; skips the test where there is none (fails in CI, which must have it)."""
+    """The chromium executable; skips the test where none is installed.
+
+    CI sets PINMECH_REQUIRE_BROWSER, and there a missing chromium fails instead.
+    """
     if CHROMIUM is None:
         if os.environ.get("PINMECH_REQUIRE_BROWSER"):
-            pytest.fail("PINMECH_REQUIRE_BROWSER is set but no chromium is installed")
-        pytest.skip("no chromium installed (apt-get install chromium)")
+            pytest.fail("PINMECH_REQUIRE_BROWSER is set but chromium is not installed")
+        pytest.skip("chromium is not installed (apt-get install chromium)")
     return CHROMIUM
 
 
-def screenshot(html_file: Path, png: Path) -> np.ndarray:
-    """RGB pixels (floats in [0, 1]) of the page as headless chromium draws it."""
-    exe = require_browser()
+def chromium_command(
+    html_file: Path, png: Path, profile: Path, *, fragment: str = "", budget_ms: int = BUDGET_MS
+) -> list[str]:
+    """The command line that draws `html_file` (address `#fragment` appended) into `png`."""
+    url = html_file.resolve().as_uri() + (f"#{fragment}" if fragment else "")
+    return [
+        require_browser(),
+        *FLAGS,
+        f"--user-data-dir={profile}",
+        f"--virtual-time-budget={budget_ms}",
+        f"--screenshot={png}",
+        url,
+    ]
+
+
+def screenshot(html_file: Path, png: Path, *, fragment: str = "") -> np.ndarray:
+    """RGB pixels (floats in [0, 1], shape (600, 800, 3)) of the page as chromium draws it."""
     with tempfile.TemporaryDirectory() as profile:
-        subprocess.run([exe, *FLAGS, f"--user-data-dir={profile}", f"--screenshot={png}", html_file.resolve().as_uri()],
-                       capture_output=True, timeout=120, check=True)
+        subprocess.run(
+            chromium_command(html_file, png, Path(profile), fragment=fragment),
+            capture_output=True,
+            timeout=TIMEOUT_S,
+            check=True,
+        )
+    return read_png(png)
+
+
+def read_png(png: Path) -> np.ndarray:
+    """RGB pixels of a PNG file, floats in [0, 1]."""
     import matplotlib.image
 
-    return matplotlib.image.imread(png)[:, :, :3]
+    return np.asarray(matplotlib.image.imread(png))[:, :, :3]
 
 
 def drawn_mask(pixels: np.ndarray) -> np.ndarray:
-    """Pixels that are not the white background (meshcat's control bar, top right, left out)."""
-    mask = np.any(pixels < 0.85, axis=2)
-    mask[:30, -260:] = False
+    """Pixels that are not the white page, meshcat's control bar and the legend left out."""
+    mask = np.any(pixels < BACKGROUND, axis=2)
+    for rows, cols in UI_BOXES:
+        mask[rows, cols] = False
     return mask
 
 
-def span_share(pixels: np.ndarray) -> float:
-    """The larger of the width and height shares spanned by drawn pixels (0 for a blank page)."""
+def span_share(pixels: np.ndarray, min_pixels: int = 50) -> float:
+    """The larger of the width and height shares of the view spanned by drawn pixels.
+
+    0 for a page with fewer than `min_pixels` drawn pixels (blank, or a speck).
+    """
     ys, xs = np.nonzero(drawn_mask(pixels))
-    if len(xs) < 50:
+    if len(xs) < min_pixels:
         return 0.0
-    return max((xs.max() - xs.min()) / pixels.shape[1], (ys.max() - ys.min()) / pixels.shape[0])
+    height, width = pixels.shape[:2]
+    return max((xs.max() - xs.min() + 1) / width, (ys.max() - ys.min() + 1) / height)
 
 
-def colour_share(pixels: np.ndarray, rgb: tuple[float, float, float], tol: float = 0.2) -> float:
-    """Share of pixels close to a colour (shading varies, hence the tolerance)."""
-    near = np.all(np.abs(pixels - np.asarray(rgb)) < tol, axis=2)
-    return float(near.mean())
+def colour_share(pixels: np.ndarray, rgb: tuple[float, float, float]) -> float:
+    """Share of the view's pixels of the colour (as `colour_mask` finds it)."""
+    return float(colour_mask(pixels, rgb).mean())
+
+
+def colour_mask(
+    pixels: np.ndarray,
+    rgb: tuple[float, float, float],
+    *,
+    hue_tol: float = 0.04,
+    min_saturation: float = 0.45,
+    min_value: float = 0.25,
+) -> np.ndarray:
+    """Pixels of the colour's hue (within `hue_tol` turns), saturated and lit.
+
+    Shading changes a surface's brightness, not its hue, hence a hue test.
+    """
+    hue = colorsys.rgb_to_hsv(*rgb)[0]
+    value = pixels.max(axis=2)
+    spread = value - pixels.min(axis=2)
+    saturation = np.where(value > 0, spread / np.maximum(value, 1e-9), 0.0)
+    distance = np.abs((_hues(pixels, value, spread) - hue + 0.5) % 1.0 - 0.5)
+    return (distance < hue_tol) & (saturation > min_saturation) & (value > min_value)
+
+
+def _hues(pixels: np.ndarray, value: np.ndarray, spread: np.ndarray) -> np.ndarray:
+    """Hue in turns [0, 1) of every pixel (as colorsys.rgb_to_hsv, vectorised)."""
+    r, g, b = (pixels[..., i] for i in range(3))
+    safe = np.maximum(spread, 1e-9)
+    hue = np.where(
+        value == r, (g - b) / safe, np.where(value == g, 2.0 + (b - r) / safe, 4.0 + (r - g) / safe)
+    )
+    return (hue / 6.0) % 1.0
