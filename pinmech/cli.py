@@ -240,6 +240,14 @@ def cmd_path(args: argparse.Namespace) -> int:
 
 
 _ARROW_COLOURS = {"velocity": (0.1, 0.2, 0.9), "acceleration": (0.9, 0.5, 0.0)}
+_ARROW_UNITS = {"velocity": "m/s", "acceleration": "m/s^2"}
+
+
+def _visuals(mechanism):
+    """The mechanism's visual geometry, built only when drawing."""
+    from pinmech.draw import load_visuals
+
+    return load_visuals(mechanism.source, mechanism.model)
 
 
 def cmd_snapshot(args: argparse.Namespace) -> int:
@@ -256,9 +264,11 @@ def cmd_snapshot(args: argparse.Namespace) -> int:
             raise PinmechError(f"--arrows {spec}: expected POINT.velocity or POINT.acceleration with a reported "
                                f"point ({', '.join(analysis.motion.points)})")
         point = analysis.motion.points[name]
-        arrows.append(Arrow(point.position, getattr(point, quantity), _ARROW_COLOURS[quantity], spec))
-    html = snapshot_html(analysis.mechanism, analysis.solution.q, points=points, arrows=arrows,
-                         show_grid=not args.no_grid)
+        arrows.append(Arrow(point.position, getattr(point, quantity), _ARROW_COLOURS[quantity], spec,
+                            _ARROW_UNITS[quantity]))
+    mechanism = analysis.mechanism
+    html = snapshot_html(mechanism.model, _visuals(mechanism), analysis.solution.q, points=points, arrows=arrows,
+                         plane_normal=mechanism.plane_normal, show_grid=not args.no_grid)
     _write(args.output, html)
     return 0
 
@@ -283,21 +293,27 @@ def cmd_animate(args: argparse.Namespace) -> int:
             qs.append(sweep.last_q.copy())
     if not qs:
         raise PinmechError("no pose of the range could be closed")
-    _write(args.output, animation_html(sweep.mechanism, qs, fps=args.fps, show_grid=not args.no_grid))
+    mechanism = sweep.mechanism
+    _write(args.output, animation_html(mechanism.model, _visuals(mechanism), qs, fps=args.fps,
+                                       plane_normal=mechanism.plane_normal, show_grid=not args.no_grid))
     return 0
 
 
 def cmd_view(args: argparse.Namespace) -> int:
     """`pinmech view SCENE`: the solved pose in a live meshcat server; prints its URL."""
     from pinmech.analysis import analyse
-    from pinmech.draw import live_view
+    from pinmech.draw import live_viewer
 
     analysis = analyse(_scene(args))
-    print(live_view(analysis.mechanism, analysis.solution.q))
-    try:
-        input("press Enter to stop the viewer\n")
-    except (EOFError, KeyboardInterrupt):  # no terminal, or Ctrl-C: stop quietly
-        pass
+    mechanism = analysis.mechanism
+    points = {n: p.position for n, p in analysis.motion.points.items()}
+    with live_viewer(mechanism.model, _visuals(mechanism), analysis.solution.q, points=points,
+                     plane_normal=mechanism.plane_normal) as view:
+        print(view.url)
+        try:
+            input("press Enter to stop the viewer\n")
+        except (EOFError, KeyboardInterrupt):  # no terminal, or Ctrl-C: stop quietly
+            pass
     return 0
 
 

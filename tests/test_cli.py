@@ -89,3 +89,16 @@ def test_help_lists_the_subcommands(capsys):
         main(["--help"])
     out = capsys.readouterr().out
     assert "solve" in out and "check" in out and "Exit codes" in out
+
+
+def test_snapshot_animate_and_view_commands(scenes_dir, tmp_path, monkeypatch, capsys):
+    pytest.importorskip("meshcat", reason='drawing needs pip install "pinmech[viz]"')
+    scene = str(scenes_dir / "r_rtr.toml")
+    assert main(["snapshot", scene, "-o", str(tmp_path / "s.html"), "--arrows", "D.velocity", "D.acceleration"]) == 0
+    assert main(["animate", scene, "-o", str(tmp_path / "a.html"), "--steps", "5"]) == 0
+    assert (tmp_path / "s.html").stat().st_size > 500_000 and (tmp_path / "a.html").stat().st_size > 500_000
+    assert main(["snapshot", scene, "-o", str(tmp_path / "x.html"), "--arrows", "Q.speed"]) == 2
+    assert "expected POINT.velocity" in capsys.readouterr().err
+    monkeypatch.setattr("builtins.input", lambda prompt="": "")
+    assert main(["view", scene]) == 0
+    assert "http://127.0.0.1:" in capsys.readouterr().out
