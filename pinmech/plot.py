@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from pinmech.exceptions import PinmechError
 from pinmech.sweep import Sweep, SweepPose
 
 
@@ -34,12 +35,11 @@ def plot_sweep(sweep: Sweep, poses: Iterable[SweepPose], path: str | Path, *,
     Links and points default to the scene's `[sweep] links/points`, else every moving one.
     """
     plt = _pyplot()
-    chosen = sweep.scene.section("sweep")
-    links = links or chosen.get("links")
-    points = points or chosen.get("points")
+    links = links or sweep.scene.names("sweep", "links")
+    points = points or sweep.scene.names("sweep", "points")
     poses = [p for p in poses if p.motion is not None]
     if not poses:
-        raise ValueError("no solved pose to plot")
+        raise PinmechError("no pose of the sweep could be solved: nothing to plot")
     first = poses[0].motion
     driver_link = sweep.mechanism.joint(sweep.driver).child_link
     links = links or [n for n in first.links if n != driver_link]

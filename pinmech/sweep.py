@@ -64,6 +64,9 @@ class Sweep:
     def from_scene(cls, scene: Scene, driver: str | None = None) -> Sweep:
         mechanism = load_mechanism(scene)
         drivers = scene_drivers(scene, mechanism)
+        if not drivers.names:
+            raise SceneError("the scene has no [drivers.NAME] table to sweep (an arm's task scene is "
+                             "followed in time by `pinmech path`)", path=str(scene.path), key="drivers")
         name = driver or drivers.names[0]
         if name not in drivers.names:
             raise SceneError(f"'{name}' is not a driver of the scene ({', '.join(drivers.names)})",
