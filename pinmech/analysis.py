@@ -66,6 +66,9 @@ def _locked_by_move(scene: Scene, types: dict[str, str], locked: dict[str, float
     if not isinstance(move, list) or not all(isinstance(n, str) for n in move):
         raise SceneError("move must be a list of joint names", path=str(scene.path), key="move")
     movable = [n for n, t in types.items() if t in ("revolute", "continuous", "prismatic")]
+    if not move:
+        raise SceneError("move = [] leaves no joint to move: name the joints the scene moves",
+                         path=str(scene.path), key="move")
     for name in move:
         if name not in movable:
             raise FrameNotFound("joint (in move)", name, movable, path=str(scene.path))
@@ -135,7 +138,7 @@ def report_lists(scene: Scene) -> tuple[list[str] | None, list[str] | None]:
     if unknown:
         raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))} in [report]; known: points, links",
                          path=str(scene.path), key="report")
-    return report.get("points"), report.get("links")
+    return scene.names("report", "points"), scene.names("report", "links")
 
 
 def analyse(scene: Scene) -> Analysis:

@@ -108,6 +108,12 @@ def _rate_options(scene: Scene) -> dict[str, Any]:
     if unknown:
         raise SceneError(f"unknown key(s) {sorted(unknown)}; known: method, damping, max_condition",
                          path=str(scene.path), key="rates")
+    for key, value in options.items():
+        number = key != "method"
+        if (number and (isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0)) or (
+                not number and not isinstance(value, str)):
+            raise SceneError(f"must be {'a positive number' if number else 'a string'}, got {value!r}",
+                             path=str(scene.path), key=f"rates.{key}")
     return dict(options)
 
 

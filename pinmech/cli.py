@@ -141,6 +141,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     """`pinmech sweep SCENE`: every pose of a cycle, streamed as CSV (and JSON lines, a plot)."""
     import numpy as np
 
+    from pinmech.scene import SOLVER_RANGES
     from pinmech.sweep import Sweep, write_csv
 
     if args.steps < 2:
@@ -152,8 +153,10 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     stop = scene.quantity(args.stop, kind, "--to") if args.stop else start + (sweep.default_values(2)[1] - sweep.start)
     values = np.linspace(start, stop, args.steps)
     if args.tol is not None:
-        if not args.tol > 0:
-            raise PinmechError(f"--tol must be positive, got {args.tol}")
+        low, high = SOLVER_RANGES["tol"]
+        if not low <= args.tol <= high:
+            raise PinmechError(f"--tol must be between {low:g} and {high:g} (relative to the mechanism's size), "
+                               f"got {args.tol}")
         sweep.solver.tol = args.tol
     poses = sweep.poses(values, skip_failures=args.skip_failures, warm_start=not args.cold_start,
                         predictor=not (args.no_predictor or args.cold_start))

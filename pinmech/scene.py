@@ -25,6 +25,10 @@ KNOWN_KEYS = {
     "title", "urdf", "robot", "drivers", "guess", "pose", "move", "lock", "points", "report", "solver",
     "task", "rates", "sweep", "draw",
 }
+#: Accepted `[solver]` values. A closure tolerance (relative to the mechanism's size)
+#: below 1e-16 is tighter than rounding allows; above 1e-3 a "closed" loop is visibly
+#: open. A singular limit below 1 would refuse every pose.
+SOLVER_RANGES = {"tol": (1e-16, 1e-3), "max_iterations": (1, 1000), "max_condition": (1.0, float("inf"))}
 _DRIVER_KEYS = {"angle": 0, "position": 0, "speed": 1, "velocity": 1, "acceleration": 2}
 
 
@@ -83,6 +87,9 @@ class Scene:
         if unknown:
             raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(KNOWN_KEYS))}",
                              path=str(self.path))
+        for key in ("urdf", "robot", "title"):
+            if key in self.raw and not isinstance(self.raw[key], str):
+                raise SceneError(f"must be a string, got {self.raw[key]!r}", path=str(self.path), key=key)
         has_urdf = isinstance(self.raw.get("urdf"), str)
         has_robot = isinstance(self.raw.get("robot"), str)
         if has_urdf == has_robot:
@@ -113,6 +120,16 @@ class Scene:
         value = self.raw.get(name, {})
         if not isinstance(value, dict):
             raise SceneError(f"[{name}] must be a table", path=str(self.path), key=name)
+        return value
+
+    def names(self, section: str, key: str) -> list[str] | None:
+        """A list of names under `[section] key = [...]` (None when absent)."""
+        value = self.section(section).get(key)
+        if value is None:
+            return None
+        if not isinstance(value, list) or not all(isinstance(n, str) for n in value):
+            raise SceneError(f"must be a list of names, e.g. [\"D\"], got {value!r}", path=str(self.path),
+                             key=f"{section}.{key}")
         return value
 
     def quantity(self, value: Any, kind: str, *keys: str) -> float:
@@ -155,6 +172,10 @@ class Scene:
                                  path=str(self.path), key=f"solver.{key}")
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
                 raise SceneError(f"solver.{key} must be a positive number, got {value!r}",
+                                 path=str(self.path), key=f"solver.{key}")
+            low, high = SOLVER_RANGES[key]
+            if not low <= value <= high:
+                raise SceneError(f"solver.{key} = {value!r} is outside [{low:g}, {high:g}]",
                                  path=str(self.path), key=f"solver.{key}")
             out[key] = allowed[key](value)
         return out
