@@ -118,6 +118,9 @@ class Mechanism:
         root = _parse_xml(path)
         full = _build_model(source, root_joint)
         model = _lock_joints(full, locked or {}, source)
+        if model.nv == 0:
+            held = f" once {', '.join(locked)} are locked" if locked else ""
+            raise ModelError(f"no joint of the model moves{held}: nothing to solve", path=source)
         links_xml = _link_names(root)
         point_names = _point_links(root)
         joint_links = {
@@ -137,7 +140,7 @@ class Mechanism:
             source=source,
             locked=dict(locked or {}),
         )
-        mech.length_scale = _length_scale(model)
+        mech.length_scale = _length_scale(model, source)
         mech.closures = [_make_closure(model, c, mech.length_scale) for c in cuts]
         _reduce_rows(mech)
         mech.plane_normal = _plane_normal(mech)
@@ -292,6 +295,9 @@ def _parse_constraint(el: ET.Element, model: pin.Model, links: list[str], source
             raise ModelError(f"missing <{side} link=\"...\"/>", path=source, element=where)
         if link not in links:
             raise ModelError(f"<{side} link=\"{link}\"/> names no link of the model", path=source, element=where)
+        if not model.existBodyName(link):
+            raise ModelError(f"<{side} link=\"{link}\"/> is not connected to the tree of joints from the root link",
+                             path=source, element=where)
         origin = el.find(f"{side}_origin")
         xyz = _vector(origin, "xyz", "0 0 0", where, source)
         rpy = _vector(origin, "rpy", "0 0 0", where, source)
@@ -393,13 +399,27 @@ def _body_frame(model: pin.Model, link: str) -> int:
     return model.getFrameId(link, pin.FrameType.BODY)
 
 
-def _length_scale(model: pin.Model) -> float:
-    """Diagonal of the box around every frame origin at the neutral configuration [m]."""
+#: Mechanism sizes pinmech accepts [m]: squares of lengths and speeds must stay finite.
+SIZE_RANGE = (1e-50, 1e50)
+
+
+def _length_scale(model: pin.Model, source: str) -> float:
+    """Diagonal of the box around every frame origin at the neutral configuration [m].
+
+    Raises:
+        ModelError: a size outside `SIZE_RANGE` (numbers that overflow, as 1e308 in an origin).
+    """
     data = model.createData()
     pin.framesForwardKinematics(model, data, pin.neutral(model))
     pts = np.array([f.translation for f in data.oMf])
-    size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))) if len(pts) else 0.0
-    return size if size > 0 else 1.0
+    with np.errstate(over="ignore", invalid="ignore"):
+        size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))) if len(pts) else 0.0
+    if size == 0:
+        return 1.0
+    if not SIZE_RANGE[0] <= size <= SIZE_RANGE[1]:
+        raise ModelError(f"the mechanism's size is {size:.3g} m, outside the {SIZE_RANGE[0]:g} to "
+                         f"{SIZE_RANGE[1]:g} m pinmech can compute with (check the <origin> numbers)", path=source)
+    return size
 
 
 def _make_closure(model: pin.Model, cut: _Cut, length_scale: float) -> Closure:
