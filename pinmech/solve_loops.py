@@ -14,7 +14,13 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pinocchio as pin
 
-from pinmech.exceptions import LoopClosureError, MobilityError, ModelError, SingularPoseError
+from pinmech.exceptions import (
+    LoopClosureError,
+    MobilityError,
+    ModelError,
+    PinmechError,
+    SingularPoseError,
+)
 from pinmech.mechanism import Mechanism
 from pinmech.results import Accuracy, LoopSolution
 
@@ -24,6 +30,8 @@ DEFAULT_TOL = 1e-13
 #: singularity accelerations lose accuracy like eps x condition^3 (tests/test_singular.py),
 #: so 1e4 keeps every acceleration pinmech gives to about 2e-4 relative or better.
 DEFAULT_MAX_CONDITION = 1e4
+#: A closure residual below this (relative to the size) is rounding, not a loop out of reach.
+ROUNDING_LEVEL = 1e-14
 
 
 def _newton_step(J: np.ndarray, r: np.ndarray) -> np.ndarray:
@@ -199,10 +207,11 @@ class LoopSolver:
     def _raise_not_closed(self, q: np.ndarray, norm: float, iterations: int, driver_q: Sequence[float]) -> None:
         drivers = ", ".join(f"{n} = {v:.6g}" for n, v in zip(self.drivers, driver_q))
         names = ", ".join(c.name for c in self.mechanism.closures)
+        why = ("the pose is out of reach for these dimensions, or the guess is on no branch" if norm > ROUNDING_LEVEL
+               else f"that is rounding level: the tolerance {self.tol:g} is tighter than floating point allows")
         raise LoopClosureError(
             f"{self.mechanism.source}: loop(s) {names} cannot be closed at {drivers} "
-            f"(residual {norm:.3g} of the mechanism size after {iterations} Newton iterations): "
-            "the pose is out of reach for these dimensions, or the guess is on no branch",
+            f"(residual {norm:.3g} of the mechanism size after {iterations} Newton iterations): {why}",
             residual=float(norm),
             iterations=iterations,
             partial=q,
@@ -275,7 +284,11 @@ class LoopSolver:
             raise ModelError(f"guess must be {self.model.nq} finite numbers, got shape {q0.shape}",
                              path=self.mechanism.source)
         q, iterations, residual = self.close(q0, dq)
-        v, a, acc = self.rates(q, dv, da, at_q=True)
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # checked just below
+            v, a, acc = self.rates(q, dv, da, at_q=True)
+        if not (np.all(np.isfinite(v)) and np.all(np.isfinite(a))):
+            raise PinmechError(f"{self.mechanism.source}: the rates overflow floating point (driver rates "
+                               f"{dv.tolist()}, accelerations {da.tolist()}): use rates of sensible size")
         accuracy = Accuracy(residual, iterations, acc.condition, acc.sigma_min,
                             acc.velocity_residual, acc.acceleration_residual)
         return LoopSolution(q=q, v=v, a=a, accuracy=accuracy, drivers=self.drivers)

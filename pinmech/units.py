@@ -30,6 +30,11 @@ JOINT_KINDS: dict[str, tuple[str, str, str]] = {
 }
 
 
+#: Largest magnitude of a quantity in SI units. Kinematics multiplies speeds and lengths
+#: (a = omega^2 r) and squares the results (norms), which must stay below 1.8e308.
+MAX_MAGNITUDE = 1e50
+
+
 @functools.lru_cache(maxsize=1)
 def _registry() -> Any:
     import pint
@@ -96,6 +101,9 @@ def to_si(value: Any, kind: str, *, where: str = "") -> float:
         ) from exc
     if not math.isfinite(number):
         raise UnitError(f"{value!r} is not a finite number", key=where)
+    if abs(number) > MAX_MAGNITUDE:
+        raise UnitError(f"{value!r} is {number:.3g} {format_si(number, kind)}, beyond the {MAX_MAGNITUDE:g} (SI) "
+                        "pinmech computes with: its squares would overflow", key=where)
     return number
 
 
