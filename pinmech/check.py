@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from pinmech.exceptions import SceneError
-from pinmech.units import to_si
+from pinmech.units import SI_UNITS, to_si
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -101,12 +101,15 @@ def load_hand_file(path: str | Path) -> HandFile:
         raise SceneError("no such hand-value file", path=str(path))
     try:
         raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise SceneError(f"malformed TOML: {exc}", path=str(path)) from exc
     if not isinstance(raw.get("scene"), str):
         raise SceneError("missing scene = \"scene.toml\"", path=str(path), key="scene")
+    entries = raw.get("value", [])
+    if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
+        raise SceneError("values must be tables: [[value]] with quantity, hand and unit", path=str(path), key="value")
     values = []
-    for i, entry in enumerate(raw.get("value", [])):
+    for i, entry in enumerate(entries):
         values.extend(_hand_values(entry, f"value[{i}]", str(path)))
     return HandFile(path, (path.parent / raw["scene"]).resolve(), str(raw.get("source", "")), values)
 
@@ -117,6 +120,8 @@ def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue
             raise SceneError(f"missing {key}", path=path, key=where)
     quantity = str(entry["quantity"])
     hand = entry["hand"] if isinstance(entry["hand"], list) else [entry["hand"]]
+    if not 1 <= len(hand) <= 3:
+        raise SceneError(f"hand = {hand!r}: give one to three printed values", path=path, key=where)
     base, component = _split_component(quantity)
     kind = _kind_of(base, str(entry.get("kind", "")), path, where)
     label = str(entry.get("label", quantity))
@@ -125,14 +130,18 @@ def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue
         if not isinstance(printed, str):
             raise SceneError(f"hand value {printed!r} must be a string as printed (e.g. \"0.386\")", path=path, key=where)
         try:
-            Decimal(printed)
-            float(printed)
+            exponent = Decimal(printed).as_tuple().exponent
+            finite = math.isfinite(float(printed)) and isinstance(exponent, int) and -300 < exponent < 300
         except (InvalidOperation, ValueError):
             raise SceneError(f"hand value {printed!r} is not a number", path=path, key=where) from None
+        if not finite:
+            raise SceneError(f"hand value {printed!r} is not a finite number as printed", path=path, key=where)
         comp = component if component is not None else (i if len(hand) > 1 else None)
         suffix = "" if len(hand) == 1 else f" {'xyz'[i]}"
         out.append(HandValue(label + suffix, base, comp, printed.strip(), str(entry["unit"]), kind))
-    to_si(f"1 {out[0].unit}", kind, where=f"{where}.unit")  # unknown or wrong unit fails here
+    factor = to_si(f"1 {out[0].unit}", kind, where=f"{where}.unit")  # unknown or wrong unit fails here
+    if not factor > 0:
+        raise SceneError(f"unit = {out[0].unit!r} is not a unit", path=path, key=f"{where}.unit")
     return out
 
 
@@ -145,6 +154,8 @@ def _split_component(quantity: str) -> tuple[str, int | None]:
 
 def _kind_of(path: str, declared: str, file: str, where: str) -> str:
     if declared:
+        if declared not in SI_UNITS:
+            raise SceneError(f"kind = {declared!r} is not one of {', '.join(SI_UNITS)}", path=file, key=where)
         return declared
     last = path.rsplit(".", 1)[-1]
     if last in _KINDS:
@@ -164,7 +175,9 @@ def lookup(result: dict[str, Any], quantity: str, component: int | None, *, wher
     if isinstance(node, list):
         if component is None:
             raise SceneError(f"{quantity!r} is a vector: add .x, .y or .z, or give a list of hand values", key=where)
-        return float(node[component])
+        node = node[component] if component < len(node) else None
+    if isinstance(node, bool) or not isinstance(node, (int, float)):
+        raise SceneError(f"{quantity!r} is not a number of the result", key=where)
     return float(node)
 
 
