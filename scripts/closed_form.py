@@ -27,9 +27,19 @@ from numpy.typing import ArrayLike, NDArray
 Array = NDArray[np.float64]
 
 
+def _real(x: ArrayLike) -> Array:
+    """x as a float array: float64, or np.longdouble when given in extended precision.
+
+    Keeping np.longdouble lets a test evaluate these formulas with an epsilon of 1e-19
+    (x86-64), a reference that does not share float64's rounding near a singular pose.
+    """
+    x = np.asarray(x)
+    return x.astype(np.result_type(x.dtype, np.float64), copy=False)
+
+
 def unit(angle: ArrayLike) -> Array:
     """Unit vector (cos angle, sin angle); last axis of length 2."""
-    angle = np.asarray(angle, dtype=float)
+    angle = _real(angle)
     return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
 
 
@@ -111,7 +121,7 @@ def r_rtr(phi: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike, AB: float = 0.10
     Raises:
         ValueError: where B coincides with C (link 3's direction is undefined).
     """
-    phi, omega1, alpha1 = np.broadcast_arrays(*(np.asarray(x, dtype=float)
+    phi, omega1, alpha1 = np.broadcast_arrays(*(_real(x)
                                                 for x in (phi, omega1, alpha1)))
     if not np.all(r_rtr_closes(AB, AC, phi)):
         raise ValueError(f"R-RTR singular: crank pin B lies on C (AB={AB}, AC={AC})")
@@ -175,7 +185,7 @@ def four_bar(theta2: ArrayLike, omega2: ArrayLike, alpha2: ArrayLike, a: float, 
     Raises:
         ValueError: where the loop cannot close (|A - O4| > b + c or < |b - c|).
     """
-    theta2, omega2, alpha2 = np.broadcast_arrays(*(np.asarray(x, dtype=float)
+    theta2, omega2, alpha2 = np.broadcast_arrays(*(_real(x)
                                                    for x in (theta2, omega2, alpha2)))
     e2 = unit(theta2)
     A = a * e2
@@ -242,7 +252,7 @@ def slider_crank(theta: ArrayLike, omega: ArrayLike, alpha: ArrayLike, r: float,
     Raises:
         ValueError: where |e - r sin(theta)| > l (the rod cannot reach the line).
     """
-    theta, omega, alpha = np.broadcast_arrays(*(np.asarray(x, dtype=float)
+    theta, omega, alpha = np.broadcast_arrays(*(_real(x)
                                                 for x in (theta, omega, alpha)))
     rise = e - r * np.sin(theta)
     if np.any(np.abs(rise) > l):
@@ -317,17 +327,17 @@ def planar_arm_rates(th1: ArrayLike, th_BC: ArrayLike, th_CD: ArrayLike, r1: flo
         ValueError: where det = 0 (arm stretched or folded at B).
     """
     th1, th_BC, th_CD, omega_CD, alpha_CD = np.broadcast_arrays(
-        *(np.asarray(x, dtype=float) for x in (th1, th_BC, th_CD, omega_CD, alpha_CD)))
+        *(_real(x) for x in (th1, th_BC, th_CD, omega_CD, alpha_CD)))
     e1, e2, e3 = unit(th1), unit(th_BC), unit(th_CD)
     det = r1 * r2 * np.sin(th_BC - th1)
     if np.any(det == 0.0):
         raise ValueError(f"3R arm singular: det = r1 r2 sin(th_BC - th1) = "
                          f"{np.atleast_1d(det)[np.atleast_1d(det == 0.0)][0]!r}")
     CD = r3 * e3
-    vC = np.asarray(vD, dtype=float) - _vec(omega_CD) * perp(CD)
+    vC = _real(vD) - _vec(omega_CD) * perp(CD)
     omega_AB = r2 * dot(vC, e2) / det
     omega_BC = -r1 * dot(vC, e1) / det
-    aC = np.asarray(aD, dtype=float) - _vec(alpha_CD) * perp(CD) + _vec(omega_CD**2) * CD
+    aC = _real(aD) - _vec(alpha_CD) * perp(CD) + _vec(omega_CD**2) * CD
     rhs = aC + _vec(omega_AB**2) * r1 * e1 + _vec(omega_BC**2) * r2 * e2
     alpha_AB = r2 * dot(rhs, e2) / det
     alpha_BC = -r1 * dot(rhs, e1) / det
@@ -351,7 +361,7 @@ def planar_arm_forward(q: ArrayLike, q_dot: ArrayLike, q_ddot: ArrayLike, r1: fl
         q_ddot: joint accelerations [rad/s^2], shape (..., 3).
         r1, r2, r3: link lengths AB, BC, CD [m].
     """
-    th, w, al = (np.cumsum(np.asarray(x, dtype=float), axis=-1) for x in (q, q_dot, q_ddot))
+    th, w, al = (np.cumsum(_real(x), axis=-1) for x in (q, q_dot, q_ddot))
     points, vels, accs = [], [], []
     p = v = acc = 0.0
     for i, r in enumerate((r1, r2, r3)):
