@@ -129,6 +129,11 @@ class Mechanism:
             if j.find("parent") is not None and j.find("child") is not None
         }
         cuts = [_parse_constraint(c, model, links_xml, source) for c in root.findall("constraint")]
+        names = [c.name for c in cuts]
+        for name in names:
+            if names.count(name) > 1:
+                raise ModelError("two <constraint> elements share this name", path=source,
+                                 element=f"<constraint name=\"{name}\">")
         mech = cls(
             model=model,
             closures=[],

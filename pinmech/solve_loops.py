@@ -169,8 +169,8 @@ class LoopSolver:
                 break
         full = self._full_residual()
         if norm > self.tol or full > max(self.tol, 1e-12) * 10:
-            self._raise_not_closed(q, norm, iterations, driver_q)
-        return q, iterations, float(max(norm, full))
+            self._raise_not_closed(q, max(norm, full), iterations, driver_q)
+        return q, iterations, max(norm, full)
 
     def _newton_update(self, q: np.ndarray, J_dep: np.ndarray, r: np.ndarray,
                        norm: float) -> tuple[np.ndarray, np.ndarray, float, bool]:
@@ -207,8 +207,14 @@ class LoopSolver:
     def _raise_not_closed(self, q: np.ndarray, norm: float, iterations: int, driver_q: Sequence[float]) -> None:
         drivers = ", ".join(f"{n} = {v:.6g}" for n, v in zip(self.drivers, driver_q))
         names = ", ".join(c.name for c in self.mechanism.closures)
-        why = ("the pose is out of reach for these dimensions, or the guess is on no branch" if norm > ROUNDING_LEVEL
-               else f"that is rounding level: the tolerance {self.tol:g} is tighter than floating point allows")
+        solved = float(np.max(np.abs(self._residual(q)), initial=0.0))  # the rows Newton solves
+        if norm <= ROUNDING_LEVEL:
+            why = f"that is rounding level: the tolerance {self.tol:g} is tighter than floating point allows"
+        elif solved <= self.tol:
+            why = ("the rows dropped as out of the mechanism's plane do not close: the two sides of the cut "
+                   "are not in one plane (check the z of the origins and the axes)")
+        else:
+            why = "the pose is out of reach for these dimensions, or the guess is on no branch"
         raise LoopClosureError(
             f"{self.mechanism.source}: loop(s) {names} cannot be closed at {drivers} "
             f"(residual {norm:.3g} of the mechanism size after {iterations} Newton iterations): {why}",
