@@ -30,6 +30,8 @@ DEFAULT_TOL = 1e-13
 #: singularity accelerations lose accuracy like eps x condition^3 (tests/test_singular.py),
 #: so 1e4 keeps every acceleration pinmech gives to about 2e-4 relative or better.
 DEFAULT_MAX_CONDITION = 1e4
+#: Largest Newton step of one joint [rad, or mechanism sizes for a prismatic joint].
+MAX_STEP = 1.0
 #: A closure residual below this (relative to the size) is rounding, not a loop out of reach.
 ROUNDING_LEVEL = 1e-14
 
@@ -188,6 +190,14 @@ class LoopSolver:
         return self._line_search(q, step, norm)
 
     def _move(self, q: np.ndarray, step: np.ndarray) -> np.ndarray:
+        """q moved by a step of the dependent joints, shortened to at most MAX_STEP.
+
+        From a guess where the Jacobian is singular a solve returns steps of 1e16 rad,
+        after which no step can move those joints (a unit in the last place of 1e16 is 2).
+        """
+        size = np.max(np.abs(step / self._dep_scale), initial=0.0)  # rad, or sizes of the mechanism
+        if size > MAX_STEP:
+            step = step * (MAX_STEP / size)
         self._step[:] = 0.0
         self._step[self._dep_v] = step
         return pin.integrate(self.model, q, self._step)
