@@ -439,10 +439,11 @@ def _make_closure(model: pin.Model, cut: _Cut, length_scale: float) -> Closure:
                    parent_link=cut.parent_link, child_link=cut.child_link, length_scale=length_scale)
 
 
-def _sample_configurations(model: pin.Model, count: int) -> list[np.ndarray]:
+def _sample_configurations(model: pin.Model, count: int, scale: np.ndarray | float = 1.0) -> list[np.ndarray]:
+    """Seeded random configurations: about a radian, or `scale` metres for a slide, from neutral."""
     rng = np.random.default_rng(20261122)
     q0 = pin.neutral(model)
-    return [pin.integrate(model, q0, rng.normal(size=model.nv)) for _ in range(count)]
+    return [pin.integrate(model, q0, scale * rng.normal(size=model.nv)) for _ in range(count)]
 
 
 def _reduce_rows(mech: Mechanism) -> None:
@@ -451,13 +452,15 @@ def _reduce_rows(mech: Mechanism) -> None:
         return
     model = mech.model
     data = model.createData()
-    samples = _sample_configurations(model, _SAMPLES)
+    columns = mech.velocity_scale()  # rows and columns dimensionless: the rank is the same at any size
+    samples = _sample_configurations(model, _SAMPLES, columns)
     stacks: list[list[np.ndarray]] = [[] for _ in mech.closures]
     for q in samples:
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
         for stack, closure in zip(stacks, mech.closures):
-            stack.append(closure.selected @ closure.relative_jacobian6(model, data))
+            rows = closure.selected * closure._scale()
+            stack.append(rows @ closure.relative_jacobian6(model, data) * columns)
     for stack, closure in zip(stacks, mech.closures):
         U, s, _ = np.linalg.svd(np.hstack(stack), full_matrices=False)
         rank = int(np.sum(s > STRUCTURAL_RANK_TOL * max(s[0], 1e-300))) if s.size else 0
@@ -483,13 +486,14 @@ def _plane_normal(mech: Mechanism) -> np.ndarray | None:
         return None
     data = model.createData()
     angular, linear = [], []
-    for q in _sample_configurations(model, 3):
+    columns = mech.velocity_scale()  # dimensionless columns and rows, as in _reduce_rows
+    for q in _sample_configurations(model, 3, columns):
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
         for fid in range(model.nframes):
-            J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+            J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED) * columns
             angular.append(J[3:])
-            linear.append(J[:3])
+            linear.append(J[:3] / mech.length_scale)
     # A = hstack(angular) is 3 x (frames * nv). A = R^T Q^T, so A's U and s are those of the
     # 3 x 3 R^T: same accuracy, and LAPACK's SVD of the wide A took 30 ms on a floating Talos.
     R = np.linalg.qr(np.hstack(angular).T, mode="r")
