@@ -93,7 +93,8 @@ class RateSolver:
             minimum-norm solution), "least_squares" (also accepts over-determined or
             inconsistent tasks: the least-squares motion, asked vs achieved reported),
             or "damped" (damped least squares with `damping`, also at singular poses).
-        damping: lambda of the damped least squares, in the Jacobian's units (SI).
+        damping: lambda of the damped least squares, dimensionless: rows and columns are
+            scaled as for the condition number (lengths in mechanism sizes).
         max_condition: above this condition number (dimensionless) the pose is singular
             (SingularPoseError) unless the method is "damped".
 
@@ -278,14 +279,23 @@ class RateSolver:
         return f"{values} (rad, m)"
 
     def _apply(self, J: np.ndarray, rhs: np.ndarray, method: str, rank: int) -> np.ndarray:
+        """Solve J x = rhs by `method`, in dimensionless rows and columns (see `_dimensionless`),
+        so that the minimum norm, the least squares and the damping weigh a turn of one radian
+        like a slide of one mechanism size: the same answer at any size, in any unit."""
+        n_c = J.shape[0] - self._row_scale.size
+        columns = self.mechanism.velocity_scale()
+        rows = np.r_[np.ones(n_c), self._row_scale]
+        J, rhs = self._dimensionless(J, n_c), rows * rhs
         if method == "exact":
-            return np.linalg.solve(J, rhs)
-        if method == "damped":
-            return J.T @ np.linalg.solve(J @ J.T + self.damping**2 * np.eye(J.shape[0]), rhs)
-        if rank == min(J.shape):
-            return np.linalg.lstsq(J, rhs, rcond=None)[0]  # minimum-norm or least-squares
-        U, s, Vt = np.linalg.svd(J, full_matrices=False)  # rank-deficient: truncated pseudo-inverse
-        return Vt[:rank].T @ ((U[:, :rank].T @ rhs) / s[:rank])
+            x = np.linalg.solve(J, rhs)
+        elif method == "damped":
+            x = J.T @ np.linalg.solve(J @ J.T + self.damping**2 * np.eye(J.shape[0]), rhs)
+        elif rank == min(J.shape):
+            x = np.linalg.lstsq(J, rhs, rcond=None)[0]  # minimum-norm or least-squares
+        else:
+            U, s, Vt = np.linalg.svd(J, full_matrices=False)  # rank-deficient: truncated pseudo-inverse
+            x = Vt[:rank].T @ ((U[:, :rank].T @ rhs) / s[:rank])
+        return columns * x
 
 
 def _rank(J: np.ndarray) -> int:

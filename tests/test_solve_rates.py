@@ -110,12 +110,14 @@ def test_redundant_task_is_numpys_minimum_norm(arm):
 
 
 def test_damped_least_squares_is_the_regularised_pseudo_inverse(arm):
-    """(J^T J + lambda^2 I)^-1 J^T x_dot, on the Jacobian numpy gets from Pinocchio."""
+    """(J^T J + lambda^2 I)^-1 J^T x_dot, on the Jacobian numpy gets from Pinocchio, its
+    linear rows divided by the arm's size (lambda is dimensionless: the same at any size)."""
     q = arm_q(arm, (50, -65, -75))
     lam = 0.05
     sol = RateSolver(arm, arm_tasks(), method="damped", damping=lam).solve(q)
     J = np.vstack([frame_jacobian(arm, q, "D")[:2], frame_jacobian(arm, q, "CD")[5:]])
-    expected = np.linalg.solve(J.T @ J + lam**2 * np.eye(3), J.T @ [1.0, 0.0, 0.0])
+    rows = np.array([1 / arm.length_scale, 1 / arm.length_scale, 1.0])[:, None]
+    expected = np.linalg.solve((rows * J).T @ (rows * J) + lam**2 * np.eye(3), (rows * J).T @ (rows[:, 0] * [1.0, 0, 0]))
     np.testing.assert_allclose(sol.v, expected, rtol=1e-12)
     assert sol.method == "damped" and not sol.is_exact()
     np.testing.assert_allclose(sol.achieved_velocity, J @ sol.v, rtol=1e-12)  # what it reports achieving
@@ -150,7 +152,9 @@ def test_over_determined_task_is_an_error_or_least_squares(arm):
         RateSolver(arm, tasks).solve(q)
     sol = RateSolver(arm, tasks, method="least_squares").solve(q)
     J = np.vstack([frame_jacobian(arm, q, "D")[[0, 1, 5]], frame_jacobian(arm, q, "C")[:1]])
-    np.testing.assert_allclose(sol.v, np.linalg.lstsq(J, [1.0, 0.0, 0.0, 2.0], rcond=None)[0], rtol=1e-12)
+    w = np.array([1, 1, arm.length_scale, 1]) / arm.length_scale  # residuals weighed dimensionless
+    np.testing.assert_allclose(sol.v, np.linalg.lstsq(w[:, None] * J, w * [1.0, 0.0, 0.0, 2.0], rcond=None)[0],
+                               rtol=1e-12)
     assert sol.method == "least_squares" and sol.rank == 3 and sol.nullspace_dim == 0
     np.testing.assert_allclose(sol.achieved_velocity, J @ sol.v, rtol=1e-12)  # what the report shows
     assert sol.velocity_error == pytest.approx(np.max(np.abs(J @ sol.v - [1.0, 0.0, 0.0, 2.0])))
