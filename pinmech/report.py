@@ -161,7 +161,8 @@ def to_text(analysis: Analysis) -> str:
     t.lines.append(
         f"  closure residual {acc.residual:.2g} (of the mechanism size {analysis.mechanism.length_scale:.4g} m), "
         f"{acc.iterations} Newton iterations, condition number {acc.condition:.4g} "
-        f"(worst-case acceleration error about {max(acc.error_estimate, 1e-15):.0e} relative)"
+        "(worst-case relative error about {:.0e} in positions, {:.0e} in velocities, {:.0e} in "
+        "accelerations)".format(*(max(b, 1e-16) for b in acc.error_bounds))
     )
     for line in (analysis.extra or {}).get("_text", []):
         t.lines.append(line)
