@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 _LINK = '<link name="{name}"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>'
@@ -109,3 +110,20 @@ def write(tmp_path: Path, name: str, text: str) -> Path:
     path = tmp_path / name
     path.write_text(text, encoding="utf-8")
     return path
+
+
+def scaled_urdf(text: str, k: float) -> str:
+    """Every length of a URDF times k: origins, box sizes, radii, lengths, prismatic limits
+    (xyz, size, radius, length, lower, upper). Angles (rpy), axes (`<axis>`, `<parent_axis>`,
+    `<child_axis>`: directions), masses and inertias keep their numbers.
+    """
+    def scale_numbers(match: re.Match) -> str:
+        numbers = " ".join(f"{float(x) * k!r}" for x in match.group(2).split())
+        return f'{match.group(1)}="{numbers}"'
+
+    def scale_tag(match: re.Match) -> str:
+        if match.group(1).endswith("axis"):
+            return match.group(0)
+        return re.sub(r'\b(xyz|size|radius|length|lower|upper)="([^"]*)"', scale_numbers, match.group(0))
+
+    return re.sub(r"<(\w+)\b[^>]*>", scale_tag, text)
