@@ -141,7 +141,6 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     """`pinmech sweep SCENE`: every pose of a cycle, streamed as CSV (and JSON lines, a plot)."""
     import numpy as np
 
-    from pinmech.scene import SOLVER_RANGES
     from pinmech.sweep import Sweep, write_csv
 
     if args.steps < 2:
@@ -153,6 +152,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     stop = scene.quantity(args.stop, kind, "--to") if args.stop else start + (sweep.default_values(2)[1] - sweep.start)
     values = np.linspace(start, stop, args.steps)
     if args.tol is not None:
+        from pinmech.scene import SOLVER_RANGES
+
         low, high = SOLVER_RANGES["tol"]
         if not low <= args.tol <= high:
             raise PinmechError(f"--tol must be between {low:g} and {high:g} (relative to the mechanism's size), "

@@ -13,7 +13,6 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.exceptions import PinmechError
 from pinmech.sweep import Sweep, SweepPose
 
 
@@ -35,11 +34,12 @@ def plot_sweep(sweep: Sweep, poses: Iterable[SweepPose], path: str | Path, *,
     Links and points default to the scene's `[sweep] links/points`, else every moving one.
     """
     plt = _pyplot()
-    links = links or sweep.scene.names("sweep", "links")
-    points = points or sweep.scene.names("sweep", "points")
+    chosen = sweep.scene.section("sweep")
+    links = links or chosen.get("links")
+    points = points or chosen.get("points")
     poses = [p for p in poses if p.motion is not None]
     if not poses:
-        raise PinmechError("no pose of the sweep could be solved: nothing to plot")
+        raise ValueError("no solved pose to plot")
     first = poses[0].motion
     driver_link = sweep.mechanism.joint(sweep.driver).child_link
     links = links or [n for n in first.links if n != driver_link]

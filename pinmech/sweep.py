@@ -67,6 +67,7 @@ class Sweep:
         if not drivers.names:
             raise SceneError("the scene has no [drivers.NAME] table to sweep (an arm's task scene is "
                              "followed in time by `pinmech path`)", path=str(scene.path), key="drivers")
+        scene.names("sweep", "links"), scene.names("sweep", "points")  # lists of names, or a SceneError now
         name = driver or drivers.names[0]
         if name not in drivers.names:
             raise SceneError(f"'{name}' is not a driver of the scene ({', '.join(drivers.names)})",
