@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from pinmech.exceptions import FrameNotFound, ModelError, SceneError
+from pinmech.exceptions import FrameNotFound, MobilityError, ModelError, SceneError
 from pinmech.mechanism import Mechanism, urdf_joint_types
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.results import LoopSolution
@@ -107,6 +107,12 @@ def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
             raise SceneError("missing its angle (or position)", path=str(scene.path), key=f"drivers.{name}")
         names.append(name)
         values.append(row)
+    if len(names) != mechanism.mobility:
+        given = ", ".join(names) or "none"
+        raise MobilityError(f"{scene.path}, drivers: {mechanism.source} has mobility {mechanism.mobility} "
+                            f"({mechanism.model.nv} joint freedoms, {mechanism.constraint_rows} independent closure "
+                            f"equations): drive that many joints; the scene drives {len(names)} ({given})",
+                            mobility=mechanism.mobility, drivers=len(names))
     arr = np.array(values, dtype=float).reshape(-1, 3)
     return Drivers(tuple(names), arr[:, 0].copy(), arr[:, 1].copy(), arr[:, 2].copy())
 
@@ -141,6 +147,34 @@ def report_lists(scene: Scene) -> tuple[list[str] | None, list[str] | None]:
     return scene.names("report", "points"), scene.names("report", "links")
 
 
+def check_scene_names(scene: Scene, mechanism: Mechanism) -> None:
+    """The points and links a scene names (`[report]`, `[points.X]`) exist in the model.
+
+    Raises:
+        FrameNotFound: naming the scene file and the table the unknown name is in.
+    """
+    points, links = report_lists(scene)
+    coincident = coincident_points(scene)
+    where = str(scene.path)
+    for name in links or []:
+        if name not in mechanism.links:
+            raise FrameNotFound("link (in [report] links)", name, list(mechanism.links), path=where)
+    for c in coincident:
+        if c.link not in mechanism.links:
+            raise FrameNotFound(f"link (in [points.{c.name}])", c.link, list(mechanism.links), path=where)
+        _frame(mechanism, c.at, f"point (in [points.{c.name}] at)", where)
+    for name in points or []:
+        if name not in {c.name for c in coincident}:
+            _frame(mechanism, name, "point or frame (in [report] points)", where)
+
+
+def _frame(mechanism: Mechanism, name: str, kind: str, where: str) -> None:
+    try:
+        mechanism.frame_id(name)
+    except FrameNotFound as exc:
+        raise FrameNotFound(kind, name, exc.known, path=where) from None
+
+
 def analyse(scene: Scene) -> Analysis:
     """Load, close the loops, solve the rates and read off the motion of a scene.
 
@@ -150,9 +184,11 @@ def analyse(scene: Scene) -> Analysis:
         from pinmech.analysis_task import analyse_task
 
         return analyse_task(scene)
+    options = scene.solver_options()
     mechanism = load_mechanism(scene)
     drivers = scene_drivers(scene, mechanism)
-    solver = LoopSolver(mechanism, drivers.names, **scene.solver_options())
+    check_scene_names(scene, mechanism)
+    solver = LoopSolver(mechanism, drivers.names, **options)
     solution = solver.solve(drivers.q, drivers.v, drivers.a, guess=scene_guess(scene, mechanism))
     points, links = report_lists(scene)
     motion = evaluate_motion(mechanism, solver.data, solution.q, solution.v, solution.a,

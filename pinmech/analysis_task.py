@@ -21,6 +21,7 @@ import numpy as np
 
 from pinmech.analysis import (
     Analysis,
+    check_scene_names,
     Drivers,
     coincident_points,
     load_mechanism,
@@ -127,6 +128,7 @@ def analyse_task(scene: Scene) -> Analysis:
         q, iterations, residual = solver.close(q, values)
     tasks = scene_tasks(scene)
     _check_frames(scene, mechanism, tasks)
+    check_scene_names(scene, mechanism)
     rates = RateSolver(mechanism, tasks, **_rate_options(scene))
     rs = rates.solve(q)
     accuracy = Accuracy(residual, iterations, rs.condition, rs.sigma_min,

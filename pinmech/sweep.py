@@ -18,6 +18,7 @@ import pinocchio as pin
 
 from pinmech.analysis import (
     Drivers,
+    check_scene_names,
     coincident_points,
     load_mechanism,
     report_lists,
@@ -62,11 +63,12 @@ class Sweep:
 
     @classmethod
     def from_scene(cls, scene: Scene, driver: str | None = None) -> Sweep:
-        mechanism = load_mechanism(scene)
-        drivers = scene_drivers(scene, mechanism)
-        if not drivers.names:
+        if not scene.section("drivers"):
             raise SceneError("the scene has no [drivers.NAME] table to sweep (an arm's task scene is "
                              "followed in time by `pinmech path`)", path=str(scene.path), key="drivers")
+        mechanism = load_mechanism(scene)
+        drivers = scene_drivers(scene, mechanism)
+        check_scene_names(scene, mechanism)
         scene.names("sweep", "links"), scene.names("sweep", "points")  # lists of names, or a SceneError now
         name = driver or drivers.names[0]
         if name not in drivers.names:
