@@ -21,8 +21,8 @@ import numpy as np
 
 from pinmech.analysis import (
     Analysis,
-    check_scene_names,
     Drivers,
+    check_scene_names,
     coincident_points,
     load_mechanism,
     report_lists,
