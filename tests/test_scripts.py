@@ -14,6 +14,7 @@ import pytest
         ("closed_form", None),
         ("benchmark_sweep", ["--poses", "40", "--repeats", "1"]),
         ("sweep_memory", ["--poses", "200"]),
+        ("singular_accuracy", []),
     ],
 )
 def test_script_runs(name, argv, capsys):
