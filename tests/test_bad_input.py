@@ -358,3 +358,10 @@ def test_every_error_class_has_its_exit_code_documented():
         assert re.search(rf"\b{cls.exit_code} [a-z]", cli.__doc__), cls
         assert re.search(rf"\b{cls.exit_code} [A-Za-z]", cli.build_parser().epilog), cls
         assert re.search(rf"\| {cls.exit_code} \|[^\n]*{cls.__name__}", readme), cls
+
+
+@pytest.mark.parametrize("option", ["--csv", "--json"])
+def test_an_output_file_that_cannot_be_written(r_rtr_scene, tmp_path, capsys, option):
+    target = tmp_path / "no such folder" / "out.csv"
+    code, err = _run(capsys, "sweep", r_rtr_scene, "--steps", "3", option, target)
+    assert code == 2 and err.startswith("pinmech: error: ") and err.count("\n") == 1 and "no such folder" in err
