@@ -273,14 +273,14 @@ def test_sweeping_a_scene_without_drivers(tmp_path, capsys):
     scene = tmp_path / "s.toml"
     scene.write_text(f'urdf = "{MODELS / "planar_arm.urdf"}"\n[pose]\nA = "10 deg"\n')
     code, err = _run(capsys, "sweep", scene, "--steps", "3")
-    assert code == 4 and "no [drivers.NAME] table to sweep" in err
+    assert code == 4 and "drivers" in err and "pinmech path" in err
     _one_line_error(code, err, "s.toml")
 
 
 @pytest.mark.parametrize("override", ["sweep.links=1", 'sweep.points=[1]'])
 def test_sweep_lists_must_be_names(r_rtr_scene, capsys, override):
     code, err = _run(capsys, "sweep", r_rtr_scene, "--steps", "3", "--set", override)
-    assert code == 4 and "must be a list of names" in err
+    assert code == 4 and override.split("=")[0] in err and "must be" in err
     _one_line_error(code, err, "r_rtr.toml")
 
 
