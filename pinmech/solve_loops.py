@@ -26,6 +26,10 @@ DEFAULT_TOL = 1e-13
 #: singularity accelerations lose accuracy like eps x condition^3 (tests/test_singular.py),
 #: so 1e4 keeps every acceleration pinmech gives to about 2e-4 relative or better.
 DEFAULT_MAX_CONDITION = 1e4
+#: With the default tolerance or a tighter one, a pose that ends between this residual and
+#: the tolerance gets one more Newton step: it costs one kinematics pass and lands at
+#: rounding level, so results do not depend on how close the guess happened to be.
+POLISH = 1e-15
 
 
 def _max_abs(x: np.ndarray) -> float:
@@ -213,6 +217,10 @@ class LoopSolver:
             iterations += 1
             if not ok:
                 break
+        if POLISH < norm <= self.tol <= DEFAULT_TOL and iterations < self.max_iterations:
+            J_dep = self._residual_jacobian()[:, self._dep]
+            q, r, norm, _ = self._newton_update(q, J_dep, r, norm)  # kept only if it helps
+            iterations += 1
         full = self._full_residual()
         if norm > self.tol or full > max(self.tol, 1e-12) * 10:
             self._raise_not_closed(q, max(norm, full), iterations, driver_q)
