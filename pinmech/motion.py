@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from pinmech.closures import _cross
 from pinmech.exceptions import FrameNotFound
 from pinmech.mechanism import Mechanism
 
@@ -171,7 +172,7 @@ def _plane_angle(rotation: np.ndarray, normal: np.ndarray | None) -> float | Non
     ref = np.array([1.0, 0.0, 0.0]) if abs(normal[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
     ref = ref - normal * (normal @ ref)
     ref /= np.linalg.norm(ref)
-    return float(np.arctan2(normal @ np.cross(ref, x_axis), ref @ x_axis))
+    return float(np.arctan2(normal @ _cross(ref, x_axis), ref @ x_axis))
 
 
 def _coincident(mechanism: Mechanism, data: pin.Data, c: CoincidentPoint) -> PointMotion:
@@ -189,8 +190,8 @@ def _coincident(mechanism: Mechanism, data: pin.Data, c: CoincidentPoint) -> Poi
     w, alpha = vel.angular, spatial_acc.angular
     return PointMotion(
         position=at,
-        velocity=vel.linear + np.cross(w, r),
-        acceleration=acc.linear + np.cross(alpha, r) + np.cross(w, np.cross(w, r)),
+        velocity=vel.linear + _cross(w, r),
+        acceleration=acc.linear + _cross(alpha, r) + _cross(w, _cross(w, r)),
         link=c.link,
     )
 
@@ -207,5 +208,5 @@ def _slider(mechanism: Mechanism, data: pin.Data, name: str, rate: float, accel:
         child=joint.child_link,
         relative_velocity=v_rel,
         relative_acceleration=accel * axis_world,
-        coriolis_acceleration=2.0 * np.cross(omega_parent, v_rel),
+        coriolis_acceleration=2.0 * _cross(omega_parent, v_rel),
     )
