@@ -20,11 +20,10 @@ Scene keys, all optional:
 
 from __future__ import annotations
 
-import csv
 import math
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
-from typing import IO, Any
+from typing import Any
 
 import numpy as np
 
@@ -183,75 +182,3 @@ class Sweep:
 
     def _format(self, value: float) -> str:
         return f"{math.degrees(value):.6g} deg" if self.is_angular else f"{value:.6g} m"
-
-
-# -------------------------------------------------------------------------- table
-def columns(sweep: Sweep, first: Motion) -> list[str]:
-    """CSV column names with units, from the first solved pose."""
-    unit = "deg" if sweep.is_angular else "m"
-    cols = [f"{sweep.driver}.q [{unit}]"]
-    planar = sweep.mechanism.plane_normal is not None
-    for name in first.links:
-        if planar:
-            cols += [f"{name}.angle [deg]", f"{name}.omega [rad/s]", f"{name}.alpha [rad/s^2]"]
-        else:
-            cols += [f"{name}.|omega| [rad/s]", f"{name}.|alpha| [rad/s^2]"]
-    for name in first.points:
-        cols += [f"{name}.{c} [m]" for c in "xyz"]
-        cols += [f"{name}.v{c} [m/s]" for c in "xyz"] + [f"{name}.|v| [m/s]"]
-        cols += [f"{name}.a{c} [m/s^2]" for c in "xyz"] + [f"{name}.|a| [m/s^2]"]
-    for name in first.sliders:
-        cols += [f"{name}.v_rel [m/s]", f"{name}.a_rel [m/s^2]", f"{name}.|a_cor| [m/s^2]"]
-    return cols + ["closure_residual [1]", "condition_number [1]", "newton_iterations [1]", "pose", "error"]
-
-
-def row(sweep: Sweep, pose: SweepPose, width: int) -> list[object]:
-    """One CSV row in the units of `columns` (empty cells where the pose failed)."""
-    first = math.degrees(pose.value) if sweep.is_angular else pose.value
-    if pose.motion is None:
-        return [first] + [""] * (width - 3) + ["failed", pose.error]
-    m, out = pose.motion, [first]
-    normal = sweep.mechanism.plane_normal
-    for link in m.links.values():
-        if normal is not None:
-            out += [math.degrees(link.angle), float(normal @ link.angular_velocity),
-                    float(normal @ link.angular_acceleration)]
-        else:
-            out += [float(np.linalg.norm(link.angular_velocity)), float(np.linalg.norm(link.angular_acceleration))]
-    for p in m.points.values():
-        out += list(p.position) + list(p.velocity) + [float(np.linalg.norm(p.velocity))]
-        out += list(p.acceleration) + [float(np.linalg.norm(p.acceleration))]
-    for name, s in m.sliders.items():
-        out += [m.joints[name].v, m.joints[name].a, float(np.linalg.norm(s.coriolis_acceleration))]
-    acc = pose.accuracy
-    return out + [acc.residual, acc.condition, acc.iterations, "interpolated" if pose.interpolated else "solved", ""]
-
-
-def write_csv(sweep: Sweep, poses: Iterable[SweepPose], stream: IO[str]) -> int:
-    """Stream poses to CSV as they are solved; returns the number of rows written."""
-    writer = csv.writer(stream)
-    header: list[str] | None = None
-    pending: list[SweepPose] = []
-    count = 0
-    for pose in poses:
-        if header is None:
-            if pose.motion is None:
-                pending.append(pose)  # header waits for the first solved pose
-                continue
-            header = columns(sweep, pose.motion)
-            writer.writerow(header)
-            for failed in pending:
-                writer.writerow([_cell(x) for x in row(sweep, failed, len(header))])
-                count += 1
-        writer.writerow([_cell(x) for x in row(sweep, pose, len(header))])
-        count += 1
-    if header is None:
-        writer.writerow([f"{sweep.driver}.q", "error"])
-        for failed in pending:
-            writer.writerow([failed.value, failed.error])
-            count += 1
-    return count
-
-
-def _cell(x: object) -> object:
-    return f"{x:.12g}" if isinstance(x, float) else x

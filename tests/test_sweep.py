@@ -14,7 +14,8 @@ import pytest
 import closed_form
 from pinmech import Scene, SweepError
 from pinmech.cli import main
-from pinmech.sweep import Sweep, write_csv
+from pinmech.sweep import Sweep
+from pinmech.tables import write_csv
 
 OMEGA1 = -50 * np.pi / 30
 
