@@ -206,8 +206,8 @@ class BatchSolver:
 # ---------------------------------------------------------------------- manifold
 def integrate_many(model: pin.Model, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
     """`pin.integrate` of each row of q (N, nq) by the row of dq (N, nv): on arrays for
-    one-dof joints (prismatic, revolute, continuous stored as cos/sin, renormalised as
-    Pinocchio does), row by row through Pinocchio for any other joint."""
+    one-dof joints (prismatic, revolute, continuous stored as cos/sin), row by row through
+    Pinocchio for any other joint."""
     out = np.empty_like(q)
     for joint in model.joints[1:]:
         iq, iv = joint.idx_q, joint.idx_v
@@ -215,9 +215,8 @@ def integrate_many(model: pin.Model, q: np.ndarray, dq: np.ndarray) -> np.ndarra
             out[:, iq] = q[:, iq] + dq[:, iv]
         elif joint.nq == 2 and joint.nv == 1:
             c, s, w = q[:, iq], q[:, iq + 1], dq[:, iv]
-            cw, sw = np.cos(w), np.sin(w)
+            cw, sw = np.cos(w), np.sin(w)  # a rotation keeps (c, s) unit to rounding
             out[:, iq], out[:, iq + 1] = cw * c - sw * s, sw * c + cw * s
-            out[:, iq : iq + 2] *= ((3.0 - (out[:, iq : iq + 2] ** 2).sum(axis=1)) / 2.0)[:, None]
         else:
             return np.array([pin.integrate(model, a, b) for a, b in zip(q, dq)])
     return out

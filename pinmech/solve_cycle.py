@@ -40,15 +40,16 @@ from pinmech.solve_loops import LoopSolver
 
 STARTS = ("predictor", "warm", "cold")
 #: Poses per chunk: what is held in memory at once.
-CHUNK = 512
+CHUNK = 4096
 #: Batched refinement: exact poses every LEVELS[0]-th, then every LEVELS[1]-th, ...,
 #: used when the driver moves less than MAX_SPAN (rad, or lengths of the mechanism)
 #: between the poses of the first level.
 LEVELS = (64, 8, 1)
 MAX_SPAN = 0.12
-#: Where the error of a quintic Hermite interpolant peaks within its interval: the
-#: middle (positions, accelerations) and (1 -+ 1/sqrt 5) / 2 (velocities).
-PEAKS = (0.5 - 0.5 / math.sqrt(5.0), 0.5, 0.5 + 0.5 / math.sqrt(5.0))
+#: Where the error of a quintic Hermite interpolant peaks within its interval (to
+#: leading order, s^3 (1 - s)^3 and its derivatives): the middle for positions and
+#: accelerations, (1 - 1/sqrt 5) / 2 for velocities (and its mirror image, as large).
+PEAKS = (0.5, 0.5 - 0.5 / math.sqrt(5.0))
 _FAILURES = (LoopClosureError, SingularPoseError)
 
 
@@ -313,18 +314,22 @@ class _Cycle:
         """Quintic Hermite in (q, q', q'') from slot `left` to slot `right`, evaluated at
         driver values `at`, in the tangent space at the left pose (exact for one-dof
         joints, whose tangent spaces are all the same)."""
-        h = x[right] - x[left]
+        # one interval per right end; `right` is sorted, so each interval's targets are contiguous
+        starts = np.flatnonzero(np.concatenate(([True], right[1:] != right[:-1])))
+        counts = np.diff(np.append(starts, len(right)))
+        i, j = left[starts], right[starts]
+        h = (x[j] - x[i])[:, None]
         if np.any(h == 0):
             raise _Fallback
-        s = ((at - x[left]) / h)[:, None]
-        h = h[:, None]
-        model = self.solver.model
-        delta = difference_many(model, q[left], q[right])
-        coeffs = (h * d1[left], h * h * d2[left], delta, h * d1[right], h * h * d2[right])
-        basis, first, second = _quintic(s)
-        p = sum(b * c for b, c in zip(basis, coeffs))
-        Q = integrate_many(model, q[left], p)
-        return Q, sum(b * c for b, c in zip(first, coeffs)) / h, sum(b * c for b, c in zip(second, coeffs)) / (h * h)
+        coeffs = _quintic_coefficients(h * d1[i], h * h * d2[i], difference_many(self.solver.model, q[i], q[j]),
+                                       h * d1[j], h * h * d2[j])
+        hw = np.repeat(h, counts, axis=0)
+        s = (at[:, None] - x[left][:, None]) / hw
+        c1, c2, c3, c4, c5 = (np.repeat(c, counts, axis=0) for c in coeffs)
+        p = s * (c1 + s * (c2 + s * (c3 + s * (c4 + s * c5))))
+        dp = c1 + s * (2 * c2 + s * (3 * c3 + s * (4 * c4 + s * 5 * c5)))
+        ddp = 2 * c2 + s * (6 * c3 + s * (12 * c4 + s * 20 * c5))
+        return integrate_many(self.solver.model, q[left], p), dp / hw, ddp / (hw * hw)
 
     def _measure(self, x: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray, solved: np.ndarray,
                  targets: np.ndarray, acc: dict[str, np.ndarray]) -> None:
@@ -393,14 +398,11 @@ def _concat(a: RangeChunk, b: RangeChunk) -> RangeChunk:
                       np.concatenate((a.interpolated, b.interpolated)), errors)
 
 
-def _quintic(s: np.ndarray) -> tuple[list, list, list]:
-    """Quintic Hermite basis on [0, 1] and its first two derivatives, for the data
-    (p0, p0', p0'', p1, p1', p1''); p0 = 0 in the tangent space, so its term is left out."""
-    s2, s3, s4, s5 = s * s, s**3, s**4, s**5
-    basis = [s - 6 * s3 + 8 * s4 - 3 * s5, 0.5 * s2 - 1.5 * s3 + 1.5 * s4 - 0.5 * s5,
-             10 * s3 - 15 * s4 + 6 * s5, -4 * s3 + 7 * s4 - 3 * s5, 0.5 * s3 - s4 + 0.5 * s5]
-    first = [1 - 18 * s2 + 32 * s3 - 15 * s4, s - 4.5 * s2 + 6 * s3 - 2.5 * s4,
-             30 * s2 - 60 * s3 + 30 * s4, -12 * s2 + 28 * s3 - 15 * s4, 1.5 * s2 - 4 * s3 + 2.5 * s4]
-    second = [-36 * s + 96 * s2 - 60 * s3, 1 - 9 * s + 18 * s2 - 10 * s3,
-              60 * s - 180 * s2 + 120 * s3, -24 * s + 84 * s2 - 60 * s3, 3 * s - 12 * s2 + 10 * s3]
-    return basis, first, second
+def _quintic_coefficients(v0: np.ndarray, a0: np.ndarray, delta: np.ndarray, v1: np.ndarray,
+                          a1: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Coefficients c1..c5 of p(s) = c1 s + ... + c5 s^5 on [0, 1] with p(0) = 0,
+    p'(0) = v0, p''(0) = a0, p(1) = delta, p'(1) = v1, p''(1) = a1 (quintic Hermite)."""
+    c3 = 10 * delta - 6 * v0 - 4 * v1 - 1.5 * a0 + 0.5 * a1
+    c4 = -15 * delta + 8 * v0 + 7 * v1 + 1.5 * a0 - a1
+    c5 = 6 * delta - 3 * v0 - 3 * v1 - 0.5 * a0 + 0.5 * a1
+    return v0, 0.5 * a0, c3, c4, c5

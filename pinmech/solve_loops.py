@@ -187,7 +187,7 @@ class LoopSolver:
 
     def set_drivers(self, q: np.ndarray, driver_q: Sequence[float]) -> np.ndarray:
         """A copy of q with the drivers' coordinates written in."""
-        q = np.array(q, dtype=float, copy=True)
+        q = q.copy() if type(q) is np.ndarray and q.dtype == float else np.array(q, dtype=float)
         for (i, continuous), value in zip(self._drv_q, driver_q):
             if continuous:
                 q[i], q[i + 1] = math.cos(value), math.sin(value)
@@ -283,6 +283,11 @@ class LoopSolver:
         """
         if not at_q:
             self._residual(q)
+        v, a, *numbers = self._rates(q, driver_v, driver_a)
+        return v, a, Accuracy(0.0, 0, *numbers)
+
+    def _rates(self, q: np.ndarray, driver_v, driver_a) -> tuple:
+        """v, a, condition, sigma_min, velocity and acceleration residuals (data at q)."""
         J = self._jacobian()
         J_dep, J_drv = J[:, self._dep], J[:, self._drv]
         condition, sigma_min = _condition(J_dep * self._dep_scale)
@@ -300,20 +305,12 @@ class LoopSolver:
         a = np.zeros(self.model.nv)
         a[self._drv] = driver_a
         if not J.size:
-            return v, a, Accuracy(0.0, 0, condition, sigma_min)
+            return v, a, condition, sigma_min, 0.0, 0.0
         v[self._dep] = _solve_square(J_dep, -(J_drv @ v[self._drv]))
         pin.forwardKinematics(self.model, self.data, q, v, self._zero_a)
         drift = self._drift()
         a[self._dep] = _solve_square(J_dep, -(J_drv @ a[self._drv]) - drift)
-        accuracy = Accuracy(
-            residual=0.0,
-            iterations=0,
-            condition=condition,
-            sigma_min=sigma_min,
-            velocity_residual=_max_abs(J @ v),
-            acceleration_residual=_max_abs(J @ a + drift),
-        )
-        return v, a, accuracy
+        return v, a, condition, sigma_min, _max_abs(J @ v), _max_abs(J @ a + drift)
 
     def solve(
         self,
@@ -336,12 +333,13 @@ class LoopSolver:
             raise ModelError(f"guess must be {self.model.nq} finite numbers, got shape {q0.shape}",
                              path=self.mechanism.source)
         q, iterations, residual = self.close(q0, dq)
-        v, a, acc = self.rates(q, dv, da, at_q=True)
-        accuracy = Accuracy(residual, iterations, acc.condition, acc.sigma_min,
-                            acc.velocity_residual, acc.acceleration_residual)
-        return LoopSolution(q=q, v=v, a=a, accuracy=accuracy, drivers=self.drivers)
+        v, a, *numbers = self._rates(q, dv, da)
+        return LoopSolution(q=q, v=v, a=a, accuracy=Accuracy(residual, iterations, *numbers), drivers=self.drivers)
 
     def _ordered(self, values: Sequence[float] | Mapping[str, float] | None) -> np.ndarray:
+        if (type(values) is np.ndarray and values.shape == (len(self.drivers),) and values.dtype == float
+                and math.isfinite(sum(values.tolist()))):
+            return values  # already in order (a sweep's arrays: no conversion)
         if values is None:
             return np.zeros(len(self.drivers))
         if isinstance(values, Mapping):
