@@ -8,6 +8,8 @@ All vectors are in the world frame, SI units.
 
 from __future__ import annotations
 
+import functools
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -168,11 +170,18 @@ def _plane_angle(rotation: np.ndarray, normal: np.ndarray | None) -> float | Non
     """Angle of the link's x axis about the plane normal, measured from the world x axis."""
     if normal is None:
         return None
+    ref = _plane_reference(*normal.tolist())
     x_axis = rotation[:, 0]
-    ref = np.array([1.0, 0.0, 0.0]) if abs(normal[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    return math.atan2(float(normal @ _cross(ref, x_axis)), float(ref @ x_axis))
+
+
+@functools.lru_cache(maxsize=8)
+def _plane_reference(nx: float, ny: float, nz: float) -> np.ndarray:
+    """The world x axis projected on the plane (the y axis when the normal is near x)."""
+    normal = np.array((nx, ny, nz))
+    ref = np.array([1.0, 0.0, 0.0]) if abs(nx) < 0.9 else np.array([0.0, 1.0, 0.0])
     ref = ref - normal * (normal @ ref)
-    ref /= np.linalg.norm(ref)
-    return float(np.arctan2(normal @ _cross(ref, x_axis), ref @ x_axis))
+    return ref / np.linalg.norm(ref)
 
 
 def _coincident(mechanism: Mechanism, data: pin.Data, c: CoincidentPoint) -> PointMotion:

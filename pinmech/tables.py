@@ -55,12 +55,12 @@ def row(sweep: Sweep, pose: SweepPose, width: int) -> list[object]:
             out += [math.degrees(link.angle), float(normal @ link.angular_velocity),
                     float(normal @ link.angular_acceleration)]
         else:
-            out += [float(np.linalg.norm(link.angular_velocity)), float(np.linalg.norm(link.angular_acceleration))]
+            out += [_norm(link.angular_velocity), _norm(link.angular_acceleration)]
     for p in m.points.values():
-        out += p.position.tolist() + p.velocity.tolist() + [float(np.linalg.norm(p.velocity))]
-        out += p.acceleration.tolist() + [float(np.linalg.norm(p.acceleration))]
+        v, a = p.velocity.tolist(), p.acceleration.tolist()
+        out += p.position.tolist() + v + [math.hypot(*v)] + a + [math.hypot(*a)]
     for name, s in m.sliders.items():
-        out += [m.joints[name].v, m.joints[name].a, float(np.linalg.norm(s.coriolis_acceleration))]
+        out += [m.joints[name].v, m.joints[name].a, _norm(s.coriolis_acceleration)]
     acc = pose.accuracy
     return out + [acc.residual, acc.condition, acc.iterations, "interpolated" if pose.interpolated else "solved", ""]
 
@@ -87,7 +87,7 @@ class SweepCsv:
         self._write(pose)
 
     def _write(self, pose: SweepPose) -> None:
-        self.writer.writerow([_cell(x) for x in row(self.sweep, pose, len(self.header))])
+        self.writer.writerow([f"{x:.12g}" if type(x) is float else x for x in row(self.sweep, pose, len(self.header))])
         self.count += 1
 
     def close(self) -> int:
@@ -154,6 +154,10 @@ class PathCsv:
 
     def close(self) -> int:
         return self.count
+
+
+def _norm(x: np.ndarray) -> float:
+    return math.hypot(*x.tolist())
 
 
 def _cell(x: object) -> object:
