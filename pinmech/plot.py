@@ -13,6 +13,7 @@ and keep at most `max_points` of them (every n-th), so memory stays bounded.
 from __future__ import annotations
 
 import math
+from array import array
 from collections.abc import Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -56,8 +57,8 @@ class SweepPlot:
         self.links, self.points = links or chosen.get("links"), points or chosen.get("points")
         self.every = max(1, math.ceil(total / max_points)) if total else 1
         self.normal = sweep.mechanism.plane_normal
-        self.x: list[float] = []
-        self.series: dict[str, dict[str, list[float]]] = {}
+        self.x = array("d")
+        self.series: dict[str, dict[str, array]] = {}
         self.failed: list[float] = []
         self.mark: tuple[float, dict[str, dict[str, float]]] | None = None  # nearest pose to the scene's
 
@@ -75,11 +76,14 @@ class SweepPlot:
             return
         if not self.series:
             self._choose(pose)
+        nearer = self.mark is None or abs(pose.value - self.sweep.start) < abs(self.mark[0] - self.sweep.start)
+        kept = pose.index % self.every == 0
+        if not (nearer or kept):
+            return
         values = self._values(pose)
-        distance = abs(pose.value - self.sweep.start)
-        if self.mark is None or distance < abs(self.mark[0] - self.sweep.start):
+        if nearer:
             self.mark = (pose.value, values)
-        if pose.index % self.every:
+        if not kept:
             return
         self.x.append(self._x(pose.value))
         for title, panel in values.items():
@@ -96,7 +100,8 @@ class SweepPlot:
             self.points = [n for n, p in motion.points.items()
                            if p.link in mech.links and model.frames[mech.links[p.link]].parentJoint != 0]
         self.sliders = list(motion.sliders)
-        self.series = {title: {name: [] for name in names} for title, names in self._panels().items()}
+        # raw doubles, not lists of floats: the kept values would pin memory pools freed by the rest
+        self.series = {title: {name: array("d") for name in names} for title, names in self._panels().items()}
 
     def _panels(self) -> dict[str, list[str]]:
         """Panel title ("quantity, symbol [unit]") -> the names drawn in it."""
