@@ -166,9 +166,9 @@ def cycle_rows(poses: int, repeats: int) -> list[dict]:
 def cycle_table(rows: list[dict]) -> str:
     floor_t = next(r["time"] for r in rows if r.get("floor"))
     default_t = next(r["time"] for r in rows if r["name"].startswith("default"))
-    lines = ["| setting | time per pose [us] | vs floor | vs default | Newton iterations per pose "
-             "| rel. error position | velocity | acceleration |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    header = ("| setting | time per pose [us] | vs floor | vs default | Newton iterations per pose "
+              "| rel. error position | velocity | acceleration |")
+    lines = [header, "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in rows:
         errors = " | ".join(f"{e:.1e}" for e in r["errors"]) if r["errors"] is not None else "- | - | -"
         iterations = f"{r['iterations']:.2f}" if r.get("iterations") is not None else "-"
@@ -184,16 +184,15 @@ def verdicts(rows: list[dict]) -> str:
     settings = [r for r in rows if r.get("iterations") is not None or r["name"].startswith("finite")]
     fastest = min(settings, key=lambda r: r["time"])
     worst = max(default["errors"])
-    return "\n".join([
-        f"- default reproduces the closed form to {worst:.1e} relative (target 1e-12): "
-        f"{'met' if worst <= 1e-12 else 'NOT met'}",
-        f"- default time per pose = {default['time'] / floor_t:.2f} x the floor with results kept "
-        f"({default['time'] / calls_t:.2f} x the bare calls alone) (target 3x): "
-        f"{'met' if default['time'] <= 3 * floor_t else 'NOT met'}",
-        f"- fastest setting ({fastest['name']}) is {default['time'] / fastest['time']:.1f} x faster than the default "
-        f"(target 5x), error in acceleration {fastest['errors'][2]:.1e}: "
-        f"{'met' if default['time'] >= 5 * fastest['time'] else 'NOT met'}",
-    ])
+    accuracy = (f"- default reproduces the closed form to {worst:.1e} relative (target 1e-12): "
+                f"{'met' if worst <= 1e-12 else 'NOT met'}")
+    speed = (f"- default time per pose = {default['time'] / floor_t:.2f} x the floor with results kept "
+             f"({default['time'] / calls_t:.2f} x the bare calls alone) (target 3x): "
+             f"{'met' if default['time'] <= 3 * floor_t else 'NOT met'}")
+    fast = (f"- fastest setting ({fastest['name']}) is {default['time'] / fastest['time']:.1f} x faster than the "
+            f"default (target 5x), error in acceleration {fastest['errors'][2]:.1e}: "
+            f"{'met' if default['time'] >= 5 * fastest['time'] else 'NOT met'}")
+    return f"{accuracy}\n{speed}\n{fast}"
 
 
 def path_rows(repeats: int) -> list[dict]:
@@ -213,8 +212,8 @@ def path_rows(repeats: int) -> list[dict]:
                 def run(step=step, gain=gain, scheme=scheme):
                     points, stopped = [], None
                     try:
-                        for p in follow_path(mech, tasks, q0, duration=0.08, step=step, gain=gain, scheme=scheme):
-                            points.append(p)
+                        points.extend(follow_path(mech, tasks, q0, duration=0.08, step=step, gain=gain,
+                                                  scheme=scheme))
                     except pinmech.TaskError:
                         stopped = points[-1].time + step
                     return points, stopped
