@@ -167,11 +167,17 @@ def test_scene_sweep_keys_set_the_defaults(tmp_path, models_dir, capsys):
 
 
 def test_a_task_scene_is_followed_in_time(scenes_dir, tmp_path, capsys):
-    """`pinmech sweep` on text 17.110's arm: the path mode (CSV and figure)."""
+    """`pinmech sweep` on text 17.110's arm: the path mode, for the scene's [sweep]
+    duration (0.08 s, 1 ms steps) or --duration; without either it says what is missing."""
     csv_path = tmp_path / "arm.csv"
+    assert main(["sweep", str(scenes_dir / "planar_arm.toml"), "--csv", str(csv_path)]) == 0
+    lines = csv_path.read_text().splitlines()
+    assert lines[0].startswith("t [s],A.q [deg]") and len(lines) == 82
     assert main(["sweep", str(scenes_dir / "planar_arm.toml"), "--duration", "10 ms", "--csv", str(csv_path)]) == 0
-    assert csv_path.read_text().splitlines()[0].startswith("t [s],A.q [deg]")
-    assert main(["sweep", str(scenes_dir / "planar_arm.toml")]) == 2
+    assert len(csv_path.read_text().splitlines()) == 12
+    text = (scenes_dir / "planar_arm.toml").read_text().split("[sweep]")[0].replace('"../', f'"{scenes_dir.parent}/')
+    (tmp_path / "arm.toml").write_text(text)
+    assert main(["sweep", str(tmp_path / "arm.toml")]) == 2
     assert "--duration" in capsys.readouterr().err
 
 
