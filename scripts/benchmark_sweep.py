@@ -86,6 +86,7 @@ SETTINGS = [
     ("interpolated, every 8th pose solved (--interpolate 8)", sweep_setting(interpolate=8)),
     ("interpolated, every 32nd pose solved (--interpolate 32)", sweep_setting(interpolate=32)),
     ("interpolated, every 128th pose solved (--interpolate 128)", sweep_setting(interpolate=128)),
+    ("interpolated, every 256th pose solved (--interpolate 256)", sweep_setting(interpolate=256)),
 ]
 
 
