@@ -20,6 +20,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from pinmech.exceptions import PinmechError
+
 if TYPE_CHECKING:
     from pinmech.mechanism import Mechanism
     from pinmech.path import PathPoint
@@ -145,7 +147,7 @@ class SweepPlot:
     def save(self, path: str | Path) -> Path:
         """Draw and save the figure (PNG, PDF or SVG, from the suffix)."""
         if not self.series:
-            raise ValueError("no solved pose to plot")
+            raise PinmechError(f"no pose of the sweep could be solved: nothing to plot in {path}")
         plt = _pyplot()
         sweep, unit = self.sweep, "deg" if self.sweep.is_angular else "m"
         x = np.array(self.x)
@@ -247,7 +249,7 @@ class PathPlot:
 
     def save(self, path: str | Path) -> Path:
         if not self.rows:
-            raise ValueError("no path point to plot")
+            raise PinmechError(f"no path point: nothing to plot in {path}")
         plt = _pyplot()
         t, data, n = np.array(self.t), np.array(self.rows), len(self.joints)
         angular = all(j.is_angular for j in self.joints)

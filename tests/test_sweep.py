@@ -210,3 +210,27 @@ def test_the_figure_needs_matplotlib(r_rtr_scene, monkeypatch, capsys):
     monkeypatch.setattr(builtins, "__import__", no_matplotlib)
     assert main(["sweep", str(r_rtr_scene), "--steps", "5", "--plot", "x.png"]) == 2
     assert 'pip install "pinmech[plot]"' in capsys.readouterr().err
+
+
+def test_a_sweep_where_every_pose_fails_plots_nothing_and_says_so(tmp_path, models_dir, capsys):
+    pytest.importorskip("matplotlib", reason='plots need pip install "pinmech[plot]"')
+    scene = _singular_scene(tmp_path, models_dir)
+    code = main(["sweep", str(scene.path), "--from", "0 deg", "--to", "0 deg", "--steps", "2", "--skip-failures",
+                 "--plot", str(tmp_path / "none.png"), "--csv", str(tmp_path / "none.csv")])
+    assert code == 2 and "nothing to plot" in capsys.readouterr().err
+    rows = list(csv.reader((tmp_path / "none.csv").open()))
+    assert rows[0] == ["A.q [deg]", "pose", "error"] and [r[1] for r in rows[1:]] == ["failed", "failed"]
+
+
+def test_the_progress_bar_shows_on_a_terminal_only(monkeypatch):
+    """Piped (the tests), poses pass through untouched; on a terminal tqdm wraps them."""
+    import sys
+
+    from pinmech.cli import _progress
+
+    items = iter(range(3))
+    assert _progress(items, 3) is items
+    pytest.importorskip("tqdm", reason='the bar needs pip install "pinmech[progress]"')
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
+    bar = _progress(range(3), 3)
+    assert type(bar).__name__ == "tqdm" and list(bar) == [0, 1, 2]
