@@ -34,8 +34,9 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import LoopClosureError, PinmechError, SingularPoseError
+from pinmech.hermite import interpolate_poses
 from pinmech.results import Accuracy, LoopSolution
-from pinmech.solve_batch import BatchSolution, BatchSolver, difference_many, integrate_many
+from pinmech.solve_batch import BatchSolution, BatchSolver
 from pinmech.solve_loops import LoopSolver
 
 STARTS = ("predictor", "warm", "cold")
@@ -311,25 +312,11 @@ class _Cycle:
 
     def _hermite_at(self, x: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray, left: np.ndarray,
                     right: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Quintic Hermite in (q, q', q'') from slot `left` to slot `right`, evaluated at
-        driver values `at`, in the tangent space at the left pose (exact for one-dof
-        joints, whose tangent spaces are all the same)."""
-        # one interval per right end; `right` is sorted, so each interval's targets are contiguous
-        starts = np.flatnonzero(np.concatenate(([True], right[1:] != right[:-1])))
-        counts = np.diff(np.append(starts, len(right)))
-        i, j = left[starts], right[starts]
-        h = (x[j] - x[i])[:, None]
-        if np.any(h == 0):
-            raise _Fallback
-        coeffs = _quintic_coefficients(h * d1[i], h * h * d2[i], difference_many(self.solver.model, q[i], q[j]),
-                                       h * d1[j], h * h * d2[j])
-        hw = np.repeat(h, counts, axis=0)
-        s = (at[:, None] - x[left][:, None]) / hw
-        c1, c2, c3, c4, c5 = (np.repeat(c, counts, axis=0) for c in coeffs)
-        p = s * (c1 + s * (c2 + s * (c3 + s * (c4 + s * c5))))
-        dp = c1 + s * (2 * c2 + s * (3 * c3 + s * (4 * c4 + s * 5 * c5)))
-        ddp = 2 * c2 + s * (6 * c3 + s * (12 * c4 + s * 20 * c5))
-        return integrate_many(self.solver.model, q[left], p), dp / hw, ddp / (hw * hw)
+        """q, q', q'' at driver values `at` between slots `left` and `right` (hermite.py)."""
+        try:
+            return interpolate_poses(self.solver.model, x, q, d1, d2, left, right, at)
+        except ValueError:  # two poses at one driver value: pose by pose instead
+            raise _Fallback from None
 
     def _measure(self, x: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray, solved: np.ndarray,
                  targets: np.ndarray, acc: dict[str, np.ndarray]) -> None:
@@ -396,13 +383,3 @@ def _concat(a: RangeChunk, b: RangeChunk) -> RangeChunk:
     errors = {**a.errors, **{len(a) + j: e for j, e in b.errors.items()}}
     return RangeChunk(a.start, np.concatenate((a.values, b.values)), solution,
                       np.concatenate((a.interpolated, b.interpolated)), errors)
-
-
-def _quintic_coefficients(v0: np.ndarray, a0: np.ndarray, delta: np.ndarray, v1: np.ndarray,
-                          a1: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Coefficients c1..c5 of p(s) = c1 s + ... + c5 s^5 on [0, 1] with p(0) = 0,
-    p'(0) = v0, p''(0) = a0, p(1) = delta, p'(1) = v1, p''(1) = a1 (quintic Hermite)."""
-    c3 = 10 * delta - 6 * v0 - 4 * v1 - 1.5 * a0 + 0.5 * a1
-    c4 = -15 * delta + 8 * v0 + 7 * v1 + 1.5 * a0 - a1
-    c5 = 6 * delta - 3 * v0 - 3 * v1 - 0.5 * a0 + 0.5 * a1
-    return v0, 0.5 * a0, c3, c4, c5
