@@ -25,11 +25,15 @@ from pinmech.exceptions import (
 )
 from pinmech.mechanism import JointInfo, Mechanism
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
+from pinmech.path import PathPoint, follow_path
 from pinmech.report import to_dict, to_json, to_text
 from pinmech.results import Accuracy, LoopSolution, RateSolution
 from pinmech.scene import Scene
+from pinmech.solve_batch import BatchSolution, BatchSolver
+from pinmech.solve_cycle import RangeChunk, solve_range
 from pinmech.solve_loops import LoopSolver
 from pinmech.solve_rates import RateSolver, Task
+from pinmech.sweep import Sweep, SweepPose
 from pinmech.units import to_si
 
 __version__ = "0.1.0"
@@ -37,6 +41,8 @@ __version__ = "0.1.0"
 __all__ = [
     "Accuracy",
     "Analysis",
+    "BatchSolution",
+    "BatchSolver",
     "CheckMismatch",
     "Closure",
     "CoincidentPoint",
@@ -50,13 +56,17 @@ __all__ = [
     "MobilityError",
     "ModelError",
     "Motion",
+    "PathPoint",
     "PinmechError",
+    "RangeChunk",
     "RateSolution",
     "RateSolver",
     "Scene",
     "SceneError",
     "SingularPoseError",
+    "Sweep",
     "SweepError",
+    "SweepPose",
     "Task",
     "TaskError",
     "UnitError",
@@ -64,8 +74,10 @@ __all__ = [
     "analyse",
     "compare",
     "evaluate_motion",
+    "follow_path",
     "load_hand_file",
     "load_mechanism",
+    "solve_range",
     "to_dict",
     "to_json",
     "to_si",

@@ -9,7 +9,6 @@ input out of range. An output file that cannot be written is 2.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import sys
 from collections.abc import Sequence
 
@@ -28,6 +27,21 @@ def _add_scene_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--acceleration", help="shortcut: the driver's acceleration, e.g. '1 rad/s^2'")
 
 
+def _add_output_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--csv", dest="csv_path", help="write the CSV here (default: standard output)")
+    parser.add_argument("--json", dest="json_path", help="also write the rows as JSON lines here")
+    parser.add_argument("--plot", dest="plot_path", help="also draw a figure here (PNG, PDF, SVG; pinmech[plot])")
+
+
+def _add_path_arguments(parser: argparse.ArgumentParser, *, required: bool) -> None:
+    parser.add_argument("--duration", required=required,
+                        help="task scenes: how long to follow the task, e.g. '0.08 s' ([sweep] duration)")
+    parser.add_argument("--step", help="task scenes: integration time step (default '1 ms')")
+    parser.add_argument("--scheme", choices=("euler", "taylor", "rk4"),
+                        help="task scenes: integration scheme (default taylor, second order)")
+    parser.add_argument("--gain", type=float, help="task scenes: feedback on the drift [1/s] (default 0: open loop)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser, with one sub-parser per subcommand."""
     parser = argparse.ArgumentParser(
@@ -44,36 +58,41 @@ def build_parser() -> argparse.ArgumentParser:
     solve.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of text")
     solve.set_defaults(func=cmd_solve)
 
-    sweep = sub.add_parser("sweep", help="sweep a driver through a cycle: CSV, JSON and plots")
+    sweep = sub.add_parser("sweep", help="sweep a driver through a cycle (or follow an arm's task in time): "
+                           "CSV, JSON lines and a figure")
     _add_scene_arguments(sweep)
     sweep.add_argument("--driver", help="the driver to sweep (default: the scene's first)")
-    sweep.add_argument("--from", dest="start", help="first value, e.g. '0 deg' (default: the scene's)")
-    sweep.add_argument("--to", dest="stop", help="last value, e.g. '360 deg' (default: one turn on)")
-    sweep.add_argument("--steps", type=int, default=361, help="number of poses, both ends included (default 361)")
-    sweep.add_argument("--csv", dest="csv_path", help="write the CSV here (default: standard output)")
-    sweep.add_argument("--json", dest="json_path", help="also write the poses as JSON lines here")
-    sweep.add_argument("--plot", dest="plot_path", help="also draw a figure here (PNG, PDF, SVG; pinmech[plot])")
+    sweep.add_argument("--from", dest="first", help="first value, e.g. '0 deg' (default: the scene's)")
+    sweep.add_argument("--to", dest="last", help="last value, e.g. '360 deg' (default: one turn on)")
+    sweep.add_argument("--steps", type=int, help="number of poses, both ends included (default 361)")
+    _add_output_arguments(sweep)
     sweep.add_argument("--links", nargs="*", help="links to plot (default: all moving but the driver's)")
     sweep.add_argument("--points", nargs="*", help="points to plot (default: all moving points)")
     sweep.add_argument("--skip-failures", action="store_true",
                        help="report a pose that cannot close as a row with its error instead of stopping")
-    sweep.add_argument("--no-predictor", action="store_true",
-                       help="start each pose from the previous one as it is, not moved along its rates")
-    sweep.add_argument("--cold-start", action="store_true",
-                       help="start every pose from the scene's guess (slower; may change branch)")
+    sweep.add_argument("--start", dest="start_mode", choices=("predictor", "warm", "cold"),
+                       help="where each pose's Newton iterations start: the previous pose moved along its "
+                       "path (predictor, default), the previous pose (warm), the scene's guess (cold)")
+    sweep.add_argument("--no-predictor", action="store_true", help="same as --start warm")
+    sweep.add_argument("--cold-start", action="store_true", help="same as --start cold")
+    sweep.add_argument("--no-batch", action="store_true",
+                       help="solve every pose on its own (default: dense sweeps solve the poses between "
+                       "exactly solved ones together, same tolerance)")
+    sweep.add_argument("--interpolate", type=int, metavar="N",
+                       help="solve every N-th pose and interpolate the others (quintic Hermite): faster, "
+                       "less accurate, accuracy measured (README: Speed and accuracy)")
     sweep.add_argument("--tol", type=float, help="closure tolerance, relative to the mechanism's size "
                        "(default 1e-13; 1e-6 is faster and good to about 1e-6)")
+    sweep.add_argument("--max-iterations", type=int, help="Newton iteration cap per pose (default 50)")
+    _add_path_arguments(sweep, required=False)
     sweep.set_defaults(func=cmd_sweep)
 
-    path = sub.add_parser("path", help="integrate an arm's task over time: joint trajectory and drift (CSV)")
+    path = sub.add_parser("path", help="integrate an arm's task over time: joint trajectory and drift")
     path.add_argument("scene", help="a task scene, e.g. models/scenes/planar_arm.toml")
-    path.add_argument("--duration", required=True, help="how long to follow the task, e.g. '0.08 s'")
-    path.add_argument("--step", default="1 ms", help="integration time step (default '1 ms')")
-    path.add_argument("--gain", type=float, default=0.0,
-                      help="feedback on the position drift [1/s] (default 0: open loop)")
-    path.add_argument("--csv", dest="csv_path", help="write the CSV here (default: standard output)")
     path.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                       help="override a scene value (repeatable)")
+    _add_path_arguments(path, required=False)
+    _add_output_arguments(path)
     path.set_defaults(func=cmd_path)
 
     snap = sub.add_parser("snapshot", help="save the solved pose as an offline meshcat HTML page (pinmech[viz])")
@@ -139,19 +158,25 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    """`pinmech sweep SCENE`: every pose of a cycle, streamed as CSV (and JSON lines, a plot)."""
+    """`pinmech sweep SCENE`: every pose of a cycle, streamed as CSV (and JSON lines, a plot);
+    a task scene is followed in time instead (as `pinmech path`)."""
     import numpy as np
 
-    from pinmech.sweep import Sweep, write_csv
+    from pinmech.sweep import Sweep, sweep_options
 
-    if args.steps < 2:
-        raise PinmechError(f"--steps must be at least 2, got {args.steps}")
     scene = _scene(args)
+    if "task" in scene.raw:
+        return _follow(args, scene)
+    options = sweep_options(scene)
+    steps = args.steps if args.steps is not None else options.get("steps", 361)
+    if steps < 2:
+        raise PinmechError(f"--steps must be at least 2, got {steps}")
     sweep = Sweep.from_scene(scene, args.driver)
     kind = "angle" if sweep.is_angular else "length"
-    start = scene.quantity(args.start, kind, "--from") if args.start else sweep.start
-    stop = scene.quantity(args.stop, kind, "--to") if args.stop else start + (sweep.default_values(2)[1] - sweep.start)
-    values = np.linspace(start, stop, args.steps)
+    first = args.first or options.get("from")
+    last = args.last or options.get("to")
+    start = scene.quantity(first, kind, "--from") if first else sweep.start
+    stop = scene.quantity(last, kind, "--to") if last else start + (sweep.default_values(2)[1] - sweep.start)
     if args.tol is not None:
         from pinmech.scene import SOLVER_RANGES
 
@@ -160,85 +185,139 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             raise PinmechError(f"--tol must be between {low:g} and {high:g} (relative to the mechanism's size), "
                                f"got {args.tol}")
         sweep.solver.tol = args.tol
-    poses = sweep.poses(values, skip_failures=args.skip_failures, warm_start=not args.cold_start,
-                        predictor=not (args.no_predictor or args.cold_start))
-    poses = _progress(poses, args.steps)
-    if args.plot_path or args.json_path:
-        poses = list(poses)
-    if args.csv_path:
-        with open(args.csv_path, "w", newline="", encoding="utf-8") as stream:
-            count = write_csv(sweep, poses, stream)
-        print(f"{count} poses written to {args.csv_path}", file=sys.stderr)
-    elif not args.plot_path and not args.json_path:
-        write_csv(sweep, poses, sys.stdout)
-    if args.json_path:
-        _write_json_lines(sweep, poses, args.json_path)
-    if args.plot_path:
-        from pinmech.plot import plot_sweep
-
-        plot_sweep(sweep, poses, args.plot_path, links=args.links, points=args.points)
-        print(f"figure written to {args.plot_path}", file=sys.stderr)
+    if args.max_iterations is not None:
+        if args.max_iterations < 1:
+            raise PinmechError(f"--max-iterations must be at least 1, got {args.max_iterations}")
+        sweep.solver.max_iterations = args.max_iterations
+    mode = "cold" if args.cold_start else "warm" if args.no_predictor else args.start_mode or options.get("start")
+    interpolate = args.interpolate if args.interpolate is not None else options.get("interpolate", 1)
+    poses = sweep.poses(np.linspace(start, stop, steps), skip_failures=args.skip_failures,
+                        start=mode or "predictor", batch=not args.no_batch and options.get("batch", True),
+                        interpolate=interpolate)
+    sinks = _sweep_sinks(args, sweep, steps)
+    with sinks:
+        for pose in _progress(poses, steps):
+            sinks.add(pose)
     return 0
 
 
-def _progress(poses, total: int):
+def _sweep_sinks(args: argparse.Namespace, sweep, steps: int) -> _Sinks:
+    from pinmech.tables import SweepCsv, SweepJsonLines
+
+    sinks = _Sinks()
+    if args.plot_path:
+        from pinmech.plot import SweepPlot
+
+        sinks.plot(SweepPlot(sweep, links=args.links, points=args.points, total=steps), args.plot_path)
+    if args.csv_path or not (args.plot_path or args.json_path):
+        sinks.table(SweepCsv, sweep, args.csv_path, "poses")
+    if args.json_path:
+        sinks.table(SweepJsonLines, sweep, args.json_path, None)
+    return sinks
+
+
+class _Sinks:
+    """Where streamed rows go (CSV, JSON lines, a figure), closed together; each output
+    file says on stderr what was written."""
+
+    def __init__(self) -> None:
+        self.tables: list = []
+        self.files: list = []
+        self.figures: list = []
+
+    def table(self, kind, source, path: str | None, what: str | None) -> None:
+        stream = open(path, "w", newline="", encoding="utf-8") if path else sys.stdout  # noqa: SIM115
+        if path:
+            self.files.append(stream)
+        self.tables.append((kind(source, stream), path, what))
+
+    def plot(self, recorder, path: str) -> None:
+        self.figures.append((recorder, path))
+
+    def add(self, row) -> None:
+        for table, _, _ in self.tables:
+            table.add(row)
+        for recorder, _ in self.figures:
+            recorder.add(row)
+
+    def __enter__(self) -> _Sinks:  # noqa: PYI034
+        return self
+
+    def __exit__(self, kind, error, trace) -> None:
+        try:
+            if error is None:
+                for table, path, what in self.tables:
+                    count = table.close()
+                    if path and what:
+                        print(f"{count} {what} written to {path}", file=sys.stderr)
+                    elif path:
+                        print(f"JSON lines written to {path}", file=sys.stderr)
+                for recorder, path in self.figures:
+                    recorder.save(path)
+                    print(f"figure written to {path}", file=sys.stderr)
+        finally:
+            for stream in self.files:
+                stream.close()
+
+
+def _progress(items, total: int):
     """A progress bar on a terminal (tqdm, if installed); nothing when piped."""
     if not sys.stderr.isatty():
-        return poses
+        return items
     try:
         from tqdm import tqdm
     except ImportError:
-        return poses
-    return tqdm(poses, total=total, unit="pose", file=sys.stderr)
-
-
-def _write_json_lines(sweep, poses, path: str) -> None:
-    import json
-
-    from pinmech.report import motion_dict
-
-    with open(path, "w", encoding="utf-8") as stream:
-        for pose in poses:
-            entry = {"index": pose.index, sweep.driver: pose.value, "error": pose.error}
-            if pose.motion is not None:
-                entry.update(motion_dict(pose.motion))
-                entry["accuracy"] = pose.accuracy.as_dict()
-            stream.write(json.dumps(entry) + "\n")
+        return items
+    return tqdm(items, total=total, unit="pose", file=sys.stderr, mininterval=0.5)
 
 
 def cmd_path(args: argparse.Namespace) -> int:
     """`pinmech path SCENE --duration T`: the task integrated in time, with its drift."""
-    import csv
-    import math
+    from pinmech.scene import Scene
 
+    return _follow(args, Scene.load(args.scene, args.overrides))
+
+
+def _follow(args: argparse.Namespace, scene) -> int:
+    """A task scene followed in time: CSV (JSON lines, a figure) of the joint trajectory."""
     from pinmech.analysis import load_mechanism
     from pinmech.analysis_task import scene_pose, scene_tasks
     from pinmech.path import follow_path
-    from pinmech.scene import Scene
+    from pinmech.sweep import sweep_options
+    from pinmech.tables import PathCsv
 
-    scene = Scene.load(args.scene, args.overrides)
-    duration = scene.quantity(args.duration, "time", "--duration")
-    step = scene.quantity(args.step, "time", "--step")
+    if "task" not in scene.raw:
+        raise PinmechError(f"{scene.path}: no [[task]] to follow; a scene with [drivers] is swept: "
+                           "pinmech sweep SCENE")
+    options = sweep_options(scene)
+    duration_text = args.duration or options.get("duration")
+    if not duration_text:
+        raise PinmechError(f"{scene.path}: say how long to follow the task: --duration '0.08 s' "
+                           "(or [sweep] duration = \"0.08 s\")")
+    duration = scene.quantity(duration_text, "time", "--duration")
+    step = scene.quantity(args.step or options.get("step", "1 ms"), "time", "--step")
     if not (duration > 0 and 0 < step <= duration):
         raise PinmechError(f"need 0 < --step <= --duration, got step {step} s, duration {duration} s")
+    scheme = args.scheme or options.get("scheme", "taylor")
+    gain = args.gain if args.gain is not None else float(options.get("gain", 0.0))
     mechanism = load_mechanism(scene)
     q0, _, _ = scene_pose(scene, mechanism)
-    joints = [j for j in mechanism.joints.values() if j.nv == 1]
-    with contextlib.ExitStack() as stack:
-        stream = stack.enter_context(open(args.csv_path, "w", newline="", encoding="utf-8")) \
-            if args.csv_path else sys.stdout
-        writer = csv.writer(stream)
-        units = [("deg", "rad/s", "rad/s^2") if j.is_angular else ("m", "m/s", "m/s^2") for j in joints]
-        writer.writerow(["t [s]"] + [f"{j.name}.{x} [{u}]" for j, us in zip(joints, units)
-                                     for x, u in zip(("q", "v", "a"), us)] + ["drift [m]"])
-        worst = 0.0
-        for point in follow_path(mechanism, scene_tasks(scene), q0, duration=duration, step=step, gain=args.gain):
-            cells = [f"{point.time:.9g}"]
-            for j in joints:
-                q = mechanism.coordinate(point.q, j.name)
-                cells += [f"{math.degrees(q) if j.is_angular else q:.12g}", f"{point.v[j.idx_v]:.12g}",
-                          f"{point.a[j.idx_v]:.12g}"]
-            writer.writerow(cells + [f"{point.drift:.3e}"])
+    total = round(duration / step) + 1
+    sinks = _Sinks()
+    if args.plot_path:
+        from pinmech.plot import PathPlot
+
+        note = f" ({scheme}, step {step:g} s" + (f", feedback {gain:g}/s)" if gain else ")")
+        sinks.plot(PathPlot(mechanism, scene.title, note=note, total=total), args.plot_path)
+    if args.csv_path or not (args.plot_path or args.json_path):
+        sinks.table(PathCsv, mechanism, args.csv_path, "path points")
+    if args.json_path:
+        sinks.table(_PathJsonLines, mechanism, args.json_path, None)
+    worst = 0.0
+    with sinks:
+        for point in _progress(follow_path(mechanism, scene_tasks(scene), q0, duration=duration, step=step,
+                                           gain=gain, scheme=scheme), total):
+            sinks.add(point)
             worst = max(worst, point.drift)
     print(f"largest drift of the path from the one asked: {worst:.3e} m", file=sys.stderr)
     return 0
@@ -326,6 +405,24 @@ def _write(path: str, html: str) -> None:
     with open(path, "w", encoding="utf-8") as stream:
         stream.write(html)
     print(f"wrote {path} ({len(html) // 1024} KB, offline: open it in any browser)", file=sys.stderr)
+
+
+class _PathJsonLines:
+    """One JSON object per path point (SI): t, q, v, a, drift, condition number."""
+
+    def __init__(self, mechanism, stream) -> None:
+        self.stream = stream
+
+    def add(self, point) -> None:
+        import json
+
+        self.stream.write(json.dumps({"t": point.time, "q": point.q.tolist(), "v": point.v.tolist(),
+                                      "a": point.a.tolist(), "drift": point.drift,
+                                      "angular_drift": point.angular_drift, "condition_number": point.condition})
+                          + "\n")
+
+    def close(self) -> None:
+        self.stream.flush()
 
 
 def cmd_check(args: argparse.Namespace) -> int:

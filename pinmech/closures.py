@@ -188,3 +188,118 @@ class Closure:
         linear = R_T @ (d_dot - _cross(w_P, d))
         angular = R_T @ (a_C.angular - a_P.angular - _cross(w_P, w_C - w_P))
         return self._rows6 @ np.concatenate((linear, angular))
+
+
+class CutEvaluator:
+    """The hot path of one closure: the numbers of `Closure.residual`, `jacobian`,
+    `residual_jacobian`, `full_residual` and `drift`, with few numpy calls per pose.
+
+    A solver evaluates these at every pose, where a numpy call costs about a microsecond
+    and a Pinocchio call a quarter of one, so the products of the constant selection,
+    basis and scale matrices with the parent frame's rotation are taken once per pose
+    (`place`), and a cut frame on the ground (constant placement, no Jacobian) turns the
+    rows into one constant matrix times the other frame's Jacobian.
+
+    Order of calls at a pose: `place` after `pin.computeJointJacobians(q)`; then any of
+    `residual`, `full_residual`, `jacobian`, `newton_jacobian`; and after
+    `pin.forwardKinematics(q, v, 0)`, `drift`. tests/test_closures.py checks every number
+    against `Closure`'s own methods.
+    """
+
+    def __init__(self, closure: Closure, model: pin.Model) -> None:
+        self.closure = closure
+        self.model = model
+        rows6 = closure._rows6
+        self.rows = rows6.shape[0]
+        self._K3 = rows6.reshape(self.rows, 2, 3)  # per row: (linear, angular) halves
+        self._has_angular = bool(np.any(rows6[:, 3:]))
+        full = closure.selected * closure._scale()  # all selected rows, scaled
+        self._full_lin, self._full_ang = full[:, :3].copy(), full[:, 3:].copy()
+        self._revolute = closure.cut_type == "revolute"
+        self._ang_axis = self._full_axis = None
+        if self._revolute:  # rows of axis x (.), as matrices: K_ang skew(axis)
+            self._ang_axis = rows6[:, 3:] @ pin.skew(closure.axis)
+            self._full_axis = self._full_ang @ pin.skew(closure.axis)
+        self._ground = model.frames[closure.parent_frame].parentJoint == 0
+        if self._ground:  # a frame on the universe joint: its placement is the world one
+            M_P = model.frames[closure.parent_frame].placement
+            self._set_parent(M_P.rotation.copy(), M_P.translation.copy())
+            self._full_lin = self._full_lin @ M_P.rotation.T  # R_P^T folded in once
+            if self._revolute:
+                self._ang_axis = self._ang_axis @ M_P.rotation.T
+                self._full_axis = self._full_axis @ M_P.rotation.T
+
+    def _set_parent(self, R_P: np.ndarray, p_P: np.ndarray) -> None:
+        self._R_P, self._p_P = R_P, p_P
+        self._W = (self._K3 @ R_P.T).reshape(self.rows, 6)  # rows6 @ diag(R_P^T, R_P^T)
+        self._W_lin = self._W[:, :3]
+
+    def place(self, data: pin.Data) -> None:
+        """Read the cut frames' placements (needs joint placements at q)."""
+        c = self.closure
+        self._M_C = pin.updateFramePlacement(self.model, data, c.child_frame)
+        if self._ground:
+            if self._has_angular:  # Closure.residual_jacobian reads data.oMf of both frames
+                pin.updateFramePlacement(self.model, data, c.parent_frame)
+        else:
+            self._M_P = pin.updateFramePlacement(self.model, data, c.parent_frame)
+            self._set_parent(self._M_P.rotation, self._M_P.translation)
+        self._delta = self._M_C.translation - self._p_P
+
+    def _in_parent(self, x: np.ndarray) -> np.ndarray:
+        """R_P^T x, except on the ground, where R_P^T is folded into the row matrices."""
+        return x if self._ground else x @ self._R_P
+
+    def _angular(self, rows_axis: np.ndarray, rows_ang: np.ndarray) -> np.ndarray:
+        """Orientation error of `Closure.residual6`, mapped by the rows' angular half:
+        axis x (R_rel child_axis) for a revolute cut, log3(R_rel) for prismatic and fixed."""
+        if self._revolute:
+            return rows_axis @ self._in_parent(self._M_C.rotation @ self.closure.child_axis)
+        return rows_ang @ pin.log3(self._R_P.T @ self._M_C.rotation)
+
+    def residual(self) -> np.ndarray:
+        """Independent rows of the scaled pose error (dimensionless)."""
+        r = self._W_lin @ self._delta
+        if self._has_angular:
+            r += self._angular(self._ang_axis, self._K3[:, 1])
+        return r
+
+    def full_residual(self) -> float:
+        """Largest error over all selected rows, the reduced-away ones included."""
+        full = self._full_lin @ self._in_parent(self._delta)
+        if self.closure.cut_type != "spherical":
+            full += self._angular(self._full_axis, self._full_ang)
+        return max(map(abs, full.tolist()), default=0.0)
+
+    def jacobian(self, data: pin.Data) -> np.ndarray:
+        """(rows, nv) constraint Jacobian (needs `pin.computeJointJacobians` at q)."""
+        c = self.closure
+        J_C = pin.getFrameJacobian(self.model, data, c.child_frame, _LWA)
+        if self._ground:
+            return self._W @ J_C
+        J_P = pin.getFrameJacobian(self.model, data, c.parent_frame, _LWA)
+        J = self._W @ (J_C - J_P)
+        J += (self._W_lin @ pin.skew(self._delta)) @ J_P[3:]
+        return J
+
+    def newton_jacobian(self, data: pin.Data) -> np.ndarray:
+        """Exact derivative of `residual` (orientation rows differ from `jacobian` off closure)."""
+        if self._has_angular:
+            return self.closure.residual_jacobian(self.model, data)
+        return self.jacobian(data)
+
+    def drift(self, data: pin.Data) -> np.ndarray:
+        """d/dt(J) q_dot (needs `pin.forwardKinematics(q, v, 0)`, and `place` at q)."""
+        c, model = self.closure, self.model
+        a_C = pin.getFrameClassicalAcceleration(model, data, c.child_frame, _LWA)
+        if self._ground:
+            return self._W @ a_C.vector
+        v_P = pin.getFrameVelocity(model, data, c.parent_frame, _LWA)
+        v_C = pin.getFrameVelocity(model, data, c.child_frame, _LWA)
+        a_P = pin.getFrameClassicalAcceleration(model, data, c.parent_frame, _LWA)
+        w_P, delta = v_P.angular, self._delta
+        dv = v_C.linear - v_P.linear
+        d = dv - _cross(w_P, delta)
+        d_dot = a_C.linear - a_P.linear - _cross(a_P.angular, delta) - _cross(w_P, dv)
+        angular = a_C.angular - a_P.angular - _cross(w_P, v_C.angular - w_P)
+        return self._W_lin @ (d_dot - _cross(w_P, d)) + self._W[:, 3:] @ angular

@@ -8,12 +8,15 @@ All vectors are in the world frame, SI units.
 
 from __future__ import annotations
 
+import functools
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
 
+from pinmech.closures import _cross
 from pinmech.exceptions import FrameNotFound
 from pinmech.mechanism import Mechanism
 
@@ -167,11 +170,18 @@ def _plane_angle(rotation: np.ndarray, normal: np.ndarray | None) -> float | Non
     """Angle of the link's x axis about the plane normal, measured from the world x axis."""
     if normal is None:
         return None
+    ref = _plane_reference(*normal.tolist())
     x_axis = rotation[:, 0]
-    ref = np.array([1.0, 0.0, 0.0]) if abs(normal[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    return math.atan2(float(normal @ _cross(ref, x_axis)), float(ref @ x_axis))
+
+
+@functools.lru_cache(maxsize=8)
+def _plane_reference(nx: float, ny: float, nz: float) -> np.ndarray:
+    """The world x axis projected on the plane (the y axis when the normal is near x)."""
+    normal = np.array((nx, ny, nz))
+    ref = np.array([1.0, 0.0, 0.0]) if abs(nx) < 0.9 else np.array([0.0, 1.0, 0.0])
     ref = ref - normal * (normal @ ref)
-    ref /= np.linalg.norm(ref)
-    return float(np.arctan2(normal @ np.cross(ref, x_axis), ref @ x_axis))
+    return ref / np.linalg.norm(ref)
 
 
 def _coincident(mechanism: Mechanism, data: pin.Data, c: CoincidentPoint) -> PointMotion:
@@ -189,8 +199,8 @@ def _coincident(mechanism: Mechanism, data: pin.Data, c: CoincidentPoint) -> Poi
     w, alpha = vel.angular, spatial_acc.angular
     return PointMotion(
         position=at,
-        velocity=vel.linear + np.cross(w, r),
-        acceleration=acc.linear + np.cross(alpha, r) + np.cross(w, np.cross(w, r)),
+        velocity=vel.linear + _cross(w, r),
+        acceleration=acc.linear + _cross(alpha, r) + _cross(w, _cross(w, r)),
         link=c.link,
     )
 
@@ -207,5 +217,5 @@ def _slider(mechanism: Mechanism, data: pin.Data, name: str, rate: float, accel:
         child=joint.child_link,
         relative_velocity=v_rel,
         relative_acceleration=accel * axis_world,
-        coriolis_acceleration=2.0 * np.cross(omega_parent, v_rel),
+        coriolis_acceleration=2.0 * _cross(omega_parent, v_rel),
     )

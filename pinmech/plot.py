@@ -1,19 +1,33 @@
-"""Figures of a sweep (matplotlib, extra `plot`): what a report shows for a mechanism.
+"""Figures of sweeps and arm paths (matplotlib, extra `plot`): what a report shows.
 
-Link angles, angular velocities and accelerations, the sliders' relative velocity and
-acceleration, and the speed and acceleration magnitudes of chosen points, against the
-driver, with the scene's own pose marked.
+A sweep's figure: link angles, angular velocities and accelerations, the sliders'
+relative velocity and acceleration, and the speed and acceleration magnitudes of chosen
+points, against the driver, with the scene's own pose marked (dashed line, dots, and
+its values in the legends). A path's figure: joint coordinates, rates, accelerations
+and the drift against time.
+
+The recorders (`SweepPlot`, `PathPlot`) take poses one at a time while a sweep streams
+and keep at most `max_points` of them (every n-th), so memory stays bounded.
 """
 
 from __future__ import annotations
 
 import math
+from array import array
 from collections.abc import Iterable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pinmech.sweep import Sweep, SweepPose
+from pinmech.exceptions import PinmechError
+
+if TYPE_CHECKING:
+    from pinmech.mechanism import Mechanism
+    from pinmech.path import PathPoint
+    from pinmech.sweep import Sweep, SweepPose
+
+MAX_POINTS = 20_000
 
 
 def _pyplot():
@@ -27,62 +41,245 @@ def _pyplot():
     return plt
 
 
+class SweepPlot:
+    """Records a sweep's plotted quantities pose by pose, then draws them (`save`).
+
+    Args:
+        links, points: what to draw (default: the scene's `[sweep] links/points`, else
+            every moving link but the driver's, and every moving point).
+        total: the number of poses to come, to keep every n-th when there are more
+            than `max_points`.
+    """
+
+    def __init__(self, sweep: Sweep, *, links: list[str] | None = None, points: list[str] | None = None,
+                 total: int | None = None, max_points: int = MAX_POINTS) -> None:
+        _pyplot()  # fail early, before the sweep runs, when matplotlib is missing
+        chosen = sweep.scene.section("sweep")
+        self.sweep = sweep
+        self.links, self.points = links or chosen.get("links"), points or chosen.get("points")
+        self.every = max(1, math.ceil(total / max_points)) if total else 1
+        self.normal = sweep.mechanism.plane_normal
+        self.x = array("d")
+        self.series: dict[str, dict[str, array]] = {}
+        self.failed: list[float] = []
+        self.mark: tuple[float, dict[str, dict[str, float]]] | None = None  # nearest pose to the scene's
+
+    def _x(self, value: float) -> float:
+        return math.degrees(value) if self.sweep.is_angular else value
+
+    def add(self, pose: SweepPose) -> None:
+        if pose.motion is None:
+            self.failed.append(self._x(pose.value))
+            if self.series:
+                self.x.append(self._x(pose.value))  # a gap in every curve
+                for panel in self.series.values():
+                    for values in panel.values():
+                        values.append(math.nan)
+            return
+        if not self.series:
+            self._choose(pose)
+        nearer = self.mark is None or abs(pose.value - self.sweep.start) < abs(self.mark[0] - self.sweep.start)
+        kept = pose.index % self.every == 0
+        if not (nearer or kept):
+            return
+        values = self._values(pose)
+        if nearer:
+            self.mark = (pose.value, values)
+        if not kept:
+            return
+        self.x.append(self._x(pose.value))
+        for title, panel in values.items():
+            for name, value in panel.items():
+                self.series[title][name].append(value)
+
+    def _choose(self, pose: SweepPose) -> None:
+        mech, motion = self.sweep.mechanism, pose.motion
+        model = mech.model
+        driver_link = mech.joint(self.sweep.driver).child_link
+        if not self.links:
+            self.links = [n for n in motion.links if n != driver_link]
+        if not self.points:
+            self.points = [n for n, p in motion.points.items()
+                           if p.link in mech.links and model.frames[mech.links[p.link]].parentJoint != 0]
+        self.sliders = list(motion.sliders)
+        # raw doubles, not lists of floats: the kept values would pin memory pools freed by the rest
+        self.series = {title: {name: array("d") for name in names} for title, names in self._panels().items()}
+
+    def _panels(self) -> dict[str, list[str]]:
+        """Panel title ("quantity, symbol [unit]") -> the names drawn in it."""
+        planar = self.normal is not None
+        panels = {}
+        if planar:
+            panels["angle, φ [deg]"] = self.links
+        panels["angular velocity, ω [rad/s]" if planar else "angular speed, |ω| [rad/s]"] = self.links
+        panels["angular acceleration, α [rad/s²]" if planar else "angular acceleration, |α| [rad/s²]"] = self.links
+        if self.sliders:
+            panels["velocity along its guide, v_rel [m/s]"] = self.sliders
+            panels["acceleration along its guide, a_rel [m/s²]"] = self.sliders
+        if self.points:
+            panels["speed, |v| [m/s]"] = self.points
+            panels["acceleration, |a| [m/s²]"] = self.points
+        return panels
+
+    def _values(self, pose: SweepPose) -> dict[str, dict[str, float]]:
+        m, n = pose.motion, self.normal
+        links = [m.links[name] for name in self.links]
+        if n is not None:
+            w = [float(n @ link.angular_velocity) for link in links]
+            alpha = [float(n @ link.angular_acceleration) for link in links]
+        else:
+            w = [float(np.linalg.norm(link.angular_velocity)) for link in links]
+            alpha = [float(np.linalg.norm(link.angular_acceleration)) for link in links]
+        out, titles = {}, list(self.series)
+        columns = []
+        if n is not None:
+            columns.append([math.degrees(link.angle) for link in links])
+        columns += [w, alpha]
+        if self.sliders:
+            columns += [[m.joints[s].v for s in self.sliders], [m.joints[s].a for s in self.sliders]]
+        if self.points:
+            columns += [[float(np.linalg.norm(m.points[p].velocity)) for p in self.points],
+                        [float(np.linalg.norm(m.points[p].acceleration)) for p in self.points]]
+        for title, column in zip(titles, columns):
+            out[title] = dict(zip(self.series[title], column))
+        return out
+
+    def save(self, path: str | Path) -> Path:
+        """Draw and save the figure (PNG, PDF or SVG, from the suffix)."""
+        if not self.series:
+            raise PinmechError(f"no pose of the sweep could be solved: nothing to plot in {path}")
+        plt = _pyplot()
+        sweep, unit = self.sweep, "deg" if self.sweep.is_angular else "m"
+        x = np.array(self.x)
+        lo, hi = np.nanmin(x), np.nanmax(x)
+        mark_x = self._x(self.mark[0])
+        marked = lo - 1e-9 * abs(lo) <= self._x(sweep.start) <= hi + 1e-9 * abs(hi)  # the scene's pose is swept
+        panels = list(self.series.items())
+        cols = 2
+        rows = math.ceil(len(panels) / cols)
+        fig, axes = plt.subplots(rows, cols, figsize=(11, 2.9 * rows), sharex=True, squeeze=False)
+        for ax, (title, series) in zip(axes.flat, panels):
+            for name, values in series.items():
+                y = np.array(values)
+                if title.startswith("angle"):  # unwrapped: no jump where a link passes 180 deg
+                    ok = np.isfinite(y)
+                    y[ok] = np.degrees(np.unwrap(np.radians(y[ok])))
+                (line,) = ax.plot(x, y, linewidth=1.5, label=name)
+                if marked:
+                    at = self.mark[1][title][name]
+                    ax.plot([mark_x], [_nearest(x, y, mark_x, at) if title.startswith("angle") else at], "o",
+                            color=line.get_color(), markersize=5)
+            if marked:
+                ax.axvline(mark_x, color="0.35", linestyle="--", linewidth=1)
+            if self.failed:
+                ax.plot(self.failed, np.zeros(len(self.failed)), "x", color="red", markersize=6,
+                        transform=ax.get_xaxis_transform(), clip_on=False)
+            quantity, label = title.split(", ")
+            ax.set_title(f"{next(iter(series))}: {quantity}" if len(series) == 1 else quantity, fontsize=10)
+            ax.set_ylabel(label)
+            ax.grid(True, alpha=0.35)
+            if len(series) > 1:
+                ax.legend(fontsize=8, loc="best")
+        spare = list(axes.flat[len(panels):])
+        for ax in spare:
+            ax.set_visible(False)
+        if spare and marked:  # the scene's pose, as numbers, where a panel is missing
+            spare[0].set_visible(True)
+            spare[0].axis("off")
+            spare[0].text(0.02, 0.95, self._summary(mark_x, unit), va="top", ha="left", family="monospace",
+                          fontsize=8.5, transform=spare[0].transAxes)
+        for column in range(cols):  # x labels under the lowest drawn panel of each column
+            shown = [ax for ax in axes[:, column] if ax.get_visible() and ax.axison]
+            if shown:
+                shown[-1].set_xlabel(f"{sweep.driver} [{unit}]")
+                shown[-1].xaxis.set_tick_params(labelbottom=True)
+        note = f"dashed: the scene's pose, {mark_x:.4g} {unit}" if marked else ""
+        if self.failed:
+            note += ("; " if note else "") + f"{len(self.failed)} pose(s) failed (red x)"
+        fig.suptitle(f"{sweep.scene.title}: {sweep.driver} swept" + (f" ({note})" if note else ""), fontsize=11)
+        fig.tight_layout()
+        return _save(plt, fig, path)
+
+    def _summary(self, mark_x: float, unit: str) -> str:
+        lines = [f"At the scene's pose, {self.sweep.driver} = {mark_x:.4g} {unit}:", ""]
+        for title, values in self.mark[1].items():
+            symbol, dim = title.split(", ")[1].split(" [")
+            for name, value in values.items():
+                lines.append(f"  {name + ' ' + symbol:<18} {value: .5g} {dim.rstrip(']')}")
+        return "\n".join(lines)
+
+
+def _nearest(x: np.ndarray, y: np.ndarray, at_x: float, fallback: float) -> float:
+    i = int(np.argmin(np.abs(x - at_x)))
+    return float(y[i]) if np.isfinite(y[i]) else fallback
+
+
 def plot_sweep(sweep: Sweep, poses: Iterable[SweepPose], path: str | Path, *,
                links: list[str] | None = None, points: list[str] | None = None) -> Path:
-    """Draw the sweep's quantities against the driver and save the figure (PNG, PDF, SVG).
+    """Draw a sweep's poses and save the figure (PNG, PDF, SVG)."""
+    recorder = SweepPlot(sweep, links=links, points=points)
+    for pose in poses:
+        recorder.add(pose)
+    return recorder.save(path)
 
-    Links and points default to the scene's `[sweep] links/points`, else every moving one.
-    """
-    plt = _pyplot()
-    chosen = sweep.scene.section("sweep")
-    links = links or chosen.get("links")
-    points = points or chosen.get("points")
-    poses = [p for p in poses if p.motion is not None]
-    if not poses:
-        raise ValueError("no solved pose to plot")
-    first = poses[0].motion
-    driver_link = sweep.mechanism.joint(sweep.driver).child_link
-    links = links or [n for n in first.links if n != driver_link]
-    points = points or [n for n, p in first.points.items()
-                        if any(np.linalg.norm(q.motion.points[n].velocity) > 0 for q in poses[:5])]
-    x = np.array([math.degrees(p.value) if sweep.is_angular else p.value for p in poses])
-    x_label = f"{sweep.driver} [{'deg' if sweep.is_angular else 'm'}]"
-    normal = sweep.mechanism.plane_normal if sweep.mechanism.plane_normal is not None else np.array([0, 0, 1.0])
 
-    panels = [
-        ("link angle [deg]",  # unwrapped, so a link turning through 180 deg draws no jump
-         {n: np.degrees(np.unwrap([p.motion.links[n].angle or 0.0 for p in poses])) for n in links}),
-        ("angular velocity ω [rad/s]", {n: [normal @ p.motion.links[n].angular_velocity for p in poses] for n in links}),
-        ("angular acceleration α [rad/s²]",
-         {n: [normal @ p.motion.links[n].angular_acceleration for p in poses] for n in links}),
-    ]
-    if first.sliders:
-        panels.append(("slider relative velocity [m/s]", {n: [p.motion.joints[n].v for p in poses] for n in first.sliders}))
-        panels.append(("slider relative acceleration [m/s²]",
-                       {n: [p.motion.joints[n].a for p in poses] for n in first.sliders}))
-    panels.append(("speed |v| [m/s]", {n: [np.linalg.norm(p.motion.points[n].velocity) for p in poses] for n in points}))
-    panels.append(("acceleration |a| [m/s²]",
-                   {n: [np.linalg.norm(p.motion.points[n].acceleration) for p in poses] for n in points}))
+class PathPlot:
+    """Records an arm path point by point, then draws joint coordinates, rates,
+    accelerations and the drift against time (`save`)."""
 
-    cols = 2
-    rows = math.ceil(len(panels) / cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(11, 2.8 * rows), sharex=True, squeeze=False)
-    mark = math.degrees(sweep.start) if sweep.is_angular else sweep.start
-    for ax, (title, series) in zip(axes.flat, panels):
-        for name, values in series.items():
-            ax.plot(x, values, label=name, linewidth=1.6)
-        ax.axvline(mark, color="0.4", linestyle="--", linewidth=1)
-        ax.set_title(title, fontsize=10)
-        ax.grid(True, alpha=0.4)
-        ax.legend(fontsize=8, loc="best")
-    for ax in axes.flat[len(panels):]:
-        ax.set_visible(False)
-    for ax in axes[-1]:
-        ax.set_xlabel(x_label)
-    fig.suptitle(f"{sweep.scene.title}: sweep of {sweep.driver} (dashed: the scene's pose, "
-                 f"{mark:.4g} {'deg' if sweep.is_angular else 'm'})", fontsize=11)
-    fig.tight_layout()
+    def __init__(self, mechanism: Mechanism, title: str, *, note: str = "", total: int | None = None,
+                 max_points: int = MAX_POINTS) -> None:
+        _pyplot()
+        self.mechanism, self.title, self.note = mechanism, title, note
+        self.joints = [j for j in mechanism.joints.values() if j.nv == 1]
+        self.every = max(1, math.ceil(total / max_points)) if total else 1
+        self.t: list[float] = []
+        self.rows: list[list[float]] = []
+        self.count = 0
+
+    def add(self, point: PathPoint) -> None:
+        self.count += 1
+        if (self.count - 1) % self.every:
+            return
+        q = [self.mechanism.coordinate(point.q, j.name) for j in self.joints]
+        q = [math.degrees(x) if j.is_angular else x for x, j in zip(q, self.joints)]
+        idx = [j.idx_v for j in self.joints]
+        self.t.append(point.time)
+        self.rows.append(q + point.v[idx].tolist() + point.a[idx].tolist() + [point.drift, point.angular_drift])
+
+    def save(self, path: str | Path) -> Path:
+        if not self.rows:
+            raise PinmechError(f"no path point: nothing to plot in {path}")
+        plt = _pyplot()
+        t, data, n = np.array(self.t), np.array(self.rows), len(self.joints)
+        angular = all(j.is_angular for j in self.joints)
+        units = ("deg", "rad/s", "rad/s²") if angular else ("deg or m", "rad/s or m/s", "rad/s² or m/s²")
+        fig, axes = plt.subplots(2, 2, figsize=(11, 6.4), sharex=True)
+        for k, (ax, name) in enumerate(zip(axes.flat[:3], ("joint coordinate q", "joint rate q̇", "joint acceleration q̈"))):
+            for i, joint in enumerate(self.joints):
+                ax.plot(t, data[:, k * n + i], linewidth=1.5, label=joint.name)
+            ax.set_title(f"{name} [{units[k]}]", fontsize=10)
+            ax.set_ylabel(f"[{units[k]}]")
+        ax = axes.flat[3]
+        drift, angle = data[:, 3 * n], data[:, 3 * n + 1]
+        floor = 1e-16
+        ax.semilogy(t, np.maximum(drift, floor), linewidth=1.5, label="position drift [m]")
+        if np.any(angle > 0):
+            ax.semilogy(t, np.maximum(angle, floor), linewidth=1.5, label="angle drift [rad]")
+        ax.set_title("drift of the achieved path from the asked one", fontsize=10)
+        ax.set_ylabel("[m] or [rad]")
+        for ax in axes.flat:
+            ax.grid(True, alpha=0.35)
+            ax.legend(fontsize=8, loc="best")
+        for ax in axes[-1]:
+            ax.set_xlabel("time t [s]")
+        fig.suptitle(f"{self.title}: task followed in time{self.note}", fontsize=11)
+        fig.tight_layout()
+        return _save(plt, fig, path)
+
+
+def _save(plt, fig, path: str | Path) -> Path:
     path = Path(path)
-    fig.savefig(path, dpi=120)
+    fig.savefig(path, dpi=130)
     plt.close(fig)
     return path

@@ -9,11 +9,13 @@ Nothing here knows which mechanism it solves.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pinocchio as pin
 
+from pinmech.closures import CutEvaluator
 from pinmech.exceptions import LoopClosureError, MobilityError, ModelError, SingularPoseError
 from pinmech.mechanism import Mechanism
 from pinmech.results import Accuracy, LoopSolution
@@ -28,16 +30,63 @@ MAX_STEP = 1.0
 #: singularity accelerations lose accuracy like eps x condition^3 (tests/test_singular.py),
 #: so 1e4 keeps every acceleration pinmech gives to about 2e-4 relative or better.
 DEFAULT_MAX_CONDITION = 1e4
+#: With the default tolerance or a tighter one, a pose that ends between this residual and
+#: the tolerance gets one more Newton step: it costs one kinematics pass and lands at
+#: rounding level, so results do not depend on how close the guess happened to be.
+POLISH = 1e-15
 
 
-def _newton_step(J: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """Newton step: a plain solve when J is square (cheap), else least squares."""
-    if J.shape[0] == J.shape[1]:
-        try:
-            return np.linalg.solve(J, -r)
-        except np.linalg.LinAlgError:
-            return np.full(J.shape[1], np.nan)
-    return np.linalg.lstsq(J, -r, rcond=None)[0]
+def _max_abs(x: np.ndarray) -> float:
+    """Largest |x_i| (0 when empty); plain Python below 9 entries, where numpy's call costs more."""
+    if x.size < 9:
+        return max(map(abs, x.tolist()), default=0.0)
+    return float(np.max(np.abs(x)))
+
+
+def _solve_square(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """A x = b for a small square A: closed forms up to 2x2 (a microsecond, where
+    np.linalg.solve costs three), LU above. NaN where A is exactly singular."""
+    n = A.shape[0]
+    if n == 1:
+        a = float(A[0, 0])
+        return np.array((float(b[0]) / a,)) if a != 0.0 else np.full(1, np.nan)
+    if n == 2:
+        (a, c), (d, e) = A.tolist()
+        f, g = b.tolist()
+        det = a * e - c * d
+        if det == 0.0:
+            return np.full(2, np.nan)
+        return np.array(((e * f - c * g) / det, (a * g - d * f) / det))
+    try:
+        return np.linalg.solve(A, b)
+    except np.linalg.LinAlgError:
+        return np.full(n, np.nan)
+
+
+def _condition(A: np.ndarray) -> tuple[float, float]:
+    """2-norm condition number and smallest singular value of a square A: closed forms up
+    to 2x2 (sigma_max^2 + sigma_min^2 = |A|_F^2, sigma_max sigma_min = |det A|), SVD above."""
+    n = A.shape[0]
+    if n == 0:
+        return 1.0, 1.0
+    if n == 1:
+        s = abs(float(A[0, 0]))
+        return (1.0 if s > 0 else math.inf), s
+    if n == 2:
+        (a, c), (d, e) = A.tolist()
+        frob2, det = a * a + c * c + d * d + e * e, abs(a * e - c * d)
+        s_max2 = 0.5 * (frob2 + math.sqrt(max(frob2 * frob2 - 4.0 * det * det, 0.0)))
+        s_min = det / math.sqrt(s_max2) if s_max2 > 0 else 0.0
+        return (s_max2 / det if det > 0 else math.inf), s_min
+    sigma = np.linalg.svd(A, compute_uv=False)
+    return (float(sigma[0] / sigma[-1]) if sigma[-1] > 0 else math.inf), float(sigma[-1])
+
+
+def _index(indices: np.ndarray) -> slice | np.ndarray:
+    """A slice when the indices are contiguous (a view, cheaper than fancy indexing)."""
+    if len(indices) and np.array_equal(indices, np.arange(indices[0], indices[-1] + 1)):
+        return slice(int(indices[0]), int(indices[-1]) + 1)
+    return indices
 
 
 class LoopSolver:
@@ -49,6 +98,9 @@ class LoopSolver:
         tol: closure tolerance, relative to the mechanism's length scale.
         max_iterations: Newton iteration cap.
         max_condition: a constraint Jacobian worse conditioned than this is singular.
+
+    After `solve`, `data` holds the joint placements and Jacobians at the solution and
+    the placements of the cut frames (call `pin.updateFramePlacements` for the others).
 
     Raises:
         FrameNotFound: a driver that is not a joint of the model.
@@ -74,6 +126,9 @@ class LoopSolver:
         self._drv_v = np.array([self._driver_index(n) for n in self.drivers], dtype=int)
         self._dep_v = np.setdiff1d(np.arange(self.model.nv), self._drv_v)
         self._check_mobility()
+        self._drv, self._dep = _index(self._drv_v), _index(self._dep_v)
+        self._drv_q = [(mechanism.joint(n).idx_q, mechanism.joint(n).kind == "continuous") for n in self.drivers]
+        self._cuts = [CutEvaluator(c, self.model) for c in mechanism.closures]
         self._step = np.zeros(self.model.nv)
         self._dep_scale = mechanism.velocity_scale()[self._dep_v]  # dimensionless columns
         self._zero_a = np.zeros(self.model.nv)
@@ -103,40 +158,45 @@ class LoopSolver:
 
     # ------------------------------------------------------------------ pieces
     def _residual(self, q: np.ndarray) -> np.ndarray:
-        """Independent closure rows at q; leaves placements and Jacobians in self.data."""
+        """Independent closure rows at q; leaves joint placements, Jacobians and the cut
+        frames' placements in self.data."""
         pin.computeJointJacobians(self.model, self.data, q)
-        pin.updateFramePlacements(self.model, self.data)
-        closures = self.mechanism.closures
-        if not closures:
-            return np.zeros(0)
-        return np.concatenate([c.residual(self.data) for c in closures])
+        cuts = self._cuts
+        if len(cuts) == 1:
+            cuts[0].place(self.data)
+            return cuts[0].residual()
+        for cut in cuts:
+            cut.place(self.data)
+        return np.concatenate([c.residual() for c in cuts]) if cuts else np.zeros(0)
 
     def _full_residual(self) -> float:
-        closures = self.mechanism.closures
-        if not closures:
-            return 0.0
-        return float(max(np.max(np.abs(c.full_residual(self.data)), initial=0.0) for c in closures))
+        return max((c.full_residual() for c in self._cuts), default=0.0)
+
+    def _stack(self, rows: list[np.ndarray]) -> np.ndarray:
+        if len(rows) == 1:
+            return rows[0]
+        return np.vstack(rows) if rows else np.zeros((0, self.model.nv))
 
     def _jacobian(self) -> np.ndarray:
-        closures = self.mechanism.closures
-        if not closures:
-            return np.zeros((0, self.model.nv))
-        return np.vstack([c.jacobian(self.model, self.data) for c in closures])
+        return self._stack([c.jacobian(self.data) for c in self._cuts])
 
     def _residual_jacobian(self) -> np.ndarray:
-        return np.vstack([c.residual_jacobian(self.model, self.data) for c in self.mechanism.closures])
+        return self._stack([c.newton_jacobian(self.data) for c in self._cuts])
 
     def _drift(self) -> np.ndarray:
-        closures = self.mechanism.closures
-        if not closures:
-            return np.zeros(0)
-        return np.concatenate([c.drift(self.model, self.data) for c in closures])
+        cuts = self._cuts
+        if len(cuts) == 1:
+            return cuts[0].drift(self.data)
+        return np.concatenate([c.drift(self.data) for c in cuts]) if cuts else np.zeros(0)
 
     def set_drivers(self, q: np.ndarray, driver_q: Sequence[float]) -> np.ndarray:
         """A copy of q with the drivers' coordinates written in."""
-        q = np.array(q, dtype=float, copy=True)
-        for name, value in zip(self.drivers, driver_q):
-            self.mechanism.set_coordinate(q, name, float(value))
+        q = q.copy() if type(q) is np.ndarray and q.dtype == float else np.array(q, dtype=float)
+        for (i, continuous), value in zip(self._drv_q, driver_q):
+            if continuous:
+                q[i], q[i + 1] = math.cos(value), math.sin(value)
+            else:
+                q[i] = value
         return q
 
     # ------------------------------------------------------------------ solves
@@ -153,16 +213,18 @@ class LoopSolver:
         """
         q = self.set_drivers(q_guess, driver_q)
         r = self._residual(q)
-        norm = np.max(np.abs(r), initial=0.0)
+        norm = _max_abs(r)
         iterations = 0
-        while norm > self.tol:
-            if iterations >= self.max_iterations:
-                break
-            J_dep = self._residual_jacobian()[:, self._dep_v]
+        while norm > self.tol and iterations < self.max_iterations:
+            J_dep = self._residual_jacobian()[:, self._dep]
             q, r, norm, ok = self._newton_update(q, J_dep, r, norm)
             iterations += 1
             if not ok:
                 break
+        if POLISH < norm <= self.tol <= DEFAULT_TOL and iterations < self.max_iterations:
+            J_dep = self._residual_jacobian()[:, self._dep]
+            q, r, norm, _ = self._newton_update(q, J_dep, r, norm)  # kept only if it helps
+            iterations += 1
         full = self._full_residual()
         if norm > self.tol or full > max(self.tol, 1e-12) * 10:
             self._raise_not_closed(q, max(norm, full), iterations, driver_q)
@@ -172,14 +234,15 @@ class LoopSolver:
                        norm: float) -> tuple[np.ndarray, np.ndarray, float, bool]:
         """A full Newton step when it lowers the residual (the usual case near a solution);
         else a minimum-norm least-squares step, halved until the residual decreases."""
-        step = _newton_step(J_dep, r)
-        if np.all(np.isfinite(step)):
-            trial = self._move(q, step)
-            r_trial = self._residual(trial)
-            trial_norm = float(np.max(np.abs(r_trial), initial=0.0))
-            if trial_norm < norm:
-                return trial, r_trial, trial_norm, True
-            self._residual(q)
+        if J_dep.shape[0] == J_dep.shape[1]:
+            step = _solve_square(J_dep, -r)
+            if math.isfinite(sum(step.tolist())):
+                trial = self._move(q, step)
+                r_trial = self._residual(trial)
+                trial_norm = _max_abs(r_trial)
+                if trial_norm < norm:
+                    return trial, r_trial, trial_norm, True
+                self._residual(q)
         step = np.linalg.lstsq(J_dep, -r, rcond=None)[0]
         return self._line_search(q, step, norm)
 
@@ -202,9 +265,9 @@ class LoopSolver:
         for _ in range(30):
             trial = self._move(q, alpha * step)
             r = self._residual(trial)
-            trial_norm = np.max(np.abs(r), initial=0.0)
+            trial_norm = _max_abs(r)
             if trial_norm < norm:
-                return trial, r, float(trial_norm), True
+                return trial, r, trial_norm, True
             alpha *= 0.5
         return q, self._residual(q), norm, False  # data back at q
 
@@ -240,38 +303,34 @@ class LoopSolver:
         """
         if not at_q:
             self._residual(q)
+        v, a, *numbers = self._rates(q, driver_v, driver_a)
+        return v, a, Accuracy(0.0, 0, *numbers)
+
+    def _rates(self, q: np.ndarray, driver_v, driver_a) -> tuple:
+        """v, a, condition, sigma_min, velocity and acceleration residuals (data at q)."""
         J = self._jacobian()
-        J_dep = J[:, self._dep_v]
-        sigma = np.linalg.svd(J_dep * self._dep_scale, compute_uv=False) if J_dep.size else np.ones(1)
-        condition = float(sigma[0] / sigma[-1]) if sigma[-1] > 0 else float("inf")
+        J_dep, J_drv = J[:, self._dep], J[:, self._drv]
+        condition, sigma_min = _condition(J_dep * self._dep_scale)
         if condition > self.max_condition:
             raise SingularPoseError(
                 f"{self.mechanism.source}: the loop constraint Jacobian is singular at this pose "
                 f"(condition number {condition:.3g} > {self.max_condition:.3g}, smallest singular "
-                f"value {sigma[-1]:.3g}): the dependent joints' rates are undefined",
+                f"value {sigma_min:.3g}): the dependent joints' rates are undefined",
                 condition=condition,
-                sigma_min=float(sigma[-1]),
+                sigma_min=sigma_min,
                 partial=q,
             )
         v = np.zeros(self.model.nv)
-        v[self._drv_v] = driver_v
-        if J_dep.size:
-            v[self._dep_v] = np.linalg.solve(J_dep, -J[:, self._drv_v] @ v[self._drv_v])
+        v[self._drv] = driver_v
+        a = np.zeros(self.model.nv)
+        a[self._drv] = driver_a
+        if not J.size:
+            return v, a, condition, sigma_min, 0.0, 0.0
+        v[self._dep] = _solve_square(J_dep, -(J_drv @ v[self._drv]))
         pin.forwardKinematics(self.model, self.data, q, v, self._zero_a)
         drift = self._drift()
-        a = np.zeros(self.model.nv)
-        a[self._drv_v] = driver_a
-        if J_dep.size:
-            a[self._dep_v] = np.linalg.solve(J_dep, -J[:, self._drv_v] @ a[self._drv_v] - drift)
-        accuracy = Accuracy(
-            residual=0.0,
-            iterations=0,
-            condition=condition,
-            sigma_min=float(sigma[-1]),
-            velocity_residual=float(np.max(np.abs(J @ v), initial=0.0)),
-            acceleration_residual=float(np.max(np.abs(J @ a + drift), initial=0.0)),
-        )
-        return v, a, accuracy
+        a[self._dep] = _solve_square(J_dep, -(J_drv @ a[self._drv]) - drift)
+        return v, a, condition, sigma_min, _max_abs(J @ v), _max_abs(J @ a + drift)
 
     def solve(
         self,
@@ -290,16 +349,17 @@ class LoopSolver:
         """
         dq, dv, da = (self._ordered(x) for x in (driver_q, driver_v, driver_a))
         q0 = self.mechanism.neutral() if guess is None else np.asarray(guess, dtype=float)
-        if q0.shape != (self.model.nq,) or not np.all(np.isfinite(q0)):
+        if q0.shape != (self.model.nq,) or not math.isfinite(sum(q0.tolist())):
             raise ModelError(f"guess must be {self.model.nq} finite numbers, got shape {q0.shape}",
                              path=self.mechanism.source)
         q, iterations, residual = self.close(q0, dq)
-        v, a, acc = self.rates(q, dv, da, at_q=True)
-        accuracy = Accuracy(residual, iterations, acc.condition, acc.sigma_min,
-                            acc.velocity_residual, acc.acceleration_residual)
-        return LoopSolution(q=q, v=v, a=a, accuracy=accuracy, drivers=self.drivers)
+        v, a, *numbers = self._rates(q, dv, da)
+        return LoopSolution(q=q, v=v, a=a, accuracy=Accuracy(residual, iterations, *numbers), drivers=self.drivers)
 
     def _ordered(self, values: Sequence[float] | Mapping[str, float] | None) -> np.ndarray:
+        if (type(values) is np.ndarray and values.shape == (len(self.drivers),) and values.dtype == float
+                and math.isfinite(sum(values.tolist()))):
+            return values  # already in order (a sweep's arrays: no conversion)
         if values is None:
             return np.zeros(len(self.drivers))
         if isinstance(values, Mapping):
@@ -309,7 +369,7 @@ class LoopSolver:
                                     mobility=self.mechanism.mobility, drivers=len(self.drivers))
             values = [values.get(n, 0.0) for n in self.drivers]
         out = np.asarray(values, dtype=float).reshape(-1)
-        if out.shape != (len(self.drivers),) or not np.all(np.isfinite(out)):
+        if out.shape != (len(self.drivers),) or not math.isfinite(sum(out.tolist())):
             raise MobilityError(f"expected {len(self.drivers)} finite driver value(s), got {values!r}",
                                 mobility=self.mechanism.mobility, drivers=len(self.drivers))
         return out

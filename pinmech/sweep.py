@@ -1,20 +1,31 @@
 """Cycles: one driver swept through a range, every pose solved, closed and rated.
 
 One `LoopSolver` (one `pin.Data`) serves the whole sweep, and each pose starts from the
-previous one, so the sweep stays on the assembly branch it started on. Rows are produced
-lazily, so a sweep of a million poses streams to a CSV file in bounded memory.
+previous one, so the sweep stays on the assembly branch it started on (solve_cycle.py:
+how, and the accuracy choices). Poses are produced lazily, a chunk at a time, so a sweep
+of a million poses streams to a CSV file in bounded memory.
+
+Scene keys, all optional:
+
+    [sweep]
+    links = ["link3"]         # what --plot draws (default: every moving link ...)
+    points = ["D"]            # ... and every moving point)
+    steps = 361               # poses, both ends included
+    from = "0 deg"            # first value (default: the scene's)
+    to = "360 deg"            # last value (default: one turn on, or one mechanism size)
+    start = "predictor"       # or "warm", "cold" (see solve_cycle.py)
+    batch = true              # batched poses between exact ones on dense sweeps
+    interpolate = 1           # > 1: every n-th pose solved, the others interpolated
 """
 
 from __future__ import annotations
 
-import csv
 import math
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
-from typing import IO
+from typing import Any
 
 import numpy as np
-import pinocchio as pin
 
 from pinmech.analysis import (
     Drivers,
@@ -25,23 +36,50 @@ from pinmech.analysis import (
     scene_drivers,
     scene_guess,
 )
-from pinmech.exceptions import LoopClosureError, SceneError, SingularPoseError, SweepError
+from pinmech.exceptions import SceneError, SweepError
 from pinmech.mechanism import Mechanism
 from pinmech.motion import Motion, evaluate_motion
 from pinmech.results import Accuracy
 from pinmech.scene import Scene
+from pinmech.solve_cycle import STARTS, RangeChunk, solve_range
 from pinmech.solve_loops import LoopSolver
+
+#: The `[sweep]` keys and their types.
+SWEEP_KEYS = {"links": list, "points": list, "steps": int, "from": str, "to": str, "start": str,
+              "batch": bool, "interpolate": int, "duration": str, "step": str, "scheme": str, "gain": (int, float)}
 
 
 @dataclass(frozen=True)
 class SweepPose:
-    """One pose of a sweep: the driver value, and the motion (None where the pose failed)."""
+    """One pose of a sweep: the driver value, and the motion (None where the pose failed).
+
+    `interpolated` poses were not solved but interpolated between solved ones; their
+    accuracy is the one measured where the interpolation error peaks (solve_cycle.py).
+    """
 
     index: int
     value: float
     motion: Motion | None
     accuracy: Accuracy | None
     error: str = ""
+    interpolated: bool = False
+
+
+def sweep_options(scene: Scene) -> dict[str, Any]:
+    """The scene's `[sweep]` table, checked (names and types)."""
+    table = scene.section("sweep")
+    for key, value in table.items():
+        kind = SWEEP_KEYS.get(key)
+        if kind is None:
+            raise SceneError(f"unknown key {key}; known: {', '.join(SWEEP_KEYS)}", path=str(scene.path),
+                             key=f"sweep.{key}")
+        if not isinstance(value, kind) or (kind is int and isinstance(value, bool)):
+            raise SceneError(f"must be {getattr(kind, '__name__', 'a number')}, got {value!r}",
+                             path=str(scene.path), key=f"sweep.{key}")
+    if "start" in table and table["start"] not in STARTS:
+        raise SceneError(f"must be one of {', '.join(STARTS)}, got {table['start']!r}", path=str(scene.path),
+                         key="sweep.start")
+    return table
 
 
 @dataclass
@@ -63,9 +101,14 @@ class Sweep:
 
     @classmethod
     def from_scene(cls, scene: Scene, driver: str | None = None) -> Sweep:
-        if not scene.section("drivers"):
-            raise SceneError("the scene has no [drivers.NAME] table to sweep (an arm's task scene is "
-                             "followed in time by `pinmech path`)", path=str(scene.path), key="drivers")
+        """Raises:
+            SceneError: a scene without drivers (a task scene is followed in time by
+                `pinmech path`), or a driver that is not one of the scene's.
+        """
+        sweep_options(scene)
+        if "task" in scene.raw or not scene.section("drivers"):
+            raise SceneError("has no [drivers] to sweep; a task scene ([[task]]) is followed in time: "
+                             "pinmech path SCENE --duration ...", path=str(scene.path), key="drivers")
         mechanism = load_mechanism(scene)
         drivers = scene_drivers(scene, mechanism)
         check_scene_names(scene, mechanism)
@@ -86,124 +129,59 @@ class Sweep:
         span = 2 * math.pi if self.is_angular else self.mechanism.length_scale
         return np.linspace(self.start, self.start + span, steps)
 
-    def poses(self, values: Iterable[float], *, skip_failures: bool = False, warm_start: bool = True,
-              predictor: bool = True) -> Iterator[SweepPose]:
+    def chunks(self, values: Iterable[float], *, start: str = "predictor", batch: bool = True,
+               interpolate: int = 1) -> Iterator[RangeChunk]:
+        """The poses' q, v, a and accuracy as arrays, a chunk at a time (no motion read-out):
+        the quickest way through a long sweep. Options: see `poses`."""
+        d = self.drivers
+        return solve_range(self.solver, self.driver, values, driver_q=d.q, driver_v=d.v, driver_a=d.a,
+                           guess=scene_guess(self.scene, self.mechanism), start=start, batch=batch,
+                           interpolate=interpolate)
+
+    def poses(self, values: Iterable[float], *, skip_failures: bool = False, start: str = "predictor",
+              batch: bool = True, interpolate: int = 1, warm_start: bool | None = None,
+              predictor: bool | None = None) -> Iterator[SweepPose]:
         """Solve the poses one after the other, each from the previous one (lazy).
 
         Args:
             skip_failures: keep a failing pose as a row with its error instead of stopping.
-            warm_start: start Newton from the previous pose (default; keeps the branch).
-                False starts every pose from the scene's guess: slower, and may jump branch.
-            predictor: (default) start from the previous pose moved along its own rates
-                and accelerations (q + v dt + a dt^2 / 2 on the manifold, dt = step / driver
-                speed): fewer Newton iterations, and the last one lands at rounding level
-                (see scripts/benchmark_sweep.py). Falls back to the warm start at zero speed.
+            start: "predictor" (default): from the previous pose moved along its path
+                derivatives (q' dx + q'' dx^2 / 2 on the manifold), one Newton step;
+                "warm": from the previous pose as it is; "cold": every pose from the
+                scene's guess (slower, and it may change branch).
+            batch: on dense sweeps, solve the poses between exactly solved ones together
+                from interpolated guesses (same tolerance, several times faster).
+            interpolate: > 1 solves every n-th pose and interpolates the others (quintic
+                Hermite in q, q', q''), for dense plots: faster, less accurate, with the
+                accuracy measured in each interval.
+            warm_start, predictor: older spelling of `start` ("warm" is predictor=False,
+                "cold" warm_start=False).
 
         Raises:
             SweepError: a pose where the loop cannot close or the Jacobian is singular,
                 naming the driver value, unless `skip_failures` (then the row says why).
         """
-        d = self.drivers
-        k = d.names.index(self.driver)
-        q_drv, v_drv, a_drv = d.q.copy(), d.v.copy(), d.a.copy()
-        guess = scene_guess(self.scene, self.mechanism)
+        if warm_start is False:
+            start = "cold"
+        elif predictor is False:
+            start = "warm"
         points, links = report_lists(self.scene)
         coincident = coincident_points(self.scene)
-        start_guess, previous = guess, None
-        model = self.mechanism.model
-        for index, value in enumerate(values):
-            q_drv[k] = value
-            if predictor and previous is not None and v_drv[k] != 0:
-                dt = (value - previous[0]) / v_drv[k]
-                guess = pin.integrate(model, previous[1].q, previous[1].v * dt + 0.5 * previous[1].a * dt * dt)
-            elif not warm_start:
-                guess = start_guess
-            try:
-                sol = self.solver.solve(q_drv, v_drv, a_drv, guess=guess)
-            except (LoopClosureError, SingularPoseError) as exc:
-                where = self._format(value)
-                if not skip_failures:
-                    raise SweepError(f"sweep stopped at {self.driver} = {where}: {exc}", driver=self.driver,
-                                     value=float(value), cause=exc) from exc
-                yield SweepPose(index, float(value), None, None, f"{type(exc).__name__}: {exc}")
-                continue
-            guess, previous = sol.q, (value, sol)
-            self.last_q = sol.q
-            motion = evaluate_motion(self.mechanism, self.solver.data, sol.q, sol.v, sol.a,
-                                     points=points, links=links, coincident=coincident)
-            yield SweepPose(index, float(value), motion, sol.accuracy)
+        for chunk in self.chunks(values, start=start, batch=batch, interpolate=interpolate):
+            for j, value in enumerate(chunk.values.tolist()):
+                index = chunk.start + j
+                if j in chunk.errors:
+                    exc = chunk.errors[j]
+                    if not skip_failures:
+                        raise SweepError(f"sweep stopped at {self.driver} = {self._format(value)}: {exc}",
+                                         driver=self.driver, value=value, cause=exc) from exc
+                    yield SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}")
+                    continue
+                sol = chunk.solution
+                self.last_q = sol.q[j]
+                motion = evaluate_motion(self.mechanism, self.solver.data, sol.q[j], sol.v[j], sol.a[j],
+                                         points=points, links=links, coincident=coincident)
+                yield SweepPose(index, value, motion, sol.accuracy(j), interpolated=bool(chunk.interpolated[j]))
 
     def _format(self, value: float) -> str:
         return f"{math.degrees(value):.6g} deg" if self.is_angular else f"{value:.6g} m"
-
-
-# -------------------------------------------------------------------------- table
-def columns(sweep: Sweep, first: Motion) -> list[str]:
-    """CSV column names with units, from the first solved pose."""
-    unit = "deg" if sweep.is_angular else "m"
-    cols = [f"{sweep.driver}.q [{unit}]"]
-    planar = sweep.mechanism.plane_normal is not None
-    for name in first.links:
-        if planar:
-            cols += [f"{name}.angle [deg]", f"{name}.omega [rad/s]", f"{name}.alpha [rad/s^2]"]
-        else:
-            cols += [f"{name}.|omega| [rad/s]", f"{name}.|alpha| [rad/s^2]"]
-    for name in first.points:
-        cols += [f"{name}.{c} [m]" for c in "xyz"]
-        cols += [f"{name}.v{c} [m/s]" for c in "xyz"] + [f"{name}.|v| [m/s]"]
-        cols += [f"{name}.a{c} [m/s^2]" for c in "xyz"] + [f"{name}.|a| [m/s^2]"]
-    for name in first.sliders:
-        cols += [f"{name}.v_rel [m/s]", f"{name}.a_rel [m/s^2]", f"{name}.|a_cor| [m/s^2]"]
-    return cols + ["closure_residual [1]", "condition_number [1]", "newton_iterations [1]", "error"]
-
-
-def row(sweep: Sweep, pose: SweepPose, width: int) -> list[object]:
-    """One CSV row in the units of `columns` (empty cells where the pose failed)."""
-    first = math.degrees(pose.value) if sweep.is_angular else pose.value
-    if pose.motion is None:
-        return [first] + [""] * (width - 2) + [pose.error]
-    m, out = pose.motion, [first]
-    normal = sweep.mechanism.plane_normal
-    for link in m.links.values():
-        if normal is not None:
-            out += [math.degrees(link.angle), float(normal @ link.angular_velocity),
-                    float(normal @ link.angular_acceleration)]
-        else:
-            out += [float(np.linalg.norm(link.angular_velocity)), float(np.linalg.norm(link.angular_acceleration))]
-    for p in m.points.values():
-        out += list(p.position) + list(p.velocity) + [float(np.linalg.norm(p.velocity))]
-        out += list(p.acceleration) + [float(np.linalg.norm(p.acceleration))]
-    for name, s in m.sliders.items():
-        out += [m.joints[name].v, m.joints[name].a, float(np.linalg.norm(s.coriolis_acceleration))]
-    acc = pose.accuracy
-    return out + [acc.residual, acc.condition, acc.iterations, ""]
-
-
-def write_csv(sweep: Sweep, poses: Iterable[SweepPose], stream: IO[str]) -> int:
-    """Stream poses to CSV as they are solved; returns the number of rows written."""
-    writer = csv.writer(stream)
-    header: list[str] | None = None
-    pending: list[SweepPose] = []
-    count = 0
-    for pose in poses:
-        if header is None:
-            if pose.motion is None:
-                pending.append(pose)  # header waits for the first solved pose
-                continue
-            header = columns(sweep, pose.motion)
-            writer.writerow(header)
-            for failed in pending:
-                writer.writerow([_cell(x) for x in row(sweep, failed, len(header))])
-                count += 1
-        writer.writerow([_cell(x) for x in row(sweep, pose, len(header))])
-        count += 1
-    if header is None:
-        writer.writerow([f"{sweep.driver}.q", "error"])
-        for failed in pending:
-            writer.writerow([failed.value, failed.error])
-            count += 1
-    return count
-
-
-def _cell(x: object) -> object:
-    return f"{x:.12g}" if isinstance(x, float) else x

@@ -1,21 +1,33 @@
-"""The speed/accuracy trade of an R-RTR cycle, measured in one run on this machine.
+"""The speed/accuracy trade of sweeps, measured in one run on this machine.
 
-For each setting: the median time per pose (median over 5 repeats of a 3600-pose cycle,
-divided by 3600) and the largest relative error of D's position, velocity and
-acceleration over the cycle against the independent closed form (scripts/closed_form.py).
-Relative error = max |pinmech - closed form| over the cycle / max |closed form| over it.
+R-RTR cycle (Problem Chapter I.9, crank at -50 rpm, 3600 poses): for each accuracy choice,
+the median time per pose (median of `--repeats` runs of the whole cycle, divided by the
+number of poses) of solving every pose, i.e. q, v, a of every joint with its accuracy
+(closure residual, condition number), and the largest relative error of D's position,
+velocity and acceleration over the cycle against the independent closed form
+(scripts/closed_form.py):
+
+    relative error = max over the cycle of |pinmech - closed form| (largest component)
+                     / max over the cycle of |closed form|
+
+D is read off each solution after the timing, the same way for every setting.
+
 Two references are measured in the same run: the closed form itself (vectorized numpy,
-the lower bound) and the bare Pinocchio calls one pose needs (kinematics, frame
-placements, frame Jacobians, classical accelerations; no solver logic), the floor of a
-Pinocchio-based tool.
+the lower bound) and the bare Pinocchio calls one pose needs, without solver logic (the
+floor of a Pinocchio-based tool): joint placements and Jacobians (computeJointJacobians),
+the cut frame's placement and frame Jacobian (its other frame is on the ground), the
+kinematics with velocities (forwardKinematics(q, v, 0)) and the cut frame's classical
+acceleration; once with the results thrown away, once kept in arrays as a tool must.
 
-Run: python scripts/benchmark_sweep.py [--poses 3600] [--repeats 5] [--out benchmark.md]
+Arm path (text 17.110: D at 1 m/s along x with CD vertical, for 0.08 s): time per step
+and the largest drift for each integration scheme, step and feedback gain.
+
+Run: python scripts/benchmark_sweep.py [--poses 3600] [--repeats 5] [--out FILE.md] [--plot FILE.png]
 """
 
 from __future__ import annotations
 
 import argparse
-import functools
 import statistics
 import sys
 import time
@@ -28,125 +40,164 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import closed_form
 
 import pinmech
+from pinmech.solve_batch import difference_many
+from pinmech.sweep import Sweep
 
 ROOT = Path(__file__).resolve().parents[1]
-OMEGA1 = -50 * np.pi / 30
+SCENE = ROOT / "models" / "scenes" / "r_rtr.toml"
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
-@functools.cache
-def _setup(tol: float = 1e-13):
-    """Model, solver and branch guess, built once per tolerance: loading is not timed per pose."""
-    mech = pinmech.Mechanism.from_urdf(ROOT / "models" / "r_rtr.urdf")
-    solver = pinmech.LoopSolver(mech, ["A"], tol=tol)
-    guess = mech.neutral()
-    mech.set_coordinate(guess, "B", np.radians(20))
-    mech.set_coordinate(guess, "B_slider", -0.06)
-    return mech, solver, guess
+# ------------------------------------------------------------------ settings
+def sweep_setting(*, tol: float | None = None, **options):
+    """pinmech's sweep (solve_cycle.py) with these options: all poses as arrays."""
+    def run(sweep: Sweep, phis: np.ndarray):
+        if tol is not None:
+            sweep.solver.tol = tol
+        chunks = list(sweep.chunks(phis, **options))
+        return tuple(np.concatenate([getattr(c.solution, k) for c in chunks]) for k in ("q", "v", "a", "iterations"))
+    return run
 
 
-def _read_d(mech, data, fid, q, v, a, out, i):
-    pin.forwardKinematics(mech.model, data, q, v, a)
-    pin.updateFramePlacements(mech.model, data)
-    out[0][i] = data.oMf[fid].translation[:2]
-    out[1][i] = pin.getFrameVelocity(mech.model, data, fid, LWA).linear[:2]
-    out[2][i] = pin.getFrameClassicalAcceleration(mech.model, data, fid, LWA).linear[:2]
-
-
-def run_exact(phis, *, tol=1e-13, warm=True, predictor=False):
-    """pinmech's solver pose by pose; returns D's (position, velocity, acceleration)."""
-    mech, solver, guess0 = _setup(tol)
-    fid, data = mech.frame_id("D"), mech.model.createData()
-    out = [np.zeros((len(phis), 2)) for _ in range(3)]
-    guess, prev = guess0, None
+def finite_differences(sweep: Sweep, phis: np.ndarray):
+    """Positions only, Newton pose by pose from the previous pose; velocities and
+    accelerations by central differences in time of q on the manifold (periodic cycle)."""
+    solver, model = sweep.solver, sweep.mechanism.model
+    omega = float(sweep.drivers.v[0])
+    q = pinmech.analysis.scene_guess(sweep.scene, sweep.mechanism)
+    Q = np.empty((len(phis), model.nq))
     for i, phi in enumerate(phis):
-        if predictor and prev is not None:
-            dt = (phi - phis[i - 1]) / OMEGA1
-            guess = pin.integrate(mech.model, prev.q, prev.v * dt + 0.5 * prev.a * dt * dt)
-        elif not warm:
-            guess = guess0
-        sol = solver.solve([phi], [OMEGA1], [0.0], guess=guess)
-        guess, prev = sol.q, sol
-        _read_d(mech, data, fid, sol.q, sol.v, sol.a, out, i)
+        q, _, _ = solver.close(q, [phi])
+        Q[i] = q
+    dt = (phis[1] - phis[0]) / omega
+    ahead, behind = np.roll(Q, -1, axis=0), np.roll(Q, 1, axis=0)
+    V = difference_many(model, behind, ahead) / (2 * dt)
+    A = (difference_many(model, Q, ahead) - difference_many(model, behind, Q)) / dt**2
+    return Q, V, A, None
+
+
+SETTINGS = [
+    ("default: batched, predictor and Hermite guesses, tol 1e-13", sweep_setting()),
+    ("pose by pose, predictor (--no-batch)", sweep_setting(batch=False)),
+    ("pose by pose, warm start (--start warm)", sweep_setting(start="warm")),
+    ("pose by pose, cold start (--start cold)", sweep_setting(start="cold")),
+    ("batched, loose tolerance (--tol 1e-6)", sweep_setting(tol=1e-6)),
+    ("finite differences of positions (Newton pose by pose)", finite_differences),
+    ("interpolated, every 8th pose solved (--interpolate 8)", sweep_setting(interpolate=8)),
+    ("interpolated, every 32nd pose solved (--interpolate 32)", sweep_setting(interpolate=32)),
+    ("interpolated, every 128th pose solved (--interpolate 128)", sweep_setting(interpolate=128)),
+    ("interpolated, every 256th pose solved (--interpolate 256)", sweep_setting(interpolate=256)),
+]
+
+
+# ------------------------------------------------------------------ references
+def floor(sweep: Sweep, Q: np.ndarray, V: np.ndarray, keep: bool) -> None:
+    """The Pinocchio calls of one pose, at the cycle's solved poses."""
+    model, data = sweep.mechanism.model, sweep.mechanism.model.createData()
+    (cut,) = sweep.mechanism.closures
+    f, zero = cut.child_frame, np.zeros(model.nv)
+    n = len(Q)
+    H, J, A = np.empty((n, 4, 4)), np.empty((n, 6, model.nv)), np.empty((n, 6))
+    for i in range(n):
+        pin.computeJointJacobians(model, data, Q[i])
+        if keep:
+            H[i] = pin.updateFramePlacement(model, data, f).homogeneous
+            J[i] = pin.getFrameJacobian(model, data, f, LWA)
+            pin.forwardKinematics(model, data, Q[i], V[i], zero)
+            A[i] = pin.getFrameClassicalAcceleration(model, data, f, LWA).vector
+        else:
+            pin.updateFramePlacement(model, data, f)
+            pin.getFrameJacobian(model, data, f, LWA)
+            pin.forwardKinematics(model, data, Q[i], V[i], zero)
+            pin.getFrameClassicalAcceleration(model, data, f, LWA)
+
+
+def read_d(sweep: Sweep, Q: np.ndarray, V: np.ndarray, A: np.ndarray) -> list[np.ndarray]:
+    """D's position, velocity and classical acceleration (x, y) at every pose."""
+    model, data = sweep.mechanism.model, sweep.mechanism.model.createData()
+    fid = sweep.mechanism.frame_id("D")
+    out = [np.empty((len(Q), 2)) for _ in range(3)]
+    for i in range(len(Q)):
+        pin.forwardKinematics(model, data, Q[i], V[i], A[i])
+        out[0][i] = pin.updateFramePlacement(model, data, fid).translation[:2]
+        out[1][i] = pin.getFrameVelocity(model, data, fid, LWA).linear[:2]
+        out[2][i] = pin.getFrameClassicalAcceleration(model, data, fid, LWA).linear[:2]
     return out
 
 
-def run_finite_differences(phis):
-    """Positions by Newton only (warm start); velocities and accelerations by central
-    differences in time over the periodic cycle."""
-    mech, solver, guess = _setup()
-    fid, data = mech.frame_id("D"), mech.model.createData()
-    dt = (phis[1] - phis[0]) / OMEGA1
-    pos = np.zeros((len(phis), 2))
-    for i, phi in enumerate(phis):
-        guess, _, _ = solver.close(guess, [phi])
-        pin.framesForwardKinematics(mech.model, data, guess)
-        pos[i] = data.oMf[fid].translation[:2]
-    vel = (np.roll(pos, -1, 0) - np.roll(pos, 1, 0)) / (2 * dt)  # the cycle is periodic
-    acc = (np.roll(pos, -1, 0) - 2 * pos + np.roll(pos, 1, 0)) / dt**2
-    return [pos, vel, acc]
+def relative_errors(ours: list[np.ndarray], reference: list[np.ndarray]) -> list[float]:
+    return [float(np.max(np.abs(a - b)) / np.max(np.abs(b))) for a, b in zip(ours, reference)]
 
 
-def run_hermite(phis, every=10):
-    """Exact poses every `every` steps; D's motion in between by quintic Hermite interpolation
-    of its position from the exact position, velocity and acceleration (time as parameter)."""
-    coarse = phis[::every]
-    exact = run_exact(np.append(coarse, coarse[0] + 2 * np.pi), predictor=True)
-    t = (np.append(coarse, coarse[0] + 2 * np.pi) - phis[0]) / OMEGA1
-    tq = (phis - phis[0]) / OMEGA1
-    idx = np.minimum((np.arange(len(phis)) // every), len(coarse) - 1)
-    h = t[idx + 1] - t[idx]
-    s = ((tq - t[idx]) / h)[:, None]
-    p0, p1 = exact[0][idx], exact[0][idx + 1]
-    v0, v1 = exact[1][idx] * h[:, None], exact[1][idx + 1] * h[:, None]
-    a0, a1 = exact[2][idx] * (h**2)[:, None], exact[2][idx + 1] * (h**2)[:, None]
-    basis = [1 - 10 * s**3 + 15 * s**4 - 6 * s**5, s - 6 * s**3 + 8 * s**4 - 3 * s**5,
-             0.5 * s**2 - 1.5 * s**3 + 1.5 * s**4 - 0.5 * s**5, 10 * s**3 - 15 * s**4 + 6 * s**5,
-             -4 * s**3 + 7 * s**4 - 3 * s**5, 0.5 * s**3 - s**4 + 0.5 * s**5]
-    d1 = [-30 * s**2 + 60 * s**3 - 30 * s**4, 1 - 18 * s**2 + 32 * s**3 - 15 * s**4,
-          s - 4.5 * s**2 + 6 * s**3 - 2.5 * s**4, 30 * s**2 - 60 * s**3 + 30 * s**4,
-          -12 * s**2 + 28 * s**3 - 15 * s**4, 1.5 * s**2 - 4 * s**3 + 2.5 * s**4]
-    d2 = [-60 * s + 180 * s**2 - 120 * s**3, -36 * s + 96 * s**2 - 60 * s**3, 1 - 9 * s + 18 * s**2 - 10 * s**3,
-          60 * s - 180 * s**2 + 120 * s**3, -24 * s + 84 * s**2 - 60 * s**3, 3 * s - 12 * s**2 + 10 * s**3]
-    coeffs = [p0, v0, a0, p1, v1, a1]
-    pos = sum(b * c for b, c in zip(basis, coeffs))
-    vel = sum(b * c for b, c in zip(d1, coeffs)) / h[:, None]
-    acc = sum(b * c for b, c in zip(d2, coeffs)) / (h**2)[:, None]
-    return [pos, vel, acc]
+def timed(fn, repeats: int):
+    """Median wall time of `repeats` calls, and the last call's result."""
+    times, result = [], None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = fn()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), result
 
 
-def run_floor(phis):
-    """The bare Pinocchio calls of one pose, at a fixed closed configuration."""
-    mech, solver, guess = _setup()
-    sol = solver.solve([phis[0]], [OMEGA1], [0.0], guess=guess)
-    model, data = mech.model, mech.model.createData()
-    cut = mech.closures[0]
-    fp, fc, fd = cut.parent_frame, cut.child_frame, mech.frame_id("D")
-    zero = np.zeros(model.nv)
-    for _ in phis:
-        pin.computeJointJacobians(model, data, sol.q)
-        pin.updateFramePlacements(model, data)
-        pin.getFrameJacobian(model, data, fp, LWA)
-        pin.getFrameJacobian(model, data, fc, LWA)
-        pin.forwardKinematics(model, data, sol.q, sol.v, zero)
-        pin.getFrameClassicalAcceleration(model, data, fp, LWA)
-        pin.getFrameClassicalAcceleration(model, data, fc, LWA)
-        pin.getFrameClassicalAcceleration(model, data, fd, LWA)
+# ------------------------------------------------------------------ tables
+def cycle_rows(poses: int, repeats: int) -> list[dict]:
+    scene = pinmech.Scene.load(SCENE)
+    phis = np.radians(30) + np.linspace(0, 2 * np.pi, poses, endpoint=False)
+    omega = float(Sweep.from_scene(scene).drivers.v[0])  # -50 rpm
+    t_cf, cf = timed(lambda: closed_form.r_rtr(phis, omega, 0.0), repeats)
+    reference = [cf.D, cf.vD, cf.aD]
+    rows = [{"name": "closed form, vectorized numpy (lower bound)", "time": t_cf / poses, "errors": [0.0] * 3}]
+    results = []
+    for name, run in SETTINGS:
+        sweep = Sweep.from_scene(scene)  # loading the model is not timed
+        t, (Q, V, A, iterations) = timed(lambda run=run, sweep=sweep: run(sweep, phis), repeats)
+        results.append((name, t, Q, V, A, iterations, sweep))
+    Q0, V0 = results[0][2], results[0][3]
+    sweep = results[0][6]
+    for keep, label in ((False, "results thrown away"), (True, "results kept in arrays: the floor")):
+        t, _ = timed(lambda keep=keep: floor(sweep, Q0, V0, keep), repeats)
+        rows.append({"name": f"bare Pinocchio calls of one pose, {label}", "time": t / poses, "errors": None,
+                     "floor": keep})
+    for name, t, Q, V, A, iterations, sweep in results:
+        rows.append({"name": name, "time": t / poses, "errors": relative_errors(read_d(sweep, Q, V, A), reference),
+                     "iterations": None if iterations is None else float(np.mean(iterations))})
+    return rows
 
 
-def run_closed_form(phis):
-    cf = closed_form.r_rtr(phis, OMEGA1, 0.0)
-    return [cf.D, cf.vD, cf.aD]
+def cycle_table(rows: list[dict]) -> str:
+    floor_t = next(r["time"] for r in rows if r.get("floor"))
+    default_t = next(r["time"] for r in rows if r["name"].startswith("default"))
+    header = ("| setting | time per pose [us] | vs floor | vs default | Newton iterations per pose "
+              "| rel. error position | velocity | acceleration |")
+    lines = [header, "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for r in rows:
+        errors = " | ".join(f"{e:.1e}" for e in r["errors"]) if r["errors"] is not None else "- | - | -"
+        iterations = f"{r['iterations']:.2f}" if r.get("iterations") is not None else "-"
+        lines.append(f"| {r['name']} | {1e6 * r['time']:.2f} | {r['time'] / floor_t:.2f} | "
+                     f"{r['time'] / default_t:.2f} | {iterations} | {errors} |")
+    return "\n".join(lines)
 
 
-def _error(result, reference):
-    if result is None:
-        return ["", "", ""]
-    return [float(np.max(np.abs(r - c)) / np.max(np.abs(c))) for r, c in zip(result, reference)]
+def verdicts(rows: list[dict]) -> str:
+    floor_t = next(r["time"] for r in rows if r.get("floor"))
+    calls_t = next(r["time"] for r in rows if r.get("floor") is False)
+    default = next(r for r in rows if r["name"].startswith("default"))
+    settings = [r for r in rows if r.get("iterations") is not None or r["name"].startswith("finite")]
+    fastest = min(settings, key=lambda r: r["time"])
+    worst = max(default["errors"])
+    accuracy = (f"- default reproduces the closed form to {worst:.1e} relative (target 1e-12): "
+                f"{'met' if worst <= 1e-12 else 'NOT met'}")
+    speed = (f"- default time per pose = {default['time'] / floor_t:.2f} x the floor with results kept "
+             f"({default['time'] / calls_t:.2f} x the bare calls alone) (target 3x): "
+             f"{'met' if default['time'] <= 3 * floor_t else 'NOT met'}")
+    fast = (f"- fastest setting ({fastest['name']}) is {default['time'] / fastest['time']:.1f} x faster than the "
+            f"default (target 5x), error in acceleration {fastest['errors'][2]:.1e}: "
+            f"{'met' if default['time'] >= 5 * fastest['time'] else 'NOT met'}")
+    return f"{accuracy}\n{speed}\n{fast}"
 
 
-def path_table(repeats: int) -> str:
-    """Text 17.110's task followed for 0.08 s: time per step and largest drift vs the step."""
+def path_rows(repeats: int) -> list[dict]:
+    """Text 17.110's task followed for 0.08 s with each scheme, step and gain."""
     from pinmech.analysis import load_mechanism
     from pinmech.analysis_task import scene_pose, scene_tasks
     from pinmech.path import follow_path
@@ -155,66 +206,36 @@ def path_table(repeats: int) -> str:
     mech = load_mechanism(scene)
     q0, _, _ = scene_pose(scene, mech)
     tasks = scene_tasks(scene)
-    lines = ["| step [s] | feedback gain [1/s] | time per step [us] | largest drift [m] |", "| --- | --- | --- | --- |"]
-    for step in (1e-2, 1e-3, 1e-4):
-        for gain in (0.0, 50.0):
-            times, drift = [], 0.0
-            for _ in range(repeats):
-                start = time.perf_counter()
-                points = list(follow_path(mech, tasks, q0, duration=0.08, step=step, gain=gain))
-                times.append((time.perf_counter() - start) / len(points))
-                drift = max(p.drift for p in points)
-            lines.append(f"| {step:g} | {gain:g} | {1e6 * statistics.median(times):.0f} | {drift:.1e} |")
+    rows = []
+    for scheme in ("euler", "taylor", "rk4"):
+        for step in (1e-2, 1e-3, 1e-4):
+            for gain in (0.0, 50.0):
+                def run(step=step, gain=gain, scheme=scheme):
+                    points, stopped = [], None
+                    try:
+                        points.extend(follow_path(mech, tasks, q0, duration=0.08, step=step, gain=gain,
+                                                  scheme=scheme))
+                    except pinmech.TaskError:
+                        stopped = points[-1].time + step
+                    return points, stopped
+                t, (points, stopped) = timed(run, repeats)
+                rows.append({"scheme": scheme, "step": step, "gain": gain, "time": t / len(points),
+                             "drift": max(p.drift for p in points), "stopped": stopped})
+    return rows
+
+
+def path_table(rows: list[dict]) -> str:
+    lines = ["| scheme | step [s] | feedback gain [1/s] | time per step [us] | largest drift [m] |",
+             "| --- | --- | --- | --- | --- |"]
+    for r in rows:
+        drift = f"{r['drift']:.1e}" + (f" (stopped at t = {r['stopped']:.2g} s: drift over 1e-3 of the arm)"
+                                       if r["stopped"] is not None else "")
+        lines.append(f"| {r['scheme']} | {r['step']:g} | {r['gain']:g} | {1e6 * r['time']:.0f} | {drift} |")
     return "\n".join(lines)
 
 
-def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--poses", type=int, default=3600)
-    parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--out", default=None, help="also write the markdown table here")
-    parser.add_argument("--plot", default=None, help="also draw time against error here (PNG; pinmech[plot])")
-    args = parser.parse_args(argv)
-    phis = np.radians(30) + np.linspace(0, 2 * np.pi, args.poses, endpoint=False)
-    reference = run_closed_form(phis)
-    settings = [
-        ("closed form, vectorized numpy (lower bound)", run_closed_form),
-        ("bare Pinocchio calls of one pose (floor)", run_floor),
-        ("default: predictor, tol 1e-13, analytic rates", lambda p: run_exact(p, predictor=True)),
-        ("warm start from the previous pose, no predictor", run_exact),
-        ("cold start (every pose from the scene's guess)", lambda p: run_exact(p, warm=False)),
-        ("predictor, loose tolerance 1e-6", lambda p: run_exact(p, tol=1e-6, predictor=True)),
-        ("finite differences of positions (tol 1e-13)", run_finite_differences),
-        ("quintic Hermite, exact every 10th pose", run_hermite),
-    ]
-    rows = []
-    for name, fn in settings:
-        times = []
-        for _ in range(args.repeats):
-            start = time.perf_counter()
-            result = fn(phis)
-            times.append((time.perf_counter() - start) / args.poses)
-        rows.append((name, statistics.median(times), _error(result, reference)))
-    default = rows[2][1]
-    lines = ["| setting | time per pose [us] | vs floor | vs default | rel. error position | velocity | acceleration |",
-             "| --- | --- | --- | --- | --- | --- | --- |"]
-    for name, t, errs in rows:
-        cells = [f"{e:.1e}" if e != "" else "-" for e in errs]
-        lines.append(f"| {name} | {1e6 * t:.1f} | {t / rows[1][1]:.0f}x | {t / default:.2f} | " + " | ".join(cells) + " |")
-    table = "\n".join(lines)
-    print(f"{args.poses} poses, median of {args.repeats} runs, numpy {np.__version__}, pin {pin.__version__}\n")
-    print(table)
-    paths = path_table(args.repeats)
-    print("\nArm path (text 17.110, D at 1 m/s along x for 0.08 s, CD vertical):\n")
-    print(paths)
-    if args.out:
-        Path(args.out).write_text(table + "\n\n" + paths + "\n", encoding="utf-8")
-    if args.plot:
-        plot_trade(rows, args.plot)
-
-
-def plot_trade(rows, path: str) -> None:
-    """Time per pose against the acceleration error, one marker per setting (log-log)."""
+def plot(cycle: list[dict], paths: list[dict], path: str) -> None:
+    """Left: time per pose against the acceleration error; right: path drift against step."""
     try:
         import matplotlib
 
@@ -223,22 +244,58 @@ def plot_trade(rows, path: str) -> None:
     except ImportError:
         print('the plot needs matplotlib: pip install "pinmech[plot]"')
         return
-    fig, ax = plt.subplots(figsize=(11, 5))
-    for name, t, errs in rows:
-        if errs[2] == "":
-            ax.axvline(1e6 * t, color="0.5", linestyle=":", label=name)
+    fig, (left, right) = plt.subplots(1, 2, figsize=(13, 6.4), gridspec_kw={"width_ratios": [1.35, 1]})
+    for r in cycle:
+        if r["errors"] is None or r["name"].startswith("closed form"):
+            style = ":" if r["name"].startswith("closed") else "--"
+            left.axvline(1e6 * r["time"], color="0.45", linestyle=style, linewidth=1)
+            label = "closed form" if style == ":" else "floor" if r.get("floor") else "Pinocchio calls only"
+            left.text(1e6 * r["time"], 0.97, label + " ", rotation=90, va="top", ha="right", fontsize=7,
+                      transform=left.get_xaxis_transform())
             continue
-        ax.scatter(1e6 * t, max(errs[2], 1e-17), s=50, label=name)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("time per pose [us]")
-    ax.set_ylabel("largest relative error of a_D over the cycle")
-    ax.set_title("R-RTR cycle: speed against accuracy (median of repeats, this machine)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(1.02, 0.0))
+        left.scatter(1e6 * r["time"], max(r["errors"][2], 1e-17), s=45, label=r["name"], zorder=3)
+    left.set_xscale("log")
+    left.set_yscale("log")
+    left.set_xlabel("time per pose [µs] (median, this machine)")
+    left.set_ylabel("largest relative error of D's acceleration")
+    left.set_title("R-RTR cycle of 3600 poses: speed against accuracy", fontsize=10)
+    left.grid(True, which="both", alpha=0.3)
+    left.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, frameon=False)
+    for scheme, colour in (("euler", "C0"), ("taylor", "C1"), ("rk4", "C2")):
+        for gain, style in ((0.0, "-"), (50.0, "--")):
+            rows = [r for r in paths if r["scheme"] == scheme and r["gain"] == gain]
+            t = statistics.median(r["time"] for r in rows)
+            right.loglog([r["step"] for r in rows], [max(r["drift"], 1e-16) for r in rows], style, marker="o",
+                         color=colour, label=f"{scheme}, gain {gain:g}/s ({1e6 * t:.0f} µs/step)")
+    right.set_xlabel("time step [s]")
+    right.set_ylabel("largest drift of D [m]")
+    right.set_title("Arm path (text 17.110, 0.08 s): drift against step", fontsize=10)
+    right.grid(True, which="both", alpha=0.3)
+    right.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
     print(f"figure written to {path}")
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--poses", type=int, default=3600)
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--out", default=None, help="also write the markdown tables here")
+    parser.add_argument("--plot", default=None, help="also draw the trade here (PNG; pinmech[plot])")
+    args = parser.parse_args(argv)
+    cycle = cycle_rows(args.poses, args.repeats)
+    paths = path_rows(max(1, min(args.repeats, 3)))
+    head = (f"{args.poses} poses, median of {args.repeats} runs, pin {pin.__version__}, numpy {np.__version__}, "
+            f"Python {sys.version.split()[0]}")
+    text = "\n\n".join([head, cycle_table(cycle), verdicts(cycle),
+                        "Arm path (text 17.110, D at 1 m/s along x, CD vertical, 0.08 s):", path_table(paths)])
+    print(text)
+    if args.out:
+        Path(args.out).write_text(text + "\n", encoding="utf-8")
+    if args.plot:
+        plot(cycle, paths, args.plot)
 
 
 if __name__ == "__main__":

@@ -8,13 +8,14 @@ import io
 import itertools
 import json
 
+import closed_form
 import numpy as np
 import pytest
 
-import closed_form
 from pinmech import Scene, SweepError
 from pinmech.cli import main
-from pinmech.sweep import Sweep, write_csv
+from pinmech.sweep import Sweep
+from pinmech.tables import write_csv
 
 OMEGA1 = -50 * np.pi / 30
 
@@ -88,8 +89,10 @@ def test_csv_columns_carry_units(sweep):
     header = next(csv.reader(io.StringIO(out.getvalue())))
     for column in ("A.q [deg]", "link3.angle [deg]", "link3.omega [rad/s]", "link3.alpha [rad/s^2]",
                    "B_slider.v_rel [m/s]", "B_slider.a_rel [m/s^2]", "D.|v| [m/s]", "D.|a| [m/s^2]",
-                   "closure_residual [1]", "condition_number [1]"):
+                   "closure_residual [1]", "condition_number [1]", "newton_iterations [1]", "pose", "error"):
         assert column in header
+    rows = list(csv.DictReader(io.StringIO(out.getvalue())))
+    assert {r["pose"] for r in rows} == {"solved"} and not any(r["error"] for r in rows)
 
 
 def test_cli_writes_csv_json_and_a_figure(r_rtr_scene, tmp_path):
@@ -124,3 +127,110 @@ def test_start_options_agree_on_the_exact_solution(sweep):
     for other in runs[1:]:
         got = np.array([p.motion.points["D"].acceleration for p in other])
         np.testing.assert_allclose(got, ref, rtol=0, atol=1e-11 * np.abs(ref).max())
+
+
+def test_cli_marks_interpolated_rows_and_writes_json_lines(r_rtr_scene, tmp_path, capsys):
+    json_path = tmp_path / "s.jsonl"
+    assert main(["sweep", str(r_rtr_scene), "--steps", "41", "--interpolate", "4", "--json", str(json_path),
+                 "--csv", str(tmp_path / "s.csv")]) == 0
+    rows = list(csv.DictReader((tmp_path / "s.csv").open()))
+    kinds = [r["pose"] for r in rows]
+    assert kinds[0] == kinds[-1] == "solved" and kinds.count("interpolated") == 30
+    entries = [json.loads(line) for line in json_path.read_text().splitlines()]
+    assert [e["pose"] for e in entries] == kinds
+    assert entries[1]["accuracy"]["closure_residual"] > 0  # measured, not assumed
+
+
+@pytest.mark.parametrize("argv, code, message", [
+    (["--interpolate", "0"], 2, "at least 1"),
+    (["--steps", "1"], 2, "at least 2"),
+    (["--tol", "-1"], 2, "positive"),
+    (["--max-iterations", "0"], 2, "at least 1"),
+    (["--set", "sweep.colour=1"], 4, "unknown key colour"),
+    (["--set", 'sweep.start="hot"'], 4, "must be one of"),
+    (["--start", "cold", "--interpolate", "4"], 2, "predictor start"),
+])
+def test_cli_bad_sweep_options_exit_with_one_line(r_rtr_scene, capsys, argv, code, message):
+    assert main(["sweep", str(r_rtr_scene), "--steps", "5", *argv]) == code
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+
+
+def test_scene_sweep_keys_set_the_defaults(tmp_path, models_dir, capsys):
+    scene = tmp_path / "s.toml"
+    scene.write_text(f'urdf = "{models_dir / "r_rtr.urdf"}"\n[drivers.A]\nangle = "30 deg"\nspeed = "-50 rpm"\n'
+                     '[guess]\nB = "20 deg"\nB_slider = "-60 mm"\n'
+                     '[sweep]\nsteps = 5\nfrom = "0 deg"\nto = "90 deg"\nstart = "warm"\n')
+    assert main(["sweep", str(scene)]) == 0
+    rows = list(csv.reader(io.StringIO(capsys.readouterr().out)))
+    assert [float(r[0]) for r in rows[1:]] == pytest.approx([0, 22.5, 45, 67.5, 90])
+
+
+def test_a_task_scene_is_followed_in_time(scenes_dir, tmp_path, capsys):
+    """`pinmech sweep` on text 17.110's arm: the path mode, for the scene's [sweep]
+    duration (0.08 s, 1 ms steps) or --duration; without either it says what is missing."""
+    csv_path = tmp_path / "arm.csv"
+    assert main(["sweep", str(scenes_dir / "planar_arm.toml"), "--csv", str(csv_path)]) == 0
+    lines = csv_path.read_text().splitlines()
+    assert lines[0].startswith("t [s],A.q [deg]") and len(lines) == 82
+    assert main(["sweep", str(scenes_dir / "planar_arm.toml"), "--duration", "10 ms", "--csv", str(csv_path)]) == 0
+    assert len(csv_path.read_text().splitlines()) == 12
+    text = (scenes_dir / "planar_arm.toml").read_text().split("[sweep]")[0].replace('"../', f'"{scenes_dir.parent}/')
+    (tmp_path / "arm.toml").write_text(text)
+    assert main(["sweep", str(tmp_path / "arm.toml")]) == 2
+    assert "--duration" in capsys.readouterr().err
+
+
+def test_the_figure_marks_failures_and_stays_bounded(tmp_path, models_dir):
+    """A failing pose leaves a gap (NaN) and a red mark; a long sweep keeps every n-th pose."""
+    pytest.importorskip("matplotlib", reason='plots need pip install "pinmech[plot]"')
+    from pinmech.plot import SweepPlot
+
+    sweep = Sweep.from_scene(_singular_scene(tmp_path, models_dir))
+    recorder = SweepPlot(sweep, total=41, max_points=20)
+    for pose in sweep.poses(np.radians(np.linspace(-20.0, 20.0, 41)), skip_failures=True):
+        recorder.add(pose)
+    assert recorder.every == 3 and len(recorder.failed) == 1
+    assert any(np.isnan(v).any() for panel in recorder.series.values() for v in panel.values())
+    png = recorder.save(tmp_path / "f.png")
+    assert png.stat().st_size > 20_000
+
+
+def test_the_figure_needs_matplotlib(r_rtr_scene, monkeypatch, capsys):
+    """Without the extra: one line naming it, exit 2, and no sweep run first."""
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_matplotlib(name, *args, **kwargs):
+        if name.startswith("matplotlib"):
+            raise ImportError(name)
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_matplotlib)
+    assert main(["sweep", str(r_rtr_scene), "--steps", "5", "--plot", "x.png"]) == 2
+    assert 'pip install "pinmech[plot]"' in capsys.readouterr().err
+
+
+def test_a_sweep_where_every_pose_fails_plots_nothing_and_says_so(tmp_path, models_dir, capsys):
+    pytest.importorskip("matplotlib", reason='plots need pip install "pinmech[plot]"')
+    scene = _singular_scene(tmp_path, models_dir)
+    code = main(["sweep", str(scene.path), "--from", "0 deg", "--to", "0 deg", "--steps", "2", "--skip-failures",
+                 "--plot", str(tmp_path / "none.png"), "--csv", str(tmp_path / "none.csv")])
+    assert code == 2 and "nothing to plot" in capsys.readouterr().err
+    rows = list(csv.reader((tmp_path / "none.csv").open()))
+    assert rows[0] == ["A.q [deg]", "pose", "error"] and [r[1] for r in rows[1:]] == ["failed", "failed"]
+
+
+def test_the_progress_bar_shows_on_a_terminal_only(monkeypatch):
+    """Piped (the tests), poses pass through untouched; on a terminal tqdm wraps them."""
+    import sys
+
+    from pinmech.cli import _progress
+
+    items = iter(range(3))
+    assert _progress(items, 3) is items
+    pytest.importorskip("tqdm", reason='the bar needs pip install "pinmech[progress]"')
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
+    bar = _progress(range(3), 3)
+    assert type(bar).__name__ == "tqdm" and list(bar) == [0, 1, 2]

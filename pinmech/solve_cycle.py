@@ -1,0 +1,385 @@
+"""A driver swept through a range: every pose closed and rated, on one assembly branch.
+
+How each pose is found is the user's accuracy choice (README, "Speed and accuracy"):
+
+    start="predictor" (default): from the previous exact pose moved along the path,
+        q (+) (q' dx + q'' dx^2 / 2) on the configuration manifold, where q' and q''
+        are the derivatives of the closed configuration with respect to the swept
+        driver (its rates at unit driver speed): a guess O(dx^3) off, one Newton step.
+    start="warm": from the previous pose as it is (O(dx) off: more Newton iterations).
+    start="cold": every pose from the same guess (the scene's): slowest, and where two
+        assembly branches are close it may land on the other one.
+    batch=True (default, with the predictor, on dense ranges): every 64th pose is
+        solved as above; the poses between are guessed by quintic Hermite interpolation
+        in (q, q', q'') of their solved neighbours, every 8th first, then the rest, and
+        closed and rated together by `BatchSolver` (every pose still meets the
+        tolerance, with its accuracy measured).
+    interpolate=n: solve every n-th pose exactly (as above) and interpolate the poses
+        between (quintic Hermite); their accuracy is measured at the points of each
+        interval where the interpolation error peaks.
+
+With the other drivers at rest, velocities and accelerations follow from the path
+derivatives exactly: q_dot = q' x_dot and q_ddot = q'' x_dot^2 + q' x_ddot.
+Poses come out in chunks (arrays), so a million-pose range runs in bounded memory.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, field
+from itertools import islice
+
+import numpy as np
+import pinocchio as pin
+
+from pinmech.exceptions import LoopClosureError, PinmechError, SingularPoseError
+from pinmech.hermite import interpolate_poses
+from pinmech.results import Accuracy, LoopSolution
+from pinmech.solve_batch import BatchSolution, BatchSolver
+from pinmech.solve_loops import LoopSolver
+
+STARTS = ("predictor", "warm", "cold")
+#: Poses per chunk: what is held in memory at once.
+CHUNK = 4096
+#: Batched refinement: exact poses every LEVELS[0]-th, then every LEVELS[1]-th, ...,
+#: used when the driver moves less than MAX_SPAN (rad, or lengths of the mechanism)
+#: between the poses of the first level.
+LEVELS = (64, 8, 1)
+MAX_SPAN = 0.12
+#: Where the error of a quintic Hermite interpolant peaks within its interval (to
+#: leading order, s^3 (1 - s)^3 and its derivatives): the middle for positions and
+#: accelerations, (1 - 1/sqrt 5) / 2 for velocities (and its mirror image, as large).
+PEAKS = (0.5, 0.5 - 0.5 / math.sqrt(5.0))
+_FAILURES = (LoopClosureError, SingularPoseError)
+
+
+@dataclass(frozen=True)
+class RangeChunk:
+    """Consecutive poses of a range, as arrays.
+
+    Attributes:
+        start: index of the first pose in the range.
+        values: the swept driver's value at each pose [rad or m].
+        solution: q, v, a and the accuracy of each pose (NaN rows where a pose failed).
+        interpolated: True where a pose was interpolated rather than solved.
+        errors: position in the chunk -> the error of a pose that failed.
+    """
+
+    start: int
+    values: np.ndarray
+    solution: BatchSolution
+    interpolated: np.ndarray
+    errors: dict[int, PinmechError] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return len(self.values)
+
+    def pose(self, j: int) -> LoopSolution | None:
+        """Pose j of the chunk as a `LoopSolution` (None where it failed)."""
+        return None if j in self.errors else self.solution.solution(j)
+
+
+def solve_range(solver: LoopSolver, driver: str, values: Iterable[float], *, driver_q: np.ndarray,
+                driver_v: np.ndarray, driver_a: np.ndarray, guess: np.ndarray, start: str = "predictor",
+                batch: bool = True, interpolate: int = 1, chunk: int = CHUNK) -> Iterator[RangeChunk]:
+    """Solve the mechanism as `driver` takes each of `values`, the other drivers held (lazy).
+
+    Args:
+        driver_q, driver_v, driver_a: every driver's coordinate, rate and acceleration
+            (SI, in `solver.drivers` order); the swept driver's coordinate is replaced.
+        guess: the configuration the first pose starts from (it picks the branch).
+        start, batch, interpolate: the accuracy choices of the module docstring.
+
+    Raises:
+        PinmechError: an unknown start, or interpolation or batches asked with the other
+            drivers moving (their path is then not the swept driver's alone).
+    """
+    cycle = _Cycle(solver, driver, driver_q, driver_v, driver_a, guess, start, batch, interpolate)
+    values = iter(values)
+    index = 0
+    while True:
+        xs = np.fromiter(islice(values, chunk), dtype=float)
+        if not xs.size:
+            return
+        yield cycle.chunk(index, xs)
+        index += len(xs)
+
+
+@dataclass
+class _Exact:
+    """The last solved pose: its path derivatives (rates at unit driver speed), and its
+    condition number."""
+
+    value: float
+    q: np.ndarray
+    d1: np.ndarray | None
+    d2: np.ndarray | None
+    condition: float = 1.0
+    sigma_min: float = 1.0
+
+
+class _Cycle:
+    def __init__(self, solver: LoopSolver, driver: str, driver_q: np.ndarray, driver_v: np.ndarray,
+                 driver_a: np.ndarray, guess: np.ndarray, start: str, batch: bool, interpolate: int) -> None:
+        if start not in STARTS:
+            raise PinmechError(f"start must be one of {', '.join(STARTS)}, got {start!r}")
+        if int(interpolate) != interpolate or interpolate < 1:
+            raise PinmechError(f"interpolate must be a whole number of poses, at least 1, got {interpolate!r}")
+        self.solver, self.k = solver, solver.drivers.index(driver)
+        self.q_drv = np.array(driver_q, dtype=float)
+        self.v_drv, self.a_drv = np.array(driver_v, dtype=float), np.array(driver_a, dtype=float)
+        others = np.delete(np.concatenate((self.v_drv, self.a_drv)), [self.k, self.k + len(self.v_drv)])
+        self.alone = not np.any(others)  # only the swept driver moves
+        if interpolate > 1 and (start != "predictor" or not self.alone):
+            raise PinmechError("interpolating a sweep needs the predictor start and the other drivers at "
+                               "rest (zero speed and acceleration): their motion is not the swept driver's path")
+        batch = batch and self.alone
+        self.start, self.interpolate = start, int(interpolate)
+        self.batch = BatchSolver(solver) if batch and start == "predictor" and solver._cuts else None
+        self.measurer = (self.batch or BatchSolver(solver)) if interpolate > 1 and solver._cuts else None
+        self.guess = np.asarray(guess, dtype=float)
+        self.ref: _Exact | None = None
+        self.unit_v = np.zeros_like(self.v_drv)
+        self.unit_v[self.k] = 1.0
+        self.zero = np.zeros_like(self.v_drv)
+        self.span_scale = 1.0 if solver.mechanism.joint(driver).is_angular else solver.mechanism.length_scale
+
+    # ------------------------------------------------------------------ chunks
+    def chunk(self, index: int, xs: np.ndarray) -> RangeChunk:
+        """Solve the poses xs that follow the last solved pose."""
+        ref = self.ref
+        if self.start != "predictor":
+            return self._sequential(index, xs)
+        if ref is None:  # the first pose, from the user's guess, then the rest
+            head = self._sequential(index, xs[:1])
+            if len(xs) == 1:
+                return head
+            rest = self.chunk(index + 1, xs[1:]) if self.ref is not None else self._sequential(index + 1, xs[1:])
+            return _concat(head, rest)
+        try:
+            if self.interpolate > 1:
+                return self._interpolated(index, xs)
+            q, d1, d2, acc = self._exact(xs, self._levels(xs))
+            return self._actual(index, xs, q, d1, d2, acc, np.zeros(len(xs), dtype=bool))
+        except _Fallback:  # near trouble: pose by pose, each failure named
+            self.ref = ref
+            return self._sequential(index, xs)
+
+    def _levels(self, xs: np.ndarray) -> tuple[int, ...]:
+        """The batched levels this chunk's spacing allows (LEVELS, MAX_SPAN)."""
+        if self.batch is None or len(xs) < 2:
+            return (1,)
+        steps = np.abs(np.diff(np.concatenate(([self.ref.value], xs))))
+        step = float(steps.max()) / self.span_scale
+        for first in range(len(LEVELS) - 1):
+            if LEVELS[first] * step <= MAX_SPAN:
+                return LEVELS[first:]
+        return (1,)
+
+    def _sequential(self, index: int, xs: np.ndarray) -> RangeChunk:
+        """Pose after pose through `LoopSolver.solve`; a failing pose is kept as an error."""
+        rows, errors = [], {}
+        for j, x in enumerate(xs):
+            try:
+                rows.append(self._solve(x, actual=True))
+            except _FAILURES as exc:
+                errors[j] = exc
+                rows.append(None)
+        return RangeChunk(index, xs, _stack(rows, self.solver), np.zeros(len(xs), dtype=bool), errors)
+
+    def _exact(self, xs: np.ndarray, levels: tuple[int, ...]):
+        """Every pose exact, in path-derivative terms: q, q', q'' and accuracy arrays.
+
+        The poses of the first level one by one from the predictor, the others batched
+        from Hermite guesses between the poses of the level before (see LEVELS).
+        """
+        n, nq, nv = len(xs), self.solver.model.nq, self.solver.model.nv
+        ref = self.ref
+        q, d1, d2 = np.empty((n + 1, nq)), np.empty((n + 1, nv)), np.empty((n + 1, nv))
+        q[0], d1[0], d2[0] = ref.q, ref.d1, ref.d2  # slot 0: the pose before the chunk
+        x = np.concatenate(([ref.value], xs))
+        acc = _accuracy_arrays(n + 1)
+        solved = np.zeros(n + 1, dtype=bool)
+        solved[0] = True
+        for j in sorted(set(range(levels[0], n + 1, levels[0])) | {n}):
+            sol = self._solve(x[j], actual=False, fail=_Fallback)
+            q[j], d1[j], d2[j] = sol.q, sol.v, sol.a
+            _store(acc, j, sol.accuracy)
+            solved[j] = True
+        for stride in levels[1:]:
+            targets = np.array([j for j in range(stride, n + 1, stride) if not solved[j]], dtype=int)
+            if not targets.size:
+                continue
+            guesses = self._hermite(x, q, d1, d2, solved, targets)[0]
+            count = len(targets)
+            out = self.batch.try_solve(guesses, self._drivers(x[targets]), np.tile(self.unit_v, (count, 1)),
+                                       np.tile(self.zero, (count, 1)))
+            if out is None:
+                raise _Fallback
+            q[targets], d1[targets], d2[targets] = out.q, out.v, out.a
+            for name in _ACCURACY:
+                acc[name][targets] = getattr(out, name)
+            solved[targets] = True
+        self.ref = _Exact(float(x[n]), q[n].copy(), d1[n].copy(), d2[n].copy(), acc["condition"][n],
+                          acc["sigma_min"][n])
+        return q[1:], d1[1:], d2[1:], {k: v[1:] for k, v in acc.items()}
+
+    def _interpolated(self, index: int, xs: np.ndarray) -> RangeChunk:
+        """Exact poses every n-th (batched when dense), Hermite between, accuracy measured."""
+        n, ref = len(xs), self.ref
+        exact_at = np.array(sorted(set(range(self.interpolate - 1, n, self.interpolate)) | {n - 1}), dtype=int)
+        qe, d1e, d2e, acc_e = self._exact(xs[exact_at], self._levels(xs[exact_at]))
+        nq, nv = qe.shape[1], d1e.shape[1]
+        q, d1, d2 = np.empty((n + 1, nq)), np.empty((n + 1, nv)), np.empty((n + 1, nv))
+        acc = _accuracy_arrays(n + 1)
+        slots = exact_at + 1
+        q[0], d1[0], d2[0] = ref.q, ref.d1, ref.d2
+        q[slots], d1[slots], d2[slots] = qe, d1e, d2e
+        for name in _ACCURACY:
+            acc[name][slots] = acc_e[name]
+        acc["condition"][0], acc["sigma_min"][0] = ref.condition, ref.sigma_min
+        solved = np.zeros(n + 1, dtype=bool)
+        solved[0] = True
+        solved[slots] = True
+        x = np.concatenate(([ref.value], xs))
+        targets = np.flatnonzero(~solved)
+        if targets.size:
+            q[targets], d1[targets], d2[targets] = self._hermite(x, q, d1, d2, solved, targets)
+            self._measure(x, q, d1, d2, solved, targets, acc)
+        interpolated = np.zeros(n, dtype=bool)
+        interpolated[targets - 1] = True
+        return self._actual(index, xs, q[1:], d1[1:], d2[1:], {k: v[1:] for k, v in acc.items()}, interpolated)
+
+    # ------------------------------------------------------------------ pieces
+    def _drivers(self, values: np.ndarray) -> np.ndarray:
+        rows = np.tile(self.q_drv, (len(values), 1))
+        rows[:, self.k] = values
+        return rows
+
+    def _solve(self, x: float, *, actual: bool, fail: type[Exception] | None = None) -> LoopSolution:
+        """One pose by `LoopSolver.solve` from the start the user chose; it becomes the
+        reference pose. With `actual` the result carries the scene's rates, else the path
+        derivatives. A failure raises, as `fail` when given."""
+        self.q_drv[self.k] = x
+        ref, solver = self.ref, self.solver
+        guess = self.guess if ref is None or self.start == "cold" else ref.q
+        if self.start == "predictor" and ref is not None:
+            dx = x - ref.value
+            guess = pin.integrate(solver.model, ref.q, ref.d1 * dx + ref.d2 * (0.5 * dx * dx))
+        path = self.start == "predictor" and self.alone  # solve at unit speed, scale after
+        try:
+            if path:
+                sol = solver.solve(self.q_drv, self.unit_v, self.zero, guess=guess)
+                d1, d2 = sol.v, sol.a
+            else:
+                sol = solver.solve(self.q_drv, self.v_drv, self.a_drv, guess=guess)
+                d1 = d2 = None
+                if self.start == "predictor":  # other drivers move: path derivatives apart
+                    d1, d2, _ = solver.rates(sol.q, self.unit_v, self.zero, at_q=True)
+        except _FAILURES:
+            if fail is not None:
+                raise fail from None
+            raise
+        self.ref = _Exact(float(x), sol.q, d1, d2, sol.accuracy.condition, sol.accuracy.sigma_min)
+        return self._scaled(sol) if actual and path else sol
+
+    def _scaled(self, sol: LoopSolution) -> LoopSolution:
+        """Path derivatives -> the scene's rates: v = q' x_dot, a = q'' x_dot^2 + q' x_ddot."""
+        w, alpha = float(self.v_drv[self.k]), float(self.a_drv[self.k])
+        acc = sol.accuracy
+        accuracy = Accuracy(acc.residual, acc.iterations, acc.condition, acc.sigma_min,
+                            abs(w) * acc.velocity_residual,
+                            w * w * acc.acceleration_residual + abs(alpha) * acc.velocity_residual)
+        return LoopSolution(sol.q, sol.v * w, sol.a * (w * w) + sol.v * alpha, accuracy, sol.drivers)
+
+    def _actual(self, index: int, xs: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray,
+                acc: dict[str, np.ndarray], interpolated: np.ndarray) -> RangeChunk:
+        """A chunk in the scene's rates, from path derivatives (as `_scaled`)."""
+        w, alpha = float(self.v_drv[self.k]), float(self.a_drv[self.k])
+        solution = BatchSolution(
+            q, d1 * w, d2 * (w * w) + d1 * alpha, acc["residual"], acc["iterations"], acc["condition"],
+            acc["sigma_min"], abs(w) * acc["velocity_residual"],
+            w * w * acc["acceleration_residual"] + abs(alpha) * acc["velocity_residual"], self.solver.drivers)
+        return RangeChunk(index, xs, solution, interpolated)
+
+    def _hermite(self, x: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray, solved: np.ndarray,
+                 targets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """q, q', q'' at the slots `targets`, between their solved neighbours."""
+        known = np.flatnonzero(solved)
+        at = np.searchsorted(known, targets)
+        return self._hermite_at(x, q, d1, d2, known[at - 1], known[at], x[targets])
+
+    def _hermite_at(self, x: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray, left: np.ndarray,
+                    right: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """q, q', q'' at driver values `at` between slots `left` and `right` (hermite.py)."""
+        try:
+            return interpolate_poses(self.solver.model, x, q, d1, d2, left, right, at)
+        except ValueError:  # two poses at one driver value: pose by pose instead
+            raise _Fallback from None
+
+    def _measure(self, x: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray, solved: np.ndarray,
+                 targets: np.ndarray, acc: dict[str, np.ndarray]) -> None:
+        """Each interpolated pose gets the worst accuracy measured at its interval's error
+        peaks (PEAKS), and the worst condition number of the interval's ends and peaks."""
+        known = np.flatnonzero(solved)
+        right_of = known[np.searchsorted(known, targets)]
+        right = np.unique(right_of)
+        left = known[np.searchsorted(known, right) - 1]
+        at = np.concatenate([x[left] + p * (x[right] - x[left]) for p in PEAKS])
+        reps = len(PEAKS)
+        probe = self._hermite_at(x, q, d1, d2, np.tile(left, reps), np.tile(right, reps), at)
+        m = self.measurer.measure(*probe) if self.measurer is not None else None
+        where = np.searchsorted(right, right_of)
+        for name in ("residual", "velocity_residual", "acceleration_residual"):
+            worst = np.max(getattr(m, name).reshape(reps, -1), axis=0) if m is not None else np.zeros(len(right))
+            acc[name][targets] = worst[where]
+        cond = np.maximum(acc["condition"][left], acc["condition"][right])
+        sigma = np.minimum(acc["sigma_min"][left], acc["sigma_min"][right])
+        if m is not None:
+            cond = np.maximum(cond, np.max(m.condition.reshape(reps, -1), axis=0))
+            sigma = np.minimum(sigma, np.min(m.sigma_min.reshape(reps, -1), axis=0))
+        acc["condition"][targets], acc["sigma_min"][targets] = cond[where], sigma[where]
+
+
+class _Fallback(Exception):
+    """A chunk that the quick path cannot take: solve it pose by pose."""
+
+
+_ACCURACY = ("residual", "iterations", "condition", "sigma_min", "velocity_residual", "acceleration_residual")
+
+
+def _accuracy_arrays(n: int) -> dict[str, np.ndarray]:
+    acc = {name: np.zeros(n) for name in _ACCURACY}
+    acc["iterations"] = np.zeros(n, dtype=int)
+    return acc
+
+
+def _store(acc: dict[str, np.ndarray], j: int, accuracy: Accuracy) -> None:
+    for name, value in zip(_ACCURACY, (accuracy.residual, accuracy.iterations, accuracy.condition,
+                                        accuracy.sigma_min, accuracy.velocity_residual,
+                                        accuracy.acceleration_residual)):
+        acc[name][j] = value
+
+
+def _stack(rows: list[LoopSolution | None], solver: LoopSolver) -> BatchSolution:
+    """LoopSolutions (None where a pose failed: NaN rows) as one BatchSolution."""
+    n, model = len(rows), solver.model
+    q, v, a = np.full((n, model.nq), np.nan), np.full((n, model.nv), np.nan), np.full((n, model.nv), np.nan)
+    acc = {name: np.full(n, np.nan) for name in _ACCURACY}
+    acc["iterations"] = np.zeros(n, dtype=int)
+    for j, sol in enumerate(rows):
+        if sol is not None:
+            q[j], v[j], a[j] = sol.q, sol.v, sol.a
+            _store(acc, j, sol.accuracy)
+    return BatchSolution(q, v, a, *(acc[name] for name in _ACCURACY), solver.drivers)
+
+
+def _concat(a: RangeChunk, b: RangeChunk) -> RangeChunk:
+    """Two consecutive chunks as one."""
+    sa, sb = a.solution, b.solution
+    fields = ("q", "v", "a", *_ACCURACY)
+    solution = BatchSolution(*(np.concatenate((getattr(sa, f), getattr(sb, f))) for f in fields), sa.drivers)
+    errors = {**a.errors, **{len(a) + j: e for j, e in b.errors.items()}}
+    return RangeChunk(a.start, np.concatenate((a.values, b.values)), solution,
+                      np.concatenate((a.interpolated, b.interpolated)), errors)

@@ -1,0 +1,164 @@
+"""Tables of many poses (sweeps and arm paths): CSV with units in the column names, and
+JSON lines, each row written as its pose is solved, so a long sweep streams.
+
+Angles are in degrees in CSV (as users plot them) and in radians in JSON (SI, as
+`pinmech solve --json`); everything else is SI in both.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from collections.abc import Iterable
+from typing import IO, TYPE_CHECKING
+
+import numpy as np
+
+from pinmech.motion import Motion
+from pinmech.report import motion_dict
+
+if TYPE_CHECKING:
+    from pinmech.mechanism import Mechanism
+    from pinmech.path import PathPoint
+    from pinmech.sweep import Sweep, SweepPose
+
+
+def columns(sweep: Sweep, first: Motion) -> list[str]:
+    """CSV column names with units, from the first solved pose."""
+    unit = "deg" if sweep.is_angular else "m"
+    cols = [f"{sweep.driver}.q [{unit}]"]
+    planar = sweep.mechanism.plane_normal is not None
+    for name in first.links:
+        if planar:
+            cols += [f"{name}.angle [deg]", f"{name}.omega [rad/s]", f"{name}.alpha [rad/s^2]"]
+        else:
+            cols += [f"{name}.|omega| [rad/s]", f"{name}.|alpha| [rad/s^2]"]
+    for name in first.points:
+        cols += [f"{name}.{c} [m]" for c in "xyz"]
+        cols += [f"{name}.v{c} [m/s]" for c in "xyz"] + [f"{name}.|v| [m/s]"]
+        cols += [f"{name}.a{c} [m/s^2]" for c in "xyz"] + [f"{name}.|a| [m/s^2]"]
+    for name in first.sliders:
+        cols += [f"{name}.v_rel [m/s]", f"{name}.a_rel [m/s^2]", f"{name}.|a_cor| [m/s^2]"]
+    return cols + ["closure_residual [1]", "condition_number [1]", "newton_iterations [1]", "pose", "error"]
+
+
+def row(sweep: Sweep, pose: SweepPose, width: int) -> list[object]:
+    """One CSV row in the units of `columns` (empty cells where the pose failed)."""
+    first = math.degrees(pose.value) if sweep.is_angular else pose.value
+    if pose.motion is None:
+        return [first] + [""] * (width - 3) + ["failed", pose.error]
+    m, out = pose.motion, [first]
+    normal = sweep.mechanism.plane_normal
+    for link in m.links.values():
+        if normal is not None:
+            out += [math.degrees(link.angle), float(normal @ link.angular_velocity),
+                    float(normal @ link.angular_acceleration)]
+        else:
+            out += [_norm(link.angular_velocity), _norm(link.angular_acceleration)]
+    for p in m.points.values():
+        v, a = p.velocity.tolist(), p.acceleration.tolist()
+        out += p.position.tolist() + v + [math.hypot(*v)] + a + [math.hypot(*a)]
+    for name, s in m.sliders.items():
+        out += [m.joints[name].v, m.joints[name].a, _norm(s.coriolis_acceleration)]
+    acc = pose.accuracy
+    return out + [acc.residual, acc.condition, acc.iterations, "interpolated" if pose.interpolated else "solved", ""]
+
+
+class SweepCsv:
+    """Writes a sweep's poses as CSV rows as they come (`add`), then `close`."""
+
+    def __init__(self, sweep: Sweep, stream: IO[str]) -> None:
+        self.sweep, self.writer = sweep, csv.writer(stream)
+        self.header: list[str] | None = None
+        self.pending: list[SweepPose] = []  # failures before the first solved pose
+        self.count = 0
+
+    def add(self, pose: SweepPose) -> None:
+        if self.header is None:
+            if pose.motion is None:
+                self.pending.append(pose)  # the header waits for the first solved pose
+                return
+            self.header = columns(self.sweep, pose.motion)
+            self.writer.writerow(self.header)
+            for failed in self.pending:
+                self._write(failed)
+            self.pending = []
+        self._write(pose)
+
+    def _write(self, pose: SweepPose) -> None:
+        self.writer.writerow([f"{x:.12g}" if type(x) is float else x for x in row(self.sweep, pose, len(self.header))])
+        self.count += 1
+
+    def close(self) -> int:
+        """Finish (a sweep where every pose failed gets a short table); the row count."""
+        if self.header is None:
+            unit = "deg" if self.sweep.is_angular else "m"
+            self.writer.writerow([f"{self.sweep.driver}.q [{unit}]", "pose", "error"])
+            for failed in self.pending:
+                first = math.degrees(failed.value) if self.sweep.is_angular else failed.value
+                self.writer.writerow([_cell(first), "failed", failed.error])
+                self.count += 1
+        return self.count
+
+
+def write_csv(sweep: Sweep, poses: Iterable[SweepPose], stream: IO[str]) -> int:
+    """Stream poses to CSV as they are solved; returns the number of rows written."""
+    table = SweepCsv(sweep, stream)
+    for pose in poses:
+        table.add(pose)
+    return table.close()
+
+
+class SweepJsonLines:
+    """One JSON object per pose and line: the driver value [rad or m], the motion in SI
+    (as `pinmech solve --json`), the accuracy, and how the pose was found."""
+
+    def __init__(self, sweep: Sweep, stream: IO[str]) -> None:
+        self.sweep, self.stream = sweep, stream
+
+    def add(self, pose: SweepPose) -> None:
+        entry = {"index": pose.index, self.sweep.driver: pose.value, "error": pose.error,
+                 "pose": "failed" if pose.motion is None else "interpolated" if pose.interpolated else "solved"}
+        if pose.motion is not None:
+            entry.update(motion_dict(pose.motion))
+            entry["accuracy"] = pose.accuracy.as_dict()
+        self.stream.write(json.dumps(entry) + "\n")
+
+    def close(self) -> None:
+        self.stream.flush()
+
+
+class PathCsv:
+    """An arm path: time, each one-dof joint's q [deg or m], v, a, the drift, the
+    condition number."""
+
+    def __init__(self, mechanism: Mechanism, stream: IO[str]) -> None:
+        self.mechanism, self.writer = mechanism, csv.writer(stream)
+        self.joints = [j for j in mechanism.joints.values() if j.nv == 1]
+        header = ["t [s]"]
+        for j in self.joints:
+            units = ("deg", "rad/s", "rad/s^2") if j.is_angular else ("m", "m/s", "m/s^2")
+            header += [f"{j.name}.{x} [{u}]" for x, u in zip(("q", "v", "a"), units)]
+        self.writer.writerow(header + ["drift [m]", "angular_drift [rad]", "condition_number [1]"])
+        self.count = 0
+
+    def add(self, point: PathPoint) -> None:
+        cells = [f"{point.time:.9g}"]
+        for j in self.joints:
+            q = self.mechanism.coordinate(point.q, j.name)
+            cells += [f"{math.degrees(q) if j.is_angular else q:.12g}", f"{point.v[j.idx_v]:.12g}",
+                      f"{point.a[j.idx_v]:.12g}"]
+        self.writer.writerow(cells + [f"{point.drift:.3e}", f"{point.angular_drift:.3e}", f"{point.condition:.6g}"])
+        self.count += 1
+
+    def close(self) -> int:
+        return self.count
+
+
+def _norm(x: np.ndarray) -> float:
+    return math.hypot(*x.tolist())
+
+
+def _cell(x: object) -> object:
+    return f"{x:.12g}" if isinstance(x, float) else x
