@@ -144,7 +144,7 @@ def test_cli_marks_interpolated_rows_and_writes_json_lines(r_rtr_scene, tmp_path
 @pytest.mark.parametrize("argv, code, message", [
     (["--interpolate", "0"], 2, "at least 1"),
     (["--steps", "1"], 2, "at least 2"),
-    (["--tol", "-1"], 2, "positive"),
+    (["--tol", "-1"], 2, "must be between"),
     (["--max-iterations", "0"], 2, "at least 1"),
     (["--set", "sweep.colour=1"], 4, "unknown key colour"),
     (["--set", 'sweep.start="hot"'], 4, "must be one of"),
