@@ -3,7 +3,9 @@
 Exit codes: 0 success; 1 hand values mismatch (`check`); 2 usage or other pinmech error;
 3 bad URDF; 4 bad scene or hand file (unknown name, unit, key); 5 drivers do not match
 the mobility; 6 a loop cannot close; 7 singular pose; 8 inconsistent task; 9 a drawing
-input out of range. An output file that cannot be written is 2.
+input out of range; 10 another assembly than the scene's (or none reachable on it);
+11 the drivers cannot go further (a fold: limit angle, extreme, stroke). An output file
+that cannot be written is 2.
 """
 
 from __future__ import annotations
@@ -48,7 +50,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="pinmech",
         description="Kinematics of mechanisms and robot arms from URDF, on Pinocchio.",
         epilog="Exit codes: 0 ok, 1 check mismatch, 2 error, 3 URDF, 4 scene, 5 mobility, "
-        "6 loop cannot close, 7 singular pose, 8 task, 9 drawing.",
+        "6 loop cannot close, 7 singular pose, 8 task, 9 drawing, 10 assembly, 11 driver limit.",
     )
     parser.add_argument("--version", action="version", version=f"pinmech {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
