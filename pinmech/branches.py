@@ -34,8 +34,8 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-#: Signs a scene may ask for (`[assembly]` values), as +1 / -1.
-SIGN_WORDS = {"+": 1, "-": -1, "left": 1, "right": -1}
+#: Signs a scene may ask for (`assembly` values), as +1 / -1: the signs reports print.
+SIGN_WORDS = {"+": 1, "-": -1}
 
 
 @dataclass(frozen=True)
@@ -72,7 +72,12 @@ class Assembly:
         return {n: {"sign": s, "label": lab} for n, s, lab in zip(self.names, self.signs, self.labels)}
 
     def describe(self) -> str:
-        return ", ".join(f"{n}: {lab}" for n, lab in zip(self.names, self.labels)) or "no loops"
+        return ", ".join(f"{n}: {lab} ({_sign_word(s)})" if lab != _sign_word(s) else f"{n}: {lab}"
+                         for n, s, lab in zip(self.names, self.signs, self.labels)) or "no loops"
+
+    def pin_hint(self) -> str:
+        """The scene line that pins this assembly."""
+        return "assembly = { " + ", ".join(f'"{n}" = "{_sign_word(s)}"' for n, s in zip(self.names, self.signs)) + " }"
 
 
 class AssemblyStructure:
