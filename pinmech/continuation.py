@@ -34,7 +34,8 @@ from pinmech.exceptions import AssemblyError, DriverLimitError, LoopClosureError
 
 #: Largest step, in radians or mechanism sizes of driver motion.
 MAX_STEP = 0.25
-#: The corrector may move at most this fraction of the predicted move (plus a floor).
+#: The corrector may move at most this fraction of the predicted move (plus a floor),
+#: and at most 2|h| of it on a step h (`Path._trust`).
 TRUST = 0.25
 #: Largest turn of the extended tangent over one step [rad] (30 deg).
 MAX_TURN = math.radians(30.0)
@@ -47,8 +48,11 @@ CORRECTOR_ITERATIONS = 8
 #: A fold is located to this, in its pivot joint's coordinate (the driver is then right
 #: to about its square: the driver is quadratic in the pivot at a fold).
 FOLD_TOL = 1e-12
+#: A pose conditioned worse than this is no place to stand on: its tangent is noise (it
+#: sits on a crossing or a fold to within 1e-10), so a step does not end there.
+SINGULAR_NODE = 1e10
 #: Pivot-parameter steps taken at most before giving up.
-MAX_PIVOT_STEPS = 200000
+MAX_PIVOT_STEPS = 20000
 
 
 @dataclass
@@ -111,7 +115,7 @@ class Path:
         if not at_q:
             solver._residual(q)
         d1, d2, condition, sigma_min, v_res, a_res, signs = solver._rates(q, self.d, self.zero, limit=math.inf)
-        if not math.isfinite(condition) or 0 in signs:
+        if not condition <= SINGULAR_NODE or 0 in signs:
             raise _Singular
         return Node(p, q, d1, d2, signs, condition, sigma_min, v_res, a_res)
 
@@ -155,7 +159,7 @@ class Path:
         if not ok:
             return None, "the corrector did not converge"
         correction = solver.scaled_norm(pin.difference(solver.model, q_pred, q))
-        if correction > TRUST * solver.scaled_norm(move) + 1e3 * solver.tol:
+        if correction > self._trust(h) * solver.scaled_norm(move) + 1e3 * solver.tol:
             return None, "the corrector left the trust region (another root nearer than the path's)"
         try:
             new = self.node(p, q, at_q=True)
@@ -169,6 +173,14 @@ class Path:
             if not (small and turn < 0.1 * MAX_TURN):
                 return None, f"the assembly changed ({_signs(node.signs)} -> {_signs(new.signs)})"
         return new, ""
+
+    def _trust(self, h: float) -> float:
+        """The share of the predicted move the corrector may add on a step h. On one
+        smooth branch the second-order predictor is off by O(h^3), a share O(h^2) of the
+        move; a root on another branch through a nearby crossing is off by a share that
+        does not shrink with h. A limit of 2|h| (in radians or sizes), at most TRUST,
+        keeps the first and, once the step is small enough, refuses the second."""
+        return min(TRUST, 2.0 * abs(h) * self.unit)
 
     def _turn(self, a: Node, b: Node) -> float:
         """Angle between the extended tangents (q', 1) of two nodes, dimensionless."""
@@ -277,6 +289,7 @@ class _Curve:
         self.scalar = [int(v) for v, ok in zip(solver._dep_v, solver.dep_is_scalar) if ok]
         if not self.scalar:
             raise path._stuck(node, "no one-coordinate joint to follow the path by")
+        self.d_hat = path.d / path.unit  # drivers' motion per radian or size along the path
         self._ds = 1e-3
 
     def _pivot(self, tangent: np.ndarray) -> int:
@@ -284,15 +297,17 @@ class _Curve:
         return max(self.scalar, key=lambda v: scaled[v])
 
     def _tangent(self, q: np.ndarray) -> np.ndarray:
-        """Unit tangent (dq in velocity space, dp) of the curve at a closed q, unoriented."""
-        solver, d = self.solver, self.path.d
+        """Unit tangent of the curve at a closed q, unoriented: dq in velocity space and,
+        last, the drivers' motion along the path in radians or mechanism sizes (p times
+        the path's unit), so that every component is of one scale."""
+        solver, d_hat = self.solver, self.d_hat
         solver._residual(q)
         J = solver._jacobian()
-        A = np.hstack([J[:, solver._dep_v] * solver._dep_scale, (J[:, solver._drv_v] @ d)[:, None]])
+        A = np.hstack([J[:, solver._dep_v] * solver._dep_scale, (J[:, solver._drv_v] @ d_hat)[:, None]])
         t = np.linalg.svd(A)[2][-1]
         out = np.zeros(solver.model.nv + 1)
         out[solver._dep_v] = t[:-1] * solver._dep_scale
-        out[solver._drv_v] = t[-1] * d
+        out[solver._drv_v] = t[-1] * d_hat
         out[-1] = t[-1]
         return out
 
@@ -301,7 +316,7 @@ class _Curve:
         the node's q' where the driver is at a fold already)."""
         n = self.node
         t = self._tangent(n.q)
-        along = np.append(n.d1, 1.0) * sense
+        along = np.append(n.d1 / self.path.unit, 1.0) * sense
         if t @ along < 0:
             t = -t
         return _CurvePoint(n.p, n.q, 0.0, t, self._pivot(t))
@@ -319,14 +334,14 @@ class _Curve:
             if norm <= solver.tol:
                 return q, p
             Jn = solver._residual_jacobian()
-            A = np.hstack([Jn[:, others], (Jn[:, solver._drv_v] @ path.d)[:, None]])
+            A = np.hstack([Jn[:, others], (Jn[:, solver._drv_v] @ self.d_hat)[:, None]])
             try:
                 step = np.linalg.solve(A, -r)
             except np.linalg.LinAlgError:
                 return None
             dv = np.zeros(solver.model.nv)
             dv[others] = step[:-1]
-            p = p + float(step[-1])
+            p = p + float(step[-1]) / path.unit
             q = solver.set_drivers(pin.integrate(solver.model, q, dv), path.drivers(p))
             r_new = solver._residual(q)
             new_norm = float(np.max(np.abs(r_new), initial=0.0))
@@ -352,7 +367,7 @@ class _Curve:
         scale = (s - a.s) / a.tangent[a.pivot]
         move = a.tangent[:-1] * scale
         guess = pin.integrate(model, a.q, move)
-        out = self._close_at(guess, a.p + a.tangent[-1] * scale, a.pivot)
+        out = self._close_at(guess, a.p + a.tangent[-1] * scale / self.path.unit, a.pivot)
         if out is None:
             return None
         q, p = out

@@ -490,12 +490,42 @@ class LoopSolver:
 
     def follow(self, q0: np.ndarray, x0: np.ndarray, x1: np.ndarray, route: Route, *,
                through_folds: bool = False) -> np.ndarray:
-        """The closed q at driver values x1, followed from the closed pose q0 at x0."""
+        """The closed q at driver values x1, followed from the closed pose q0 at x0.
+
+        A single angular driver asked to turn more than once is followed one turn first:
+        where that turn brings the mechanism back onto q0 (a closed curve: every later
+        turn repeats it exactly), only the rest of the way is followed."""
+        x0, x1 = np.asarray(x0, dtype=float), np.asarray(x1, dtype=float)
         if np.array_equal(x0, x1):
             return q0.copy()
+        turn = 2.0 * math.pi
+        moving = np.flatnonzero(x1 != x0)
+        if not through_folds and len(moving) == 1 and abs(x1 - x0)[moving[0]] > turn \
+                and self.mechanism.joint(self.drivers[moving[0]]).is_angular:
+            k = int(moving[0])
+            once = x0.copy()
+            once[k] += math.copysign(turn, x1[k] - x0[k])
+            q_turn = self.follow(q0, x0, once, route)
+            if self.turn_gap(q0, q_turn) <= max(1e3 * self.tol, 1e-10):
+                rest = x0.copy()
+                rest[k] += math.fmod(x1[k] - x0[k], turn)
+                return self.set_drivers(self.follow(q0, x0, rest, route), x1)
+            return self.follow(q_turn, once, x1, route)
         path = Path(self, x0, x1 - x0, through_folds=through_folds)
         node = path.follow(path.node(0.0, q0), 1.0, route)
         return node.q
+
+    def turn_gap(self, q0: np.ndarray, q1: np.ndarray) -> float:
+        """Largest joint difference between two poses, angles modulo a turn [rad], slides
+        in mechanism sizes: 0 where q1 is q0 after whole turns."""
+        dv = pin.difference(self.model, q0, q1)
+        gap = 0.0
+        for joint in self.mechanism.joints.values():
+            for i in range(joint.idx_v, joint.idx_v + joint.nv):
+                d = float(dv[i])
+                d = math.remainder(d, 2 * math.pi) if joint.is_angular else d / self.mechanism.length_scale
+                gap = max(gap, abs(d))
+        return gap
 
     def _solution(self, q: np.ndarray, dv: np.ndarray, da: np.ndarray, residual: float, iterations: int,
                   route: Route | None) -> LoopSolution:

@@ -26,7 +26,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import pinocchio as pin
 
 from pinmech.analysis import (
     Drivers,
@@ -199,18 +198,7 @@ class Sweep:
         of the driver, a mechanism back on its start has a gap at rounding level."""
         if self.first_q is None or self.last_q is None:
             return math.nan
-        model = self.mechanism.model
-        dv = pin.difference(model, self.first_q, self.last_q)
-        gap = 0.0
-        for joint in self.mechanism.joints.values():
-            for i in range(joint.idx_v, joint.idx_v + joint.nv):
-                d = float(dv[i])
-                if joint.is_angular:
-                    d = math.remainder(d, 2 * math.pi)
-                else:
-                    d /= self.mechanism.length_scale
-                gap = max(gap, abs(d))
-        return gap
+        return self.solver.turn_gap(self.first_q, self.last_q)
 
     def _format(self, value: float) -> str:
         return f"{math.degrees(value):.6g} deg" if self.is_angular else f"{value:.6g} m"
