@@ -163,8 +163,8 @@ class Path:
         q, residual = solver.correct(q_pred, self.drivers(p), max_iterations=CORRECTOR_ITERATIONS)
         if residual is None:
             return None, "the corrector did not converge"
-        correction = solver.scaled_norm(pin.difference(solver.model, q_pred, q))
-        if correction > self._trust(h) * solver.scaled_norm(move) + 1e3 * solver.tol:
+        # the corrector's steps bound its displacement from the prediction (triangle inequality)
+        if solver.moved > self._trust(h) * solver.scaled_norm(move) + 1e3 * solver.tol:
             return None, "the corrector left the trust region (another root nearer than the path's)"
         try:
             new = self.node(p, q, at_q=True, residual=residual)

@@ -157,6 +157,7 @@ class LoopSolver:
         self.structure = AssemblyStructure(self.model, mechanism.closures, self._dep_v, mechanism.plane_normal)
         self.reference: Reference | None = None
         self.iterations = 0  # Newton iterations of the last `correct`
+        self.moved = 0.0  # sum of the scaled sizes of its steps: a bound on how far it moved q
 
     def _joint_nv(self, v: int) -> int:
         for joint in self.model.joints[1:]:
@@ -272,7 +273,7 @@ class LoopSolver:
         q = self.set_drivers(q_guess, driver_q)
         r = self._residual(q)
         norm = _max_abs(r)
-        self.iterations = 0
+        self.iterations, self.moved = 0, 0.0
         for _ in range(max_iterations):
             if norm <= self.tol:
                 break
@@ -339,9 +340,10 @@ class LoopSolver:
         From a guess where the Jacobian is singular a solve returns steps of 1e16 rad,
         after which no step can move those joints (a unit in the last place of 1e16 is 2).
         """
-        size = np.max(np.abs(step / self._dep_scale), initial=0.0)  # rad, or sizes of the mechanism
+        size = float(np.max(np.abs(step / self._dep_scale), initial=0.0))  # rad, or sizes of the mechanism
         if size > MAX_STEP:
             step = step * (MAX_STEP / size)
+        self.moved += min(size, MAX_STEP)
         self._step[:] = 0.0
         self._step[self._dep_v] = step
         return pin.integrate(self.model, q, self._step)
