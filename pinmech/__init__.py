@@ -13,6 +13,7 @@ from pinmech.closures import Closure
 from pinmech.exceptions import (
     CheckMismatch,
     FrameNotFound,
+    IndeterminateForcesError,
     LoopClosureError,
     MobilityError,
     ModelError,
@@ -23,6 +24,10 @@ from pinmech.exceptions import (
     TaskError,
     UnitError,
 )
+from pinmech.flywheel import EnergyFluctuation, energy_fluctuation
+from pinmech.forces import ForceSolution, ForceSolver, Load, PowerBalance, Reaction, mechanical_advantage
+from pinmech.forces_scene import ForceSettings, force_settings
+from pinmech.forces_sweep import SweepForces
 from pinmech.mechanism import JointInfo, Mechanism
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.path import PathPoint, follow_path
@@ -47,8 +52,14 @@ __all__ = [
     "Closure",
     "CoincidentPoint",
     "Drivers",
+    "EnergyFluctuation",
+    "ForceSettings",
+    "ForceSolution",
+    "ForceSolver",
     "FrameNotFound",
+    "IndeterminateForcesError",
     "JointInfo",
+    "Load",
     "LoopClosureError",
     "LoopSolution",
     "LoopSolver",
@@ -58,14 +69,17 @@ __all__ = [
     "Motion",
     "PathPoint",
     "PinmechError",
+    "PowerBalance",
     "RangeChunk",
     "RateSolution",
     "RateSolver",
+    "Reaction",
     "Scene",
     "SceneError",
     "SingularPoseError",
     "Sweep",
     "SweepError",
+    "SweepForces",
     "SweepPose",
     "Task",
     "TaskError",
@@ -73,10 +87,13 @@ __all__ = [
     "__version__",
     "analyse",
     "compare",
+    "energy_fluctuation",
     "evaluate_motion",
     "follow_path",
+    "force_settings",
     "load_hand_file",
     "load_mechanism",
+    "mechanical_advantage",
     "solve_range",
     "to_dict",
     "to_json",

@@ -406,3 +406,15 @@ class ForceSolver:
             kinetic += float(twists[i].dot(inertial))
         pin.updateFramePlacements(model, data)
         return gravity_power, load_power, kinetic
+
+
+def mechanical_advantage(solution: ForceSolution, loads: Sequence[Load]) -> float | None:
+    """Output load over input effort, |F| / |tau| ([1/m] for a turning driver, [1] for a
+    slider), for one driver and one load with a force; inf at a toggle (zero effort).
+    Meaningful in statics, where it is the inverse of the load point's velocity ratio."""
+    forces = [load for load in loads if np.any(load.force != 0)]
+    if len(solution.drivers) != 1 or len(forces) != 1:
+        return None
+    effort = abs(float(solution.effort[0]))
+    size = float(np.linalg.norm(forces[0].force))
+    return size / effort if effort > 0 else math.inf

@@ -61,7 +61,8 @@ def _vector(x: np.ndarray, planar_z: bool, unit: str, size: float) -> str:
     return "(" + ", ".join(_num(c if abs(c) > floor else 0.0) for c in parts) + f") {unit}"
 
 
-def forces_text(f: ForceSolution, mechanism: Mechanism, *, static: bool, loads: list[str]) -> list[str]:
+def forces_text(f: ForceSolution, mechanism: Mechanism, *, static: bool, loads: list[str],
+                advantage: float | None = None) -> list[str]:
     """Report lines: what was assumed, driver efforts, reactions, the power balance."""
     normal = mechanism.plane_normal
     planar_z = normal is not None and abs(abs(normal[2]) - 1.0) < 1e-12
@@ -74,6 +75,9 @@ def forces_text(f: ForceSolution, mechanism: Mechanism, *, static: bool, loads: 
     for name, effort in zip(f.drivers, f.effort):
         kind = "torque" if mechanism.joint(name).is_angular else "force"
         lines.append(f"  {name:<10} driver {kind} = {_num(effort)} {_effort_unit(mechanism, name)}")
+    if advantage is not None:
+        unit = "1/m" if mechanism.joint(f.drivers[0]).is_angular else ""
+        lines.append(f"  mechanical advantage |F_load| / |{f.drivers[0]} effort| = {advantage:.6g} {unit}".rstrip())
     lines += ["", "Joint reactions (force of the first link on the second, world frame)",
               "-------------------------------------------------------------------"]
     size = max((r.magnitude for r in f.reactions.values()), default=0.0)

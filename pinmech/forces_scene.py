@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from pinmech.exceptions import FrameNotFound, SceneError
-from pinmech.forces import ForceSolver, Load
+from pinmech.forces import ForceSolver, Load, mechanical_advantage
 from pinmech.mechanism import Mechanism
 from pinmech.scene import Scene
 
@@ -212,6 +212,9 @@ def analyse_forces(scene: Scene, mechanism: Mechanism, drivers: tuple[str, ...],
     if static:
         v, a = np.zeros_like(v), np.zeros_like(a)
     solution = solver.solve(q, v, a)
-    loads = [spec.name for spec in settings.loads]
-    return solution, {"forces": forces_dict(solution, mechanism, static=static),
-                      "_text": forces_text(solution, mechanism, static=static, loads=loads)}
+    names = [spec.name for spec in settings.loads]
+    advantage = mechanical_advantage(solution, solver.loads) if static else None
+    section = forces_dict(solution, mechanism, static=static)
+    section["mechanical_advantage"] = advantage
+    return solution, {"forces": section,
+                      "_text": forces_text(solution, mechanism, static=static, loads=names, advantage=advantage)}

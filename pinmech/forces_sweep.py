@@ -17,7 +17,7 @@ import numpy as np
 
 from pinmech.exceptions import SceneError
 from pinmech.flywheel import EnergyFluctuation, energy_fluctuation
-from pinmech.forces import ForceSolution
+from pinmech.forces import ForceSolution, mechanical_advantage
 from pinmech.forces_report import forces_dict
 from pinmech.forces_scene import ForceSettings, force_settings, force_solver
 from pinmech.sweep import Sweep, SweepPose
@@ -89,7 +89,12 @@ class SweepForces:
                 cols += [f"{name}.normal [N]", f"{name}.moment [N*m]"]
             else:
                 cols += [f"{name}.F{c} [N]" for c in ("xy" if planar else "xyz")] + [f"{name}.|F| [N]"]
+        if self._advantage(first) is not None:
+            cols.append(f"mechanical_advantage [{'1/m' if self._angular(first.drivers[0]) else '1'}]")
         return cols + ["power_residual [1]"]
+
+    def _advantage(self, f: ForceSolution) -> float | None:
+        return mechanical_advantage(f, self.solver.loads) if self.static else None
 
     def cells(self, f: ForceSolution | None, width: int) -> list[object]:
         """One row of `columns` (blank where the pose failed)."""
@@ -104,6 +109,9 @@ class SweepForces:
                 out += [float(np.linalg.norm(r.normal_force)), moment]
             else:
                 out += [float(x) for x in (r.force[:2] if planar else r.force)] + [r.magnitude]
+        advantage = self._advantage(f)
+        if advantage is not None:
+            out.append(advantage)
         return out + [max(f.power.residual, f.equation_residual)]
 
     def _planar_z(self) -> bool:
@@ -133,14 +141,14 @@ class SweepForces:
             if crossings:
                 lines.append(f"{name}: the driver effort changes sign (zero: toggle or load reversal) near "
                              + ", ".join(crossings))
-        energy = self.energy()
+        energy = None if self.static else self.energy()
         if energy is not None:
-            lines.append(f"{name}: mean torque {energy.mean_torque:.6g} N m over {math.degrees(energy.span):.6g} deg; "
+            lines.append(f"{name}: mean torque {_shown(energy.mean_torque, self.efforts):.6g} N m over {math.degrees(energy.span):.6g} deg; "
                          f"energy fluctuation {energy.energy_fluctuation:.6g} J (slowest at "
                          f"{math.degrees(energy.slowest_angle):.4g} deg, fastest at "
                          f"{math.degrees(energy.fastest_angle):.4g} deg)")
             speed = abs(float(self.sweep.drivers.v[self.driver_index]))
-            if self.flywheel and speed > 0 and not self.static:
+            if self.flywheel and speed > 0:
                 lines.append(f"{name}: coefficient of speed fluctuation {energy.speed_fluctuation(self.flywheel, speed):.4g}"
                              f" with a {self.flywheel:.6g} kg m^2 flywheel at {speed:.6g} rad/s (flywheel inertia only)")
         return lines
@@ -208,7 +216,8 @@ class TorquePlot:
         ax.plot(x, y, lw=1.5, label=f"{f.sweep.driver} driver {'torque' if angular else 'force'}")
         energy = f.energy()
         if energy is not None:
-            ax.axhline(energy.mean_torque, color="k", lw=0.8, ls="--", label=f"mean {energy.mean_torque:.4g} N m")
+            mean = _shown(energy.mean_torque, f.efforts)
+            ax.axhline(mean, color="k", lw=0.8, ls="--", label=f"mean {mean:.4g} N m")
             ax.fill_between(x, y, energy.mean_torque, alpha=0.2,
                             label=f"energy fluctuation {energy.energy_fluctuation:.4g} J")
         ax.set_xlabel(f"{f.sweep.driver} [{'deg' if angular else 'm'}]")
@@ -218,3 +227,8 @@ class TorquePlot:
         ax.legend(fontsize=8)
         fig.tight_layout()
         return _save(plt, fig, path)
+
+
+def _shown(mean: float, efforts: list[float]) -> float:
+    """The mean torque, with rounding noise (below 1e-12 of the largest torque) shown as 0."""
+    return mean if abs(mean) > 1e-12 * max(map(abs, efforts), default=0.0) else 0.0
