@@ -25,7 +25,14 @@ from pinmech.exceptions import (
     UnitError,
 )
 from pinmech.flywheel import EnergyFluctuation, energy_fluctuation
-from pinmech.forces import ForceSolution, ForceSolver, Load, PowerBalance, Reaction, mechanical_advantage
+from pinmech.forces import (
+    ForceSolution,
+    ForceSolver,
+    Load,
+    PowerBalance,
+    Reaction,
+    mechanical_advantage,
+)
 from pinmech.forces_scene import ForceSettings, force_settings
 from pinmech.forces_sweep import SweepForces
 from pinmech.mechanism import JointInfo, Mechanism

@@ -15,10 +15,10 @@ import numpy as np
 
 from pinmech.exceptions import FrameNotFound, MobilityError, ModelError, SceneError
 from pinmech.forces import ForceSolution
+from pinmech.forces_scene import analyse_forces, wants_forces
 from pinmech.mechanism import Mechanism, urdf_joint_types
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.results import LoopSolution
-from pinmech.forces_scene import analyse_forces, wants_forces
 from pinmech.scene import Scene
 from pinmech.solve_loops import LoopSolver
 

@@ -95,8 +95,8 @@ def forces_text(f: ForceSolution, mechanism: Mechanism, *, static: bool, loads: 
                                  f"moment {_num(moment)} N m (about {name}'s origin)"]
         lines.append(f"  {label:<10} " + "   ".join(cells))
     p = f.power
-    lines += ["", f"  power balance ({p.velocity} velocities): drivers {p.driver_power:.6g} W + gravity "
-              f"{p.gravity_power:.6g} W + loads {p.load_power:.6g} W = dT/dt {p.kinetic_rate:.6g} W, "
-              f"residual {p.residual:.1e}; equations residual {f.equation_residual:.1e}, "
-              f"condition number {f.condition:.4g}"]
+    lines += ["", (f"  power balance ({p.velocity} velocities): drivers {p.driver_power:.6g} W + gravity "
+                   f"{p.gravity_power:.6g} W + loads {p.load_power:.6g} W = dT/dt {p.kinetic_rate:.6g} W, "
+                   f"residual {p.residual:.1e}; equations residual {f.equation_residual:.1e}, "
+                   f"condition number {f.condition:.4g}")]
     return lines

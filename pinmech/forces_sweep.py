@@ -132,8 +132,8 @@ class SweepForces:
         """Lines for the end of a sweep: the cycle's torque, energy, zero crossings, residual."""
         name, angular = self.sweep.driver, self.sweep.is_angular
         unit = "N m" if angular else "N"
-        lines = [f"forces at {len(self.values)} poses ({'statics' if self.static else 'dynamics'}); "
-                 f"largest power-balance or equation residual {self.worst_power:.1e}"]
+        lines = [(f"forces at {len(self.values)} poses ({'statics' if self.static else 'dynamics'}); "
+                  f"largest power-balance or equation residual {self.worst_power:.1e}")]
         if self.efforts:
             e = np.array(self.efforts)
             lines.append(f"{name}: driver {'torque' if angular else 'force'} from {e.min():.6g} to {e.max():.6g} {unit}")

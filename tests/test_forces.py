@@ -196,7 +196,7 @@ def test_statics_is_virtual_work_by_finite_differences(which):
         f = ForceSolver(mech, [driver], gravity=g, loads=[load]).solve(sol.q, sol.v, sol.a)
         assert f.power.velocity == "virtual" and f.power.residual < 1e-12
 
-        def positions(t):
+        def positions(t, build=build, mech=mech, point=point):
             _, s = build(t, 0.0, 0.0)
             data = mech.model.createData()
             pin.framesForwardKinematics(mech.model, data, s.q)

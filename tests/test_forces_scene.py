@@ -72,6 +72,13 @@ def test_statics_gives_the_mechanical_advantage_of_virtual_work(capsys):
         assert out["power"]["velocity"] == "virtual" and out["power"]["residual"] < 1e-12
 
 
+def test_check_compares_hand_forces_at_their_printed_precision(capsys):
+    """The hand file holds the Newton-Euler values as scripts/closed_form_forces.py prints
+    them; every one is correctly rounded (within half a unit of its last digit)."""
+    assert main(["check", str(SCENES / "slider_crank_dynamic.hand.toml")]) == 0
+    assert "8 ok, 0 within rounding, 0 mismatch" in capsys.readouterr().out
+
+
 def test_python_api_carries_the_forces():
     analysis = pinmech.analyse(pinmech.Scene.load(SCENE))
     assert analysis.forces.effort[0] == pytest.approx(hand(45.0).T, rel=1e-9)
