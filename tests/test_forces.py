@@ -155,6 +155,38 @@ def test_virtual_power_holds_at_random_poses(which):
         assert f.is_balanced(1e-12)
 
 
+def test_a_spatial_loop_balances_its_power(tmp_path):
+    """The spatial RSUR (spherical cut, 3 rows; a universal joint in the tree), gravity and a
+    load in 3-D: virtual power to rounding, and the spherical cut carries no moment."""
+    from tests._mechanisms import spatial_rsur_urdf
+
+    path = tmp_path / "rsur.urdf"
+    path.write_text(spatial_rsur_urdf())
+    mech = pinmech.Mechanism.from_urdf(path)
+    rng = np.random.default_rng(3)
+    for theta in (0.0, 1.0, 2.0):
+        sol = pinmech.LoopSolver(mech, ["R1"]).solve([theta], [2.0], [1.0], guess=mech.neutral())
+        load = Load("F", mech.links["coupler"], rng.normal(size=3) * 10, rng.normal(size=3))
+        f = ForceSolver(mech, ["R1"], gravity=(0.3, -1.0, -G), loads=[load]).solve(sol.q, sol.v, sol.a)
+        assert f.power.residual < 1e-12 and f.equation_residual < 1e-12
+        np.testing.assert_array_equal(f.reactions["S"].moment, np.zeros(3))
+        assert f.reactions["S"].magnitude > 0
+
+
+def test_a_driven_slider_gives_the_force_of_equal_power():
+    """Same pose and motion driven at the piston instead of the crank: one driver either
+    way, so its power is the same, F v_piston = tau omega (1e-10 relative: rounding and the
+    closure tolerance)."""
+    mech, sol = slider_crank(np.radians(70), 200.0, 30.0)
+    by_crank = ForceSolver(mech, ["O"], gravity=(0, -G, 0)).solve(sol.q, sol.v, sol.a)
+    by_piston = ForceSolver(mech, ["slide"], gravity=(0, -G, 0)).solve(sol.q, sol.v, sol.a)
+    v_piston = sol.v[mech.joint("slide").idx_v]
+    assert by_piston.effort[0] * v_piston == pytest.approx(by_crank.effort[0] * 200.0, rel=1e-10)
+    assert by_piston.reactions["slide"].axial_force == pytest.approx(by_piston.effort[0], rel=1e-12)
+    assert abs(by_piston.reactions["O"].axial_moment) < 1e-12 * abs(by_crank.effort[0])
+    assert by_piston.power.residual < 1e-12
+
+
 def test_driver_power_is_the_rate_of_mechanical_energy_by_finite_differences():
     """At constant crank speed, tau omega = d/dt (T + V_gravity + V_load), with T = v^T M v / 2
     (CRBA) and the potentials from positions, all differenced over +-h of crank angle.
