@@ -409,12 +409,24 @@ class ForceSolver:
 
 
 def mechanical_advantage(solution: ForceSolution, loads: Sequence[Load]) -> float | None:
-    """Output load over input effort, |F| / |tau| ([1/m] for a turning driver, [1] for a
-    slider), for one driver and one load with a force; inf at a toggle (zero effort).
-    Meaningful in statics, where it is the inverse of the load point's velocity ratio."""
-    forces = [load for load in loads if np.any(load.force != 0)]
-    if len(solution.drivers) != 1 or len(forces) != 1:
+    """Output load over input effort for one driver and one load: |F| / |tau| for a force
+    load ([1/m] on a turning driver, [1] on a slider), |T_load| / |tau| for a torque load
+    ([1] on a turning driver, [m] on a slider); inf at a toggle (zero effort), None when it
+    does not apply. Meaningful in statics, where it is the inverse velocity ratio."""
+    if len(solution.drivers) != 1 or len(loads) != 1:
         return None
+    load = loads[0]
+    has_force, has_torque = bool(np.any(load.force != 0)), bool(np.any(load.torque != 0))
+    if has_force == has_torque:
+        return None
+    size = float(np.linalg.norm(load.force if has_force else load.torque))
     effort = abs(float(solution.effort[0]))
-    size = float(np.linalg.norm(forces[0].force))
     return size / effort if effort > 0 else math.inf
+
+
+def advantage_unit(driver_angular: bool, load: Load) -> str:
+    """The unit of `mechanical_advantage`: 1/m, 1 or m."""
+    force = bool(np.any(load.force != 0))
+    if force == driver_angular:
+        return "1/m" if force else "m"
+    return "1"

@@ -62,7 +62,7 @@ def _vector(x: np.ndarray, planar_z: bool, unit: str, size: float) -> str:
 
 
 def forces_text(f: ForceSolution, mechanism: Mechanism, *, static: bool, loads: list[str],
-                advantage: float | None = None) -> list[str]:
+                advantage: tuple[float | None, str] = (None, "")) -> list[str]:
     """Report lines: what was assumed, driver efforts, reactions, the power balance."""
     normal = mechanism.plane_normal
     planar_z = normal is not None and abs(abs(normal[2]) - 1.0) < 1e-12
@@ -75,9 +75,8 @@ def forces_text(f: ForceSolution, mechanism: Mechanism, *, static: bool, loads: 
     for name, effort in zip(f.drivers, f.effort):
         kind = "torque" if mechanism.joint(name).is_angular else "force"
         lines.append(f"  {name:<10} driver {kind} = {_num(effort)} {_effort_unit(mechanism, name)}")
-    if advantage is not None:
-        unit = "1/m" if mechanism.joint(f.drivers[0]).is_angular else ""
-        lines.append(f"  mechanical advantage |F_load| / |{f.drivers[0]} effort| = {advantage:.6g} {unit}".rstrip())
+    if advantage[0] is not None:
+        lines.append(f"  mechanical advantage |load| / |{f.drivers[0]} effort| = {advantage[0]:.6g} {advantage[1]}")
     lines += ["", "Joint reactions (force of the first link on the second, world frame)",
               "-------------------------------------------------------------------"]
     size = max((r.magnitude for r in f.reactions.values()), default=0.0)

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from pinmech.exceptions import FrameNotFound, SceneError
-from pinmech.forces import ForceSolver, Load, mechanical_advantage
+from pinmech.forces import ForceSolver, Load, advantage_unit, mechanical_advantage
 from pinmech.mechanism import Mechanism
 from pinmech.scene import Scene
 
@@ -214,7 +214,8 @@ def analyse_forces(scene: Scene, mechanism: Mechanism, drivers: tuple[str, ...],
     solution = solver.solve(q, v, a)
     names = [spec.name for spec in settings.loads]
     advantage = mechanical_advantage(solution, solver.loads) if static else None
+    unit = advantage_unit(mechanism.joint(drivers[0]).is_angular, solver.loads[0]) if advantage is not None else ""
     section = forces_dict(solution, mechanism, static=static)
     section["mechanical_advantage"] = advantage
-    return solution, {"forces": section,
-                      "_text": forces_text(solution, mechanism, static=static, loads=names, advantage=advantage)}
+    text = forces_text(solution, mechanism, static=static, loads=names, advantage=(advantage, unit))
+    return solution, {"forces": section, "_text": text}

@@ -17,7 +17,7 @@ import numpy as np
 
 from pinmech.exceptions import SceneError
 from pinmech.flywheel import EnergyFluctuation, energy_fluctuation
-from pinmech.forces import ForceSolution, mechanical_advantage
+from pinmech.forces import ForceSolution, advantage_unit, mechanical_advantage
 from pinmech.forces_report import forces_dict
 from pinmech.forces_scene import ForceSettings, force_settings, force_solver
 from pinmech.sweep import Sweep, SweepPose
@@ -90,7 +90,8 @@ class SweepForces:
             else:
                 cols += [f"{name}.F{c} [N]" for c in ("xy" if planar else "xyz")] + [f"{name}.|F| [N]"]
         if self._advantage(first) is not None:
-            cols.append(f"mechanical_advantage [{'1/m' if self._angular(first.drivers[0]) else '1'}]")
+            unit = advantage_unit(self._angular(first.drivers[0]), self.solver.loads[0])
+            cols.append(f"mechanical_advantage [{unit}]")
         return cols + ["power_residual [1]"]
 
     def _advantage(self, f: ForceSolution) -> float | None:

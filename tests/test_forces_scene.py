@@ -72,6 +72,29 @@ def test_statics_gives_the_mechanical_advantage_of_virtual_work(capsys):
         assert out["power"]["velocity"] == "virtual" and out["power"]["residual"] < 1e-12
 
 
+def test_four_bar_statics_advantage_is_the_inverse_velocity_ratio_and_toggles_are_its_limits(capsys):
+    """A torque T4 on the rocker, gravity off: tau2 = -T4 omega4 / omega2, so the advantage
+    |T4| / |tau2| = |omega2 / omega4| (closed form, 1e-10); it vanishes where the rocker
+    stops, at the limit positions, where crank and coupler are in line: |O2 B| = b +- a,
+    B on the rocker's circle. The sweep reports those crank angles (printed to 4 digits,
+    linear interpolation over 0.5 deg steps: 0.05 deg)."""
+    scene, off = str(SCENES / "four_bar_dynamic.toml"), 'gravity.acceleration="0 m/s^2"'
+    assert main(["forces", scene, "--static", "--json", "--set", off]) == 0
+    out = json.loads(capsys.readouterr().out)["forces"]
+    k = cf.four_bar(np.radians(60.0), 1.0, 0.0, 0.04, 0.12, 0.08, 0.10)
+    assert out["mechanical_advantage"] == pytest.approx(abs(1.0 / float(k.omega4)), rel=1e-10)
+    assert out["drivers"]["O2"]["effort"] == pytest.approx(0.5 * float(k.omega4), rel=1e-10)  # T4 = -0.5 N m
+    assert main(["sweep", scene, "--static", "--set", off, "--steps", "721"]) == 0
+    line = [x for x in capsys.readouterr().err.splitlines() if "changes sign" in x][0]
+    found = sorted(float(x) % 360 for x in line.split("near ")[1].replace(" deg", "").split(", "))
+    a, b, c, d = 0.04, 0.12, 0.08, 0.10
+    limits = []
+    for reach, turn in ((b + a, 0.0), (b - a, 180.0)):
+        x = (reach**2 - c**2 + d**2) / (2 * d)
+        limits.append((np.degrees(np.arctan2(np.sqrt(reach**2 - x**2), x)) + turn) % 360)
+    np.testing.assert_allclose(found, sorted(limits), atol=0.05)
+
+
 def test_check_compares_hand_forces_at_their_printed_precision(capsys):
     """The hand file holds the Newton-Euler values as scripts/closed_form_forces.py prints
     them; every one is correctly rounded (within half a unit of its last digit)."""
