@@ -85,7 +85,7 @@ def test_four_bar_statics_advantage_is_the_inverse_velocity_ratio_and_toggles_ar
     assert out["mechanical_advantage"] == pytest.approx(abs(1.0 / float(k.omega4)), rel=1e-10)
     assert out["drivers"]["O2"]["effort"] == pytest.approx(0.5 * float(k.omega4), rel=1e-10)  # T4 = -0.5 N m
     assert main(["sweep", scene, "--static", "--set", off, "--steps", "721"]) == 0
-    line = [x for x in capsys.readouterr().err.splitlines() if "changes sign" in x][0]
+    line = next(x for x in capsys.readouterr().err.splitlines() if "changes sign" in x)
     found = sorted(float(x) % 360 for x in line.split("near ")[1].replace(" deg", "").split(", "))
     a, b, c, d = 0.04, 0.12, 0.08, 0.10
     limits = []
