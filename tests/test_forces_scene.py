@@ -223,3 +223,27 @@ def test_missing_masses_name_the_links(tmp_path, capsys):
 def test_forces_on_a_task_scene_are_refused(capsys):
     assert main(["forces", str(SCENES / "planar_arm.toml")]) == 4
     assert "not for [[task]] scenes" in capsys.readouterr().err
+
+
+def test_torque_plot_is_drawn(tmp_path, capsys):
+    pytest.importorskip("matplotlib", reason='needs pip install "pinmech[plot]"')
+    path = tmp_path / "torque.png"
+    assert main(["sweep", str(SCENE), "--steps", "37", "--torque-plot", str(path)]) == 0
+    assert path.stat().st_size > 10_000 and "figure written to" in capsys.readouterr().err
+
+
+def test_failed_poses_leave_blank_force_cells(tmp_path, capsys):
+    """The four-bar driven at its rocker cannot turn it fully: the poses out of reach are
+    rows with their error and empty force cells; the others carry forces."""
+    text = (SCENES / "four_bar_dynamic.toml").read_text().replace('urdf = "../', f'urdf = "{SCENES.parent}/')
+    text = text.replace("[drivers.O2]", "[drivers.O4]").replace('angle = "60 deg"', 'angle = "100 deg"')
+    text = text.replace('O4 = "100 deg"', 'O2 = "60 deg"')
+    path = tmp_path / "rocker.toml"
+    path.write_text(text)
+    assert main(["sweep", str(path), "--steps", "37", "--skip-failures", "--start", "cold"]) == 0
+    rows = _rows(capsys.readouterr().out)
+    failed = [r for r in rows if r["pose"] == "failed"]
+    solved = [r for r in rows if r["pose"] == "solved"]
+    assert failed and solved
+    assert all(r["O4.torque [N*m]"] == "" for r in failed)
+    assert all(float(r["power_residual [1]"]) < 1e-12 for r in solved)
