@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from pinmech.closures import _cross
 from pinmech.exceptions import IndeterminateForcesError, ModelError
 from pinmech.mechanism import Mechanism
 
@@ -334,7 +335,7 @@ class ForceSolver:
     # ------------------------------------------------------------------ wrenches
     def _world_to_joint(self, joint: int, point: np.ndarray, force: np.ndarray, moment: np.ndarray) -> pin.Force:
         """A force at `point` and a moment (world frame) as a spatial force in a joint's frame."""
-        return self.data.oMi[joint].actInv(pin.Force(force, moment + np.cross(point, force)))
+        return self.data.oMi[joint].actInv(pin.Force(force, moment + _cross(point, force)))
 
     def _load_wrenches(self) -> list[pin.Force]:
         """The loads as RNEA external forces, one per joint, in the joints' local frames."""
