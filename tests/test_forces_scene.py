@@ -101,6 +101,15 @@ def test_check_compares_hand_forces_at_their_printed_precision(capsys):
     assert "8 ok, 0 within rounding, 0 mismatch" in capsys.readouterr().out
 
 
+def test_static_in_the_scene_is_the_static_flag(capsys):
+    assert main(["forces", str(SCENE), "--json", "--static"]) == 0
+    by_flag = json.loads(capsys.readouterr().out)["forces"]
+    assert main(["forces", str(SCENE), "--json", "--set", "forces.static=true"]) == 0
+    by_scene = json.loads(capsys.readouterr().out)["forces"]
+    assert by_scene["static"] and by_scene["drivers"] == by_flag["drivers"]
+    assert by_scene["power"]["kinetic_rate"] == 0.0
+
+
 def test_python_api_carries_the_forces():
     analysis = pinmech.analyse(pinmech.Scene.load(SCENE))
     assert analysis.forces.effort[0] == pytest.approx(hand(45.0).T, rel=1e-9)
