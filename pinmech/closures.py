@@ -72,7 +72,9 @@ class Closure:
         axis: joint axis in P (unit), for revolute and prismatic cuts.
         child_axis: joint axis in C (unit); equals `axis` once the loop is closed.
         basis: (k, n_sel) constant row basis of the independent rows (set by mechanism.py).
-        length_scale: position rows are divided by this [m] so rows are dimensionless.
+        length_scale: the loop's size [m] (mechanism.py): position rows are divided by it
+            so rows are dimensionless, and the closure tolerance is relative to it.
+        joints: ids of the Pinocchio joints on the loop (set by mechanism.py).
     """
 
     name: str
@@ -85,6 +87,7 @@ class Closure:
     child_link: str = ""
     basis: np.ndarray | None = None
     length_scale: float = 1.0
+    joints: tuple[int, ...] = ()
     _select: np.ndarray = field(init=False, repr=False)
     _rows6: np.ndarray = field(init=False, repr=False)
 

@@ -9,6 +9,8 @@ import numpy as np
 
 #: Machine epsilon of float64, the rounding of every number pinmech computes.
 EPS = float(np.finfo(float).eps)
+#: Constants of the position, velocity and acceleration bounds (`Accuracy.error_bounds`).
+BOUND_FACTORS = (2.0, 4.0, 16.0)
 
 
 @dataclass(frozen=True)
@@ -38,15 +40,18 @@ class Accuracy:
 
         With m = max(residual, eps) (what the loop closure left, or rounding) and k the
         condition number: positions 2 k m (the residual left along the Jacobian's soft
-        direction), velocities k^2 m, accelerations k^3 m. Accelerations reach k^3 m where
-        the rates stay finite while k grows (an R-RTR whose guide passes through its pivot);
-        where the rates grow with k (a four-bar's toggle or dead centres) they do better,
-        about k^2 m, and an open arm's rate problem gives k eps for both. Measured against
-        extended-precision closed forms in tests/test_singular.py.
+        direction), velocities 4 k^2 m, accelerations 16 k^3 m. Accelerations reach k^3 m
+        where the rates stay finite while k grows (an R-RTR whose guide passes through its
+        pivot: 3.1 k^3 m, the worst measured); where the rates grow with k (a four-bar's
+        toggle or dead centres) they do better, about k^2 m, and an open arm's rate problem
+        gives k eps for both. The factors 4 and 16 are margins of about 5 over the worst
+        ratios measured against extended-precision closed forms (tests/test_singular.py,
+        scripts/singular_accuracy.py): k depends on how lengths are made dimensionless (by
+        the loops' sizes), which no law fixes to better than a small factor.
         """
         m = max(self.residual, EPS)
         k = self.condition
-        return 2 * k * m, k**2 * m, k**3 * m
+        return BOUND_FACTORS[0] * k * m, BOUND_FACTORS[1] * k**2 * m, BOUND_FACTORS[2] * k**3 * m
 
     @property
     def error_estimate(self) -> float:

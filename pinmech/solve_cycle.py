@@ -171,7 +171,7 @@ class _Cycle:
         self.mirror = (1.0, 0.0)  # p = a x + b: past each fold crossed, values are mirrored at it
         self.notes: dict[int, str] = {}
         self._index, self._iterations, self._batching = 0, 0, False
-        self.span_scale = 1.0 if solver.mechanism.joint(driver).is_angular else solver.mechanism.length_scale
+        self.span_scale = float(solver.mechanism.velocity_scale()[solver.mechanism.joint(driver).idx_v])  # 1: a turn
 
     # ------------------------------------------------------------------ chunks
     def chunk(self, index: int, xs: np.ndarray) -> RangeChunk:

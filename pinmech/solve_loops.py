@@ -527,13 +527,13 @@ class LoopSolver:
 
     def turn_gap(self, q0: np.ndarray, q1: np.ndarray) -> float:
         """Largest joint difference between two poses, angles modulo a turn [rad], slides
-        in mechanism sizes: 0 where q1 is q0 after whole turns."""
+        in sizes of their loops: 0 where q1 is q0 after whole turns."""
         dv = pin.difference(self.model, q0, q1)
         gap = 0.0
         for joint in self.mechanism.joints.values():
             for i in range(joint.idx_v, joint.idx_v + joint.nv):
                 d = float(dv[i])
-                d = math.remainder(d, 2 * math.pi) if joint.is_angular else d / self.mechanism.length_scale
+                d = math.remainder(d, 2 * math.pi) if joint.is_angular else d * float(self._v_scale_inv[i])
                 gap = max(gap, abs(d))
         return gap
 
