@@ -225,12 +225,25 @@ class CutEvaluator:
             self._full_axis = self._full_ang @ pin.skew(closure.axis)
         self._ground = model.frames[closure.parent_frame].parentJoint == 0
         if self._ground:  # a frame on the universe joint: its placement is the world one
-            M_P = model.frames[closure.parent_frame].placement
-            self._set_parent(M_P.rotation.copy(), M_P.translation.copy())
-            self._full_lin = self._full_lin @ M_P.rotation.T  # R_P^T folded in once
-            if self._revolute:
-                self._ang_axis = self._ang_axis @ M_P.rotation.T
-                self._full_axis = self._full_axis @ M_P.rotation.T
+            self._frame = model.frames[closure.parent_frame]  # the model's own frame, read live
+            self._row_mats = (self._full_lin, self._ang_axis, self._full_axis)
+            self._fold(self._frame.placement.copy())
+
+    def _fold(self, M_P: pin.SE3) -> None:
+        """A ground cut frame's placement folded into the row matrices (R_P^T once)."""
+        self._M_ground = M_P
+        self._set_parent(M_P.rotation.copy(), M_P.translation.copy())
+        full_lin, ang_axis, full_axis = self._row_mats
+        self._full_lin = full_lin @ M_P.rotation.T
+        if self._revolute:
+            self._ang_axis = ang_axis @ M_P.rotation.T
+            self._full_axis = full_axis @ M_P.rotation.T
+
+    def refresh(self) -> None:
+        """Fold a ground cut frame's placement again if the model's frame was moved since
+        (nothing is cached that the model can change: a check costs under a microsecond)."""
+        if self._ground and not self._frame.placement == self._M_ground:
+            self._fold(self._frame.placement.copy())
 
     def _set_parent(self, R_P: np.ndarray, p_P: np.ndarray) -> None:
         self._R_P, self._p_P = R_P, p_P
@@ -242,6 +255,7 @@ class CutEvaluator:
         c = self.closure
         self._M_C = pin.updateFramePlacement(self.model, data, c.child_frame)
         if self._ground:
+            self.refresh()
             if self._has_angular:  # Closure.residual_jacobian reads data.oMf of both frames
                 pin.updateFramePlacement(self.model, data, c.parent_frame)
         else:

@@ -181,3 +181,35 @@ class IndeterminateForcesError(SingularPoseError):
         super().__init__(message, condition=condition, sigma_min=sigma_min)
         self.unknowns = unknowns
         self.equations = equations
+
+
+class OptionError(PinmechError):
+    """A solver option given through the Python API is out of its range (as the scene's
+    [solver] table is checked): a NaN, an infinity or a tolerance that closes nothing.
+
+    Attributes:
+        option: the option's name ("tol", "max_iterations", "max_condition").
+        value: the value given.
+    """
+
+    exit_code = 2
+
+    def __init__(self, message: str, *, option: str, value: Any):
+        super().__init__(message)
+        self.option = option
+        self.value = value
+
+
+class RateOverflowError(PinmechError):
+    """Driver rates so large that velocities or accelerations overflow float64 (a speed of
+    1e160 rad/s squares to infinity): nothing finite can be stated."""
+
+    exit_code = 2
+
+
+class ConcurrentUseError(PinmechError):
+    """One solver (a `LoopSolver`, and the `Sweep` or `BatchSolver` built on it) used by two
+    threads at once: it keeps one Pinocchio `Data` and work buffers, so its answers would be
+    mixed. Give each thread its own solver (README, "When to trust the numbers")."""
+
+    exit_code = 2

@@ -20,7 +20,7 @@ import pinocchio as pin
 
 from pinmech.cut_arrays import ArrayCut, RowCut
 from pinmech.results import Accuracy, LoopSolution
-from pinmech.solve_loops import DEFAULT_TOL, POLISH, LoopSolver
+from pinmech.solve_loops import DEFAULT_TOL, POLISH, LoopSolver, serialized
 
 #: A guess needing a Newton step larger than this (dimensionless: of the mechanism's size,
 #: or radians) is not "close": the batch hands the poses back to the pose-by-pose solver.
@@ -78,7 +78,9 @@ class BatchSolver:
         self.model = solver.model
         self._cuts = [(ArrayCut if not ev._has_angular else RowCut)(ev) for ev in solver._cuts]
         self._zero = np.zeros(self.model.nv)
+        self.lock = solver.lock  # one Pinocchio Data: the solver's
 
+    @serialized
     def try_solve(self, guesses: np.ndarray, driver_q: np.ndarray, driver_v: np.ndarray,
                   driver_a: np.ndarray) -> BatchSolution | None:
         """Solve N poses: guesses (N, nq), drivers' q, v, a (N, number of drivers).
@@ -118,6 +120,7 @@ class BatchSolver:
             return None
         return self._rates(Q, driver_v, driver_a, np.maximum(error, full), iterations)
 
+    @serialized
     def measure(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> BatchSolution:
         """The accuracy of given poses (N rows of q, v, a), e.g. interpolated ones: closure
         residual, condition number, and the residuals of the velocity and acceleration
@@ -197,6 +200,8 @@ class BatchSolver:
         V[:, s._dep] = solve_batch(J_dep, -np.einsum("nkj,nj->nk", J_drv, driver_v))
         drift = self._drift(Q, V)
         A[:, s._dep] = solve_batch(J_dep, -np.einsum("nkj,nj->nk", J_drv, driver_a) - drift)
+        if not (np.isfinite(V).all() and np.isfinite(A).all()):
+            return None  # the pose-by-pose solver names the pose (RateOverflowError)
         return BatchSolution(Q, V, A, residual, iterations, condition, sigma_min,
                              *self._equation_residuals(J, V, A, drift), s.drivers, s.structure.signs_many(J_dep))
 

@@ -175,8 +175,9 @@ class _Cycle:
 
     # ------------------------------------------------------------------ chunks
     def chunk(self, index: int, xs: np.ndarray) -> RangeChunk:
-        """Solve the poses xs that follow the last solved pose."""
-        out = self._chunk(index, xs)
+        """Solve the poses xs that follow the last solved pose (holding the solver's lock)."""
+        with self.solver.lock:
+            out = self._chunk(index, xs)
         notes = {j - index: n for j, n in self.notes.items() if index <= j < index + len(xs)}
         if notes:
             out = RangeChunk(out.start, out.values, out.solution, out.interpolated, out.errors, notes)
@@ -407,14 +408,22 @@ class _Cycle:
         accuracy = Accuracy(acc.residual, acc.iterations, acc.condition, acc.sigma_min,
                             abs(w) * acc.velocity_residual,
                             w * w * acc.acceleration_residual + abs(alpha) * acc.velocity_residual)
-        return LoopSolution(sol.q, sol.v * w, sol.a * (w * w) + sol.v * alpha, accuracy, sol.drivers)
+        with np.errstate(over="ignore", invalid="ignore"):
+            v, a = sol.v * w, sol.a * (w * w) + sol.v * alpha
+        if not math.isfinite(sum(v.tolist()) + sum(a.tolist())):
+            raise self.solver._overflow(sol.q, self.v_drv, self.a_drv)
+        return LoopSolution(sol.q, v, a, accuracy, sol.drivers)
 
     def _actual(self, index: int, xs: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray,
                 acc: dict[str, np.ndarray], interpolated: np.ndarray) -> RangeChunk:
         """A chunk in the scene's rates, from path derivatives (as `_scaled`)."""
         w, alpha = float(self.v_drv[self.k]), float(self.a_drv[self.k])
+        with np.errstate(over="ignore", invalid="ignore"):
+            v, a = d1 * w, d2 * (w * w) + d1 * alpha
+        if not (np.isfinite(v).all() and np.isfinite(a).all()):
+            raise self.solver._overflow(q[0], self.v_drv, self.a_drv)
         solution = BatchSolution(
-            q, d1 * w, d2 * (w * w) + d1 * alpha, acc["residual"], acc["iterations"], acc["condition"],
+            q, v, a, acc["residual"], acc["iterations"], acc["condition"],
             acc["sigma_min"], abs(w) * acc["velocity_residual"],
             w * w * acc["acceleration_residual"] + abs(alpha) * acc["velocity_residual"], self.solver.drivers)
         return RangeChunk(index, xs, solution, interpolated)

@@ -9,9 +9,12 @@ Nothing here knows which mechanism it solves.
 
 from __future__ import annotations
 
+import functools
 import math
-from collections.abc import Mapping, Sequence
+import threading
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any, TypeVar
 
 import numpy as np
 import pinocchio as pin
@@ -19,7 +22,15 @@ import pinocchio as pin
 from pinmech.branches import AssemblyStructure
 from pinmech.closures import CutEvaluator
 from pinmech.continuation import Path, Route
-from pinmech.exceptions import AssemblyError, LoopClosureError, MobilityError, ModelError, SingularPoseError
+from pinmech.exceptions import (
+    AssemblyError,
+    LoopClosureError,
+    MobilityError,
+    ModelError,
+    OptionError,
+    RateOverflowError,
+    SingularPoseError,
+)
 from pinmech.mechanism import Mechanism
 from pinmech.results import Accuracy, LoopSolution
 
@@ -37,6 +48,36 @@ DEFAULT_MAX_CONDITION = 1e4
 #: the tolerance gets one more Newton step: it costs one kinematics pass and lands at
 #: rounding level, so results do not depend on how close the guess happened to be.
 POLISH = 1e-15
+#: The ranges of the solver's options, for the Python API as for a scene's [solver] table.
+SOLVER_RANGES = {"tol": (1e-16, 1e-3), "max_iterations": (1, 1000), "max_condition": (1.0, math.inf)}
+
+_Method = TypeVar("_Method", bound=Callable[..., Any])
+
+
+def serialized(method: _Method) -> _Method:
+    """A solver method that holds the solver's lock: threads sharing one solver take turns
+    (its Pinocchio `Data` and buffers hold one pose at a time), the same thread re-enters."""
+    @functools.wraps(method)
+    def locked(self, *args, **kwargs):
+        with self.lock:
+            return method(self, *args, **kwargs)
+    return locked  # type: ignore[return-value]
+
+
+def checked_option(name: str, value: Any) -> float | int:
+    """A solver option within `SOLVER_RANGES` (a number, not NaN; max_iterations whole).
+
+    Raises:
+        OptionError: naming the option, the value and the range.
+    """
+    low, high = SOLVER_RANGES[name]
+    whole = name == "max_iterations"
+    number = float(value) if isinstance(value, (int, float, np.number)) and not isinstance(value, bool) else math.nan
+    ok = low <= number <= high and (not whole or number == int(number))  # NaN is in no range
+    if not ok:
+        kind = "a whole number" if whole else "a number"
+        raise OptionError(f"{name} = {value!r} must be {kind} in [{low:g}, {high:g}]", option=name, value=value)
+    return int(number) if whole else number
 
 
 def _max_abs(x: np.ndarray) -> float:
@@ -115,15 +156,21 @@ class LoopSolver:
     Args:
         mechanism: the model with its loop closures.
         drivers: names of the joints whose motion is given (as many as the mobility).
-        tol: closure tolerance, relative to the mechanism's length scale.
-        max_iterations: Newton iteration cap.
-        max_condition: a constraint Jacobian worse conditioned than this is singular.
+        tol: closure tolerance, relative to each loop's size (SOLVER_RANGES: 1e-16 to 1e-3).
+        max_iterations: Newton iteration cap (1 to 1000).
+        max_condition: a constraint Jacobian worse conditioned than this is singular (>= 1).
 
     After `solve`, `data` holds the joint placements and Jacobians at the solution and
     the placements of the cut frames (call `pin.updateFramePlacements` for the others).
 
+    Threads: the public methods hold `lock` (re-entrant), so threads sharing one solver
+    take turns and each gets its own right answer; a thread reading `data` itself holds
+    `lock` meanwhile. To solve in parallel, give each thread its own solver.
+
     Raises:
         FrameNotFound: a driver that is not a joint of the model.
+        OptionError: tol, max_iterations or max_condition out of SOLVER_RANGES (also when
+            set later).
         MobilityError: more or fewer drivers than the mechanism's mobility.
     """
 
@@ -140,6 +187,7 @@ class LoopSolver:
         self.model = mechanism.model
         self.data = self.model.createData()
         self.drivers = tuple(drivers)
+        self.lock = threading.RLock()
         self.tol = tol
         self.max_iterations = max_iterations
         self.max_condition = max_condition
@@ -158,6 +206,34 @@ class LoopSolver:
         self.reference: Reference | None = None
         self.iterations = 0  # Newton iterations of the last `correct`
         self.moved = 0.0  # sum of the scaled sizes of its steps: a bound on how far it moved q
+
+    # ------------------------------------------------------------------ options
+    @property
+    def tol(self) -> float:
+        """Closure tolerance (dimensionless, of each loop's size), in SOLVER_RANGES."""
+        return self._tol
+
+    @tol.setter
+    def tol(self, value: float) -> None:
+        self._tol = checked_option("tol", value)
+
+    @property
+    def max_iterations(self) -> int:
+        """Newton iteration cap, in SOLVER_RANGES."""
+        return self._max_iterations
+
+    @max_iterations.setter
+    def max_iterations(self, value: int) -> None:
+        self._max_iterations = checked_option("max_iterations", value)
+
+    @property
+    def max_condition(self) -> float:
+        """Largest condition number accepted before a pose is singular, in SOLVER_RANGES."""
+        return self._max_condition
+
+    @max_condition.setter
+    def max_condition(self, value: float) -> None:
+        self._max_condition = checked_option("max_condition", value)
 
     def _joint_nv(self, v: int) -> int:
         for joint in self.model.joints[1:]:
@@ -232,6 +308,7 @@ class LoopSolver:
         return q
 
     # ------------------------------------------------------------------ solves
+    @serialized
     def close(self, q_guess: np.ndarray, driver_q: Sequence[float]) -> tuple[np.ndarray, int, float]:
         """Newton on the closure residual with the drivers held.
 
@@ -361,7 +438,7 @@ class LoopSolver:
         return q, self._residual(q), norm, False  # data back at q
 
     def _raise_not_closed(self, q: np.ndarray, norm: float, iterations: int, driver_q: Sequence[float]) -> None:
-        drivers = ", ".join(f"{n} = {v:.6g}" for n, v in zip(self.drivers, driver_q))
+        drivers = self.describe_drivers(driver_q)
         names = ", ".join(c.name for c in self.mechanism.closures)
         solved = float(np.max(np.abs(self._residual(q)), initial=0.0))  # the rows Newton solves
         if norm <= ROUNDING_LEVEL:
@@ -379,6 +456,7 @@ class LoopSolver:
             partial=q,
         )
 
+    @serialized
     def rates(self, q: np.ndarray, driver_v: Sequence[float], driver_a: Sequence[float], *,
               at_q: bool = False) -> tuple[np.ndarray, np.ndarray, Accuracy]:
         """Velocities and accelerations at a closed configuration q.
@@ -423,7 +501,16 @@ class LoopSolver:
         pin.forwardKinematics(self.model, self.data, q, v, self._zero_a)
         drift = self._drift()
         a[self._dep] = _solve_square(J_dep, -(J_drv @ a[self._drv]) - drift)
+        if not math.isfinite(sum(v.tolist()) + sum(a.tolist())):
+            raise self._overflow(q, driver_v, driver_a)
         return v, a, condition, sigma_min, _max_abs(J @ v), _max_abs(J @ a + drift), signs
+
+    def _overflow(self, q: np.ndarray, driver_v, driver_a) -> RateOverflowError:
+        return RateOverflowError(
+            f"{self.mechanism.source}: at {self.describe_drivers(self._driver_values(q))} the rates overflow "
+            f"float64 (driver speeds {', '.join(f'{x:.3g}' for x in np.ravel(driver_v))}, accelerations "
+            f"{', '.join(f'{x:.3g}' for x in np.ravel(driver_a))} in rad/s, m/s and their squares): "
+            f"nothing finite can be stated; give speeds whose squares stay far below 1e308")
 
     def _driver_values(self, q: np.ndarray) -> list[float]:
         out = []
@@ -431,6 +518,7 @@ class LoopSolver:
             out.append(math.atan2(q[i + 1], q[i]) if continuous else float(q[i]))
         return out
 
+    @serialized
     def set_reference(self, driver_q: Sequence[float] | Mapping[str, float], guess: np.ndarray | None = None,
                       assembly: Mapping[str, int] | None | str = "keep") -> Reference:
         """Close the loops at `driver_q` from `guess` (default: neutral) and make that pose
@@ -462,6 +550,7 @@ class LoopSolver:
         self.reference = Reference(dq.copy(), q, signs, keep=assembly != "any")
         return self.reference
 
+    @serialized
     def solve(
         self,
         driver_q: Sequence[float] | Mapping[str, float],
@@ -498,6 +587,7 @@ class LoopSolver:
         q, iterations, residual = self.close(self._guess(guess), dq)
         return self._solution(q, dv, da, residual, iterations, None)
 
+    @serialized
     def follow(self, q0: np.ndarray, x0: np.ndarray, x1: np.ndarray, route: Route, *,
                through_folds: bool = False) -> np.ndarray:
         """The closed q at driver values x1, followed from the closed pose q0 at x0.
