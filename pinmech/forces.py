@@ -38,6 +38,7 @@ import pinocchio as pin
 from pinmech.closures import _cross
 from pinmech.exceptions import IndeterminateForcesError, ModelError
 from pinmech.mechanism import Mechanism
+from pinmech.solve_loops import describe_joint_values
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 #: Default largest condition number of the (dimensionless) force equations: as for velocities.
@@ -257,7 +258,13 @@ class ForceSolver:
         power_terms = self._power_terms(q, v, a, virtual)
         load_wrenches = self._load_wrenches()
         b = pin.rnea(model, data, q, v, a, load_wrenches).copy()
-        x, condition, method = self._solve_system(J_c, b)
+        try:
+            x, condition, method = self._solve_system(J_c, b)
+        except IndeterminateForcesError as exc:  # name the pose, in the user's units
+            at = describe_joint_values(self.mechanism, self.drivers, [self.mechanism.coordinate(q, n) for n in self.drivers])
+            said = str(exc).replace("at this pose", f"at {at}") if "at this pose" in str(exc) else f"{exc} (at {at})"
+            raise IndeterminateForcesError(said, condition=exc.condition, sigma_min=exc.sigma_min,
+                                           unknowns=exc.unknowns, equations=exc.equations) from None
         effort, lam = x[: len(self.drivers)], x[len(self.drivers) :]
         cut_wrenches = self._cut_wrenches(lam)
         total = [f + g for f, g in zip(load_wrenches, self._as_external(cut_wrenches))]

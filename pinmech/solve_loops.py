@@ -80,6 +80,18 @@ def checked_option(name: str, value: Any) -> float | int:
     return int(number) if whole else number
 
 
+def describe_joint_values(mechanism: Mechanism, names: Sequence[str], values: Sequence[float]) -> str:
+    """One-dof joints' values as a user reads them in an error: angles in degrees, lengths
+    in metres ("O2 = 90 deg, slide = 0.15 m")."""
+    out = []
+    for name, value in zip(names, values):
+        if mechanism.joint(name).is_angular:
+            out.append(f"{name} = {math.degrees(value):.10g} deg")
+        else:
+            out.append(f"{name} = {value:.10g} m")
+    return ", ".join(out)
+
+
 def _max_abs(x: np.ndarray) -> float:
     """Largest |x_i| (0 when empty); plain Python below 9 entries, where numpy's call costs more."""
     if x.size < 9:
@@ -387,13 +399,7 @@ class LoopSolver:
 
     def describe_drivers(self, values: Sequence[float]) -> str:
         """Driver values as a user reads them: angles in degrees, lengths in metres."""
-        out = []
-        for name, value in zip(self.drivers, values):
-            if self.mechanism.joint(name).is_angular:
-                out.append(f"{name} = {math.degrees(value):.10g} deg")
-            else:
-                out.append(f"{name} = {value:.10g} m")
-        return ", ".join(out)
+        return describe_joint_values(self.mechanism, self.drivers, values)
 
     def _newton_update(self, q: np.ndarray, J_dep: np.ndarray, r: np.ndarray,
                        norm: float) -> tuple[np.ndarray, np.ndarray, float, bool]:
@@ -450,7 +456,7 @@ class LoopSolver:
             why = "the pose is out of reach for these dimensions, or the guess is on no branch"
         raise LoopClosureError(
             f"{self.mechanism.source}: loop(s) {names} cannot be closed at {drivers} "
-            f"(residual {norm:.3g} of the mechanism size after {iterations} Newton iterations): {why}",
+            f"(residual {norm:.3g} of the loop's size after {iterations} Newton iterations): {why}",
             residual=float(norm),
             iterations=iterations,
             partial=q,

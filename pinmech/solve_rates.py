@@ -34,7 +34,7 @@ import pinocchio as pin
 from pinmech.exceptions import SingularPoseError, TaskError
 from pinmech.mechanism import Mechanism
 from pinmech.results import RateSolution
-from pinmech.solve_loops import DEFAULT_MAX_CONDITION
+from pinmech.solve_loops import DEFAULT_MAX_CONDITION, describe_joint_values
 
 COMPONENTS = ("x", "y", "z", "wx", "wy", "wz")
 METHODS = ("exact", "least_squares", "damped")
@@ -274,9 +274,8 @@ class RateSolver:
                          f"drop those rows {hint}")
 
     def _pose(self, q: np.ndarray) -> str:
-        values = ", ".join(f"{name} = {self.mechanism.coordinate(q, name):.6g}"
-                           for name, j in self.mechanism.joints.items() if j.nv == 1)
-        return f"{values} (rad, m)"
+        names = [name for name, j in self.mechanism.joints.items() if j.nv == 1]
+        return describe_joint_values(self.mechanism, names, [self.mechanism.coordinate(q, n) for n in names])
 
     def _apply(self, J: np.ndarray, rhs: np.ndarray, method: str, rank: int) -> np.ndarray:
         """Solve J x = rhs by `method`, in dimensionless rows and columns (see `_dimensionless`),

@@ -158,7 +158,7 @@ def test_four_bar_closer_to_its_limit_is_refused(toggle_four_bar):
 
 
 def test_four_bar_past_its_limit_cannot_close(toggle_four_bar):
-    with pytest.raises(LoopClosureError, match="cannot be closed at O2 = 1.2997"):
+    with pytest.raises(LoopClosureError, match=r"cannot be closed at O2 = 74\.4\d* deg"):
         LoopSolver(toggle_four_bar, ["O2"]).solve([float(THETA_LIMIT) + 1e-3])
 
 
@@ -252,7 +252,7 @@ def test_slider_crank_dead_centres_approached_from_the_piston(bundled_slider_cra
 
 
 def test_slider_crank_piston_past_its_stroke_cannot_close(bundled_slider_crank):
-    with pytest.raises(LoopClosureError, match=r"cannot be closed at slide = 0\.1998"):
+    with pytest.raises(LoopClosureError, match=r"cannot be closed at slide = 0\.1998\d* m"):
         LoopSolver(bundled_slider_crank, ["slide"]).solve([float(X_OUTER) + 1e-4])
 
 
@@ -283,7 +283,7 @@ def test_planar_arm_stretched_is_refused(models_dir):
     arm = Mechanism.from_urdf(models_dir / "planar_arm.urdf")
     q = arm.neutral()
     arm.set_coordinate(q, "C", -np.pi / 2)
-    with pytest.raises(SingularPoseError, match="A = 0, B = 0, C = -1.5708"):
+    with pytest.raises(SingularPoseError, match="A = 0 deg, B = 0 deg, C = -90 deg"):
         RateSolver(arm, _arm_tasks()).solve(q)
 
 
