@@ -36,6 +36,7 @@ class BatchSolution:
             accelerations [rad/s^2 or m/s^2].
         residual, iterations, condition, sigma_min, velocity_residual,
         acceleration_residual: (N,) the fields of `Accuracy`, per pose.
+        interpolation: (N, 3) `Accuracy.interpolation` per pose, or None (every pose solved).
     """
 
     q: np.ndarray
@@ -49,14 +50,16 @@ class BatchSolution:
     acceleration_residual: np.ndarray
     drivers: tuple[str, ...] = ()
     signs: np.ndarray | None = None  # (N, blocks) assembly signatures (branches.py), where computed
+    interpolation: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.q)
 
     def accuracy(self, i: int) -> Accuracy:
+        added = (0.0, 0.0, 0.0) if self.interpolation is None else tuple(map(float, self.interpolation[i]))
         return Accuracy(float(self.residual[i]), int(self.iterations[i]), float(self.condition[i]),
                         float(self.sigma_min[i]), float(self.velocity_residual[i]),
-                        float(self.acceleration_residual[i]))
+                        float(self.acceleration_residual[i]), added)
 
     def solution(self, i: int) -> LoopSolution:
         """Pose i as the `LoopSolution` that `LoopSolver.solve` returns."""

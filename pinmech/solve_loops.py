@@ -507,8 +507,8 @@ class LoopSolver:
         pin.forwardKinematics(self.model, self.data, q, v, self._zero_a)
         drift = self._drift()
         a[self._dep] = _solve_square(J_dep, -(J_drv @ a[self._drv]) - drift)
-        if not math.isfinite(sum(v.tolist()) + sum(a.tolist())):
-            raise self._overflow(q, driver_v, driver_a)
+        if condition <= self.max_condition and not math.isfinite(sum(v.tolist()) + sum(a.tolist())):
+            raise self._overflow(q, driver_v, driver_a)  # a regular pose: the driver rates are too large
         return v, a, condition, sigma_min, _max_abs(J @ v), _max_abs(J @ a + drift), signs
 
     def _overflow(self, q: np.ndarray, driver_v, driver_a) -> RateOverflowError:
