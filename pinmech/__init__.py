@@ -15,7 +15,6 @@ from pinmech.continuation import Route
 from pinmech.exceptions import (
     AssemblyError,
     CheckMismatch,
-    ConcurrentUseError,
     DriverLimitError,
     FrameNotFound,
     IndeterminateForcesError,
@@ -65,7 +64,6 @@ __all__ = [
     "BatchSolution",
     "BatchSolver",
     "CheckMismatch",
-    "ConcurrentUseError",
     "Closure",
     "CoincidentPoint",
     "DriverLimitError",

@@ -241,7 +241,8 @@ class CutEvaluator:
 
     def refresh(self) -> None:
         """Fold a ground cut frame's placement again if the model's frame was moved since
-        (nothing is cached that the model can change: a check costs under a microsecond)."""
+        (nothing is cached that the model can change). Solvers call it once per call of
+        their public methods (under a microsecond), not per pose."""
         if self._ground and not self._frame.placement == self._M_ground:
             self._fold(self._frame.placement.copy())
 
@@ -255,7 +256,6 @@ class CutEvaluator:
         c = self.closure
         self._M_C = pin.updateFramePlacement(self.model, data, c.child_frame)
         if self._ground:
-            self.refresh()
             if self._has_angular:  # Closure.residual_jacobian reads data.oMf of both frames
                 pin.updateFramePlacement(self.model, data, c.parent_frame)
         else:

@@ -43,7 +43,6 @@ class ArrayCut:
         self.revolute = ev._revolute
 
     def allocate(self, n: int, nv: int) -> None:
-        self.ev.refresh()  # a ground cut frame moved since the last batch
         self.H_C, self.J_C, self.a_C = np.empty((n, 4, 4)), np.empty((n, 6, nv)), np.empty((n, 6))
         if not self.ground:
             self.H_P, self.J_P = np.empty((n, 4, 4)), np.empty((n, 6, nv))

@@ -206,10 +206,3 @@ class RateOverflowError(PinmechError):
 
     exit_code = 2
 
-
-class ConcurrentUseError(PinmechError):
-    """One solver (a `LoopSolver`, and the `Sweep` or `BatchSolver` built on it) used by two
-    threads at once: it keeps one Pinocchio `Data` and work buffers, so its answers would be
-    mixed. Give each thread its own solver (README, "When to trust the numbers")."""
-
-    exit_code = 2

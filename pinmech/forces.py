@@ -36,9 +36,9 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.closures import _cross
-from pinmech.exceptions import IndeterminateForcesError, ModelError
+from pinmech.exceptions import IndeterminateForcesError, ModelError, OptionError
 from pinmech.mechanism import Mechanism
-from pinmech.solve_loops import describe_joint_values
+from pinmech.solve_loops import checked_option, describe_joint_values
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 #: Default largest condition number of the (dimensionless) force equations: as for velocities.
@@ -210,12 +210,15 @@ class ForceSolver:
         self.mechanism = mechanism
         self.model = pin.Model(mechanism.model)  # a copy: its gravity is ours, not the user's
         self.gravity = np.asarray(gravity, dtype=float).reshape(3)
+        if not np.all(np.isfinite(self.gravity)):
+            raise OptionError(f"gravity = {tuple(gravity)!r} must be three finite numbers [m/s^2]",
+                              option="gravity", value=gravity)
         self.model.gravity = pin.Motion(self.gravity, np.zeros(3))
         self.data = self.model.createData()
         self.drivers = tuple(drivers)
         self.loads = tuple(loads)
         self.minimum_norm = minimum_norm
-        self.max_condition = max_condition
+        self.max_condition = checked_option("max_condition", max_condition)
         self._drv_v = np.array([self._driver_index(n) for n in self.drivers], dtype=int)
         self._scale = mechanism.velocity_scale()
         self._check_masses(set(massless))

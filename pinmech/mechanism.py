@@ -360,6 +360,9 @@ def _lock_joints(model: pin.Model, locked: dict[str, float], source: str) -> pin
             raise FrameNotFound("joint to lock", name, [n for n in model.names[1:]], path=source)
         jid = model.getJointId(name)
         joint = model.joints[jid]
+        if not isinstance(value, (int, float, np.number)) or not np.isfinite(value):
+            raise ModelError(f"joint '{name}' cannot be locked at {value!r}: give a finite number (rad or m)",
+                             path=source)
         if joint.nq == 2 and joint.nv == 1:
             q_ref[joint.idx_q : joint.idx_q + 2] = (np.cos(value), np.sin(value))
         elif joint.nq == 1:

@@ -82,6 +82,7 @@ class BatchSolver:
         self._cuts = [(ArrayCut if not ev._has_angular else RowCut)(ev) for ev in solver._cuts]
         self._zero = np.zeros(self.model.nv)
         self.lock = solver.lock  # one Pinocchio Data: the solver's
+        self.refresh = solver.refresh
 
     @serialized
     def try_solve(self, guesses: np.ndarray, driver_q: np.ndarray, driver_v: np.ndarray,

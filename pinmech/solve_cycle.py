@@ -40,6 +40,7 @@ from pinmech.exceptions import (
     AssemblyError,
     DriverLimitError,
     LoopClosureError,
+    OptionError,
     PinmechError,
     SingularPoseError,
 )
@@ -121,7 +122,11 @@ def solve_range(solver: LoopSolver, driver: str, values: Iterable[float], *, dri
     Raises:
         PinmechError: an unknown start, or interpolation or batches asked with the other
             drivers moving (their path is then not the swept driver's alone).
+        OptionError: a chunk size that is not a whole number >= 1, or a value of the
+            range that is not finite (raised when the range reaches it).
     """
+    if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
+        raise OptionError(f"chunk = {chunk!r} must be a whole number of poses, at least 1", option="chunk", value=chunk)
     cycle = _Cycle(solver, driver, driver_q, driver_v, driver_a, guess, start, batch, interpolate, through_folds)
     values = iter(values)
     index = 0
@@ -129,6 +134,10 @@ def solve_range(solver: LoopSolver, driver: str, values: Iterable[float], *, dri
         xs = np.fromiter(islice(values, chunk), dtype=float)
         if not xs.size:
             return
+        if not np.all(np.isfinite(xs)):
+            bad = int(np.flatnonzero(~np.isfinite(xs))[0])
+            raise OptionError(f"the driver value at position {index + bad} of the range is {float(xs[bad])}: "
+                              f"every value of {driver} must be a finite number", option="values", value=float(xs[bad]))
         yield cycle.chunk(index, xs)
         index += len(xs)
 
@@ -184,6 +193,7 @@ class _Cycle:
     def chunk(self, index: int, xs: np.ndarray) -> RangeChunk:
         """Solve the poses xs that follow the last solved pose (holding the solver's lock)."""
         with self.solver.lock:
+            self.solver.refresh()
             out = self._chunk(index, xs)
         notes = {j - index: n for j, n in self.notes.items() if index <= j < index + len(xs)}
         if notes:

@@ -42,7 +42,7 @@ ROUNDING_LEVEL = 1e-14
 MAX_STEP = 1.0
 #: Default largest condition number accepted before a pose is called singular. Near a
 #: singularity accelerations lose accuracy like eps x condition^3 (tests/test_singular.py),
-#: so 1e4 keeps every acceleration pinmech gives to about 2e-4 relative or better.
+#: so 1e4 keeps every acceleration pinmech gives to about 1e-3 relative or better.
 DEFAULT_MAX_CONDITION = 1e4
 #: With the default tolerance or a tighter one, a pose that ends between this residual and
 #: the tolerance gets one more Newton step: it costs one kinematics pass and lands at
@@ -56,10 +56,12 @@ _Method = TypeVar("_Method", bound=Callable[..., Any])
 
 def serialized(method: _Method) -> _Method:
     """A solver method that holds the solver's lock: threads sharing one solver take turns
-    (its Pinocchio `Data` and buffers hold one pose at a time), the same thread re-enters."""
+    (its Pinocchio `Data` and buffers hold one pose at a time), the same thread re-enters.
+    It first reads again what the user may have changed in the model (`refresh`)."""
     @functools.wraps(method)
     def locked(self, *args, **kwargs):
         with self.lock:
+            self.refresh()
             return method(self, *args, **kwargs)
     return locked  # type: ignore[return-value]
 
@@ -247,6 +249,12 @@ class LoopSolver:
     def max_condition(self, value: float) -> None:
         self._max_condition = checked_option("max_condition", value)
 
+    def refresh(self) -> None:
+        """Read again the placements of ground cut frames, which the user may have moved in
+        the model since the last call (the hot path folds them into its row matrices)."""
+        for cut in self._cuts:
+            cut.refresh()
+
     def _joint_nv(self, v: int) -> int:
         for joint in self.model.joints[1:]:
             if joint.idx_v <= v < joint.idx_v + joint.nv:
@@ -336,18 +344,18 @@ class LoopSolver:
         r = self._residual(q)
         norm = _max_abs(r)
         iterations = 0
-        while norm > self.tol and iterations < self.max_iterations:
+        while norm > self._tol and iterations < self._max_iterations:
             J_dep = self._residual_jacobian()[:, self._dep]
             q, r, norm, ok = self._newton_update(q, J_dep, r, norm)
             iterations += 1
             if not ok:
                 break
-        if POLISH < norm <= self.tol <= DEFAULT_TOL and iterations < self.max_iterations:
+        if POLISH < norm <= self._tol <= DEFAULT_TOL and iterations < self._max_iterations:
             J_dep = self._residual_jacobian()[:, self._dep]
             q, r, norm, _ = self._newton_update(q, J_dep, r, norm)  # kept only if it helps
             iterations += 1
         full = self._full_residual()
-        if norm > self.tol or full > max(self.tol, 1e-12) * 10:
+        if norm > self._tol or full > max(self._tol, 1e-12) * 10:
             self._raise_not_closed(q, max(norm, full), iterations, driver_q)
         return q, iterations, max(norm, full)
 
@@ -364,7 +372,7 @@ class LoopSolver:
         norm = _max_abs(r)
         self.iterations, self.moved = 0, 0.0
         for _ in range(max_iterations):
-            if norm <= self.tol:
+            if norm <= self._tol:
                 break
             J_dep = self._residual_jacobian()[:, self._dep]
             self.iterations += 1
@@ -375,7 +383,7 @@ class LoopSolver:
                 q_new = self._move(q, step)
                 r_new = self._residual(q_new)
                 new_norm = _max_abs(r_new)
-                if new_norm > 0.5 * norm and new_norm > self.tol:
+                if new_norm > 0.5 * norm and new_norm > self._tol:
                     self._residual(q)
                     return q, None
                 q, r, norm = q_new, r_new, new_norm
@@ -383,12 +391,12 @@ class LoopSolver:
                 q, r, norm, ok = self._newton_update(q, J_dep, r, norm)
                 if not ok:
                     return q, None
-        if POLISH < norm <= self.tol <= DEFAULT_TOL:
+        if POLISH < norm <= self._tol <= DEFAULT_TOL:
             J_dep = self._residual_jacobian()[:, self._dep]
             q, r, norm, _ = self._newton_update(q, J_dep, r, norm)
             self.iterations += 1
         full = self._full_residual()
-        if norm > self.tol or full > max(self.tol, 1e-12) * 10:
+        if norm > self._tol or full > max(self._tol, 1e-12) * 10:
             return q, None
         return q, max(norm, full)
 

@@ -34,7 +34,7 @@ import pinocchio as pin
 from pinmech.exceptions import SingularPoseError, TaskError
 from pinmech.mechanism import Mechanism
 from pinmech.results import RateSolution
-from pinmech.solve_loops import DEFAULT_MAX_CONDITION, describe_joint_values
+from pinmech.solve_loops import DEFAULT_MAX_CONDITION, checked_option, describe_joint_values
 
 COMPONENTS = ("x", "y", "z", "wx", "wy", "wz")
 METHODS = ("exact", "least_squares", "damped")
@@ -118,7 +118,7 @@ class RateSolver:
         self.frames = [mechanism.frame_id(t.frame) for t in self.tasks]
         self.method = method
         self.damping = float(damping)
-        self.max_condition = max_condition
+        self.max_condition = checked_option("max_condition", max_condition)  # NaN would turn the check off
         self.x_dot = np.concatenate([t.velocity for t in self.tasks])
         self.x_ddot = np.concatenate([t.acceleration for t in self.tasks])
         self.row_names = [f"{t.frame}.{c}" for t in self.tasks for c in t.components]
