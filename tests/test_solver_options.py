@@ -191,3 +191,43 @@ def test_one_sweep_shared_by_two_threads(r_rtr_scene, fast_switching):
         a = np.array([r[1][:2] for r in rows])
         assert np.abs(v - cf.vD).max() <= 1e-12 * np.abs(cf.vD).max()
         assert np.abs(a - cf.aD).max() <= 1e-12 * np.abs(cf.aD).max()
+
+
+# ------------------------------------------------------------------ more of the same kind
+@pytest.mark.parametrize("values", [[0.1, float("nan"), 0.3], [0.1, float("inf")], [float("-inf")]])
+def test_a_range_with_a_value_that_is_not_finite_is_refused(r_rtr_scene, values):
+    """Before: an infinite value hung the continuation; NaN read as an assembly change."""
+    sweep = Sweep.from_scene(Scene.load(r_rtr_scene))
+    with pytest.raises(OptionError, match="must be a finite number") as info:
+        list(sweep.poses(values))
+    assert info.value.option == "values"
+
+
+@pytest.mark.parametrize("chunk", [0, -1, 2.5, True])
+def test_a_chunk_size_that_holds_no_pose_is_refused(r_rtr_scene, chunk):
+    """Before: chunk=0 returned no pose at all, silently."""
+    sweep = Sweep.from_scene(Scene.load(r_rtr_scene))
+    d = sweep.drivers
+    with pytest.raises(OptionError, match="chunk"):
+        list(solve_range(sweep.solver, sweep.driver, [0.1, 0.2], driver_q=d.q, driver_v=d.v, driver_a=d.a,
+                         chunk=chunk))
+
+
+def test_rate_and_force_solvers_check_their_options(models_dir, four_bar):
+    from pinmech import ForceSolver, RateSolver, Task
+
+    arm = Mechanism.from_urdf(models_dir / "planar_arm.urdf")
+    tasks = [Task("D", ("x", "y"), np.ones(2), np.zeros(2)), Task("CD", ("wz",), np.zeros(1), np.zeros(1))]
+    with pytest.raises(OptionError, match="max_condition"):
+        RateSolver(arm, tasks, max_condition=float("nan"))  # before: the singular check was off
+    with pytest.raises(OptionError, match="max_condition"):
+        ForceSolver(four_bar, ["O2"], max_condition=float("nan"))
+    with pytest.raises(OptionError, match="gravity"):
+        ForceSolver(four_bar, ["O2"], gravity=(0.0, float("nan"), 0.0))  # before: NaN efforts
+
+
+def test_a_joint_locked_at_nan_is_named(models_dir):
+    from pinmech import ModelError
+
+    with pytest.raises(ModelError, match="joint 'O4' cannot be locked at nan"):
+        Mechanism.from_urdf(models_dir / "four_bar.urdf", locked={"O4": float("nan")})
