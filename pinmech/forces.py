@@ -29,6 +29,7 @@ mechanism is at rest (statics: the principle of virtual work).
 from __future__ import annotations
 
 import math
+import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -38,7 +39,7 @@ import pinocchio as pin
 from pinmech.closures import _cross
 from pinmech.exceptions import IndeterminateForcesError, ModelError, OptionError
 from pinmech.mechanism import Mechanism
-from pinmech.solve_loops import checked_option, describe_joint_values
+from pinmech.solve_loops import checked_option, describe_joint_values, serialized
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 #: Default largest condition number of the (dimensionless) force equations: as for velocities.
@@ -214,6 +215,7 @@ class ForceSolver:
             raise OptionError(f"gravity = {tuple(gravity)!r} must be three finite numbers [m/s^2]",
                               option="gravity", value=gravity)
         self.model.gravity = pin.Motion(self.gravity, np.zeros(3))
+        self.lock = threading.RLock()  # one Data: threads sharing the solver take turns
         self.data = self.model.createData()
         self.drivers = tuple(drivers)
         self.loads = tuple(loads)
@@ -246,6 +248,7 @@ class ForceSolver:
                              "massless: [forces] massless = [...])", path=mech.source)
 
     # ------------------------------------------------------------------ solve
+    @serialized
     def solve(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> ForceSolution:
         """Driver efforts and reactions at a solved pose (q closed, v and a consistent).
 

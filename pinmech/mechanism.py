@@ -442,8 +442,9 @@ def _check_size(size: float, source: str) -> None:
 
 
 def _length_scale(model: pin.Model, closures: list[Closure], source: str) -> float:
-    """The mechanism's size [m]: the largest of its loops' sizes; without loops, the box
-    around every frame origin at the neutral configuration.
+    """The mechanism's size [m]: the largest of its loops' sizes; without loops (an arm),
+    the box around its joints and the frames they move, at the neutral configuration
+    (frames fixed to the ground, however far, do not count).
 
     Each loop's size (its `length_scale`, the scale of its closure tolerance) is the box
     around what closes it: the origins of the joints on its path through the tree and the
@@ -466,7 +467,10 @@ def _length_scale(model: pin.Model, closures: list[Closure], source: str) -> flo
         _check_size(closure.length_scale, source)
     if closures:
         return max(c.length_scale for c in closures)
-    return every if every > 0 else 1.0
+    moving = [data.oMi[j].translation for j in range(1, model.njoints)]
+    moving += [data.oMf[i].translation for i in range(model.nframes) if model.frames[i].parentJoint != 0]
+    size = _box(np.array(moving))
+    return size if size > 0 else (every or 1.0)
 
 
 def _loop_joints(model: pin.Model, closure: Closure) -> tuple[int, ...]:

@@ -57,11 +57,14 @@ _Method = TypeVar("_Method", bound=Callable[..., Any])
 def serialized(method: _Method) -> _Method:
     """A solver method that holds the solver's lock: threads sharing one solver take turns
     (its Pinocchio `Data` and buffers hold one pose at a time), the same thread re-enters.
-    It first reads again what the user may have changed in the model (`refresh`)."""
+    It first reads again what the user may have changed in the model (`refresh`, where
+    the solver has one)."""
     @functools.wraps(method)
     def locked(self, *args, **kwargs):
         with self.lock:
-            self.refresh()
+            refresh = getattr(self, "refresh", None)
+            if refresh is not None:
+                refresh()
             return method(self, *args, **kwargs)
     return locked  # type: ignore[return-value]
 

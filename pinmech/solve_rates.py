@@ -25,6 +25,7 @@ rows cannot all hold is a TaskError and a singular pose a SingularPoseError.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -34,7 +35,7 @@ import pinocchio as pin
 from pinmech.exceptions import SingularPoseError, TaskError
 from pinmech.mechanism import Mechanism
 from pinmech.results import RateSolution
-from pinmech.solve_loops import DEFAULT_MAX_CONDITION, checked_option, describe_joint_values
+from pinmech.solve_loops import DEFAULT_MAX_CONDITION, checked_option, describe_joint_values, serialized
 
 COMPONENTS = ("x", "y", "z", "wx", "wy", "wz")
 METHODS = ("exact", "least_squares", "damped")
@@ -113,6 +114,7 @@ class RateSolver:
             raise TaskError(f"damping must be a positive number, got {damping!r}")
         self.mechanism = mechanism
         self.model = mechanism.model
+        self.lock = threading.RLock()  # one Data: threads sharing the solver take turns
         self.data = self.model.createData()
         self.tasks = tuple(tasks)
         self.frames = [mechanism.frame_id(t.frame) for t in self.tasks]
@@ -127,6 +129,7 @@ class RateSolver:
         self._generic: tuple[int, np.ndarray, list[int]] | None = None  # rank, rows, dependent rows
 
     # ------------------------------------------------------------------ solve
+    @serialized
     def solve(self, q: np.ndarray, velocity: np.ndarray | None = None,
               acceleration: np.ndarray | None = None) -> RateSolution:
         """Joint rates and accelerations at configuration q (loops already closed).

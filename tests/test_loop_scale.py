@@ -166,3 +166,22 @@ def test_floating_and_planar_joints_scale_their_translations_only(tmp_path):
     base, floating = mech.joint("root_joint"), mech.joint("float")
     assert scale[base.idx_v:base.idx_v + 6].tolist() == [mech.length_scale] * 3 + [1.0] * 3
     assert scale[floating.idx_v:floating.idx_v + 3].tolist() == [0.18, 0.18, 1.0]
+
+
+def test_an_arm_ignores_a_far_point_fixed_to_the_ground(tmp_path, models_dir):
+    """An open chain's size is that of its joints and what they move: a named point 1e6 m
+    away on the ground would weigh the task's x, y rows 1e-6 against its wz row (a false
+    singular pose)."""
+    from pinmech import RateSolver, Task
+
+    text = _with((models_dir / "planar_arm.urdf").read_text(), _far_point(1e6))
+    far = Mechanism.from_urdf(write(tmp_path, "arm.urdf", text))
+    near = Mechanism.from_urdf(models_dir / "planar_arm.urdf")
+    assert far.length_scale == near.length_scale == pytest.approx(0.77)
+    tasks = [Task("D", ("x", "y"), np.array([1.0, 0.0]), np.zeros(2)), Task("CD", ("wz",), np.zeros(1), np.zeros(1))]
+    q = near.neutral()
+    for name, angle in (("A", 0.9), ("B", -1.1), ("C", -1.3)):
+        near.set_coordinate(q, name, angle)
+    a, b = RateSolver(far, tasks).solve(q), RateSolver(near, tasks).solve(q)
+    assert a.condition == pytest.approx(b.condition, rel=1e-12)
+    np.testing.assert_allclose(a.v, b.v, rtol=1e-12)

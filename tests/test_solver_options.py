@@ -231,3 +231,26 @@ def test_a_joint_locked_at_nan_is_named(models_dir):
 
     with pytest.raises(ModelError, match="joint 'O4' cannot be locked at nan"):
         Mechanism.from_urdf(models_dir / "four_bar.urdf", locked={"O4": float("nan")})
+
+
+def test_a_rate_solver_shared_by_two_threads(models_dir, fast_switching):
+    """The arm's rate problem (text 17.110's arm) from two threads at once, against one thread."""
+    from pinmech import RateSolver, Task
+
+    arm = Mechanism.from_urdf(models_dir / "planar_arm.urdf")
+    tasks = [Task("D", ("x", "y"), np.array([1.0, 0.0]), np.zeros(2)), Task("CD", ("wz",), np.zeros(1), np.zeros(1))]
+    solver = RateSolver(arm, tasks)
+
+    def pose(x):
+        q = arm.neutral()
+        for name, angle in (("A", 0.9 + x), ("B", -1.1 - x), ("C", -1.3 + 0.5 * x)):
+            arm.set_coordinate(q, name, angle)
+        return q
+
+    xs = [np.linspace(0.0, 0.5, 400), np.linspace(0.5, 0.0, 400)]
+    shared = _in_threads(lambda i: [solver.solve(pose(x)) for x in xs[i]])
+    alone = RateSolver(arm, tasks)
+    for i in range(2):
+        for x, sol in zip(xs[i], shared[i]):
+            ref = alone.solve(pose(x))
+            np.testing.assert_allclose(np.r_[sol.v, sol.a], np.r_[ref.v, ref.a], rtol=1e-12, atol=1e-14)
