@@ -92,10 +92,17 @@ class Closure:
     _rows6: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        for name in ("axis", "child_axis"):  # own read-only copies: the rows are built from them
+            axis = np.array(getattr(self, name), dtype=float)
+            axis.flags.writeable = False
+            super().__setattr__(name, axis)
         self._select = selection_matrix(self.cut_type, self.axis)
         self.basis = np.eye(self._select.shape[0]) if self.basis is None else self.basis  # sets _rows6
 
     def __setattr__(self, name: str, value: object) -> None:
+        if self.__dict__.get("_in_use"):
+            raise AttributeError(f"closure '{self.name}' is in use by a solver: its {name} cannot change "
+                                 "(the solver's rows are built from it); load the mechanism again instead")
         super().__setattr__(name, value)
         if name in ("basis", "length_scale") and hasattr(self, "_select") and self.basis is not None:
             # basis @ selection @ diag(scale), once: the map from a relative 6-vector to rows
@@ -210,6 +217,7 @@ class CutEvaluator:
     """
 
     def __init__(self, closure: Closure, model: pin.Model) -> None:
+        closure.__dict__["_in_use"] = True  # what the rows below are built from stays as it is
         self.closure = closure
         self.model = model
         rows6 = closure._rows6

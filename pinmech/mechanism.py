@@ -71,7 +71,9 @@ class Mechanism:
         joints: name -> JointInfo of every joint that moves.
         links: name -> Pinocchio BODY frame id, for every link that is not a point.
         points: name -> frame id of every named point.
-        length_scale: size of the mechanism [m]; position tolerances are relative to it.
+        length_scale: size of the mechanism [m]: its largest loop's (each closure's own
+            `length_scale` sets that loop's tolerance), or for an open chain the box of its
+            joints and the frames they move; never a frame that closes no loop.
         plane_normal: unit normal of the motion plane for a planar mechanism, else None.
         locked: joints locked out of the model, with their values (SI).
     """

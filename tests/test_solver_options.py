@@ -254,3 +254,17 @@ def test_a_rate_solver_shared_by_two_threads(models_dir, fast_switching):
         for x, sol in zip(xs[i], shared[i]):
             ref = alone.solve(pose(x))
             np.testing.assert_allclose(np.r_[sol.v, sol.a], np.r_[ref.v, ref.a], rtol=1e-12, atol=1e-14)
+
+
+def test_a_closure_in_use_cannot_change_under_its_solver(four_bar):
+    """What a solver's rows are built from (axes, scale, basis) is fixed once it is in use:
+    changing it would leave the solver with rows of the old cut, in silence."""
+    solver = LoopSolver(four_bar, ["O2"])
+    c = four_bar.closures[0]
+    with pytest.raises(AttributeError, match="in use by a solver"):
+        c.length_scale = 1.0
+    with pytest.raises(AttributeError, match="in use by a solver"):
+        c.axis = np.array([1.0, 0.0, 0.0])
+    with pytest.raises(ValueError):
+        c.axis[0] = 1.0  # read-only
+    assert solver.solve([1.0]).accuracy.residual <= 1e-13
