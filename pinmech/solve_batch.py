@@ -86,12 +86,12 @@ class BatchSolver:
 
     @serialized
     def try_solve(self, guesses: np.ndarray, driver_q: np.ndarray, driver_v: np.ndarray,
-                  driver_a: np.ndarray) -> BatchSolution | None:
+                  driver_a: np.ndarray, max_step: float = MAX_BATCH_STEP) -> BatchSolution | None:
         """Solve N poses: guesses (N, nq), drivers' q, v, a (N, number of drivers).
 
         Returns:
             The solved poses, or None when one of them needs the pose-by-pose solver: a
-            guess too far from its solution (a Newton step over `MAX_BATCH_STEP`), a loop
+            guess too far from its solution (a Newton step over `max_step`), a loop
             that does not close within the iteration cap, or a singular Jacobian. That
             solver then says which pose, and why, in its own words.
         """
@@ -108,13 +108,13 @@ class BatchSolver:
             bad = np.flatnonzero(error > s.tol)
             if not bad.size:
                 break
-            if iterations.max(initial=0) >= s.max_iterations or not self._newton(Q, bad, r):
+            if iterations.max(initial=0) >= s.max_iterations or not self._newton(Q, bad, r, max_step):
                 return None
             iterations[bad] += 1
             r = self._rows("residual")
             error = np.abs(r).max(axis=1, initial=0.0)
         polish = np.flatnonzero(error > POLISH) if s.tol <= DEFAULT_TOL else ()  # as LoopSolver.close
-        if len(polish) and self._newton(Q, polish, r):
+        if len(polish) and self._newton(Q, polish, r, max_step):
             iterations[polish] += 1
             error = np.abs(self._rows("residual")).max(axis=1, initial=0.0)
             if np.any(error > s.tol):
@@ -176,13 +176,13 @@ class BatchSolver:
         parts = [getattr(c, name)() for c in self._cuts]
         return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1)
 
-    def _newton(self, Q: np.ndarray, bad: np.ndarray, r: np.ndarray) -> bool:
+    def _newton(self, Q: np.ndarray, bad: np.ndarray, r: np.ndarray, max_step: float = MAX_BATCH_STEP) -> bool:
         """One Newton step on the poses `bad`; False when a step is not small or finite."""
         s = self.solver
         J_dep = self._rows("newton_jacobian")[bad][:, :, s._dep]
         step = solve_batch(J_dep, -r[bad])
         size = np.abs(step * s._dep_scale).max(initial=0.0)
-        if not np.isfinite(size) or size > MAX_BATCH_STEP:
+        if not np.isfinite(size) or size > max_step:
             return False
         full = np.zeros((len(bad), self.model.nv))
         full[:, s._dep] = step

@@ -66,6 +66,10 @@ PEAKS = (0.5, 0.5 - 0.5 / math.sqrt(5.0))
 #: peaks there; higher orders shift the peak and change its height
 #: (tests/test_interpolation_bounds.py checks it against the R-RTR's closed form).
 INTERPOLATION_SAFETY = 4.0
+#: Largest Newton step (rad, or loop sizes) from an interpolated guess to the exact pose it
+#: is measured against: the guess is as good as the interpolation, and the assembly is
+#: checked after (a step to another branch is refused by its signature).
+MEASURE_STEP = 0.05
 _FAILURES = (LoopClosureError, SingularPoseError, AssemblyError, DriverLimitError)
 
 
@@ -504,7 +508,7 @@ class _Cycle:
         pose by pose (a guess too far for the batch)."""
         n, ref = len(at), self.ref
         out = self.measurer.try_solve(guesses, self._drivers(at), np.tile(self.unit_v, (n, 1)),
-                                      np.tile(self.zero, (n, 1)))
+                                      np.tile(self.zero, (n, 1)), max_step=MEASURE_STEP)
         if out is not None and not (ref.signs and np.any(out.signs != np.array(ref.signs))):
             return out.q, out.v, out.a
         solver = self.solver
