@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from pinmech.exceptions import AssemblyError, DriverLimitError, LoopClosureError, PinmechError
+from pinmech.exceptions import AssemblyError, DriverLimitError, PinmechError
 
 #: Largest step, in radians or mechanism sizes of driver motion.
 MAX_STEP = 0.25
@@ -417,5 +417,3 @@ class _Curve:
 def _signs(signs: tuple[int, ...]) -> str:
     return "(" + ", ".join("+" if s > 0 else "-" if s < 0 else "0" for s in signs) + ")"
 
-
-__all__ = ["Node", "Path", "Route", "LoopClosureError"]

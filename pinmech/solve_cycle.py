@@ -31,7 +31,6 @@ from dataclasses import dataclass, field
 from itertools import islice
 
 import numpy as np
-import pinocchio as pin
 
 from pinmech.continuation import Node, Path, Route
 from pinmech.exceptions import (

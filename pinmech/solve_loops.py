@@ -19,7 +19,13 @@ import pinocchio as pin
 from pinmech.branches import AssemblyStructure
 from pinmech.closures import CutEvaluator
 from pinmech.continuation import Path, Route
-from pinmech.exceptions import AssemblyError, LoopClosureError, MobilityError, ModelError, SingularPoseError
+from pinmech.exceptions import (
+    AssemblyError,
+    LoopClosureError,
+    MobilityError,
+    ModelError,
+    SingularPoseError,
+)
 from pinmech.mechanism import Mechanism
 from pinmech.results import Accuracy, LoopSolution
 

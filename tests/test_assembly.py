@@ -14,20 +14,20 @@ from __future__ import annotations
 
 import math
 
+import closed_form
 import numpy as np
 import pytest
+from closed_form_six_bar import stephenson_d
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-import closed_form
 import pinmech
-from tests._mechanisms import four_bar_urdf, spatial_rsur_urdf, stephenson_six_bar_urdf, write
-from closed_form_six_bar import stephenson_d
 from pinmech import AssemblyError, DriverLimitError, LoopSolver, Mechanism, SingularPoseError
 from pinmech.cli import main
 from pinmech.solve_cycle import solve_range
+from tests._mechanisms import four_bar_urdf, spatial_rsur_urdf, stephenson_six_bar_urdf, write
 
-SIX = dict(a=0.04, b=0.12, c=0.08, d=0.10, cx=0.06, cy=0.04, b2=0.10, c2=0.09, o6=(0.16, 0.10))
+SIX = {"a": 0.04, "b": 0.12, "c": 0.08, "d": 0.10, "cx": 0.06, "cy": 0.04, "b2": 0.10, "c2": 0.09, "o6": (0.16, 0.10)}
 
 
 # ---------------------------------------------------------------------- helpers
@@ -203,7 +203,7 @@ def test_a_sweep_past_a_limit_stops_there_or_goes_through_onto_the_other_branch(
     solver = LoopSolver(mech, ["O2"])
     solver.set_reference([math.pi], _four_bar_guess(mech, math.pi, *dims, +1))
     values = np.radians(np.arange(180, -1, -5.0))  # down to 0 deg, past the limit at 28.96 deg
-    q, errors, _ = _sweep(solver, values)
+    _q, errors, _ = _sweep(solver, values)
     first_bad = min(errors)
     assert math.degrees(values[first_bad - 1]) > math.degrees(lim) > math.degrees(values[first_bad])
     assert all(isinstance(errors[i], DriverLimitError) for i in errors)
@@ -296,7 +296,7 @@ def test_random_four_bar_sweeps_never_change_assembly_in_silence(tmp_path_factor
     mech = _four_bar(tmp, a, b, c, d)
     solver = LoopSolver(mech, ["O2"])
     try:
-        ref = solver.set_reference([start], _four_bar_guess(mech, start, a, b, c, d, branch))
+        solver.set_reference([start], _four_bar_guess(mech, start, a, b, c, d, branch))
     except (SingularPoseError, pinmech.LoopClosureError):
         return
     values = start + np.radians(np.arange(0, 370, step))
