@@ -117,6 +117,7 @@ class LoopSolver:
     have. `solve` without a guess then reaches the asked driver values from the reference
     by continuation (continuation.py), never by a cold Newton solve; with a guess it
     solves from the guess and raises AssemblyError if it lands on another assembly.
+    Without `set_reference`, the first pose solved becomes the reference.
 
     Args:
         mechanism: the model with its loop closures.
@@ -504,6 +505,8 @@ class LoopSolver:
         if guess is None and ref is not None:  # assembly "any": Newton from the reference pose
             guess = ref.q
         q, iterations, residual = self.close(self._guess(guess), dq)
+        if ref is None:  # the first pose solved names the assembly of the later ones
+            self.set_reference(dq, q)
         return self._solution(q, dv, da, residual, iterations, None)
 
     def follow(self, q0: np.ndarray, x0: np.ndarray, x1: np.ndarray, route: Route, *,

@@ -397,3 +397,16 @@ def test_sweep_json_lines_say_where_a_fold_was_crossed(tmp_path, models_dir, cap
     assert "crossed a fold at O2 = 28.955" in capsys.readouterr().err
     assert main(["sweep", str(scene), "--from", "180 deg", "--to", "0 deg", "--steps", "19"]) == 11
     assert "cannot go past O2 = 28.955" in capsys.readouterr().err
+
+
+def test_a_solver_without_reference_takes_its_first_pose_as_one(tmp_path):
+    a, b, c, d = 0.04, 0.12, 0.08, 0.10
+    mech = _four_bar(tmp_path, a, b, c, d)
+    solver = LoopSolver(mech, ["O2"])
+    first = solver.solve([1.0], guess=_four_bar_guess(mech, 1.0, a, b, c, d, -1))
+    assert solver.reference is not None and solver.reference.signs == first.assembly.signs
+    later = solver.solve([4.0])  # by continuation from the first pose
+    assert np.allclose(_rocker_tip(mech, later.q, c, d), closed_form.four_bar(4.0, 0, 0, a, b, c, d, -1).B,
+                       atol=1e-12 * 0.16)
+    with pytest.raises(AssemblyError):
+        solver.solve([4.0], guess=_four_bar_guess(mech, 4.0, a, b, c, d, +1))
