@@ -410,3 +410,19 @@ def test_a_solver_without_reference_takes_its_first_pose_as_one(tmp_path):
                        atol=1e-12 * 0.16)
     with pytest.raises(AssemblyError):
         solver.solve([4.0], guess=_four_bar_guess(mech, 4.0, a, b, c, d, +1))
+
+
+def test_the_batch_mode_hands_back_poses_of_another_assembly(tmp_path):
+    """BatchSolver from guesses on the other side: None (the pose-by-pose solver then
+    names the pose), never those poses."""
+    a, b, c, d = 0.04, 0.12, 0.08, 0.10
+    mech = _four_bar(tmp_path, a, b, c, d)
+    solver = LoopSolver(mech, ["O2"])
+    solver.set_reference([1.0], _four_bar_guess(mech, 1.0, a, b, c, d, +1))
+    thetas = np.linspace(1.0, 1.1, 5)
+    batch = pinmech.BatchSolver(solver)
+    same = np.array([_four_bar_guess(mech, t, a, b, c, d, +1) for t in thetas])
+    other = np.array([_four_bar_guess(mech, t, a, b, c, d, -1) for t in thetas])
+    zeros = np.zeros((5, 1))
+    assert batch.try_solve(same, thetas[:, None], zeros, zeros) is not None
+    assert batch.try_solve(other, thetas[:, None], zeros, zeros) is None
