@@ -51,6 +51,9 @@ FOLD_TOL = 1e-12
 #: A pose conditioned worse than this is no place to stand on: its tangent is noise (it
 #: sits on a crossing or a fold to within 1e-10), so a step does not end there.
 SINGULAR_NODE = 1e10
+#: Landing on a target from the pivot-parametrized curve: bisection along it until the
+#: bracket is this small in driver motion (radians or sizes).
+LAND_TOL = 1e-12
 #: Pivot-parameter steps taken at most before giving up.
 MAX_PIVOT_STEPS = 20000
 
@@ -216,7 +219,7 @@ class Path:
             if nxt.dp * state.dp <= 0:  # the driver turned back: a fold in between
                 fold = curve.locate_fold(state, nxt)
                 if (fold.p - p_target) * sense >= 0:  # the target comes before the fold
-                    return self._land(state, fold, p_target), p_target
+                    return self._land(curve, state, fold, p_target), p_target
                 x_fold = self.drivers(fold.p)
                 if not self.through_folds:
                     raise DriverLimitError(
@@ -230,13 +233,26 @@ class Path:
                 p_target = 2.0 * fold.p - p_target
                 sense = -sense
             elif (nxt.p - p_target) * sense >= 0:  # passed the target: close there
-                return self._land(state, nxt, p_target), p_target
+                return self._land(curve, state, nxt, p_target), p_target
             state = curve.repivot(nxt)
         raise self._stuck(node, why)
 
-    def _land(self, a: _CurvePoint, b: _CurvePoint, p_target: float) -> Node:
-        """The pose at p_target between two curve points that bracket it."""
-        w = (p_target - a.p) / (b.p - a.p)
+    def _land(self, curve: _Curve, a: _CurvePoint, b: _CurvePoint, p_target: float) -> Node:
+        """The pose at p_target between two curve points that bracket it (p monotonic
+        between them): bisection along the curve until the driver is within LAND_TOL
+        of the target, then Newton with the drivers held, from a pose that close to
+        one root only (near a fold the other root is only sqrt(distance) away)."""
+        for _ in range(60):
+            if abs(b.p - a.p) * self.unit <= LAND_TOL:
+                break
+            mid = curve.point_at(a, 0.5 * (a.s + b.s))
+            if mid is None:
+                break
+            if (mid.p - p_target) * (a.p - p_target) > 0:
+                a = mid
+            else:
+                b = mid
+        w = (p_target - a.p) / (b.p - a.p) if b.p != a.p else 0.0
         model = self.solver.model
         guess = pin.integrate(model, a.q, w * pin.difference(model, a.q, b.q))
         q, residual = self.solver.correct(guess, self.drivers(p_target), max_iterations=50, strict=False)
