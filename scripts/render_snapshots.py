@@ -16,8 +16,6 @@ Run: python scripts/render_snapshots.py   (needs pinmech[viz] and Debian's chrom
 from __future__ import annotations
 
 import math
-import shutil
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -28,19 +26,6 @@ ROOT = Path(__file__).resolve().parents[1]
 IMAGES = ROOT / "docs" / "images"
 MODELS = ROOT / "models"
 SCENES = {"r_rtr": ["v_D", "a_D"], "planar_arm": ["v_B", "v_C", "v_D"]}  # picture: arrows drawn
-FLAGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--enable-unsafe-swiftshader",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--virtual-time-budget=3000",
-    "--window-size=800,600",
-]  # as tests/browser.py
 BLUE, ORANGE = (0.1, 0.2, 0.9), (0.9, 0.5, 0.0)
 Z = np.array([0.0, 0.0, 1.0])
 
@@ -114,19 +99,11 @@ def page(name: str, arrow_labels: list[str]) -> str:
     )
 
 
-def photograph(chromium: str, html: Path, png: Path, profile: Path) -> None:
-    """Headless chromium's screenshot of a page (800 x 600 pixels)."""
-    subprocess.run(
-        [chromium, *FLAGS, f"--user-data-dir={profile}", f"--screenshot={png}", html.as_uri()],
-        capture_output=True,
-        timeout=120,
-        check=True,
-    )
-
-
 def main() -> None:
     """Write docs/images/NAME.png for every picture in SCENES."""
-    chromium = shutil.which("chromium")
+    from pinmech.draw.browser import find_chromium, photograph
+
+    chromium = find_chromium()
     if chromium is None:
         print("this script needs Debian's chromium: apt-get install chromium")
         return
@@ -141,7 +118,7 @@ def main() -> None:
         for name, arrow_labels in SCENES.items():
             html = Path(tmp) / f"{name}.html"
             html.write_text(page(name, arrow_labels), encoding="utf-8")
-            photograph(chromium, html, IMAGES / f"{name}.png", Path(tmp) / "profile")
+            photograph(chromium, html, IMAGES / f"{name}.png")
             print(f"wrote {IMAGES / f'{name}.png'}")
 
 
