@@ -328,10 +328,11 @@ _ARROW_UNITS = {"velocity": "m/s", "acceleration": "m/s^2"}
 
 
 def _visuals(mechanism):
-    """The mechanism's visual geometry, built only when drawing."""
+    """The mechanism's visual geometry, built only when drawing; links without visuals sketched."""
     from pinmech.draw import load_visuals
+    from pinmech.draw.sketch import sketch_visuals
 
-    return load_visuals(mechanism.source, mechanism.model)
+    return sketch_visuals(mechanism, load_visuals(mechanism.source, mechanism.model))
 
 
 def cmd_snapshot(args: argparse.Namespace) -> int:

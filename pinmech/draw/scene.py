@@ -200,14 +200,16 @@ class _Scene:
         camera.set_property("far", distance * 100)
 
     def add_points(self, points: Mapping[str, np.ndarray], size: float) -> None:
-        """Draw named points (world frame [m]) as dark dots with their names."""
+        """Draw named points (world frame [m]) as dark dots with their names; points at one
+        place (B of the crank, B3 of the guide under it) share one label, "B, B3"."""
         g = _meshcat().geometry
         for name, p in points.items():
             node = self.vis[f"{ROOT}/points/{_node(name)}"]
             on_top = g.MeshBasicMaterial(color=_POINT_COLOUR, transparent=True, depthTest=False)
             node.set_object(g.Sphere(0.01 * size), on_top)  # seen through the bodies
             node.set_transform(_translation(p))
-            self.add_label(f"points/{_node(name)}/label", name, self._label_offset(size), size)
+        for names in coincident_groups(points, 1e-6 * size):
+            self.add_label(f"points/{_node(names[0])}/label", ", ".join(names), self._label_offset(size), size)
 
     def move_points(self, frame: Any, points: Mapping[str, np.ndarray]) -> None:
         """Move the named points in one animation frame."""
@@ -255,6 +257,19 @@ class _Scene:
             if arrow.label:
                 tip = arrow.start + vec + self._label_offset(size)
                 self.add_label(f"arrows/{i}/label", arrow.label, tip, size)
+
+
+def coincident_groups(points: Mapping[str, np.ndarray], tol: float) -> list[list[str]]:
+    """Names of the points, grouped where they lie within `tol` [m] of each other (in order)."""
+    groups: list[list[str]] = []
+    for name, p in points.items():
+        for group in groups:
+            if np.linalg.norm(points[group[0]] - p) <= tol:
+                group.append(name)
+                break
+        else:
+            groups.append([name])
+    return groups
 
 
 def _draw_pose(
