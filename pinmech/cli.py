@@ -114,6 +114,18 @@ def build_parser() -> argparse.ArgumentParser:
     anim.add_argument("--no-grid", action="store_true", help="hide meshcat's grid and axes")
     anim.set_defaults(func=cmd_animate)
 
+    poly = sub.add_parser("polygon", help="draw the velocity (or acceleration) polygon of a planar pose as SVG")
+    poly.add_argument("scene", help="scene file (TOML), e.g. models/scenes/r_rtr.toml")
+    poly.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                      help="override a scene value, e.g. --set 'drivers.A.acceleration=\"2 rad/s^2\"' (repeatable)")
+    poly.add_argument("--angle", help="shortcut: the (single) driver's angle or position, e.g. '45 deg'")
+    poly.add_argument("--speed", help="shortcut: the driver's speed, e.g. '-50 rpm'")
+    poly.add_argument("-o", "--output", required=True, help="the SVG file to write")
+    poly.add_argument("--acceleration", dest="acceleration_polygon", action="store_true",
+                      help="the acceleration polygon (normal, tangential and Coriolis parts) instead; the "
+                      "driver's acceleration comes from the scene or --set")
+    poly.set_defaults(func=cmd_polygon)
+
     live = sub.add_parser("view", help="show the solved pose in a live meshcat server (a browser tab)")
     _add_scene_arguments(live)
     live.set_defaults(func=cmd_view)
@@ -384,6 +396,19 @@ def cmd_animate(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_polygon(args: argparse.Namespace) -> int:
+    """`pinmech polygon SCENE -o v.svg [--acceleration]`: the graphical method's polygon."""
+    from pinmech.analysis import analyse
+    from pinmech.draw.polygon_svg import polygon_svg
+    from pinmech.polygon import acceleration_polygon, velocity_polygon
+
+    args.acceleration = None  # the flag names the polygon here, not the driver's acceleration
+    analysis = analyse(_scene(args))
+    polygon = (acceleration_polygon if args.acceleration_polygon else velocity_polygon)(analysis)
+    _write_text(args.output, polygon_svg(polygon), "SVG drawing")
+    return 0
+
+
 def cmd_view(args: argparse.Namespace) -> int:
     """`pinmech view SCENE`: the solved pose in a live meshcat server; prints its URL."""
     from pinmech.analysis import analyse
@@ -400,6 +425,18 @@ def cmd_view(args: argparse.Namespace) -> int:
         except (EOFError, KeyboardInterrupt):  # no terminal, or Ctrl-C: stop quietly
             pass
     return 0
+
+
+def _write_text(path: str, text: str, what: str) -> None:
+    """Write a whole file at once (a failed write leaves no half file behind) and say so."""
+    import os
+    import tempfile
+
+    folder = os.path.dirname(os.path.abspath(path))
+    with tempfile.NamedTemporaryFile("w", encoding="utf-8", dir=folder, delete=False, suffix=".part") as stream:
+        stream.write(text)
+    os.replace(stream.name, path)
+    print(f"wrote {path} ({what}, {max(1, len(text) // 1024)} KB)", file=sys.stderr)
 
 
 def _write(path: str, html: str) -> None:
