@@ -68,6 +68,13 @@ def build_parser() -> argparse.ArgumentParser:
     _add_output_arguments(sweep)
     sweep.add_argument("--links", nargs="*", help="links to plot (default: all moving but the driver's)")
     sweep.add_argument("--points", nargs="*", help="points to plot (default: all moving points)")
+    sweep.add_argument("--paths", dest="paths_path",
+                       help="also draw the points' paths, with the mechanism at the scene's pose, here (PNG, PDF, SVG)")
+    sweep.add_argument("--angles", choices=("continuous", "wrapped"), default="continuous",
+                       help="link angles in the figure: continuous (default, no jump at 180 deg) or wrapped "
+                       "to (-180, 180] deg")
+    sweep.add_argument("--path-plane", choices=("xy", "yz", "zx"),
+                       help="a spatial mechanism's paths projected on this world plane (default xy)")
     sweep.add_argument("--skip-failures", action="store_true",
                        help="report a pose that cannot close as a row with its error instead of stopping")
     sweep.add_argument("--start", dest="start_mode", choices=("predictor", "warm", "cold"),
@@ -217,15 +224,34 @@ def _sweep_sinks(args: argparse.Namespace, sweep, steps: int) -> _Sinks:
     from pinmech.tables import SweepCsv, SweepJsonLines
 
     sinks = _Sinks()
-    if args.plot_path:
+    if args.plot_path or args.paths_path:
         from pinmech.plot import SweepPlot
 
-        sinks.plot(SweepPlot(sweep, links=args.links, points=args.points, total=steps), args.plot_path)
-    if args.csv_path or not (args.plot_path or args.json_path):
+        recorder = SweepPlot(sweep, links=args.links, points=args.points, total=steps, angles=args.angles,
+                             plane=args.path_plane)
+        if args.plot_path:
+            sinks.plot(recorder, args.plot_path)
+        if args.paths_path:
+            sinks.plot(_PathsFigure(recorder, feed=not args.plot_path), args.paths_path)
+    if args.csv_path or not (args.plot_path or args.json_path or args.paths_path):
         sinks.table(SweepCsv, sweep, args.csv_path, "poses")
     if args.json_path:
         sinks.table(SweepJsonLines, sweep, args.json_path, None)
     return sinks
+
+
+class _PathsFigure:
+    """The paths figure of a sweep's recorder (fed once, whoever feeds it)."""
+
+    def __init__(self, recorder, *, feed: bool) -> None:
+        self.recorder, self.feed = recorder, feed
+
+    def add(self, pose) -> None:
+        if self.feed:
+            self.recorder.add(pose)
+
+    def save(self, path: str):
+        return self.recorder.save_paths(path)
 
 
 class _Sinks:

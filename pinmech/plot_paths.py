@@ -1,0 +1,145 @@
+"""Paths of points over a sweep (the coupler curve, a foot's path), drawn in the mechanism's
+plane with the mechanism itself at the scene's pose, equal axes, the direction of travel
+marked. A spatial mechanism's paths are projected on a chosen world plane (xy, yz, zx).
+
+The mechanism is drawn as a textbook sketches it (`pinmech.linkage`): bars, plates,
+slider blocks, guides and ground triangles, one colour a link.
+"""
+
+from __future__ import annotations
+
+from array import array
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pinocchio as pin
+
+from pinmech.exceptions import PinmechError
+from pinmech.linkage import sketch_links, world_nodes
+from pinmech.motion import _plane_reference
+
+if TYPE_CHECKING:
+    from pinmech.mechanism import Mechanism
+
+PLANES = {"xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
+_COLOURS = ("#d62728", "#1f5fbf", "#2ca02c", "#e08a0b", "#8c4cbf", "#17a2b0")  # as the 3-D sketches
+
+
+class PathRecorder:
+    """Keeps the points' places pose by pose, in the drawing plane's coordinates [m].
+
+    Args:
+        mechanism: the model (its plane, or `plane` for a spatial one).
+        plane: None (the mechanism's plane; "xy" for a spatial mechanism) or one of PLANES.
+    """
+
+    def __init__(self, mechanism: Mechanism, plane: str | None = None) -> None:
+        if plane is not None and plane not in PLANES:
+            raise PinmechError(f"the path plane must be one of {', '.join(PLANES)}, got {plane!r}")
+        self.mechanism = mechanism
+        normal = mechanism.plane_normal
+        if plane is None and normal is not None:
+            e1 = _plane_reference(*normal.tolist())
+            self.axes, self.names = np.array([e1, np.cross(normal, e1)]), ("x", "y")
+        else:
+            i, j = PLANES[plane or "xy"]
+            self.axes, self.names = np.eye(3)[[i, j]], ("xyz"[i], "xyz"[j])
+        self.uv: dict[str, tuple[array, array]] = {}
+        self.count = 0
+
+    def add(self, positions: dict[str, np.ndarray]) -> None:
+        """One pose: point name -> world position [m] (NaN where the pose failed)."""
+        for name, p in positions.items():
+            u, v = self.uv.setdefault(name, (array("d"), array("d")))
+            uv = self.axes @ p
+            u.append(float(uv[0]))
+            v.append(float(uv[1]))
+        self.count += 1
+
+    def draw(self, ax, q: np.ndarray | None, travel: str) -> None:
+        """Paths, the mechanism at q (if given) and arrows of travel, on matplotlib axes."""
+        scale, unit = (1000.0, "mm") if self._size() < 1.0 else (1.0, "m")
+        if q is not None:
+            draw_linkage(ax, self.mechanism, q, self.axes, scale)
+        for k, (name, (u, v)) in enumerate(self.uv.items()):
+            u, v = np.array(u) * scale, np.array(v) * scale
+            (line,) = ax.plot(u, v, linewidth=1.6, linestyle=("-", "--", "-.", ":")[k % 4], label=f"path of {name}",
+                              zorder=4)
+            _arrows(ax, u, v, line.get_color())
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel(f"{self.names[0]} [{unit}]", fontsize=9)
+        ax.set_ylabel(f"{self.names[1]} [{unit}]", fontsize=9)
+        ax.set_title(f"paths of points ({travel}); mechanism at the scene's pose", fontsize=10)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+
+    def _size(self) -> float:
+        values = [np.abs(np.array(c)) for uv in self.uv.values() for c in uv]
+        finite = [x[np.isfinite(x)] for x in values]
+        return float(max((np.max(x) for x in finite if x.size), default=0.0))
+
+
+def _arrows(ax, u: np.ndarray, v: np.ndarray, colour: str, count: int = 4) -> None:
+    """Arrowheads along a path, the way it is travelled."""
+    ok = np.nonzero(np.isfinite(u) & np.isfinite(v))[0]
+    if len(ok) < 3:
+        return
+    for k in np.linspace(0, len(ok) - 2, count + 2)[1:-1].astype(int):
+        i, j = ok[k], ok[k + 1]
+        if j != i + 1 or (u[i], v[i]) == (u[j], v[j]):
+            continue
+        ax.annotate("", xy=(u[j], v[j]), xytext=(u[i], v[i]), zorder=5,
+                    arrowprops={"arrowstyle": "-|>", "color": colour, "lw": 1.4, "mutation_scale": 14})
+
+
+def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scale: float = 1.0) -> None:
+    """The mechanism at q on matplotlib axes, in the plane spanned by `axes` (2 x 3) [m x scale]."""
+    from matplotlib.patches import Polygon
+
+    data = mechanism.model.createData()
+    pin.forwardKinematics(mechanism.model, data, q)
+    sketches = sketch_links(mechanism)
+    spans = [np.linalg.norm(a.position - b.position) for s in sketches.values() for a in s.nodes for b in s.nodes]
+    size = scale * max(spans, default=mechanism.length_scale)
+    for k, link in enumerate(sketches.values()):
+        uv = (world_nodes(link, data) @ axes.T) * scale
+        colour = "0.45" if link.is_ground else _COLOURS[k % len(_COLOURS)]
+        if link.is_ground:
+            _ground(ax, link, uv, size, axes, scale)
+            continue
+        if len(uv) >= 3:
+            hull = uv[np.argsort(np.arctan2(*(uv - uv.mean(axis=0)).T[::-1]))]
+            ax.add_patch(Polygon(hull, closed=True, facecolor=colour, alpha=0.3, edgecolor=colour, lw=2, zorder=2))
+        elif len(uv) == 2:
+            ax.plot(uv[:, 0], uv[:, 1], color=colour, linewidth=4, solid_capstyle="round", zorder=2)
+        if link.slide_axis is not None:
+            axis = axes @ (data.oMi[link.joint].rotation @ link.slide_axis)
+            _block(ax, uv[0], axis / max(np.linalg.norm(axis), 1e-300), size, colour)
+        for node, p in zip(link.nodes, uv):
+            if node.kind == "revolute":
+                ax.plot(*p, "o", markersize=5, markerfacecolor="white", markeredgecolor="0.15", zorder=3)
+
+
+def _ground(ax, link, uv: np.ndarray, size: float, axes: np.ndarray, scale: float) -> None:
+    """Triangles under the fixed pivots, a dashed line along each guide."""
+    from matplotlib.patches import Polygon
+
+    h = 0.08 * size
+    for node, p in zip(link.nodes, uv):
+        if node.kind == "revolute":
+            ax.add_patch(Polygon([p, p + (-0.6 * h, -h), p + (0.6 * h, -h)], closed=True, facecolor="0.75",
+                                 edgecolor="0.3", zorder=1))
+            ax.plot([p[0] - h, p[0] + h], [p[1] - h] * 2, color="0.3", linewidth=1.5, zorder=1)
+    for origin, axis in link.guides:
+        p, d = axes @ origin * scale, axes @ axis
+        ends = np.array([p - 0.3 * size * d, p + 1.5 * size * d])
+        ax.plot(ends[:, 0], ends[:, 1], color="0.45", linestyle="--", linewidth=1.2, zorder=1)
+
+
+def _block(ax, centre: np.ndarray, axis: np.ndarray, size: float, colour: str) -> None:
+    from matplotlib.patches import Polygon
+
+    across = np.array([-axis[1], axis[0]])
+    a, b = 0.1 * size * axis, 0.055 * size * across
+    corners = [centre - a - b, centre + a - b, centre + a + b, centre - a + b]
+    ax.add_patch(Polygon(corners, closed=True, facecolor=colour, edgecolor="0.15", alpha=0.8, zorder=3))
