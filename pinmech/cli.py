@@ -133,6 +133,13 @@ def build_parser() -> argparse.ArgumentParser:
                       "driver's acceleration comes from the scene or --set")
     poly.set_defaults(func=cmd_polygon)
 
+    page = sub.add_parser("report", help="write one offline HTML page: drawing, tables, polygons, sweep figures")
+    _add_scene_arguments(page)
+    page.add_argument("-o", "--output", required=True, help="the HTML file to write")
+    page.add_argument("--hand", help="a hand-value file to check on the page (as pinmech check)")
+    page.add_argument("--steps", type=int, default=121, help="poses of the sweep drawn (default 121; 0: none)")
+    page.set_defaults(func=cmd_report)
+
     live = sub.add_parser("view", help="show the solved pose in a live meshcat server (a browser tab)")
     _add_scene_arguments(live)
     live.set_defaults(func=cmd_view)
@@ -432,6 +439,28 @@ def cmd_polygon(args: argparse.Namespace) -> int:
     analysis = analyse(_scene(args))
     polygon = (acceleration_polygon if args.acceleration_polygon else velocity_polygon)(analysis)
     _write_text(args.output, polygon_svg(polygon), "SVG drawing")
+    return 0
+
+
+def cmd_report(args: argparse.Namespace) -> int:
+    """`pinmech report SCENE -o page.html [--hand FILE]`: everything about the scene on one offline page."""
+    from pinmech.analysis import analyse
+    from pinmech.draw.report_page import report_html
+
+    if args.steps < 0 or args.steps == 1:
+        raise PinmechError(f"--steps must be 0 (no sweep) or at least 2, got {args.steps}")
+    hand_text = None
+    analysis = analyse(_scene(args))
+    if args.hand:
+        from pinmech.check import DEFAULT_SLACK, compare, format_verdicts, load_hand_file
+        from pinmech.report import to_dict
+        from pinmech.scene import Scene
+
+        hand = load_hand_file(args.hand)
+        checked = analyse(Scene.load(hand.scene))
+        verdicts = compare(to_dict(checked), hand.values, DEFAULT_SLACK)
+        hand_text = f"{hand.source or hand.path}  vs  pinmech on {hand.scene.name}\n" + format_verdicts(verdicts)
+    _write_text(args.output, report_html(analysis, steps=args.steps, hand_text=hand_text), "offline page")
     return 0
 
 

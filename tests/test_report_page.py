@@ -1,0 +1,118 @@
+"""The one-page report, links sketched where a URDF has no visuals, and notebook display.
+
+The page is opened in headless chromium as the drawing tests do: it draws (pixels that are
+not the white page), the meshcat frame is framed (its drawing spans most of the frame), and
+nothing is fetched (no script, link or image points off the page).
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from pinmech import Scene, analyse
+from pinmech.cli import main
+from pinmech.draw import load_visuals
+from pinmech.draw.report_page import snapshot
+from pinmech.draw.sketch import sketch_visuals
+from pinmech.linkage import sketch_links
+from tests.browser import screenshot, span_share
+from tests.conftest import MODELS, SCENES
+
+OFF_PAGE = r"""<script[^>]*\ssrc=|<link[^>]*href=|(src|href)=["']?(https?:)?//|src=["']?file:"""
+
+
+def bare_scene(tmp_path, name: str) -> Scene:
+    """A bundled scene on a copy of its URDF with every <visual> taken out: a user's model."""
+    text = (MODELS / f"{name}.urdf").read_text(encoding="utf-8")
+    text = re.sub(r"<visual>.*?</visual>", "", text, flags=re.S)
+    (tmp_path / f"{name}.urdf").write_text(text, encoding="utf-8")
+    scene = (SCENES / f"{name}.toml").read_text(encoding="utf-8")
+    scene = re.sub(r'urdf = ".*"', f'urdf = "{name}.urdf"', scene)
+    (tmp_path / f"{name}.toml").write_text(scene, encoding="utf-8")
+    return Scene.load(tmp_path / f"{name}.toml")
+
+
+@pytest.mark.parametrize("name", ["four_bar", "slider_crank", "r_rtr"])
+def test_every_link_without_visuals_is_sketched(tmp_path, name):
+    """Each moving link gets geometry on its own joint; a bar is as long as the link (plus
+    its width, the rounded ends); the ground gets a triangle per fixed pivot."""
+    analysis = analyse(bare_scene(tmp_path, name))
+    mech = analysis.mechanism
+    visuals = sketch_visuals(mech, load_visuals(mech.source, mech.model))
+    assert len(load_visuals(mech.source, mech.model).geometryObjects) == 0
+    drawn = {g.parentJoint for g in visuals.geometryObjects}
+    links = sketch_links(mech)
+    assert {link.joint for link in links.values()} <= drawn
+    pivots = [n for n in links["ground"].nodes if n.kind == "revolute"]
+    assert sum(g.parentJoint == 0 and g.name.startswith("sketch_ground") for g in visuals.geometryObjects) >= len(pivots)
+    for link in links.values():
+        if len(link.nodes) == 2 and not link.is_ground:
+            length = np.linalg.norm(link.nodes[0].position - link.nodes[1].position)
+            boxes = [g.geometry for g in visuals.geometryObjects if g.parentJoint == link.joint
+                     and type(g.geometry).__name__ == "Box"]
+            widths = [2 * b.halfSide[1] for b in boxes]
+            assert any(abs(2 * b.halfSide[0] - length - w) < 1e-12 for b, w in zip(boxes, widths))
+
+
+def test_a_slider_block_and_the_pivots_of_a_bare_slider_crank():
+    mech = analyse(Scene.load(SCENES / "slider_crank.toml")).mechanism
+    links = sketch_links(mech)
+    assert links["piston"].slide_axis is not None  # the block
+    assert links["ground"].guides  # the guide it runs on
+    assert {n.kind for n in links["ground"].nodes} == {"revolute", "prismatic"}
+
+
+@pytest.mark.browser
+def test_a_bare_four_bar_is_drawn_and_framed(tmp_path):
+    analysis = analyse(bare_scene(tmp_path, "four_bar"))
+    page = tmp_path / "bare.html"
+    snapshot(analysis).save(page)
+    assert span_share(screenshot(page, tmp_path / "bare.png")) > 0.6
+
+
+@pytest.mark.browser
+def test_the_report_page_draws_offline(tmp_path):
+    out = tmp_path / "page.html"
+    assert main(["report", str(SCENES / "r_rtr.toml"), "-o", str(out), "--steps", "25",
+                 "--hand", str(SCENES / "r_rtr.hand.toml")]) == 0
+    page = out.read_text(encoding="utf-8")
+    assert not re.search(OFF_PAGE, page)
+    for part in ("Velocity polygon", "Acceleration polygon", "data:image/png;base64,", "<iframe", "MISMATCH"
+                 if "MISMATCH" in page else "OK"):
+        assert part in page
+    pixels = screenshot(out, tmp_path / "page.png", window=(1000, 1400))
+    assert span_share(pixels) > 0.8
+    frame = pixels[60:580, :]  # the meshcat frame, under the page's title
+    drawn = np.any(frame < 0.9, axis=2)
+    assert drawn.mean() > 0.02  # the mechanism (and grid) drawn in the frame, not a blank box
+
+
+def test_the_report_page_of_a_bare_model(tmp_path):
+    scene = bare_scene(tmp_path, "slider_crank")
+    out = tmp_path / "bare_page.html"
+    assert main(["report", str(scene.path), "-o", str(out), "--steps", "13"]) == 0
+    page = out.read_text(encoding="utf-8")
+    assert "paths" in page and "Velocity polygon" in page and not re.search(OFF_PAGE, page)
+
+
+def test_notebooks_show_tables_and_the_drawing():
+    analysis = analyse(Scene.load(SCENES / "r_rtr.toml"))
+    table = analysis._repr_html_()
+    assert table.count("<table>") == 2 and "<td>D</td>" in table and "10.3803" in table  # |a_D|
+    frame = snapshot(analysis)._repr_html_()
+    assert frame.startswith("<iframe") and "srcdoc=" in frame
+
+
+def test_report_steps_must_be_sensible(tmp_path, capsys):
+    assert main(["report", str(SCENES / "r_rtr.toml"), "-o", str(tmp_path / "x.html"), "--steps", "1"]) == 2
+    assert "--steps" in capsys.readouterr().err and not (tmp_path / "x.html").exists()
+
+
+def test_snapshot_html_unchanged_for_models_with_visuals():
+    """A model with its own visuals keeps exactly them (nothing sketched on top)."""
+    mech = analyse(Scene.load(SCENES / "r_rtr.toml")).mechanism
+    own = load_visuals(mech.source, mech.model)
+    assert len(sketch_visuals(mech, own).geometryObjects) == len(own.geometryObjects)
