@@ -6,7 +6,8 @@ w x BP; in the acceleration polygon the relative acceleration is drawn as its no
 a^n_PB = -w^2 BP (towards B) then its tangential part a^t_PB = alpha x BP. A point of one
 link under a point of another (B3 of the guide under the slider pin B) is joined by the
 sliding velocity v_rel = v_B - v_B3, and in accelerations by the Coriolis part
-2 w x v_rel (w of the guide) then the sliding acceleration a_rel.
+2 w x v_rel (w of the guide) then the sliding acceleration a_rel. The points of a link are
+taken in a chain, a fixed pivot first: C, then B3 about C, then D about B3.
 
 Which points share a link: the link a point hangs on, and the links a pin at its place
 joins (`pinmech.linkage`). The numbers are pinmech's (`Analysis.motion`); the polygon is
@@ -114,20 +115,31 @@ def _polygon(analysis: Analysis, quantity: str) -> Polygon:
     for link, members in _link_members(analysis).items():
         w = float(normal @ motion.links[link].angular_velocity) if link in motion.links else None
         alpha = float(normal @ motion.links[link].angular_acceleration) if link in motion.links else None
-        base = members[0]
-        for name in members[1:]:
+        for base, name in zip(members, members[1:]):  # a chain: each point about the one before
             vectors += _relative(analysis, axes, labels, images, base, name, w, alpha, acc)
     for c in coincident_points(analysis.scene):
         if c.name in labels and c.at in labels:
             vectors += _sliding(analysis, axes, labels, images, c, acc)
-    largest = max((np.linalg.norm(v) for v in images.values()), default=0.0)
-    vectors = [v for v in vectors if np.linalg.norm(v.head - v.tail) > 1e-9 * largest  # none of zero length,
-               and not (v.kind == "relative" and np.linalg.norm(v.tail) == 0.0)]  # nor twice from the pole
-    return Polygon(quantity, "m/s^2" if acc else "m/s", images, labels, vectors, axes, _title(analysis, quantity))
+    return Polygon(quantity, "m/s^2" if acc else "m/s", images, labels, _drawn(vectors, images), axes,
+                   _title(analysis, quantity))
+
+
+def _drawn(vectors: list[PolygonVector], images: dict[str, np.ndarray]) -> list[PolygonVector]:
+    """The vectors worth drawing: none of zero length, and none drawn twice (a relative
+    vector from a fixed pivot's image is the absolute one: o->b is v_B and v_BA)."""
+    tol = 1e-9 * max((np.linalg.norm(v) for v in images.values()), default=0.0)
+    absolute = [v for v in vectors if v.kind == "absolute"]
+
+    def twice(v: PolygonVector) -> bool:
+        return v.kind != "absolute" and any(
+            np.linalg.norm(v.tail - a.tail) <= tol and np.linalg.norm(v.head - a.head) <= tol for a in absolute)
+
+    return [v for v in vectors if np.linalg.norm(v.head - v.tail) > tol and not twice(v)]
 
 
 def _link_members(analysis: Analysis) -> dict[str, list[str]]:
-    """Moving link -> the reported points on it (a pin's point on both links), a fixed one first."""
+    """Moving link -> the reported points on it (a pin's point on both links), fixed ones
+    first, then in the report's order."""
     mech, motion = analysis.mechanism, analysis.motion
     coincident = {c.name for c in coincident_points(analysis.scene)}
     data = mech.model.createData()

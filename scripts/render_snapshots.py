@@ -7,8 +7,15 @@ route as the browser tests (tests/browser.py).
 - `docs/images/planar_arm.png`: the 3R arm of text 17.110 at (50, -65, -75) deg, D moving
   at 1 m/s along x while CD does not turn: velocities of B, C and D (one scale).
 
-Poses and rates come from the independent closed forms in scripts/closed_form.py; the models
-are built from the URDF files directly.
+- `docs/images/four_bar.png`, `docs/images/slider_crank.png`: the bundled scenes as
+  `pinmech snapshot` draws them; `docs/images/four_bar_bare.png`: the four-bar with every
+  `<visual>` taken out (a user's model), its links sketched from its joints and points.
+- `docs/images/sweep_r_rtr.png`, `docs/images/paths_four_bar.png`: `pinmech sweep --plot`
+  and `--paths`; `docs/images/polygon_v_r_rtr.png`, `polygon_a_r_rtr.png`: `pinmech polygon`.
+
+Poses and rates of the first two come from the independent closed forms in
+scripts/closed_form.py; the models are built from the URDF files directly. The others run
+pinmech's own commands on the bundled scenes.
 
 Run: python scripts/render_snapshots.py   (needs pinmech[viz] and Debian's chromium)
 """
@@ -99,6 +106,39 @@ def page(name: str, arrow_labels: list[str]) -> str:
     )
 
 
+def cli_pictures(chromium: str, tmp: Path) -> None:
+    """The pictures pinmech's own commands make: snapshots, a bare model, figures, polygons."""
+    import re
+
+    from pinmech.cli import main as pinmech
+    from pinmech.draw.browser import photograph
+
+    scenes = MODELS / "scenes"
+    bare = tmp / "four_bar_bare.urdf"
+    bare.write_text(re.sub(r"<visual>.*?</visual>", "", (MODELS / "four_bar.urdf").read_text(), flags=re.S))
+    scene = (scenes / "four_bar.toml").read_text()
+    (tmp / "four_bar_bare.toml").write_text(re.sub(r'urdf = ".*"', 'urdf = "four_bar_bare.urdf"', scene))
+    for name, scene_file in (("four_bar", scenes / "four_bar.toml"), ("slider_crank", scenes / "slider_crank.toml"),
+                             ("four_bar_bare", tmp / "four_bar_bare.toml")):
+        html = tmp / f"{name}.html"
+        pinmech(["snapshot", str(scene_file), "-o", str(html), "--no-grid"])
+        photograph(chromium, html, IMAGES / f"{name}.png")
+    pinmech(["sweep", str(scenes / "r_rtr.toml"), "--plot", str(IMAGES / "sweep_r_rtr.png"), "--csv", str(tmp / "s.csv")])
+    pinmech(["sweep", str(scenes / "four_bar.toml"), "--paths", str(IMAGES / "paths_four_bar.png")])
+    for kind in ("v", "a"):
+        svg = tmp / f"polygon_{kind}.svg"
+        pinmech(["polygon", str(scenes / "r_rtr.toml"), "-o", str(svg)] + (["--acceleration"] if kind == "a" else []))
+        photograph(chromium, svg, IMAGES / f"polygon_{kind}_r_rtr.png", window=_svg_pixels(svg))
+
+
+def _svg_pixels(svg: Path) -> tuple[int, int]:
+    """The size of an SVG drawing given in millimetres, in CSS pixels (96 per inch)."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(svg).getroot()
+    return tuple(round(float(root.get(k).removesuffix("mm")) * 96 / 25.4) + 1 for k in ("width", "height"))
+
+
 def main() -> None:
     """Write docs/images/NAME.png for every picture in SCENES."""
     from pinmech.draw.browser import find_chromium, photograph
@@ -120,6 +160,7 @@ def main() -> None:
             html.write_text(page(name, arrow_labels), encoding="utf-8")
             photograph(chromium, html, IMAGES / f"{name}.png")
             print(f"wrote {IMAGES / f'{name}.png'}")
+        cli_pictures(chromium, Path(tmp))
 
 
 if __name__ == "__main__":

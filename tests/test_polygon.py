@@ -53,31 +53,34 @@ CASES = [((), 30.0, -50.0 * math.pi / 30.0, 0.0),
 
 @pytest.mark.parametrize(("overrides", "theta", "omega", "alpha"), CASES)
 def test_r_rtr_velocity_polygon_measures_the_closed_form(overrides, theta, omega, alpha):
-    """o->b is v_B, o->d is v_D, o->b3 is v_B3 = w3 x CB, and b3->b is the sliding velocity
-    v_B - v_B3 (minus the closed form's v_rel, which is B3's on the block)."""
+    """o->b is v_B, o->d is v_D, o->b3 is v_B3 = w3 x CB, b3->d is v_DB3 = w3 x B3D, and b3->b
+    is the sliding velocity v_B - v_B3 (minus the closed form's v_rel, B3's on the block)."""
     ref = cf.r_rtr(math.radians(theta), omega, alpha)
     per_mm, v, labels, _ = read_svg(polygon_svg(velocity_polygon(r_rtr(overrides))))
     atol = READ_MM * per_mm
     np.testing.assert_allclose(v["v_B"], ref.vB, atol=atol)
     np.testing.assert_allclose(v["v_D"], ref.vD, atol=atol)
     np.testing.assert_allclose(v["v_B3"], ref.vB3, atol=atol)
+    B3D = ref.D - ref.B
+    np.testing.assert_allclose(v["v_DB3"], ref.omega3 * np.array([-B3D[1], B3D[0]]), atol=atol)
     np.testing.assert_allclose(v["v_BB3"], -ref.v_rel, atol=atol)
     assert "o, a, c" in labels  # the fixed pivots' images at the pole share its label
 
 
 @pytest.mark.parametrize(("overrides", "theta", "omega", "alpha"), CASES)
 def test_r_rtr_acceleration_polygon_measures_the_closed_form(overrides, theta, omega, alpha):
-    """o'->d' is a_D; about C: the normal part w3^2 |CD| towards C, the tangential part
-    alpha3 k x CD; B about B3: the Coriolis part 2 w3 k x (v_B - v_B3), then the sliding
-    acceleration along the guide (minus the closed form's, which is B3's on the block)."""
+    """o'->d' is a_D; B3 about C, D about B3: normal parts w3^2 r towards the base point,
+    tangential parts alpha3 k x r; B about B3: the Coriolis part 2 w3 k x (v_B - v_B3), then
+    the sliding acceleration along the guide (minus the closed form's, B3's on the block)."""
     ref = cf.r_rtr(math.radians(theta), omega, alpha)
     per_mm, a, _, _ = read_svg(polygon_svg(acceleration_polygon(r_rtr(overrides))))
     atol = READ_MM * per_mm
     CD = ref.D - np.array([0.05, 0.0])
     np.testing.assert_allclose(a["a_D"], ref.aD, atol=atol)
     np.testing.assert_allclose(a["a_B"], ref.aB, atol=atol)
-    np.testing.assert_allclose(a["a^n_DC"], -ref.omega3**2 * CD, atol=atol)
-    np.testing.assert_allclose(a["a^t_DC"], ref.alpha3 * np.array([-CD[1], CD[0]]), atol=atol)
+    for name, r in (("B3C", ref.B - np.array([0.05, 0.0])), ("DB3", ref.D - ref.B)):
+        np.testing.assert_allclose(a[f"a^n_{name}"], -ref.omega3**2 * r, atol=atol)
+        np.testing.assert_allclose(a[f"a^t_{name}"], ref.alpha3 * np.array([-r[1], r[0]]), atol=atol)
     np.testing.assert_allclose(a["a^c_BB3"], -ref.coriolis, atol=atol)
     np.testing.assert_allclose(a["a^r_BB3"], -ref.a_rel, atol=atol)
     u = CD / np.linalg.norm(CD)

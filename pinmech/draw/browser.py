@@ -24,6 +24,7 @@ FLAGS = (
     "--disable-background-networking",
     "--disable-component-update",
     "--disable-sync",
+    "--hide-scrollbars",
 )
 WINDOW = (800, 600)  # width, height of the view [pixels]
 BUDGET_MS = 3000  # virtual time for the page to load and draw [ms]
