@@ -191,4 +191,4 @@ def _title(analysis: Analysis, quantity: str) -> str:
     scene = analysis.scene
     spec = scene.section("drivers")
     drivers = "; ".join(f"{n}: " + ", ".join(str(v) for v in spec[n].values()) for n in spec)
-    return f"{quantity.capitalize()} polygon: {scene.title} ({drivers})"
+    return f"{quantity.capitalize()} polygon: {scene.title}" + (f" ({drivers})" if drivers else "")

@@ -102,3 +102,24 @@ def test_the_title_gives_the_drivers_speed(figures, tmp_path):
     assert main(["sweep", str(SCENES / "r_rtr.toml"), "--steps", "5", "--plot", str(tmp_path / "t.png")]) == 0
     assert "-50 rpm" in figures[0].texts[0].get_text() or "-50 rpm" in figures[0]._suptitle.get_text()
 
+
+
+def test_paths_on_a_chosen_world_plane(figures, tmp_path):
+    """--path-plane yz: D's path drawn as (y, z) = (the closed form's y, 0)."""
+    assert main(["sweep", str(SCENES / "r_rtr.toml"), "--steps", "13", "--path-plane", "yz",
+                 "--paths", str(tmp_path / "p.png")]) == 0
+    ax = figures[0].axes[0]
+    (line,) = [x for x in ax.get_lines() if x.get_label() == "path of D"]
+    u, v = (np.asarray(a, dtype=float) for a in line.get_data())
+    theta = np.radians(np.linspace(30, 390, 13))
+    np.testing.assert_allclose(u, 1000 * cf.r_rtr(theta, 1.0, 0.0).D[:, 1], atol=1e-9)
+    np.testing.assert_allclose(v, 0.0, atol=1e-12)
+    assert ax.get_xlabel() == "y [mm]" and ax.get_ylabel() == "z [mm]"
+
+
+def test_a_fixed_points_path_is_a_dot(figures, tmp_path):
+    """The path of the fixed pivot A stays at A: every drawn place is (0, 0)."""
+    assert main(["sweep", str(SCENES / "r_rtr.toml"), "--steps", "5", "--points", "A",
+                 "--paths", str(tmp_path / "p.png")]) == 0
+    (line,) = [x for x in figures[0].axes[0].get_lines() if x.get_label() == "path of A"]
+    np.testing.assert_allclose(np.asarray(line.get_xydata(), dtype=float), 0.0, atol=1e-12)
