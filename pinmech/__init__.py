@@ -10,6 +10,7 @@ A user's script imports from here only:
 from pinmech.analysis import Analysis, Drivers, analyse, load_mechanism
 from pinmech.check import compare, load_hand_file
 from pinmech.closures import Closure
+from pinmech.draw.report_page import HtmlPage, report_html, snapshot
 from pinmech.exceptions import (
     CheckMismatch,
     FrameNotFound,
@@ -26,6 +27,7 @@ from pinmech.exceptions import (
 from pinmech.mechanism import JointInfo, Mechanism
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.path import PathPoint, follow_path
+from pinmech.polygon import Polygon, acceleration_polygon, velocity_polygon
 from pinmech.report import to_dict, to_json, to_text
 from pinmech.results import Accuracy, LoopSolution, RateSolution
 from pinmech.scene import Scene
@@ -48,6 +50,7 @@ __all__ = [
     "CoincidentPoint",
     "Drivers",
     "FrameNotFound",
+    "HtmlPage",
     "JointInfo",
     "LoopClosureError",
     "LoopSolution",
@@ -58,6 +61,7 @@ __all__ = [
     "Motion",
     "PathPoint",
     "PinmechError",
+    "Polygon",
     "RangeChunk",
     "RateSolution",
     "RateSolver",
@@ -71,15 +75,19 @@ __all__ = [
     "TaskError",
     "UnitError",
     "__version__",
+    "acceleration_polygon",
     "analyse",
     "compare",
     "evaluate_motion",
     "follow_path",
     "load_hand_file",
     "load_mechanism",
+    "report_html",
+    "snapshot",
     "solve_range",
     "to_dict",
     "to_json",
     "to_si",
     "to_text",
+    "velocity_polygon",
 ]

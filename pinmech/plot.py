@@ -221,22 +221,25 @@ class SweepPlot:
         symbol, dim = label.split(" [")
         angle = title.startswith("angle")
         constants = []
-        for k, (name, values) in enumerate(series.items()):
-            y = np.array(values)[order]
-            if angle:
-                y = _angles(y, self.angles)
+        curves = {name: _angles(np.array(v)[order], self.angles) if angle else np.array(v)[order]
+                  for name, v in series.items()}
+        largest = max((float(np.nanmax(np.abs(y))) for y in curves.values() if np.any(np.isfinite(y))), default=0.0)
+        flat = max(1e-9 * largest, 1e-12)  # changes below this are rounding (1e-12: noise about an exact 0)
+        for k, (name, y) in enumerate(curves.items()):
             finite = y[np.isfinite(y)]
-            if finite.size and np.ptp(finite) <= 1e-9 * max(float(np.max(np.abs(finite))), 1e-300):
-                constants.append(f"{name}: {symbol} = {finite[0]:.6g} [{dim} (constant, not drawn)")
+            if finite.size and np.ptp(finite) <= flat:
+                constants.append(f"{name}: {symbol} = {finite[0]:.6g} {dim.rstrip(']')} (constant, not drawn)")
                 continue
-            (line,) = ax.plot(x, y, linewidth=1.6, linestyle=_STYLES[k % len(_STYLES)], label=name)
+            (line,) = ax.plot(x, y, linewidth=1.6, color=f"C{k % 10}", linestyle=_STYLES[k % len(_STYLES)],
+                              label=name)  # a name keeps its colour and dash from panel to panel
             if mark_x is not None:
                 at = _nearest(x, y, mark_x, self.mark[1][title][name])
                 ax.plot([mark_x], [at], "o", color=line.get_color(), markersize=5)
         if mark_x is not None:
             ax.axvline(mark_x, color="0.35", linestyle="--", linewidth=1)
         if constants:
-            ax.text(0.02, 0.04, "\n".join(constants), transform=ax.transAxes, fontsize=8, color="0.3")
+            ax.text(0.02, 0.04, "\n".join(constants), transform=ax.transAxes, fontsize=8, color="0.25", zorder=6,
+                    bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "0.8", "boxstyle": "round"})
         drawn = len(series) - len(constants)
         name = next(iter(series))
         ax.set_title(f"{name}: {quantity}" if len(series) == 1 else quantity, fontsize=10)

@@ -15,7 +15,7 @@ import pytest
 from pinmech import Scene, analyse
 from pinmech.cli import main
 from pinmech.draw import load_visuals
-from pinmech.draw.report_page import snapshot
+from pinmech import snapshot
 from pinmech.draw.sketch import sketch_visuals
 from pinmech.linkage import sketch_links
 from tests.browser import screenshot, span_share
@@ -116,3 +116,12 @@ def test_snapshot_html_unchanged_for_models_with_visuals():
     mech = analyse(Scene.load(SCENES / "r_rtr.toml")).mechanism
     own = load_visuals(mech.source, mech.model)
     assert len(sketch_visuals(mech, own).geometryObjects) == len(own.geometryObjects)
+
+
+def test_points_at_one_place_share_one_label():
+    """B (crank pin) and B3 (guide point under it) coincide: one label "B, B3"; D apart."""
+    from pinmech.draw.scene import coincident_groups
+
+    points = {"B": np.array([0.1, 0.05, 0.0]), "D": np.array([0.2, 0.1, 0.0]), "B3": np.array([0.1, 0.05, 1e-9])}
+    assert coincident_groups(points, 1e-6) == [["B", "B3"], ["D"]]
+    assert coincident_groups(points, 1e-12) == [["B"], ["D"], ["B3"]]
