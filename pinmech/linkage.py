@@ -56,6 +56,15 @@ class LinkSketch:
     def is_ground(self) -> bool:
         return self.joint == 0
 
+    @property
+    def is_plate(self) -> bool:
+        """Three or more nodes not on one line: drawn as a plate, not as a bar."""
+        if len(self.nodes) < 3:
+            return False
+        points = np.array([n.position for n in self.nodes])
+        sigma = np.linalg.svd(points - points.mean(axis=0), compute_uv=False)
+        return bool(sigma[1] > 1e-3 * sigma[0])
+
 
 def sketch_links(mechanism: Mechanism) -> dict[str, LinkSketch]:
     """Every link of the mechanism (the ground included) with its nodes; one per joint."""

@@ -22,6 +22,7 @@ if TYPE_CHECKING:
     from pinmech.mechanism import Mechanism
 
 PLANES = {"xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
+_PATH_COLOURS = ("#111111", "#7b2d8b", "#0b6e6e", "#9c2f2f")  # dark: the paths over the light sketch
 _COLOURS = ("#d62728", "#1f5fbf", "#2ca02c", "#e08a0b", "#8c4cbf", "#17a2b0")  # as the 3-D sketches
 
 
@@ -41,9 +42,11 @@ class PathRecorder:
         if plane is None and normal is not None:
             e1 = _plane_reference(*normal.tolist())
             self.axes, self.names = np.array([e1, np.cross(normal, e1)]), ("x", "y")
+            self.projection = ""
         else:
             i, j = PLANES[plane or "xy"]
             self.axes, self.names = np.eye(3)[[i, j]], ("xyz"[i], "xyz"[j])
+            self.projection = f", projected on the world {plane or 'xy'} plane"
         self.uv: dict[str, tuple[array, array]] = {}
         self.count = 0
 
@@ -63,13 +66,13 @@ class PathRecorder:
             draw_linkage(ax, self.mechanism, q, self.axes, scale)
         for k, (name, (u, v)) in enumerate(self.uv.items()):
             u, v = np.array(u) * scale, np.array(v) * scale
-            (line,) = ax.plot(u, v, linewidth=1.6, linestyle=("-", "--", "-.", ":")[k % 4], label=f"path of {name}",
-                              zorder=4)
+            (line,) = ax.plot(u, v, linewidth=1.6, color=_PATH_COLOURS[k % len(_PATH_COLOURS)],
+                              linestyle=("-", "--", "-.", ":")[k % 4], label=f"path of {name}", zorder=4)
             _arrows(ax, u, v, line.get_color())
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_xlabel(f"{self.names[0]} [{unit}]", fontsize=9)
         ax.set_ylabel(f"{self.names[1]} [{unit}]", fontsize=9)
-        ax.set_title(f"paths of points ({travel}); mechanism at the scene's pose", fontsize=10)
+        ax.set_title(f"paths of points ({travel}){self.projection};\nmechanism at the scene's pose", fontsize=10)
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
 
@@ -107,17 +110,47 @@ def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scal
         if link.is_ground:
             _ground(ax, link, uv, size, axes, scale)
             continue
-        if len(uv) >= 3:
-            hull = uv[np.argsort(np.arctan2(*(uv - uv.mean(axis=0)).T[::-1]))]
-            ax.add_patch(Polygon(hull, closed=True, facecolor=colour, alpha=0.3, edgecolor=colour, lw=2, zorder=2))
-        elif len(uv) == 2:
-            ax.plot(uv[:, 0], uv[:, 1], color=colour, linewidth=4, solid_capstyle="round", zorder=2)
+        if link.is_plate and len(_hull(uv)) >= 3:
+            ax.add_patch(Polygon(_hull(uv), closed=True, facecolor=colour, alpha=0.3, edgecolor=colour, lw=2,
+                                 zorder=2))
+        elif len(uv) >= 2:  # a bar, end to end (its points on it)
+            ends = uv[list(_farthest(uv))]
+            ax.plot(ends[:, 0], ends[:, 1], color=colour, linewidth=4, solid_capstyle="round", zorder=2)
         if link.slide_axis is not None:
             axis = axes @ (data.oMi[link.joint].rotation @ link.slide_axis)
             _block(ax, uv[0], axis / max(np.linalg.norm(axis), 1e-300), size, colour)
         for node, p in zip(link.nodes, uv):
             if node.kind == "revolute":
                 ax.plot(*p, "o", markersize=5, markerfacecolor="white", markeredgecolor="0.15", zorder=3)
+
+
+def _farthest(uv: np.ndarray) -> tuple[int, int]:
+    """Indices of the two points farthest apart."""
+    d = np.linalg.norm(uv[:, None, :] - uv[None, :, :], axis=2)
+    i, j = np.unravel_index(np.argmax(d), d.shape)
+    return int(i), int(j)
+
+
+def _hull(uv: np.ndarray) -> np.ndarray:
+    """The convex hull of points in the plane, counter-clockwise (Andrew's monotone chain)."""
+    pts = sorted(map(tuple, np.round(uv, 12)))
+    if len(pts) < 3:
+        return np.array(pts)
+
+    def half(points):
+        out = []
+        for p in points:
+            while len(out) >= 2 and _turn(out[-2], out[-1], p) <= 0:
+                out.pop()
+            out.append(p)
+        return out[:-1]
+
+    return np.array(half(pts) + half(pts[::-1]))
+
+
+def _turn(o, a, b) -> float:
+    """z of (a - o) x (b - o): positive for a left turn."""
+    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
 
 
 def _ground(ax, link, uv: np.ndarray, size: float, axes: np.ndarray, scale: float) -> None:

@@ -125,3 +125,35 @@ def test_points_at_one_place_share_one_label():
     points = {"B": np.array([0.1, 0.05, 0.0]), "D": np.array([0.2, 0.1, 0.0]), "B3": np.array([0.1, 0.05, 1e-9])}
     assert coincident_groups(points, 1e-6) == [["B", "B3"], ["D"]]
     assert coincident_groups(points, 1e-12) == [["B"], ["D"], ["B3"]]
+
+
+def test_a_spatial_users_mechanism_without_visuals(tmp_path, capsys, monkeypatch):
+    """A spatial RSUR loop with a point M on its coupler, no visuals: its paths are projected
+    on the plane asked (read back against the CSV's M.z, M.x), every link is sketched, and a
+    polygon is refused with a named error (exit 9)."""
+    import pinmech.plot
+    from tests._mechanisms import spatial_rsur_urdf
+
+    kept = []
+    monkeypatch.setattr(pinmech.plot, "_save", lambda plt, fig, path: kept.append(fig) or path)
+
+    urdf = spatial_rsur_urdf().replace("</robot>", '<link name="M"/><joint name="pM" type="fixed"><parent '
+                                       'link="coupler"/><child link="M"/><origin xyz="0.075 0 0"/></joint></robot>')
+    (tmp_path / "rsur.urdf").write_text(urdf, encoding="utf-8")
+    scene = tmp_path / "rsur.toml"
+    scene.write_text('title = "RSUR"\nurdf = "rsur.urdf"\n[drivers.R1]\nangle = "20 deg"\nspeed = "60 rpm"\n',
+                     encoding="utf-8")
+    csv, png = tmp_path / "r.csv", tmp_path / "p.png"
+    assert main(["sweep", str(scene), "--from", "0 deg", "--to", "120 deg", "--steps", "25", "--csv", str(csv),
+                 "--paths", str(png), "--path-plane", "zx"]) == 0
+    lines = csv.read_text(encoding="utf-8").splitlines()
+    header, rows = lines[0].split(","), np.array([r.split(",") for r in lines[1:]])
+    zx = 1000 * rows[:, [header.index("M.z [m]"), header.index("M.x [m]")]].astype(float)  # [mm]
+    (path,) = [x for x in kept[0].axes[0].get_lines() if x.get_label() == "path of M"]
+    np.testing.assert_allclose(np.asarray(path.get_xydata(), dtype=float), zx, atol=1e-6)  # CSV: 12 digits
+    assert "projected on the world zx plane" in kept[0].axes[0].get_title()
+    mech = analyse(Scene.load(scene)).mechanism
+    visuals = sketch_visuals(mech, load_visuals(mech.source, mech.model))
+    assert {link.joint for link in sketch_links(mech).values()} <= {g.parentJoint for g in visuals.geometryObjects}
+    assert main(["polygon", str(scene), "-o", str(tmp_path / "v.svg")]) == 9
+    assert "planar" in capsys.readouterr().err and not (tmp_path / "v.svg").exists()

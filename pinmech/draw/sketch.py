@@ -78,9 +78,11 @@ def _link_shapes(link: LinkSketch, scale: float, normal: np.ndarray | None, coal
             shapes.append((coal.Box(2 * scale, 0.3 * width, 0.3 * width), rail))
     if link.is_ground:
         return shapes
-    if len(points) >= 3 and normal is not None:
+    if link.is_plate and normal is not None:
         shapes.append((_plate(points, normal, width, coal), pin.SE3.Identity()))
     else:
+        if not link.is_plate:  # nodes on one line: one bar from end to end
+            points = _ends(points)
         pairs = list(zip(points, points[1:] + points[:1])) if len(points) > 2 else list(zip(points, points[1:]))
         shapes += [_bar(a, b, width, normal, coal) for a, b in pairs if np.linalg.norm(b - a) > 1e-9 * scale]
     if len(points) == 1 and link.slide_axis is None:
@@ -109,6 +111,15 @@ def _ground_shapes(link: LinkSketch, scale: float, world_normal: np.ndarray | No
         shapes.append((coal.Convex.convexHull([np.asarray(x, float) for x in prism], True, None),
                        pin.SE3.Identity()))
     return shapes
+
+
+def _ends(points: list[np.ndarray]) -> list[np.ndarray]:
+    """The two farthest apart of points on one line (all of them if fewer than three)."""
+    if len(points) < 3:
+        return points
+    pairs = [(np.linalg.norm(a - b), i, j) for i, a in enumerate(points) for j, b in enumerate(points) if i < j]
+    _, i, j = max(pairs, key=lambda t: t[0])
+    return [points[i], points[j]]
 
 
 def _longest_link(sketches) -> float:
