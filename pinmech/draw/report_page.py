@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from pinmech.analysis import Analysis
+from pinmech.exceptions import PinmechError
 
 
 def report_html(analysis: Analysis, *, steps: int = 121, hand_text: str | None = None) -> str:
@@ -61,9 +62,12 @@ def _sweep(analysis: Analysis, steps: int) -> str:
     for pose in sweep.poses(sweep.default_values(steps), skip_failures=True):
         recorder.add(pose)
     with tempfile.TemporaryDirectory() as folder:
-        figures = [recorder.save(Path(folder) / "sweep.png")]
-        if recorder.points:
-            figures.append(recorder.save_paths(Path(folder) / "paths.png"))
+        try:
+            figures = [recorder.save(Path(folder) / "sweep.png")]
+            if recorder.points:
+                figures.append(recorder.save_paths(Path(folder) / "paths.png"))
+        except PinmechError as exc:  # every pose failed: the page says so, the rest stands
+            return f"<p>No sweep figure: {html.escape(str(exc))}</p>"
         return "".join(f'<img alt="{p.stem}" src="data:image/png;base64,{base64.b64encode(p.read_bytes()).decode()}">'
                        for p in figures)
 
