@@ -29,7 +29,7 @@ def report_html(analysis: Analysis, *, steps: int = 121, hand_text: str | None =
 
     sections = [("Drawing", _drawing(analysis)), ("Motion", motion_table_html(analysis)),
                 ("Report", _pre(to_text(analysis)))]
-    if analysis.mechanism.plane_normal is not None and "task" not in analysis.scene.raw:
+    if analysis.mechanism.plane_normal is not None:
         sections.append(("Velocity and acceleration polygons", _polygons(analysis)))
     if steps and "task" not in analysis.scene.raw:
         sections.append(("Over a turn of the driver", _sweep(analysis, steps)))
