@@ -17,6 +17,7 @@ the images (the rigid-body formulas against Pinocchio's point accelerations).
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -115,7 +116,7 @@ def _polygon(analysis: Analysis, quantity: str) -> Polygon:
     for link, members in _link_members(analysis).items():
         w = float(normal @ motion.links[link].angular_velocity) if link in motion.links else None
         alpha = float(normal @ motion.links[link].angular_acceleration) if link in motion.links else None
-        for base, name in zip(members, members[1:]):  # a chain: each point about the one before
+        for base, name in itertools.pairwise(members):  # a chain: each point about the one before
             vectors += _relative(analysis, axes, labels, images, base, name, w, alpha, acc)
     for c in coincident_points(analysis.scene):
         if c.name in labels and c.at in labels:

@@ -115,7 +115,7 @@ def cli_pictures(chromium: str, tmp: Path) -> None:
 
     scenes = MODELS / "scenes"
     bare = tmp / "four_bar_bare.urdf"
-    bare.write_text(re.sub(r"<visual>.*?</visual>", "", (MODELS / "four_bar.urdf").read_text(), flags=re.S))
+    bare.write_text(re.sub(r"<visual>.*?</visual>", "", (MODELS / "four_bar.urdf").read_text(), flags=re.DOTALL))
     scene = (scenes / "four_bar.toml").read_text()
     (tmp / "four_bar_bare.toml").write_text(re.sub(r'urdf = ".*"', 'urdf = "four_bar_bare.urdf"', scene))
     for name, scene_file in (("four_bar", scenes / "four_bar.toml"), ("slider_crank", scenes / "slider_crank.toml"),

@@ -12,10 +12,9 @@ import re
 import numpy as np
 import pytest
 
-from pinmech import Scene, analyse
+from pinmech import Scene, analyse, snapshot
 from pinmech.cli import main
 from pinmech.draw import load_visuals
-from pinmech import snapshot
 from pinmech.draw.sketch import sketch_visuals
 from pinmech.linkage import sketch_links
 from tests.browser import screenshot, span_share
@@ -27,7 +26,7 @@ OFF_PAGE = r"""<script[^>]*\ssrc=|<link[^>]*href=|(src|href)=["']?(https?:)?//|s
 def bare_scene(tmp_path, name: str) -> Scene:
     """A bundled scene on a copy of its URDF with every <visual> taken out: a user's model."""
     text = (MODELS / f"{name}.urdf").read_text(encoding="utf-8")
-    text = re.sub(r"<visual>.*?</visual>", "", text, flags=re.S)
+    text = re.sub(r"<visual>.*?</visual>", "", text, flags=re.DOTALL)
     (tmp_path / f"{name}.urdf").write_text(text, encoding="utf-8")
     scene = (SCENES / f"{name}.toml").read_text(encoding="utf-8")
     scene = re.sub(r'urdf = ".*"', f'urdf = "{name}.urdf"', scene)

@@ -8,6 +8,8 @@ symbol (a triangle). Links that carry their own `<visual>` keep it.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pinocchio as pin
 
@@ -83,7 +85,7 @@ def _link_shapes(link: LinkSketch, scale: float, normal: np.ndarray | None, coal
     else:
         if not link.is_plate:  # nodes on one line: one bar from end to end
             points = _ends(points)
-        pairs = list(zip(points, points[1:] + points[:1])) if len(points) > 2 else list(zip(points, points[1:]))
+        pairs = list(itertools.pairwise(points + points[:1] if len(points) > 2 else points))  # closed if 3 or more
         shapes += [_bar(a, b, width, normal, coal) for a, b in pairs if np.linalg.norm(b - a) > 1e-9 * scale]
     if len(points) == 1 and link.slide_axis is None:
         shapes.append((coal.Sphere(width), pin.SE3(np.eye(3), points[0])))
