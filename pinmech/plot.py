@@ -1,10 +1,12 @@
 """Figures of sweeps and arm paths (matplotlib, extra `plot`): what a report shows.
 
 A sweep's figure: link angles, angular velocities and accelerations, the sliders'
-relative velocity and acceleration, and the speed and acceleration magnitudes of chosen
-points, against the driver, with the scene's own pose marked (dashed line, dots, and
-its values in the legends). A path's figure: joint coordinates, rates, accelerations
-and the drift against time.
+position, velocity and acceleration along their guide, and the speed and acceleration
+magnitudes of chosen points, against the driver (0 to 360 deg for a whole turn, whatever
+angle it starts at), with the scene's own pose marked (dashed line, dots, and its values in
+a panel), the driver's rates in the title, constant quantities named instead of drawn, and
+a last panel with the points' paths (`pinmech.plot_paths`). A path's figure: joint
+coordinates, rates, accelerations and the drift against time.
 
 The recorders (`SweepPlot`, `PathPlot`) take poses one at a time while a sweep streams
 and keep at most `max_points` of them (every n-th), so memory stays bounded.
@@ -52,6 +54,10 @@ class SweepPlot:
             every moving link but the driver's, and every moving point).
         total: the number of poses to come, to keep every n-th when there are more
             than `max_points`.
+        angles: "continuous" (no jump where a link passes 180 deg) or "wrapped" to
+            (-180, 180] deg, with a gap where an angle wraps.
+        plane: the world plane ("xy", "yz", "zx") a spatial mechanism's paths are
+            projected on (None: the mechanism's own plane, or xy).
     """
 
     def __init__(self, sweep: Sweep, *, links: list[str] | None = None, points: list[str] | None = None,
