@@ -73,8 +73,8 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--angles", choices=("continuous", "wrapped"), default="continuous",
                        help="link angles in the figure: continuous (default, no jump at 180 deg) or wrapped "
                        "to (-180, 180] deg")
-    sweep.add_argument("--path-plane", choices=("xy", "yz", "zx"),
-                       help="a spatial mechanism's paths projected on this world plane (default xy)")
+    sweep.add_argument("--path-plane", choices=("xy", "yz", "zx", "3d"),
+                       help="a spatial mechanism's paths projected on this world plane (default xy), or 3d")
     sweep.add_argument("--skip-failures", action="store_true",
                        help="report a pose that cannot close as a row with its error instead of stopping")
     sweep.add_argument("--start", dest="start_mode", choices=("predictor", "warm", "cold"),

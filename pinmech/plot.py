@@ -57,7 +57,7 @@ class SweepPlot:
         angles: "continuous" (no jump where a link passes 180 deg) or "wrapped" to
             (-180, 180] deg, with a gap where an angle wraps.
         plane: the world plane ("xy", "yz", "zx") a spatial mechanism's paths are
-            projected on (None: the mechanism's own plane, or xy).
+            projected on (None: the mechanism's own plane, or xy), or "3d": a 3-D view.
     """
 
     def __init__(self, sweep: Sweep, *, links: list[str] | None = None, points: list[str] | None = None,
@@ -190,7 +190,11 @@ class SweepPlot:
                 ax.plot(failed, np.zeros(len(failed)), "x", color="red", markersize=6,
                         transform=ax.get_xaxis_transform(), clip_on=False)
         if drawn_paths:
-            self.paths.draw(axes.flat[len(panels)], self.mark_q, self._travel())
+            ax = axes.flat[len(panels)]
+            if self.paths.is_3d:  # a 3-D panel in the same place
+                ax.remove()
+                ax = fig.add_subplot(rows, cols, len(panels) + 1, projection="3d")
+            self.paths.draw(ax, self.mark_q, self._travel())
         spare = list(axes.flat[len(panels) + drawn_paths:])
         for ax in spare:
             ax.set_visible(False)
@@ -208,7 +212,8 @@ class SweepPlot:
         if not self.points or self.paths.count == 0:
             raise PinmechError(f"no point to trace: nothing to draw in {path} (name points with --points)")
         plt = _pyplot()
-        fig, ax = plt.subplots(figsize=(8, 6.5))
+        fig = plt.figure(figsize=(8, 6.5))
+        ax = fig.add_subplot(projection="3d" if self.paths.is_3d else None)
         self.paths.draw(ax, self.mark_q, self._travel())
         fig.suptitle(f"{self.sweep.scene.title}: paths over the sweep", fontsize=11)
         fig.tight_layout()

@@ -27,40 +27,48 @@ _COLOURS = ("#d62728", "#1f5fbf", "#2ca02c", "#e08a0b", "#8c4cbf", "#17a2b0")  #
 
 
 class PathRecorder:
-    """Keeps the points' places pose by pose, in the drawing plane's coordinates [m].
+    """Keeps the points' places pose by pose (world frame [m]), then draws them in a plane
+    or in 3-D.
 
     Args:
         mechanism: the model (its plane, or `plane` for a spatial one).
-        plane: None (the mechanism's plane; "xy" for a spatial mechanism) or one of PLANES.
+        plane: None (the mechanism's plane; "xy" for a spatial mechanism), one of PLANES
+            (a projection on that world plane), or "3d" (a 3-D view).
     """
 
     def __init__(self, mechanism: Mechanism, plane: str | None = None) -> None:
-        if plane is not None and plane not in PLANES:
-            raise PinmechError(f"the path plane must be one of {', '.join(PLANES)}, got {plane!r}")
-        self.mechanism = mechanism
+        if plane is not None and plane not in (*PLANES, "3d"):
+            raise PinmechError(f"the path plane must be one of {', '.join(PLANES)} or 3d, got {plane!r}")
+        self.mechanism, self.is_3d = mechanism, plane == "3d"
         normal = mechanism.plane_normal
         if plane is None and normal is not None:
             e1 = _plane_reference(*normal.tolist())
             self.axes, self.names = np.array([e1, np.cross(normal, e1)]), ("x", "y")
             self.projection = ""
         else:
-            i, j = PLANES[plane or "xy"]
+            i, j = PLANES["xy" if plane in (None, "3d") else plane]
             self.axes, self.names = np.eye(3)[[i, j]], ("xyz"[i], "xyz"[j])
-            self.projection = f", projected on the world {plane or 'xy'} plane"
-        self.uv: dict[str, tuple[array, array]] = {}
+            self.projection = ", 3-D view" if self.is_3d else f", projected on the world {plane or 'xy'} plane"
+        self.xyz: dict[str, tuple[array, array, array]] = {}
         self.count = 0
 
     def add(self, positions: dict[str, np.ndarray]) -> None:
         """One pose: point name -> world position [m] (NaN where the pose failed)."""
         for name, p in positions.items():
-            u, v = self.uv.setdefault(name, (array("d"), array("d")))
-            uv = self.axes @ p
-            u.append(float(uv[0]))
-            v.append(float(uv[1]))
+            for values, x in zip(self.xyz.setdefault(name, (array("d"), array("d"), array("d"))), p.tolist()):
+                values.append(x)
         self.count += 1
 
+    @property
+    def uv(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """The paths in the drawing plane's coordinates [m]."""
+        return {name: tuple(self.axes @ np.array(xyz)) for name, xyz in self.xyz.items()}
+
     def draw(self, ax, q: np.ndarray | None, travel: str) -> None:
-        """Paths, the mechanism at q (if given) and arrows of travel, on matplotlib axes."""
+        """Paths, the mechanism at q (if given) and arrows of travel, on matplotlib axes
+        (3-D axes when the recorder is 3-D)."""
+        if self.is_3d:
+            return self._draw_3d(ax, q, travel)
         scale, unit = (1000.0, "mm") if self._size() < 1.0 else (1.0, "m")
         if q is not None:
             draw_linkage(ax, self.mechanism, q, self.axes, scale)
@@ -72,12 +80,42 @@ class PathRecorder:
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_xlabel(f"{self.names[0]} [{unit}]", fontsize=9)
         ax.set_ylabel(f"{self.names[1]} [{unit}]", fontsize=9)
+        self._finish(ax, travel)
+        return None
+
+    def _draw_3d(self, ax, q: np.ndarray | None, travel: str) -> None:
+        scale, unit = (1000.0, "mm") if self._size() < 1.0 else (1.0, "m")
+        if q is not None:
+            draw_linkage_3d(ax, self.mechanism, q, scale)
+        for k, (name, xyz) in enumerate(self.xyz.items()):
+            x, y, z = (np.array(c) * scale for c in xyz)
+            colour = _PATH_COLOURS[k % len(_PATH_COLOURS)]
+            ax.plot(x, y, z, linewidth=1.6, color=colour, linestyle=("-", "--", "-.", ":")[k % 4],
+                    label=f"path of {name}")
+            ok = np.nonzero(np.isfinite(x) & np.isfinite(y) & np.isfinite(z))[0]
+            arrow = 0.08 * self._size() * scale
+            for i in ok[len(ok) // 5 :: max(1, len(ok) // 5)][:4]:  # arrows of travel
+                step = np.array([x[i + 1] - x[i], y[i + 1] - y[i], z[i + 1] - z[i]]) if i + 1 < len(x) else np.zeros(3)
+                if np.all(np.isfinite(step)) and np.linalg.norm(step) > 0:
+                    ax.quiver(x[i], y[i], z[i], *step, color=colour, length=arrow, normalize=True,
+                              arrow_length_ratio=0.5, linewidth=1.6)
+        lo, hi = np.array(ax.get_xlim3d() + ax.get_ylim3d() + ax.get_zlim3d()).reshape(3, 2).T
+        centre, half = (lo + hi) / 2, float(np.max(hi - lo)) / 2
+        ax.set_xlim3d(centre[0] - half, centre[0] + half)  # equal axes
+        ax.set_ylim3d(centre[1] - half, centre[1] + half)
+        ax.set_zlim3d(centre[2] - half, centre[2] + half)
+        ax.set_box_aspect((1, 1, 1))
+        for axis, label in zip("xyz", "xyz"):
+            getattr(ax, f"set_{axis}label")(f"{label} [{unit}]", fontsize=9)
+        self._finish(ax, travel)
+
+    def _finish(self, ax, travel: str) -> None:
         ax.set_title(f"paths of points ({travel}){self.projection};\nmechanism at the scene's pose", fontsize=10)
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
 
     def _size(self) -> float:
-        values = [np.abs(np.array(c)) for uv in self.uv.values() for c in uv]
+        values = [np.abs(np.array(c)) for xyz in self.xyz.values() for c in xyz]
         finite = [x[np.isfinite(x)] for x in values]
         return float(max((np.max(x) for x in finite if x.size), default=0.0))
 
@@ -125,7 +163,7 @@ def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scal
 
 
 def _farthest(uv: np.ndarray) -> tuple[int, int]:
-    """Indices of the two points farthest apart."""
+    """Indices of the two points farthest apart (in the plane or in space)."""
     d = np.linalg.norm(uv[:, None, :] - uv[None, :, :], axis=2)
     i, j = np.unravel_index(np.argmax(d), d.shape)
     return int(i), int(j)
@@ -151,6 +189,22 @@ def _hull(uv: np.ndarray) -> np.ndarray:
 def _turn(o, a, b) -> float:
     """z of (a - o) x (b - o): positive for a left turn."""
     return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+
+def draw_linkage_3d(ax, mechanism: Mechanism, q: np.ndarray, scale: float = 1.0) -> None:
+    """The mechanism at q on 3-D matplotlib axes: each link's nodes joined by lines [m x scale]."""
+    data = mechanism.model.createData()
+    pin.forwardKinematics(mechanism.model, data, q)
+    for k, link in enumerate(sketch_links(mechanism).values()):
+        xyz = world_nodes(link, data) * scale
+        colour = "0.45" if link.is_ground else _COLOURS[k % len(_COLOURS)]
+        pins = xyz[[n.kind == "revolute" for n in link.nodes]]
+        if len(pins):
+            ax.scatter(*pins.T, s=18, facecolors="white", edgecolors="0.15", depthshade=False)
+        if link.is_ground or len(xyz) < 2:
+            continue
+        ring = np.vstack([xyz, xyz[:1]]) if link.is_plate else xyz[list(_farthest(xyz))]
+        ax.plot(*ring.T, color=colour, linewidth=3.5)
 
 
 def _ground(ax, link, uv: np.ndarray, size: float, axes: np.ndarray, scale: float) -> None:

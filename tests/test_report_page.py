@@ -126,15 +126,10 @@ def test_points_at_one_place_share_one_label():
     assert coincident_groups(points, 1e-12) == [["B"], ["D"], ["B3"]]
 
 
-def test_a_spatial_users_mechanism_without_visuals(tmp_path, capsys, monkeypatch):
-    """A spatial RSUR loop with a point M on its coupler, no visuals: its paths are projected
-    on the plane asked (read back against the CSV's M.z, M.x), every link is sketched, and a
-    polygon is refused with a named error (exit 9)."""
-    import pinmech.plot
+@pytest.fixture
+def rsur(tmp_path):
+    """A user's spatial RSUR loop with a point M on its coupler, no visuals (its scene file)."""
     from tests._mechanisms import spatial_rsur_urdf
-
-    kept = []
-    monkeypatch.setattr(pinmech.plot, "_save", lambda plt, fig, path: kept.append(fig) or path)
 
     urdf = spatial_rsur_urdf().replace("</robot>", '<link name="M"/><joint name="pM" type="fixed"><parent '
                                        'link="coupler"/><child link="M"/><origin xyz="0.075 0 0"/></joint></robot>')
@@ -142,19 +137,42 @@ def test_a_spatial_users_mechanism_without_visuals(tmp_path, capsys, monkeypatch
     scene = tmp_path / "rsur.toml"
     scene.write_text('title = "RSUR"\nurdf = "rsur.urdf"\n[drivers.R1]\nangle = "20 deg"\nspeed = "60 rpm"\n',
                      encoding="utf-8")
-    csv, png = tmp_path / "r.csv", tmp_path / "p.png"
+    return scene
+
+
+def _sweep_m(scene, plane: str, monkeypatch) -> tuple[np.ndarray, object]:
+    """M's places from the CSV [mm], and the paths figure pinmech drew, kept open."""
+    import pinmech.plot
+
+    kept = []
+    monkeypatch.setattr(pinmech.plot, "_save", lambda plt, fig, path: kept.append(fig) or path)
+    csv = scene.parent / f"{plane}.csv"
     assert main(["sweep", str(scene), "--from", "0 deg", "--to", "120 deg", "--steps", "25", "--csv", str(csv),
-                 "--paths", str(png), "--path-plane", "zx"]) == 0
+                 "--paths", str(scene.parent / f"{plane}.png"), "--path-plane", plane]) == 0
     lines = csv.read_text(encoding="utf-8").splitlines()
     header, rows = lines[0].split(","), np.array([r.split(",") for r in lines[1:]])
-    zx = 1000 * rows[:, [header.index("M.z [m]"), header.index("M.x [m]")]].astype(float)  # [mm]
-    (path,) = [x for x in kept[0].axes[0].get_lines() if x.get_label() == "path of M"]
-    np.testing.assert_allclose(np.asarray(path.get_xydata(), dtype=float), zx, atol=1e-6)  # CSV: 12 digits
-    assert "projected on the world zx plane" in kept[0].axes[0].get_title()
-    mech = analyse(Scene.load(scene)).mechanism
+    xyz = 1000 * rows[:, [header.index(f"M.{c} [m]") for c in "xyz"]].astype(float)
+    return xyz, kept[0]
+
+
+def test_a_spatial_mechanisms_paths_projected_or_in_3d(rsur, monkeypatch):
+    """Projected on zx, the path drawn is (M.z, M.x) of the CSV; in 3-D it is (x, y, z).
+    Tolerance 1e-6 mm: the CSV keeps 12 significant digits of metres."""
+    xyz, fig = _sweep_m(rsur, "zx", monkeypatch)
+    (path,) = [x for x in fig.axes[0].get_lines() if x.get_label() == "path of M"]
+    np.testing.assert_allclose(np.asarray(path.get_xydata(), dtype=float), xyz[:, [2, 0]], atol=1e-6)
+    assert "projected on the world zx plane" in fig.axes[0].get_title()
+    xyz, fig = _sweep_m(rsur, "3d", monkeypatch)
+    (path,) = [x for x in fig.axes[0].get_lines() if x.get_label() == "path of M"]
+    np.testing.assert_allclose(np.column_stack(path.get_data_3d()), xyz, atol=1e-6)
+
+
+def test_a_spatial_users_mechanism_without_visuals(rsur, tmp_path, capsys):
+    """Every link of the spatial loop is sketched; a polygon is refused by name (exit 9)."""
+    mech = analyse(Scene.load(rsur)).mechanism
     visuals = sketch_visuals(mech, load_visuals(mech.source, mech.model))
     assert {link.joint for link in sketch_links(mech).values()} <= {g.parentJoint for g in visuals.geometryObjects}
-    assert main(["polygon", str(scene), "-o", str(tmp_path / "v.svg")]) == 9
+    assert main(["polygon", str(rsur), "-o", str(tmp_path / "v.svg")]) == 9
     assert "planar" in capsys.readouterr().err and not (tmp_path / "v.svg").exists()
 
 
