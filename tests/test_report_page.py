@@ -186,3 +186,11 @@ def test_every_bundled_planar_scene_makes_a_page(tmp_path, name):
     assert "<iframe" in page and "<table>" in page and "Velocity polygon" in page
     assert ('<img alt="sweep"' in page) == ("task" not in Scene.load(SCENES / f"{name}.toml").raw)
     assert not re.search(OFF_PAGE, page)
+
+
+def test_an_animation_joins_labels_only_of_points_together_in_every_frame():
+    from pinmech.draw.pages import _together
+
+    frames = [{"B": np.zeros(3), "B3": np.zeros(3), "P": np.zeros(3)},
+              {"B": np.ones(3), "B3": np.ones(3), "P": np.zeros(3)}]
+    assert _together(frames, 1e-9) == [["B", "B3"], ["P"]]

@@ -14,7 +14,15 @@ import pinocchio as pin
 from pinmech.draw.geometry import _size
 from pinmech.draw.inputs import DrawError, _configuration, _points, _stack
 from pinmech.draw.offline import _OfflineWindow
-from pinmech.draw.scene import Arrow, _animate, _draw_pose, _legend, _meshcat, _Scene
+from pinmech.draw.scene import (
+    Arrow,
+    _animate,
+    _draw_pose,
+    _legend,
+    _meshcat,
+    _Scene,
+    coincident_groups,
+)
 
 
 def load_visuals(
@@ -113,7 +121,7 @@ def animation_html(
     labels = scene.label_boxes([p for f in frames for p in f.values()], _size(body))
     size, grid = scene.frame(np.vstack([body, labels]))
     scene.pose(scene.vis, qs[0])
-    scene.add_points(frames[0], size)
+    scene.add_points(frames[0], size, _together(frames, 1e-6 * size))
     _animate(scene, qs, frames, fps)
     return scene.vis.window.page(title, _legend(grid if show_grid else None, {}), fps=fps)
 
@@ -168,6 +176,18 @@ def live_viewer(
     except BaseException:
         _stop_server(window)
         raise
+
+
+def _together(frames: Sequence[Mapping[str, np.ndarray]], tol: float) -> list[list[str]]:
+    """Names of points at one place (within tol [m]) in every frame: they share a label."""
+    groups = coincident_groups(frames[0], tol)
+    out = []
+    for group in groups:
+        if all(np.linalg.norm(f[name] - f[group[0]]) <= tol for f in frames for name in group):
+            out.append(group)
+        else:
+            out += [[name] for name in group]
+    return out
 
 
 def _stop_server(window: Any) -> None:

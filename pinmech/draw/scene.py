@@ -199,16 +199,22 @@ class _Scene:
         camera.set_property("near", distance / 100)
         camera.set_property("far", distance * 100)
 
-    def add_points(self, points: Mapping[str, np.ndarray], size: float) -> None:
+    def add_points(
+        self, points: Mapping[str, np.ndarray], size: float, groups: list[list[str]] | None = None
+    ) -> None:
         """Draw named points (world frame [m]) as dark dots with their names; points at one
-        place (B of the crank, B3 of the guide under it) share one label, "B, B3"."""
+        place (B of the crank, B3 of the guide under it) share one label, "B, B3".
+
+        Args:
+            groups: the names that share a label (default: those at one place now).
+        """
         g = _meshcat().geometry
         for name, p in points.items():
             node = self.vis[f"{ROOT}/points/{_node(name)}"]
             on_top = g.MeshBasicMaterial(color=_POINT_COLOUR, transparent=True, depthTest=False)
             node.set_object(g.Sphere(0.01 * size), on_top)  # seen through the bodies
             node.set_transform(_translation(p))
-        for names in coincident_groups(points, 1e-6 * size):
+        for names in groups if groups is not None else coincident_groups(points, 1e-6 * size):
             self.add_label(f"points/{_node(names[0])}/label", ", ".join(names), self._label_offset(size), size)
 
     def move_points(self, frame: Any, points: Mapping[str, np.ndarray]) -> None:
