@@ -180,13 +180,16 @@ def live_viewer(
 
 def _together(frames: Sequence[Mapping[str, np.ndarray]], tol: float) -> list[list[str]]:
     """Names of points at one place (within tol [m]) in every frame: they share a label."""
-    groups = coincident_groups(frames[0], tol)
-    out = []
-    for group in groups:
-        if all(np.linalg.norm(f[name] - f[group[0]]) <= tol for f in frames for name in group):
-            out.append(group)
-        else:
-            out += [[name] for name in group]
+    out: list[list[str]] = []
+    for group in coincident_groups(frames[0], tol):
+        parts: list[list[str]] = []
+        for name in group:
+            part = next((p for p in parts if all(np.linalg.norm(f[name] - f[p[0]]) <= tol for f in frames)), None)
+            if part is None:
+                parts.append([name])
+            else:
+                part.append(name)
+        out += parts
     return out
 
 
