@@ -121,8 +121,12 @@ def _polygon(analysis: Analysis, quantity: str) -> Polygon:
     for c in coincident_points(analysis.scene):
         if c.name in labels and c.at in labels:
             vectors += _sliding(analysis, axes, labels, images, c, acc)
-    return Polygon(quantity, "m/s^2" if acc else "m/s", images, labels, _drawn(vectors, images), axes,
-                   _title(analysis, quantity))
+    drawn = _drawn(vectors, images)
+    if not drawn:
+        raise DrawError(f"{analysis.scene.path}: no reported point has a {quantity}: nothing to draw in the "
+                        f"{quantity} polygon; report moving points ([report] points)", argument="scene",
+                        value=list(labels))
+    return Polygon(quantity, "m/s^2" if acc else "m/s", images, labels, drawn, axes, _title(analysis, quantity))
 
 
 def _drawn(vectors: list[PolygonVector], images: dict[str, np.ndarray]) -> list[PolygonVector]:

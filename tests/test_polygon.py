@@ -144,3 +144,26 @@ def test_cli_writes_the_svg_and_a_failed_write_leaves_nothing(tmp_path, capsys):
     assert main(["polygon", str(SCENES / "r_rtr.toml"), "-o", str(missing)]) == 2
     assert not missing.exists()
     assert "no_such_folder" in capsys.readouterr().err
+
+
+def test_a_polygon_of_fixed_points_only_is_a_named_error(capsys, tmp_path):
+    """Only the fixed pivots reported: nothing moves, nothing to draw, one line and exit 9."""
+    text = (SCENES / "r_rtr.toml").read_text(encoding="utf-8").replace("../", str(SCENES.parent) + "/")
+    text = re.sub(r"\[points\.B3\][^\[]*", "", text).replace('"A", "B", "B3", "C", "D"', '"A", "C"')
+    scene, out = tmp_path / "fixed.toml", tmp_path / "v.svg"
+    scene.write_text(text, encoding="utf-8")
+    assert main(["polygon", str(scene), "-o", str(out)]) == 9
+    assert "nothing to draw" in capsys.readouterr().err and not out.exists()
+
+
+def test_bad_recorder_options_are_named_errors():
+    from pinmech.exceptions import PinmechError
+    from pinmech.plot import SweepPlot
+    from pinmech.plot_paths import PathRecorder
+    from pinmech.sweep import Sweep
+
+    sweep = Sweep.from_scene(Scene.load(SCENES / "r_rtr.toml"))
+    with pytest.raises(PinmechError, match="angles must be one of continuous, wrapped"):
+        SweepPlot(sweep, angles="degrees")
+    with pytest.raises(PinmechError, match="path plane must be one of xy, yz, zx or 3d"):
+        PathRecorder(sweep.mechanism, "xz")
