@@ -7,6 +7,7 @@ nothing is fetched (no script, link or image points off the page).
 
 from __future__ import annotations
 
+import html
 import re
 
 import numpy as np
@@ -17,9 +18,11 @@ from pinmech.cli import main
 from pinmech.draw import load_visuals
 from pinmech.draw.sketch import sketch_visuals
 from pinmech.linkage import sketch_links
-from tests.browser import screenshot, span_share
+from tests.browser import colour_mask, screenshot, span_share
 from tests.conftest import MODELS, SCENES
 
+CRANK_RED, GUIDE_GREEN = (0.85, 0.15, 0.15), (0.15, 0.65, 0.25)  # the R-RTR's link1 and link3
+FRAME_HEIGHT = 520  # the drawing's frame on the page [CSS pixels]
 OFF_PAGE = r"""<script[^>]*\ssrc=|<link[^>]*href=|(src|href)=["']?(https?:)?//|src=["']?file:"""
 
 
@@ -78,15 +81,16 @@ def test_the_report_page_draws_offline(tmp_path):
     assert main(["report", str(SCENES / "r_rtr.toml"), "-o", str(out), "--steps", "25",
                  "--hand", str(SCENES / "r_rtr.hand.toml")]) == 0
     page = out.read_text(encoding="utf-8")
-    assert not re.search(OFF_PAGE, page)
+    assert not re.search(OFF_PAGE, html.unescape(page))
     for part in ("Velocity polygon", "Acceleration polygon", '<img alt="sweep"', '<img alt="paths"', "<iframe", "MISMATCH"
                  if "MISMATCH" in page else "OK"):
         assert part in page
     pixels = screenshot(out, tmp_path / "page.png", window=(1000, 1400))
     assert span_share(pixels) > 0.8
-    frame = pixels[60:580, :]  # the meshcat frame, under the page's title
-    drawn = np.any(frame < 0.9, axis=2)
-    assert drawn.mean() > 0.02  # the mechanism (and grid) drawn in the frame, not a blank box
+    crank, guide = (colour_mask(pixels, rgb) for rgb in (CRANK_RED, GUIDE_GREEN))
+    assert crank.sum() > 1000 and guide.sum() > 1000  # the R-RTR's crank and guide, drawn in the frame
+    rows = np.nonzero(crank | guide)[0]
+    assert rows.max() - rows.min() > 0.5 * FRAME_HEIGHT  # framed: the mechanism fills its frame
 
 
 def test_the_report_page_of_a_bare_model(tmp_path):
@@ -94,7 +98,7 @@ def test_the_report_page_of_a_bare_model(tmp_path):
     out = tmp_path / "bare_page.html"
     assert main(["report", str(scene.path), "-o", str(out), "--steps", "13"]) == 0
     page = out.read_text(encoding="utf-8")
-    assert "paths" in page and "Velocity polygon" in page and not re.search(OFF_PAGE, page)
+    assert "paths" in page and "Velocity polygon" in page and not re.search(OFF_PAGE, html.unescape(page))
 
 
 def test_notebooks_show_tables_and_the_drawing():
@@ -185,7 +189,7 @@ def test_every_bundled_planar_scene_makes_a_page(tmp_path, name):
     page = out.read_text(encoding="utf-8")
     assert "<iframe" in page and "<table>" in page and "Velocity polygon" in page
     assert ('<img alt="sweep"' in page) == ("task" not in Scene.load(SCENES / f"{name}.toml").raw)
-    assert not re.search(OFF_PAGE, page)
+    assert not re.search(OFF_PAGE, html.unescape(page))
 
 
 def test_an_animation_joins_labels_only_of_points_together_in_every_frame():
