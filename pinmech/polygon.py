@@ -26,7 +26,7 @@ import pinocchio as pin
 from pinmech.analysis import Analysis, coincident_points
 from pinmech.draw.inputs import DrawError
 from pinmech.linkage import pin_links, sketch_links
-from pinmech.motion import _plane_reference
+from pinmech.motion import _plane_reference, evaluate_motion
 
 KINDS = {
     "absolute": "from the pole",
@@ -113,14 +113,14 @@ def _polygon(analysis: Analysis, quantity: str) -> Polygon:
         images[labels[name]] = axes @ (p.acceleration if acc else p.velocity)
     vectors = [PolygonVector("absolute", np.zeros(2), images[labels[n]], "o" + prime, labels[n], f"{quantity[0]}_{n}")
                for n in motion.points if np.linalg.norm(images[labels[n]]) > 0]
-    for link, members in _link_members(analysis).items():
-        w = float(normal @ motion.links[link].angular_velocity) if link in motion.links else None
-        alpha = float(normal @ motion.links[link].angular_acceleration) if link in motion.links else None
-        for base, name in itertools.pairwise(members):  # a chain: each point about the one before
-            vectors += _relative(analysis, axes, labels, images, base, name, w, alpha, acc)
-    for c in coincident_points(analysis.scene):
-        if c.name in labels and c.at in labels:
-            vectors += _sliding(analysis, axes, labels, images, c, acc)
+    members = _link_members(analysis)
+    coincident = [c for c in coincident_points(analysis.scene) if c.name in labels and c.at in labels]
+    rates = _link_rates(analysis, [*members, *(c.link for c in coincident)])
+    for link, names in members.items():
+        for base, name in itertools.pairwise(names):  # a chain: each point about the one before
+            vectors += _relative(analysis, axes, labels, images, base, name, *rates[link], acc)
+    for c in coincident:
+        vectors += _sliding(analysis, axes, labels, images, c, rates[c.link][0], acc)
     drawn = _drawn(vectors, images)
     if not drawn:
         raise DrawError(f"{analysis.scene.path}: no reported point has a {quantity}: nothing to draw in the "
@@ -162,31 +162,41 @@ def _link_members(analysis: Analysis) -> dict[str, list[str]]:
     return {link: names for link, names in members.items() if len(names) > 1}
 
 
-def _relative(analysis, axes, labels, images, base: str, name: str, w, alpha, acc: bool) -> list[PolygonVector]:
-    """The relative motion of `name` about `base`, points of one link."""
+def _link_rates(analysis: Analysis, links: list[str]) -> dict[str, tuple[float, float]]:
+    """Link -> its angular velocity [rad/s] and acceleration [rad/s^2] about the plane normal,
+    read off the solved pose (also for links the scene does not report)."""
+    mech, sol = analysis.mechanism, analysis.solution
+    motion = evaluate_motion(mech, mech.model.createData(), sol.q, sol.v, sol.a, points=[], links=sorted(set(links)))
+    n = mech.plane_normal
+    return {name: (float(n @ m.angular_velocity), float(n @ m.angular_acceleration))
+            for name, m in motion.links.items()}
+
+
+def _relative(analysis, axes, labels, images, base: str, name: str, w: float, alpha: float,
+              acc: bool) -> list[PolygonVector]:
+    """The relative motion of `name` about `base`, points of one link turning at w [rad/s],
+    alpha [rad/s^2]."""
     points = analysis.motion.points
     r = axes @ (points[name].position - points[base].position)
     tail, end = images[labels[base]], labels[name]
     pair = f"{name}{base}"
     if not acc:
         return [PolygonVector("relative", tail, images[end], labels[base], end, f"v_{pair}")]
-    w = w if w is not None else 0.0
     normal = -w * w * r
-    tangential = (alpha or 0.0) * np.array([-r[1], r[0]])
+    tangential = alpha * np.array([-r[1], r[0]])
     return [PolygonVector("normal", tail, tail + normal, labels[base], "", f"a^n_{pair}"),
             PolygonVector("tangential", tail + normal, tail + normal + tangential, "", end, f"a^t_{pair}")]
 
 
-def _sliding(analysis, axes, labels, images, c, acc: bool) -> list[PolygonVector]:
-    """The point `c.at` about the point `c.name` of the guide link under it."""
-    motion, normal = analysis.motion, analysis.mechanism.plane_normal
+def _sliding(analysis, axes, labels, images, c, w: float, acc: bool) -> list[PolygonVector]:
+    """The point `c.at` about the point `c.name` of the guide link under it (turning at w [rad/s])."""
+    motion = analysis.motion
     on_guide, moving = motion.points[c.name], motion.points[c.at]
     v_rel = axes @ (moving.velocity - on_guide.velocity)
     tail, end = images[labels[c.name]], labels[c.at]
     pair = f"{c.at}{c.name}"
     if not acc:
         return [PolygonVector("sliding", tail, images[end], labels[c.name], end, f"v_{pair}")]
-    w = float(normal @ motion.links[c.link].angular_velocity) if c.link in motion.links else 0.0
     coriolis = 2.0 * w * np.array([-v_rel[1], v_rel[0]])
     return [PolygonVector("coriolis", tail, tail + coriolis, labels[c.name], "", f"a^c_{pair}"),
             PolygonVector("sliding", tail + coriolis, images[end], "", end, f"a^r_{pair}")]

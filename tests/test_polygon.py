@@ -48,7 +48,8 @@ def r_rtr(overrides=()):
 
 
 CASES = [((), 30.0, -50.0 * math.pi / 30.0, 0.0),
-         (('drivers.A.angle="110 deg"', 'drivers.A.acceleration="20 rad/s^2"'), 110.0, -50.0 * math.pi / 30.0, 20.0)]
+         (('drivers.A.angle="110 deg"', 'drivers.A.acceleration="20 rad/s^2"'), 110.0, -50.0 * math.pi / 30.0, 20.0),
+         (('report.links=["link1"]',), 30.0, -50.0 * math.pi / 30.0, 0.0)]  # link 3's rates not reported
 
 
 @pytest.mark.parametrize(("overrides", "theta", "omega", "alpha"), CASES)
