@@ -170,7 +170,7 @@ class SweepPlot:
             raise PinmechError(f"no pose of the sweep could be solved: nothing to plot in {path}")
         plt = _pyplot()
         sweep, unit = self.sweep, "deg" if self.sweep.is_angular else "m"
-        x, order, turn = _driver_axis(np.array(self.x), self.sweep.is_angular)
+        x, order, turn = _driver_axis(np.array(self.x), self.sweep.is_angular and self._comes_back())
         mark_x = self._x(self.mark[0]) % 360.0 if turn else self._x(self.mark[0])
         lo, hi = np.nanmin(x), np.nanmax(x)
         marked = lo - 1e-9 * abs(lo) <= mark_x <= hi + 1e-9 * abs(hi)  # the scene's pose is swept
@@ -206,6 +206,22 @@ class SweepPlot:
         fig.suptitle(self._title(marked, mark_x, unit), fontsize=11)
         fig.tight_layout()
         return _save(plt, fig, path)
+
+    def _comes_back(self) -> bool:
+        """Whether every drawn quantity ends where it began (angles modulo 360 deg): only
+        then is a whole turn drawn from 0 to 360 deg without a jump where it began."""
+        for title, panel in self.series.items():
+            for values in panel.values():
+                y = np.array(values)
+                y = y[np.isfinite(y)]
+                if y.size < 2:
+                    continue
+                gap = abs(y[-1] - y[0])
+                if title.startswith("angle"):
+                    gap = abs((gap + 180.0) % 360.0 - 180.0)
+                if gap > 1e-6 * max(float(np.max(np.abs(y))), 1e-9):
+                    return False
+        return True
 
     def save_paths(self, path: str | Path) -> Path:
         """Only the paths of the points, with the mechanism at the scene's pose, in a figure."""
@@ -280,7 +296,8 @@ class SweepPlot:
 
 def _driver_axis(x: np.ndarray, angular: bool) -> tuple[np.ndarray, np.ndarray, bool]:
     """The driver values as drawn, the order of the poses along them, and whether they
-    make one whole turn (then drawn from 0 to 360 deg, whatever angle the sweep began at)."""
+    make one whole turn (then drawn from 0 to 360 deg, whatever angle the sweep began at;
+    `angular` False: as swept)."""
     finite = x[np.isfinite(x)]
     turn = angular and finite.size > 1 and abs(np.ptp(finite) - 360.0) <= 1e-9 * 360.0
     if not turn:

@@ -11,6 +11,7 @@ import closed_form as cf
 import numpy as np
 import pytest
 
+from pinmech import Scene
 from pinmech.cli import main
 from tests.conftest import SCENES
 
@@ -123,3 +124,20 @@ def test_a_fixed_points_path_is_a_dot(figures, tmp_path):
                  "--paths", str(tmp_path / "p.png")]) == 0
     (line,) = [x for x in figures[0].axes[0].get_lines() if x.get_label() == "path of A"]
     np.testing.assert_allclose(np.asarray(line.get_xydata(), dtype=float), 0.0, atol=1e-12)
+
+
+def test_a_turn_that_does_not_come_back_is_drawn_as_swept(figures, tmp_path):
+    """Were the mechanism elsewhere after its turn, folding 360..390 onto 0..30 would draw a
+    jump at 30 deg: then the axis runs as swept, 30..390 (the last pose is moved to mimic it)."""
+    from pinmech.plot import SweepPlot
+    from pinmech.sweep import Sweep
+
+    sweep = Sweep.from_scene(Scene.load(SCENES / "r_rtr.toml"))
+    recorder = SweepPlot(sweep)
+    for pose in sweep.poses(sweep.default_values(37)):
+        recorder.add(pose)
+    recorder.save(tmp_path / "back.png")
+    assert _axes(figures[-1], "link3: angle").get_xlim() == (0.0, 360.0)
+    recorder.series["speed, |v| [m/s]"]["D"][-1] *= 1.01
+    recorder.save(tmp_path / "elsewhere.png")
+    assert _axes(figures[-1], "link3: angle").get_xlim() == pytest.approx((30.0, 390.0))
