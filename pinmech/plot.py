@@ -278,11 +278,12 @@ class SweepPlot:
     def _title(self, marked: bool, mark_x: float, unit: str) -> str:
         sweep = self.sweep
         spec = sweep.scene.section("drivers").get(sweep.driver, {})
-        rates = [f"{key} {value}" for key, value in spec.items() if key not in ("angle", "position")]
+        rate = "speed" if sweep.is_angular else "velocity"
+        speed = spec.get("speed", spec.get("velocity", "0"))  # as the scene writes them; absent: 0
         note = f"dashed: the scene's pose, {mark_x:.4g} {unit}" if marked else ""
         if self.failed:
             note += ("; " if note else "") + f"{len(self.failed)} pose(s) failed (red x)"
-        driven = f"driver {sweep.driver} at " + ", ".join(rates) if rates else f"driver {sweep.driver}"
+        driven = f"driver {sweep.driver} at {rate} {speed}, acceleration {spec.get('acceleration', '0')}"
         return f"{sweep.scene.title}: {driven}" + (f"\n({note})" if note else "")
 
     def _summary(self, mark_x: float, unit: str) -> str:

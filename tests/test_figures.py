@@ -99,9 +99,12 @@ def test_constant_curves_are_said_not_drawn(figures, tmp_path):
     assert legend is None or legend.get_bbox_to_anchor().x0 >= ax.get_window_extent().x1 - 1
 
 
-def test_the_title_gives_the_drivers_speed(figures, tmp_path):
-    assert main(["sweep", str(SCENES / "r_rtr.toml"), "--steps", "5", "--plot", str(tmp_path / "t.png")]) == 0
-    assert "-50 rpm" in figures[0].texts[0].get_text() or "-50 rpm" in figures[0]._suptitle.get_text()
+@pytest.mark.parametrize(("scene", "said"), [("r_rtr", "driver A at speed -50 rpm, acceleration 0 rad/s^2"),
+                                             ("four_bar", "driver O2 at speed 120 rpm, acceleration 0")])
+def test_the_title_gives_the_drivers_speed_and_acceleration(figures, tmp_path, scene, said):
+    """As the scene writes them (the four-bar's scene gives no acceleration: 0)."""
+    assert main(["sweep", str(SCENES / f"{scene}.toml"), "--steps", "5", "--plot", str(tmp_path / "t.png")]) == 0
+    assert said in figures[0].get_suptitle()
 
 
 
