@@ -27,14 +27,15 @@ def report_html(analysis: Analysis, *, steps: int = 121, hand_text: str | None =
     """
     from pinmech.report import to_text
 
-    sections = [("Drawing", _drawing(analysis)), ("Motion", motion_table_html(analysis)),
+    sections = [("Drawing", _caption(_CAPTIONS["drawing"]) + _drawing(analysis)),
+                ("Motion", _caption(_CAPTIONS["motion"]) + motion_table_html(analysis)),
                 ("Report", _pre(to_text(analysis)))]
     if analysis.mechanism.plane_normal is not None:
-        sections.append(("Velocity and acceleration polygons", _polygons(analysis)))
+        sections.append(("Velocity and acceleration polygons", _caption(_CAPTIONS["polygons"]) + _polygons(analysis)))
     if steps and "task" not in analysis.scene.raw:
-        sections.append(("Over a turn of the driver", _sweep(analysis, steps)))
+        sections.append(("Over a turn of the driver", _caption(_CAPTIONS["sweep"]) + _sweep(analysis, steps)))
     if hand_text is not None:
-        sections.append(("Hand calculation checked", _pre(hand_text)))
+        sections.append(("Hand calculation checked", _caption(_CAPTIONS["hand"]) + _pre(hand_text)))
     body = "\n".join(f"<section><h2>{html.escape(t)}</h2>\n{content}</section>" for t, content in sections)
     title = html.escape(analysis.scene.title)
     return _PAGE.format(title=title, body=body)
@@ -70,6 +71,22 @@ def _sweep(analysis: Analysis, steps: int) -> str:
             return f"<p>No sweep figure: {html.escape(str(exc))}</p>"
         return "".join(f'<img alt="{p.stem}" src="data:image/png;base64,{base64.b64encode(p.read_bytes()).decode()}">'
                        for p in figures)
+
+
+_CAPTIONS = {
+    "drawing": "The mechanism at the scene's pose, named points as black dots (drag to turn, scroll to zoom).",
+    "motion": "World frame, SI units; φ, ω, α about the plane's normal for a planar mechanism.",
+    "polygons": "From the pole o: each point's velocity (acceleration); between points of one link their "
+                "relative motion (normal and tangential parts), between a guide and its slider the sliding "
+                "and Coriolis parts. The scale is written on each drawing.",
+    "sweep": "Every quantity against the driver over one turn (the scene's pose dashed), and the paths of "
+             "the points with the mechanism at the scene's pose.",
+    "hand": "Each hand value against pinmech's, within the rounding of its printed digits.",
+}
+
+
+def _caption(text: str) -> str:
+    return f'<p class="caption">{html.escape(text)}</p>'
 
 
 def _pre(text: str) -> str:
@@ -111,6 +128,7 @@ _PAGE = """<!DOCTYPE html>
 body {{font: 14px sans-serif; margin: 16px auto; max-width: 1100px; color: #222}}
 h1 {{font-size: 20px}} h2 {{font-size: 16px; border-bottom: 1px solid #ccc}}
 iframe.drawing {{width: 100%; height: 520px; border: 1px solid #ccc}}
+.caption {{color: #555; margin: 4px 0 8px}}
 pre {{font-size: 12px; background: #f7f7f7; padding: 8px; overflow-x: auto}}
 img, .figure svg {{max-width: 100%; height: auto}} .figure {{display: inline-block; width: 49%; vertical-align: top}}
 table {{border-collapse: collapse; margin: 6px 0}} td, th {{border: 1px solid #ccc; padding: 2px 6px}}
