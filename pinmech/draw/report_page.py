@@ -130,7 +130,7 @@ h1 {{font-size: 20px}} h2 {{font-size: 16px; border-bottom: 1px solid #ccc}}
 iframe.drawing {{width: 100%; height: 520px; border: 1px solid #ccc}}
 .caption {{color: #555; margin: 4px 0 8px}}
 pre {{font-size: 12px; background: #f7f7f7; padding: 8px; overflow-x: auto}}
-img, .figure svg {{max-width: 100%; height: auto}} .figure {{display: inline-block; width: 49%; vertical-align: top}}
+img, .figure svg {{max-width: 100%; height: auto}} img[alt="paths"] {{max-width: 760px}} .figure {{display: inline-block; width: 49%; vertical-align: top}}
 table {{border-collapse: collapse; margin: 6px 0}} td, th {{border: 1px solid #ccc; padding: 2px 6px}}
 </style></head>
 <body><h1>{title}</h1>
