@@ -15,7 +15,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import PinmechError
-from pinmech.linkage import sketch_links, world_nodes
+from pinmech.linkage import link_colour, sketch_links, world_nodes
 from pinmech.motion import _plane_reference
 
 if TYPE_CHECKING:
@@ -23,7 +23,6 @@ if TYPE_CHECKING:
 
 PLANES = {"xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
 _PATH_COLOURS = ("#111111", "#7b2d8b", "#0b6e6e", "#9c2f2f")  # dark: the paths over the light sketch
-_COLOURS = ("#d62728", "#1f5fbf", "#2ca02c", "#e08a0b", "#8c4cbf", "#17a2b0")  # as the 3-D sketches
 
 
 class PathRecorder:
@@ -144,7 +143,7 @@ def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scal
     size = scale * max(spans, default=mechanism.length_scale)
     for k, link in enumerate(sketches.values()):
         uv = (world_nodes(link, data) @ axes.T) * scale
-        colour = "0.45" if link.is_ground else _COLOURS[k % len(_COLOURS)]
+        colour = link_colour(k, link)  # as in the 3-D drawings
         if link.is_ground:
             _ground(ax, link, uv, size, axes, scale)
             continue
@@ -197,7 +196,7 @@ def draw_linkage_3d(ax, mechanism: Mechanism, q: np.ndarray, scale: float = 1.0)
     pin.forwardKinematics(mechanism.model, data, q)
     for k, link in enumerate(sketch_links(mechanism).values()):
         xyz = world_nodes(link, data) * scale
-        colour = "0.45" if link.is_ground else _COLOURS[k % len(_COLOURS)]
+        colour = link_colour(k, link)  # as in the 3-D drawings
         pins = xyz[[n.kind == "revolute" for n in link.nodes]]
         if len(pins):
             ax.scatter(*pins.T, s=18, facecolors="white", edgecolors="0.15", depthshade=False)

@@ -9,9 +9,11 @@ route as the browser tests (tests/browser.py).
 
 - `docs/images/four_bar.png`, `docs/images/slider_crank.png`: the bundled scenes as
   `pinmech snapshot` draws them; `docs/images/four_bar_bare.png`: the four-bar with every
-  `<visual>` taken out (a user's model), its links sketched from its joints and points.
-- `docs/images/sweep_r_rtr.png`, `docs/images/paths_four_bar.png`: `pinmech sweep --plot`
-  and `--paths`; `docs/images/polygon_v_r_rtr.png`, `polygon_a_r_rtr.png`: `pinmech polygon`.
+  `<visual>` taken out (a user's model), and `docs/images/jansen_leg.png`, a model written
+  without any: their links sketched from their joints and points.
+- `docs/images/sweep_r_rtr.png`, `docs/images/paths_four_bar.png`, `paths_jansen_leg.png`:
+  `pinmech sweep --plot` and `--paths`; `docs/images/polygon_v_r_rtr.png`,
+  `polygon_a_r_rtr.png`: `pinmech polygon`.
 
 Poses and rates of the first two come from the independent closed forms in
 scripts/closed_form.py; the models are built from the URDF files directly. The others run
@@ -119,12 +121,13 @@ def cli_pictures(chromium: str, tmp: Path) -> None:
     scene = (scenes / "four_bar.toml").read_text()
     (tmp / "four_bar_bare.toml").write_text(re.sub(r'urdf = ".*"', 'urdf = "four_bar_bare.urdf"', scene))
     for name, scene_file in (("four_bar", scenes / "four_bar.toml"), ("slider_crank", scenes / "slider_crank.toml"),
-                             ("four_bar_bare", tmp / "four_bar_bare.toml")):
+                             ("four_bar_bare", tmp / "four_bar_bare.toml"), ("jansen_leg", scenes / "jansen_leg.toml")):
         html = tmp / f"{name}.html"
         pinmech(["snapshot", str(scene_file), "-o", str(html), "--no-grid"])
         photograph(chromium, html, IMAGES / f"{name}.png")
     pinmech(["sweep", str(scenes / "r_rtr.toml"), "--plot", str(IMAGES / "sweep_r_rtr.png"), "--csv", str(tmp / "s.csv")])
-    pinmech(["sweep", str(scenes / "four_bar.toml"), "--paths", str(IMAGES / "paths_four_bar.png")])
+    for name in ("four_bar", "jansen_leg"):
+        pinmech(["sweep", str(scenes / f"{name}.toml"), "--paths", str(IMAGES / f"paths_{name}.png")])
     for kind in ("v", "a"):
         svg = tmp / f"polygon_{kind}.svg"
         pinmech(["polygon", str(scenes / "r_rtr.toml"), "-o", str(svg)] + (["--acceleration"] if kind == "a" else []))

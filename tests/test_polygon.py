@@ -88,7 +88,7 @@ def test_r_rtr_acceleration_polygon_measures_the_closed_form(overrides, theta, o
     assert abs(u[0] * a["a^r_BB3"][1] - u[1] * a["a^r_BB3"][0]) <= atol  # the sliding part runs along the guide
 
 
-@pytest.mark.parametrize("scene", ["four_bar", "slider_crank", "r_rtr"])
+@pytest.mark.parametrize("scene", ["four_bar", "slider_crank", "r_rtr", "jansen_leg"])
 @pytest.mark.parametrize("make", [velocity_polygon, acceleration_polygon])
 def test_every_point_drawn_from_the_pole_as_pinmech_computes_it(scene, make):
     """Each o->p read back is pinmech's velocity (acceleration) of P; the chains of relative
@@ -168,3 +168,19 @@ def test_bad_recorder_options_are_named_errors():
         SweepPlot(sweep, angles="degrees")
     with pytest.raises(PinmechError, match="path plane must be one of xy, yz, zx or 3d"):
         PathRecorder(sweep.mechanism, "xz")
+
+
+def test_jansen_foot_velocity_and_acceleration_by_finite_differences():
+    """The foot G of the Jansen leg: o->g is dG/dtheta w and o'->g' is d2G/dtheta2 w^2 (the
+    crank at a constant 60 rpm), central differences of the closed form with h = 1e-4 rad:
+    truncation ~h^2 |G'''| ~ 1e-8 m and rounding ~eps |G| / h^2 ~ 2e-8 m, far below the
+    read-back tolerance (1 um on paper, 5e-5 m/s or more)."""
+    from closed_form_jansen import jansen_leg
+
+    analysis = analyse(Scene.load(SCENES / "jansen_leg.toml"))
+    w, h, theta = 2 * math.pi, 1e-4, math.pi / 2
+    G = [jansen_leg(theta + k * h)["G"] for k in (-1, 0, 1)]
+    per_mm, v, _, _ = read_svg(polygon_svg(velocity_polygon(analysis)))
+    np.testing.assert_allclose(v["v_G"], w * (G[2] - G[0]) / (2 * h), atol=READ_MM * per_mm)
+    per_mm, a, _, _ = read_svg(polygon_svg(acceleration_polygon(analysis)))
+    np.testing.assert_allclose(a["a_G"], w**2 * (G[2] - 2 * G[1] + G[0]) / h**2, atol=READ_MM * per_mm)

@@ -180,7 +180,7 @@ def test_a_spatial_users_mechanism_without_visuals(rsur, tmp_path, capsys):
     assert "planar" in capsys.readouterr().err and not (tmp_path / "v.svg").exists()
 
 
-@pytest.mark.parametrize("name", ["four_bar", "slider_crank", "planar_arm", "r_rtr_task"])
+@pytest.mark.parametrize("name", ["four_bar", "slider_crank", "planar_arm", "r_rtr_task", "jansen_leg"])
 def test_every_bundled_planar_scene_makes_a_page(tmp_path, name):
     """Drawing, tables and report on every page; polygons for each planar scene; the sweep
     figure where there is a driver to sweep (task scenes are followed in time instead)."""

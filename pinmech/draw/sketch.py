@@ -14,19 +14,9 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.draw.geometry import _screen_up
-from pinmech.linkage import LinkSketch, sketch_links
+from pinmech.linkage import LinkSketch, link_colour, sketch_links
 from pinmech.mechanism import Mechanism
 
-#: One colour a link, in turn (RGBA); the ground is grey.
-PALETTE = (
-    (0.85, 0.15, 0.15, 1.0),
-    (0.15, 0.35, 0.85, 1.0),
-    (0.15, 0.65, 0.25, 1.0),
-    (0.9, 0.55, 0.05, 1.0),
-    (0.55, 0.25, 0.75, 1.0),
-    (0.1, 0.65, 0.7, 1.0),
-)
-GROUND = (0.45, 0.45, 0.45, 1.0)
 _BAR = 0.05  # bar width, as a share of the longest link
 _BLOCK = (0.2, 0.11)  # slider block length and width, shares of the longest link
 _GROUND = 0.1  # ground triangle height, share of the longest link
@@ -54,7 +44,7 @@ def sketch_visuals(mechanism: Mechanism, visual_model: pin.GeometryModel | None 
     for i, link in enumerate(sketches.values()):
         if link.joint in drawn:
             continue
-        colour = np.array(GROUND if link.is_ground else PALETTE[i % len(PALETTE)])
+        colour = np.array([*link_colour(i, link), 1.0])
         local_normal = None if normal is None else data.oMi[link.joint].rotation.T @ normal
         shapes = _ground_shapes(link, scale, normal) if link.is_ground else []
         shapes += _link_shapes(link, scale, local_normal, coal)
