@@ -516,6 +516,9 @@ def _write_text(path: str, text: str, what: str) -> None:
     folder = os.path.dirname(os.path.abspath(path))
     with tempfile.NamedTemporaryFile("w", encoding="utf-8", dir=folder, delete=False, suffix=".part") as stream:
         stream.write(text)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(stream.name, 0o666 & ~umask)  # as open() would make it, not the temporary file's 0600
     os.replace(stream.name, path)
     print(f"wrote {path} ({what}, {max(1, len(text) // 1024)} KB)", file=sys.stderr)
 

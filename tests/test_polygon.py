@@ -184,3 +184,15 @@ def test_jansen_foot_velocity_and_acceleration_by_finite_differences():
     np.testing.assert_allclose(v["v_G"], w * (G[2] - G[0]) / (2 * h), atol=READ_MM * per_mm)
     per_mm, a, _, _ = read_svg(polygon_svg(acceleration_polygon(analysis)))
     np.testing.assert_allclose(a["a_G"], w**2 * (G[2] - 2 * G[1] + G[0]) / h**2, atol=READ_MM * per_mm)
+
+
+def test_the_svg_file_is_made_as_any_file_is(tmp_path):
+    """Written whole then moved in place, with the permissions open() gives (not 0600)."""
+    import os
+
+    out = tmp_path / "v.svg"
+    assert main(["polygon", str(SCENES / "r_rtr.toml"), "-o", str(out)]) == 0
+    umask = os.umask(0)
+    os.umask(umask)
+    assert out.stat().st_mode & 0o777 == 0o666 & ~umask
+    assert [p.name for p in tmp_path.iterdir()] == ["v.svg"]  # no temporary file left
