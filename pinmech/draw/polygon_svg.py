@@ -105,13 +105,12 @@ def _labels(polygon: Polygon, at, per_mm: float, centre: np.ndarray) -> list[str
         else:
             groups.append([name])
     out = []
+    places = [polygon.images[g[0]] for g in groups]
     for group in groups:
         p = polygon.images[group[0]]
-        away = p - centre
-        n = np.linalg.norm(away)
-        offset = away / n if n > 1e-12 * per_mm else np.array([-0.7, 0.7])
+        offset = _label_direction(p, places, polygon, centre, per_mm)
         x, y = at(p)
-        x, y = x + 4.0 * offset[0], y - 4.0 * offset[1]
+        x, y = x + 4.5 * offset[0], y - 4.5 * offset[1]
         anchor = "start" if offset[0] > 0.3 else "end" if offset[0] < -0.3 else "middle"
         text = html.escape(", ".join(group))
         px, py = at(p)
@@ -119,6 +118,32 @@ def _labels(polygon: Polygon, at, per_mm: float, centre: np.ndarray) -> list[str
         out.append(f'<text class="label" x="{x:.3f}" y="{y + 1.4:.3f}" font-size="4" text-anchor="{anchor}" '
                    f'font-style="italic">{text}</text>')
     return out
+
+
+def _label_direction(p: np.ndarray, places: list[np.ndarray], polygon: Polygon, centre: np.ndarray,
+                     per_mm: float) -> np.ndarray:
+    """Where to set a label off its image (a unit vector on paper, y up): of eight directions,
+    the one whose label spot (4 mm out) lies farthest from every vector and other image,
+    away from the drawing's centre on a tie."""
+    spots = [np.array([np.cos(t), np.sin(t)]) for t in np.radians(np.arange(0, 360, 45))]
+    segments = [(v.tail / per_mm, v.head / per_mm) for v in polygon.vectors]  # on paper [mm]
+    others = [q / per_mm for q in places if np.linalg.norm(q - p) > 1e-12 * per_mm]
+    outward = p - centre
+    outward = outward / np.linalg.norm(outward) if np.linalg.norm(outward) > 1e-12 * per_mm else np.zeros(2)
+
+    def clearance(direction: np.ndarray) -> float:
+        spot = p / per_mm + 4.5 * direction
+        near = [_to_segment(spot, a, b) for a, b in segments] + [np.linalg.norm(spot - q) for q in others]
+        return min(min(near, default=99.0), 6.0) + 0.5 * float(direction @ outward)
+
+    return max(spots, key=clearance)
+
+
+def _to_segment(x: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    """Distance from the point x to the segment a-b (same units)."""
+    ab = b - a
+    t = float(np.clip((x - a) @ ab / max(float(ab @ ab), 1e-300), 0.0, 1.0))
+    return float(np.linalg.norm(x - a - t * ab))
 
 
 def _footer(polygon: Polygon, per_mm: float, height: float, width: float) -> list[str]:
