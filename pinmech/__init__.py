@@ -12,6 +12,7 @@ from pinmech.branches import Assembly
 from pinmech.check import compare, load_hand_file
 from pinmech.closures import Closure
 from pinmech.continuation import Route
+from pinmech.draw.report_page import HtmlPage, report_html, snapshot
 from pinmech.exceptions import (
     AssemblyError,
     CheckMismatch,
@@ -42,6 +43,7 @@ from pinmech.forces_sweep import SweepForces
 from pinmech.mechanism import JointInfo, Mechanism
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.path import PathPoint, follow_path
+from pinmech.polygon import Polygon, acceleration_polygon, velocity_polygon
 from pinmech.report import to_dict, to_json, to_text
 from pinmech.results import Accuracy, LoopSolution, RateSolution
 from pinmech.scene import Scene
@@ -72,6 +74,7 @@ __all__ = [
     "ForceSolver",
     "FrameNotFound",
     "IndeterminateForcesError",
+    "HtmlPage",
     "JointInfo",
     "Load",
     "LoopClosureError",
@@ -84,6 +87,7 @@ __all__ = [
     "PathPoint",
     "PinmechError",
     "PowerBalance",
+    "Polygon",
     "RangeChunk",
     "RateSolution",
     "RateSolver",
@@ -101,6 +105,7 @@ __all__ = [
     "TaskError",
     "UnitError",
     "__version__",
+    "acceleration_polygon",
     "analyse",
     "compare",
     "energy_fluctuation",
@@ -110,9 +115,12 @@ __all__ = [
     "load_hand_file",
     "load_mechanism",
     "mechanical_advantage",
+    "report_html",
+    "snapshot",
     "solve_range",
     "to_dict",
     "to_json",
     "to_si",
     "to_text",
+    "velocity_polygon",
 ]

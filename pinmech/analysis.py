@@ -46,6 +46,12 @@ class Analysis:
     extra: dict[str, Any] | None = None
     forces: ForceSolution | None = None  # driver efforts and reactions, when the scene asks (forces.py)
 
+    def _repr_html_(self) -> str:
+        """Jupyter shows the points' and links' motion as tables."""
+        from pinmech.draw.report_page import motion_table_html
+
+        return f"<h4>{self.scene.title}</h4>" + motion_table_html(self)
+
 
 def load_mechanism(scene: Scene) -> Mechanism:
     """The scene's URDF as a Mechanism, with the scene's `[lock]` joints locked out."""

@@ -84,6 +84,13 @@ def build_parser() -> argparse.ArgumentParser:
     _add_output_arguments(sweep)
     sweep.add_argument("--links", nargs="*", help="links to plot (default: all moving but the driver's)")
     sweep.add_argument("--points", nargs="*", help="points to plot (default: all moving points)")
+    sweep.add_argument("--paths", dest="paths_path",
+                       help="also draw the points' paths, with the mechanism at the scene's pose, here (PNG, PDF, SVG)")
+    sweep.add_argument("--angles", choices=("continuous", "wrapped"), default="continuous",
+                       help="link angles in the figure: continuous (default, no jump at 180 deg) or wrapped "
+                       "to (-180, 180] deg")
+    sweep.add_argument("--path-plane", choices=("xy", "yz", "zx", "3d"),
+                       help="a spatial mechanism's paths projected on this world plane (default xy), or 3d")
     sweep.add_argument("--skip-failures", action="store_true",
                        help="report a pose that cannot close as a row with its error instead of stopping")
     sweep.add_argument("--start", dest="start_mode", choices=("predictor", "warm", "cold"),
@@ -139,6 +146,25 @@ def build_parser() -> argparse.ArgumentParser:
     anim.add_argument("--skip-failures", action="store_true", help="leave out poses that cannot close")
     anim.add_argument("--no-grid", action="store_true", help="hide meshcat's grid and axes")
     anim.set_defaults(func=cmd_animate)
+
+    poly = sub.add_parser("polygon", help="draw the velocity (or acceleration) polygon of a planar pose as SVG")
+    poly.add_argument("scene", help="scene file (TOML), e.g. models/scenes/r_rtr.toml")
+    poly.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                      help="override a scene value, e.g. --set 'drivers.A.acceleration=\"2 rad/s^2\"' (repeatable)")
+    poly.add_argument("--angle", help="shortcut: the (single) driver's angle or position, e.g. '45 deg'")
+    poly.add_argument("--speed", help="shortcut: the driver's speed, e.g. '-50 rpm'")
+    poly.add_argument("-o", "--output", required=True, help="the SVG file to write")
+    poly.add_argument("--acceleration", dest="acceleration_polygon", action="store_true",
+                      help="the acceleration polygon (normal, tangential and Coriolis parts) instead; the "
+                      "driver's acceleration comes from the scene or --set")
+    poly.set_defaults(func=cmd_polygon)
+
+    page = sub.add_parser("report", help="write one offline HTML page: drawing, tables, polygons, sweep figures")
+    _add_scene_arguments(page)
+    page.add_argument("-o", "--output", required=True, help="the HTML file to write")
+    page.add_argument("--hand", help="a hand-value file to check on the page (as pinmech check)")
+    page.add_argument("--steps", type=int, default=121, help="poses of the sweep drawn (default 121; 0: none)")
+    page.set_defaults(func=cmd_report)
 
     live = sub.add_parser("view", help="show the solved pose in a live meshcat server (a browser tab)")
     _add_scene_arguments(live)
@@ -286,16 +312,35 @@ def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, forces=None) -> _S
 
         csv_kind, json_kind, source = ForceCsv, ForceJsonLines, forces
         sinks.plot(TorquePlot(forces), args.torque_plot)  # collects every pose's forces; drawn if a path is given
-    if args.plot_path:
+    if args.plot_path or args.paths_path:
         from pinmech.plot import SweepPlot
 
-        sinks.plot(SweepPlot(sweep, links=args.links, points=args.points, total=steps), args.plot_path)
-    only_figures = args.plot_path or args.json_path or (forces is not None and args.torque_plot)
+        recorder = SweepPlot(sweep, links=args.links, points=args.points, total=steps, angles=args.angles,
+                             plane=args.path_plane)
+        if args.plot_path:
+            sinks.plot(recorder, args.plot_path)
+        if args.paths_path:
+            sinks.plot(_PathsFigure(recorder, feed=not args.plot_path), args.paths_path)
+    only_figures = args.plot_path or args.json_path or args.paths_path or (forces is not None and args.torque_plot)
     if args.csv_path or not only_figures:
         sinks.table(csv_kind, source, args.csv_path, "poses")
     if args.json_path:
         sinks.table(json_kind, source, args.json_path, None)
     return sinks
+
+
+class _PathsFigure:
+    """The paths figure of a sweep's recorder (fed once, whoever feeds it)."""
+
+    def __init__(self, recorder, *, feed: bool) -> None:
+        self.recorder, self.feed = recorder, feed
+
+    def add(self, pose) -> None:
+        if self.feed:
+            self.recorder.add(pose)
+
+    def save(self, path: str):
+        return self.recorder.save_paths(path)
 
 
 class _Sinks:
@@ -412,10 +457,11 @@ _ARROW_UNITS = {"velocity": "m/s", "acceleration": "m/s^2"}
 
 
 def _visuals(mechanism):
-    """The mechanism's visual geometry, built only when drawing."""
+    """The mechanism's visual geometry, built only when drawing; links without visuals sketched."""
     from pinmech.draw import load_visuals
+    from pinmech.draw.sketch import sketch_visuals
 
-    return load_visuals(mechanism.source, mechanism.model)
+    return sketch_visuals(mechanism, load_visuals(mechanism.source, mechanism.model))
 
 
 def cmd_snapshot(args: argparse.Namespace) -> int:
@@ -467,6 +513,41 @@ def cmd_animate(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_polygon(args: argparse.Namespace) -> int:
+    """`pinmech polygon SCENE -o v.svg [--acceleration]`: the graphical method's polygon."""
+    from pinmech.analysis import analyse
+    from pinmech.draw.polygon_svg import polygon_svg
+    from pinmech.polygon import acceleration_polygon, velocity_polygon
+
+    args.acceleration = None  # the flag names the polygon here, not the driver's acceleration
+    analysis = analyse(_scene(args))
+    polygon = (acceleration_polygon if args.acceleration_polygon else velocity_polygon)(analysis)
+    _write_text(args.output, polygon_svg(polygon), "SVG drawing")
+    return 0
+
+
+def cmd_report(args: argparse.Namespace) -> int:
+    """`pinmech report SCENE -o page.html [--hand FILE]`: everything about the scene on one offline page."""
+    from pinmech.analysis import analyse
+    from pinmech.draw.report_page import report_html
+
+    if args.steps < 0 or args.steps == 1:
+        raise PinmechError(f"--steps must be 0 (no sweep) or at least 2, got {args.steps}")
+    hand_text = None
+    analysis = analyse(_scene(args))
+    if args.hand:
+        from pinmech.check import DEFAULT_SLACK, compare, format_verdicts, load_hand_file
+        from pinmech.report import to_dict
+        from pinmech.scene import Scene
+
+        hand = load_hand_file(args.hand)
+        checked = analyse(Scene.load(hand.scene))
+        verdicts = compare(to_dict(checked), hand.values, DEFAULT_SLACK)
+        hand_text = f"{hand.source or hand.path}  vs  pinmech on {hand.scene.name}\n" + format_verdicts(verdicts)
+    _write_text(args.output, report_html(analysis, steps=args.steps, hand_text=hand_text), "offline page")
+    return 0
+
+
 def cmd_view(args: argparse.Namespace) -> int:
     """`pinmech view SCENE`: the solved pose in a live meshcat server; prints its URL."""
     from pinmech.analysis import analyse
@@ -483,6 +564,21 @@ def cmd_view(args: argparse.Namespace) -> int:
         except (EOFError, KeyboardInterrupt):  # no terminal, or Ctrl-C: stop quietly
             pass
     return 0
+
+
+def _write_text(path: str, text: str, what: str) -> None:
+    """Write a whole file at once (a failed write leaves no half file behind) and say so."""
+    import os
+    import tempfile
+
+    folder = os.path.dirname(os.path.abspath(path))
+    with tempfile.NamedTemporaryFile("w", encoding="utf-8", dir=folder, delete=False, suffix=".part") as stream:
+        stream.write(text)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(stream.name, 0o666 & ~umask)  # as open() would make it, not the temporary file's 0600
+    os.replace(stream.name, path)
+    print(f"wrote {path} ({what}, {max(1, len(text) // 1024)} KB)", file=sys.stderr)
 
 
 def _write(path: str, html: str) -> None:

@@ -39,7 +39,7 @@ def columns(sweep: Sweep, first: Motion) -> list[str]:
         cols += [f"{name}.v{c} [m/s]" for c in "xyz"] + [f"{name}.|v| [m/s]"]
         cols += [f"{name}.a{c} [m/s^2]" for c in "xyz"] + [f"{name}.|a| [m/s^2]"]
     for name in first.sliders:
-        cols += [f"{name}.v_rel [m/s]", f"{name}.a_rel [m/s^2]", f"{name}.|a_cor| [m/s^2]"]
+        cols += [f"{name}.s [m]", f"{name}.v_rel [m/s]", f"{name}.a_rel [m/s^2]", f"{name}.|a_cor| [m/s^2]"]
     return cols + ["closure_residual [1]", "condition_number [1]", "newton_iterations [1]", "pose", "error"]
 
 
@@ -60,7 +60,7 @@ def row(sweep: Sweep, pose: SweepPose, width: int) -> list[object]:
         v, a = p.velocity.tolist(), p.acceleration.tolist()
         out += p.position.tolist() + v + [math.hypot(*v)] + a + [math.hypot(*a)]
     for name, s in m.sliders.items():
-        out += [m.joints[name].v, m.joints[name].a, _norm(s.coriolis_acceleration)]
+        out += [m.joints[name].q, m.joints[name].v, m.joints[name].a, _norm(s.coriolis_acceleration)]
     acc = pose.accuracy
     return out + [acc.residual, acc.condition, acc.iterations, "interpolated" if pose.interpolated else "solved", ""]
 
