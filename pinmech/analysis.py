@@ -44,16 +44,45 @@ class Analysis:
 
 
 def load_mechanism(scene: Scene) -> Mechanism:
-    """The scene's URDF as a Mechanism, with the scene's `[lock]` joints locked out."""
-    if not scene.urdf.is_file():
-        raise ModelError(f"the scene's urdf = \"{scene.raw['urdf']}\" is not a file", path=str(scene.path))
-    types = urdf_joint_types(scene.urdf)
+    """The scene's model (URDF, linkage, MJCF) as a Mechanism, `[lock]` joints locked out."""
+    kind = scene.model_kind
+    path = scene.urdf if kind in ("urdf", "robot") else scene.model_file(kind)
+    if not path.is_file():
+        raise ModelError(f"the scene's {kind} = \"{scene.raw[kind]}\" is not a file", path=str(scene.path))
+    loader = _model_loader(scene, kind, path)
+    types = loader.joint_types()
     locked = {}
     for name, value in scene.section("lock").items():
         locked[name] = scene.quantity(value, _kind(types, name), "lock", name)
     if "move" in scene.raw:
         locked.update(_locked_by_move(scene, types, locked))
-    return Mechanism.from_urdf(scene.urdf, locked=locked)
+    return loader.load(locked)
+
+
+@dataclass(frozen=True)
+class _Loader:
+    """How to read one kind of model file: its joint types, then the mechanism."""
+
+    joint_types: Any
+    load: Any
+
+
+def _model_loader(scene: Scene, kind: str, path) -> _Loader:
+    if kind == "linkage":
+        from pinmech.linkage import joint_kinds, load_linkage
+
+        return _Loader(lambda: joint_kinds(path), lambda locked: load_linkage(path, locked=locked))
+    if kind == "mjcf":
+        from pinmech.mjcf import load_mjcf, mjcf_joint_types
+
+        return _Loader(lambda: mjcf_joint_types(path), lambda locked: load_mjcf(path, locked=locked))
+    if "sidecar" in scene.raw:
+        from pinmech.sidecar import load_extended_urdf
+
+        sidecar = scene.model_file("sidecar")
+        return _Loader(lambda: urdf_joint_types(path),
+                       lambda locked: load_extended_urdf(path, sidecar, locked=locked))
+    return _Loader(lambda: urdf_joint_types(path), lambda locked: Mechanism.from_urdf(path, locked=locked))
 
 
 def _kind(types: dict[str, str], name: str) -> str:

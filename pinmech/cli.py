@@ -331,7 +331,7 @@ def _visuals(mechanism):
     """The mechanism's visual geometry, built only when drawing."""
     from pinmech.draw import load_visuals
 
-    return load_visuals(mechanism.source, mechanism.model)
+    return load_visuals(mechanism.urdf_path or mechanism.source, mechanism.model)
 
 
 def cmd_snapshot(args: argparse.Namespace) -> int:

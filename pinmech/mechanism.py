@@ -74,6 +74,10 @@ class Mechanism:
         length_scale: size of the mechanism [m]; position tolerances are relative to it.
         plane_normal: unit normal of the motion plane for a planar mechanism, else None.
         locked: joints locked out of the model, with their values (SI).
+        urdf_path: the URDF the model was built from, when `source` is another file (a
+            linkage drawn in TOML, an MJCF file): drawings read their visuals from it.
+        reference: the reference configuration (the drawn pose of a linkage), else None
+            (the neutral configuration is the reference).
     """
 
     model: pin.Model
@@ -85,6 +89,8 @@ class Mechanism:
     plane_normal: np.ndarray | None
     source: str = "<model>"
     locked: dict[str, float] = field(default_factory=dict)
+    urdf_path: str | None = None
+    reference: np.ndarray | None = None
 
     # ---------------------------------------------------------------- construction
     @classmethod
@@ -202,7 +208,9 @@ class Mechanism:
         return scale
 
     def neutral(self) -> np.ndarray:
-        """The model's neutral configuration (all joint coordinates zero)."""
+        """The reference configuration: a linkage's drawn pose, else all joint coordinates zero."""
+        if self.reference is not None:
+            return self.reference.copy()
         return pin.neutral(self.model)
 
     def set_coordinate(self, q: np.ndarray, name: str, value: float) -> None:

@@ -1,0 +1,623 @@
+"""A planar linkage written as drawn (TOML) -> a URDF with `<constraint>` loop cuts.
+
+Mechanism people think in joint coordinates on a drawing. A linkage file gives every
+joint's world coordinates at one drawn pose, the links and the joints and points each
+carries, sliders and pin-in-slot joints one line each; this module picks a spanning tree
+(breadth first from the ground), turns every other joint into one loop cut, and writes a
+URDF whose reference configuration is the drawn pose. See the README section
+"Linkages as drawn" for the format; `parse_linkage` reads and validates it once, and
+`linkage_urdf` writes the URDF text.
+
+Conventions of the generated URDF (all in the plane z = 0, axes along z):
+  * every link's frame sits on its parent joint, its x axis along its first bar (towards
+    the next point the link lists), so a link's reported angle is the textbook phi;
+  * a pin's coordinate is the angle between the x axes of its two links [rad], a
+    slider's the displacement of its block from the drawn position along the line [m];
+  * `Linkage.reference` holds those coordinates at the drawn pose: the default guess.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections import deque
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from pinmech.exceptions import ModelError, UnitError
+from pinmech.units import to_si
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+GROUND = "ground"
+_KEYS = {"title", "ground", "params", "joints", "links", "sliders", "slots", "colors"}
+_COLOURS = ["0.85 0.15 0.15", "0.15 0.35 0.85", "0.15 0.65 0.25", "0.85 0.55 0.1", "0.55 0.2 0.75",
+            "0.1 0.65 0.7", "0.75 0.3 0.5", "0.45 0.45 0.15"]
+
+
+@dataclass(frozen=True)
+class Edge:
+    """One joint between two links of the graph: a pin (revolute) or a slide (prismatic).
+
+    Attributes:
+        name: the URDF joint (or cut) name.
+        kind: "revolute" or "prismatic".
+        links: the two links it joins.
+        at: its point in the world at the drawn pose [m] (x, y).
+        direction: unit direction of a slide, world frame at the drawn pose.
+    """
+
+    name: str
+    kind: str
+    links: tuple[str, str]
+    at: np.ndarray
+    direction: np.ndarray | None = None
+
+
+@dataclass
+class Linkage:
+    """A drawn linkage, parsed and validated: SI units, world frame, at the drawn pose.
+
+    Attributes:
+        points: every named point's world position [m] (joints and points of interest).
+        links: link name -> the names it carries, in the order written.
+        edges: every joint of the graph (pins split into pairs, slots into pin + slide).
+        point_links: named point -> the one link it is fixed on.
+        sliders: slide edge names -> their block link (drawn as a block).
+        hidden: links added for pin-in-slot joints (a block of zero size).
+    """
+
+    source: str
+    title: str
+    points: dict[str, np.ndarray]
+    links: dict[str, list[str]]
+    edges: list[Edge]
+    point_links: dict[str, str]
+    blocks: dict[str, Edge] = field(default_factory=dict)
+    hidden: set[str] = field(default_factory=set)
+
+
+# ------------------------------------------------------------------------- reading
+def parse_linkage(path: str | Path) -> Linkage:
+    """Read a linkage file: values with units, names checked, the drawn pose constructed.
+
+    Raises:
+        ModelError: a missing file, malformed TOML, an unknown key or name, a value without
+            units, a construction that cannot be drawn (circles that do not meet).
+    """
+    path = Path(path)
+    source = str(path)
+    if not path.is_file():
+        raise ModelError("no such linkage file", path=source)
+    try:
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ModelError(f"malformed TOML: {exc}", path=source) from exc
+    unknown = set(raw) - _KEYS
+    if unknown:
+        raise ModelError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_KEYS))}",
+                         path=source)
+    reader = _Reader(source, _table(raw, "params", source))
+    points = reader.points(_table(raw, "joints", source))
+    ground = _names(raw.get("ground", []), "ground", source)
+    links = {GROUND: list(ground)}
+    for name, value in _table(raw, "links", source).items():
+        if name == GROUND:
+            raise ModelError("the ground is listed by ground = [...], not as a link", path=source,
+                             element="[links] ground")
+        links[name] = _names(value, f"[links] {name}", source)
+    for link, names in links.items():
+        for name in names:
+            if name not in points:
+                raise ModelError(f"names joint '{name}', which [joints] does not give", path=source,
+                                 element=f"[links] {link}" if link != GROUND else "ground")
+    if len(links) < 2:
+        raise ModelError("no link: list the moving links under [links]", path=source)
+    linkage = Linkage(source, str(raw.get("title", path.stem)), points, links, [], {})
+    _pins(linkage)
+    for name, spec in _table(raw, "sliders", source).items():
+        _slider(linkage, reader, name, spec)
+    for name, spec in _table(raw, "slots", source).items():
+        _slot(linkage, reader, name, spec)
+    _check_names(linkage)
+    return linkage
+
+
+def _table(raw: dict[str, Any], key: str, source: str) -> dict[str, Any]:
+    value = raw.get(key, {})
+    if not isinstance(value, dict):
+        raise ModelError(f"[{key}] must be a table", path=source, element=key)
+    return value
+
+
+def _names(value: Any, where: str, source: str) -> list[str]:
+    if not isinstance(value, list) or not all(isinstance(n, str) for n in value):
+        raise ModelError(f"must be a list of joint names, e.g. [\"A\", \"B\"], got {value!r}", path=source,
+                         element=where)
+    if len(set(value)) != len(value):
+        raise ModelError(f"lists a joint twice: {value}", path=source, element=where)
+    return list(value)
+
+
+class _Reader:
+    """Lengths and angles of one file: quantities with units, or names of `[params]`."""
+
+    def __init__(self, source: str, params: dict[str, Any]):
+        self.source = source
+        self.params = {name: self._quantity(value, "length", f"params.{name}") for name, value in params.items()}
+
+    def _quantity(self, value: Any, kind: str, where: str) -> float:
+        try:
+            return to_si(value, kind, where=where)
+        except UnitError as exc:
+            raise ModelError(str(exc), path=self.source) from exc
+
+    def length(self, value: Any, where: str) -> float:
+        """A length [m]: "15 mm", a parameter name "crank", or "-crank"."""
+        if isinstance(value, str):
+            text = value.strip()
+            sign = -1.0 if text.startswith("-") else 1.0
+            name = text.lstrip("+-").strip()
+            if name in self.params:
+                return sign * self.params[name]
+            if name.isidentifier() and not any(c.isdigit() for c in text):
+                try:
+                    return self._quantity(value, "length", where)
+                except ModelError:
+                    known = ", ".join(self.params) or "none"
+                    raise ModelError(f"'{name}' is neither a length with units nor a parameter "
+                                     f"(params: {known})", path=self.source, element=where) from None
+        return self._quantity(value, "length", where)
+
+    def angle(self, value: Any, where: str) -> float:
+        return self._quantity(value, "angle", where)
+
+    def points(self, table: dict[str, Any]) -> dict[str, np.ndarray]:
+        """World positions of `[joints]`, in the order written (constructions use earlier ones)."""
+        out: dict[str, np.ndarray] = {}
+        for name, spec in table.items():
+            where = f"[joints] {name}"
+            if isinstance(spec, list):
+                if len(spec) != 2:
+                    raise ModelError(f"give two coordinates [x, y] with units, got {spec!r}", path=self.source,
+                                     element=where)
+                out[name] = np.array([self.length(spec[0], f"{where} x"), self.length(spec[1], f"{where} y")])
+            elif isinstance(spec, dict):
+                out[name] = self._construction(name, spec, out, where)
+            else:
+                raise ModelError(f"give [x, y] with units or a construction table, got {spec!r}",
+                                 path=self.source, element=where)
+        return out
+
+    def _construction(self, name: str, spec: dict[str, Any], known: dict[str, np.ndarray], where: str) -> np.ndarray:
+        """`{from = "O", length = "m", angle = "30 deg"}` or `{from = ["A", "B"], lengths = [..], side = ..}`."""
+        origin = spec.get("from")
+        bases = [origin] if isinstance(origin, str) else origin
+        if not isinstance(bases, list) or not all(isinstance(b, str) for b in bases):
+            raise ModelError("a construction needs from = \"JOINT\" (with length, angle) or from = [\"A\", \"B\"] "
+                             "(with lengths, side)", path=self.source, element=where)
+        for base in bases:
+            if base not in known:
+                raise ModelError(f"from names '{base}', which is not given above it", path=self.source,
+                                 element=where)
+        if len(bases) == 1:
+            if set(spec) != {"from", "length", "angle"}:
+                raise ModelError("a polar construction has exactly from, length, angle", path=self.source,
+                                 element=where)
+            r, phi = self.length(spec["length"], f"{where} length"), self.angle(spec["angle"], f"{where} angle")
+            return known[bases[0]] + r * np.array([math.cos(phi), math.sin(phi)])
+        if len(bases) != 2 or set(spec) != {"from", "lengths", "side"}:
+            raise ModelError("a compass construction has exactly from = [\"A\", \"B\"], lengths = [|A..|, |B..|], "
+                             "side = \"left\" or \"right\" (of the line A -> B)", path=self.source, element=where)
+        lengths = spec["lengths"]
+        if not isinstance(lengths, list) or len(lengths) != 2:
+            raise ModelError(f"lengths must be two lengths, got {lengths!r}", path=self.source, element=where)
+        if spec["side"] not in ("left", "right"):
+            raise ModelError(f"side must be \"left\" or \"right\", got {spec['side']!r}", path=self.source,
+                             element=where)
+        r1, r2 = (self.length(v, f"{where} lengths") for v in lengths)
+        return _compass(known[bases[0]], known[bases[1]], r1, r2, spec["side"] == "left",
+                        f"{self.source}, {where}")
+
+
+def _compass(a: np.ndarray, b: np.ndarray, r1: float, r2: float, left: bool, where: str) -> np.ndarray:
+    """The point at r1 from a and r2 from b, left or right of a -> b [m]."""
+    d = float(np.linalg.norm(b - a))
+    if d == 0 or r1 <= 0 or r2 <= 0 or r1 + r2 < d or abs(r1 - r2) > d:
+        raise ModelError(f"cannot be drawn: circles of radii {r1:.6g} m and {r2:.6g} m about points "
+                         f"{d:.6g} m apart do not meet (the linkage cannot be assembled here)", path=where)
+    u = (b - a) / d
+    along = (d * d + r1 * r1 - r2 * r2) / (2 * d)
+    across = math.sqrt(max(r1 * r1 - along * along, 0.0))
+    normal = np.array([-u[1], u[0]])
+    return a + along * u + (across if left else -across) * normal
+
+
+def _pins(linkage: Linkage) -> None:
+    """Names on two or more links become pins (split into pairs), on one link points."""
+    carriers: dict[str, list[str]] = {}
+    for link, names in linkage.links.items():
+        for name in names:
+            carriers.setdefault(name, []).append(link)
+    for name, on in carriers.items():
+        if len(on) == 1:
+            linkage.point_links[name] = on[0]
+            continue
+        for other in on[1:]:
+            label = name if len(on) == 2 else f"{name}_{other}"
+            linkage.edges.append(Edge(label, "revolute", (on[0], other), linkage.points[name]))
+
+
+def _link(linkage: Linkage, value: Any, key: str, where: str) -> str:
+    if not isinstance(value, str) or value not in linkage.links:
+        known = ", ".join(linkage.links)
+        raise ModelError(f"{key} = {value!r} names no link (links: {known})", path=linkage.source, element=where)
+    return value
+
+
+def _direction(linkage: Linkage, reader: _Reader, spec: dict[str, Any], at: np.ndarray, where: str) -> np.ndarray:
+    """`along = "30 deg"` or `along = ["A", "B"]`: a unit direction in the world [-]."""
+    along = spec.get("along")
+    if along is None:
+        raise ModelError("has no line: give along = \"ANGLE\" or along = [\"P\", \"Q\"]", path=linkage.source,
+                         element=where)
+    if isinstance(along, list):
+        if len(along) != 2 or not all(isinstance(n, str) and n in linkage.points for n in along):
+            raise ModelError(f"along = {along!r} must name two joints of [joints]", path=linkage.source,
+                             element=where)
+        vector = linkage.points[along[1]] - linkage.points[along[0]]
+        if np.linalg.norm(vector) < 1e-12 * max(1.0, float(np.linalg.norm(at))):
+            raise ModelError(f"along = {along!r}: the two joints coincide, so they give no direction",
+                             path=linkage.source, element=where)
+        return vector / np.linalg.norm(vector)
+    phi = reader.angle(along, f"{where} along")
+    return np.array([math.cos(phi), math.sin(phi)])
+
+
+def _slider(linkage: Linkage, reader: _Reader, name: str, spec: Any) -> None:
+    """`S = {block = "piston", on = "ground", at = "B", along = "0 deg"}`: a prismatic pair."""
+    where = f"[sliders] {name}"
+    if not isinstance(spec, dict) or not set(spec) <= {"block", "on", "at", "along"}:
+        raise ModelError("a slider is {block = LINK, on = LINK, at = JOINT, along = ANGLE or [P, Q]}",
+                         path=linkage.source, element=where)
+    block = _link(linkage, spec.get("block"), "block", where)
+    on = _link(linkage, spec.get("on"), "on", where)
+    if block == on:
+        raise ModelError(f"block and on are the same link '{block}'", path=linkage.source, element=where)
+    at = spec.get("at")
+    if at not in linkage.links[block]:
+        raise ModelError(f"at = {at!r} must be a joint the block '{block}' lists", path=linkage.source,
+                         element=where)
+    edge = Edge(name, "prismatic", (on, block), linkage.points[at],
+                _direction(linkage, reader, spec, linkage.points[at], where))
+    linkage.edges.append(edge)
+    linkage.blocks[block] = edge
+
+
+def _slot(linkage: Linkage, reader: _Reader, name: str, spec: Any) -> None:
+    """`A = {pin = "crank", slot = "rocker", along = ["O4", "A"]}`: a pin sliding in a slot."""
+    where = f"[slots] {name}"
+    if not isinstance(spec, dict) or not set(spec) <= {"pin", "slot", "along"}:
+        raise ModelError("a pin-in-slot joint is {pin = LINK, slot = LINK, along = ANGLE or [P, Q]}",
+                         path=linkage.source, element=where)
+    pin_link = _link(linkage, spec.get("pin"), "pin", where)
+    slot_link = _link(linkage, spec.get("slot"), "slot", where)
+    if name not in linkage.points:
+        raise ModelError(f"the slot's pin '{name}' is not given in [joints]", path=linkage.source, element=where)
+    if name not in linkage.links[pin_link]:
+        raise ModelError(f"the pin '{name}' must be listed by its link '{pin_link}'", path=linkage.source,
+                         element=where)
+    at = linkage.points[name]
+    block = f"{name}_block"
+    linkage.links[block] = [name]
+    linkage.hidden.add(block)
+    linkage.edges.append(Edge(f"{name}_pin", "revolute", (pin_link, block), at))
+    edge = Edge(f"{name}_slide", "prismatic", (slot_link, block), at, _direction(linkage, reader, spec, at, where))
+    linkage.edges.append(edge)
+    linkage.blocks[block] = edge
+    linkage.point_links.pop(name, None)
+
+
+def _check_names(linkage: Linkage) -> None:
+    """Links, points and joints share one namespace in the URDF."""
+    seen: dict[str, str] = {}
+    for kind, names in (("link", linkage.links), ("point", linkage.point_links),
+                        ("joint", [e.name for e in linkage.edges])):
+        for name in names:
+            if name in seen and not (kind == "point" and seen[name] == "link"):
+                raise ModelError(f"'{name}' names both a {seen[name]} and a {kind}: rename one",
+                                 path=linkage.source)
+            seen.setdefault(name, kind)
+    for link, names in linkage.links.items():
+        if link != GROUND and not names:
+            raise ModelError("lists no joint", path=linkage.source, element=f"[links] {link}")
+
+
+# ------------------------------------------------------------------------- the tree
+@dataclass(frozen=True)
+class Tree:
+    """Spanning tree of the link graph: parent edge of each link, and the cut edges."""
+
+    order: list[str]
+    parent: dict[str, tuple[Edge, str]]
+    cuts: list[Edge]
+
+
+def spanning_tree(linkage: Linkage) -> Tree:
+    """Breadth first from the ground, slides before pins, so ground joints stay in the tree.
+
+    Raises:
+        ModelError: a link not connected to the ground through joints.
+    """
+    edges = sorted(linkage.edges, key=lambda e: e.kind != "prismatic")
+    seen, order, parent, used = {GROUND}, [GROUND], {}, set()
+    queue = deque([GROUND])
+    while queue:
+        link = queue.popleft()
+        for edge in edges:
+            if link not in edge.links:
+                continue
+            other = edge.links[1] if edge.links[0] == link else edge.links[0]
+            if other not in seen:
+                seen.add(other)
+                order.append(other)
+                parent[other] = (edge, link)
+                used.add(edge.name)
+                queue.append(other)
+    lost = [n for n in linkage.links if n not in seen]
+    if lost:
+        raise ModelError(f"link(s) {', '.join(lost)} are joined to the ground by no chain of joints",
+                         path=linkage.source, element="[links]")
+    return Tree(order, parent, [e for e in linkage.edges if e.name not in used])
+
+
+# ------------------------------------------------------------------------- URDF text
+@dataclass(frozen=True)
+class _Frame:
+    origin: np.ndarray  # world [m]
+    phi: float  # x axis angle in the world at the drawn pose [rad]
+
+    def local(self, p: np.ndarray) -> np.ndarray:
+        c, s = math.cos(self.phi), math.sin(self.phi)
+        d = p - self.origin
+        return np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1]])
+
+
+def _wrap(angle: float) -> float:
+    return math.atan2(math.sin(angle), math.cos(angle))
+
+
+def _xyz(p: np.ndarray, z: float = 0.0) -> str:
+    return f"{_num(p[0])} {_num(p[1])} {_num(z)}"
+
+
+def _num(x: float) -> str:
+    return repr(float(x)) if x != 0 else "0"
+
+
+def _frames(linkage: Linkage, tree: Tree) -> dict[str, _Frame]:
+    """Each link's frame: on its parent joint, x along its first bar (or along its slide)."""
+    frames = {GROUND: _Frame(np.zeros(2), 0.0)}
+    for link in tree.order[1:]:
+        edge, _ = tree.parent[link]
+        origin = edge.at
+        if link in linkage.blocks:
+            d = linkage.blocks[link].direction
+            phi = math.atan2(d[1], d[0])
+        else:
+            phi = 0.0
+            for name in linkage.links[link]:
+                vector = linkage.points[name] - origin
+                if np.linalg.norm(vector) > 1e-9 * _size(linkage):
+                    phi = math.atan2(vector[1], vector[0])
+                    break
+        frames[link] = _Frame(origin, phi)
+    return frames
+
+
+def _size(linkage: Linkage) -> float:
+    pts = np.array(list(linkage.points.values()))
+    return max(float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))), 1e-300)
+
+
+def linkage_urdf(linkage: Linkage) -> tuple[str, dict[str, float]]:
+    """The URDF text and each tree joint's coordinate at the drawn pose [rad or m]."""
+    tree = spanning_tree(linkage)
+    frames = _frames(linkage, tree)
+    size = _size(linkage)
+    lines = [f"<robot name={quoteattr(Path(linkage.source).stem)}>",
+             f"  <!-- generated by pinmech from {linkage.source}: edit that file, not this one -->",
+             '  <material name="ground"><color rgba="0.35 0.35 0.35 1"/></material>']
+    for i, colour in enumerate(_COLOURS):
+        lines.append(f'  <material name="c{i}"><color rgba="{colour} 1"/></material>')
+    reference: dict[str, float] = {}
+    for i, link in enumerate(tree.order):
+        lines += _link_xml(linkage, link, frames[link], size, i)
+    for link in tree.order[1:]:
+        edge, parent = tree.parent[link]
+        lines.append(_joint_xml(edge, parent, link, frames, reference, size))
+    for cut in tree.cuts:
+        lines.append(_cut_xml(cut, frames))
+    for name, link in linkage.point_links.items():
+        lines.append(f'  <link name={quoteattr(name)}/>')
+        lines.append(f'  <joint name={quoteattr("point_" + name)} type="fixed"><parent link={quoteattr(link)}/>'
+                     f'<child link={quoteattr(name)}/><origin xyz="{_xyz(frames[link].local(linkage.points[name]))}"/>'
+                     '</joint>')
+    lines.append("</robot>")
+    return "\n".join(lines) + "\n", reference
+
+
+def _joint_xml(edge: Edge, parent: str, child: str, frames: dict[str, _Frame], reference: dict[str, float],
+               size: float) -> str:
+    p, c = frames[parent], frames[child]
+    xyz = _xyz(p.local(edge.at))
+    head = f'  <joint name={quoteattr(edge.name)} type="{"continuous" if edge.kind == "revolute" else "prismatic"}">'
+    links = f"<parent link={quoteattr(parent)}/><child link={quoteattr(child)}/>"
+    if edge.kind == "revolute":
+        reference[edge.name] = _wrap(c.phi - p.phi)
+        return f'{head}{links}<origin xyz="{xyz}"/><axis xyz="0 0 1"/></joint>'
+    reference[edge.name] = 0.0
+    axis = c.local(c.origin + edge.direction)  # URDF axes are in the joint frame, turned by rpy
+    rpy = f"0 0 {_num(_wrap(c.phi - p.phi))}"
+    span = 1e3 * size
+    return (f'{head}{links}<origin xyz="{xyz}" rpy="{rpy}"/><axis xyz="{_xyz(axis)}"/>'
+            f'<limit lower="{_num(-span)}" upper="{_num(span)}" effort="0" velocity="0"/></joint>')
+
+
+def _cut_xml(cut: Edge, frames: dict[str, _Frame]) -> str:
+    a, b = cut.links
+    pa, pb = frames[a], frames[b]
+    if cut.kind == "revolute":
+        return (f'  <constraint name={quoteattr(cut.name)} type="revolute">'
+                f'<parent link={quoteattr(a)}/><parent_origin xyz="{_xyz(pa.local(cut.at))}"/>'
+                '<parent_axis xyz="0 0 1"/>'
+                f'<child link={quoteattr(b)}/><child_origin xyz="{_xyz(pb.local(cut.at))}"/>'
+                '<child_axis xyz="0 0 1"/></constraint>')
+    # slide cut: both cut frames world-aligned at the drawn pose, the line along the axis
+    axis = _xyz(cut.direction)
+    return (f'  <constraint name={quoteattr(cut.name)} type="prismatic">'
+            f'<parent link={quoteattr(a)}/><parent_origin xyz="{_xyz(pa.local(cut.at))}" '
+            f'rpy="0 0 {_num(-pa.phi)}"/><parent_axis xyz="{axis}"/>'
+            f'<child link={quoteattr(b)}/><child_origin xyz="{_xyz(pb.local(cut.at))}" '
+            f'rpy="0 0 {_num(-pb.phi)}"/><child_axis xyz="{axis}"/></constraint>')
+
+
+# ------------------------------------------------------------------------- visuals
+def _link_xml(linkage: Linkage, link: str, frame: _Frame, size: float, index: int) -> list[str]:
+    """A link with bars between its joints, pins, a block for a slider, a symbol for the ground."""
+    if link in linkage.hidden:
+        return [f"  <link name={quoteattr(link)}/>"]
+    width = 0.02 * size
+    material = "ground" if link == GROUND else f"c{(index - 1) % len(_COLOURS)}"
+    z = -width if link == GROUND else 0.4 * width * (index % 5)
+    names = linkage.links[link]
+    local = [frame.local(linkage.points[n]) for n in names]
+    shapes = []
+    if link == GROUND:
+        for p in local:
+            shapes.append((p, 0.0, f'<cylinder radius="{_num(0.9 * width)}" length="{_num(width)}"/>'))
+        for edge in linkage.edges:
+            if edge.kind == "prismatic" and GROUND in edge.links:
+                phi = math.atan2(edge.direction[1], edge.direction[0])
+                shapes.append((frame.local(edge.at), phi,
+                               f'<box size="{_num(0.5 * size)} {_num(0.3 * width)} {_num(0.3 * width)}"/>'))
+    else:
+        ring = local if len(local) > 2 else local[:2]
+        for i, p in enumerate(ring):
+            q = ring[(i + 1) % len(ring)]
+            if len(ring) == 2 and i == 1:
+                break
+            length = float(np.linalg.norm(q - p))
+            if length > 1e-9 * size:
+                shapes.append(((p + q) / 2, math.atan2(q[1] - p[1], q[0] - p[0]),
+                               f'<box size="{_num(length)} {_num(width)} {_num(0.5 * width)}"/>'))
+        if link in linkage.blocks:
+            shapes.append((frame.local(linkage.blocks[link].at), 0.0,
+                           f'<box size="{_num(3 * width)} {_num(1.5 * width)} {_num(width)}"/>'))
+        for p in local:
+            shapes.append((p, 0.0, f'<cylinder radius="{_num(0.6 * width)}" length="{_num(1.2 * width)}"/>'))
+    out = [f"  <link name={quoteattr(link)}>"]
+    if link != GROUND:
+        out.append('    <inertial><mass value="1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" '
+                   'iyz="0"/></inertial>')
+    for p, phi, geometry in shapes:
+        out.append(f'    <visual><origin xyz="{_xyz(p, z)}" rpy="0 0 {_num(phi)}"/><geometry>{geometry}</geometry>'
+                   f'<material name="{material}"/></visual>')
+    out.append("  </link>")
+    return out
+
+
+# ------------------------------------------------------------------------- loading
+def build_urdf(path: str | Path, output: str | Path) -> Linkage:
+    """`pinmech build`: write the URDF of a linkage file to `output` (whole, or not at all)."""
+    linkage = parse_linkage(path)
+    text, _ = linkage_urdf(linkage)
+    _write_whole(Path(output), text)
+    return linkage
+
+
+def _write_whole(path: Path, text: str) -> None:
+    """Write to a temporary file beside `path`, then rename: never a half-written URDF."""
+    import os
+    import tempfile
+
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent if str(path.parent) else ".")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as stream:
+            stream.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _cached_urdf(text: str) -> Path:
+    """The generated URDF in a per-user cache folder, named by its content (for drawings)."""
+    import hashlib
+    import os
+    import tempfile
+
+    folder = Path(tempfile.gettempdir()) / f"pinmech-{os.getuid() if hasattr(os, 'getuid') else 'user'}"
+    folder.mkdir(mode=0o700, exist_ok=True)
+    path = folder / f"linkage-{hashlib.sha256(text.encode()).hexdigest()[:20]}.urdf"
+    if not path.is_file() or path.read_text(encoding="utf-8") != text:
+        _write_whole(path, text)
+    return path
+
+
+def load_linkage(path: str | Path, *, locked: dict[str, float] | None = None):
+    """A linkage file as a Mechanism, its reference configuration the drawn pose.
+
+    Args:
+        path: the linkage file (TOML).
+        locked: joints to lock, name -> value [rad or m] (as `Mechanism.from_urdf`).
+
+    Raises:
+        ModelError: anything wrong in the file (one line naming the file and the key).
+    """
+    from pinmech.mechanism import Mechanism
+
+    linkage = parse_linkage(path)
+    text, reference = linkage_urdf(linkage)
+    urdf = _cached_urdf(text)
+    mech = Mechanism.from_urdf(urdf, locked=locked)
+    mech.source, mech.urdf_path = str(path), str(urdf)
+    q = pin_neutral(mech)
+    for name, value in reference.items():
+        if name in mech.joints:
+            mech.set_coordinate(q, name, value)
+    mech.reference = q
+    _check_closed(mech)
+    return mech
+
+
+def pin_neutral(mech) -> np.ndarray:
+    import pinocchio as pin
+
+    return pin.neutral(mech.model)
+
+
+def joint_kinds(path: str | Path) -> dict[str, str]:
+    """Joint name -> "revolute" or "prismatic" of a linkage file's tree and cut joints."""
+    linkage = parse_linkage(path)
+    return {e.name: e.kind for e in linkage.edges}
+
+
+def _check_closed(mech) -> None:
+    """The drawn pose closes every loop (a guard: it does by construction)."""
+    import pinocchio as pin
+
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, mech.reference)
+    for closure in mech.closures:
+        gap = float(np.max(np.abs(closure.residual(data)), initial=0.0))
+        if gap > 1e-9:
+            raise ModelError(f"loop cut {closure.name} is open by {gap:.3g} (relative) at the drawn pose",
+                             path=mech.source)
