@@ -9,8 +9,8 @@ URDF whose reference configuration is the drawn pose. See the README section
 `linkage_urdf` writes the URDF text.
 
 Conventions of the generated URDF (all in the plane z = 0, axes along z):
-  * every link's frame sits on its parent joint, its x axis along its first bar (towards
-    the next point the link lists), so a link's reported angle is the textbook phi;
+  * every link's frame sits on its parent joint, its x axis from the first point the link
+    lists to the next, so a link's reported angle is the textbook phi of that bar;
   * a pin's coordinate is the angle between the x axes of its two links [rad], a
     slider's the displacement of its block from the drawn position along the line [m];
   * `Linkage.reference` holds those coordinates at the drawn pose: the default guess.
@@ -403,7 +403,7 @@ def _num(x: float) -> str:
 
 
 def _frames(linkage: Linkage, tree: Tree) -> dict[str, _Frame]:
-    """Each link's frame: on its parent joint, x along its first bar (or along its slide)."""
+    """Each link's frame: on its parent joint, x from its first listed point to the next (a block: its slide)."""
     frames = {GROUND: _Frame(np.zeros(2), 0.0)}
     for link in tree.order[1:]:
         edge, _ = tree.parent[link]
@@ -412,9 +412,11 @@ def _frames(linkage: Linkage, tree: Tree) -> dict[str, _Frame]:
             d = linkage.blocks[link].direction
             phi = math.atan2(d[1], d[0])
         else:
+            names = linkage.links[link]
+            first = linkage.points[names[0]]
             phi = 0.0
-            for name in linkage.links[link]:
-                vector = linkage.points[name] - origin
+            for name in names[1:]:
+                vector = linkage.points[name] - first
                 if np.linalg.norm(vector) > 1e-9 * _size(linkage):
                     phi = math.atan2(vector[1], vector[0])
                     break

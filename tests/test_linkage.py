@@ -1,0 +1,304 @@
+"""Linkages written as drawn: the generated URDF moves as the closed forms and hand URDFs say.
+
+Every expected number comes from scripts/closed_form.py (Norton's four-bar, the offset
+slider-crank, the R-RTR) or from a circle-intersection chain written here, never from the
+linkage module. Poses are followed from the drawn pose in steps of 10-30 deg, each solve
+started at the last one, so the branch is the drawn one.
+
+Tolerances: loops close to 1e-13 of the mechanism's size (~0.1-0.2 m), and away from
+toggle poses the condition numbers stay below 1e3, so positions agree to ~1e-13 m and rates
+to ~1e-12 relative; we allow 1e-10 m for positions and 1e-9 relative (to the largest value
+over the cycle) for angles, rates and accelerations. A wrong branch, sign or missing term
+is off by 1e-3 or more.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from pinmech import Mechanism
+from pinmech.exceptions import ModelError
+from pinmech.linkage import load_linkage, parse_linkage, linkage_urdf
+from pinmech.motion import evaluate_motion
+from pinmech.solve_loops import LoopSolver
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
+import closed_form as cf  # noqa: E402
+
+LINKAGES = Path(__file__).resolve().parents[1] / "models" / "linkages"
+POS_TOL = 1e-10  # [m]
+REL_TOL = 1e-9
+
+
+def follow(mech: Mechanism, driver: str, values, omega: float, alpha: float = 0.0, *, start=None,
+           points=None, links=None):
+    """Solve at each driver value in turn, each started at the last pose; the motions."""
+    solver = LoopSolver(mech, [driver])
+    q = mech.neutral() if start is None else start
+    out = []
+    for value in values:
+        sol = solver.solve([value], [omega], [alpha], guess=q)
+        q = sol.q
+        out.append(evaluate_motion(mech, solver.data, sol.q, sol.v, sol.a, points=points, links=links))
+    return out
+
+
+def path_to(first: float, values) -> list[float]:
+    """Steps of at most 15 deg from `first` through every value in turn."""
+    out, last = [], first
+    for value in values:
+        n = max(1, int(math.ceil(abs(value - last) / math.radians(15))))
+        out += list(np.linspace(last, value, n + 1)[1:])
+        last = value
+    return out
+
+
+def angle_close(actual, expected, scale, label):
+    diff = np.angle(np.exp(1j * (np.asarray(actual) - np.asarray(expected))))
+    np.testing.assert_allclose(diff, 0.0, atol=REL_TOL * max(scale, 1.0), err_msg=label)
+
+
+def circle(a, b, ra, rb, sign):
+    """The point at ra from a and rb from b, left (+1) or right (-1) of a -> b."""
+    d = np.linalg.norm(b - a)
+    u = (b - a) / d
+    x = (d * d + ra * ra - rb * rb) / (2 * d)
+    return a + x * u + sign * math.sqrt(ra * ra - x * x) * np.array([-u[1], u[0]])
+
+
+# ------------------------------------------------------------------- four-bar
+THETAS = np.radians([0.0, 30.0, 60.0, 95.0, 150.0, 200.0, 260.0, 330.0])
+
+
+def test_four_bar_drawn_matches_norton_and_the_hand_urdf(models_dir):
+    mech = load_linkage(LINKAGES / "four_bar.toml")
+    values = path_to(0.0, THETAS)
+    motions = follow(mech, "O2", values, omega=12.0, alpha=3.0, points=["P"])
+    hand = Mechanism.from_urdf(models_dir / "four_bar.urdf")
+    guess = hand.neutral()
+    hand.set_coordinate(guess, "A", math.radians(40))
+    hand.set_coordinate(guess, "O4", math.radians(100))
+    hand_motions = follow(hand, "O2", values, omega=12.0, alpha=3.0, start=guess, points=["P"])
+    ref = cf.four_bar(np.array(values), 12.0, 3.0, 0.04, 0.12, 0.08, 0.10, branch=+1)
+    for k, (m, h) in enumerate(zip(motions, hand_motions)):
+        angle_close(m.links["coupler"].angle, ref.theta3[k], 1, "theta3")
+        angle_close(m.links["rocker"].angle, ref.theta4[k], 1, "theta4")
+        np.testing.assert_allclose(m.links["coupler"].angular_velocity[2], ref.omega3[k],
+                                   atol=REL_TOL * np.max(np.abs(ref.omega3)))
+        np.testing.assert_allclose(m.links["rocker"].angular_acceleration[2], ref.alpha4[k],
+                                   atol=REL_TOL * np.max(np.abs(ref.alpha4)))
+        # P is drawn at (100, 30) mm, so on the hand URDF's coupler it sits elsewhere:
+        # compare P through the coupler's own frame (A, theta3) instead.
+        A = ref.A[k]
+        P0 = np.array([0.100, 0.030]) - np.array([0.04, 0.0])
+        theta3_0 = cf.four_bar(0.0, 0.0, 0.0, 0.04, 0.12, 0.08, 0.10).theta3
+        turn = ref.theta3[k] - theta3_0
+        R = np.array([[math.cos(turn), -math.sin(turn)], [math.sin(turn), math.cos(turn)]])
+        np.testing.assert_allclose(m.points["P"].position[:2], A + R @ P0, atol=POS_TOL)
+        for name in ("coupler", "rocker"):
+            np.testing.assert_allclose(m.links[name].angular_velocity, h.links[name].angular_velocity,
+                                       atol=REL_TOL * 20)
+
+
+def test_drawn_pose_is_the_reference_and_closes():
+    mech = load_linkage(LINKAGES / "four_bar.toml")
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, mech.neutral())
+    ref = cf.four_bar(0.0, 0.0, 0.0, 0.04, 0.12, 0.08, 0.10)
+    for closure in mech.closures:
+        np.testing.assert_allclose(closure.residual(data), 0.0, atol=1e-14)
+    assert mech.coordinate(mech.neutral(), "O4") == pytest.approx(ref.theta4, abs=1e-14)
+    assert mech.mobility == 1 and [c.rows for c in mech.closures] == [2]
+
+
+# ------------------------------------------------------------------- slider-cranks
+def test_offset_slider_crank_matches_closed_form():
+    mech = load_linkage(LINKAGES / "slider_crank.toml")
+    values = path_to(0.0, np.radians([40.0, 120.0, 210.0, 300.0]))
+    motions = follow(mech, "O", values, omega=-5.0, alpha=2.0, links=["rod"])
+    ref = cf.slider_crank(np.array(values), -5.0, 2.0, r=0.04, l=0.13, e=0.05)
+    x = np.array([0.160 + m.joints["slide"].q for m in motions])
+    np.testing.assert_allclose(x, ref.x_B, atol=POS_TOL)
+    np.testing.assert_allclose([m.joints["slide"].v for m in motions], ref.v_B, atol=REL_TOL)
+    np.testing.assert_allclose([m.joints["slide"].a for m in motions], ref.a_B, atol=REL_TOL * 10)
+    angle_close([m.links["rod"].angle for m in motions], ref.beta, 1, "beta")
+
+
+def test_inverted_slider_crank_matches_r_rtr_closed_form_and_hand_urdf(models_dir):
+    mech = load_linkage(LINKAGES / "inverted_slider_crank.toml")
+    values = path_to(math.pi / 2, np.radians([150.0, 240.0, 330.0, 420.0]))
+    motions = follow(mech, "A", values, omega=3.0, alpha=-1.0, points=["D"], links=["guide"])
+    ref = cf.r_rtr(np.array(values), 3.0, -1.0)
+    angle_close([m.links["guide"].angle for m in motions], ref.phi3, 1, "phi3")
+    np.testing.assert_allclose([m.points["D"].position[:2] for m in motions], ref.D, atol=POS_TOL)
+    np.testing.assert_allclose([m.points["D"].velocity[:2] for m in motions], ref.vD,
+                               atol=REL_TOL * np.max(np.abs(ref.vD)))
+    np.testing.assert_allclose([m.points["D"].acceleration[:2] for m in motions], ref.aD,
+                               atol=REL_TOL * np.max(np.abs(ref.aD)))
+    np.testing.assert_allclose([m.links["guide"].angular_acceleration[2] for m in motions], ref.alpha3,
+                               atol=REL_TOL * np.max(np.abs(ref.alpha3)))
+
+
+# ------------------------------------------------------------------- six-bars
+def _six_bar_reference(kind: str, theta2: float):
+    """D and link 6's angle of the Watt or Stephenson file, from Norton and one circle."""
+    fb = cf.four_bar(theta2, 0.0, 0.0, 0.04, 0.12, 0.08, 0.10, branch=+1)
+    fb0 = cf.four_bar(0.0, 0.0, 0.0, 0.04, 0.12, 0.08, 0.10, branch=+1)
+    if kind == "watt":
+        O4, O6 = np.array([0.1, 0.0]), np.array([0.19, 0.03])
+        B0 = fb0.B
+        C0 = circle(O4, B0, 0.06, 0.05, -1)
+        turn = fb.theta4 - fb0.theta4
+        C = O4 + _rot(turn) @ (C0 - O4)
+        D = circle(C, O6, 0.09, 0.07, +1)
+    else:
+        O6 = np.array([0.16, 0.11])
+        C0 = circle(fb0.A, fb0.B, 0.07, 0.07, +1)
+        C = fb.A + _rot(fb.theta3 - fb0.theta3) @ (C0 - fb0.A)
+        D = circle(C, O6, 0.08, 0.06, +1)
+    return C, D
+
+
+def _rot(t):
+    return np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
+
+
+@pytest.mark.parametrize("kind", ["watt", "stephenson"])
+def test_six_bars_match_four_bar_plus_dyad(kind, tmp_path):
+    mech = load_linkage(LINKAGES / f"{kind}.toml")
+    assert mech.mobility == 1 and len(mech.closures) == 2
+    values = path_to(0.0, np.radians([25.0, 50.0, 75.0]))
+    solver = LoopSolver(mech, ["O2"])
+    q = mech.neutral()
+    data = solver.data
+    link6 = mech.links["link6"]
+    for value in values:
+        sol = solver.solve([value], [0.0], [0.0], guess=q)
+        q = sol.q
+        pin.framesForwardKinematics(mech.model, data, q)
+        C, D = _six_bar_reference(kind, value)
+        # link6's frame sits on O6 with x towards D (its first bar), so D is at |O6 D| along x
+        O6 = data.oMf[link6].translation[:2]
+        x_axis = data.oMf[link6].rotation[:2, 0]
+        length = 0.07 if kind == "watt" else 0.06
+        np.testing.assert_allclose(O6 + length * x_axis, D, atol=POS_TOL)
+
+
+# ------------------------------------------------------------------- Jansen
+JANSEN = dict(a=38, b=41.5, c=39.3, d=40.1, e=55.8, f=39.4, g=36.7, h=65.7, i=49, j=50, k=61.9, l=7.8, m=15)
+
+
+def jansen_foot(theta: float) -> np.ndarray:
+    """The foot G [m] at crank angle theta, by compass from the holy numbers (mm)."""
+    n = {k: v / 1000 for k, v in JANSEN.items()}
+    B = np.array([-n["a"], -n["l"]])
+    A = n["m"] * np.array([math.cos(theta), math.sin(theta)])
+    C = circle(A, B, n["j"], n["b"], -1)
+    D = circle(A, B, n["k"], n["c"], +1)
+    E = circle(B, C, n["d"], n["e"], +1)
+    F = circle(E, D, n["f"], n["g"], -1)
+    return circle(F, D, n["h"], n["i"], -1)
+
+
+def test_jansen_foot_follows_the_compass_construction_over_a_turn():
+    mech = load_linkage(LINKAGES / "jansen.toml")
+    assert mech.mobility == 1 and len(mech.closures) == 3
+    thetas = np.radians(np.arange(15.0, 361.0, 15.0))
+    omega = 2 * math.pi  # one turn a second
+    motions = follow(mech, "O", thetas, omega=omega, points=["G"])
+    foot = np.array([jansen_foot(t) for t in thetas])
+    np.testing.assert_allclose([m.points["G"].position[:2] for m in motions], foot, atol=POS_TOL)
+    # velocity: central difference of the construction, h = 1e-6 rad: truncation
+    # h^2/6 |G'''| ~ 1e-13 m/rad^3 * ..., round-off 1e-16 m / 1e-6 ~ 1e-10 m/s
+    h = 1e-6
+    fd = np.array([(jansen_foot(t + h) - jansen_foot(t - h)) / (2 * h) * omega for t in thetas])
+    np.testing.assert_allclose([m.points["G"].velocity[:2] for m in motions], fd, atol=1e-7)
+    # the foot's path: its lowest point and the stride along it, from the construction
+    assert min(p[1] for p in foot) == pytest.approx(min(m.points["G"].position[1] for m in motions), abs=POS_TOL)
+
+
+def test_jansen_file_is_short():
+    lines = [line for line in (LINKAGES / "jansen.toml").read_text().splitlines() if line.strip()]
+    assert len(lines) < 30
+
+
+# ------------------------------------------------------------------- errors
+BASE = """ground = ["O2", "O4"]
+[joints]
+O2 = ["0 mm", "0 mm"]
+O4 = ["100 mm", "0 mm"]
+A = ["40 mm", "0 mm"]
+B = { from = ["A", "O4"], lengths = ["120 mm", "80 mm"], side = "left" }
+[links]
+crank = ["O2", "A"]
+coupler = ["A", "B"]
+rocker = ["O4", "B"]
+"""
+
+
+@pytest.mark.parametrize("change, words", [
+    (('A = ["40 mm", "0 mm"]', 'A = ["40", "0 mm"]'), ["[joints] A x", "no unit"]),
+    (('crank = ["O2", "A"]', 'crank = ["O2", "Z"]'), ["[links] crank", "'Z'"]),
+    (('"120 mm", "80 mm"', '"20 mm", "30 mm"'), ["[joints] B", "do not meet", "0.02", "0.03"]),
+    (('A = ["40 mm", "0 mm"]', 'A = ["crank_len", "0 mm"]'), ["[joints] A x", "crank_len", "params"]),
+    (('ground = ["O2", "O4"]', 'ground = "O2"'), ["ground", "list"]),
+    (('side = "left"', 'side = "up"'), ["[joints] B", "side"]),
+    (('rocker = ["O4", "B"]', 'rocker = ["O4", "B"]\nfloating = ["X"]\n[joints.X]'), ["malformed TOML"]),
+    (('[links]', 'colour = 1\n[links]'), ["[joints] colour"]),
+    (('rocker = ["O4", "B"]', 'rocker = ["O4", "B"]\nloose = ["Q", "R"]'), ["Q"]),
+])
+def test_errors_name_file_key_and_numbers(tmp_path, change, words):
+    path = tmp_path / "bad.toml"
+    old, new = change
+    assert old in BASE
+    path.write_text(BASE.replace(old, new, 1))
+    with pytest.raises(ModelError) as err:
+        load_linkage(path)
+    message = str(err.value)
+    assert str(path) in message and "\n" not in message
+    for word in words:
+        assert word in message, message
+
+
+def test_slider_without_a_line_and_unconnected_link(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text((LINKAGES / "slider_crank.toml").read_text().replace(', along = "0 deg"', ""))
+    with pytest.raises(ModelError, match=r"\[sliders\] slide.*no line"):
+        load_linkage(path)
+    text = BASE.replace("[links]", 'P1 = ["0 mm", "50 mm"]\nP2 = ["10 mm", "50 mm"]\n[links]') + 'lone = ["P1", "P2"]\n'
+    path.write_text(text)
+    with pytest.raises(ModelError, match="lone.*joined to the ground by no chain"):
+        load_linkage(path)
+
+
+def test_missing_file_and_unknown_key(tmp_path):
+    with pytest.raises(ModelError, match="no such linkage file"):
+        load_linkage(tmp_path / "none.toml")
+    path = tmp_path / "k.toml"
+    path.write_text("linkz = 1\n" + BASE)
+    with pytest.raises(ModelError, match="unknown key.*linkz"):
+        load_linkage(path)
+
+
+def test_params_vary_the_design(tmp_path):
+    """A named parameter moves every coordinate that uses it: crank 40 -> 30 mm."""
+    text = BASE.replace('ground = ["O2", "O4"]', 'ground = ["O2", "O4"]\nparams = { r = "30 mm" }')
+    path = tmp_path / "p.toml"
+    path.write_text(text.replace('A = ["40 mm", "0 mm"]', 'A = ["r", "0 mm"]'))
+    mech = load_linkage(path)
+    motion = follow(mech, "O2", [0.5], omega=1.0, links=["rocker"])[0]
+    ref = cf.four_bar(0.5, 1.0, 0.0, 0.03, 0.12, 0.08, 0.10, branch=+1)
+    angle_close(motion.links["rocker"].angle, ref.theta4, 1, "theta4")
+
+
+def test_urdf_text_is_valid_for_pinocchio_alone():
+    """The generated URDF builds in Pinocchio without pinmech: a user can take it elsewhere."""
+    text, reference = linkage_urdf(parse_linkage(LINKAGES / "jansen.toml"))
+    model = pin.buildModelFromXML(text)
+    assert model.nv == 7 and set(reference) <= set(model.names)
