@@ -249,7 +249,7 @@ rocker = ["O4", "B"]
     (('A = ["40 mm", "0 mm"]', 'A = ["crank_len", "0 mm"]'), ["[joints] A x", "crank_len", "params"]),
     (('ground = ["O2", "O4"]', 'ground = "O2"'), ["ground", "list"]),
     (('side = "left"', 'side = "up"'), ["[joints] B", "side"]),
-    (('rocker = ["O4", "B"]', 'rocker = ["O4", "B"]\nfloating = ["X"]\n[joints.X]'), ["malformed TOML"]),
+    (('rocker = ["O4", "B"]', 'rocker = ["O4", "B"]\nfloating = ["X"]\n[joints.X]'), ["[joints] X", "construction"]),
     (('[links]', 'colour = 1\n[links]'), ["[joints] colour"]),
     (('rocker = ["O4", "B"]', 'rocker = ["O4", "B"]\nloose = ["Q", "R"]'), ["Q"]),
 ])
