@@ -118,6 +118,11 @@ def build_parser() -> argparse.ArgumentParser:
     _add_scene_arguments(live)
     live.set_defaults(func=cmd_view)
 
+    build = sub.add_parser("build", help="write the URDF (with <constraint> loop cuts) of a linkage drawn in TOML")
+    build.add_argument("linkage", help="linkage file (TOML), e.g. models/linkages/jansen.toml")
+    build.add_argument("-o", "--output", required=True, help="the URDF file to write")
+    build.set_defaults(func=cmd_build)
+
     check = sub.add_parser("check", help="compare hand-calculated values with pinmech")
     check.add_argument("hand_file", help="hand-value file (TOML), e.g. models/scenes/r_rtr.hand.toml")
     check.add_argument("--slack", type=float, default=None,
@@ -380,6 +385,20 @@ def cmd_animate(args: argparse.Namespace) -> int:
     mechanism = sweep.mechanism
     _write(args.output, animation_html(mechanism.model, _visuals(mechanism), qs, fps=args.fps,
                                        plane_normal=mechanism.plane_normal, show_grid=not args.no_grid))
+    return 0
+
+
+def cmd_build(args: argparse.Namespace) -> int:
+    """`pinmech build LINKAGE -o FILE.urdf`: the URDF of a drawn linkage, written whole or not at all."""
+    from pinmech.linkage import build_urdf, spanning_tree
+
+    try:
+        linkage = build_urdf(args.linkage, args.output)
+    except OSError as exc:
+        raise PinmechError(f"cannot write {args.output}: {exc.strerror or exc}") from exc
+    cuts = [edge.name for edge in spanning_tree(linkage).cuts]
+    print(f"{args.output} written: {len(linkage.links) - 1} links, {len(linkage.edges) - len(cuts)} tree joints, "
+          f"loop cuts: {', '.join(cuts) or 'none'}")
     return 0
 
 
