@@ -56,7 +56,9 @@ def load_mechanism(scene: Scene) -> Mechanism:
         locked[name] = scene.quantity(value, _kind(types, name), "lock", name)
     if "move" in scene.raw:
         locked.update(_locked_by_move(scene, types, locked))
-    return loader.load(locked)
+    mechanism = loader.load(locked)
+    add_scene_points(scene, mechanism)
+    return mechanism
 
 
 @dataclass(frozen=True)
@@ -160,10 +162,36 @@ def coincident_points(scene: Scene) -> list[CoincidentPoint]:
     out = []
     for name, spec in scene.section("points").items():
         if not isinstance(spec, dict) or set(spec) != {"at", "link"}:
-            raise SceneError("a coincident point needs exactly at = \"POINT\" and link = \"LINK\"",
+            raise SceneError("a point needs exactly at = \"POINT\" (the point of LINK under it) or at = [x, y, z] "
+                             "(coordinates in LINK's frame, with units), and link = \"LINK\"",
                              path=str(scene.path), key=f"points.{name}")
-        out.append(CoincidentPoint(name, str(spec["at"]), str(spec["link"])))
+        if not isinstance(spec["at"], list):
+            out.append(CoincidentPoint(name, str(spec["at"]), str(spec["link"])))
     return out
+
+
+def add_scene_points(scene: Scene, mechanism: Mechanism) -> None:
+    """`[points.P] link = "coupler", at = ["60 mm", "30 mm", "0 mm"]`: a point fixed on a link.
+
+    The coordinates are in the link's frame (for a drawn linkage: origin on its parent
+    joint, x from its first listed point to the next). Adds the point to the mechanism.
+    """
+    for name, spec in scene.section("points").items():
+        if not isinstance(spec, dict) or not isinstance(spec.get("at"), list):
+            continue
+        key = f"points.{name}"
+        at = spec["at"]
+        if len(at) != 3:
+            raise SceneError(f"at = {at!r} must be three coordinates [x, y, z] with units", path=str(scene.path),
+                             key=key)
+        xyz = [scene.quantity(value, "length", "points", name, "at") for value in at]
+        link = str(spec["link"])
+        if link not in mechanism.links:
+            raise FrameNotFound(f"link (in [points.{name}])", link, list(mechanism.links), path=str(scene.path))
+        if name in mechanism.points or mechanism.model.existFrame(name):
+            raise SceneError(f"the model already has a frame called '{name}': name the point otherwise",
+                             path=str(scene.path), key=key)
+        mechanism.add_point(name, link, np.array(xyz))
 
 
 def report_lists(scene: Scene) -> tuple[list[str] | None, list[str] | None]:

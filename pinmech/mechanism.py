@@ -157,6 +157,18 @@ class Mechanism:
         mech.plane_normal = _plane_normal(mech)
         return mech
 
+    def add_point(self, name: str, link: str, xyz: np.ndarray) -> int:
+        """Fix a named point on a link, at `xyz` [m] in the link's frame; its frame id.
+
+        Call before creating solvers: a `pin.Data` made earlier lacks the new frame.
+        """
+        body_id = self.links[link]
+        body = self.model.frames[body_id]
+        frame = pin.Frame(name, body.parentJoint, body_id, body.placement * pin.SE3(np.eye(3), np.asarray(xyz, float)),
+                          pin.FrameType.OP_FRAME)
+        self.points[name] = self.model.addFrame(frame, False)
+        return self.points[name]
+
     # ---------------------------------------------------------------- look-ups
     def joint(self, name: str) -> JointInfo:
         """The joint called `name`; FrameNotFound lists the known ones otherwise."""
