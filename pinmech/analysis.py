@@ -140,10 +140,16 @@ def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
         values.append(row)
     if len(names) != mechanism.mobility:
         given = ", ".join(names) or "none"
+        idle = ""
+        if len(names) < mechanism.mobility:
+            free = mechanism.idle_joints(names)
+            if free:
+                idle = (f"; with those held, {', '.join(free)} can still move (a joint spinning freely, as a rod "
+                        f"about its own axis): lock it under [lock] or drive it")
         raise MobilityError(f"{scene.path}, drivers: {mechanism.source} has mobility {mechanism.mobility} "
-                            f"({mechanism.model.nv} joint freedoms, {mechanism.constraint_rows} independent closure "
-                            f"equations): drive that many joints; the scene drives {len(names)} ({given})",
-                            mobility=mechanism.mobility, drivers=len(names))
+                            f"({mechanism.model.nv} joint freedoms, {mechanism.rank_report().rank} independent "
+                            f"closure equations): drive that many joints; the scene drives {len(names)} ({given})"
+                            f"{idle}", mobility=mechanism.mobility, drivers=len(names))
     arr = np.array(values, dtype=float).reshape(-1, 3)
     return Drivers(tuple(names), arr[:, 0].copy(), arr[:, 1].copy(), arr[:, 2].copy())
 

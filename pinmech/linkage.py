@@ -589,21 +589,13 @@ def load_linkage(path: str | Path, *, locked: dict[str, float] | None = None):
     linkage = parse_linkage(path)
     text, reference = linkage_urdf(linkage)
     urdf = _cached_urdf(text)
-    mech = Mechanism.from_urdf(urdf, locked=locked)
+    try:
+        mech = Mechanism.from_urdf(urdf, locked=locked, reference=reference)
+    except ModelError as exc:  # name the user's file, not the generated one
+        raise ModelError(str(exc).replace(str(urdf), str(path)), path=None) from exc
     mech.source, mech.urdf_path = str(path), str(urdf)
-    q = pin_neutral(mech)
-    for name, value in reference.items():
-        if name in mech.joints:
-            mech.set_coordinate(q, name, value)
-    mech.reference = q
     _check_closed(mech)
     return mech
-
-
-def pin_neutral(mech) -> np.ndarray:
-    import pinocchio as pin
-
-    return pin.neutral(mech.model)
 
 
 def joint_kinds(path: str | Path) -> dict[str, str]:

@@ -91,6 +91,7 @@ class Mechanism:
     locked: dict[str, float] = field(default_factory=dict)
     urdf_path: str | None = None
     reference: np.ndarray | None = None
+    _rank: object = field(default=None, repr=False, compare=False)
 
     # ---------------------------------------------------------------- construction
     @classmethod
@@ -101,6 +102,7 @@ class Mechanism:
         locked: dict[str, float] | None = None,
         package_dirs: list[str] | None = None,
         root_joint: str | None = None,
+        reference: dict[str, float] | None = None,
     ) -> Mechanism:
         """Load a URDF with its `<constraint>` loop cuts.
 
@@ -114,6 +116,8 @@ class Mechanism:
                 (a floating base, joint "root_joint", nq 7 / nv 6, as example-robot-data
                 builds humanoids). A free flyer cannot be locked by one value: leave it
                 out (None) when a scene holds the base still.
+            reference: joint name -> coordinate [rad or m] of a closed reference pose (a
+                linkage's drawn pose); the others stay at zero. Default: all zero.
 
         Raises:
             ModelError: malformed XML or URDF, or a malformed `<constraint>`.
@@ -155,7 +159,28 @@ class Mechanism:
         mech.closures = [_make_closure(model, c, mech.length_scale) for c in cuts]
         _reduce_rows(mech)
         mech.plane_normal = _plane_normal(mech)
+        if reference:
+            q = pin.neutral(model)
+            for name, value in reference.items():
+                if name in mech.joints:
+                    mech.set_coordinate(q, name, value)
+            mech.reference = q
+        mech.check_independent()
         return mech
+
+    def check_independent(self) -> None:
+        """Refuse loops whose equations repeat each other: the loop solver needs them independent.
+
+        Raises:
+            ModelError: naming the cuts, the row count, the rank and the true mobility.
+        """
+        report = self.rank_report()
+        if report.rank < report.rows:
+            names = ", ".join(report.redundant) or ", ".join(c.name for c in self.closures)
+            raise ModelError(f"the loop cuts {names} repeat each other's equations ({report.rows} closure rows of "
+                             f"rank {report.rank} on the closed poses), so the mobility is {self.mobility}, "
+                             f"not {self.model.nv - report.rows}; pinmech's loop solver needs independent "
+                             f"equations: remove one of {names} (it closes by itself)", path=self.source)
 
     def add_point(self, name: str, link: str, xyz: np.ndarray) -> int:
         """Fix a named point on a link, at `xyz` [m] in the link's frame; its frame id.
@@ -203,8 +228,27 @@ class Mechanism:
 
     @property
     def mobility(self) -> int:
-        """Degrees of freedom left once every loop is closed (Gruebler, from ranks)."""
-        return self.model.nv - self.constraint_rows
+        """Degrees of freedom left once every loop is closed.
+
+        The joint freedoms minus the rank of the closure rows on the closed poses near the
+        reference configuration (see `pinmech.mobility`): loops that repeat each other
+        (a double parallelogram) do not lower it twice.
+        """
+        return self.model.nv - self.rank_report().rank
+
+    def rank_report(self):
+        """The closure rows' rank on closed poses (computed once, then kept)."""
+        if self._rank is None:
+            from pinmech.mobility import constraint_rank
+
+            self._rank = constraint_rank(self)
+        return self._rank
+
+    def idle_joints(self, drivers: list[str]) -> list[str]:
+        """Joints the loops leave free to move while `drivers` are held (a spinning rod)."""
+        from pinmech.mobility import idle_joints
+
+        return idle_joints(self, drivers, self.rank_report().q)
 
     def velocity_scale(self) -> np.ndarray:
         """Per degree of freedom: the length scale for prismatic joints, 1 for the others.
