@@ -336,7 +336,12 @@ def _visuals(mechanism):
     """The mechanism's visual geometry, built only when drawing."""
     from pinmech.draw import load_visuals
 
-    return load_visuals(mechanism.urdf_path or mechanism.source, mechanism.model)
+    path = mechanism.urdf_path or mechanism.source
+    if str(path).endswith(".xml"):
+        from pinmech.mjcf import mjcf_visuals
+
+        return mjcf_visuals(path, mechanism.model)
+    return load_visuals(path, mechanism.model)
 
 
 def cmd_snapshot(args: argparse.Namespace) -> int:

@@ -19,8 +19,10 @@ import os
 import sys
 import tempfile
 import xml.etree.ElementTree as ET
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -165,6 +167,66 @@ class Mechanism:
                 if name in mech.joints:
                     mech.set_coordinate(q, name, value)
             mech.reference = q
+        mech.check_independent()
+        return mech
+
+    @classmethod
+    def from_model(
+        cls,
+        model: pin.Model,
+        constraints: Sequence[Any] = (),
+        *,
+        names: Sequence[str] | None = None,
+        points: Sequence[str] | None = None,
+        source: str = "<model>",
+        reference: np.ndarray | None = None,
+        urdf_path: str | None = None,
+    ) -> Mechanism:
+        """A mechanism from a `pin.Model` and Pinocchio constraint models, as built in code.
+
+        Args:
+            model: the kinematic tree (copied: frames are added to the copy, not to it).
+            constraints: `pin.PointAnchorConstraintModel` (a ball joint: spherical cut),
+                `pin.FrameAnchorConstraintModel` (a weld: fixed cut), or the legacy
+                `pin.RigidConstraintModel` of type CONTACT_3D or CONTACT_6D.
+            names: the loop cuts' names (default: each constraint's name, else "loop1", ...).
+            points: frames reported as named points (default: every OP_FRAME, e.g. MJCF sites).
+            source: what to call the model in messages (its file).
+            reference: a configuration at which the loops close (default: neutral).
+            urdf_path: a URDF with the visuals, if any (for drawings).
+
+        Raises:
+            ModelError: an unknown constraint class or type, a joint id out of range.
+        """
+        model = pin.Model(model)
+        cuts = [_anchor_cut(c, i, names, model, source) for i, c in enumerate(constraints)]
+        listed = [c.name for c in cuts]
+        for name in listed:
+            if listed.count(name) > 1:
+                raise ModelError(f"two constraints share the name '{name}'", path=source)
+        bodies = [f.name for f in model.frames if f.type == pin.FrameType.BODY]
+        joint_links = {}
+        for jid in range(1, model.njoints):
+            child = next((f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == jid),
+                         model.names[jid])
+            parent = next((f.name for f in model.frames if f.type == pin.FrameType.BODY
+                           and f.parentJoint == model.parents[jid]), "universe")
+            joint_links[model.names[jid]] = (parent, child)
+        if points is None:
+            points = [f.name for f in model.frames if f.type == pin.FrameType.OP_FRAME]
+        mech = cls(model=model, closures=[], joints=_joint_infos(model, joint_links),
+                   links={n: _body_frame(model, n) for n in bodies},
+                   points={n: model.getFrameId(n) for n in points}, length_scale=1.0, plane_normal=None,
+                   source=source, urdf_path=urdf_path)
+        mech.length_scale = _length_scale(model, source)
+        mech.closures = [_anchor_closure(model, cut, mech.length_scale) for cut in cuts]
+        _reduce_rows(mech)
+        mech.plane_normal = _plane_normal(mech)
+        if reference is not None:
+            mech.reference = np.array(reference, dtype=float)
+            if mech.reference.shape != (model.nq,):
+                raise ModelError(f"reference has {mech.reference.size} coordinates, the model nq = {model.nq}",
+                                 path=source)
         mech.check_independent()
         return mech
 
@@ -501,6 +563,53 @@ def _make_closure(model: pin.Model, cut: _Cut, length_scale: float) -> Closure:
         frame_ids.append(model.addFrame(frame, False))
     return Closure(cut.name, cut.cut_type, frame_ids[0], frame_ids[1], cut.parent_axis, cut.child_axis,
                    parent_link=cut.parent_link, child_link=cut.child_link, length_scale=length_scale)
+
+
+@dataclass(frozen=True)
+class _AnchorCut:
+    """A loop cut given by two joints and a placement on each (Pinocchio's constraint models)."""
+
+    name: str
+    cut_type: str
+    joint1: int
+    placement1: pin.SE3
+    joint2: int
+    placement2: pin.SE3
+
+
+_ANCHOR_TYPES = {"PointAnchorConstraintModel": "spherical", "FrameAnchorConstraintModel": "fixed"}
+
+
+def _anchor_cut(constraint: Any, index: int, names: Sequence[str] | None, model: pin.Model, source: str) -> _AnchorCut:
+    kind = type(constraint).__name__
+    if kind == "RigidConstraintModel":
+        cut_type = {pin.ContactType.CONTACT_3D: "spherical", pin.ContactType.CONTACT_6D: "fixed"}.get(constraint.type)
+    else:
+        cut_type = _ANCHOR_TYPES.get(kind)
+    if cut_type is None:
+        raise ModelError(f"constraint {index + 1} is a {kind} ({getattr(constraint, 'type', '')}); pinmech closes "
+                         "loops with point anchors (3D), frame anchors (6D) or RigidConstraintModel of type "
+                         "CONTACT_3D or CONTACT_6D", path=source)
+    own = str(getattr(constraint, "name", "") or "")
+    name = names[index] if names is not None else own or f"loop{index + 1}"
+    for jid in (constraint.joint1_id, constraint.joint2_id):
+        if not 0 <= jid < model.njoints:
+            raise ModelError(f"constraint '{name}' names joint id {jid}; the model has {model.njoints}", path=source)
+    return _AnchorCut(name, cut_type, int(constraint.joint1_id), pin.SE3(constraint.joint1_placement),
+                      int(constraint.joint2_id), pin.SE3(constraint.joint2_placement))
+
+
+def _anchor_closure(model: pin.Model, cut: _AnchorCut, length_scale: float) -> Closure:
+    frame_ids, links = [], []
+    for side, joint, placement in (("parent", cut.joint1, cut.placement1), ("child", cut.joint2, cut.placement2)):
+        body = next((i for i, f in enumerate(model.frames) if f.parentJoint == joint
+                     and f.type in (pin.FrameType.BODY, pin.FrameType.FIXED_JOINT)), 0)
+        frame_ids.append(model.addFrame(pin.Frame(f"{cut.name}__{side}", joint, body, placement,
+                                                  pin.FrameType.OP_FRAME), False))
+        links.append(model.frames[body].name)
+    z = np.array([0.0, 0.0, 1.0])
+    return Closure(cut.name, cut.cut_type, frame_ids[0], frame_ids[1], z, z, parent_link=links[0],
+                   child_link=links[1], length_scale=length_scale)
 
 
 def _sample_configurations(model: pin.Model, count: int, scale: np.ndarray | float = 1.0) -> list[np.ndarray]:
