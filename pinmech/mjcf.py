@@ -100,6 +100,12 @@ def _wrapped(root: ET.Element, source: str) -> Path:
         world.remove(body)
         wrapper.append(body)
     world.append(wrapper)
+    for eq in root.findall("equality"):  # Pinocchio knows no body "world": the wrapper is fixed to it
+        for el in eq:
+            if el.get("site1") is None:
+                for key in ("body1", "body2"):
+                    if el.get(key) in (None, "world"):
+                        el.set(key, WRAPPER)
     text = ET.tostring(root, encoding="unicode")
     folder = Path(tempfile.gettempdir()) / f"pinmech-{os.getuid() if hasattr(os, 'getuid') else 'user'}"
     folder.mkdir(mode=0o700, exist_ok=True)
