@@ -121,6 +121,14 @@ def _scene_joint(scene: Scene, mechanism: Mechanism, name: str, key: str):
 def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
     """The `[drivers]` table in SI units, checked against the model's joints."""
     table = scene.driver_table()
+    if not table and mechanism.motors:  # a sidecar's motors, at the reference pose, at rest
+        reference = mechanism.neutral()
+        table = {name: {"angle" if mechanism.joint(name).kind != "prismatic" else "position": 0.0}
+                 for name in mechanism.motors}
+        values = [[mechanism.coordinate(reference, name), 0.0, 0.0] for name in mechanism.motors]
+        if len(values) == mechanism.mobility:
+            arr = np.array(values, dtype=float).reshape(-1, 3)
+            return Drivers(tuple(mechanism.motors), arr[:, 0].copy(), arr[:, 1].copy(), arr[:, 2].copy())
     names, values = [], []
     for name, spec in table.items():
         if name in mechanism.locked:

@@ -80,6 +80,8 @@ class Mechanism:
             linkage drawn in TOML, an MJCF file): drawings read their visuals from it.
         reference: the reference configuration (the drawn pose of a linkage), else None
             (the neutral configuration is the reference).
+        motors: the actuated joints a file names (a Gepetto sidecar's name_mot): the
+            default drivers.
     """
 
     model: pin.Model
@@ -93,6 +95,7 @@ class Mechanism:
     locked: dict[str, float] = field(default_factory=dict)
     urdf_path: str | None = None
     reference: np.ndarray | None = None
+    motors: list[str] = field(default_factory=list)
     _rank: object = field(default=None, repr=False, compare=False)
 
     # ---------------------------------------------------------------- construction
