@@ -23,12 +23,15 @@ from pinmech.exceptions import (
     TaskError,
     UnitError,
 )
+from pinmech.linkage import build_urdf, load_linkage
 from pinmech.mechanism import JointInfo, Mechanism
+from pinmech.mjcf import load_mjcf
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.path import PathPoint, follow_path
 from pinmech.report import to_dict, to_json, to_text
 from pinmech.results import Accuracy, LoopSolution, RateSolution
 from pinmech.scene import Scene
+from pinmech.sidecar import load_extended_urdf
 from pinmech.solve_batch import BatchSolution, BatchSolver
 from pinmech.solve_cycle import RangeChunk, solve_range
 from pinmech.solve_loops import LoopSolver
@@ -72,11 +75,15 @@ __all__ = [
     "UnitError",
     "__version__",
     "analyse",
+    "build_urdf",
     "compare",
     "evaluate_motion",
     "follow_path",
+    "load_extended_urdf",
     "load_hand_file",
+    "load_linkage",
     "load_mechanism",
+    "load_mjcf",
     "solve_range",
     "to_dict",
     "to_json",
