@@ -29,7 +29,7 @@ mujoco = pytest.importorskip("mujoco")
 
 MJCF = Path(__file__).resolve().parents[1] / "models" / "mjcf"
 SOLVABLE = {"four_bar": ("O2", [0.3, 0.8, 1.4]), "slider_crank": ("O", [0.4, 1.2, 2.0]),
-            "ball_loop": ("O2", [0.2, 0.4])}
+            "ball_loop": ("O2", [0.2, 0.4]), "leg": ("hip", [-0.1, -0.25])}
 
 
 def mujoco_model(name: str, driver: str | None = None, value: float = 0.0):
@@ -51,11 +51,14 @@ def mujoco_solve(name: str, driver: str, value: float):
 
 
 def set_qpos(mech, q, m, d) -> None:
-    """pinmech's q into MuJoCo's qpos, joint by joint (a ball: x y z w -> w x y z)."""
-    for name, joint in mech.joints.items():
-        adr = m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)]
+    """pinmech's q into MuJoCo's qpos: same joint order (depth first in the file), a ball's
+    quaternion x y z w -> w x y z; a body's several hinges are one composite joint in Pinocchio."""
+    parts = []
+    for joint in sorted(mech.joints.values(), key=lambda j: j.idx_q):
         part = q[joint.idx_q: joint.idx_q + joint.nq]
-        d.qpos[adr: adr + joint.nq] = part if joint.nq != 4 else np.roll(part, 1)
+        parts.append(np.roll(part, 1) if joint.nq == 4 else part)
+    assert m.nq == mech.model.nq
+    d.qpos[:] = np.concatenate(parts)
     mujoco.mj_forward(m, d)
 
 
@@ -65,7 +68,7 @@ def sites(mech, data, m, d):
     return ours, np.array(d.site_xpos)
 
 
-@pytest.mark.parametrize("name", ["four_bar", "slider_crank", "ball_loop", "leg"])
+@pytest.mark.parametrize("name", ["four_bar", "slider_crank", "ball_loop", "leg", "leg_ball"])
 def test_bodies_and_sites_sit_where_mujoco_puts_them_at_qpos0(name):
     mech = load_mjcf(MJCF / f"{name}.xml")
     data = mech.model.createData()
@@ -90,6 +93,10 @@ def test_pinocchio_alone_drops_the_second_top_body_and_pinmech_keeps_it():
 
 def test_a_fixed_top_body_keeps_its_pos():
     """The leg's pelvis sits at z = 1 m: Pinocchio alone puts it at the origin."""
+    bare = pin.buildModelFromMJCF(str(MJCF / "leg.xml"))
+    bare_data = bare.createData()
+    pin.framesForwardKinematics(bare, bare_data, pin.neutral(bare))
+    assert bare_data.oMf[bare.getFrameId("pelvis")].translation[2] == 0.0  # the trap, as installed
     mech = load_mjcf(MJCF / "leg.xml")
     data = mech.model.createData()
     pin.framesForwardKinematics(mech.model, data, mech.neutral())
@@ -145,10 +152,10 @@ def test_point_velocities_are_finite_differences_of_mujoco_positions(name):
 
 def test_cassie_like_rod_spin_is_named(tmp_path, capsys):
     """Hip driven, the rod hangs on a ball: mobility 2, and the ball joint is the idle one."""
-    mech = load_mjcf(MJCF / "leg.xml")
+    mech = load_mjcf(MJCF / "leg_ball.xml")
     assert mech.mobility == 2 and mech.idle_joints(["hip"]) == ["rod_ball"]
     scene = tmp_path / "leg.toml"
-    scene.write_text(f'mjcf = "{MJCF / "leg.xml"}"\n[drivers.hip]\nangle = "10 deg"\n')
+    scene.write_text(f'mjcf = "{MJCF / "leg_ball.xml"}"\n[drivers.hip]\nangle = "10 deg"\n')
     assert main(["solve", str(scene)]) == 5
     err = capsys.readouterr().err
     assert "rod_ball" in err and "lock" in err and len(err.strip().splitlines()) == 1
