@@ -21,8 +21,11 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from pinmech import Mechanism
+from pinmech.cli import main
 from pinmech.exceptions import ModelError
 from pinmech.linkage import load_linkage, parse_linkage, linkage_urdf
 from pinmech.motion import evaluate_motion
@@ -302,3 +305,58 @@ def test_urdf_text_is_valid_for_pinocchio_alone():
     text, reference = linkage_urdf(parse_linkage(LINKAGES / "jansen.toml"))
     model = pin.buildModelFromXML(text)
     assert model.nv == 7 and set(reference) <= set(model.names)
+
+
+# ------------------------------------------------------------------- more classes
+def test_r_rtr_with_a_block_sliding_on_the_moving_guide(tmp_path):
+    """The R-RTR again, as a block pinned to the crank sliding on link 3: the slide is the cut."""
+    text = (LINKAGES / "inverted_slider_crank.toml").read_text()
+    text = text.replace('crank = ["A", "B"]', 'crank = ["A", "B"]\nblock = ["B"]')
+    text = text.replace('[slots]\nB = { pin = "crank", slot = "guide", along = ["C", "B"] }',
+                        '[sliders]\nS = { block = "block", on = "guide", at = "B", along = ["C", "B"] }')
+    path = tmp_path / "r_rtr_slider.toml"
+    path.write_text(text)
+    mech = load_linkage(path)
+    assert [c.name for c in mech.closures] == ["S"] and mech.closures[0].cut_type == "prismatic"
+    values = path_to(math.pi / 2, np.radians([200.0, 330.0, 420.0]))
+    motions = follow(mech, "A", values, omega=-2.0, alpha=0.5, points=["D"], links=["guide"])
+    ref = cf.r_rtr(np.array(values), -2.0, 0.5)
+    np.testing.assert_allclose([m.points["D"].position[:2] for m in motions], ref.D, atol=POS_TOL)
+    np.testing.assert_allclose([m.links["guide"].angular_velocity[2] for m in motions], ref.omega3,
+                               atol=REL_TOL * np.max(np.abs(ref.omega3)))
+
+
+@settings(max_examples=15, deadline=None, derandomize=True)
+@given(a=st.floats(0.02, 0.05), b=st.floats(0.10, 0.16), c=st.floats(0.07, 0.12), theta=st.floats(0.0, 2 * math.pi))
+def test_any_drawn_crank_rocker_follows_norton(tmp_path_factory, a, b, c, theta):
+    """Random Grashof crank-rockers (ground 0.1 m, crank shortest), drawn with the crank along x."""
+    d = 0.10
+    # |A - O4| runs over [d - a, d + a]: the loop closes all round, 5 mm from the toggles
+    assume(abs(b - c) + 0.005 < d - a and a + d + 0.005 < b + c)
+    text = BASE.replace('"40 mm", "0 mm"]', f'"{a * 1000!r} mm", "0 mm"]').replace(
+        '"120 mm", "80 mm"', f'"{b * 1000!r} mm", "{c * 1000!r} mm"')
+    path = tmp_path_factory.mktemp("fb") / "fb.toml"
+    path.write_text(text)
+    mech = load_linkage(path)
+    values = path_to(0.0, [theta])
+    motion = follow(mech, "O2", values, omega=1.0, links=["coupler", "rocker"])[-1]
+    ref = cf.four_bar(values[-1], 1.0, 0.0, a, b, c, d, branch=+1)
+    angle_close(motion.links["rocker"].angle, ref.theta4, 1, "theta4")
+    np.testing.assert_allclose(motion.links["coupler"].angular_velocity[2], ref.omega3, atol=1e-8)
+
+
+def test_build_writes_the_urdf_whole(tmp_path, capsys):
+    out = tmp_path / "jansen.urdf"
+    assert main(["build", str(LINKAGES / "jansen.toml"), "-o", str(out)]) == 0
+    said = capsys.readouterr().out
+    assert "loop cuts: C, D_rocker, F" in said and "7 links" in said
+    text = out.read_text()
+    assert text.count("<constraint ") == 3 and pin.buildModelFromXML(text).nv == 7
+    assert Mechanism.from_urdf(out).mobility == 1  # a plain URDF, loadable without the TOML
+    bad = tmp_path / "bad.toml"
+    bad.write_text(BASE.replace('"120 mm", "80 mm"', '"20 mm", "30 mm"'))
+    out.write_text("previous")
+    assert main(["build", str(bad), "-o", str(out)]) == 3
+    assert out.read_text() == "previous"  # a failed build leaves the old file alone
+    assert main(["build", str(LINKAGES / "jansen.toml"), "-o", str(tmp_path / "no" / "x.urdf")]) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 2
