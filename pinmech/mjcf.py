@@ -167,12 +167,10 @@ def load_mjcf(path: str | Path, *, locked: dict[str, float] | None = None) -> Me
 
 
 def _qpos0(model: pin.Model) -> np.ndarray:
+    """MuJoCo's qpos0 as Pinocchio's parser stores it (joint `ref` values), else neutral."""
     configs = model.referenceConfigurations
-    for key in configs:
-        name = key[0] if isinstance(key, tuple) else key
-        if name == "qpos0":
-            value = key[1] if isinstance(key, tuple) else configs[key]
-            return np.array(value, dtype=float)
+    if "qpos0" in configs:
+        return np.array(configs["qpos0"], dtype=float)
     return pin.neutral(model)
 
 

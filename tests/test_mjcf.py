@@ -212,3 +212,18 @@ def test_mjcf_scene_solves_like_the_urdf_one(scenes_dir, capsys):
         np.testing.assert_allclose(ours["links"][link]["angular_velocity"], theirs["links"][link]["angular_velocity"],
                                    atol=1e-12)
     np.testing.assert_allclose(ours["points"]["P"]["position"], theirs["points"]["P"]["position"], atol=1e-14)
+
+
+def test_joint_ref_values_make_qpos0_the_reference(tmp_path):
+    """A hinge with ref="0.2": the drawn pose is qpos0 = 0.2, not 0, in MuJoCo and in pinmech."""
+    path = _variant(tmp_path, '<joint name="O4" type="hinge" axis="0 0 1"/>',
+                    '<joint name="O4" type="hinge" axis="0 0 1" ref="0.2"/>')
+    mech = load_mjcf(path)
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    np.testing.assert_allclose(mech.neutral(), m.qpos0, atol=0)
+    solver = LoopSolver(mech, ["O2"])
+    sol = solver.solve([0.7], guess=mech.neutral())
+    set_qpos(mech, sol.q, m, d)
+    eq = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+    np.testing.assert_allclose(d.efc_pos[eq], 0.0, atol=1e-13)
