@@ -27,12 +27,12 @@ from hypothesis import strategies as st
 from pinmech import Mechanism
 from pinmech.cli import main
 from pinmech.exceptions import ModelError
-from pinmech.linkage import load_linkage, parse_linkage, linkage_urdf
+from pinmech.linkage import linkage_urdf, load_linkage, parse_linkage
 from pinmech.motion import evaluate_motion
 from pinmech.solve_loops import LoopSolver
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
-import closed_form as cf  # noqa: E402
+import closed_form as cf
 
 LINKAGES = Path(__file__).resolve().parents[1] / "models" / "linkages"
 POS_TOL = 1e-10  # [m]
@@ -56,7 +56,7 @@ def path_to(first: float, values) -> list[float]:
     """Steps of at most 15 deg from `first` through every value in turn."""
     out, last = [], first
     for value in values:
-        n = max(1, int(math.ceil(abs(value - last) / math.radians(15))))
+        n = max(1, math.ceil(abs(value - last) / math.radians(15)))
         out += list(np.linspace(last, value, n + 1)[1:])
         last = value
     return out
@@ -191,10 +191,14 @@ def test_six_bars_match_four_bar_plus_dyad(kind, tmp_path):
         x_axis = data.oMf[link6].rotation[:2, 0]
         length = 0.07 if kind == "watt" else 0.06
         np.testing.assert_allclose(O6 + length * x_axis, D, atol=POS_TOL)
+        # link5's x axis runs from C to D (the order it lists them): checks C as well
+        np.testing.assert_allclose(data.oMf[mech.links["link5"]].rotation[:2, 0], (D - C) / np.linalg.norm(D - C),
+                                   atol=POS_TOL)
 
 
 # ------------------------------------------------------------------- Jansen
-JANSEN = dict(a=38, b=41.5, c=39.3, d=40.1, e=55.8, f=39.4, g=36.7, h=65.7, i=49, j=50, k=61.9, l=7.8, m=15)
+JANSEN = {"a": 38, "b": 41.5, "c": 39.3, "d": 40.1, "e": 55.8, "f": 39.4, "g": 36.7, "h": 65.7, "i": 49, "j": 50,
+          "k": 61.9, "l": 7.8, "m": 15}
 
 
 def jansen_foot(theta: float) -> np.ndarray:
