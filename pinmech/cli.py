@@ -395,7 +395,8 @@ def cmd_animate(args: argparse.Namespace) -> int:
 
 def cmd_build(args: argparse.Namespace) -> int:
     """`pinmech build LINKAGE -o FILE.urdf`: the URDF of a drawn linkage, written whole or not at all."""
-    from pinmech.linkage import build_urdf, spanning_tree
+    from pinmech.linkage import build_urdf
+    from pinmech.linkage_urdf import spanning_tree
 
     try:
         linkage = build_urdf(args.linkage, args.output)

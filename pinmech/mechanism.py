@@ -202,7 +202,9 @@ class Mechanism:
             ModelError: an unknown constraint class or type, a joint id out of range.
         """
         model = pin.Model(model)
-        cuts = [_anchor_cut(c, i, names, model, source) for i, c in enumerate(constraints)]
+        from pinmech.anchors import anchor_closure, anchor_cut
+
+        cuts = [anchor_cut(c, i, names, model, source) for i, c in enumerate(constraints)]
         listed = [c.name for c in cuts]
         for name in listed:
             if listed.count(name) > 1:
@@ -222,7 +224,7 @@ class Mechanism:
                    points={n: model.getFrameId(n) for n in points}, length_scale=1.0, plane_normal=None,
                    source=source, urdf_path=urdf_path)
         mech.length_scale = _length_scale(model, source)
-        mech.closures = [_anchor_closure(model, cut, mech.length_scale) for cut in cuts]
+        mech.closures = [anchor_closure(model, cut, mech.length_scale) for cut in cuts]
         _reduce_rows(mech)
         mech.plane_normal = _plane_normal(mech)
         if reference is not None:
@@ -566,53 +568,6 @@ def _make_closure(model: pin.Model, cut: _Cut, length_scale: float) -> Closure:
         frame_ids.append(model.addFrame(frame, False))
     return Closure(cut.name, cut.cut_type, frame_ids[0], frame_ids[1], cut.parent_axis, cut.child_axis,
                    parent_link=cut.parent_link, child_link=cut.child_link, length_scale=length_scale)
-
-
-@dataclass(frozen=True)
-class _AnchorCut:
-    """A loop cut given by two joints and a placement on each (Pinocchio's constraint models)."""
-
-    name: str
-    cut_type: str
-    joint1: int
-    placement1: pin.SE3
-    joint2: int
-    placement2: pin.SE3
-
-
-_ANCHOR_TYPES = {"PointAnchorConstraintModel": "spherical", "FrameAnchorConstraintModel": "fixed"}
-
-
-def _anchor_cut(constraint: Any, index: int, names: Sequence[str] | None, model: pin.Model, source: str) -> _AnchorCut:
-    kind = type(constraint).__name__
-    if kind == "RigidConstraintModel":
-        cut_type = {pin.ContactType.CONTACT_3D: "spherical", pin.ContactType.CONTACT_6D: "fixed"}.get(constraint.type)
-    else:
-        cut_type = _ANCHOR_TYPES.get(kind)
-    if cut_type is None:
-        raise ModelError(f"constraint {index + 1} is a {kind} ({getattr(constraint, 'type', '')}); pinmech closes "
-                         "loops with point anchors (3D), frame anchors (6D) or RigidConstraintModel of type "
-                         "CONTACT_3D or CONTACT_6D", path=source)
-    own = str(getattr(constraint, "name", "") or "")
-    name = names[index] if names is not None else own or f"loop{index + 1}"
-    for jid in (constraint.joint1_id, constraint.joint2_id):
-        if not 0 <= jid < model.njoints:
-            raise ModelError(f"constraint '{name}' names joint id {jid}; the model has {model.njoints}", path=source)
-    return _AnchorCut(name, cut_type, int(constraint.joint1_id), pin.SE3(constraint.joint1_placement),
-                      int(constraint.joint2_id), pin.SE3(constraint.joint2_placement))
-
-
-def _anchor_closure(model: pin.Model, cut: _AnchorCut, length_scale: float) -> Closure:
-    frame_ids, links = [], []
-    for side, joint, placement in (("parent", cut.joint1, cut.placement1), ("child", cut.joint2, cut.placement2)):
-        body = next((i for i, f in enumerate(model.frames) if f.parentJoint == joint
-                     and f.type in (pin.FrameType.BODY, pin.FrameType.FIXED_JOINT)), 0)
-        frame_ids.append(model.addFrame(pin.Frame(f"{cut.name}__{side}", joint, body, placement,
-                                                  pin.FrameType.OP_FRAME), False))
-        links.append(model.frames[body].name)
-    z = np.array([0.0, 0.0, 1.0])
-    return Closure(cut.name, cut.cut_type, frame_ids[0], frame_ids[1], z, z, parent_link=links[0],
-                   child_link=links[1], length_scale=length_scale)
 
 
 def _sample_configurations(model: pin.Model, count: int, scale: np.ndarray | float = 1.0) -> list[np.ndarray]:

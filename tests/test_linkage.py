@@ -27,7 +27,8 @@ from hypothesis import strategies as st
 from pinmech import Mechanism
 from pinmech.cli import main
 from pinmech.exceptions import ModelError
-from pinmech.linkage import linkage_urdf, load_linkage, parse_linkage
+from pinmech.linkage import load_linkage, parse_linkage
+from pinmech.linkage_urdf import linkage_urdf
 from pinmech.motion import evaluate_motion
 from pinmech.solve_loops import LoopSolver
 
