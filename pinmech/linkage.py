@@ -13,13 +13,16 @@ Conventions of the generated URDF (all in the plane z = 0, axes along z):
     lists to the next, so a link's reported angle is the textbook phi of that bar;
   * a pin's coordinate is the angle between the x axes of its two links [rad], a
     slider's the displacement of its block from the drawn position along the line [m];
-  * `Linkage.reference` holds those coordinates at the drawn pose: the default guess.
+  * those coordinates at the drawn pose are the mechanism's reference: the default guess.
 """
 
 from __future__ import annotations
 
+import hashlib
 import math
+import os
 import sys
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -348,9 +351,6 @@ def build_urdf(path: str | Path, output: str | Path) -> Linkage:
 
 def _write_whole(path: Path, text: str) -> None:
     """Write to a temporary file beside `path`, then rename: never a half-written URDF."""
-    import os
-    import tempfile
-
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent if str(path.parent) else ".")
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as stream:
@@ -363,10 +363,6 @@ def _write_whole(path: Path, text: str) -> None:
 
 def _cached_urdf(text: str) -> Path:
     """The generated URDF in a per-user cache folder, named by its content (for drawings)."""
-    import hashlib
-    import os
-    import tempfile
-
     folder = Path(tempfile.gettempdir()) / f"pinmech-{os.getuid() if hasattr(os, 'getuid') else 'user'}"
     folder.mkdir(mode=0o700, exist_ok=True)
     path = folder / f"linkage-{hashlib.sha256(text.encode()).hexdigest()[:20]}.urdf"
