@@ -10,6 +10,8 @@ fixed cut). Its known traps, each handled here or refused in one line:
 * a `connect` anchor is taken at the reference pose (qpos0), as MuJoCo does: the loop is
   the one that is closed at qpos0, so a model drawn open at qpos0 is refused where it can be
   seen (sites given to `connect` that do not meet at qpos0) and otherwise documented;
+* a floating base (a `<freejoint>` on a top-level body, as Cassie's pelvis) is held at its
+  qpos0 pose: pinmech computes the mechanism's motion relative to its base;
 * equality types pinmech cannot close (`joint`, `tendon`, `flex`), inactive equalities, and
   `weld` with `relpose` are refused, never dropped.
 
@@ -96,7 +98,10 @@ def _wrapped(root: ET.Element, source: str) -> Path:
     for key in ("meshdir", "texturedir", "assetdir"):  # the copy lives elsewhere: absolute folders
         compiler.set(key, str(folder_of / compiler.get(key, "")) + os.sep)
     wrapper = ET.Element("body", {"name": WRAPPER})
-    for body in bodies:
+    for body in bodies:  # a floating base is held where qpos0 puts it: motion relative to it
+        for joint in body.findall("freejoint") + [j for j in body.findall("joint") if j.get("type") == "free"]:
+            body.remove(joint)
+
         world.remove(body)
         wrapper.append(body)
     world.append(wrapper)

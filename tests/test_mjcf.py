@@ -227,3 +227,16 @@ def test_joint_ref_values_make_qpos0_the_reference(tmp_path):
     set_qpos(mech, sol.q, m, d)
     eq = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
     np.testing.assert_allclose(d.efc_pos[eq], 0.0, atol=1e-13)
+
+
+def test_a_floating_base_is_held_at_qpos0(tmp_path):
+    """Cassie's pelvis floats (<freejoint/>): the leg moves relative to it, as with a fixed one."""
+    path = _variant(tmp_path, '<geom type="box" size="0.05 0.05 0.03" rgba="0.5 0.5 0.5 1"/>',
+                    '<freejoint name="root"/><geom type="box" size="0.05 0.05 0.03" rgba="0.5 0.5 0.5 1"/>',
+                    name="leg")
+    floating, fixed = load_mjcf(path), load_mjcf(MJCF / "leg.xml")
+    assert "root" not in floating.joints and floating.mobility == fixed.mobility == 1
+    ours = LoopSolver(floating, ["hip"]).solve([-0.2], [1.0])
+    theirs = LoopSolver(fixed, ["hip"]).solve([-0.2], [1.0])
+    np.testing.assert_allclose(ours.q, theirs.q, atol=1e-14)
+    np.testing.assert_allclose(ours.v, theirs.v, atol=1e-14)
