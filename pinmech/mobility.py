@@ -103,6 +103,13 @@ def constraint_rank(mech) -> RankReport:
         q = close_least_squares(mech, data, pin.integrate(mech.model, q0, step * mech.velocity_scale()))
         if q is not None:
             poses.append(q)
+    if len(poses) == 1:  # no neighbour closed: other closed poses, so one singular pose cannot decide
+        seeds = np.random.default_rng(11)
+        for _ in range(4):
+            start = pin.integrate(mech.model, q0, seeds.normal(size=mech.model.nv) * mech.velocity_scale())
+            q = close_least_squares(mech, data, start)
+            if q is not None:
+                poses.append(q)
     jacobians = [stacked_jacobian(mech, data, q) for q in poses]
     ranks = [_rank(J) for J in jacobians]
     best = int(np.argmax(ranks))
