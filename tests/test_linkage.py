@@ -365,3 +365,19 @@ def test_build_writes_the_urdf_whole(tmp_path, capsys):
     assert out.read_text() == "previous"  # a failed build leaves the old file alone
     assert main(["build", str(LINKAGES / "jansen.toml"), "-o", str(tmp_path / "no" / "x.urdf")]) == 2
     assert len(capsys.readouterr().err.strip().splitlines()) == 2
+
+
+@pytest.mark.parametrize("head, code, words", [
+    ('linkage = "{L}/four_bar.toml"\nurdf = "x.urdf"\n', 4, ["exactly one of"]),
+    ('linkage = "{L}/missing.toml"\n', 3, ["linkage", "not a file"]),
+    ('mjcf = "{L}/missing.xml"\n', 3, ["mjcf", "not a file"]),
+    ('linkage = "{L}/four_bar.toml"\nsidecar = "robot.yaml"\n', 4, ["sidecar", "urdf"]),
+])
+def test_scene_model_keys(tmp_path, capsys, head, code, words):
+    scene = tmp_path / "s.toml"
+    scene.write_text(head.format(L=LINKAGES) + '[drivers.O2]\nangle = "10 deg"\n')
+    assert main(["solve", str(scene)]) == code
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and str(scene) in err
+    for word in words:
+        assert word in err, err
