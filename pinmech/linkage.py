@@ -68,8 +68,8 @@ class Linkage:
         links: link name -> the names it carries, in the order written.
         edges: every joint of the graph (pins split into pairs, slots into pin + slide).
         point_links: named point -> the one link it is fixed on.
-        sliders: slide edge names -> their block link (drawn as a block).
-        hidden: links added for pin-in-slot joints (a block of zero size).
+        blocks: block link -> the slide it moves on (sliders' blocks, slots' hidden blocks).
+        hidden: links added for pin-in-slot joints (no visual of their own).
     """
 
     source: str

@@ -381,3 +381,19 @@ def test_scene_model_keys(tmp_path, capsys, head, code, words):
     assert len(err.splitlines()) == 1 and str(scene) in err
     for word in words:
         assert word in err, err
+
+
+def test_the_readme_jansen_leg_is_under_30_lines_and_the_bundled_one(tmp_path):
+    """A user copying the README's Jansen leg gets the bundled file's linkage, point for point."""
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    section = readme[readme.index("### Linkages as drawn"):]
+    block = section[section.index("```toml") + len("```toml\n"):]
+    block = block[: block.index("```")]
+    assert len([line for line in block.splitlines() if line.strip()]) < 30
+    path = tmp_path / "jansen.toml"
+    path.write_text(block)
+    ours, bundled = parse_linkage(path), parse_linkage(LINKAGES / "jansen.toml")
+    assert ours.links == bundled.links
+    for name, point in bundled.points.items():
+        np.testing.assert_array_equal(ours.points[name], point)
+    assert load_linkage(path).mobility == 1
