@@ -12,6 +12,8 @@ fixed cut). Its known traps, each handled here or refused in one line:
   seen (sites given to `connect` that do not meet at qpos0) and otherwise documented;
 * a floating base (a `<freejoint>` on a top-level body, as Cassie's pelvis) is held at its
   qpos0 pose: pinmech computes the mechanism's motion relative to its base;
+* an `axisangle` axis that is not of unit length is used as is (MuJoCo normalises it): pinmech
+  normalises every one before parsing;
 * equality types pinmech cannot close (`joint`, `tendon`, `flex`), inactive equalities, and
   `weld` with `relpose` are refused, never dropped.
 
@@ -90,6 +92,7 @@ def _wrapped(root: ET.Element, source: str) -> Path:
         raise ModelError("<worldbody> has no <body>: nothing moves", path=source)
     if any(b.get("name") == WRAPPER for b in root.iter("body")):
         raise ModelError(f"a body is called {WRAPPER}, the name pinmech gives its wrapper", path=source)
+    _normalise_axisangles(root, source)
     compiler = root.find("compiler")
     if compiler is None:
         compiler = ET.Element("compiler")
@@ -120,6 +123,25 @@ def _wrapped(root: ET.Element, source: str) -> Path:
         tmp.write_text(text, encoding="utf-8")
         os.replace(tmp, out)
     return out
+
+
+def _normalise_axisangles(root: ET.Element, source: str) -> None:
+    """Unit axes in every `axisangle`: MuJoCo normalises them, Pinocchio's parser does not
+    (axisangle="0.3 0.5 0.8 40" turns a body by a wrong rotation there, 0.15 rad off)."""
+    for el in root.iter():
+        text = el.get("axisangle")
+        if text is None:
+            continue
+        try:
+            x, y, z, angle = (float(v) for v in text.split())
+        except ValueError:
+            raise ModelError(f"axisangle=\"{text}\" is not four numbers", path=source,
+                             element=f"<{el.tag} name=\"{el.get('name', '')}\">") from None
+        norm = (x * x + y * y + z * z) ** 0.5
+        if not norm > 0:
+            raise ModelError(f"axisangle=\"{text}\" has no axis", path=source,
+                             element=f"<{el.tag} name=\"{el.get('name', '')}\">")
+        el.set("axisangle", f"{x / norm!r} {y / norm!r} {z / norm!r} {angle!r}")
 
 
 def _build(path: Path, source: str) -> tuple[pin.Model, list, list]:

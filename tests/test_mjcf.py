@@ -240,3 +240,25 @@ def test_a_floating_base_is_held_at_qpos0(tmp_path):
     theirs = LoopSolver(fixed, ["hip"]).solve([-0.2], [1.0])
     np.testing.assert_allclose(ours.q, theirs.q, atol=1e-14)
     np.testing.assert_allclose(ours.v, theirs.v, atol=1e-14)
+
+
+@pytest.mark.parametrize("attr", ['axisangle="0.3 0.5 0.8 40"', 'xyaxes="1 1 0 -1 1 0.3"', 'zaxis="0.2 0.4 1"',
+                                  'quat="2 0.2 0.6 0.4"', 'euler="10 20 30"'])
+def test_every_way_of_turning_a_body_agrees_with_mujoco(tmp_path, attr):
+    """Pinocchio's parser takes axisangle's axis unnormalised (0.15 rad off for this one)."""
+    xml = f"""<mujoco><worldbody><body name="a" pos="0.1 0.2 0.3" {attr}><joint name="j" type="hinge" axis="0 1 0"/>
+      <geom type="sphere" size="0.01"/><body name="b" pos="0.1 0 0" {attr}><joint name="k" type="slide" axis="0 2 1"/>
+      <geom type="sphere" size="0.01"/><site name="s" pos="0 0.1 0"/></body></body></worldbody></mujoco>"""
+    path = tmp_path / "turned.xml"
+    path.write_text(xml)
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    mech = load_mjcf(path)
+    q = np.array([0.7, 0.05])
+    d.qpos[:] = q
+    mujoco.mj_forward(m, d)
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, q)
+    for i in range(1, m.nbody):
+        np.testing.assert_allclose(data.oMf[mech.links[m.body(i).name]].rotation, d.xmat[i].reshape(3, 3), atol=1e-12)
+    np.testing.assert_allclose(data.oMf[mech.points["s"]].translation, d.site_xpos[0], atol=1e-12)
