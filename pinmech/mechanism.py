@@ -622,7 +622,8 @@ def _plane_normal(mech: Mechanism) -> np.ndarray | None:
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
         for fid in range(model.nframes):
-            J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED) * columns
+            # reshaped: for a one-dof model Pinocchio hands back a (6,) vector, not (6, 1)
+            J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED).reshape(6, -1) * columns
             angular.append(J[3:])
             linear.append(J[:3] / mech.length_scale)
     # A = hstack(angular) is 3 x (frames * nv). A = R^T Q^T, so A's U and s are those of the

@@ -180,8 +180,13 @@ def load_mjcf(path: str | Path, *, locked: dict[str, float] | None = None) -> Me
         raise ModelError(f"[lock] is not supported for MJCF models yet ({', '.join(locked)}): give the joint a "
                          "range of zero in the file, or drive it", path=source)
     connects, welds, elements = _equalities(root, source)
+    if root.find("worldbody") is not None and root.find("worldbody").find(".//frame") is not None:
+        raise ModelError("Pinocchio's parser drops a <frame> with every body in it: write those bodies without "
+                         "the <frame> (its pos and orientation composed into theirs)", path=source,
+                         element="<worldbody> <frame>")
     wrapped = _wrapped(root, source)
     model, points, frames = _build(wrapped, source)
+    _check_everything_read(root, model, source)
     if len(points) != len(connects) or len(frames) != len(welds):
         raise ModelError(f"Pinocchio read {len(points)} connect and {len(frames)} weld constraints, the file has "
                          f"{len(connects)} and {len(welds)}", path=source, element="<equality>")
@@ -191,6 +196,24 @@ def load_mjcf(path: str | Path, *, locked: dict[str, float] | None = None) -> Me
     _check_sites(mech, elements, source)
     _check_closed(mech, source)
     return mech
+
+
+_DOFS = {"hinge": 1, "slide": 1, "ball": 3}
+
+
+def _check_everything_read(root: ET.Element, model: pin.Model, source: str) -> None:
+    """Every named body and every joint freedom of the file is in Pinocchio's model."""
+    bodies = {f.name for f in model.frames if f.type == pin.FrameType.BODY}
+    for body in root.find("worldbody").iter("body"):
+        name = body.get("name")
+        if name and name not in bodies:
+            raise ModelError("Pinocchio's parser left this body out of the model", path=source,
+                             element=f"<body name=\"{name}\">")
+    typed_defaults = any(j.get("type") for d in root.findall("default") for j in d.iter("joint"))
+    freedoms = sum(_DOFS.get(j.get("type", "hinge"), 0) for j in root.find("worldbody").iter("joint"))
+    if not typed_defaults and freedoms != model.nv:  # (a default class may set a joint's type)
+        raise ModelError(f"the file's joints have {freedoms} freedoms, Pinocchio's model {model.nv}", path=source,
+                         element="<joint>")
 
 
 def _qpos0(model: pin.Model) -> np.ndarray:

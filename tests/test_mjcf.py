@@ -262,3 +262,24 @@ def test_every_way_of_turning_a_body_agrees_with_mujoco(tmp_path, attr):
     for i in range(1, m.nbody):
         np.testing.assert_allclose(data.oMf[mech.links[m.body(i).name]].rotation, d.xmat[i].reshape(3, 3), atol=1e-12)
     np.testing.assert_allclose(data.oMf[mech.points["s"]].translation, d.site_xpos[0], atol=1e-12)
+
+
+def test_a_frame_element_is_refused_not_dropped(tmp_path):
+    """Pinocchio's parser drops <frame> and every body in it (the model lost body b here)."""
+    path = tmp_path / "framed.xml"
+    path.write_text("""<mujoco><worldbody><body name="a"><joint name="j" type="hinge" axis="0 0 1"/>
+      <geom type="sphere" size="0.01"/><frame pos="0.1 0 0" euler="0 0 30"><body name="b" pos="0.1 0 0">
+      <joint name="k" type="hinge" axis="0 1 0"/><geom type="sphere" size="0.01"/></body></frame></body>
+      </worldbody></mujoco>""")
+    assert "k" not in list(pin.buildModelFromMJCF(str(path)).names)  # the trap, as installed
+    with pytest.raises(ModelError, match="<frame>"):
+        load_mjcf(path)
+
+
+def test_a_one_joint_model_loads(tmp_path):
+    """A single hinge: Pinocchio returns (6,) Jacobians for one freedom; pinmech keeps (6, 1)."""
+    path = tmp_path / "one.xml"
+    path.write_text("""<mujoco><worldbody><body name="a"><joint name="j" type="hinge" axis="0 0 1"/>
+      <geom type="sphere" size="0.01"/><site name="tip" pos="0.1 0 0"/></body></worldbody></mujoco>""")
+    mech = load_mjcf(path)
+    assert mech.mobility == 1 and mech.plane_normal is not None
