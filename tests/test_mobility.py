@@ -7,9 +7,10 @@ of the code, which takes singular values of the constraint Jacobian.
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
-from pinmech import Mechanism
+from pinmech import Mechanism, Scene, analyse
 from pinmech.cli import main
 from pinmech.exceptions import ModelError
 from pinmech.linkage import load_linkage
@@ -98,3 +99,19 @@ def test_a_spinning_rod_is_named_with_the_advice_to_lock_it(tmp_path, capsys):
     # locking the named joint leaves one freedom: the crank drives the rocker
     scene.write_text(f'urdf = "{urdf}"\n[drivers.O2]\nangle = "10 deg"\n[lock]\n{idle[0]} = "0 deg"\n')
     assert main(["solve", str(scene)]) == 0
+
+
+def test_a_one_joint_urdf_loads_and_solves(tmp_path, capsys):
+    """Pinocchio returns a (6,) Jacobian for a one-dof model: main crashed with LinAlgError."""
+    urdf = write(tmp_path, "one.urdf", """<robot name="one"><link name="base"/>
+      <link name="arm"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+      <joint name="j" type="continuous"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/></joint>
+      <link name="tip"/><joint name="point_tip" type="fixed"><parent link="arm"/><child link="tip"/>
+      <origin xyz="0.1 0 0"/></joint></robot>""")
+    mech = Mechanism.from_urdf(urdf)
+    assert mech.mobility == 1 and list(mech.plane_normal) == [0.0, 0.0, 1.0]
+    scene = tmp_path / "one.toml"
+    scene.write_text(f'urdf = "{urdf}"\n[drivers.j]\nangle = "90 deg"\n')
+    assert main(["solve", str(scene)]) == 0
+    tip = analyse(Scene.load(scene)).motion.points["tip"].position
+    np.testing.assert_allclose(tip, [0.0, 0.1, 0.0], atol=1e-16)  # 0.1 m arm at 90 deg
