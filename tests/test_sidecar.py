@@ -140,3 +140,19 @@ def test_a_6d_closure_on_a_planar_five_bar_locks_it(tmp_path):
     sidecar.write_text("closed_loop: [['closedloop1_A', 'closedloop1_B']]\ntype: ['6d']\nname_mot: ['mot1']\n")
     mech = load_extended_urdf(FIVE[0], sidecar)
     assert mech.mobility == 1 and mech.constraint_rows == 3 and mech.motors == ["mot1"]
+
+
+def test_joint_changes_fixed_and_spherical(tmp_path):
+    """FIXED elbow2: a four-bar (mobility 1). SPHERICAL elbow1: distal1 spins idle between two
+    ball joints (3 = 2 + 1 idle), and pinmech names elbow1 when the two motors are driven."""
+    sidecar = tmp_path / "robot.yaml"
+    base = "closed_loop: [['closedloop1_A', 'closedloop1_B']]\ntype: ['3d']\nname_mot: ['mot1']\n"
+    sidecar.write_text(base + "joint_name: ['elbow2']\njoint_type: ['FIXED']\n")
+    fixed = load_extended_urdf(FIVE[0], sidecar)
+    assert "elbow2" not in fixed.joints and fixed.mobility == 1
+    q = LoopSolver(fixed, ["mot1"]).solve([-0.1], guess=fixed.neutral()).q  # the four-bar closes
+    assert np.isfinite(q).all()
+    sidecar.write_text(base + "joint_name: ['elbow1']\njoint_type: ['SPHERICAL']\n")
+    ball = load_extended_urdf(FIVE[0], sidecar)
+    assert ball.joints["elbow1"].nq == 4 and ball.mobility == 3
+    assert ball.idle_joints(["mot1", "mot2"]) == ["elbow1"]
