@@ -147,6 +147,46 @@ def test_inverted_slider_crank_matches_r_rtr_closed_form_and_hand_urdf(models_di
                                atol=REL_TOL * np.max(np.abs(ref.aD)))
     np.testing.assert_allclose([m.links["guide"].angular_acceleration[2] for m in motions], ref.alpha3,
                                atol=REL_TOL * np.max(np.abs(ref.alpha3)))
+    hand = Mechanism.from_urdf(models_dir / "r_rtr.urdf")
+    guess = hand.neutral()
+    hand.set_coordinate(guess, "A", math.pi / 2)
+    hand.set_coordinate(guess, "B", math.radians(20))
+    hand.set_coordinate(guess, "B_slider", -0.06)
+    theirs = follow(hand, "A", values, omega=3.0, alpha=-1.0, start=guess, points=["D"])
+    np.testing.assert_allclose([m.points["D"].acceleration for m in motions],
+                               [m.points["D"].acceleration for m in theirs], atol=REL_TOL * np.max(np.abs(ref.aD)))
+
+
+def test_drawn_slider_crank_moves_as_the_bundled_hand_urdf(models_dir, tmp_path):
+    """models/slider_crank.urdf (r 50 mm, l 150 mm, e 10 mm) drawn with the crank along x."""
+    x_B = 0.05 + math.sqrt(0.15**2 - 0.01**2)
+    path = tmp_path / "sc.toml"
+    path.write_text(f"""ground = ["O"]
+[joints]
+O = ["0 mm", "0 mm"]
+A = ["50 mm", "0 mm"]
+B = ["{x_B * 1000!r} mm", "10 mm"]
+[links]
+crank = ["O", "A"]
+rod = ["A", "B"]
+piston = ["B"]
+[sliders]
+slide = {{ block = "piston", on = "ground", at = "B", along = "0 deg" }}
+""")
+    drawn = load_linkage(path)
+    hand = Mechanism.from_urdf(models_dir / "slider_crank.urdf")
+    guess = hand.neutral()
+    hand.set_coordinate(guess, "slide", x_B)
+    values = path_to(0.0, np.radians([45.0, 170.0, 300.0]))
+    omega = 3000 * 2 * math.pi / 60
+    ours = follow(drawn, "O", values, omega=omega, links=["rod"])
+    theirs = follow(hand, "O", values, omega=omega, start=guess, links=["rod"])
+    for o, t in zip(ours, theirs):
+        assert o.joints["slide"].q + x_B == pytest.approx(t.joints["slide"].q, abs=POS_TOL)
+        assert o.joints["slide"].a == pytest.approx(t.joints["slide"].a, rel=REL_TOL)
+        np.testing.assert_allclose(o.links["rod"].angular_velocity, t.links["rod"].angular_velocity,
+                                   atol=REL_TOL * omega)
+        angle_close(o.links["rod"].angle, t.links["rod"].angle, 1, "rod")
 
 
 # ------------------------------------------------------------------- six-bars
