@@ -152,8 +152,12 @@ def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
         if len(names) < mechanism.mobility:
             free = mechanism.idle_joints(names)
             if free:
+                single = [n for n in free if n in mechanism.joints and mechanism.joints[n].nv == 1]
+                advice = ("lock it under [lock] or drive it" if len(single) == len(free) else
+                          "a ball joint cannot be locked by one value: give it two hinges across the rod instead "
+                          "(a universal joint), or lock or drive a one-freedom joint")
                 idle = (f"; with those held, {', '.join(free)} can still move (a joint spinning freely, as a rod "
-                        f"about its own axis): lock it under [lock] or drive it")
+                        f"about its own axis): {advice}")
         raise MobilityError(f"{scene.path}, drivers: {mechanism.source} has mobility {mechanism.mobility} "
                             f"({mechanism.model.nv} joint freedoms, {mechanism.rank_report().rank} independent "
                             f"closure equations): drive that many joints; the scene drives {len(names)} ({given})"

@@ -158,7 +158,7 @@ def test_cassie_like_rod_spin_is_named(tmp_path, capsys):
     scene.write_text(f'mjcf = "{MJCF / "leg_ball.xml"}"\n[drivers.hip]\nangle = "10 deg"\n')
     assert main(["solve", str(scene)]) == 5
     err = capsys.readouterr().err
-    assert "rod_ball" in err and "lock" in err and len(err.strip().splitlines()) == 1
+    assert "rod_ball" in err and "universal joint" in err and len(err.strip().splitlines()) == 1
 
 
 def _variant(tmp_path, old: str, new: str, name: str = "four_bar") -> Path:
