@@ -8,11 +8,16 @@ A user's script imports from here only:
 """
 
 from pinmech.analysis import Analysis, Drivers, analyse, load_mechanism
+from pinmech.branches import Assembly
 from pinmech.check import compare, load_hand_file
 from pinmech.closures import Closure
+from pinmech.continuation import Route
 from pinmech.exceptions import (
+    AssemblyError,
     CheckMismatch,
+    DriverLimitError,
     FrameNotFound,
+    IndeterminateForcesError,
     LoopClosureError,
     MobilityError,
     ModelError,
@@ -23,6 +28,17 @@ from pinmech.exceptions import (
     TaskError,
     UnitError,
 )
+from pinmech.flywheel import EnergyFluctuation, energy_fluctuation
+from pinmech.forces import (
+    ForceSolution,
+    ForceSolver,
+    Load,
+    PowerBalance,
+    Reaction,
+    mechanical_advantage,
+)
+from pinmech.forces_scene import ForceSettings, force_settings
+from pinmech.forces_sweep import SweepForces
 from pinmech.linkage import build_urdf, load_linkage
 from pinmech.mechanism import JointInfo, Mechanism
 from pinmech.mjcf import load_mjcf
@@ -34,7 +50,7 @@ from pinmech.scene import Scene
 from pinmech.sidecar import load_extended_urdf
 from pinmech.solve_batch import BatchSolution, BatchSolver
 from pinmech.solve_cycle import RangeChunk, solve_range
-from pinmech.solve_loops import LoopSolver
+from pinmech.solve_loops import LoopSolver, Reference
 from pinmech.solve_rates import RateSolver, Task
 from pinmech.sweep import Sweep, SweepPose
 from pinmech.units import to_si
@@ -44,14 +60,23 @@ __version__ = "0.1.0"
 __all__ = [
     "Accuracy",
     "Analysis",
+    "Assembly",
+    "AssemblyError",
     "BatchSolution",
     "BatchSolver",
     "CheckMismatch",
     "Closure",
     "CoincidentPoint",
+    "DriverLimitError",
     "Drivers",
+    "EnergyFluctuation",
+    "ForceSettings",
+    "ForceSolution",
+    "ForceSolver",
     "FrameNotFound",
+    "IndeterminateForcesError",
     "JointInfo",
+    "Load",
     "LoopClosureError",
     "LoopSolution",
     "LoopSolver",
@@ -61,14 +86,19 @@ __all__ = [
     "Motion",
     "PathPoint",
     "PinmechError",
+    "PowerBalance",
     "RangeChunk",
     "RateSolution",
     "RateSolver",
+    "Reaction",
+    "Reference",
+    "Route",
     "Scene",
     "SceneError",
     "SingularPoseError",
     "Sweep",
     "SweepError",
+    "SweepForces",
     "SweepPose",
     "Task",
     "TaskError",
@@ -77,13 +107,16 @@ __all__ = [
     "analyse",
     "build_urdf",
     "compare",
+    "energy_fluctuation",
     "evaluate_motion",
     "follow_path",
+    "force_settings",
     "load_extended_urdf",
     "load_hand_file",
     "load_linkage",
     "load_mechanism",
     "load_mjcf",
+    "mechanical_advantage",
     "solve_range",
     "to_dict",
     "to_json",

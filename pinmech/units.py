@@ -21,6 +21,9 @@ SI_UNITS: dict[str, str] = {
     "velocity": "meter / second",
     "acceleration": "meter / second ** 2",
     "time": "second",
+    "force": "newton",
+    "torque": "newton * meter",
+    "moment_of_inertia": "kilogram * meter ** 2",
 }
 
 #: For a joint coordinate: the kind of q, v and a for a revolute and a prismatic joint.
@@ -120,6 +123,9 @@ def _example(kind: str) -> str:
         "velocity": "m/s",
         "acceleration": "m/s^2",
         "time": "s",
+        "force": "N",
+        "torque": "N*m",
+        "moment_of_inertia": "kg*m^2",
     }[kind]
 
 
@@ -133,4 +139,7 @@ def format_si(value: float, kind: str) -> str:
         "velocity": "m/s",
         "acceleration": "m/s^2",
         "time": "s",
+        "force": "N",
+        "torque": "N m",
+        "moment_of_inertia": "kg m^2",
     }[kind]
