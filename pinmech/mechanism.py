@@ -170,7 +170,6 @@ class Mechanism:
                 if name in mech.joints:
                     mech.set_coordinate(q, name, value)
             mech.reference = q
-        mech.check_independent()
         return mech
 
     @classmethod
@@ -232,7 +231,6 @@ class Mechanism:
             if mech.reference.shape != (model.nq,):
                 raise ModelError(f"reference has {mech.reference.size} coordinates, the model nq = {model.nq}",
                                  path=source)
-        mech.check_independent()
         return mech
 
     def check_independent(self) -> None:
@@ -245,7 +243,7 @@ class Mechanism:
         if report.rank < report.rows:
             names = ", ".join(report.redundant) or ", ".join(c.name for c in self.closures)
             raise ModelError(f"the loop cuts {names} repeat each other's equations ({report.rows} closure rows of "
-                             f"rank {report.rank} on the closed poses), so the mobility is {self.mobility}, "
+                             f"rank {report.rank} on the closed poses), so the mobility is {self.model.nv - report.rank}, "
                              f"not {self.model.nv - report.rows}; pinmech's loop solver needs independent "
                              f"equations: remove one of {names} (it closes by itself)", path=self.source)
 
@@ -295,12 +293,18 @@ class Mechanism:
 
     @property
     def mobility(self) -> int:
-        """Degrees of freedom left once every loop is closed.
+        """Degrees of freedom left once every loop is closed: what the drivers must number.
 
         The joint freedoms minus the rank of the closure rows on the closed poses near the
         reference configuration (see `pinmech.mobility`): loops that repeat each other
         (a double parallelogram) do not lower it twice.
+
+        Raises:
+            ModelError: the loops repeat each other's equations, which the loop solver cannot
+                take (the message gives the true mobility and the cuts to remove). A mechanism
+                with redundant loops still loads, for force analysis (`ForceSolver`).
         """
+        self.check_independent()
         return self.model.nv - self.rank_report().rank
 
     def rank_report(self):

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pinmech import Mechanism, Scene, analyse
+from pinmech import LoopSolver, Mechanism, Scene, analyse
 from pinmech.cli import main
 from pinmech.exceptions import ModelError
 from pinmech.linkage import load_linkage
@@ -36,8 +36,10 @@ coupler = ["A1", "A2", "A3"]
 def test_double_parallelogram_has_mobility_one_and_is_refused_by_name(tmp_path):
     path = tmp_path / "dp.toml"
     path.write_text(DOUBLE_PARALLELOGRAM)
+    mech = load_linkage(path)  # it loads (forces can use it), but the loop solver cannot:
+    assert mech.model.nv - mech.rank_report().rank == 1
     with pytest.raises(ModelError) as err:
-        load_linkage(path)
+        LoopSolver(mech, ["O1"])
     message = str(err.value)
     # 4 pins in the tree, 2 cuts of 2 rows: rows say 0, the rank (3) says 1
     assert "mobility is 1, not 0" in message and "rank 3" in message and str(path) in message
@@ -57,8 +59,11 @@ def test_a_locking_spherical_cut_does_not_make_mobility_negative(tmp_path):
     <parent link="coupler"/> <parent_origin xyz="0.12 0 0"/> <child link="rocker"/> <child_origin xyz="0.08 0 0"/>
   </constraint></robot>""")
     path = write(tmp_path, "fb.urdf", text)
+    scene = tmp_path / "s.toml"
+    scene.write_text(f'urdf = "{path}"\n[drivers.O2]\nangle = "10 deg"\n')
+    assert main(["solve", str(scene)]) == 3
     with pytest.raises(ModelError, match=r"B, B_again.*mobility is 1, not -1"):
-        Mechanism.from_urdf(path)
+        _ = Mechanism.from_urdf(path).mobility
 
 
 def test_mobility_of_plain_loops_is_unchanged(models_dir):
