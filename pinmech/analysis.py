@@ -182,7 +182,8 @@ def scene_guess(scene: Scene, mechanism: Mechanism) -> np.ndarray:
 def scene_solver(scene: Scene, mechanism: Mechanism, drivers: Drivers) -> LoopSolver:
     """A LoopSolver for the scene, its reference set: the scene file's driver values and
     `[guess]` (with `assembly`, if given, checked), so every pose asked is reached on the
-    scene's assembly by continuation.
+    scene's assembly by continuation. A model drawn closed (a linkage file, MJCF's qpos0)
+    without `[guess]` has its drawn pose as the reference.
 
     Raises:
         SceneError: a malformed `assembly`.
@@ -201,7 +202,12 @@ def scene_solver(scene: Scene, mechanism: Mechanism, drivers: Drivers) -> LoopSo
         assembly = "keep" if asked is None else parse_assembly(asked, solver.structure) or "any"
     except ValueError as exc:
         raise SceneError(str(exc), path=str(scene.path), key="assembly") from None
-    solver.set_reference(ref_drivers.q, scene_guess(scene, mechanism), assembly)
+    if mechanism.reference is not None and not scene.section("guess"):
+        # a drawn linkage, an MJCF file at qpos0: the pose as drawn is the reference assembly
+        drawn = [mechanism.coordinate(mechanism.reference, name) for name in drivers.names]
+        solver.set_reference(drawn, mechanism.neutral(), assembly)
+    else:
+        solver.set_reference(ref_drivers.q, scene_guess(scene, mechanism), assembly)
     return solver
 
 

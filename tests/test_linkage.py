@@ -24,7 +24,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from pinmech import Mechanism
+from pinmech import Mechanism, Scene, analyse
 from pinmech.cli import main
 from pinmech.exceptions import ModelError
 from pinmech.linkage import load_linkage, parse_linkage
@@ -437,3 +437,12 @@ def test_the_readme_jansen_leg_is_under_30_lines_and_the_bundled_one(tmp_path):
     for name, point in bundled.points.items():
         np.testing.assert_array_equal(ours.points[name], point)
     assert load_linkage(path).mobility == 1
+
+
+@pytest.mark.parametrize("angle", [200.0, -150.0, 330.0])
+def test_a_scene_reaches_far_poses_on_the_drawn_assembly(scenes_dir, angle):
+    """The Jansen scene asked for a crank angle far from the drawing: the foot is the compass
+    construction's (same sides as drawn), reached from the drawn pose by continuation."""
+    scene = Scene.load(scenes_dir / "jansen.toml", [f'drivers.O.angle="{angle} deg"'])
+    foot = analyse(scene).motion.points["G"].position[:2]
+    np.testing.assert_allclose(foot, jansen_foot(math.radians(angle)), atol=POS_TOL)
