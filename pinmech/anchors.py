@@ -64,3 +64,51 @@ def anchor_closure(model: pin.Model, cut: AnchorCut, length_scale: float) -> Clo
     z = np.array([0.0, 0.0, 1.0])
     return Closure(cut.name, cut.cut_type, frame_ids[0], frame_ids[1], z, z, parent_link=links[0],
                    child_link=links[1], length_scale=length_scale)
+
+
+def lock_anchored(model: pin.Model, cuts: list[AnchorCut], locked: dict[str, float], reference: np.ndarray | None,
+                  source: str) -> tuple[pin.Model, list[AnchorCut], np.ndarray | None]:
+    """Lock one-freedom joints out of the model, moving each cut side onto the nearest joint
+    left moving (its placement composed at the locked values): the model, cuts, reference.
+
+    Raises:
+        FrameNotFound: a locked joint that is not in the model.
+        ModelError: a locked joint with several freedoms (a ball, a free joint).
+    """
+    from pinmech.exceptions import FrameNotFound
+
+    q_full = pin.neutral(model) if reference is None else np.array(reference, dtype=float)
+    ids = []
+    for name, value in locked.items():
+        if not model.existJointName(name):
+            raise FrameNotFound("joint to lock", name, list(model.names[1:]), path=source)
+        jid = model.getJointId(name)
+        joint = model.joints[jid]
+        if joint.nv != 1:
+            raise ModelError(f"joint '{name}' has {joint.nv} freedoms and cannot be locked by one value", path=source)
+        q_full[joint.idx_q: joint.idx_q + joint.nq] = (np.cos(value), np.sin(value)) if joint.nq == 2 else value
+        ids.append(jid)
+    data = model.createData()
+    pin.forwardKinematics(model, data, q_full)
+    reduced = pin.buildReducedModel(model, ids, q_full)
+
+    def moved(joint: int, placement: pin.SE3) -> tuple[int, pin.SE3]:
+        keep = joint
+        while keep in ids:
+            keep = model.parents[keep]
+        new_id = reduced.getJointId(model.names[keep]) if keep else 0
+        return new_id, data.oMi[keep].actInv(data.oMi[joint]) * placement
+
+    new_cuts = []
+    for cut in cuts:
+        j1, m1 = moved(cut.joint1, cut.placement1)
+        j2, m2 = moved(cut.joint2, cut.placement2)
+        new_cuts.append(AnchorCut(cut.name, cut.cut_type, j1, m1, j2, m2))
+    q_reduced = None
+    if reference is not None:
+        q_reduced = pin.neutral(reduced)
+        for jid in range(1, reduced.njoints):
+            old = model.joints[model.getJointId(reduced.names[jid])]
+            new = reduced.joints[jid]
+            q_reduced[new.idx_q: new.idx_q + new.nq] = q_full[old.idx_q: old.idx_q + old.nq]
+    return reduced, new_cuts, q_reduced

@@ -183,6 +183,7 @@ class Mechanism:
         source: str = "<model>",
         reference: np.ndarray | None = None,
         urdf_path: str | None = None,
+        locked: dict[str, float] | None = None,
     ) -> Mechanism:
         """A mechanism from a `pin.Model` and Pinocchio constraint models, as built in code.
 
@@ -196,14 +197,20 @@ class Mechanism:
             source: what to call the model in messages (its file).
             reference: a configuration at which the loops close (default: neutral).
             urdf_path: a URDF with the visuals, if any (for drawings).
+            locked: one-freedom joints to lock out, name -> value [rad or m]; the cuts on
+                them move to the nearest joint left moving.
 
         Raises:
-            ModelError: an unknown constraint class or type, a joint id out of range.
+            ModelError: an unknown constraint class or type, a joint id out of range, a
+                locked joint with several freedoms.
+            FrameNotFound: a locked joint the model lacks.
         """
         model = pin.Model(model)
-        from pinmech.anchors import anchor_closure, anchor_cut
+        from pinmech.anchors import anchor_closure, anchor_cut, lock_anchored
 
         cuts = [anchor_cut(c, i, names, model, source) for i, c in enumerate(constraints)]
+        if locked:
+            model, cuts, reference = lock_anchored(model, cuts, locked, reference, source)
         listed = [c.name for c in cuts]
         for name in listed:
             if listed.count(name) > 1:
@@ -221,7 +228,7 @@ class Mechanism:
         mech = cls(model=model, closures=[], joints=_joint_infos(model, joint_links),
                    links={n: _body_frame(model, n) for n in bodies},
                    points={n: model.getFrameId(n) for n in points}, length_scale=1.0, plane_normal=None,
-                   source=source, urdf_path=urdf_path)
+                   source=source, urdf_path=urdf_path, locked=dict(locked or {}))
         mech.length_scale = _length_scale(model, source)
         mech.closures = [anchor_closure(model, cut, mech.length_scale) for cut in cuts]
         _reduce_rows(mech)

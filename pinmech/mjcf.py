@@ -171,14 +171,11 @@ def load_mjcf(path: str | Path, *, locked: dict[str, float] | None = None) -> Me
 
     Raises:
         ModelError: a malformed file, an equality pinmech cannot close, a connect whose sites
-            do not meet at qpos0, a tree Pinocchio cannot build, locked joints (not supported).
+            do not meet at qpos0, a tree Pinocchio cannot build, a locked ball joint.
     """
     path = Path(path)
     source = str(path)
     root = _parse(path)
-    if locked:
-        raise ModelError(f"[lock] is not supported for MJCF models yet ({', '.join(locked)}): give the joint a "
-                         "range of zero in the file, or drive it", path=source)
     connects, welds, elements = _equalities(root, source)
     if root.find("worldbody") is not None and root.find("worldbody").find(".//frame") is not None:
         raise ModelError("Pinocchio's parser drops a <frame> with every body in it: write those bodies without "
@@ -195,6 +192,9 @@ def load_mjcf(path: str | Path, *, locked: dict[str, float] | None = None) -> Me
                                 reference=qpos0, urdf_path=str(wrapped))
     _check_sites(mech, elements, source)
     _check_closed(mech, source)
+    if locked:  # checked as drawn; then the joints the scene holds are locked out
+        mech = Mechanism.from_model(model, points + frames, names=connects + welds, source=source,
+                                    reference=qpos0, urdf_path=str(wrapped), locked=locked)
     return mech
 
 

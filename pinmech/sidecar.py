@@ -90,9 +90,6 @@ def load_extended_urdf(urdf: str | Path, sidecar: str | Path, *,
     root = _parse_xml(urdf)
     model = _build_model(str(urdf))
     model = _changed_joints(model, content["joint_name"], content["joint_type"], str(sidecar))
-    if locked:
-        raise ModelError(f"[lock] is not supported with a sidecar yet ({', '.join(locked)}): add the joints to "
-                         "joint_name with joint_type FIXED", path=str(sidecar))
     constraints, names = [], []
     for (a, b), kind in zip(content["closed_loop"], content["type"]):
         for name in (a, b):
@@ -105,7 +102,7 @@ def load_extended_urdf(urdf: str | Path, sidecar: str | Path, *,
         names.append(f"{a}C{b}")
     points = [n for n in _point_links(root) if model.existFrame(n)]
     mech = Mechanism.from_model(model, constraints, names=names, points=points, source=str(urdf),
-                                urdf_path=str(urdf))
+                                urdf_path=str(urdf), locked=locked)
     for motor in content["name_mot"]:
         if motor not in mech.joints:
             raise ModelError(f"motor '{motor}' is not a joint of {urdf.name} (joints: {', '.join(mech.joints)})",

@@ -283,3 +283,20 @@ def test_a_one_joint_model_loads(tmp_path):
       <geom type="sphere" size="0.01"/><site name="tip" pos="0.1 0 0"/></body></worldbody></mujoco>""")
     mech = load_mjcf(path)
     assert mech.mobility == 1 and mech.plane_normal is not None
+
+
+def test_lock_in_an_mjcf_scene(tmp_path):
+    """[lock] O2 = 0.5 rad on the MJCF four-bar: nothing left to drive, and the pose is the one
+    the unlocked four-bar has with O2 driven to 0.5 rad; a ball joint cannot be locked."""
+    locked = load_mjcf(MJCF / "four_bar.xml", locked={"O2": 0.5})
+    assert locked.mobility == 0 and locked.locked == {"O2": 0.5}
+    q = LoopSolver(locked, []).solve([], guess=locked.neutral()).q
+    free = load_mjcf(MJCF / "four_bar.xml")
+    q_free = LoopSolver(free, ["O2"]).solve([0.5], guess=free.neutral()).q
+    data, data_free = locked.model.createData(), free.model.createData()
+    pin.framesForwardKinematics(locked.model, data, q)
+    pin.framesForwardKinematics(free.model, data_free, q_free)
+    np.testing.assert_allclose(data.oMf[locked.points["P"]].translation, data_free.oMf[free.points["P"]].translation,
+                               atol=1e-12)
+    with pytest.raises(ModelError, match="rod_ball.*3 freedoms"):
+        load_mjcf(MJCF / "leg_ball.xml", locked={"rod_ball": 0.0})

@@ -156,3 +156,19 @@ def test_joint_changes_fixed_and_spherical(tmp_path):
     ball = load_extended_urdf(FIVE[0], sidecar)
     assert ball.joints["elbow1"].nq == 4 and ball.mobility == 3
     assert ball.idle_joints(["mot1", "mot2"]) == ["elbow1"]
+
+
+def test_locking_the_joint_that_carries_a_cut_moves_the_cut_onto_its_parent():
+    """elbow2 locked at 0.2 rad: distal2 (which carries closedloop1_B) joins proximal2. Driving
+    mot1 must give the pose of the unlocked five-bar driven by mot1 and elbow2 = 0.2."""
+    locked = load_extended_urdf(*FIVE, locked={"elbow2": 0.2})
+    assert "elbow2" not in locked.joints and locked.mobility == 1
+    free = load_extended_urdf(*FIVE)
+    q_free = LoopSolver(free, ["mot1", "elbow2"]).solve([-0.1, 0.2], guess=free.neutral()).q
+    q_locked = LoopSolver(locked, ["mot1"]).solve([-0.1], guess=locked.neutral()).q
+    d_free, d_locked = free.model.createData(), locked.model.createData()
+    pin.framesForwardKinematics(free.model, d_free, q_free)
+    pin.framesForwardKinematics(locked.model, d_locked, q_locked)
+    for point in ("closedloop1_A", "closedloop1_B"):
+        np.testing.assert_allclose(d_locked.oMf[locked.points[point]].translation,
+                                   d_free.oMf[free.points[point]].translation, atol=1e-12)
