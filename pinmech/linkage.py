@@ -38,7 +38,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 GROUND = "ground"
-_KEYS = {"title", "ground", "params", "joints", "links", "sliders", "slots", "colors"}
+_KEYS = {"title", "ground", "params", "joints", "links", "sliders", "slots", "colors", "axes", "balls"}
 
 @dataclass(frozen=True)
 class Edge:
@@ -50,6 +50,7 @@ class Edge:
         links: the two links it joins.
         at: its point in the world at the drawn pose [m] (x, y).
         direction: unit direction of a slide, world frame at the drawn pose.
+        axis: unit axis of a pin in a spatial linkage, world frame at the drawn pose.
     """
 
     name: str
@@ -57,6 +58,7 @@ class Edge:
     links: tuple[str, str]
     at: np.ndarray
     direction: np.ndarray | None = None
+    axis: np.ndarray | None = None
 
 
 @dataclass
@@ -70,6 +72,8 @@ class Linkage:
         point_links: named point -> the one link it is fixed on.
         blocks: block link -> the slide it moves on (sliders' blocks, slots' hidden blocks).
         hidden: links added for pin-in-slot joints (no visual of their own).
+        spatial: points are 3-D (x, y, z) and pins have their own axes (`[axes]`), balls
+            (`balls = [...]`) are spherical joints; else planar, in z = 0, axes along z.
     """
 
     source: str
@@ -80,6 +84,9 @@ class Linkage:
     point_links: dict[str, str]
     blocks: dict[str, Edge] = field(default_factory=dict)
     hidden: set[str] = field(default_factory=set)
+    spatial: bool = False
+    axes: dict[str, np.ndarray] = field(default_factory=dict)
+    balls: set[str] = field(default_factory=set)
 
 
 # ------------------------------------------------------------------------- reading
@@ -119,6 +126,7 @@ def parse_linkage(path: str | Path) -> Linkage:
     if len(links) < 2:
         raise ModelError("no link: list the moving links under [links]", path=source)
     linkage = Linkage(source, str(raw.get("title", path.stem)), points, links, [], {})
+    _spatial(linkage, raw, source)
     _pins(linkage)
     for name, spec in _table(raw, "sliders", source).items():
         _slider(linkage, reader, name, spec)
@@ -183,10 +191,10 @@ class _Reader:
         for name, spec in table.items():
             where = f"[joints] {name}"
             if isinstance(spec, list):
-                if len(spec) != 2:
-                    raise ModelError(f"give two coordinates [x, y] with units, got {spec!r}", path=self.source,
-                                     element=where)
-                out[name] = np.array([self.length(spec[0], f"{where} x"), self.length(spec[1], f"{where} y")])
+                if len(spec) not in (2, 3):
+                    raise ModelError(f"give coordinates [x, y] (or [x, y, z]) with units, got {spec!r}",
+                                     path=self.source, element=where)
+                out[name] = np.array([self.length(v, f"{where} {c}") for v, c in zip(spec, "xyz")])
             elif isinstance(spec, dict):
                 out[name] = self._construction(name, spec, out, where)
             else:
@@ -210,7 +218,7 @@ class _Reader:
                 raise ModelError("a polar construction has exactly from, length, angle", path=self.source,
                                  element=where)
             r, phi = self.length(spec["length"], f"{where} length"), self.angle(spec["angle"], f"{where} angle")
-            return known[bases[0]] + r * np.array([math.cos(phi), math.sin(phi)])
+            return known[bases[0]][:2] + r * np.array([math.cos(phi), math.sin(phi)])
         if len(bases) != 2 or set(spec) != {"from", "lengths", "side"}:
             raise ModelError("a compass construction has exactly from = [\"A\", \"B\"], lengths = [|A..|, |B..|], "
                              "side = \"left\" or \"right\" (of the line A -> B)", path=self.source, element=where)
@@ -221,7 +229,7 @@ class _Reader:
             raise ModelError(f"side must be \"left\" or \"right\", got {spec['side']!r}", path=self.source,
                              element=where)
         r1, r2 = (self.length(v, f"{where} lengths") for v in lengths)
-        return _compass(known[bases[0]], known[bases[1]], r1, r2, spec["side"] == "left",
+        return _compass(known[bases[0]][:2], known[bases[1]][:2], r1, r2, spec["side"] == "left",
                         f"{self.source}, {where}")
 
 
@@ -238,6 +246,35 @@ def _compass(a: np.ndarray, b: np.ndarray, r1: float, r2: float, left: bool, whe
     return a + along * u + (across if left else -across) * normal
 
 
+def _spatial(linkage: Linkage, raw: dict[str, Any], source: str) -> None:
+    """3-D coordinates, `[axes]` or `balls`: a spatial linkage (2-D entries lie in z = 0)."""
+    axes = _table(raw, "axes", source)
+    balls = _names(raw.get("balls", []), "balls", source)
+    linkage.spatial = bool(axes or balls or any(p.size == 3 for p in linkage.points.values()))
+    if not linkage.spatial:
+        return
+    linkage.points = {n: np.append(p, 0.0) if p.size == 2 else p for n, p in linkage.points.items()}
+    z = np.array([0.0, 0.0, 1.0])
+    for name in linkage.points:
+        linkage.axes[name] = z
+    for name, value in axes.items():
+        where = f"[axes] {name}"
+        if name not in linkage.points:
+            raise ModelError(f"'{name}' is not a joint of [joints]", path=source, element=where)
+        if (not isinstance(value, list) or len(value) != 3
+                or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
+            raise ModelError(f"an axis is three numbers, e.g. [0, 0, 1], got {value!r}", path=source, element=where)
+        axis = np.array(value, dtype=float)
+        norm = float(np.linalg.norm(axis))
+        if not (math.isfinite(norm) and norm > 0):
+            raise ModelError(f"{value!r} is not a direction", path=source, element=where)
+        linkage.axes[name] = axis / norm
+    for name in balls:
+        if name not in linkage.points:
+            raise ModelError(f"'{name}' is not a joint of [joints]", path=source, element="balls")
+    linkage.balls = set(balls)
+
+
 def _pins(linkage: Linkage) -> None:
     """Names on two or more links become pins (split into pairs), on one link points."""
     carriers: dict[str, list[str]] = {}
@@ -248,9 +285,11 @@ def _pins(linkage: Linkage) -> None:
         if len(on) == 1:
             linkage.point_links[name] = on[0]
             continue
+        kind = "spherical" if name in linkage.balls else "revolute"
         for other in on[1:]:
             label = name if len(on) == 2 else f"{name}_{other}"
-            linkage.edges.append(Edge(label, "revolute", (on[0], other), linkage.points[name]))
+            linkage.edges.append(Edge(label, kind, (on[0], other), linkage.points[name],
+                                      axis=linkage.axes.get(name) if linkage.spatial else None))
 
 
 def _link(linkage: Linkage, value: Any, key: str, where: str) -> str:
@@ -276,7 +315,7 @@ def _direction(linkage: Linkage, reader: _Reader, spec: dict[str, Any], at: np.n
                              path=linkage.source, element=where)
         return vector / np.linalg.norm(vector)
     phi = reader.angle(along, f"{where} along")
-    return np.array([math.cos(phi), math.sin(phi)])
+    return np.array([math.cos(phi), math.sin(phi), 0.0][: at.size])
 
 
 def _slider(linkage: Linkage, reader: _Reader, name: str, spec: Any) -> None:
@@ -305,6 +344,9 @@ def _slot(linkage: Linkage, reader: _Reader, name: str, spec: Any) -> None:
     if not isinstance(spec, dict) or not set(spec) <= {"pin", "slot", "along"}:
         raise ModelError("a pin-in-slot joint is {pin = LINK, slot = LINK, along = ANGLE or [P, Q]}",
                          path=linkage.source, element=where)
+    if linkage.spatial:
+        raise ModelError("pin-in-slot joints are planar only: in a spatial linkage, give the block as a link "
+                         "with a slider and a pin", path=linkage.source, element=where)
     pin_link = _link(linkage, spec.get("pin"), "pin", where)
     slot_link = _link(linkage, spec.get("slot"), "slot", where)
     if name not in linkage.points:

@@ -24,13 +24,12 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from pinmech import Mechanism, Scene, analyse
+from pinmech import LoopSolver, Mechanism, Scene, analyse
 from pinmech.cli import main
 from pinmech.exceptions import ModelError
 from pinmech.linkage import load_linkage, parse_linkage
 from pinmech.linkage_urdf import linkage_urdf
 from pinmech.motion import evaluate_motion
-from pinmech.solve_loops import LoopSolver
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
 import closed_form as cf
@@ -446,3 +445,85 @@ def test_a_scene_reaches_far_poses_on_the_drawn_assembly(scenes_dir, angle):
     scene = Scene.load(scenes_dir / "jansen.toml", [f'drivers.O.angle="{angle} deg"'])
     foot = analyse(scene).motion.points["G"].position[:2]
     np.testing.assert_allclose(foot, jansen_foot(math.radians(angle)), atol=POS_TOL)
+
+
+# ------------------------------------------------------------------- spatial
+def test_spatial_rsur_drawn_moves_as_the_hand_urdf(tmp_path):
+    """The RSUR of tests/_mechanisms.py, drawn where the hand URDF closes at R1 = 0.3 rad (its
+    joint positions and axes read off Pinocchio there), a ball S as the cut: every joint's
+    coordinate from the drawn pose plus its drawn value is the hand model's, with equal rates."""
+    from tests._mechanisms import spatial_rsur_urdf, write
+
+    hand = Mechanism.from_urdf(write(tmp_path, "rsur.urdf", spatial_rsur_urdf()))
+    solver = LoopSolver(hand, ["R1"])
+    drawn_q = solver.solve([0.3], guess=hand.neutral()).q
+    data = hand.model.createData()
+    pin.framesForwardKinematics(hand.model, data, drawn_q)
+    at = {n: data.oMi[hand.model.getJointId(n)] for n in ("R1", "U1", "U2", "R4")}
+    S = data.oMf[hand.closures[0].parent_frame].translation
+
+    def mm(v):
+        return "[" + ", ".join(f'"{float(x) * 1000!r} mm"' for x in v) + "]"
+
+    def axis(name, local):
+        return "[" + ", ".join(repr(float(x)) for x in at[name].rotation @ np.array(local)) + "]"
+
+    path = tmp_path / "rsur.toml"
+    path.write_text(f"""ground = ["R1", "R4"]
+balls = ["S"]
+[joints]
+R1 = {mm(at["R1"].translation)}
+U1 = {mm(at["U1"].translation)}
+U2 = {mm(at["U2"].translation)}
+S = {mm(S)}
+R4 = {mm(at["R4"].translation)}
+[axes]
+R1 = {axis("R1", [0, 0, 1])}
+U1 = {axis("U1", [0, 0, 1])}
+U2 = {axis("U2", [0, 1, 0])}
+R4 = {axis("R4", [1, 0, 0])}
+[links]
+crank = ["R1", "U1"]
+cross = ["U1", "U2"]
+coupler = ["U2", "S"]
+rocker = ["R4", "S"]
+""")
+    mech = load_linkage(path)
+    assert mech.mobility == 1 and mech.plane_normal is None
+    assert [(c.name, c.cut_type) for c in mech.closures] == [("S", "spherical")]
+    ours, theirs = LoopSolver(mech, ["R1"]), solver
+    q_ours, q_hand = mech.neutral(), drawn_q
+    for r1 in (0.4, 0.6, 0.2, 0.0, -0.2):
+        a = ours.solve([r1 - 0.3], [1.5], [0.0], guess=q_ours)
+        b = theirs.solve([r1], [1.5], [0.0], guess=q_hand)
+        q_ours, q_hand = a.q, b.q
+        for name in ("U1", "U2", "R4"):
+            assert mech.coordinate(a.q, name) + hand.coordinate(drawn_q, name) == pytest.approx(
+                hand.coordinate(b.q, name), abs=1e-11)
+            assert a.v[mech.joints[name].idx_v] == pytest.approx(b.v[hand.joints[name].idx_v], abs=1e-10)
+
+
+def test_spatial_errors(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text(BASE + "[axes]\nA = [0, 0]\n")
+    with pytest.raises(ModelError, match=r"\[axes\] A.*three numbers"):
+        load_linkage(path)
+    path.write_text(BASE + "[axes]\nZ = [0, 0, 1]\n")
+    with pytest.raises(ModelError, match=r"\[axes\] Z.*not a joint"):
+        load_linkage(path)
+    path.write_text(BASE + "[axes]\nA = [0, 0, 0]\n")
+    with pytest.raises(ModelError, match=r"\[axes\] A.*not a direction"):
+        load_linkage(path)
+
+
+def test_a_planar_linkage_written_in_3d_moves_as_the_planar_one(tmp_path):
+    """The four-bar with z coordinates and z axes given: spatial writer, same motion."""
+    path = tmp_path / "fb3.toml"
+    path.write_text(BASE.replace('O2 = ["0 mm", "0 mm"]', 'O2 = ["0 mm", "0 mm", "0 mm"]'))
+    mech = load_linkage(path)
+    motion = follow(mech, "O2", path_to(0.0, [1.0]), omega=2.0, links=["rocker"])[-1]
+    ref = cf.four_bar(1.0, 2.0, 0.0, 0.04, 0.12, 0.08, 0.10, branch=+1)
+    theta4_drawn = cf.four_bar(0.0, 0.0, 0.0, 0.04, 0.12, 0.08, 0.10, branch=+1).theta4
+    # spatial frames are world-aligned at the drawing: the rocker turned by theta4 - theta4(0)
+    angle_close(motion.links["rocker"].angle, ref.theta4 - theta4_drawn, 1, "theta4")
+    assert motion.links["rocker"].angular_velocity[2] == pytest.approx(ref.omega4, abs=1e-9)
