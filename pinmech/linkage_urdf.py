@@ -321,7 +321,7 @@ def _spatial_joint_xml(edge: Edge, parent: str, child: str, origin: dict[str, np
 
 
 def _spatial_link_xml(linkage: Linkage, link: str, origin: np.ndarray, size: float, index: int) -> list[str]:
-    """Cylinders between a link's joints in turn, a ball at each joint; pivots for the ground."""
+    """Cylinders between a link's joints in turn, a ball at each joint; the ground: its pivots only."""
     width = 0.02 * size
     material = "ground" if link == GROUND else f"c{(index - 1) % len(_COLOURS)}"
     local = [linkage.points[n] - origin for n in linkage.links[link]]
@@ -329,7 +329,7 @@ def _spatial_link_xml(linkage: Linkage, link: str, origin: np.ndarray, size: flo
     if link != GROUND:
         out.append('    <inertial><mass value="1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" '
                    'iyz="0"/></inertial>')
-    ring = local + local[:1] if len(local) > 2 else local[:2]  # a closed outline, or one bar
+    ring = [] if link == GROUND else local + local[:1] if len(local) > 2 else local[:2]  # outline, or a bar
     pairs = [(ring[i], ring[i + 1]) for i in range(len(ring) - 1)]
     for p, q in pairs:
         length = float(np.linalg.norm(q - p))
