@@ -527,3 +527,10 @@ def test_a_planar_linkage_written_in_3d_moves_as_the_planar_one(tmp_path):
     # spatial frames are world-aligned at the drawing: the rocker turned by theta4 - theta4(0)
     angle_close(motion.links["rocker"].angle, ref.theta4 - theta4_drawn, 1, "theta4")
     assert motion.links["rocker"].angular_velocity[2] == pytest.approx(ref.omega4, abs=1e-9)
+
+
+@pytest.mark.parametrize("scene", ["jansen", "four_bar_drawn", "rsur_drawn", "four_bar_mjcf", "leg_mjcf", "five_bar",
+                                   "delta"])
+def test_bundled_scenes_of_other_formats_solve(scenes_dir, scene, capsys):
+    assert main(["solve", str(scenes_dir / f"{scene}.toml"), "--json"]) == 0
+    assert capsys.readouterr().out.lstrip().startswith("{")
