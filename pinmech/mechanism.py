@@ -252,7 +252,8 @@ class Mechanism:
             raise ModelError(f"the loop cuts {names} repeat each other's equations ({report.rows} closure rows of "
                              f"rank {report.rank} on the closed poses), so the mobility is {self.model.nv - report.rank}, "
                              f"not {self.model.nv - report.rows}; pinmech's loop solver needs independent "
-                             f"equations: remove one of {names} (it closes by itself)", path=self.source)
+                             f"equations: leave out one of {names} (and a link only it held, whose motion "
+                             f"repeats the others')", path=self.source)
 
     def add_point(self, name: str, link: str, xyz: np.ndarray) -> int:
         """Fix a named point on a link, at `xyz` [m] in the link's frame; its frame id.
