@@ -40,13 +40,16 @@ from pinmech.forces import (
 )
 from pinmech.forces_scene import ForceSettings, force_settings
 from pinmech.forces_sweep import SweepForces
+from pinmech.linkage import build_urdf, load_linkage
 from pinmech.mechanism import JointInfo, Mechanism
+from pinmech.mjcf import load_mjcf
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.path import PathPoint, follow_path
 from pinmech.polygon import Polygon, acceleration_polygon, velocity_polygon
 from pinmech.report import to_dict, to_json, to_text
 from pinmech.results import Accuracy, LoopSolution, RateSolution
 from pinmech.scene import Scene
+from pinmech.sidecar import load_extended_urdf
 from pinmech.solve_batch import BatchSolution, BatchSolver
 from pinmech.solve_cycle import RangeChunk, solve_range
 from pinmech.solve_loops import LoopSolver, Reference
@@ -107,13 +110,17 @@ __all__ = [
     "__version__",
     "acceleration_polygon",
     "analyse",
+    "build_urdf",
     "compare",
     "energy_fluctuation",
     "evaluate_motion",
     "follow_path",
     "force_settings",
+    "load_extended_urdf",
     "load_hand_file",
+    "load_linkage",
     "load_mechanism",
+    "load_mjcf",
     "mechanical_advantage",
     "report_html",
     "snapshot",

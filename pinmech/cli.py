@@ -170,6 +170,11 @@ def build_parser() -> argparse.ArgumentParser:
     _add_scene_arguments(live)
     live.set_defaults(func=cmd_view)
 
+    build = sub.add_parser("build", help="write the URDF (with <constraint> loop cuts) of a linkage drawn in TOML")
+    build.add_argument("linkage", help="linkage file (TOML), e.g. models/linkages/jansen.toml")
+    build.add_argument("-o", "--output", required=True, help="the URDF file to write")
+    build.set_defaults(func=cmd_build)
+
     check = sub.add_parser("check", help="compare hand-calculated values with pinmech")
     check.add_argument("hand_file", help="hand-value file (TOML), e.g. models/scenes/r_rtr.hand.toml")
     check.add_argument("--slack", type=float, default=None,
@@ -461,7 +466,14 @@ def _visuals(mechanism):
     from pinmech.draw import load_visuals
     from pinmech.draw.sketch import sketch_visuals
 
-    return sketch_visuals(mechanism, load_visuals(mechanism.source, mechanism.model))
+    path = mechanism.urdf_path or mechanism.source
+    if str(path).endswith(".xml"):
+        from pinmech.mjcf import mjcf_visuals
+
+        visuals = mjcf_visuals(path, mechanism.model)
+    else:
+        visuals = load_visuals(path, mechanism.model)
+    return sketch_visuals(mechanism, visuals)
 
 
 def cmd_snapshot(args: argparse.Namespace) -> int:
@@ -545,6 +557,21 @@ def cmd_report(args: argparse.Namespace) -> int:
         verdicts = compare(to_dict(checked), hand.values, DEFAULT_SLACK)
         hand_text = f"{hand.source or hand.path}  vs  pinmech on {hand.scene.name}\n" + format_verdicts(verdicts)
     _write_text(args.output, report_html(analysis, steps=args.steps, hand_text=hand_text), "offline page")
+    return 0
+
+
+def cmd_build(args: argparse.Namespace) -> int:
+    """`pinmech build LINKAGE -o FILE.urdf`: the URDF of a drawn linkage, written whole or not at all."""
+    from pinmech.linkage import build_urdf
+    from pinmech.linkage_urdf import spanning_tree
+
+    try:
+        linkage = build_urdf(args.linkage, args.output)
+    except OSError as exc:
+        raise PinmechError(f"cannot write {args.output}: {exc.strerror or exc}") from exc
+    cuts = [edge.name for edge in spanning_tree(linkage).cuts]
+    print(f"{args.output} written: {len(linkage.links) - 1} links, {len(linkage.edges) - len(cuts)} tree joints, "
+          f"loop cuts: {', '.join(cuts) or 'none'}")
     return 0
 
 

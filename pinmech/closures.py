@@ -141,8 +141,9 @@ class Closure:
         Needs `pin.computeJointJacobians` and `pin.updateFramePlacements` at q.
         """
         M_P, M_C = data.oMf[self.parent_frame], data.oMf[self.child_frame]
-        J_P = pin.getFrameJacobian(model, data, self.parent_frame, _LWA)
-        J_C = pin.getFrameJacobian(model, data, self.child_frame, _LWA)
+        # (6, nv) even for a one-dof model, where Pinocchio returns a (6,) vector
+        J_P = pin.getFrameJacobian(model, data, self.parent_frame, _LWA).reshape(6, -1)
+        J_C = pin.getFrameJacobian(model, data, self.child_frame, _LWA).reshape(6, -1)
         delta = M_C.translation - M_P.translation
         R_T = M_P.rotation.T
         linear = R_T @ (J_C[:3] - J_P[:3] + pin.skew(delta) @ J_P[3:])

@@ -19,8 +19,10 @@ import os
 import sys
 import tempfile
 import xml.etree.ElementTree as ET
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -74,6 +76,12 @@ class Mechanism:
         length_scale: size of the mechanism [m]; position tolerances are relative to it.
         plane_normal: unit normal of the motion plane for a planar mechanism, else None.
         locked: joints locked out of the model, with their values (SI).
+        urdf_path: the URDF the model was built from, when `source` is another file (a
+            linkage drawn in TOML, an MJCF file): drawings read their visuals from it.
+        reference: the reference configuration (the drawn pose of a linkage), else None
+            (the neutral configuration is the reference).
+        motors: the actuated joints a file names (a Gepetto sidecar's name_mot): the
+            default drivers.
     """
 
     model: pin.Model
@@ -85,6 +93,10 @@ class Mechanism:
     plane_normal: np.ndarray | None
     source: str = "<model>"
     locked: dict[str, float] = field(default_factory=dict)
+    urdf_path: str | None = None
+    reference: np.ndarray | None = None
+    motors: list[str] = field(default_factory=list)
+    _rank: object = field(default=None, repr=False, compare=False)
 
     # ---------------------------------------------------------------- construction
     @classmethod
@@ -95,6 +107,7 @@ class Mechanism:
         locked: dict[str, float] | None = None,
         package_dirs: list[str] | None = None,
         root_joint: str | None = None,
+        reference: dict[str, float] | None = None,
     ) -> Mechanism:
         """Load a URDF with its `<constraint>` loop cuts.
 
@@ -108,6 +121,8 @@ class Mechanism:
                 (a floating base, joint "root_joint", nq 7 / nv 6, as example-robot-data
                 builds humanoids). A free flyer cannot be locked by one value: leave it
                 out (None) when a scene holds the base still.
+            reference: joint name -> coordinate [rad or m] of a closed reference pose (a
+                linkage's drawn pose); the others stay at zero. Default: all zero.
 
         Raises:
             ModelError: malformed XML or URDF, or a malformed `<constraint>`.
@@ -149,7 +164,108 @@ class Mechanism:
         mech.closures = [_make_closure(model, c, mech.length_scale) for c in cuts]
         _reduce_rows(mech)
         mech.plane_normal = _plane_normal(mech)
+        if reference:
+            q = pin.neutral(model)
+            for name, value in reference.items():
+                if name in mech.joints:
+                    mech.set_coordinate(q, name, value)
+            mech.reference = q
         return mech
+
+    @classmethod
+    def from_model(
+        cls,
+        model: pin.Model,
+        constraints: Sequence[Any] = (),
+        *,
+        names: Sequence[str] | None = None,
+        points: Sequence[str] | None = None,
+        source: str = "<model>",
+        reference: np.ndarray | None = None,
+        urdf_path: str | None = None,
+        locked: dict[str, float] | None = None,
+    ) -> Mechanism:
+        """A mechanism from a `pin.Model` and Pinocchio constraint models, as built in code.
+
+        Args:
+            model: the kinematic tree (copied: frames are added to the copy, not to it).
+            constraints: `pin.PointAnchorConstraintModel` (a ball joint: spherical cut),
+                `pin.FrameAnchorConstraintModel` (a weld: fixed cut), or the legacy
+                `pin.RigidConstraintModel` of type CONTACT_3D or CONTACT_6D.
+            names: the loop cuts' names (default: each constraint's name, else "loop1", ...).
+            points: frames reported as named points (default: every OP_FRAME, e.g. MJCF sites).
+            source: what to call the model in messages (its file).
+            reference: a configuration at which the loops close (default: neutral).
+            urdf_path: a URDF with the visuals, if any (for drawings).
+            locked: one-freedom joints to lock out, name -> value [rad or m]; the cuts on
+                them move to the nearest joint left moving.
+
+        Raises:
+            ModelError: an unknown constraint class or type, a joint id out of range, a
+                locked joint with several freedoms.
+            FrameNotFound: a locked joint the model lacks.
+        """
+        model = pin.Model(model)
+        from pinmech.anchors import anchor_closure, anchor_cut, lock_anchored
+
+        cuts = [anchor_cut(c, i, names, model, source) for i, c in enumerate(constraints)]
+        if locked:
+            model, cuts, reference = lock_anchored(model, cuts, locked, reference, source)
+        listed = [c.name for c in cuts]
+        for name in listed:
+            if listed.count(name) > 1:
+                raise ModelError(f"two constraints share the name '{name}'", path=source)
+        bodies = [f.name for f in model.frames if f.type == pin.FrameType.BODY]
+        joint_links = {}
+        for jid in range(1, model.njoints):
+            child = next((f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == jid),
+                         model.names[jid])
+            parent = next((f.name for f in model.frames if f.type == pin.FrameType.BODY
+                           and f.parentJoint == model.parents[jid]), "universe")
+            joint_links[model.names[jid]] = (parent, child)
+        if points is None:
+            points = [f.name for f in model.frames if f.type == pin.FrameType.OP_FRAME]
+        mech = cls(model=model, closures=[], joints=_joint_infos(model, joint_links),
+                   links={n: _body_frame(model, n) for n in bodies},
+                   points={n: model.getFrameId(n) for n in points}, length_scale=1.0, plane_normal=None,
+                   source=source, urdf_path=urdf_path, locked=dict(locked or {}))
+        mech.length_scale = _length_scale(model, source)
+        mech.closures = [anchor_closure(model, cut, mech.length_scale) for cut in cuts]
+        _reduce_rows(mech)
+        mech.plane_normal = _plane_normal(mech)
+        if reference is not None:
+            mech.reference = np.array(reference, dtype=float)
+            if mech.reference.shape != (model.nq,):
+                raise ModelError(f"reference has {mech.reference.size} coordinates, the model nq = {model.nq}",
+                                 path=source)
+        return mech
+
+    def check_independent(self) -> None:
+        """Refuse loops whose equations repeat each other: the loop solver needs them independent.
+
+        Raises:
+            ModelError: naming the cuts, the row count, the rank and the true mobility.
+        """
+        report = self.rank_report()
+        if report.rank < report.rows:
+            names = ", ".join(report.redundant) or ", ".join(c.name for c in self.closures)
+            raise ModelError(f"the loop cuts {names} repeat each other's equations ({report.rows} closure rows of "
+                             f"rank {report.rank} on the closed poses), so the mobility is {self.model.nv - report.rank}, "
+                             f"not {self.model.nv - report.rows}; pinmech's loop solver needs independent "
+                             f"equations: leave out one of {names} (and a link only it held, whose motion "
+                             f"repeats the others')", path=self.source)
+
+    def add_point(self, name: str, link: str, xyz: np.ndarray) -> int:
+        """Fix a named point on a link, at `xyz` [m] in the link's frame; its frame id.
+
+        Call before creating solvers: a `pin.Data` made earlier lacks the new frame.
+        """
+        body_id = self.links[link]
+        body = self.model.frames[body_id]
+        frame = pin.Frame(name, body.parentJoint, body_id, body.placement * pin.SE3(np.eye(3), np.asarray(xyz, float)),
+                          pin.FrameType.OP_FRAME)
+        self.points[name] = self.model.addFrame(frame, False)
+        return self.points[name]
 
     # ---------------------------------------------------------------- look-ups
     def joint(self, name: str) -> JointInfo:
@@ -185,8 +301,33 @@ class Mechanism:
 
     @property
     def mobility(self) -> int:
-        """Degrees of freedom left once every loop is closed (Gruebler, from ranks)."""
-        return self.model.nv - self.constraint_rows
+        """Degrees of freedom left once every loop is closed: what the drivers must number.
+
+        The joint freedoms minus the rank of the closure rows on the closed poses near the
+        reference configuration (see `pinmech.mobility`): loops that repeat each other
+        (a double parallelogram) do not lower it twice.
+
+        Raises:
+            ModelError: the loops repeat each other's equations, which the loop solver cannot
+                take (the message gives the true mobility and the cuts to remove). A mechanism
+                with redundant loops still loads, for force analysis (`ForceSolver`).
+        """
+        self.check_independent()
+        return self.model.nv - self.rank_report().rank
+
+    def rank_report(self):
+        """The closure rows' rank on closed poses (computed once, then kept)."""
+        if self._rank is None:
+            from pinmech.mobility import constraint_rank
+
+            self._rank = constraint_rank(self)
+        return self._rank
+
+    def idle_joints(self, drivers: list[str]) -> list[str]:
+        """Joints the loops leave free to move while `drivers` are held (a spinning rod)."""
+        from pinmech.mobility import idle_joints
+
+        return idle_joints(self, drivers, self.rank_report().q)
 
     def velocity_scale(self) -> np.ndarray:
         """Per degree of freedom: the length scale for prismatic joints, 1 for the others.
@@ -202,7 +343,9 @@ class Mechanism:
         return scale
 
     def neutral(self) -> np.ndarray:
-        """The model's neutral configuration (all joint coordinates zero)."""
+        """The reference configuration: a linkage's drawn pose, else all joint coordinates zero."""
+        if self.reference is not None:
+            return self.reference.copy()
         return pin.neutral(self.model)
 
     def set_coordinate(self, q: np.ndarray, name: str, value: float) -> None:
@@ -491,7 +634,8 @@ def _plane_normal(mech: Mechanism) -> np.ndarray | None:
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
         for fid in range(model.nframes):
-            J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED) * columns
+            # reshaped: for a one-dof model Pinocchio hands back a (6,) vector, not (6, 1)
+            J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED).reshape(6, -1) * columns
             angular.append(J[3:])
             linear.append(J[:3] / mech.length_scale)
     # A = hstack(angular) is 3 x (frames * nv). A = R^T Q^T, so A's U and s are those of the

@@ -2,7 +2,7 @@
 plane with the mechanism itself at the scene's pose, equal axes, the direction of travel
 marked. A spatial mechanism's paths are projected on a chosen world plane (xy, yz, zx).
 
-The mechanism is drawn as a textbook sketches it (`pinmech.linkage`): bars, plates,
+The mechanism is drawn as a textbook sketches it (`pinmech.link_nodes`): bars, plates,
 slider blocks, guides and ground triangles, one colour a link.
 """
 
@@ -15,7 +15,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import PinmechError
-from pinmech.linkage import link_colour, sketch_links, world_nodes
+from pinmech.link_nodes import link_colour, sketch_links, world_nodes
 from pinmech.motion import _plane_reference
 
 if TYPE_CHECKING:

@@ -10,7 +10,7 @@ sliding velocity v_rel = v_B - v_B3, and in accelerations by the Coriolis part
 taken in a chain, a fixed pivot first: C, then B3 about C, then D about B3.
 
 Which points share a link: the link a point hangs on, and the links a pin at its place
-joins (`pinmech.linkage`). The numbers are pinmech's (`Analysis.motion`); the polygon is
+joins (`pinmech.link_nodes`). The numbers are pinmech's (`Analysis.motion`); the polygon is
 their picture, and `Polygon.closure_error` says how well the chains of components land on
 the images (the rigid-body formulas against Pinocchio's point accelerations).
 """
@@ -25,7 +25,7 @@ import pinocchio as pin
 
 from pinmech.analysis import Analysis, coincident_points
 from pinmech.draw.inputs import DrawError
-from pinmech.linkage import pin_links, sketch_links
+from pinmech.link_nodes import pin_links, sketch_links
 from pinmech.motion import _plane_reference, evaluate_motion
 
 KINDS = {

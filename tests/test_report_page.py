@@ -17,7 +17,7 @@ from pinmech import Scene, analyse, snapshot
 from pinmech.cli import main
 from pinmech.draw import load_visuals
 from pinmech.draw.sketch import sketch_visuals
-from pinmech.linkage import sketch_links
+from pinmech.link_nodes import sketch_links
 from tests.browser import colour_mask, screenshot, span_share
 from tests.conftest import MODELS, SCENES
 

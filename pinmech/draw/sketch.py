@@ -1,4 +1,4 @@
-"""Visual geometry for links that have none: each drawn from its nodes (`pinmech.linkage`).
+"""Visual geometry for links that have none: each drawn from its nodes (`pinmech.link_nodes`).
 
 A link with two nodes is a bar between them, with three or more a plate over them (a
 planar mechanism) or bars joining them in turn (a spatial one); a slider block is a box
@@ -14,7 +14,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.draw.geometry import _screen_up
-from pinmech.linkage import LinkSketch, link_colour, sketch_links
+from pinmech.link_nodes import LinkSketch, link_colour, sketch_links
 from pinmech.mechanism import Mechanism
 
 _BAR = 0.05  # bar width, as a share of the longest link
