@@ -20,6 +20,7 @@ A printed value is an interval: "0.386" means [0.3855, 0.3865]. Verdicts:
 from __future__ import annotations
 
 import math
+import re
 import sys
 from dataclasses import dataclass
 from decimal import Decimal, InvalidOperation
@@ -139,7 +140,10 @@ def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue
         comp = component if component is not None else (i if len(hand) > 1 else None)
         suffix = "" if len(hand) == 1 else f" {'xyz'[i]}"
         out.append(HandValue(label + suffix, base, comp, printed.strip(), str(entry["unit"]), kind))
-    factor = to_si(f"1 {out[0].unit}", kind, where=f"{where}.unit")  # unknown or wrong unit fails here
+    unit = out[0].unit
+    if not unit.strip() or re.search(r"^\s*[-+.\d]|,", unit):
+        raise SceneError(f"unit = {unit!r} is not a unit (e.g. \"m/s\", \"deg\")", path=path, key=f"{where}.unit")
+    factor = to_si(f"1 {unit}", kind, where=f"{where}.unit")  # unknown or wrong unit fails here
     if not factor > 0:
         raise SceneError(f"unit = {out[0].unit!r} is not a unit", path=path, key=f"{where}.unit")
     return out
