@@ -13,6 +13,7 @@ from pinmech.closures import Closure
 from pinmech.exceptions import (
     CheckMismatch,
     FrameNotFound,
+    Interrupted,
     LoopClosureError,
     MobilityError,
     ModelError,
@@ -48,6 +49,7 @@ __all__ = [
     "CoincidentPoint",
     "Drivers",
     "FrameNotFound",
+    "Interrupted",
     "JointInfo",
     "LoopClosureError",
     "LoopSolution",

@@ -9,11 +9,15 @@ input out of range. An output file that cannot be written is 2.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import signal
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 from pinmech import __version__
-from pinmech.exceptions import PinmechError
+from pinmech.exceptions import Interrupted, PinmechError
+from pinmech.outputs import OutputFile, check_distinct, plot_path, write_whole
 
 
 def _add_scene_arguments(parser: argparse.ArgumentParser) -> None:
@@ -160,13 +164,12 @@ def cmd_solve(args: argparse.Namespace) -> int:
 def cmd_sweep(args: argparse.Namespace) -> int:
     """`pinmech sweep SCENE`: every pose of a cycle, streamed as CSV (and JSON lines, a plot);
     a task scene is followed in time instead (as `pinmech path`)."""
-    import numpy as np
-
-    from pinmech.sweep import Sweep, sweep_options
+    from pinmech.sweep import DriverValues, Sweep, sweep_options
 
     scene = _scene(args)
     if "task" in scene.raw:
         return _follow(args, scene)
+    figure = _check_outputs(args, scene)
     options = sweep_options(scene)
     steps = args.steps if args.steps is not None else options.get("steps", 361)
     if steps < 2:
@@ -191,24 +194,24 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         sweep.solver.max_iterations = args.max_iterations
     mode = "cold" if args.cold_start else "warm" if args.no_predictor else args.start_mode or options.get("start")
     interpolate = args.interpolate if args.interpolate is not None else options.get("interpolate", 1)
-    poses = sweep.poses(np.linspace(start, stop, steps), skip_failures=args.skip_failures,
+    poses = sweep.poses(DriverValues(start, stop, steps), skip_failures=args.skip_failures,
                         start=mode or "predictor", batch=not args.no_batch and options.get("batch", True),
                         interpolate=interpolate)
-    sinks = _sweep_sinks(args, sweep, steps)
+    sinks = _sweep_sinks(args, sweep, steps, figure)
     with sinks:
         for pose in _progress(poses, steps):
             sinks.add(pose)
     return 0
 
 
-def _sweep_sinks(args: argparse.Namespace, sweep, steps: int) -> _Sinks:
+def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | None) -> _Sinks:
     from pinmech.tables import SweepCsv, SweepJsonLines
 
     sinks = _Sinks()
     if args.plot_path:
         from pinmech.plot import SweepPlot
 
-        sinks.plot(SweepPlot(sweep, links=args.links, points=args.points, total=steps), args.plot_path)
+        sinks.plot(SweepPlot(sweep, links=args.links, points=args.points, total=steps), figure)
     if args.csv_path or not (args.plot_path or args.json_path):
         sinks.table(SweepCsv, sweep, args.csv_path, "poses")
     if args.json_path:
@@ -217,47 +220,122 @@ def _sweep_sinks(args: argparse.Namespace, sweep, steps: int) -> _Sinks:
 
 
 class _Sinks:
-    """Where streamed rows go (CSV, JSON lines, a figure), closed together; each output
-    file says on stderr what was written."""
+    """Where streamed rows go (CSV, JSON lines, a figure), finished together: each file is
+    written through a temporary file and renamed when every row is in (outputs.py); on a
+    failure or a signal, what was written is kept as NAME.partial and the file named on
+    the command line is left as it was. Each output says on stderr what was written."""
 
     def __init__(self) -> None:
-        self.tables: list = []
-        self.files: list = []
-        self.figures: list = []
+        self.tables: list = []  # (table, OutputFile or None for stdout, what)
+        self.figures: list = []  # (recorder, OutputFile)
 
     def table(self, kind, source, path: str | None, what: str | None) -> None:
-        stream = open(path, "w", newline="", encoding="utf-8") if path else sys.stdout  # noqa: SIM115
-        if path:
-            self.files.append(stream)
-        self.tables.append((kind(source, stream), path, what))
+        output = OutputFile(path) if path else None
+        stream = output.open() if output else sys.stdout
+        self.tables.append((kind(source, stream), output, what))
 
-    def plot(self, recorder, path: str) -> None:
-        self.figures.append((recorder, path))
+    def plot(self, recorder, path: Path) -> None:
+        output = OutputFile(path)
+        output.open(text=False)
+        self.figures.append((recorder, output))
 
     def add(self, row) -> None:
-        for table, _, _ in self.tables:
-            table.add(row)
-        for recorder, _ in self.figures:
-            recorder.add(row)
+        with _SIGNALS.held():  # one row goes to every output or to none
+            for table, _, _ in self.tables:
+                table.add(row)
+            for recorder, _ in self.figures:
+                recorder.add(row)
 
     def __enter__(self) -> _Sinks:  # noqa: PYI034
         return self
 
     def __exit__(self, kind, error, trace) -> None:
+        if error is not None:
+            self._abandon()
+            return
+        try:  # every row is in: the tables are complete, then the figures (which may still fail)
+            counts = [table.close() for table, _, _ in self.tables]
+            for (_, output, what), count in zip(self.tables, counts):
+                if output:
+                    output.commit()
+                    said = f"{count} {what}" if what else "JSON lines"
+                    print(f"{said} written to {output.path}", file=sys.stderr)
+            for recorder, output in self.figures:
+                recorder.save(output.temporary)
+                print(f"figure written to {output.commit()}", file=sys.stderr)
+        except BaseException:
+            self._abandon()
+            raise
+
+    def _abandon(self) -> None:
+        """Keep what was written as NAME.partial, and say so."""
+        for output in [o for _, o, _ in self.tables if o] + [o for _, o in self.figures]:
+            partial = output.abandon()
+            if partial:
+                left = "left as it was" if output.path.exists() else "not written"
+                print(f"pinmech: incomplete output kept in {partial} ({output.path} {left})", file=sys.stderr)
+
+
+def _check_outputs(args: argparse.Namespace, scene) -> Path | None:
+    """Before computing: the figure's format, one file per output, no output over an input.
+    Returns the figure's path (".png" added to a name without suffix)."""
+    figure = plot_path(args.plot_path) if args.plot_path else None
+    check_distinct({"--csv": args.csv_path, "--json": args.json_path, "--plot": figure},
+                   {"the scene file": scene.path, "the URDF": _urdf_path(scene)})
+    return figure
+
+
+def _urdf_path(scene) -> Path:
+    try:
+        return scene.urdf
+    except PinmechError:
+        return scene.path
+
+
+class _Signals:
+    """SIGINT, SIGTERM and SIGHUP raised as `Interrupted` (a KeyboardInterrupt) while a
+    command runs, so outputs are finished as partial and servers stop; inside `held()`
+    the signal waits until the block is done."""
+
+    def __init__(self) -> None:
+        self.holding = False
+        self.pending: int | None = None
+
+    def _handle(self, signum, frame) -> None:
+        if self.holding:
+            self.pending = signum
+            return
+        raise Interrupted(signum)
+
+    @contextlib.contextmanager
+    def installed(self):
+        import threading
+
+        if threading.current_thread() is not threading.main_thread():
+            yield
+            return
+        names = [n for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)]
+        saved = {n: signal.signal(getattr(signal, n), self._handle) for n in names}
         try:
-            if error is None:
-                for table, path, what in self.tables:
-                    count = table.close()
-                    if path and what:
-                        print(f"{count} {what} written to {path}", file=sys.stderr)
-                    elif path:
-                        print(f"JSON lines written to {path}", file=sys.stderr)
-                for recorder, path in self.figures:
-                    recorder.save(path)
-                    print(f"figure written to {path}", file=sys.stderr)
+            yield
         finally:
-            for stream in self.files:
-                stream.close()
+            for n, handler in saved.items():
+                signal.signal(getattr(signal, n), handler)
+            self.holding, self.pending = False, None
+
+    @contextlib.contextmanager
+    def held(self):
+        self.holding = True
+        try:
+            yield
+        finally:
+            self.holding = False
+            pending, self.pending = self.pending, None
+            if pending is not None:
+                raise Interrupted(pending)
+
+
+_SIGNALS = _Signals()
 
 
 def _progress(items, total: int):
@@ -289,6 +367,7 @@ def _follow(args: argparse.Namespace, scene) -> int:
     if "task" not in scene.raw:
         raise PinmechError(f"{scene.path}: no [[task]] to follow; a scene with [drivers] is swept: "
                            "pinmech sweep SCENE")
+    figure = _check_outputs(args, scene)
     options = sweep_options(scene)
     duration_text = args.duration or options.get("duration")
     if not duration_text:
@@ -308,7 +387,7 @@ def _follow(args: argparse.Namespace, scene) -> int:
         from pinmech.plot import PathPlot
 
         note = f" ({scheme}, step {step:g} s" + (f", feedback {gain:g}/s)" if gain else ")")
-        sinks.plot(PathPlot(mechanism, scene.title, note=note, total=total), args.plot_path)
+        sinks.plot(PathPlot(mechanism, scene.title, note=note, total=total), figure)
     if args.csv_path or not (args.plot_path or args.json_path):
         sinks.table(PathCsv, mechanism, args.csv_path, "path points")
     if args.json_path:
@@ -357,22 +436,25 @@ def cmd_snapshot(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Most frames `pinmech animate` puts in one page (each frame keeps every link's placement).
+_MAX_FRAMES = 20_000
+
+
 def cmd_animate(args: argparse.Namespace) -> int:
     """`pinmech animate SCENE -o FILE.html`: a driver cycle, each frame a solved, closed pose."""
-    import numpy as np
-
     from pinmech.draw import animation_html
-    from pinmech.sweep import Sweep
+    from pinmech.sweep import DriverValues, Sweep
 
     scene = _scene(args)
     sweep = Sweep.from_scene(scene)
     kind = "angle" if sweep.is_angular else "length"
     start = scene.quantity(args.start, kind, "--from") if args.start else sweep.start
     stop = scene.quantity(args.stop, kind, "--to") if args.stop else start + (sweep.default_values(2)[1] - sweep.start)
-    if args.steps < 2:
-        raise PinmechError(f"--steps must be at least 2, got {args.steps}")
+    if not 2 <= args.steps <= _MAX_FRAMES:
+        raise PinmechError(f"--steps must be between 2 and {_MAX_FRAMES} frames (each is kept in the page), "
+                           f"got {args.steps}")
     qs = []
-    for pose in sweep.poses(np.linspace(start, stop, args.steps), skip_failures=args.skip_failures):
+    for pose in sweep.poses(DriverValues(start, stop, args.steps), skip_failures=args.skip_failures):
         if pose.motion is not None:
             qs.append(sweep.last_q.copy())
     if not qs:
@@ -402,8 +484,7 @@ def cmd_view(args: argparse.Namespace) -> int:
 
 
 def _write(path: str, html: str) -> None:
-    with open(path, "w", encoding="utf-8") as stream:
-        stream.write(html)
+    write_whole(path, html)
     print(f"wrote {path} ({len(html) // 1024} KB, offline: open it in any browser)", file=sys.stderr)
 
 
@@ -445,7 +526,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return args.func(args)
+        with _SIGNALS.installed():
+            return args.func(args)
+    except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM, SIGHUP: one line, 128 + the signal's number
+        signum = getattr(exc, "signum", signal.SIGINT)
+        print(f"pinmech: interrupted by {signal.Signals(signum).name}: stopped", file=sys.stderr)
+        return 128 + int(signum)
     except PinmechError as exc:
         print(f"pinmech: error: {exc}", file=sys.stderr)
         return exc.exit_code

@@ -128,3 +128,20 @@ class SweepError(PinmechError):
         self.value = value
         self.cause = cause
         self.exit_code = cause.exit_code
+
+
+class Interrupted(KeyboardInterrupt):
+    """The run was stopped by a signal: Ctrl-C (SIGINT), SIGTERM or SIGHUP (the terminal
+    closed). A KeyboardInterrupt, so code that stops on Ctrl-C stops on all three.
+
+    Attributes:
+        signum: the signal's number.
+        exit_code: 128 + signum, as a shell reports a process a signal stopped (130 for Ctrl-C).
+    """
+
+    def __init__(self, signum: int):
+        import signal
+
+        self.signum = int(signum)
+        self.exit_code = 128 + self.signum
+        super().__init__(f"interrupted by {signal.Signals(self.signum).name}")

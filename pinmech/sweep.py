@@ -21,7 +21,7 @@ Scene keys, all optional:
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -63,6 +63,44 @@ class SweepPose:
     accuracy: Accuracy | None
     error: str = ""
     interpolated: bool = False
+
+
+@dataclass(frozen=True)
+class DriverValues(Sequence):
+    """`steps` evenly spaced driver values from `first` to `last` [rad or m], both ends
+    included, as `np.linspace` gives them but computed when read: a sweep of 1e10 poses
+    streams in constant memory."""
+
+    first: float
+    last: float
+    steps: int
+
+    def __post_init__(self) -> None:
+        if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
+            raise ValueError(f"steps must be a positive whole number, got {self.steps!r}")
+
+    def __len__(self) -> int:
+        return self.steps
+
+    def __getitem__(self, index):  # int -> float, slice -> array
+        if isinstance(index, slice):
+            return np.array([self._at(i) for i in range(*index.indices(self.steps))])
+        i = index + self.steps if index < 0 else index
+        if not 0 <= i < self.steps:
+            raise IndexError(f"pose {index} of {self.steps}")
+        return self._at(i)
+
+    def __iter__(self) -> Iterator[float]:
+        return (self._at(i) for i in range(self.steps))
+
+    def __array__(self, dtype=None, copy=None) -> np.ndarray:
+        return np.linspace(self.first, self.last, self.steps, dtype=dtype)
+
+    def _at(self, i: int) -> float:
+        if i == self.steps - 1 and self.steps > 1:
+            return float(self.last)
+        step = (self.last - self.first) / (self.steps - 1) if self.steps > 1 else 0.0
+        return float(self.first + i * step)
 
 
 def sweep_options(scene: Scene) -> dict[str, Any]:
@@ -124,10 +162,11 @@ class Sweep:
     def is_angular(self) -> bool:
         return self.mechanism.joint(self.driver).is_angular
 
-    def default_values(self, steps: int = 361) -> np.ndarray:
-        """One full turn from the scene's angle (both ends included), or +-the mechanism's size."""
+    def default_values(self, steps: int = 361) -> DriverValues:
+        """One full turn from the scene's angle (both ends included), or +-the mechanism's
+        size; computed when read (a `DriverValues`)."""
         span = 2 * math.pi if self.is_angular else self.mechanism.length_scale
-        return np.linspace(self.start, self.start + span, steps)
+        return DriverValues(self.start, self.start + span, steps)
 
     def chunks(self, values: Iterable[float], *, start: str = "predictor", batch: bool = True,
                interpolate: int = 1) -> Iterator[RangeChunk]:

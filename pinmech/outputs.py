@@ -1,0 +1,136 @@
+"""Output files written whole or not at all.
+
+Each output goes to a hidden temporary file next to its destination and is renamed over
+it only when the run succeeds, so an existing file is never truncated or replaced by a
+half-written one, and two runs writing the same path leave one complete file. When the
+run fails or is interrupted, what was written is kept as `NAME.partial` (and the
+destination is left as it was): a reader cannot take it for a complete result.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+from typing import IO
+
+from pinmech.exceptions import PinmechError
+
+#: Figure formats `--plot` writes (matplotlib's, by suffix).
+PLOT_FORMATS = ("png", "pdf", "svg")
+PARTIAL_SUFFIX = ".partial"
+
+
+class OutputFile:
+    """A destination file, written through a temporary file in its folder.
+
+    `open()` creates the temporary file (so a missing folder or a read-only one fails
+    before any computing); `commit()` renames it over the destination; `abandon()` keeps
+    what was written as `NAME.partial` (or removes it when empty) and returns that path.
+    """
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        self.temporary: Path | None = None
+        self.stream: IO[str] | None = None
+
+    def open(self, *, text: bool = True) -> IO[str] | None:
+        """Create the temporary file; in text mode return it opened for writing."""
+        folder = self.path.parent if str(self.path.parent) else Path(".")
+        handle, name = tempfile.mkstemp(dir=folder, prefix=f".{self.path.name}.", suffix=f".tmp{self.path.suffix}")
+        self.temporary = Path(name)
+        os.chmod(handle, _mode(self.path))
+        if not text:
+            os.close(handle)
+            return None
+        self.stream = os.fdopen(handle, "w", newline="", encoding="utf-8")
+        return self.stream
+
+    def commit(self) -> Path:
+        """Close the temporary file and rename it over the destination; the destination."""
+        self._close()
+        if self.temporary is not None:
+            os.replace(self.temporary, self.path)
+            self.temporary = None
+        return self.path
+
+    def abandon(self) -> Path | None:
+        """Keep a non-empty temporary file as `NAME.partial` (returned); remove an empty one."""
+        self._close()
+        temporary, self.temporary = self.temporary, None
+        if temporary is None or not temporary.exists():
+            return None
+        if temporary.stat().st_size == 0:
+            temporary.unlink()
+            return None
+        partial = self.path.with_name(self.path.name + PARTIAL_SUFFIX)
+        os.replace(temporary, partial)
+        return partial
+
+    def _close(self) -> None:
+        if self.stream is not None:
+            self.stream.close()
+            self.stream = None
+
+
+def _mode(path: Path) -> int:
+    """Permissions of the new file: the existing file's, else those the umask allows."""
+    try:
+        return path.stat().st_mode & 0o777
+    except OSError:
+        umask = os.umask(0)
+        os.umask(umask)
+        return 0o666 & ~umask
+
+
+def write_whole(path: str | Path, text: str) -> None:
+    """Write a text file whole (through a temporary file renamed on success)."""
+    output = OutputFile(path)
+    stream = output.open()
+    try:
+        stream.write(text)
+    except BaseException:
+        output.abandon()
+        raise
+    output.commit()
+
+
+def plot_path(path: str) -> Path:
+    """The figure file `--plot PATH` writes: PATH itself, with ".png" added when it has no
+    suffix. Checked before anything is computed.
+
+    Raises:
+        PinmechError: a suffix matplotlib does not write (only PNG, PDF and SVG).
+    """
+    target = Path(path)
+    suffix = target.suffix.lower().lstrip(".")
+    if not suffix:
+        return target.with_name(target.name + ".png")
+    if suffix not in PLOT_FORMATS:
+        raise PinmechError(f"--plot {path}: cannot draw a .{suffix} figure; use a name ending in "
+                           f"{', '.join('.' + f for f in PLOT_FORMATS)}")
+    return target
+
+
+def check_distinct(outputs: dict[str, str | Path | None], inputs: dict[str, str | Path] | None = None) -> None:
+    """Every output to its own file, and none over an input.
+
+    Args:
+        outputs: option -> path (None: not asked), e.g. {"--csv": "a.csv", "--json": None}.
+        inputs: what the run reads, e.g. {"the scene": "four_bar.toml"}.
+
+    Raises:
+        PinmechError: two options name one file, or an option names an input.
+    """
+    seen: dict[str, str] = {}
+    for option, path in outputs.items():
+        if path is None:
+            continue
+        key = os.path.realpath(path)
+        if key in seen:
+            raise PinmechError(f"{seen[key]} and {option} both name {path}: give each output its own file")
+        seen[key] = option
+    for what, path in (inputs or {}).items():
+        key = os.path.realpath(path)
+        if key in seen:
+            raise PinmechError(f"{seen[key]} {path} would overwrite {what}: write the output elsewhere")
