@@ -58,6 +58,19 @@ class JointInfo:
         return self.kind in ("revolute", "continuous")
 
 
+@dataclass(frozen=True)
+class MimicJoint:
+    """A URDF `<mimic>` joint: its coordinate is `multiplier * q_leader + offset`, and its
+    rates follow [rad or m, and per second]. Pinocchio builds it as a joint with no
+    degree of freedom of its own, so every position, Jacobian and rate honours it."""
+
+    name: str
+    leader: str
+    multiplier: float
+    offset: float
+    kind: str  # the URDF type of the follower: "revolute", "continuous" or "prismatic"
+
+
 @dataclass
 class Mechanism:
     """A Pinocchio model with the user's names: joints, links, points and loop closures.
@@ -74,6 +87,7 @@ class Mechanism:
         length_scale: size of the mechanism [m]; position tolerances are relative to it.
         plane_normal: unit normal of the motion plane for a planar mechanism, else None.
         locked: joints locked out of the model, with their values (SI).
+        mimics: joints following another one (URDF `<mimic>`) and still moving.
     """
 
     model: pin.Model
@@ -85,6 +99,7 @@ class Mechanism:
     plane_normal: np.ndarray | None
     source: str = "<model>"
     locked: dict[str, float] = field(default_factory=dict)
+    mimics: dict[str, MimicJoint] = field(default_factory=dict)
 
     # ---------------------------------------------------------------- construction
     @classmethod
@@ -116,8 +131,10 @@ class Mechanism:
         path = Path(path)
         source = str(path)
         root = _parse_xml(path)
-        full = _build_model(source, root_joint)
-        model = _lock_joints(full, locked or {}, source)
+        mimics = _mimic_joints(root, source)
+        full = _build_model(source, root_joint, mimic=bool(mimics))
+        locked = _with_followers(dict(locked or {}), mimics, source)
+        model = _lock_joints(full, locked, source)
         if model.nv == 0:
             held = f" once {', '.join(locked)} are locked" if locked else ""
             raise ModelError(f"no joint of the model moves{held}: nothing to solve", path=source)
@@ -144,6 +161,7 @@ class Mechanism:
             plane_normal=None,
             source=source,
             locked=dict(locked or {}),
+            mimics={n: m for n, m in mimics.items() if n not in (locked or {})},
         )
         mech.length_scale = _length_scale(model, source)
         mech.closures = [_make_closure(model, c, mech.length_scale) for c in cuts]
@@ -208,6 +226,10 @@ class Mechanism:
     def set_coordinate(self, q: np.ndarray, name: str, value: float) -> None:
         """Write a joint's coordinate (angle [rad] or length [m]) into q, in place."""
         j = self.joint(name)
+        if name in self.mimics:
+            leader = self.mimics[name].leader
+            raise ModelError(f"joint '{name}' follows '{leader}' (URDF <mimic>): give {leader}'s value instead",
+                             path=self.source)
         if j.kind == "continuous":
             q[j.idx_q : j.idx_q + 2] = (np.cos(value), np.sin(value))
         elif j.nq == 1:
@@ -217,6 +239,9 @@ class Mechanism:
 
     def coordinate(self, q: np.ndarray, name: str) -> float:
         """A one-dof joint's coordinate (angle in (-pi, pi] for a continuous joint)."""
+        if name in self.mimics:
+            m = self.mimics[name]
+            return m.multiplier * self.coordinate(q, m.leader) + m.offset
         j = self.joint(name)
         if j.kind == "continuous":
             return float(np.arctan2(q[j.idx_q + 1], q[j.idx_q]))
@@ -319,8 +344,9 @@ def _parse_constraint(el: ET.Element, model: pin.Model, links: list[str], source
 _ROOT_JOINTS = {"free_flyer": pin.JointModelFreeFlyer}
 
 
-def _build_model(source: str, root_joint: str | None = None) -> pin.Model:
-    """pin.buildModelFromUrdf, with urdfdom's own stderr chatter folded into the error."""
+def _build_model(source: str, root_joint: str | None = None, *, mimic: bool = False) -> pin.Model:
+    """pin.buildModelFromUrdf (honouring `<mimic>` when asked), with urdfdom's own stderr
+    chatter folded into the error."""
     if root_joint is not None and root_joint not in _ROOT_JOINTS:
         raise ModelError(f"root_joint must be None or one of {', '.join(_ROOT_JOINTS)}, got {root_joint!r}",
                          path=source)
@@ -331,7 +357,7 @@ def _build_model(source: str, root_joint: str | None = None) -> pin.Model:
             sys.stderr.flush()
             os.dup2(sink.fileno(), 2)
             try:
-                return pin.buildModelFromUrdf(source, *args)
+                return pin.buildModelFromUrdf(source, *args, mimic=mimic)
             except (ValueError, RuntimeError) as exc:
                 error = exc
         finally:
@@ -341,6 +367,61 @@ def _build_model(source: str, root_joint: str | None = None) -> pin.Model:
         said = " ".join(sink.read().decode(errors="replace").split())
     detail = f" ({said})" if said else ""
     raise ModelError(f"Pinocchio cannot build the model: {error}{detail}", path=source) from error
+
+
+def _mimic_joints(root: ET.Element, source: str) -> dict[str, MimicJoint]:
+    """The joints with a `<mimic joint="..." multiplier="..." offset="..."/>` element.
+
+    Raises:
+        ModelError: a leader that is not a one-dof joint of the file, itself a follower,
+            or numbers that are not finite.
+    """
+    types = {j.get("name"): j.get("type") for j in root.findall("joint")}
+    out = {}
+    for joint in root.findall("joint"):
+        element = joint.find("mimic")
+        if element is None:
+            continue
+        name, leader = joint.get("name"), element.get("joint")
+        where = f"<joint name=\"{name}\"> <mimic>"
+        numbers = {}
+        for key, default in (("multiplier", "1"), ("offset", "0")):
+            try:
+                numbers[key] = float(element.get(key, default))
+            except ValueError:
+                numbers[key] = float("nan")
+            if not np.isfinite(numbers[key]):
+                raise ModelError(f"{key}=\"{element.get(key)}\" is not a finite number", path=source, element=where)
+        if leader == name or types.get(leader) not in ("revolute", "continuous", "prismatic"):
+            raise ModelError(f"joint=\"{leader}\" is not another revolute or prismatic joint of the file",
+                             path=source, element=where)
+        out[name] = MimicJoint(name, leader, numbers["multiplier"], numbers["offset"], str(types.get(name)))
+    for m in out.values():
+        if m.leader in out:
+            raise ModelError(f"follows '{m.leader}', which itself follows '{out[m.leader].leader}': "
+                             "make both follow the same joint", path=source, element=f"<joint name=\"{m.name}\"> <mimic>")
+    return out
+
+
+def _with_followers(locked: dict[str, float], mimics: dict[str, MimicJoint], source: str) -> dict[str, float]:
+    """Locked joints, with every follower of a locked leader locked where it must be.
+
+    Raises:
+        ModelError: a follower locked while its leader moves, or locked at another value
+            than its leader gives.
+    """
+    for m in mimics.values():
+        follows = m.multiplier * locked[m.leader] + m.offset if m.leader in locked else None
+        if m.name in locked and follows is None:
+            raise ModelError(f"joint '{m.name}' follows '{m.leader}' (URDF <mimic>) and cannot be locked while "
+                             f"{m.leader} moves: lock {m.leader} instead", path=source)
+        if m.name in locked and abs(locked[m.name] - follows) > 1e-9 * max(1.0, abs(follows)):
+            raise ModelError(f"joint '{m.name}' is locked at {locked[m.name]:.9g} but follows '{m.leader}' "
+                             f"(URDF <mimic>): {m.multiplier:g} x {locked[m.leader]:.9g} + {m.offset:g} = "
+                             f"{follows:.9g}", path=source)
+        if follows is not None:
+            locked[m.name] = follows
+    return locked
 
 
 def _lock_joints(model: pin.Model, locked: dict[str, float], source: str) -> pin.Model:
@@ -353,14 +434,36 @@ def _lock_joints(model: pin.Model, locked: dict[str, float], source: str) -> pin
             raise FrameNotFound("joint to lock", name, [n for n in model.names[1:]], path=source)
         jid = model.getJointId(name)
         joint = model.joints[jid]
-        if joint.nq == 2 and joint.nv == 1:
+        if joint.nq == 0 and "Mimic" in joint.shortname():
+            pass  # a follower: its leader, locked with it, sets where it is held
+        elif joint.nq == 2 and joint.nv == 1:
             q_ref[joint.idx_q : joint.idx_q + 2] = (np.cos(value), np.sin(value))
         elif joint.nq == 1:
             q_ref[joint.idx_q] = value
         else:
             raise ModelError(f"joint '{name}' has {joint.nq} coordinates and cannot be locked by one value", path=source)
         ids.append(jid)
-    return pin.buildReducedModel(model, ids, q_ref)
+    return _reduced(model, ids, q_ref)
+
+
+def _reduced(model: pin.Model, ids: list[int], q_ref: np.ndarray) -> pin.Model:
+    """pin.buildReducedModel, also when a locked joint has the name of a link (Pinocchio
+    then finds "several frames" by that name): such a joint is renamed while the model
+    is reduced, and its fixed frame named back."""
+    model = pin.Model(model)
+    renamed = {}
+    for jid in ids:
+        name = model.names[jid]
+        if sum(f.name == name for f in model.frames) > 1:
+            renamed[f"{name}__pinmech_locked"] = name
+            model.names[jid] = f"{name}__pinmech_locked"
+            for frame in model.frames:
+                if frame.name == name and frame.type == pin.FrameType.JOINT:
+                    frame.name = f"{name}__pinmech_locked"
+    reduced = pin.buildReducedModel(model, ids, q_ref)
+    for frame in reduced.frames:
+        frame.name = renamed.get(frame.name, frame.name)
+    return reduced
 
 
 def _joint_kind(joint: pin.JointModel) -> str:
@@ -491,7 +594,8 @@ def _plane_normal(mech: Mechanism) -> np.ndarray | None:
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
         for fid in range(model.nframes):
-            J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED) * columns
+            J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+            J = J.reshape(6, model.nv) * columns  # Pinocchio gives a 6 x 1 Jacobian as a vector
             angular.append(J[3:])
             linear.append(J[:3] / mech.length_scale)
     # A = hstack(angular) is 3 x (frames * nv). A = R^T Q^T, so A's U and s are those of the

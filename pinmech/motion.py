@@ -127,13 +127,28 @@ def evaluate_motion(
     for c in coincident:
         point_motion.setdefault(c.name, _coincident(mechanism, data, c))
     return Motion(
-        joints={n: JointMotion(mechanism.coordinate(q, n), float(v[j.idx_v]), float(a[j.idx_v]), j.kind)
-                for n, j in mechanism.joints.items() if j.nv == 1},
+        joints=_joint_motions(mechanism, q, v, a),
         links=link_motion,
         points=point_motion,
         sliders={n: _slider(mechanism, data, n, float(v[j.idx_v]), float(a[j.idx_v]))
                  for n, j in mechanism.joints.items() if j.kind == "prismatic"},
     )
+
+
+def _joint_motions(mechanism: Mechanism, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict[str, JointMotion]:
+    """Every one-dof joint's coordinate and rates; a `<mimic>` follower's from its leader's."""
+    out = {}
+    for name, joint in mechanism.joints.items():
+        if name in mechanism.mimics:
+            m = mechanism.mimics[name]
+            leader = mechanism.joints[m.leader]
+            kind = m.kind if m.kind in ("revolute", "continuous", "prismatic") else leader.kind
+            out[name] = JointMotion(mechanism.coordinate(q, name), m.multiplier * float(v[leader.idx_v]),
+                                    m.multiplier * float(a[leader.idx_v]), kind)
+        elif joint.nv == 1:
+            out[name] = JointMotion(mechanism.coordinate(q, name), float(v[joint.idx_v]), float(a[joint.idx_v]),
+                                    joint.kind)
+    return out
 
 
 def _moving_links(mechanism: Mechanism) -> list[str]:

@@ -95,3 +95,91 @@ def test_malformed_urdf(tmp_path, text, message):
 def test_missing_file(tmp_path):
     with pytest.raises(ModelError, match="no such URDF file"):
         Mechanism.from_urdf(tmp_path / "absent.urdf")
+
+
+# ---------------------------------------------------------------- <mimic> joints
+R1, R2, R3 = 0.30, 0.30, 0.17  # the planar 3R arm's links AB, BC, CD [m] (planar_arm.urdf)
+
+
+def _mimic_arm(tmp_path, models_dir, mimic='<mimic joint="B" multiplier="2" offset="0.1"/>'):
+    text = (models_dir / "planar_arm.urdf").read_text()
+    return write(tmp_path, "arm.urdf", text.replace('<joint name="C" type="revolute">',
+                                                    f'<joint name="C" type="revolute">{mimic}'))
+
+
+def _tip(qa, qb, va, vb, aa, ab):
+    """Closed form of D on the 3R arm with q_C = 2 q_B + 0.1: position, velocity, acceleration."""
+    th = np.array([qa, qa + qb, qa + 3 * qb + 0.1])  # absolute angles of AB, BC, CD
+    w = np.array([va, va + vb, va + 3 * vb])
+    al = np.array([aa, aa + ab, aa + 3 * ab])
+    r = np.array([R1, R2, R3])
+    e, n = np.array([np.cos(th), np.sin(th)]), np.array([-np.sin(th), np.cos(th)])
+    return e @ r, n @ (r * w), n @ (r * al) - e @ (r * w**2)
+
+
+def test_a_mimic_joint_follows_its_leader_in_positions_and_rates(tmp_path, models_dir):
+    from pinmech import evaluate_motion
+
+    mech = Mechanism.from_urdf(_mimic_arm(tmp_path, models_dir))
+    assert mech.model.nv == 2 and mech.mimics["C"].leader == "B"  # C is no freedom of its own
+    q, v, a = np.array([0.4, -0.7]), np.array([1.3, -2.1]), np.array([0.5, 3.0])
+    motion = evaluate_motion(mech, mech.model.createData(), q, v, a)
+    position, velocity, acceleration = _tip(*q, *v, *a)
+    d = motion.points["D"]
+    # The closed form and Pinocchio agree to rounding: 1e-12 of the 0.77 m arm and its rates.
+    np.testing.assert_allclose(d.position[:2], position, atol=1e-12)
+    np.testing.assert_allclose(d.velocity[:2], velocity, atol=1e-12)
+    np.testing.assert_allclose(d.acceleration[:2], acceleration, atol=1e-12)
+    c = motion.joints["C"]
+    assert (c.q, c.v, c.a) == pytest.approx((2 * -0.7 + 0.1, 2 * -2.1, 2 * 3.0), abs=1e-15)
+
+
+def test_locking_a_mimic_leader_holds_its_follower_where_it_follows(tmp_path, models_dir):
+    mech = Mechanism.from_urdf(_mimic_arm(tmp_path, models_dir), locked={"B": -0.7})
+    assert mech.model.nv == 1 and mech.locked["C"] == pytest.approx(-1.3, abs=1e-15)
+    from pinmech import evaluate_motion
+
+    motion = evaluate_motion(mech, mech.model.createData(), np.array([0.4]), np.array([1.3]), np.array([0.5]))
+    np.testing.assert_allclose(motion.points["D"].position[:2], _tip(0.4, -0.7, 0, 0, 0, 0)[0], atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "mimic, locked, message",
+    [
+        ('<mimic joint="B"/>', {"C": 0.2}, "cannot be locked while B moves: lock B instead"),
+        ('<mimic joint="B" multiplier="2"/>', {"C": 0.2, "B": 0.2}, r"locked at 0.2 but follows 'B'.*= 0.4"),
+        ('<mimic joint="nope"/>', {}, 'joint="nope" is not another revolute or prismatic joint'),
+        ('<mimic joint="C"/>', {}, 'joint="C" is not another'),
+        ('<mimic joint="B" multiplier="x"/>', {}, 'multiplier="x" is not a finite number'),
+        ('<mimic joint="B" offset="nan"/>', {}, 'offset="nan" is not a finite number'),
+    ],
+)
+def test_mimic_joints_that_cannot_be_honoured_are_refused(tmp_path, models_dir, mimic, locked, message):
+    with pytest.raises(ModelError, match=message):
+        Mechanism.from_urdf(_mimic_arm(tmp_path, models_dir, mimic), locked=locked)
+
+
+def test_a_mimic_follower_cannot_be_set_directly(tmp_path, models_dir):
+    mech = Mechanism.from_urdf(_mimic_arm(tmp_path, models_dir))
+    with pytest.raises(ModelError, match="'C' follows 'B'.*give B's value"):
+        mech.set_coordinate(mech.neutral(), "C", 0.3)
+
+
+def test_a_locked_joint_may_share_its_name_with_a_link(tmp_path, models_dir):
+    """Joint AB drives link AB: Pinocchio's reduction found "several frames" by that name."""
+    text = (models_dir / "planar_arm.urdf").read_text().replace('<joint name="A" type', '<joint name="AB" type')
+    mech = Mechanism.from_urdf(write(tmp_path, "arm.urdf", text), locked={"AB": 0.4})
+    assert mech.model.nv == 2 and "AB" in mech.links
+    from pinmech import evaluate_motion
+
+    motion = evaluate_motion(mech, mech.model.createData(), np.array([0.0, -0.6]), np.zeros(2), np.zeros(2))
+    th = np.array([0.4, 0.4, -0.2])
+    np.testing.assert_allclose(motion.points["D"].position[:2], np.array([np.cos(th), np.sin(th)]) @ [R1, R2, R3],
+                               atol=1e-12)
+
+
+def test_a_model_with_one_freedom_left_loads(models_dir):
+    """Pinocchio returns a one-column Jacobian as a vector; the plane is still found."""
+    mech = Mechanism.from_urdf(models_dir / "planar_arm.urdf", locked={"B": 0.3, "C": 0.2})
+    assert mech.model.nv == 1
+    np.testing.assert_allclose(mech.plane_normal, [0, 0, 1], atol=1e-12)
