@@ -380,8 +380,8 @@ def _mimic_joints(root: ET.Element, source: str) -> dict[str, MimicJoint]:
     out = {}
     for joint in root.findall("joint"):
         element = joint.find("mimic")
-        if element is None:
-            continue
+        if element is None or joint.get("type") not in ("revolute", "continuous", "prismatic"):
+            continue  # a fixed joint has no coordinate to follow with (Talos's grippers)
         name, leader = joint.get("name"), element.get("joint")
         where = f"<joint name=\"{name}\"> <mimic>"
         numbers = {}
