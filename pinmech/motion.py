@@ -12,12 +12,13 @@ import functools
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
 from pinmech.closures import _cross
-from pinmech.exceptions import FrameNotFound
+from pinmech.exceptions import FrameNotFound, ModelError
 from pinmech.mechanism import Mechanism
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -114,6 +115,11 @@ def evaluate_motion(
         links: links to report (default: all that move).
     """
     model = mechanism.model
+    q, v, a = (_vector(x, n, name, mechanism) for x, n, name in ((q, model.nq, "q"), (v, model.nv, "v"),
+                                                                 (a, model.nv, "a")))
+    if not isinstance(data, pin.Data) or len(data.oMi) != model.njoints or len(data.oMf) != model.nframes:
+        raise ModelError("data must be a pin.Data of the mechanism's model (mechanism.model.createData())",
+                         path=mechanism.source)
     pin.forwardKinematics(model, data, q, v, a)
     pin.updateFramePlacements(model, data)
     link_names = list(links) if links is not None else _moving_links(mechanism)
@@ -133,6 +139,18 @@ def evaluate_motion(
         sliders={n: _slider(mechanism, data, n, float(v[j.idx_v]), float(a[j.idx_v]))
                  for n, j in mechanism.joints.items() if j.kind == "prismatic"},
     )
+
+
+def _vector(x: Any, size: int, name: str, mechanism: Mechanism) -> np.ndarray:
+    """x as `size` finite floats, else a ModelError naming the argument and what it got."""
+    try:
+        out = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"{name} must be {size} numbers (SI), got {x!r:.80}", path=mechanism.source) from None
+    if out.shape != (size,) or not np.all(np.isfinite(out)):
+        raise ModelError(f"{name} must be {size} finite numbers (SI), got shape {out.shape}"
+                         + ("" if out.shape != (size,) else " with a non-finite number"), path=mechanism.source)
+    return out
 
 
 def _joint_motions(mechanism: Mechanism, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict[str, JointMotion]:

@@ -36,7 +36,7 @@ from pinmech.analysis import (
     scene_drivers,
     scene_guess,
 )
-from pinmech.exceptions import SceneError, SweepError
+from pinmech.exceptions import ModelError, SceneError, SweepError
 from pinmech.mechanism import Mechanism
 from pinmech.motion import Motion, evaluate_motion
 from pinmech.results import Accuracy
@@ -173,7 +173,7 @@ class Sweep:
         """The poses' q, v, a and accuracy as arrays, a chunk at a time (no motion read-out):
         the quickest way through a long sweep. Options: see `poses`."""
         d = self.drivers
-        return solve_range(self.solver, self.driver, values, driver_q=d.q, driver_v=d.v, driver_a=d.a,
+        return solve_range(self.solver, self.driver, self._checked(values), driver_q=d.q, driver_v=d.v, driver_a=d.a,
                            guess=scene_guess(self.scene, self.mechanism), start=start, batch=batch,
                            interpolate=interpolate)
 
@@ -221,6 +221,22 @@ class Sweep:
                 motion = evaluate_motion(self.mechanism, self.solver.data, sol.q[j], sol.v[j], sol.a[j],
                                          points=points, links=links, coincident=coincident)
                 yield SweepPose(index, value, motion, sol.accuracy(j), interpolated=bool(chunk.interpolated[j]))
+
+    def _checked(self, values: Iterable[float]) -> Iterator[float]:
+        """The driver values as floats, or a ModelError naming the first that is not a finite number."""
+        unit = "rad" if self.is_angular else "m"
+        if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
+            raise ModelError(f"values of {self.driver} must be numbers [{unit}], got {values!r:.80}",
+                             path=self.mechanism.source)
+        for index, value in enumerate(values):
+            try:
+                number = float(value)
+            except (TypeError, ValueError):
+                number = math.nan
+            if isinstance(value, (str, bytes, bool)) or not math.isfinite(number):
+                raise ModelError(f"value {index} of {self.driver} is {value!r:.40}, not a finite number [{unit}]",
+                                 path=self.mechanism.source)
+            yield number
 
     def _format(self, value: float) -> str:
         return f"{math.degrees(value):.6g} deg" if self.is_angular else f"{value:.6g} m"
