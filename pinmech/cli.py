@@ -360,7 +360,7 @@ def _follow(args: argparse.Namespace, scene) -> int:
     """A task scene followed in time: CSV (JSON lines, a figure) of the joint trajectory."""
     from pinmech.analysis import load_mechanism
     from pinmech.analysis_task import scene_pose, scene_tasks
-    from pinmech.path import follow_path
+    from pinmech.path import check_timing, follow_path, step_count
     from pinmech.sweep import sweep_options
     from pinmech.tables import PathCsv
 
@@ -379,9 +379,11 @@ def _follow(args: argparse.Namespace, scene) -> int:
         raise PinmechError(f"need 0 < --step <= --duration, got step {step} s, duration {duration} s")
     scheme = args.scheme or options.get("scheme", "taylor")
     gain = args.gain if args.gain is not None else float(options.get("gain", 0.0))
+    check_timing(duration, step, gain, names=("--duration", "--step", "--gain" if args.gain is not None
+                                              else f"{scene.path}: [sweep] gain"))
     mechanism = load_mechanism(scene)
     q0, _, _ = scene_pose(scene, mechanism)
-    total = round(duration / step) + 1
+    total = step_count(duration, step) + 1
     sinks = _Sinks()
     if args.plot_path:
         from pinmech.plot import PathPlot

@@ -50,11 +50,14 @@ class LinkMotion:
 
 @dataclass(frozen=True)
 class JointMotion:
-    """Coordinate [rad or m], rate and acceleration of a one-dof joint."""
+    """Coordinate [rad or m], rate and acceleration of a one-dof joint; arrays for a joint of
+    several freedoms: a planar joint's (x [m], y [m], theta [rad]) and their rates, else
+    Pinocchio's configuration (a quaternion for a spherical or floating joint) and its
+    tangent rates (linear then angular, in the joint's frame)."""
 
-    q: float
-    v: float
-    a: float
+    q: float | np.ndarray
+    v: float | np.ndarray
+    a: float | np.ndarray
     kind: str
 
 
@@ -166,7 +169,25 @@ def _joint_motions(mechanism: Mechanism, q: np.ndarray, v: np.ndarray, a: np.nda
         elif joint.nv == 1:
             out[name] = JointMotion(mechanism.coordinate(q, name), float(v[joint.idx_v]), float(a[joint.idx_v]),
                                     joint.kind)
+        elif joint.nv > 1:
+            out[name] = _multi_dof(mechanism, joint.id, q, v, a)
     return out
+
+
+_MULTI_DOF_KINDS = {"JointModelPlanar": "planar", "JointModelSpherical": "spherical",
+                    "JointModelSphericalZYX": "spherical_zyx", "JointModelFreeFlyer": "floating",
+                    "JointModelTranslation": "translation"}
+
+
+def _multi_dof(mechanism: Mechanism, jid: int, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> JointMotion:
+    """A joint of several freedoms; a planar joint's (cos, sin) pair becomes its angle."""
+    joint = mechanism.model.joints[jid]
+    kind = _MULTI_DOF_KINDS.get(joint.shortname(), "other")
+    qj = q[joint.idx_q : joint.idx_q + joint.nq].copy()
+    vj, aj = v[joint.idx_v : joint.idx_v + joint.nv].copy(), a[joint.idx_v : joint.idx_v + joint.nv].copy()
+    if kind == "planar":
+        qj = np.array([qj[0], qj[1], math.atan2(qj[3], qj[2])])
+    return JointMotion(qj, vj, aj, kind)
 
 
 def _moving_links(mechanism: Mechanism) -> list[str]:

@@ -16,6 +16,10 @@ def _vec(x: np.ndarray) -> list[float]:
     return [float(c) for c in np.asarray(x).reshape(-1)]
 
 
+def _number(x: float | np.ndarray) -> float | list[float]:
+    return x if isinstance(x, float) else _vec(x)
+
+
 def motion_dict(motion: Motion) -> dict[str, Any]:
     """The `joints`, `links`, `points` and `sliders` sections (SI, world frame)."""
     links = {}
@@ -28,7 +32,8 @@ def motion_dict(motion: Motion) -> dict[str, Any]:
             entry["angle"] = link.angle
         links[name] = entry
     return {
-        "joints": {n: {"q": j.q, "v": j.v, "a": j.a, "type": j.kind} for n, j in motion.joints.items()},
+        "joints": {n: {"q": _number(j.q), "v": _number(j.v), "a": _number(j.a), "type": j.kind}
+                   for n, j in motion.joints.items()},
         "links": links,
         "points": {
             n: {"position": _vec(p.position), "velocity": _vec(p.velocity), "acceleration": _vec(p.acceleration),
@@ -174,7 +179,14 @@ def _angle_or_length(analysis: Analysis, name: str, q: float) -> str:
     return f"{math.degrees(q):.6g} deg" if joint.is_angular else f"{q:.6g} m"
 
 
-def _joint_cells(kind: str, q: float, v: float, a: float) -> list[str]:
+def _joint_cells(kind: str, q, v, a) -> list[str]:
+    if kind == "planar":
+        return [f"x, y = ({_num(q[0])}, {_num(q[1])}) m, theta = {_num(math.degrees(q[2]))} deg",
+                f"v = ({_num(v[0])}, {_num(v[1])}) m/s (joint frame), omega = {_num(v[2])} rad/s",
+                f"a = ({_num(a[0])}, {_num(a[1])}) m/s^2 (joint frame), alpha = {_num(a[2])} rad/s^2"]
+    if not isinstance(q, float):
+        return [f"{kind}: q = ({', '.join(_num(x) for x in q)})", f"v = ({', '.join(_num(x) for x in v)})",
+                f"a = ({', '.join(_num(x) for x in a)}) (Pinocchio's configuration and tangent rates, SI)"]
     if kind == "prismatic":
         return [f"q = {_num(q)} m", f"v = {_num(v)} m/s", f"a = {_num(a)} m/s^2"]
     return [
