@@ -511,13 +511,18 @@ class _PathJsonLines:
 def cmd_check(args: argparse.Namespace) -> int:
     """`pinmech check HAND_FILE`: hand values against pinmech, non-zero exit on a mismatch."""
     from pinmech.analysis import analyse
-    from pinmech.check import DEFAULT_SLACK, compare, format_verdicts, load_hand_file
+    from pinmech.check import DEFAULT_SLACK, check_slack, compare, format_verdicts, load_hand_file
     from pinmech.report import to_dict
     from pinmech.scene import Scene
 
+    slack = args.slack if args.slack is not None else DEFAULT_SLACK
+    try:
+        check_slack(slack, "--slack")
+    except PinmechError as exc:  # a usage error (2), not a hand file's (4)
+        raise PinmechError(str(exc)) from None
     hand = load_hand_file(args.hand_file)
     analysis = analyse(Scene.load(hand.scene, args.overrides))
-    verdicts = compare(to_dict(analysis), hand.values, args.slack if args.slack is not None else DEFAULT_SLACK)
+    verdicts = compare(to_dict(analysis), hand.values, slack)
     print(f"{hand.source or hand.path}  vs  pinmech on {hand.scene.name}")
     print(format_verdicts(verdicts))
     return 1 if any(v.verdict == "MISMATCH" for v in verdicts) else 0
