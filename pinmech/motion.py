@@ -39,13 +39,16 @@ class LinkMotion:
     """Orientation, angular velocity [rad/s] and angular acceleration [rad/s^2] of a link.
 
     `angle` is the rotation about the mechanism's plane normal [rad] (planar mechanisms
-    only, else None): the angle of the link's x axis, as a textbook's phi.
+    only, else None): the angle of the link's x axis, as a textbook's phi, measured in the
+    plane. A link whose x axis is (nearly) normal to the plane has no such angle: its y
+    axis is measured instead (its z axis if y is too), and `angle_axis` says which.
     """
 
     rotation: np.ndarray
     angular_velocity: np.ndarray
     angular_acceleration: np.ndarray
     angle: float | None
+    angle_axis: str = "x"
 
 
 @dataclass(frozen=True)
@@ -212,21 +215,35 @@ def _link_motion(mechanism: Mechanism, data: pin.Data, name: str) -> LinkMotion:
     fid = mechanism.links[name]
     model = mechanism.model
     rotation = data.oMf[fid].rotation.copy()
+    angle, axis = _plane_angle(rotation, mechanism.plane_normal)
     return LinkMotion(
         rotation=rotation,
         angular_velocity=pin.getFrameVelocity(model, data, fid, _LWA).angular.copy(),
         angular_acceleration=pin.getFrameAcceleration(model, data, fid, _LWA).angular.copy(),
-        angle=_plane_angle(rotation, mechanism.plane_normal),
+        angle=angle,
+        angle_axis=axis,
     )
 
 
-def _plane_angle(rotation: np.ndarray, normal: np.ndarray | None) -> float | None:
-    """Angle of the link's x axis about the plane normal, measured from the world x axis."""
+#: A link axis is measured in the plane when its projection on the plane is at least this
+#: long (it is within 60 deg of the plane): its in-plane direction is then exact to
+#: rounding. Of x, y and z one always qualifies (their squared projections add up to 2).
+_IN_PLANE = 0.5
+
+
+def _plane_angle(rotation: np.ndarray, normal: np.ndarray | None) -> tuple[float | None, str]:
+    """Angle about the plane normal of the link's x axis (else y, else z: the first that
+    lies within 60 deg of the plane), from the world x axis projected on the plane; and
+    which axis was measured."""
     if normal is None:
-        return None
+        return None, "x"
     ref = _plane_reference(*normal.tolist())
-    x_axis = rotation[:, 0]
-    return math.atan2(float(normal @ _cross(ref, x_axis)), float(ref @ x_axis))
+    for k, name in enumerate("xyz"):
+        axis = rotation[:, k]
+        in_plane = axis - normal * float(normal @ axis)
+        if math.hypot(*in_plane.tolist()) >= _IN_PLANE or name == "z":
+            return math.atan2(float(normal @ _cross(ref, in_plane)), float(ref @ in_plane)), name
+    raise AssertionError("unreachable")  # pragma: no cover
 
 
 @functools.lru_cache(maxsize=8)

@@ -30,6 +30,8 @@ def motion_dict(motion: Motion) -> dict[str, Any]:
         }
         if link.angle is not None:
             entry["angle"] = link.angle
+            if link.angle_axis != "x":
+                entry["angle_axis"] = link.angle_axis  # the link's x axis is normal to the plane
         links[name] = entry
     return {
         "joints": {n: {"q": _number(j.q), "v": _number(j.v), "a": _number(j.a), "type": j.kind}
@@ -141,7 +143,8 @@ def to_text(analysis: Analysis) -> str:
         t.head("Link angles (x axis from world x)")
         for name, link in m.links.items():
             if link.angle is not None:
-                t.row(name, f"phi = {_num(math.degrees(link.angle))} deg = {_num(link.angle)} rad")
+                axis = "" if link.angle_axis == "x" else f"   (its {link.angle_axis} axis: x is normal to the plane)"
+                t.row(name, f"phi = {_num(math.degrees(link.angle))} deg = {_num(link.angle)} rad{axis}")
     t.head("Angular velocities and accelerations")
     for name, link in m.links.items():
         t.row(name, "omega = " + t.spin(link.angular_velocity, "rad/s"), "alpha = " + t.spin(link.angular_acceleration, "rad/s^2"))

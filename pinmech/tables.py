@@ -29,9 +29,10 @@ def columns(sweep: Sweep, first: Motion) -> list[str]:
     unit = "deg" if sweep.is_angular else "m"
     cols = [f"{sweep.driver}.q [{unit}]"]
     planar = sweep.mechanism.plane_normal is not None
-    for name in first.links:
+    for name, link in first.links.items():
         if planar:
-            cols += [f"{name}.angle [deg]", f"{name}.omega [rad/s]", f"{name}.alpha [rad/s^2]"]
+            angle = "angle" if link.angle_axis == "x" else f"angle_of_{link.angle_axis}_axis"  # x normal to the plane
+            cols += [f"{name}.{angle} [deg]", f"{name}.omega [rad/s]", f"{name}.alpha [rad/s^2]"]
         else:
             cols += [f"{name}.|omega| [rad/s]", f"{name}.|alpha| [rad/s^2]"]
     for name in first.points:

@@ -53,3 +53,29 @@ def test_a_mimic_follower_is_in_the_joints_report(tmp_path, models_dir):
     # C = -B: CD keeps AB's direction (50 deg); its rate is minus B's.
     assert report["C"]["q"] == pytest.approx(np.radians(65), abs=1e-15)
     assert report["C"]["v"] == pytest.approx(-report["B"]["v"], abs=1e-15) and report["B"]["v"] != 0
+
+
+def test_a_link_whose_x_axis_is_normal_to_the_plane_reports_its_y_axis_angle(tmp_path, models_dir):
+    """Joint C turned so that link CD's x axis is the plane's normal (world z): its x axis has
+    no direction in the plane, so phi is that of its y axis, theta_A + theta_B + theta_C + 90 deg."""
+    text = (models_dir / "planar_arm.urdf").read_text()
+    text = text.replace('<origin xyz="0.30 0 0"/><axis xyz="0 0 1"/>\n    <limit lower="-3.14159265" upper="3.14159265" '
+                        'effort="100" velocity="10"/>\n  </joint>\n\n  <link name="A"/>',
+                        '<origin xyz="0.30 0 0" rpy="0 -1.5707963267948966 0"/><axis xyz="1 0 0"/>\n    '
+                        '<limit lower="-3.2" upper="3.2" effort="1" velocity="1"/>\n  </joint>\n\n  <link name="A"/>')
+    text = text.replace('<child link="D"/><origin xyz="0.17 0 0"/>', '<child link="D"/><origin xyz="0 0 -0.17"/>')
+    assert 'rpy="0 -1.5707963267948966 0"' in text
+    write(tmp_path, "arm.urdf", text)
+    scene = write(tmp_path, "arm.toml", 'urdf = "arm.urdf"\n[pose]\nA = "50 deg"\nB = "-65 deg"\nC = "33.376 deg"\n'
+                  '[[task]]\nframe = "D"\ncomponents = ["x", "y"]\nvelocity = ["1 m/s", "0 m/s"]\n')
+    analysis = analyse(Scene.load(scene))
+    cd = analysis.motion.links["CD"]
+    assert cd.angle_axis == "y"
+    # 50 - 65 + 33.376 + 90 = 108.376 deg, to rounding (1e-12 rad).
+    assert cd.angle == pytest.approx(np.radians(108.376), abs=1e-12)
+    assert to_dict(analysis)["links"]["CD"]["angle_axis"] == "y"
+    assert "(its y axis: x is normal to the plane)" in to_text(analysis)
+    # D, 0.17 m along CD's direction in the plane (its -z axis is world (cos, sin) of 18.376 deg):
+    th = np.radians([50, -15, 18.376])
+    np.testing.assert_allclose(analysis.motion.points["D"].position[:2],
+                               np.array([np.cos(th), np.sin(th)]) @ [0.30, 0.30, 0.17], atol=1e-12)
