@@ -140,11 +140,21 @@ def coincident_points(scene: Scene) -> list[CoincidentPoint]:
 def report_lists(scene: Scene) -> tuple[list[str] | None, list[str] | None]:
     """Points and links the scene asks to report (None: all)."""
     report = scene.section("report")
-    unknown = set(report) - {"points", "links"}
+    unknown = set(report) - {"points", "links", "limits"}
     if unknown:
-        raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))} in [report]; known: points, links",
+        raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))} in [report]; known: points, links, limits",
                          path=str(scene.path), key="report")
     return scene.names("report", "points"), scene.names("report", "links")
+
+
+def limit_mode(scene: Scene, asked: str | None = None) -> str:
+    """What a joint beyond its URDF limits is: "warn" (default) or "error"; `asked` (the
+    command line's --limits) overrides the scene's `[report] limits`."""
+    mode = asked or scene.section("report").get("limits", "warn")
+    if mode not in ("warn", "error"):
+        raise SceneError(f"limits must be \"warn\" or \"error\", got {mode!r}", path=str(scene.path),
+                         key="report.limits")
+    return mode
 
 
 def check_scene_names(scene: Scene, mechanism: Mechanism) -> None:

@@ -3,7 +3,9 @@
 Exit codes: 0 success; 1 hand values mismatch (`check`); 2 usage or other pinmech error;
 3 bad URDF; 4 bad scene or hand file (unknown name, unit, key); 5 drivers do not match
 the mobility; 6 a loop cannot close; 7 singular pose; 8 inconsistent task; 9 a drawing
-input out of range. An output file that cannot be written is 2.
+input out of range; 10 a joint beyond its URDF <limit> (with --limits error). An output
+file that cannot be written is 2. Stopped by a signal: 128 + its number (130 Ctrl-C, 143
+SIGTERM, 129 SIGHUP), outputs kept as NAME.partial.
 """
 
 from __future__ import annotations
@@ -46,13 +48,19 @@ def _add_path_arguments(parser: argparse.ArgumentParser, *, required: bool) -> N
     parser.add_argument("--gain", type=float, help="task scenes: feedback on the drift [1/s] (default 0: open loop)")
 
 
+def _add_limits_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--limits", choices=("warn", "error"),
+                        help="a joint beyond its URDF <limit>: a warning (default) or an error (exit 10)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser, with one sub-parser per subcommand."""
     parser = argparse.ArgumentParser(
         prog="pinmech",
         description="Kinematics of mechanisms and robot arms from URDF, on Pinocchio.",
         epilog="Exit codes: 0 ok, 1 check mismatch, 2 error, 3 URDF, 4 scene, 5 mobility, "
-        "6 loop cannot close, 7 singular pose, 8 task, 9 drawing.",
+        "6 loop cannot close, 7 singular pose, 8 task, 9 drawing, 10 joint limit (--limits error), "
+        "130 Ctrl-C (128 + signal).",
     )
     parser.add_argument("--version", action="version", version=f"pinmech {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -60,6 +68,7 @@ def build_parser() -> argparse.ArgumentParser:
     solve = sub.add_parser("solve", help="solve a scene and print the report (or JSON)")
     _add_scene_arguments(solve)
     solve.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of text")
+    _add_limits_argument(solve)
     solve.set_defaults(func=cmd_solve)
 
     sweep = sub.add_parser("sweep", help="sweep a driver through a cycle (or follow an arm's task in time): "
@@ -72,6 +81,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_output_arguments(sweep)
     sweep.add_argument("--links", nargs="*", help="links to plot (default: all moving but the driver's)")
     sweep.add_argument("--points", nargs="*", help="points to plot (default: all moving points)")
+    _add_limits_argument(sweep)
     sweep.add_argument("--skip-failures", action="store_true",
                        help="report a pose that cannot close as a row with its error instead of stopping")
     sweep.add_argument("--start", dest="start_mode", choices=("predictor", "warm", "cold"),
@@ -153,17 +163,25 @@ def _scene(args: argparse.Namespace):
 
 def cmd_solve(args: argparse.Namespace) -> int:
     """`pinmech solve SCENE`: the textbook-ordered report, or `--json`."""
-    from pinmech.analysis import analyse
+    from pinmech.analysis import analyse, limit_mode
+    from pinmech.limits import enforce, limit_violations
     from pinmech.report import to_json, to_text
 
-    analysis = analyse(_scene(args))
+    scene = _scene(args)
+    mode = limit_mode(scene, args.limits)
+    analysis = analyse(scene)
+    violations = limit_violations(analysis.mechanism, analysis.motion)
+    enforce(violations, mode, str(scene.path))
     print(to_json(analysis) if args.json else to_text(analysis), end="" if not args.json else "\n")
+    for v in violations:
+        print(f"pinmech: warning: {v.describe()} (URDF <limit>)", file=sys.stderr)
     return 0
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
     """`pinmech sweep SCENE`: every pose of a cycle, streamed as CSV (and JSON lines, a plot);
     a task scene is followed in time instead (as `pinmech path`)."""
+    from pinmech.analysis import limit_mode
     from pinmech.sweep import DriverValues, Sweep, sweep_options
 
     scene = _scene(args)
@@ -197,11 +215,40 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     poses = sweep.poses(DriverValues(start, stop, steps), skip_failures=args.skip_failures,
                         start=mode or "predictor", batch=not args.no_batch and options.get("batch", True),
                         interpolate=interpolate)
+    limits = _SweepLimits(sweep, limit_mode(scene, args.limits))
     sinks = _sweep_sinks(args, sweep, steps, figure)
     with sinks:
         for pose in _progress(poses, steps):
+            limits.check(pose)
             sinks.add(pose)
+    limits.summary(steps)
     return 0
+
+
+class _SweepLimits:
+    """Poses of a sweep that put a joint beyond its URDF <limit>: counted and summed up in a
+    warning, or the sweep stopped at the first (LimitError) in mode "error"."""
+
+    def __init__(self, sweep, mode: str) -> None:
+        self.sweep, self.mode = sweep, mode
+        self.count, self.first = 0, ""
+
+    def check(self, pose) -> None:
+        from pinmech.limits import enforce, limit_violations
+
+        if pose.motion is None:
+            return
+        violations = limit_violations(self.sweep.mechanism, pose.motion)
+        if violations:
+            at = f"at {self.sweep.driver} = {self.sweep._format(pose.value)}"
+            enforce(violations, self.mode, f"sweep stopped {at}")
+            self.count += 1
+            self.first = self.first or f"{at}: " + "; ".join(v.describe() for v in violations)
+
+    def summary(self, total: int) -> None:
+        if self.count:
+            print(f"pinmech: warning: {self.count} of {total} poses put joints beyond their URDF <limit> (first "
+                  f"{self.first}); see the beyond_limits column", file=sys.stderr)
 
 
 def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | None) -> _Sinks:

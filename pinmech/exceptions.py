@@ -145,3 +145,18 @@ class Interrupted(KeyboardInterrupt):
         self.signum = int(signum)
         self.exit_code = 128 + self.signum
         super().__init__(f"interrupted by {signal.Signals(self.signum).name}")
+
+
+class LimitError(PinmechError):
+    """A solved pose puts a joint beyond its URDF `<limit>`, and limits were asked to be
+    errors (`--limits error`); by default they are reported as warnings.
+
+    Attributes:
+        violations: the `LimitViolation`s (joint, value, lower, upper; SI).
+    """
+
+    exit_code = 10
+
+    def __init__(self, message: str, *, violations: list[Any]):
+        super().__init__(message)
+        self.violations = violations

@@ -88,6 +88,8 @@ class Mechanism:
         plane_normal: unit normal of the motion plane for a planar mechanism, else None.
         locked: joints locked out of the model, with their values (SI).
         mimics: joints following another one (URDF `<mimic>`) and still moving.
+        limits: name -> (lower, upper) position limits of the URDF's `<limit>` [rad or m],
+            for the revolute and prismatic joints that give them.
     """
 
     model: pin.Model
@@ -100,6 +102,7 @@ class Mechanism:
     source: str = "<model>"
     locked: dict[str, float] = field(default_factory=dict)
     mimics: dict[str, MimicJoint] = field(default_factory=dict)
+    limits: dict[str, tuple[float, float]] = field(default_factory=dict)
 
     # ---------------------------------------------------------------- construction
     @classmethod
@@ -163,6 +166,7 @@ class Mechanism:
             locked=dict(locked or {}),
             mimics={n: m for n, m in mimics.items() if n not in (locked or {})},
         )
+        mech.limits = {n: lu for n, lu in _joint_limits(root, source).items() if n in mech.joints}
         mech.length_scale = _length_scale(model, source)
         mech.closures = [_make_closure(model, c, mech.length_scale) for c in cuts]
         _reduce_rows(mech)
@@ -367,6 +371,34 @@ def _build_model(source: str, root_joint: str | None = None, *, mimic: bool = Fa
         said = " ".join(sink.read().decode(errors="replace").split())
     detail = f" ({said})" if said else ""
     raise ModelError(f"Pinocchio cannot build the model: {error}{detail}", path=source) from error
+
+
+def _joint_limits(root: ET.Element, source: str) -> dict[str, tuple[float, float]]:
+    """Position limits `<limit lower="..." upper="..."/>` of revolute and prismatic joints
+    (a continuous joint has none; a bound left out is no bound).
+
+    Raises:
+        ModelError: a bound that is not a number, or lower > upper.
+    """
+    out = {}
+    for joint in root.findall("joint"):
+        element = joint.find("limit")
+        if element is None or joint.get("type") not in ("revolute", "prismatic"):
+            continue
+        if element.get("lower") is None and element.get("upper") is None:
+            continue
+        where = f"<joint name=\"{joint.get('name')}\"> <limit>"
+        bounds = []
+        for key, default in (("lower", "-inf"), ("upper", "inf")):
+            try:
+                bounds.append(float(element.get(key, default)))
+            except ValueError:
+                raise ModelError(f"{key}=\"{element.get(key)}\" is not a number", path=source, element=where) from None
+        if not bounds[0] <= bounds[1]:
+            raise ModelError(f"lower=\"{element.get('lower')}\" is above upper=\"{element.get('upper')}\"",
+                             path=source, element=where)
+        out[joint.get("name")] = (bounds[0], bounds[1])
+    return out
 
 
 def _mimic_joints(root: ET.Element, source: str) -> dict[str, MimicJoint]:

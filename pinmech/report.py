@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from pinmech.analysis import Analysis
+from pinmech.limits import limit_violations
 from pinmech.motion import Motion
 
 
@@ -68,6 +69,7 @@ def to_dict(analysis: Analysis) -> dict[str, Any]:
         },
     }
     out.update(motion_dict(analysis.motion))
+    out["limit_violations"] = [v.as_dict() for v in limit_violations(analysis.mechanism, analysis.motion)]
     out["accuracy"] = analysis.solution.accuracy.as_dict()
     if analysis.extra:
         out.update({k: v for k, v in analysis.extra.items() if not k.startswith("_")})
@@ -164,6 +166,10 @@ def to_text(analysis: Analysis) -> str:
     t.head("Joints")
     for name, j in m.joints.items():
         t.row(name, *_joint_cells(j.kind, j.q, j.v, j.a))
+    violations = limit_violations(analysis.mechanism, analysis.motion)
+    if violations:
+        t.head("Joint limits (URDF <limit>)")
+        t.lines += [f"  WARNING: {v.describe()}" for v in violations]
     acc = analysis.solution.accuracy
     t.head("Accuracy")
     t.lines.append(

@@ -15,6 +15,7 @@ from typing import IO, TYPE_CHECKING
 
 import numpy as np
 
+from pinmech.limits import limit_violations
 from pinmech.motion import Motion
 from pinmech.report import motion_dict
 
@@ -41,7 +42,8 @@ def columns(sweep: Sweep, first: Motion) -> list[str]:
         cols += [f"{name}.a{c} [m/s^2]" for c in "xyz"] + [f"{name}.|a| [m/s^2]"]
     for name in first.sliders:
         cols += [f"{name}.v_rel [m/s]", f"{name}.a_rel [m/s^2]", f"{name}.|a_cor| [m/s^2]"]
-    return cols + ["closure_residual [1]", "condition_number [1]", "newton_iterations [1]", "pose", "error"]
+    return cols + ["closure_residual [1]", "condition_number [1]", "newton_iterations [1]", "beyond_limits", "pose",
+                   "error"]
 
 
 def row(sweep: Sweep, pose: SweepPose, width: int) -> list[object]:
@@ -63,7 +65,9 @@ def row(sweep: Sweep, pose: SweepPose, width: int) -> list[object]:
     for name, s in m.sliders.items():
         out += [m.joints[name].v, m.joints[name].a, _norm(s.coriolis_acceleration)]
     acc = pose.accuracy
-    return out + [acc.residual, acc.condition, acc.iterations, "interpolated" if pose.interpolated else "solved", ""]
+    beyond = " ".join(v.joint for v in limit_violations(sweep.mechanism, m))
+    return out + [acc.residual, acc.condition, acc.iterations, beyond, "interpolated" if pose.interpolated else "solved",
+                  ""]
 
 
 class SweepCsv:
@@ -123,6 +127,7 @@ class SweepJsonLines:
                  "pose": "failed" if pose.motion is None else "interpolated" if pose.interpolated else "solved"}
         if pose.motion is not None:
             entry.update(motion_dict(pose.motion))
+            entry["limit_violations"] = [v.as_dict() for v in limit_violations(self.sweep.mechanism, pose.motion)]
             entry["accuracy"] = pose.accuracy.as_dict()
         self.stream.write(json.dumps(entry) + "\n")
 

@@ -1,0 +1,78 @@
+"""Joint limits: a pose beyond a URDF <limit> is reported (text, JSON, CSV), a warning by
+default and an error (exit 10) on request.
+
+The R-RTR's slide coordinate is minus the distance CB (B on the crank, AB = 0.1 m; C on
+the ground, AC = 0.05 m): q = -sqrt(AB^2 + AC^2 - 2 AB AC cos A). With the slide's limits
+made +-0.1 m, it is beyond them exactly where cos A < 0.25 (A between 75.5 and 284.5 deg).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+
+import pytest
+
+from pinmech.cli import main
+from tests.conftest import MODELS, SCENES
+
+
+def _cb(angle_deg: float) -> float:
+    return math.sqrt(0.1**2 + 0.05**2 - 2 * 0.1 * 0.05 * math.cos(math.radians(angle_deg)))
+
+
+@pytest.fixture
+def tight(tmp_path):
+    text = (MODELS / "r_rtr.urdf").read_text()
+    assert 'lower="-0.15" upper="0.15"' in text
+    (tmp_path / "tight.urdf").write_text(text.replace('lower="-0.15" upper="0.15"', 'lower="-0.1" upper="0.1"'))
+    scene = tmp_path / "tight.toml"
+    scene.write_text((SCENES / "r_rtr.toml").read_text().replace('urdf = "../r_rtr.urdf"', 'urdf = "tight.urdf"'))
+    return scene
+
+
+def test_a_pose_beyond_a_limit_is_a_warning_in_text_json_and_stderr(tight, capsys):
+    assert main(["solve", str(tight), "--angle", "90 deg"]) == 0
+    out, err = capsys.readouterr()
+    assert "WARNING: B_slider = -0.111803 m is below its lower limit -0.1 m" in out
+    assert "warning: B_slider = -0.111803 m is below its lower limit -0.1 m" in err
+    assert main(["solve", str(tight), "--angle", "90 deg", "--json"]) == 0
+    [violation] = json.loads(capsys.readouterr().out)["limit_violations"]
+    assert violation["joint"] == "B_slider" and violation["lower"] == -0.1
+    assert violation["value"] == pytest.approx(-_cb(90), abs=1e-12)  # the closed form, to rounding
+
+
+def test_a_pose_within_the_limits_says_nothing(tight, capsys):
+    assert main(["solve", str(tight), "--angle", "30 deg", "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert json.loads(out)["limit_violations"] == [] and "warning" not in err and _cb(30) < 0.1
+
+
+def test_limits_as_errors_exit_10_naming_the_joint(tight, capsys):
+    assert main(["solve", str(tight), "--angle", "90 deg", "--limits", "error"]) == 10
+    err = capsys.readouterr().err
+    assert "B_slider = -0.111803 m is below its lower limit -0.1 m (URDF <limit>)" in err and "Traceback" not in err
+    assert main(["solve", str(tight), "--angle", "90 deg", "--set", 'report.limits="error"']) == 10
+
+
+def test_a_sweep_marks_the_poses_beyond_the_limits(tight, tmp_path, capsys):
+    out = tmp_path / "s.csv"
+    assert main(["sweep", str(tight), "--steps", "19", "--csv", str(out)]) == 0  # 30 to 390 deg by 20 deg
+    rows = list(csv.DictReader(out.open()))
+    beyond = [float(r["A.q [deg]"]) for r in rows if r["beyond_limits"] == "B_slider"]
+    assert beyond == [a for a in range(30, 391, 20) if math.cos(math.radians(a)) < 0.25]
+    assert "10 of 19 poses put joints beyond their URDF <limit>" in capsys.readouterr().err
+    assert main(["sweep", str(tight), "--steps", "19", "--csv", str(out), "--limits", "error"]) == 10
+    assert "sweep stopped at A = 90 deg: B_slider" in capsys.readouterr().err
+
+
+def test_malformed_limits_are_model_errors(tmp_path):
+    from pinmech import Mechanism, ModelError
+
+    text = (MODELS / "r_rtr.urdf").read_text()
+    for bad, message in (('lower="x" upper="0.15"', 'lower value \\(x\\) is not a valid float'),  # urdfdom's
+                         ('lower="0.2" upper="0.15"', 'lower="0.2" is above upper="0.15"')):
+        (tmp_path / "bad.urdf").write_text(text.replace('lower="-0.15" upper="0.15"', bad))
+        with pytest.raises(ModelError, match=message):
+            Mechanism.from_urdf(tmp_path / "bad.urdf")
