@@ -239,8 +239,17 @@ def live_viewer(
     """
     meshcat = _meshcat()
     q = _configuration(model, q, "q")
-    with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL: the caller decides
-        window = meshcat.Visualizer().window
+    from pinmech.view_server import start_server
+
+    process, zmq_url, _ = start_server()  # on 127.0.0.1 only, and stopping with pinmech (view_server.py)
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL: the caller decides
+            window = meshcat.visualizer.ViewerWindow(zmq_url=zmq_url, start_server=False, server_args=[])
+    except BaseException:
+        process.kill()
+        process.wait(timeout=10)
+        raise
+    window.server_proc = process
     try:
         scene = _Scene(model, visual_model, window, show_grid=show_grid)
         return LiveView(scene.vis, _draw_pose(scene, q, points, arrows, plane_normal))
@@ -255,6 +264,9 @@ def _stop_server(window: Any) -> None:
     if window.server_proc is not None and window.server_proc.poll() is None:
         window.server_proc.kill()
         window.server_proc.wait(timeout=10)
+    for pipe in (window.server_proc.stdin, window.server_proc.stdout) if window.server_proc is not None else ():
+        if pipe is not None:
+            pipe.close()
 
 
 # ------------------------------------------------------------------------------------ drawing
@@ -265,6 +277,7 @@ def _meshcat() -> Any:
             import meshcat
             import meshcat.animation
             import meshcat.geometry
+            import meshcat.visualizer
     except ImportError as exc:
         raise ImportError(INSTALL_HINT) from exc
     return meshcat
