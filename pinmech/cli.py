@@ -457,9 +457,13 @@ _ARROW_UNITS = {"velocity": "m/s", "acceleration": "m/s^2"}
 
 def _visuals(mechanism):
     """The mechanism's visual geometry, built only when drawing."""
-    from pinmech.draw import load_visuals
+    from pinmech.draw import package_visuals
 
-    return load_visuals(mechanism.source, mechanism.model)
+    visuals, skipped = package_visuals(mechanism.source, mechanism.model)
+    for mesh in skipped:
+        print(f"pinmech: warning: mesh {mesh} left out of the drawing: it is outside the model's package",
+              file=sys.stderr)
+    return visuals
 
 
 def cmd_snapshot(args: argparse.Namespace) -> int:

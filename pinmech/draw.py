@@ -99,7 +99,16 @@ def arrow_scales(arrows: Sequence[Arrow], size: float) -> dict[str, float]:
 def load_visuals(
     urdf_path: str | Path, model: pin.Model, package_dirs: Sequence[str | Path] = ()
 ) -> pin.GeometryModel:
-    """The visual geometry of a URDF (meshes included), built only when drawing.
+    """The visual geometry of a URDF (meshes of its own package only), built only when
+    drawing; `package_visuals` also says which meshes were left out."""
+    return package_visuals(urdf_path, model, package_dirs)[0]
+
+
+def package_visuals(
+    urdf_path: str | Path, model: pin.Model, package_dirs: Sequence[str | Path] = ()
+) -> tuple[pin.GeometryModel, list[str]]:
+    """The visual geometry of a URDF, and the mesh files left out of it because they lie
+    outside the model's own package (visual_files.py: a page must carry no other file).
 
     Args:
         urdf_path: the URDF file `model` was built from.
@@ -107,18 +116,21 @@ def load_visuals(
         package_dirs: folders holding `package://NAME/...` meshes; by default the URDF's
             own folder and its parents.
     """
+    from pinmech.visual_files import drop_outside, package_roots
+
     path = Path(urdf_path)
     if not path.is_file():
         raise DrawError(f"no URDF file at {path}", argument="urdf_path", value=str(path))
     dirs = [str(d) for d in package_dirs] or [str(p) for p in path.resolve().parents][:5]
     try:
-        return pin.buildGeomFromUrdf(model, str(path), pin.GeometryType.VISUAL, package_dirs=dirs)
+        visuals = pin.buildGeomFromUrdf(model, str(path), pin.GeometryType.VISUAL, package_dirs=dirs)
     except (ValueError, RuntimeError) as exc:
         raise DrawError(
             f"{path}: cannot build its visual geometry: {exc}",
             argument="urdf_path",
             value=str(path),
         ) from exc
+    return visuals, drop_outside(visuals, model, package_roots(path, dirs))
 
 
 def snapshot_html(
