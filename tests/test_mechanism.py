@@ -183,3 +183,31 @@ def test_a_model_with_one_freedom_left_loads(models_dir):
     mech = Mechanism.from_urdf(models_dir / "planar_arm.urdf", locked={"B": 0.3, "C": 0.2})
     assert mech.model.nv == 1
     np.testing.assert_allclose(mech.plane_normal, [0, 0, 1], atol=1e-12)
+
+
+def _chain(tmp_path, n: int):
+    links = "".join(f'<link name="l{i}"/>' for i in range(n + 1))
+    joints = "".join(f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+                     '<origin xyz="0.1 0 0"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/>'
+                     "</joint>" for i in range(n))
+    return write(tmp_path, "chain.urdf", f'<?xml version="1.0"?><robot name="c">{links}{joints}</robot>')
+
+
+def test_a_chain_of_2000_links_is_refused_in_one_line_before_allocating(tmp_path):
+    # Pinocchio's Data grows as joints^3 (4 GB at 400): 2,000 would be MemoryError after minutes.
+    import time
+
+    start = time.perf_counter()
+    with pytest.raises(ModelError, match=r"keeps 2000 moving joints; .* about 500 GB .* at most 256: lock"):
+        Mechanism.from_urdf(_chain(tmp_path, 2000))
+    assert time.perf_counter() - start < 20
+
+
+def test_locking_brings_a_long_chain_within_the_limit(tmp_path, monkeypatch):
+    import pinmech.mechanism
+
+    monkeypatch.setattr(pinmech.mechanism, "MAX_JOINTS", 20)
+    urdf = _chain(tmp_path, 25)
+    with pytest.raises(ModelError, match="keeps 25 moving joints"):
+        Mechanism.from_urdf(urdf)
+    assert Mechanism.from_urdf(urdf, locked={f"j{i}": 0.1 for i in range(5)}).model.nv == 20
