@@ -471,7 +471,9 @@ def cmd_snapshot(args: argparse.Namespace) -> int:
     from pinmech.analysis import analyse
     from pinmech.draw import Arrow, snapshot_html
 
-    analysis = analyse(_scene(args))
+    scene = _scene(args)
+    _check_page(args, scene)
+    analysis = analyse(scene)
     points = {n: p.position for n, p in analysis.motion.points.items()}
     arrows = []
     for spec in args.arrows:
@@ -499,6 +501,7 @@ def cmd_animate(args: argparse.Namespace) -> int:
     from pinmech.sweep import DriverValues, Sweep
 
     scene = _scene(args)
+    _check_page(args, scene)
     sweep = Sweep.from_scene(scene)
     kind = "angle" if sweep.is_angular else "length"
     start = scene.quantity(args.start, kind, "--from") if args.start else sweep.start
@@ -534,6 +537,11 @@ def cmd_view(args: argparse.Namespace) -> int:
         except (EOFError, KeyboardInterrupt):  # no terminal, or Ctrl-C: stop quietly
             pass
     return 0
+
+
+def _check_page(args: argparse.Namespace, scene) -> None:
+    """Before computing: the page's file can be made and is not an input."""
+    check_distinct({"-o": args.output}, {"the scene file": scene.path, "the URDF": _urdf_path(scene)})
 
 
 def _write(path: str, html: str) -> None:

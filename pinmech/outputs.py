@@ -35,7 +35,11 @@ class OutputFile:
         self.stream: IO[str] | None = None
 
     def open(self, *, text: bool = True) -> IO[str] | None:
-        """Create the temporary file; in text mode return it opened for writing."""
+        """Create the temporary file; in text mode return it opened for writing. A pipe or a
+        device (/dev/stdout) is written directly: it cannot be renamed over."""
+        if text and _special(self.path):
+            self.stream = open(self.path, "w", newline="", encoding="utf-8")  # noqa: SIM115
+            return self.stream
         folder = self.path.parent if str(self.path.parent) else Path(".")
         handle, name = tempfile.mkstemp(dir=folder, prefix=f".{self.path.name}.", suffix=f".tmp{self.path.suffix}")
         self.temporary = Path(name)
@@ -71,6 +75,20 @@ class OutputFile:
         if self.stream is not None:
             self.stream.close()
             self.stream = None
+
+
+def _check_destination(option: str, path: Path) -> None:
+    """A file can be made at `path`: it is not a folder, and its folder exists."""
+    if path.is_dir():
+        raise PinmechError(f"{option} {path} is a folder: give a file name")
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise PinmechError(f"{option} {path}: no such folder {folder}")
+
+
+def _special(path: Path) -> bool:
+    """An existing file that is not a regular one (a pipe, /dev/stdout): written directly."""
+    return path.exists() and not path.is_file() and not path.is_dir()
 
 
 def _mode(path: Path) -> int:
@@ -126,6 +144,7 @@ def check_distinct(outputs: dict[str, str | Path | None], inputs: dict[str, str 
     for option, path in outputs.items():
         if path is None:
             continue
+        _check_destination(option, Path(path))
         key = os.path.realpath(path)
         if key in seen:
             raise PinmechError(f"{seen[key]} and {option} both name {path}: give each output its own file")

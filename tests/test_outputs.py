@@ -111,7 +111,7 @@ def test_driver_values_are_linspace_without_its_array():
     assert len(huge) == 10**10 and huge[-1] == 1.0 and huge[1] == pytest.approx(1 / (10**10 - 1), rel=1e-15)
 
 
-def _sweep_process(scene: Path, folder: Path, steps: str = "100000000") -> subprocess.Popen:
+def _sweep_process(scene: Path, folder: Path, steps: str = "10000000000") -> subprocess.Popen:
     return subprocess.Popen(
         [sys.executable, "-m", "pinmech", "sweep", str(scene), "--from", "-20 deg", "--to", "-10 deg",
          "--steps", steps, "--csv", str(folder / "b.csv"), "--json", str(folder / "b.jsonl")],
@@ -128,7 +128,7 @@ def _wait_for_rows(folder: Path, process: subprocess.Popen) -> None:
 
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
-def test_a_signal_stops_a_sweep_with_one_line_and_agreeing_partial_files(singular_at_zero, tmp_path, signum):
+def test_a_signal_stops_a_sweep_of_1e10_poses_with_one_line_and_agreeing_partial_files(singular_at_zero, tmp_path, signum):
     process = _sweep_process(singular_at_zero, tmp_path)
     _wait_for_rows(tmp_path, process)
     process.send_signal(signum)
@@ -148,3 +148,38 @@ def test_two_sweeps_writing_one_file_leave_one_complete_file(r_rtr_scene, tmp_pa
     assert [r.wait(timeout=120) for r in runs] == [0, 0]
     assert len(out.read_text().splitlines()) - 1 in (3000, 3001)  # one run's rows, whole
     assert _files(tmp_path) == {"a.csv"}
+
+
+@pytest.mark.parametrize("command", ["snapshot", "animate"])
+def test_a_page_over_its_own_scene_or_urdf_is_refused(tmp_path, models_dir, command, capsys):
+    pytest.importorskip("meshcat")
+    scene = tmp_path / "s.toml"
+    scene.write_text(f'urdf = "{models_dir / "r_rtr.urdf"}"\n[drivers.A]\nangle = "30 deg"\n'
+                     '[guess]\nB = "20 deg"\nB_slider = "-60 mm"\n')
+    text = scene.read_text()
+    for target, what in ((scene, "the scene file"), (models_dir / "r_rtr.urdf", "the URDF")):
+        assert main([command, str(scene), "-o", str(target)]) == 2
+        assert f"would overwrite {what}" in capsys.readouterr().err
+    assert scene.read_text() == text
+
+
+@pytest.mark.parametrize("target, message", [(".", "is a folder: give a file name"),
+                                             ("missing/x.csv", "no such folder")])
+def test_an_output_that_cannot_be_a_file_is_refused_before_computing(singular_at_zero, tmp_path, capsys, target,
+                                                                     message):
+    code = main(["sweep", str(singular_at_zero), "--from", "0 deg", "--to", "1 deg", "--steps", "2",
+                 "--csv", str(tmp_path / target)])
+    assert code == 2 and message in capsys.readouterr().err  # 2, not the pose's 7: checked first
+
+
+def test_a_pipe_is_written_directly(r_rtr_scene, tmp_path, capsys):
+    import threading
+
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    got: list[str] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_text()))
+    reader.start()
+    assert main(["sweep", str(r_rtr_scene), "--steps", "4", "--csv", str(fifo)]) == 0
+    reader.join(timeout=30)
+    assert len(got[0].splitlines()) == 5 and _files(tmp_path) == {"pipe"}
