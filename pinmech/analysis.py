@@ -95,6 +95,10 @@ def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
         if name in mechanism.locked:
             raise SceneError(f"joint '{name}' is both driven and locked", path=str(scene.path), key=f"drivers.{name}")
         joint = _scene_joint(scene, mechanism, name, "drivers")
+        if name in mechanism.mimics:
+            leader = mechanism.mimics[name].leader
+            raise SceneError(f"joint '{name}' follows '{leader}' (URDF <mimic>): drive {leader} instead",
+                             path=str(scene.path), key=f"drivers.{name}")
         row = [0.0, 0.0, 0.0]
         given = [False, False, False]
         for key, value in spec.items():
@@ -122,6 +126,10 @@ def scene_guess(scene: Scene, mechanism: Mechanism) -> np.ndarray:
     q = mechanism.neutral()
     for name, value in scene.section("guess").items():
         joint = _scene_joint(scene, mechanism, name, "guess")
+        if name in mechanism.mimics:
+            leader = mechanism.mimics[name].leader
+            raise SceneError(f"joint '{name}' follows '{leader}' (URDF <mimic>): give {leader}'s value instead",
+                             path=str(scene.path), key=f"guess.{name}")
         mechanism.set_coordinate(q, name, scene.joint_quantity(value, joint.kind, 0, "guess", name))
     return q
 

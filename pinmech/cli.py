@@ -301,18 +301,24 @@ class _Sinks:
             self._abandon()
             return
         try:  # every row is in: the tables are complete, then the figures (which may still fail)
-            counts = [table.close() for table, _, _ in self.tables]
-            for (_, output, what), count in zip(self.tables, counts):
-                if output:
-                    output.commit()
-                    said = f"{count} {what}" if what else "JSON lines"
-                    print(f"{said} written to {output.path}", file=sys.stderr)
-            for recorder, output in self.figures:
-                recorder.save(output.temporary)
-                print(f"figure written to {output.commit()}", file=sys.stderr)
+            with _SIGNALS.held():  # all of them finished before a signal stops the run
+                self._finish()
         except BaseException:
             self._abandon()
             raise
+
+    def _finish(self) -> None:
+        """Close the tables and rename them over their names, then draw and rename the figures."""
+        counts = [table.close() for table, _, _ in self.tables]
+        for (_, output, what), count in zip(self.tables, counts):
+            if output:
+                output.commit()
+                said = f"{count} {what}" if what else "JSON lines"
+                print(f"{said} written to {output.path}", file=sys.stderr)
+        for recorder, output in self.figures:
+            recorder.save(output.temporary)
+            output.commit()
+            print(f"figure written to {output.path}", file=sys.stderr)
 
     def _abandon(self) -> None:
         """Keep what was written as NAME.partial, and say so."""

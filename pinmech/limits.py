@@ -39,16 +39,20 @@ class LimitViolation:
 
 
 def limit_violations(mechanism: Mechanism, motion: Motion) -> list[LimitViolation]:
-    """The joints of a solved pose beyond their URDF limits (a margin of 1e-9, relative to
-    the bound or absolute below 1, for the rounding of a closed loop)."""
+    """The joints of a solved pose beyond their URDF limits, locked ones included (a margin
+    of 1e-9, relative to the bound or absolute below 1, for the rounding of a closed loop)."""
     out = []
-    for name, (lower, upper) in mechanism.limits.items():
+    for name, limit in mechanism.limits.items():
         joint = motion.joints.get(name)
-        if joint is None or not isinstance(joint.q, float):
+        if name in mechanism.locked:  # held where the scene locks it
+            value = mechanism.locked[name]
+        elif joint is not None and isinstance(joint.q, float):
+            value = joint.q
+        else:
             continue
-        margin = 1e-9 * max(1.0, abs(lower), abs(upper))
-        if joint.q < lower - margin or joint.q > upper + margin:
-            out.append(LimitViolation(name, joint.q, lower, upper, joint.kind != "prismatic"))
+        margin = 1e-9 * max(1.0, abs(limit.lower), abs(limit.upper))
+        if value < limit.lower - margin or value > limit.upper + margin:
+            out.append(LimitViolation(name, value, limit.lower, limit.upper, limit.angular))
     return out
 
 

@@ -59,6 +59,15 @@ class JointInfo:
 
 
 @dataclass(frozen=True)
+class JointLimit:
+    """A joint's position limits from the URDF's `<limit>` [rad, or m when not angular]."""
+
+    lower: float
+    upper: float
+    angular: bool
+
+
+@dataclass(frozen=True)
 class MimicJoint:
     """A URDF `<mimic>` joint: its coordinate is `multiplier * q_leader + offset`, and its
     rates follow [rad or m, and per second]. Pinocchio builds it as a joint with no
@@ -88,8 +97,8 @@ class Mechanism:
         plane_normal: unit normal of the motion plane for a planar mechanism, else None.
         locked: joints locked out of the model, with their values (SI).
         mimics: joints following another one (URDF `<mimic>`) and still moving.
-        limits: name -> (lower, upper) position limits of the URDF's `<limit>` [rad or m],
-            for the revolute and prismatic joints that give them.
+        limits: name -> position limits of the URDF's `<limit>` [rad or m],
+            for the revolute and prismatic joints that give them (locked ones included).
     """
 
     model: pin.Model
@@ -102,7 +111,7 @@ class Mechanism:
     source: str = "<model>"
     locked: dict[str, float] = field(default_factory=dict)
     mimics: dict[str, MimicJoint] = field(default_factory=dict)
-    limits: dict[str, tuple[float, float]] = field(default_factory=dict)
+    limits: dict[str, JointLimit] = field(default_factory=dict)
 
     # ---------------------------------------------------------------- construction
     @classmethod
@@ -167,7 +176,7 @@ class Mechanism:
             locked=dict(locked or {}),
             mimics={n: m for n, m in mimics.items() if n not in (locked or {})},
         )
-        mech.limits = {n: lu for n, lu in _joint_limits(root, source).items() if n in mech.joints}
+        mech.limits = {n: lu for n, lu in _joint_limits(root, source).items() if n in mech.joints or n in mech.locked}
         mech.length_scale = _length_scale(model, source)
         mech.closures = [_make_closure(model, c, mech.length_scale) for c in cuts]
         _reduce_rows(mech)
@@ -374,7 +383,7 @@ def _build_model(source: str, root_joint: str | None = None, *, mimic: bool = Fa
     raise ModelError(f"Pinocchio cannot build the model: {error}{detail}", path=source) from error
 
 
-def _joint_limits(root: ET.Element, source: str) -> dict[str, tuple[float, float]]:
+def _joint_limits(root: ET.Element, source: str) -> dict[str, JointLimit]:
     """Position limits `<limit lower="..." upper="..."/>` of revolute and prismatic joints
     (a continuous joint has none; a bound left out is no bound).
 
@@ -398,7 +407,7 @@ def _joint_limits(root: ET.Element, source: str) -> dict[str, tuple[float, float
         if not bounds[0] <= bounds[1]:
             raise ModelError(f"lower=\"{element.get('lower')}\" is above upper=\"{element.get('upper')}\"",
                              path=source, element=where)
-        out[joint.get("name")] = (bounds[0], bounds[1])
+        out[joint.get("name")] = JointLimit(bounds[0], bounds[1], joint.get("type") == "revolute")
     return out
 
 

@@ -31,6 +31,7 @@ class OutputFile:
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
+        self.target = Path(os.path.realpath(path))  # a symbolic link is written through, not replaced
         self.temporary: Path | None = None
         self.stream: IO[str] | None = None
 
@@ -40,10 +41,10 @@ class OutputFile:
         if text and _special(self.path):
             self.stream = open(self.path, "w", newline="", encoding="utf-8")  # noqa: SIM115
             return self.stream
-        folder = self.path.parent if str(self.path.parent) else Path(".")
-        handle, name = tempfile.mkstemp(dir=folder, prefix=f".{self.path.name}.", suffix=f".tmp{self.path.suffix}")
+        handle, name = tempfile.mkstemp(dir=self.target.parent, prefix=f".{self.target.name}.",
+                                        suffix=f".tmp{self.target.suffix}")
         self.temporary = Path(name)
-        os.chmod(handle, _mode(self.path))
+        os.chmod(handle, _mode(self.target))
         if not text:
             os.close(handle)
             return None
@@ -54,7 +55,7 @@ class OutputFile:
         """Close the temporary file and rename it over the destination; the destination."""
         self._close()
         if self.temporary is not None:
-            os.replace(self.temporary, self.path)
+            os.replace(self.temporary, self.target)
             self.temporary = None
         return self.path
 
@@ -67,7 +68,7 @@ class OutputFile:
         if temporary.stat().st_size == 0:
             temporary.unlink()
             return None
-        partial = self.path.with_name(self.path.name + PARTIAL_SUFFIX)
+        partial = self.target.with_name(self.target.name + PARTIAL_SUFFIX)
         os.replace(temporary, partial)
         return partial
 

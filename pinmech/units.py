@@ -82,6 +82,8 @@ MAX_MAGNITUDE = 1e50
 
 _NUMBER = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?(?:infinity|inf|nan)\b)\s*(.*)",
                      re.IGNORECASE | re.DOTALL)
+#: Typographic spellings of a unit: s² is s^2, m·s is m*s, μ (Greek mu) is µ (micro sign).
+_TYPOGRAPHY = str.maketrans({"²": "^2", "³": "^3", "·": "*", "⋅": "*", "\u03bc": "\u00b5"})
 _EXPONENT = re.compile(r"(\^|\*\*)\s*[+-]?\d+")
 _DMS = re.compile(
     r"([+-]?)\s*(\d+)\s*(?:°|deg|degrees?)\s*"
@@ -152,7 +154,8 @@ def _split(text: str, kind: str, where: str) -> tuple[float, str]:
     if match is None:
         raise UnitError(f"cannot read quantity {text!r}: expected a number then a unit, e.g. "
                         f"'1.5 {_example(kind)}'", key=where)
-    unit = re.sub(r"\s*(\*\*|[/*^])\s*", r"\1", match.group(2).strip())
+    unit = match.group(2).strip().translate(_TYPOGRAPHY)
+    unit = re.sub(r"\s*(\*\*|[/*^])\s*", r"\1", unit)
     if re.search(r"\d", _EXPONENT.sub("", unit)):
         angles = " (an angle may be written 30° 20' 15\")" if kind.startswith(("angle", "angular")) else ""
         raise UnitError(f"{text!r} holds more than one number: write one number and one unit, e.g. "

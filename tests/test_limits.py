@@ -76,3 +76,14 @@ def test_malformed_limits_are_model_errors(tmp_path):
         (tmp_path / "bad.urdf").write_text(text.replace('lower="-0.15" upper="0.15"', bad))
         with pytest.raises(ModelError, match=message):
             Mechanism.from_urdf(tmp_path / "bad.urdf")
+
+
+def test_a_joint_locked_beyond_its_limit_is_reported(tmp_path, capsys):
+    # The planar arm's joints are limited to +-3.14159265 rad; C locked at 200 deg is beyond.
+    scene = tmp_path / "arm.toml"
+    scene.write_text(f'urdf = "{MODELS / "planar_arm.urdf"}"\n[lock]\nC = "200 deg"\n[pose]\nA = "50 deg"\n'
+                     'B = "-65 deg"\n[[task]]\nframe = "D"\ncomponents = ["x", "y"]\nvelocity = ["1 m/s", "0 m/s"]\n')
+    assert main(["solve", str(scene), "--json"]) == 0
+    [violation] = json.loads(capsys.readouterr().out)["limit_violations"]
+    assert violation == {"joint": "C", "value": pytest.approx(math.radians(200)), "lower": -3.14159265,
+                         "upper": 3.14159265}

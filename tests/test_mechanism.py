@@ -211,3 +211,14 @@ def test_locking_brings_a_long_chain_within_the_limit(tmp_path, monkeypatch):
     with pytest.raises(ModelError, match="keeps 25 moving joints"):
         Mechanism.from_urdf(urdf)
     assert Mechanism.from_urdf(urdf, locked={f"j{i}": 0.1 for i in range(5)}).model.nv == 20
+
+
+def test_a_scene_driving_or_guessing_a_mimic_follower_is_told_to_use_its_leader(tmp_path, models_dir):
+    from pinmech import Scene, SceneError, analyse
+
+    _mimic_arm(tmp_path, models_dir)
+    task = '[[task]]\nframe = "D"\ncomponents = ["x", "y"]\nvelocity = ["1 m/s", "0 m/s"]\n'
+    for text in ('[drivers.C]\nangle = "10 deg"\n[drivers.A]\nangle = "10 deg"\n', f'[guess]\nC = "10 deg"\n{task}'):
+        scene = write(tmp_path, "s.toml", f'urdf = "arm.urdf"\n{text}')
+        with pytest.raises(SceneError, match="'C' follows 'B' \\(URDF <mimic>\\)"):
+            analyse(Scene.load(scene))

@@ -183,3 +183,18 @@ def test_a_pipe_is_written_directly(r_rtr_scene, tmp_path, capsys):
     assert main(["sweep", str(r_rtr_scene), "--steps", "4", "--csv", str(fifo)]) == 0
     reader.join(timeout=30)
     assert len(got[0].splitlines()) == 5 and _files(tmp_path) == {"pipe"}
+
+
+def test_an_output_through_a_symbolic_link_replaces_its_target(r_rtr_scene, tmp_path, capsys):
+    (tmp_path / "real").mkdir()
+    target = tmp_path / "real" / "a.csv"
+    target.write_text("old\n")
+    os.symlink(target, tmp_path / "link.csv")
+    assert main(["sweep", str(r_rtr_scene), "--steps", "3", "--csv", str(tmp_path / "link.csv")]) == 0
+    assert (tmp_path / "link.csv").is_symlink() and len(target.read_text().splitlines()) == 4
+    assert _files(tmp_path / "real") == {"a.csv"}
+
+
+def test_animate_refuses_more_frames_than_a_page_can_keep(r_rtr_scene, tmp_path, capsys):
+    assert main(["animate", str(r_rtr_scene), "-o", str(tmp_path / "a.html"), "--steps", "10000000000"]) == 2
+    assert "--steps must be between 2 and 20000 frames" in capsys.readouterr().err

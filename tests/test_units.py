@@ -144,3 +144,11 @@ def test_common_units_are_read_without_importing_pint():
             "[to_si(t, k) for t, k in (('30 deg', 'angle'), ('-50 rpm', 'angular_velocity'), ('150 mm', 'length'))]; "
             "sys.exit('pint' in sys.modules)")
     assert subprocess.run([sys.executable, "-c", code], check=False).returncode == 0
+
+
+@pytest.mark.parametrize("text, kind, si", [("1 rad/s²", "angular_acceleration", 1.0),
+                                            ("2 m·s^-2", "acceleration", 2.0),
+                                            ("5 \u03bcm", "length", 5e-6),  # Greek mu, as keyboards type it
+                                            ("5 \u00b5m", "length", 5e-6)])  # the micro sign
+def test_typographic_spellings_of_units(text, kind, si):
+    assert to_si(text, kind) == pytest.approx(si, rel=1e-15)
