@@ -508,22 +508,25 @@ def _reduced(model: pin.Model, ids: list[int], q_ref: np.ndarray) -> pin.Model:
     return reduced
 
 
-#: Most joints a model may keep. Pinocchio's `Data` grows as the cube of the joint count
-#: (measured with Pinocchio 4.1: 69 MB at 100 joints, 0.5 GB at 200, 4 GB at 400, chains
-#: and stars alike), and pinmech makes several; past this a model would exhaust memory.
-MAX_JOINTS = 256
-_DATA_BYTES_PER_JOINT_CUBED = 62.5
+#: Most degrees of freedom a model may keep. Pinocchio's `Data` allocates, whatever it is
+#: used for, four nv x nv x nv tensors (second derivatives of the inverse dynamics:
+#: d2tau_dqdq, d2tau_dvdv, d2tau_dqdv, d2tau_dadq; data.hxx) and a 6 x nv x nv one, so its
+#: size grows as nv^3: measured with Pinocchio 4.1, 69 MB at nv = 100, 0.5 GB at 200, 4 GB at
+#: 400 (62.5 bytes per nv^3, chains and stars alike). pinmech makes several Data; past this
+#: a model would exhaust memory (a 1,000-link chain: 62 GB) before anything is solved.
+MAX_DOF = 256
+_DATA_BYTES_PER_DOF_CUBED = 62.5
 
 
 def _check_size(model: pin.Model, source: str) -> None:
     """Raises ModelError (one line, with the memory it would take) for a model with more
-    joints than `MAX_JOINTS`, before Pinocchio tries to allocate its Data."""
-    joints = model.njoints - 1
-    if joints > MAX_JOINTS:
-        gigabytes = _DATA_BYTES_PER_JOINT_CUBED * joints**3 / 1e9
-        raise ModelError(f"the model keeps {joints} moving joints; Pinocchio's working data for it would take about "
-                         f"{gigabytes:.3g} GB (it grows as the cube of the joint count), so pinmech takes at most "
-                         f"{MAX_JOINTS}: lock the joints the scene holds still ([lock], or move = [...])", path=source)
+    degrees of freedom than `MAX_DOF`, before Pinocchio tries to allocate its Data."""
+    if model.nv > MAX_DOF:
+        gigabytes = _DATA_BYTES_PER_DOF_CUBED * model.nv**3 / 1e9
+        raise ModelError(f"the model keeps {model.nv} degrees of freedom ({model.njoints - 1} joints); Pinocchio's "
+                         f"working data for it would take about {gigabytes:.3g} GB (it holds nv x nv x nv tensors of "
+                         f"second derivatives), so pinmech takes at most {MAX_DOF}: lock the joints the scene holds "
+                         "still ([lock], or move = [...])", path=source)
 
 
 def _joint_kind(joint: pin.JointModel) -> str:

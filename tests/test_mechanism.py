@@ -194,11 +194,12 @@ def _chain(tmp_path, n: int):
 
 
 def test_a_chain_of_2000_links_is_refused_in_one_line_before_allocating(tmp_path):
-    # Pinocchio's Data grows as joints^3 (4 GB at 400): 2,000 would be MemoryError after minutes.
+    # Pinocchio's Data holds nv^3 tensors (4 GB at 400): 2,000 would be MemoryError after minutes.
     import time
 
     start = time.perf_counter()
-    with pytest.raises(ModelError, match=r"keeps 2000 moving joints; .* about 500 GB .* at most 256: lock"):
+    with pytest.raises(ModelError, match=r"keeps 2000 degrees of freedom \(2000 joints\); .* about 500 GB .* "
+                                         "at most 256: lock"):
         Mechanism.from_urdf(_chain(tmp_path, 2000))
     assert time.perf_counter() - start < 20
 
@@ -206,9 +207,9 @@ def test_a_chain_of_2000_links_is_refused_in_one_line_before_allocating(tmp_path
 def test_locking_brings_a_long_chain_within_the_limit(tmp_path, monkeypatch):
     import pinmech.mechanism
 
-    monkeypatch.setattr(pinmech.mechanism, "MAX_JOINTS", 20)
+    monkeypatch.setattr(pinmech.mechanism, "MAX_DOF", 20)
     urdf = _chain(tmp_path, 25)
-    with pytest.raises(ModelError, match="keeps 25 moving joints"):
+    with pytest.raises(ModelError, match="keeps 25 degrees of freedom"):
         Mechanism.from_urdf(urdf)
     assert Mechanism.from_urdf(urdf, locked={f"j{i}": 0.1 for i in range(5)}).model.nv == 20
 
