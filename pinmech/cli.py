@@ -3,7 +3,7 @@
 Exit codes: 0 success; 1 hand values mismatch (`check`); 2 usage or other pinmech error;
 3 bad URDF; 4 bad scene or hand file (unknown name, unit, key); 5 drivers do not match
 the mobility; 6 a loop cannot close; 7 singular pose; 8 inconsistent task; 9 a drawing
-input out of range; 10 a joint beyond its URDF <limit> (with --limits error). An output
+input out of range; 12 a joint beyond its URDF <limit> (with --limits error). An output
 file that cannot be written is 2. Stopped by a signal: 128 + its number (130 Ctrl-C, 143
 SIGTERM, 129 SIGHUP), outputs kept as NAME.partial.
 """
@@ -50,7 +50,7 @@ def _add_path_arguments(parser: argparse.ArgumentParser, *, required: bool) -> N
 
 def _add_limits_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--limits", choices=("warn", "error"),
-                        help="a joint beyond its URDF <limit>: a warning (default) or an error (exit 10)")
+                        help="a joint beyond its URDF <limit>: a warning (default) or an error (exit 12)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -59,7 +59,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="pinmech",
         description="Kinematics of mechanisms and robot arms from URDF, on Pinocchio.",
         epilog="Exit codes: 0 ok, 1 check mismatch, 2 error, 3 URDF, 4 scene, 5 mobility, "
-        "6 loop cannot close, 7 singular pose, 8 task, 9 drawing, 10 joint limit (--limits error), "
+        "6 loop cannot close, 7 singular pose, 8 task, 9 drawing, 12 joint limit (--limits error), "
         "130 Ctrl-C (128 + signal).",
     )
     parser.add_argument("--version", action="version", version=f"pinmech {__version__}")

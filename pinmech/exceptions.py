@@ -155,7 +155,7 @@ class LimitError(PinmechError):
         violations: the `LimitViolation`s (joint, value, lower, upper; SI).
     """
 
-    exit_code = 10
+    exit_code = 12
 
     def __init__(self, message: str, *, violations: list[Any]):
         super().__init__(message)
