@@ -8,10 +8,14 @@ A user's script imports from here only:
 """
 
 from pinmech.analysis import Analysis, Drivers, analyse, load_mechanism
+from pinmech.branches import Assembly
 from pinmech.check import compare, load_hand_file
 from pinmech.closures import Closure
+from pinmech.continuation import Route
 from pinmech.exceptions import (
+    AssemblyError,
     CheckMismatch,
+    DriverLimitError,
     FrameNotFound,
     Interrupted,
     LoopClosureError,
@@ -32,7 +36,7 @@ from pinmech.results import Accuracy, LoopSolution, RateSolution
 from pinmech.scene import Scene
 from pinmech.solve_batch import BatchSolution, BatchSolver
 from pinmech.solve_cycle import RangeChunk, solve_range
-from pinmech.solve_loops import LoopSolver
+from pinmech.solve_loops import LoopSolver, Reference
 from pinmech.solve_rates import RateSolver, Task
 from pinmech.sweep import Sweep, SweepPose
 from pinmech.units import to_si
@@ -42,11 +46,14 @@ __version__ = "0.1.0"
 __all__ = [
     "Accuracy",
     "Analysis",
+    "Assembly",
+    "AssemblyError",
     "BatchSolution",
     "BatchSolver",
     "CheckMismatch",
     "Closure",
     "CoincidentPoint",
+    "DriverLimitError",
     "Drivers",
     "FrameNotFound",
     "Interrupted",
@@ -63,6 +70,8 @@ __all__ = [
     "RangeChunk",
     "RateSolution",
     "RateSolver",
+    "Reference",
+    "Route",
     "Scene",
     "SceneError",
     "SingularPoseError",

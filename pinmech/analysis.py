@@ -13,7 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from pinmech.exceptions import FrameNotFound, MobilityError, ModelError, SceneError
+from pinmech.branches import parse_assembly
+from pinmech.exceptions import FrameNotFound, MobilityError, ModelError, PinmechError, SceneError
 from pinmech.mechanism import Mechanism, urdf_joint_types
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.results import LoopSolution
@@ -134,6 +135,32 @@ def scene_guess(scene: Scene, mechanism: Mechanism) -> np.ndarray:
     return q
 
 
+def scene_solver(scene: Scene, mechanism: Mechanism, drivers: Drivers) -> LoopSolver:
+    """A LoopSolver for the scene, its reference set: the scene file's driver values and
+    `[guess]` (with `assembly`, if given, checked), so every pose asked is reached on the
+    scene's assembly by continuation.
+
+    Raises:
+        SceneError: a malformed `assembly`.
+        AssemblyError: the guess closes on another assembly than `assembly` asks.
+    """
+    solver = LoopSolver(mechanism, drivers.names, **scene.solver_options())
+    reference = scene.reference()
+    try:
+        ref_drivers = scene_drivers(reference, mechanism) if reference is not scene else drivers
+    except PinmechError:
+        ref_drivers = drivers
+    if ref_drivers.names != drivers.names:
+        ref_drivers = drivers
+    asked = scene.assembly()
+    try:
+        assembly = "keep" if asked is None else parse_assembly(asked, solver.structure) or "any"
+    except ValueError as exc:
+        raise SceneError(str(exc), path=str(scene.path), key="assembly") from None
+    solver.set_reference(ref_drivers.q, scene_guess(scene, mechanism), assembly)
+    return solver
+
+
 def coincident_points(scene: Scene) -> list[CoincidentPoint]:
     """`[points.NAME] at = "B", link = "link3"`: points of a link under another point."""
     out = []
@@ -202,12 +229,13 @@ def analyse(scene: Scene) -> Analysis:
         from pinmech.analysis_task import analyse_task
 
         return analyse_task(scene)
-    options = scene.solver_options()
+    scene.solver_options()  # settings first: a bad one is named before the model is read
+    scene.assembly()
     mechanism = load_mechanism(scene)
     drivers = scene_drivers(scene, mechanism)
     check_scene_names(scene, mechanism)
-    solver = LoopSolver(mechanism, drivers.names, **options)
-    solution = solver.solve(drivers.q, drivers.v, drivers.a, guess=scene_guess(scene, mechanism))
+    solver = scene_solver(scene, mechanism, drivers)
+    solution = solver.solve(drivers.q, drivers.v, drivers.a)
     points, links = report_lists(scene)
     motion = evaluate_motion(mechanism, solver.data, solution.q, solution.v, solution.a,
                              points=points, links=links, coincident=coincident_points(scene))

@@ -3,9 +3,11 @@
 Exit codes: 0 success; 1 hand values mismatch (`check`); 2 usage or other pinmech error;
 3 bad URDF; 4 bad scene or hand file (unknown name, unit, key); 5 drivers do not match
 the mobility; 6 a loop cannot close; 7 singular pose; 8 inconsistent task; 9 a drawing
-input out of range; 12 a joint beyond its URDF <limit> (with --limits error). An output
-file that cannot be written is 2. Stopped by a signal: 128 + its number (130 Ctrl-C, 143
-SIGTERM, 129 SIGHUP), outputs kept as NAME.partial.
+input out of range; 10 another assembly than the scene's (or none reachable on it);
+11 the drivers cannot go further (a fold: limit angle, extreme, stroke); 12 a joint beyond
+its URDF <limit> (with --limits error). An output file that cannot be written is 2.
+Stopped by a signal: 128 + its number (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP), outputs kept
+as NAME.partial.
 """
 
 from __future__ import annotations
@@ -59,8 +61,8 @@ def build_parser() -> argparse.ArgumentParser:
         prog="pinmech",
         description="Kinematics of mechanisms and robot arms from URDF, on Pinocchio.",
         epilog="Exit codes: 0 ok, 1 check mismatch, 2 error, 3 URDF, 4 scene, 5 mobility, "
-        "6 loop cannot close, 7 singular pose, 8 task, 9 drawing, 12 joint limit (--limits error), "
-        "130 Ctrl-C (128 + signal).",
+        "6 loop cannot close, 7 singular pose, 8 task, 9 drawing, 10 assembly, 11 driver limit, "
+        "12 joint limit (--limits error), 130 Ctrl-C (128 + signal).",
     )
     parser.add_argument("--version", action="version", version=f"pinmech {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -98,6 +100,9 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--tol", type=float, help="closure tolerance, relative to the mechanism's size "
                        "(default 1e-13; 1e-6 is faster and good to about 1e-6)")
     sweep.add_argument("--max-iterations", type=int, help="Newton iteration cap per pose (default 50)")
+    sweep.add_argument("--through-folds", action="store_true",
+                       help="at a fold of the driver (a limit angle), go on onto the other branch with the "
+                       "driver turning back (a whole coupler curve); default: stop there, naming the limit")
     _add_path_arguments(sweep, required=False)
     sweep.set_defaults(func=cmd_sweep)
 
@@ -214,15 +219,36 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     interpolate = args.interpolate if args.interpolate is not None else options.get("interpolate", 1)
     poses = sweep.poses(DriverValues(start, stop, steps), skip_failures=args.skip_failures,
                         start=mode or "predictor", batch=not args.no_batch and options.get("batch", True),
-                        interpolate=interpolate)
+                        interpolate=interpolate, through_folds=args.through_folds)
     limits = _SweepLimits(sweep, limit_mode(scene, args.limits))
     sinks = _sweep_sinks(args, sweep, steps, figure)
     with sinks:
         for pose in _progress(poses, steps):
+            if pose.note:
+                print(f"pinmech: at pose {pose.index}: {pose.note}", file=sys.stderr)
             limits.check(pose)
             sinks.add(pose)
     limits.summary(steps)
+    _say_return(sweep, stop - start)
     return 0
+
+
+def _say_return(sweep, span: float) -> None:
+    """After whole turns of an angular driver, say whether the mechanism came back."""
+    import math
+
+    turns = span / (2 * math.pi)
+    if not sweep.is_angular or abs(turns) < 0.5 or abs(turns - round(turns)) > 1e-12:
+        return
+    gap = sweep.return_gap()
+    if math.isnan(gap):
+        return
+    if gap <= 1e-9:
+        print(f"pinmech: after {round(abs(turns))} turn(s) the mechanism is back where it began "
+              f"(largest joint gap {gap:.1e})", file=sys.stderr)
+    else:
+        print(f"pinmech: after {round(abs(turns))} turn(s) the mechanism is NOT back where it began "
+              f"(largest joint gap {gap:.3g} rad or sizes): it returns after more turns", file=sys.stderr)
 
 
 class _SweepLimits:

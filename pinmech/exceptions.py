@@ -130,6 +130,44 @@ class SweepError(PinmechError):
         self.exit_code = cause.exit_code
 
 
+class AssemblyError(PinmechError):
+    """A pose is not on the assembly (branch) asked for, or cannot be reached on it.
+
+    Attributes:
+        expected: the assembly signature asked (one sign per loop block, see branches.py).
+        found: the signature found (empty where no pose was found).
+        drivers: the driver joints' names.
+        value: their values where it happened [rad or m].
+    """
+
+    exit_code = 10
+
+    def __init__(self, message: str, *, expected: tuple, found: tuple, drivers: tuple = (),
+                 value: tuple = ()):
+        super().__init__(message)
+        self.expected = tuple(expected)
+        self.found = tuple(found)
+        self.drivers = tuple(drivers)
+        self.value = tuple(value)
+
+
+class DriverLimitError(PinmechError):
+    """The drivers cannot go further on this assembly: a fold (a non-Grashof crank's limit
+    angle, a rocker's extreme, a piston's stroke), located to rounding.
+
+    Attributes:
+        limit: the drivers' values at the fold [rad or m].
+        drivers: the driver joints' names.
+    """
+
+    exit_code = 11
+
+    def __init__(self, message: str, *, limit: tuple, drivers: tuple = ()):
+        super().__init__(message)
+        self.limit = tuple(limit)
+        self.drivers = tuple(drivers)
+
+
 class Interrupted(KeyboardInterrupt):
     """The run was stopped by a signal: Ctrl-C (SIGINT), SIGTERM or SIGHUP (the terminal
     closed). A KeyboardInterrupt, so code that stops on Ctrl-C stops on all three.

@@ -70,10 +70,32 @@ def to_dict(analysis: Analysis) -> dict[str, Any]:
     }
     out.update(motion_dict(analysis.motion))
     out["limit_violations"] = [v.as_dict() for v in limit_violations(analysis.mechanism, analysis.motion)]
+    out.update(assembly_dict(analysis))
     out["accuracy"] = analysis.solution.accuracy.as_dict()
     if analysis.extra:
         out.update({k: v for k, v in analysis.extra.items() if not k.startswith("_")})
     return out
+
+
+def assembly_dict(analysis: Analysis) -> dict[str, Any]:
+    """The assembly (per loop block: sign and label), how the pose was reached, and
+    whether the scene pins its assembly ([guess] or assembly)."""
+    sol = analysis.solution
+    if sol.assembly is None:
+        return {}
+    out: dict[str, Any] = {"assembly": sol.assembly.as_dict(), "assembly_pinned": _pinned(analysis)}
+    route = sol.route
+    if route is not None:
+        out["route"] = {
+            "from": dict(zip(analysis.drivers.names, map(float, route.start))),
+            "continuation_steps": route.steps,
+            "change_points": [dict(zip(analysis.drivers.names, map(float, x))) for x in route.change_points],
+        }
+    return out
+
+
+def _pinned(analysis: Analysis) -> bool:
+    return bool(analysis.scene.section("guess")) or "assembly" in analysis.scene.raw
 
 
 def to_json(analysis: Analysis) -> str:
@@ -170,17 +192,43 @@ def to_text(analysis: Analysis) -> str:
     if violations:
         t.head("Joint limits (URDF <limit>)")
         t.lines += [f"  WARNING: {v.describe()}" for v in violations]
+    _assembly_lines(t, analysis)
     acc = analysis.solution.accuracy
     t.head("Accuracy")
     t.lines.append(
         f"  closure residual {acc.residual:.2g} (of the mechanism size {analysis.mechanism.length_scale:.4g} m), "
-        f"{acc.iterations} Newton iterations, condition number {acc.condition:.4g} "
+        f"{acc.iterations} {'continuation steps' if analysis.solution.route else 'Newton iterations'}, "
+        f"condition number {acc.condition:.4g} "
         "(worst-case relative error about {:.0e} in positions, {:.0e} in velocities, {:.0e} in "
         "accelerations)".format(*(max(b, 1e-16) for b in acc.error_bounds))
     )
     for line in (analysis.extra or {}).get("_text", []):
         t.lines.append(line)
     return "\n".join(t.lines) + "\n"
+
+
+def _assembly_lines(t: _Text, analysis: Analysis) -> None:
+    """Which assembly the pose is on, and how it was reached."""
+    sol = analysis.solution
+    if sol.assembly is None:
+        return
+    t.head("Assembly (sign of each loop block's Jacobian determinant; README: Assemblies)")
+    for name, sign, label in zip(sol.assembly.names, sol.assembly.signs, sol.assembly.labels):
+        word = "+" if sign > 0 else "-" if sign < 0 else "0"
+        t.row(f"loop {name}", label if label == word else f"{label} ({word})")
+    route = sol.route
+    if route is not None:
+        start = ", ".join(f"{n} = {_angle_or_length(analysis, n, x)}" for n, x in zip(analysis.drivers.names, route.start))
+        if route.steps == 0:
+            t.lines.append(f"  the scene's own pose ({start}), closed from its [guess]")
+        else:
+            t.lines.append(f"  reached from the scene's pose ({start}) by continuation, {route.steps} steps")
+        for x in route.change_points:
+            at = ", ".join(f"{n} = {_angle_or_length(analysis, n, v)}" for n, v in zip(analysis.drivers.names, x))
+            t.lines.append(f"  passed a change point near {at}, on the branch of continuous tangent")
+    if not _pinned(analysis):
+        t.lines.append(f"  the scene has no [guess]: this assembly was found from the neutral configuration; "
+                       f"pin it with [guess] or {sol.assembly.pin_hint()}")
 
 
 def _angle_or_length(analysis: Analysis, name: str, q: float) -> str:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -80,6 +81,11 @@ class LoopSolution:
         v: joint velocities [rad/s or m/s], one per degree of freedom.
         a: joint accelerations [rad/s^2 or m/s^2].
         accuracy: residuals, iterations and conditioning of this solve.
+        assembly: the assembly the pose is on (`branches.Assembly`: a sign and a label
+            per loop block), None for a mechanism without loops.
+        route: how the pose was reached (`continuation.Route`: from which driver values,
+            in how many continuation steps, change points and folds passed), None for a
+            Newton solve from a guess.
     """
 
     q: np.ndarray
@@ -87,6 +93,8 @@ class LoopSolution:
     a: np.ndarray
     accuracy: Accuracy
     drivers: tuple[str, ...] = field(default=())
+    assembly: Any = None
+    route: Any = None
 
     def is_closed(self, tol: float = 1e-9) -> bool:
         """True when every loop closes to `tol` (relative to the mechanism's size)."""

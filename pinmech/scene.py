@@ -7,6 +7,7 @@ type). See the README section "Scene files" for the format.
 
 from __future__ import annotations
 
+import copy
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,7 +24,7 @@ else:  # pragma: no cover
 #: Top-level keys a scene may have; other modules (tasks, sweeps) register theirs here.
 KNOWN_KEYS = {
     "title", "urdf", "robot", "drivers", "guess", "pose", "move", "lock", "points", "report", "solver",
-    "task", "rates", "sweep", "draw",
+    "task", "rates", "sweep", "draw", "assembly",
 }
 #: Accepted `[solver]` values. A closure tolerance (relative to the mechanism's size)
 #: below 1e-16 is tighter than rounding allows; above 1e-3 a "closed" loop is visibly
@@ -39,10 +40,14 @@ class Scene:
     Attributes:
         path: the scene file (relative paths inside it are relative to its folder).
         raw: the TOML content, after command-line overrides.
+        base: the TOML content as the file has it, before overrides: its drivers' values
+            are the reference pose that names the assembly (`--angle` asks for another
+            pose of the same assembly, reached by continuation).
     """
 
     path: Path
     raw: dict[str, Any] = field(default_factory=dict)
+    base: dict[str, Any] | None = None
 
     # -------------------------------------------------------------- loading
     @classmethod
@@ -59,7 +64,7 @@ class Scene:
             raw = tomllib.loads(path.read_text(encoding="utf-8"))
         except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
             raise SceneError(f"malformed TOML: {exc}", path=str(path)) from exc
-        scene = cls(path=path, raw=raw)
+        scene = cls(path=path, raw=raw, base=copy.deepcopy(raw))
         for item in overrides or []:
             scene.override(item)
         scene._validate()
@@ -156,6 +161,23 @@ class Scene:
                 raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))}; use angle (or position), "
                                  "speed (or velocity), acceleration", path=str(self.path), key=f"drivers.{name}")
         return drivers
+
+    def reference(self) -> Scene:
+        """The scene as its file has it, with the overrides of everything but the drivers
+        (a `--set guess...` picks the reference's assembly, `--angle` only the pose)."""
+        if self.base is None:
+            return self
+        raw = copy.deepcopy(self.raw)
+        raw["drivers"] = copy.deepcopy(self.base.get("drivers", {}))
+        return Scene(self.path, raw, self.base)
+
+    def assembly(self) -> Any:
+        """The `assembly` value as written: absent (None), "any", or a table loop -> sign."""
+        value = self.raw.get("assembly")
+        if value is not None and value != "any" and not isinstance(value, dict):
+            raise SceneError(f'must be "any" or a table such as assembly = {{ B = "+" }}, got {value!r}',
+                             path=str(self.path), key="assembly")
+        return value
 
     @staticmethod
     def driver_order(key: str) -> int:

@@ -48,6 +48,7 @@ class BatchSolution:
     velocity_residual: np.ndarray
     acceleration_residual: np.ndarray
     drivers: tuple[str, ...] = ()
+    signs: np.ndarray | None = None  # (N, blocks) assembly signatures (branches.py), where computed
 
     def __len__(self) -> int:
         return len(self.q)
@@ -197,7 +198,7 @@ class BatchSolver:
         drift = self._drift(Q, V)
         A[:, s._dep] = solve_batch(J_dep, -np.einsum("nkj,nj->nk", J_drv, driver_a) - drift)
         return BatchSolution(Q, V, A, residual, iterations, condition, sigma_min,
-                             *self._equation_residuals(J, V, A, drift), s.drivers)
+                             *self._equation_residuals(J, V, A, drift), s.drivers, s.structure.signs_many(J_dep))
 
 
 # ---------------------------------------------------------------------- manifold

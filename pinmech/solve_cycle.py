@@ -33,7 +33,14 @@ from itertools import islice
 import numpy as np
 import pinocchio as pin
 
-from pinmech.exceptions import LoopClosureError, PinmechError, SingularPoseError
+from pinmech.continuation import Node, Path, Route
+from pinmech.exceptions import (
+    AssemblyError,
+    DriverLimitError,
+    LoopClosureError,
+    PinmechError,
+    SingularPoseError,
+)
 from pinmech.hermite import interpolate_poses
 from pinmech.results import Accuracy, LoopSolution
 from pinmech.solve_batch import BatchSolution, BatchSolver
@@ -51,7 +58,7 @@ MAX_SPAN = 0.12
 #: leading order, s^3 (1 - s)^3 and its derivatives): the middle for positions and
 #: accelerations, (1 - 1/sqrt 5) / 2 for velocities (and its mirror image, as large).
 PEAKS = (0.5, 0.5 - 0.5 / math.sqrt(5.0))
-_FAILURES = (LoopClosureError, SingularPoseError)
+_FAILURES = (LoopClosureError, SingularPoseError, AssemblyError, DriverLimitError)
 
 
 @dataclass(frozen=True)
@@ -64,6 +71,8 @@ class RangeChunk:
         solution: q, v, a and the accuracy of each pose (NaN rows where a pose failed).
         interpolated: True where a pose was interpolated rather than solved.
         errors: position in the chunk -> the error of a pose that failed.
+        notes: position in the chunk -> what the path passed on its way to that pose (a
+            change point, or a fold crossed with `through_folds`: the assembly changed).
     """
 
     start: int
@@ -71,6 +80,7 @@ class RangeChunk:
     solution: BatchSolution
     interpolated: np.ndarray
     errors: dict[int, PinmechError] = field(default_factory=dict)
+    notes: dict[int, str] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return len(self.values)
@@ -81,21 +91,31 @@ class RangeChunk:
 
 
 def solve_range(solver: LoopSolver, driver: str, values: Iterable[float], *, driver_q: np.ndarray,
-                driver_v: np.ndarray, driver_a: np.ndarray, guess: np.ndarray, start: str = "predictor",
-                batch: bool = True, interpolate: int = 1, chunk: int = CHUNK) -> Iterator[RangeChunk]:
+                driver_v: np.ndarray, driver_a: np.ndarray, guess: np.ndarray | None = None,
+                start: str = "predictor", batch: bool = True, interpolate: int = 1, chunk: int = CHUNK,
+                through_folds: bool = False) -> Iterator[RangeChunk]:
     """Solve the mechanism as `driver` takes each of `values`, the other drivers held (lazy).
+
+    The first pose is reached from the solver's reference (`LoopSolver.set_reference`)
+    by continuation; without a reference it is solved from `guess` and becomes the
+    reference. Each later pose follows from the one before by continuation with step
+    control (continuation.py): any spacing gives the same poses.
 
     Args:
         driver_q, driver_v, driver_a: every driver's coordinate, rate and acceleration
             (SI, in `solver.drivers` order); the swept driver's coordinate is replaced.
-        guess: the configuration the first pose starts from (it picks the branch).
+        guess: the configuration the first pose starts from when the solver has no
+            reference (it picks the assembly).
         start, batch, interpolate: the accuracy choices of the module docstring.
+        through_folds: at a fold of the driver, go on onto the other branch, the driver
+            turning back (values past the fold are mirrored at it); else the poses past
+            it fail with DriverLimitError.
 
     Raises:
         PinmechError: an unknown start, or interpolation or batches asked with the other
             drivers moving (their path is then not the swept driver's alone).
     """
-    cycle = _Cycle(solver, driver, driver_q, driver_v, driver_a, guess, start, batch, interpolate)
+    cycle = _Cycle(solver, driver, driver_q, driver_v, driver_a, guess, start, batch, interpolate, through_folds)
     values = iter(values)
     index = 0
     while True:
@@ -117,11 +137,13 @@ class _Exact:
     d2: np.ndarray | None
     condition: float = 1.0
     sigma_min: float = 1.0
+    signs: tuple[int, ...] = ()
 
 
 class _Cycle:
     def __init__(self, solver: LoopSolver, driver: str, driver_q: np.ndarray, driver_v: np.ndarray,
-                 driver_a: np.ndarray, guess: np.ndarray, start: str, batch: bool, interpolate: int) -> None:
+                 driver_a: np.ndarray, guess: np.ndarray | None, start: str, batch: bool, interpolate: int,
+                 through_folds: bool = False) -> None:
         if start not in STARTS:
             raise PinmechError(f"start must be one of {', '.join(STARTS)}, got {start!r}")
         if int(interpolate) != interpolate or interpolate < 1:
@@ -138,24 +160,37 @@ class _Cycle:
         self.start, self.interpolate = start, int(interpolate)
         self.batch = BatchSolver(solver) if batch and start == "predictor" and solver._cuts else None
         self.measurer = (self.batch or BatchSolver(solver)) if interpolate > 1 and solver._cuts else None
-        self.guess = np.asarray(guess, dtype=float)
+        self.guess = None if guess is None else np.asarray(guess, dtype=float)
         self.ref: _Exact | None = None
         self.unit_v = np.zeros_like(self.v_drv)
         self.unit_v[self.k] = 1.0
         self.zero = np.zeros_like(self.v_drv)
+        x0 = self.q_drv.copy()
+        x0[self.k] = 0.0
+        self.path = Path(solver, x0, self.unit_v, through_folds=through_folds)  # p = the swept value
+        self.mirror = (1.0, 0.0)  # p = a x + b: past each fold crossed, values are mirrored at it
+        self.notes: dict[int, str] = {}
+        self._index, self._steps, self._batching = 0, 0, False
         self.span_scale = 1.0 if solver.mechanism.joint(driver).is_angular else solver.mechanism.length_scale
 
     # ------------------------------------------------------------------ chunks
     def chunk(self, index: int, xs: np.ndarray) -> RangeChunk:
         """Solve the poses xs that follow the last solved pose."""
+        out = self._chunk(index, xs)
+        notes = {j - index: n for j, n in self.notes.items() if index <= j < index + len(xs)}
+        if notes:
+            out = RangeChunk(out.start, out.values, out.solution, out.interpolated, out.errors, notes)
+        return out
+
+    def _chunk(self, index: int, xs: np.ndarray) -> RangeChunk:
         ref = self.ref
-        if self.start != "predictor":
+        if self.start != "predictor" or self.mirror != (1.0, 0.0):  # past a fold: pose by pose
             return self._sequential(index, xs)
         if ref is None:  # the first pose, from the user's guess, then the rest
             head = self._sequential(index, xs[:1])
             if len(xs) == 1:
                 return head
-            rest = self.chunk(index + 1, xs[1:]) if self.ref is not None else self._sequential(index + 1, xs[1:])
+            rest = self._chunk(index + 1, xs[1:]) if self.ref is not None else self._sequential(index + 1, xs[1:])
             return _concat(head, rest)
         try:
             if self.interpolate > 1:
@@ -179,14 +214,16 @@ class _Cycle:
 
     def _sequential(self, index: int, xs: np.ndarray) -> RangeChunk:
         """Pose after pose through `LoopSolver.solve`; a failing pose is kept as an error."""
-        rows, errors = [], {}
+        rows, errors, values = [], {}, xs.copy()
         for j, x in enumerate(xs):
+            self._index = index + j
             try:
                 rows.append(self._solve(x, actual=True))
+                values[j] = self.ref.value
             except _FAILURES as exc:
                 errors[j] = exc
                 rows.append(None)
-        return RangeChunk(index, xs, _stack(rows, self.solver), np.zeros(len(xs), dtype=bool), errors)
+        return RangeChunk(index, values, _stack(rows, self.solver), np.zeros(len(xs), dtype=bool), errors)
 
     def _exact(self, xs: np.ndarray, levels: tuple[int, ...]):
         """Every pose exact, in path-derivative terms: q, q', q'' and accuracy arrays.
@@ -202,11 +239,12 @@ class _Cycle:
         acc = _accuracy_arrays(n + 1)
         solved = np.zeros(n + 1, dtype=bool)
         solved[0] = True
-        for j in sorted(set(range(levels[0], n + 1, levels[0])) | {n}):
-            sol = self._solve(x[j], actual=False, fail=_Fallback)
-            q[j], d1[j], d2[j] = sol.q, sol.v, sol.a
-            _store(acc, j, sol.accuracy)
-            solved[j] = True
+        self._batching = True
+        try:
+            for j in sorted(set(range(levels[0], n + 1, levels[0])) | {n}):
+                self._solve_level(x, j, q, d1, d2, acc, solved)
+        finally:
+            self._batching = False
         for stride in levels[1:]:
             targets = np.array([j for j in range(stride, n + 1, stride) if not solved[j]], dtype=int)
             if not targets.size:
@@ -215,15 +253,23 @@ class _Cycle:
             count = len(targets)
             out = self.batch.try_solve(guesses, self._drivers(x[targets]), np.tile(self.unit_v, (count, 1)),
                                        np.tile(self.zero, (count, 1)))
-            if out is None:
+            if out is None or (ref.signs and np.any(out.signs != np.array(ref.signs))):
                 raise _Fallback
             q[targets], d1[targets], d2[targets] = out.q, out.v, out.a
             for name in _ACCURACY:
                 acc[name][targets] = getattr(out, name)
             solved[targets] = True
         self.ref = _Exact(float(x[n]), q[n].copy(), d1[n].copy(), d2[n].copy(), acc["condition"][n],
-                          acc["sigma_min"][n])
+                          acc["sigma_min"][n], self.ref.signs)
         return q[1:], d1[1:], d2[1:], {k: v[1:] for k, v in acc.items()}
+
+    def _solve_level(self, x: np.ndarray, j: int, q: np.ndarray, d1: np.ndarray, d2: np.ndarray,
+                     acc: dict[str, np.ndarray], solved: np.ndarray) -> None:
+        """Slot j solved exactly (path derivatives), or _Fallback."""
+        sol = self._solve(x[j], actual=False, fail=_Fallback)
+        q[j], d1[j], d2[j] = sol.q, sol.v, sol.a
+        _store(acc, j, sol.accuracy)
+        solved[j] = True
 
     def _interpolated(self, index: int, xs: np.ndarray) -> RangeChunk:
         """Exact poses every n-th (batched when dense), Hermite between, accuracy measured."""
@@ -258,31 +304,101 @@ class _Cycle:
         return rows
 
     def _solve(self, x: float, *, actual: bool, fail: type[Exception] | None = None) -> LoopSolution:
-        """One pose by `LoopSolver.solve` from the start the user chose; it becomes the
+        """One pose, from the start the user chose, by the assembly rules; it becomes the
         reference pose. With `actual` the result carries the scene's rates, else the path
         derivatives. A failure raises, as `fail` when given."""
-        self.q_drv[self.k] = x
-        ref, solver = self.ref, self.solver
-        guess = self.guess if ref is None or self.start == "cold" else ref.q
-        if self.start == "predictor" and ref is not None:
-            dx = x - ref.value
-            guess = pin.integrate(solver.model, ref.q, ref.d1 * dx + ref.d2 * (0.5 * dx * dx))
-        path = self.start == "predictor" and self.alone  # solve at unit speed, scale after
         try:
-            if path:
-                sol = solver.solve(self.q_drv, self.unit_v, self.zero, guess=guess)
-                d1, d2 = sol.v, sol.a
-            else:
-                sol = solver.solve(self.q_drv, self.v_drv, self.a_drv, guess=guess)
-                d1 = d2 = None
-                if self.start == "predictor":  # other drivers move: path derivatives apart
-                    d1, d2, _ = solver.rates(sol.q, self.unit_v, self.zero, at_q=True)
+            node = self._reach(x)
         except _FAILURES:
             if fail is not None:
                 raise fail from None
             raise
-        self.ref = _Exact(float(x), sol.q, d1, d2, sol.accuracy.condition, sol.accuracy.sigma_min)
-        return self._scaled(sol) if actual and path else sol
+        solver = self.solver
+        self.ref = _Exact(node.p, node.q, node.d1, node.d2, node.condition, node.sigma_min, node.signs)
+        self.q_drv[self.k] = node.p
+        accuracy = Accuracy(0.0, 0, node.condition, node.sigma_min, node.velocity_residual,
+                            node.acceleration_residual)
+        if node.condition > solver.max_condition:
+            try:
+                solver._residual(node.q)
+                solver._rates(node.q, self.zero, self.zero)  # raises SingularPoseError, named
+            except SingularPoseError:
+                if fail is not None:
+                    raise fail from None
+                raise
+        residual = max(max(map(abs, solver._residual(node.q).tolist()), default=0.0), solver._full_residual())
+        accuracy = Accuracy(residual, self._steps, *(getattr(accuracy, f) for f in _ACCURACY[2:]))
+        sol = LoopSolution(node.q, node.d1, node.d2, accuracy, solver.drivers)
+        if not actual:
+            return sol
+        if self.alone:
+            return self._scaled(sol)
+        v, a, acc = solver.rates(node.q, self.v_drv, self.a_drv)
+        return LoopSolution(node.q, v, a, Accuracy(residual, self._steps, acc.condition, acc.sigma_min,
+                                                   acc.velocity_residual, acc.acceleration_residual),
+                            solver.drivers)
+
+    def _reach(self, x: float) -> Node:
+        """The node at swept value x (mirrored past folds crossed), by the start chosen."""
+        solver, path, ref = self.solver, self.path, self.ref
+        a, b = self.mirror
+        p = a * x + b
+        self._steps = 0
+        if ref is None:
+            return self._first(p)
+        node = Node(ref.value, ref.q, ref.d1, ref.d2, ref.signs, ref.condition, ref.sigma_min)
+        if self.start == "predictor":
+            route = Route((ref.value,))
+            node = path.follow(node, p, route)
+            self._steps = route.steps
+            self._note(route)
+            return node
+        guess = ref.q if self.start == "warm" else self._cold_guess()
+        self.q_drv[self.k] = p
+        q, self._steps, _ = solver.close(guess, self.q_drv)
+        new = path.node(p, q, at_q=True) if solver._cuts else path.node(p, q)
+        if ref.signs and new.signs != ref.signs:
+            raise AssemblyError(
+                f"{solver.mechanism.source}: a {self.start} start at {solver.describe_drivers(self.q_drv)} "
+                f"lands on another assembly ({new.signs} instead of {ref.signs}): use the predictor start",
+                expected=ref.signs, found=new.signs, drivers=solver.drivers, value=tuple(self.q_drv.tolist()))
+        return new
+
+    def _first(self, p: float) -> Node:
+        """The first pose: from the solver's reference by continuation, else from the guess
+        (which then becomes the reference)."""
+        solver = self.solver
+        self.q_drv[self.k] = p
+        if solver.reference is None:
+            solver.set_reference(self.q_drv, self.guess)
+        ref = solver.reference
+        route = Route(tuple(ref.driver_q.tolist()))
+        if ref.keep:
+            q = solver.follow(ref.q, ref.driver_q, self.q_drv.copy(), route)
+        else:
+            q, _, _ = solver.close(self._cold_guess(), self.q_drv)
+        self._steps = route.steps
+        return self.path.node(p, q)
+
+    def _cold_guess(self) -> np.ndarray:
+        if self.guess is not None:
+            return self.guess
+        ref = self.solver.reference
+        return ref.q if ref is not None else self.solver.mechanism.neutral()
+
+    def _note(self, route: Route) -> None:
+        """Record what a step passed: change points, and folds crossed (values mirrored).
+        The batched levels hand such a step back to the pose-by-pose path, which names
+        the pose."""
+        if (route.change_points or route.folds) and self._batching:
+            raise _Fallback
+        solver, index = self.solver, self._index
+        for x in route.change_points:
+            self.notes[index] = f"passed a change point near {solver.describe_drivers(x)} (branch of continuous tangent kept)"
+        for x, p in zip(route.folds, route.fold_p):
+            a, b = self.mirror
+            self.mirror = (-a, 2.0 * p - b)
+            self.notes[index] = f"crossed a fold at {solver.describe_drivers(x)}: the driver turns back, the assembly changed"
 
     def _scaled(self, sol: LoopSolution) -> LoopSolution:
         """Path derivatives -> the scene's rates: v = q' x_dot, a = q'' x_dot^2 + q' x_ddot."""

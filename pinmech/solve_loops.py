@@ -11,12 +11,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
 
+from pinmech.branches import AssemblyStructure
 from pinmech.closures import CutEvaluator
-from pinmech.exceptions import LoopClosureError, MobilityError, ModelError, SingularPoseError
+from pinmech.continuation import Path, Route
+from pinmech.exceptions import AssemblyError, LoopClosureError, MobilityError, ModelError, SingularPoseError
 from pinmech.mechanism import Mechanism
 from pinmech.results import Accuracy, LoopSolution
 
@@ -89,8 +92,25 @@ def _index(indices: np.ndarray) -> slice | np.ndarray:
     return indices
 
 
+@dataclass(frozen=True)
+class Reference:
+    """The pose that names the assembly: the drivers' values [rad or m], the closed q,
+    its assembly signature, and whether other poses must keep it (False: "any")."""
+
+    driver_q: np.ndarray
+    q: np.ndarray
+    signs: tuple[int, ...]
+    keep: bool = True
+
+
 class LoopSolver:
     """Solves one mechanism pose after pose, keeping Pinocchio `Data` and buffers alive.
+
+    Assemblies: `set_reference` closes the loops once at given driver values from a
+    guess; that pose's assembly signature (branches.py) is the one every later pose must
+    have. `solve` without a guess then reaches the asked driver values from the reference
+    by continuation (continuation.py), never by a cold Newton solve; with a guess it
+    solves from the guess and raises AssemblyError if it lands on another assembly.
 
     Args:
         mechanism: the model with its loop closures.
@@ -131,7 +151,17 @@ class LoopSolver:
         self._cuts = [CutEvaluator(c, self.model) for c in mechanism.closures]
         self._step = np.zeros(self.model.nv)
         self._dep_scale = mechanism.velocity_scale()[self._dep_v]  # dimensionless columns
+        self._v_scale_inv = 1.0 / mechanism.velocity_scale()
+        self.dep_is_scalar = [self._joint_nv(int(v)) == 1 for v in self._dep_v]
         self._zero_a = np.zeros(self.model.nv)
+        self.structure = AssemblyStructure(self.model, mechanism.closures, self._dep_v, mechanism.plane_normal)
+        self.reference: Reference | None = None
+
+    def _joint_nv(self, v: int) -> int:
+        for joint in self.model.joints[1:]:
+            if joint.idx_v <= v < joint.idx_v + joint.nv:
+                return joint.nv
+        return 0
 
     # ------------------------------------------------------------------ set-up
     def _driver_index(self, name: str) -> int:
@@ -230,6 +260,55 @@ class LoopSolver:
             self._raise_not_closed(q, max(norm, full), iterations, driver_q)
         return q, iterations, max(norm, full)
 
+    def correct(self, q_guess: np.ndarray, driver_q: np.ndarray, *, max_iterations: int,
+                strict: bool = True) -> tuple[np.ndarray, bool]:
+        """Newton from a predicted pose with the drivers held: (q, converged).
+
+        strict: full Newton steps only, each at least halving the residual (a corrector
+        that does not contract is not close to one root); else as `close`, with the
+        least-squares and backtracking safeguard."""
+        q = self.set_drivers(q_guess, driver_q)
+        r = self._residual(q)
+        norm = _max_abs(r)
+        for _ in range(max_iterations):
+            if norm <= self.tol:
+                break
+            J_dep = self._residual_jacobian()[:, self._dep]
+            if strict:
+                step = _solve_square(J_dep, -r) if J_dep.shape[0] == J_dep.shape[1] else np.full(1, np.nan)
+                if not math.isfinite(sum(step.tolist())):
+                    return q, False
+                q_new = self._move(q, step)
+                r_new = self._residual(q_new)
+                new_norm = _max_abs(r_new)
+                if new_norm > 0.5 * norm and new_norm > self.tol:
+                    self._residual(q)
+                    return q, False
+                q, r, norm = q_new, r_new, new_norm
+            else:
+                q, r, norm, ok = self._newton_update(q, J_dep, r, norm)
+                if not ok:
+                    return q, False
+        if POLISH < norm <= self.tol <= DEFAULT_TOL:
+            J_dep = self._residual_jacobian()[:, self._dep]
+            q, r, norm, _ = self._newton_update(q, J_dep, r, norm)
+        return q, norm <= self.tol and self._full_residual() <= max(self.tol, 1e-12) * 10
+
+    def scaled_norm(self, dv: np.ndarray) -> float:
+        """Largest |component| of a velocity-space vector, prismatic parts in mechanism
+        sizes (dimensionless)."""
+        return _max_abs(dv * self._v_scale_inv)
+
+    def describe_drivers(self, values: Sequence[float]) -> str:
+        """Driver values as a user reads them: angles in degrees, lengths in metres."""
+        out = []
+        for name, value in zip(self.drivers, values):
+            if self.mechanism.joint(name).is_angular:
+                out.append(f"{name} = {math.degrees(value):.10g} deg")
+            else:
+                out.append(f"{name} = {value:.10g} m")
+        return ", ".join(out)
+
     def _newton_update(self, q: np.ndarray, J_dep: np.ndarray, r: np.ndarray,
                        norm: float) -> tuple[np.ndarray, np.ndarray, float, bool]:
         """A full Newton step when it lowers the residual (the usual case near a solution);
@@ -303,17 +382,20 @@ class LoopSolver:
         """
         if not at_q:
             self._residual(q)
-        v, a, *numbers = self._rates(q, driver_v, driver_a)
+        v, a, *numbers, _ = self._rates(q, driver_v, driver_a)
         return v, a, Accuracy(0.0, 0, *numbers)
 
-    def _rates(self, q: np.ndarray, driver_v, driver_a) -> tuple:
-        """v, a, condition, sigma_min, velocity and acceleration residuals (data at q)."""
+    def _rates(self, q: np.ndarray, driver_v, driver_a, limit: float | None = None) -> tuple:
+        """v, a, condition, sigma_min, velocity and acceleration residuals, and the assembly
+        signature (data at q). A condition number over `limit` (default: max_condition)
+        is a SingularPoseError."""
         J = self._jacobian()
         J_dep, J_drv = J[:, self._dep], J[:, self._drv]
         condition, sigma_min = _condition(J_dep * self._dep_scale)
-        if condition > self.max_condition:
+        if condition > (self.max_condition if limit is None else limit):
             raise SingularPoseError(
-                f"{self.mechanism.source}: the loop constraint Jacobian is singular at this pose "
+                f"{self.mechanism.source}: the loop constraint Jacobian is singular at "
+                f"{self.describe_drivers(self._driver_values(q))} "
                 f"(condition number {condition:.3g} > {self.max_condition:.3g}, smallest singular "
                 f"value {sigma_min:.3g}): the dependent joints' rates are undefined",
                 condition=condition,
@@ -325,12 +407,50 @@ class LoopSolver:
         a = np.zeros(self.model.nv)
         a[self._drv] = driver_a
         if not J.size:
-            return v, a, condition, sigma_min, 0.0, 0.0
+            return v, a, condition, sigma_min, 0.0, 0.0, ()
+        signs = self.structure.signs(J_dep)
         v[self._dep] = _solve_square(J_dep, -(J_drv @ v[self._drv]))
         pin.forwardKinematics(self.model, self.data, q, v, self._zero_a)
         drift = self._drift()
         a[self._dep] = _solve_square(J_dep, -(J_drv @ a[self._drv]) - drift)
-        return v, a, condition, sigma_min, _max_abs(J @ v), _max_abs(J @ a + drift)
+        return v, a, condition, sigma_min, _max_abs(J @ v), _max_abs(J @ a + drift), signs
+
+    def _driver_values(self, q: np.ndarray) -> list[float]:
+        out = []
+        for i, continuous in self._drv_q:
+            out.append(math.atan2(q[i + 1], q[i]) if continuous else float(q[i]))
+        return out
+
+    def set_reference(self, driver_q: Sequence[float] | Mapping[str, float], guess: np.ndarray | None = None,
+                      assembly: Mapping[str, int] | None | str = "keep") -> Reference:
+        """Close the loops at `driver_q` from `guess` (default: neutral) and make that pose
+        the reference whose assembly later solves keep.
+
+        Args:
+            assembly: "keep" (the pose's own assembly), "any" (no check: every later
+                solve is a Newton solve from its guess, on whichever assembly it lands),
+                or block name -> sign (+1/-1) that the reference must have.
+
+        Raises:
+            LoopClosureError: the loops do not close from the guess.
+            SingularPoseError: the reference is a singular pose (its assembly has no name).
+            AssemblyError: the guess closes on another assembly than `assembly` asks.
+        """
+        dq = self._ordered(driver_q)
+        q, _, _ = self.close(self._guess(guess), dq)
+        signs = self._rates(q, np.zeros(len(dq)), np.zeros(len(dq)))[-1]
+        if isinstance(assembly, Mapping):
+            wrong = [n for n, s in zip(self.structure.names, signs) if n in assembly and assembly[n] != s]
+            if wrong:
+                found = self.structure.assembly(signs, self.data)
+                raise AssemblyError(
+                    f"{self.mechanism.source}: at {self.describe_drivers(dq)} the guess closes on assembly "
+                    f"{found.describe()}, not the one asked for loop(s) {', '.join(wrong)}: change [guess] "
+                    f"(a guess nearer the assembly asked) or [assembly]",
+                    expected=tuple(assembly.get(n, s) for n, s in zip(self.structure.names, signs)),
+                    found=signs, drivers=self.drivers, value=tuple(dq.tolist()))
+        self.reference = Reference(dq.copy(), q, signs, keep=assembly != "any")
+        return self.reference
 
     def solve(
         self,
@@ -341,20 +461,94 @@ class LoopSolver:
     ) -> LoopSolution:
         """Close the loops and solve the rates for one pose.
 
+        With a reference (`set_reference`) and no guess, the pose is reached from the
+        reference by continuation along the straight driver path, on its assembly. With
+        a guess (or no reference), Newton starts from the guess; a reference's assembly
+        is then checked.
+
         Args:
             driver_q: driver coordinates [rad or m], in the order of `drivers` or by name.
             driver_v: driver velocities [rad/s or m/s] (zero when omitted).
             driver_a: driver accelerations [rad/s^2 or m/s^2] (zero when omitted).
-            guess: starting configuration; it picks the assembly branch (default: neutral).
+            guess: starting configuration (default: continuation from the reference, or
+                the neutral configuration without one).
+
+        Raises:
+            LoopClosureError, SingularPoseError: the pose does not close, or is singular.
+            AssemblyError: the pose is on another assembly than the reference's.
+            DriverLimitError: continuation meets a fold of the drivers before the pose.
         """
         dq, dv, da = (self._ordered(x) for x in (driver_q, driver_v, driver_a))
+        ref = self.reference
+        if guess is None and ref is not None and ref.keep:
+            route = Route(tuple(ref.driver_q.tolist()))
+            q = self.follow(ref.q, ref.driver_q, dq, route)
+            residual = max(_max_abs(self._residual(q)), self._full_residual())
+            return self._solution(q, dv, da, residual, route.steps, route)
+        q, iterations, residual = self.close(self._guess(guess), dq)
+        return self._solution(q, dv, da, residual, iterations, None)
+
+    def follow(self, q0: np.ndarray, x0: np.ndarray, x1: np.ndarray, route: Route, *,
+               through_folds: bool = False) -> np.ndarray:
+        """The closed q at driver values x1, followed from the closed pose q0 at x0.
+
+        A single angular driver asked to turn more than once is followed one turn first:
+        where that turn brings the mechanism back onto q0 (a closed curve: every later
+        turn repeats it exactly), only the rest of the way is followed."""
+        x0, x1 = np.asarray(x0, dtype=float), np.asarray(x1, dtype=float)
+        if np.array_equal(x0, x1):
+            return q0.copy()
+        turn = 2.0 * math.pi
+        moving = np.flatnonzero(x1 != x0)
+        if not through_folds and len(moving) == 1 and abs(x1 - x0)[moving[0]] > turn \
+                and self.mechanism.joint(self.drivers[moving[0]]).is_angular:
+            k = int(moving[0])
+            once = x0.copy()
+            once[k] += math.copysign(turn, x1[k] - x0[k])
+            q_turn = self.follow(q0, x0, once, route)
+            if self.turn_gap(q0, q_turn) <= max(1e3 * self.tol, 1e-10):
+                rest = x0.copy()
+                rest[k] += math.fmod(x1[k] - x0[k], turn)
+                return self.set_drivers(self.follow(q0, x0, rest, route), x1)
+            return self.follow(q_turn, once, x1, route)
+        path = Path(self, x0, x1 - x0, through_folds=through_folds)
+        node = path.follow(path.node(0.0, q0), 1.0, route)
+        return node.q
+
+    def turn_gap(self, q0: np.ndarray, q1: np.ndarray) -> float:
+        """Largest joint difference between two poses, angles modulo a turn [rad], slides
+        in mechanism sizes: 0 where q1 is q0 after whole turns."""
+        dv = pin.difference(self.model, q0, q1)
+        gap = 0.0
+        for joint in self.mechanism.joints.values():
+            for i in range(joint.idx_v, joint.idx_v + joint.nv):
+                d = float(dv[i])
+                d = math.remainder(d, 2 * math.pi) if joint.is_angular else d / self.mechanism.length_scale
+                gap = max(gap, abs(d))
+        return gap
+
+    def _solution(self, q: np.ndarray, dv: np.ndarray, da: np.ndarray, residual: float, iterations: int,
+                  route: Route | None) -> LoopSolution:
+        """Rates at a closed q (data at q), the assembly checked against the reference."""
+        v, a, *numbers, signs = self._rates(q, dv, da)
+        ref = self.reference
+        if ref is not None and ref.keep and signs != ref.signs and not (route and (route.folds or route.change_points)):
+            expected, found = self.structure.assembly(ref.signs), self.structure.assembly(signs, self.data)
+            raise AssemblyError(
+                f"{self.mechanism.source}: at {self.describe_drivers(self._driver_values(q))} the pose is on "
+                f"assembly {found.describe()}, not the reference's {expected.describe()} (from its guess: solve "
+                f"without a guess to follow the reference, or set assembly = \"any\")",
+                expected=ref.signs, found=signs, drivers=self.drivers, value=tuple(self._driver_values(q)))
+        assembly = self.structure.assembly(signs, self.data) if signs else None
+        return LoopSolution(q=q, v=v, a=a, accuracy=Accuracy(residual, iterations, *numbers), drivers=self.drivers,
+                            assembly=assembly, route=route)
+
+    def _guess(self, guess: np.ndarray | None) -> np.ndarray:
         q0 = self.mechanism.neutral() if guess is None else np.asarray(guess, dtype=float)
         if q0.shape != (self.model.nq,) or not math.isfinite(sum(q0.tolist())):
             raise ModelError(f"guess must be {self.model.nq} finite numbers, got shape {q0.shape}",
                              path=self.mechanism.source)
-        q, iterations, residual = self.close(q0, dq)
-        v, a, *numbers = self._rates(q, dv, da)
-        return LoopSolution(q=q, v=v, a=a, accuracy=Accuracy(residual, iterations, *numbers), drivers=self.drivers)
+        return q0
 
     def _ordered(self, values: Sequence[float] | Mapping[str, float] | None) -> np.ndarray:
         if (type(values) is np.ndarray and values.shape == (len(self.drivers),) and values.dtype == float

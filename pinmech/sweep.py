@@ -34,7 +34,7 @@ from pinmech.analysis import (
     load_mechanism,
     report_lists,
     scene_drivers,
-    scene_guess,
+    scene_solver,
 )
 from pinmech.exceptions import ModelError, SceneError, SweepError
 from pinmech.mechanism import Mechanism
@@ -63,6 +63,7 @@ class SweepPose:
     accuracy: Accuracy | None
     error: str = ""
     interpolated: bool = False
+    note: str = ""
 
 
 @dataclass(frozen=True)
@@ -136,6 +137,7 @@ class Sweep:
     start: float
     drivers: Drivers
     last_q: np.ndarray | None = None  # configuration of the last pose solved (for drawing)
+    first_q: np.ndarray | None = None  # configuration of the first pose solved
 
     @classmethod
     def from_scene(cls, scene: Scene, driver: str | None = None) -> Sweep:
@@ -155,7 +157,7 @@ class Sweep:
         if name not in drivers.names:
             raise SceneError(f"'{name}' is not a driver of the scene ({', '.join(drivers.names)})",
                              path=str(scene.path), key="drivers")
-        solver = LoopSolver(mechanism, drivers.names, **scene.solver_options())
+        solver = scene_solver(scene, mechanism, drivers)
         return cls(scene, mechanism, solver, name, float(drivers.q[drivers.names.index(name)]), drivers)
 
     @property
@@ -169,17 +171,16 @@ class Sweep:
         return DriverValues(self.start, self.start + span, steps)
 
     def chunks(self, values: Iterable[float], *, start: str = "predictor", batch: bool = True,
-               interpolate: int = 1) -> Iterator[RangeChunk]:
+               interpolate: int = 1, through_folds: bool = False) -> Iterator[RangeChunk]:
         """The poses' q, v, a and accuracy as arrays, a chunk at a time (no motion read-out):
         the quickest way through a long sweep. Options: see `poses`."""
         d = self.drivers
         return solve_range(self.solver, self.driver, self._checked(values), driver_q=d.q, driver_v=d.v, driver_a=d.a,
-                           guess=scene_guess(self.scene, self.mechanism), start=start, batch=batch,
-                           interpolate=interpolate)
+                           start=start, batch=batch, interpolate=interpolate, through_folds=through_folds)
 
     def poses(self, values: Iterable[float], *, skip_failures: bool = False, start: str = "predictor",
               batch: bool = True, interpolate: int = 1, warm_start: bool | None = None,
-              predictor: bool | None = None) -> Iterator[SweepPose]:
+              predictor: bool | None = None, through_folds: bool = False) -> Iterator[SweepPose]:
         """Solve the poses one after the other, each from the previous one (lazy).
 
         Args:
@@ -195,6 +196,10 @@ class Sweep:
                 accuracy measured in each interval.
             warm_start, predictor: older spelling of `start` ("warm" is predictor=False,
                 "cold" warm_start=False).
+            through_folds: at a fold of the driver (a limit angle), go on onto the other
+                branch with the driver turning back, values past the fold mirrored at it
+                (a whole coupler curve of a non-Grashof linkage); the pose after it carries
+                a note. Without it, the poses past a fold fail with DriverLimitError.
 
         Raises:
             SweepError: a pose where the loop cannot close or the Jacobian is singular,
@@ -206,7 +211,8 @@ class Sweep:
             start = "warm"
         points, links = report_lists(self.scene)
         coincident = coincident_points(self.scene)
-        for chunk in self.chunks(values, start=start, batch=batch, interpolate=interpolate):
+        for chunk in self.chunks(values, start=start, batch=batch, interpolate=interpolate,
+                                 through_folds=through_folds):
             for j, value in enumerate(chunk.values.tolist()):
                 index = chunk.start + j
                 if j in chunk.errors:
@@ -218,9 +224,20 @@ class Sweep:
                     continue
                 sol = chunk.solution
                 self.last_q = sol.q[j]
+                if self.first_q is None:
+                    self.first_q = sol.q[j]
                 motion = evaluate_motion(self.mechanism, self.solver.data, sol.q[j], sol.v[j], sol.a[j],
                                          points=points, links=links, coincident=coincident)
-                yield SweepPose(index, value, motion, sol.accuracy(j), interpolated=bool(chunk.interpolated[j]))
+                yield SweepPose(index, value, motion, sol.accuracy(j), interpolated=bool(chunk.interpolated[j]),
+                                note=chunk.notes.get(j, ""))
+
+    def return_gap(self) -> float:
+        """How far the last pose solved is from the first: the largest joint difference,
+        angles modulo a turn [rad], slides in mechanism sizes. After a sweep of whole turns
+        of the driver, a mechanism back on its start has a gap at rounding level."""
+        if self.first_q is None or self.last_q is None:
+            return math.nan
+        return self.solver.turn_gap(self.first_q, self.last_q)
 
     def _checked(self, values: Iterable[float]) -> Iterator[float]:
         """The driver values as floats, or a ModelError naming the first that is not a finite number."""

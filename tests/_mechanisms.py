@@ -127,3 +127,36 @@ def scaled_urdf(text: str, k: float) -> str:
         return re.sub(r'\b(xyz|size|radius|length|lower|upper)="([^"]*)"', scale_numbers, match.group(0))
 
     return re.sub(r"<(\w+)\b[^>]*>", scale_tag, text)
+
+
+def stephenson_six_bar_urdf(a: float = 0.04, b: float = 0.12, c: float = 0.08, d: float = 0.10,
+                            cx: float = 0.06, cy: float = 0.04, b2: float = 0.10, c2: float = 0.09,
+                            o6: tuple[float, float] = (0.16, 0.10)) -> str:
+    """Stephenson III six-bar: the four-bar O2-A-B-O4 (cut at B), its coupler a ternary link
+    carrying the pin C at (cx, cy) in the coupler's frame, and a dyad C-D-O6 to the ground
+    pivot O6 (link5 from C, link6 from O6, cut at D). Two loops, driven at the crank O2."""
+    return f"""<?xml version="1.0"?>
+<robot name="stephenson_six_bar">
+  <link name="ground"/>
+  {_links("crank", "coupler", "rocker", "link5", "link6")}
+  <joint name="O2" type="continuous"><parent link="ground"/><child link="crank"/><axis xyz="0 0 1"/></joint>
+  <joint name="A" type="continuous"><parent link="crank"/><child link="coupler"/>
+    <origin xyz="{a} 0 0"/><axis xyz="0 0 1"/></joint>
+  <joint name="O4" type="continuous"><parent link="ground"/><child link="rocker"/>
+    <origin xyz="{d} 0 0"/><axis xyz="0 0 1"/></joint>
+  <joint name="C" type="continuous"><parent link="coupler"/><child link="link5"/>
+    <origin xyz="{cx} {cy} 0"/><axis xyz="0 0 1"/></joint>
+  <joint name="O6" type="continuous"><parent link="ground"/><child link="link6"/>
+    <origin xyz="{o6[0]} {o6[1]} 0"/><axis xyz="0 0 1"/></joint>
+  <constraint name="B" type="revolute">
+    <parent link="coupler"/> <parent_origin xyz="{b} 0 0"/> <parent_axis xyz="0 0 1"/>
+    <child link="rocker"/> <child_origin xyz="{c} 0 0"/> <child_axis xyz="0 0 1"/>
+  </constraint>
+  <constraint name="D" type="revolute">
+    <parent link="link5"/> <parent_origin xyz="{b2} 0 0"/> <parent_axis xyz="0 0 1"/>
+    <child link="link6"/> <child_origin xyz="{c2} 0 0"/> <child_axis xyz="0 0 1"/>
+  </constraint>
+  <link name="D_pin"/>
+  <joint name="point_D" type="fixed"><parent link="link5"/><child link="D_pin"/><origin xyz="{b2} 0 0"/></joint>
+</robot>
+"""

@@ -1,5 +1,5 @@
 """Joint limits: a pose beyond a URDF <limit> is reported (text, JSON, CSV), a warning by
-default and an error (exit 10) on request.
+default and an error (exit 12) on request.
 
 The R-RTR's slide coordinate is minus the distance CB (B on the crank, AB = 0.1 m; C on
 the ground, AC = 0.05 m): q = -sqrt(AB^2 + AC^2 - 2 AB AC cos A). With the slide's limits
@@ -49,11 +49,11 @@ def test_a_pose_within_the_limits_says_nothing(tight, capsys):
     assert json.loads(out)["limit_violations"] == [] and "warning" not in err and _cb(30) < 0.1
 
 
-def test_limits_as_errors_exit_10_naming_the_joint(tight, capsys):
-    assert main(["solve", str(tight), "--angle", "90 deg", "--limits", "error"]) == 10
+def test_limits_as_errors_exit_12_naming_the_joint(tight, capsys):
+    assert main(["solve", str(tight), "--angle", "90 deg", "--limits", "error"]) == 12
     err = capsys.readouterr().err
     assert "B_slider = -0.111803 m is below its lower limit -0.1 m (URDF <limit>)" in err and "Traceback" not in err
-    assert main(["solve", str(tight), "--angle", "90 deg", "--set", 'report.limits="error"']) == 10
+    assert main(["solve", str(tight), "--angle", "90 deg", "--set", 'report.limits="error"']) == 12
 
 
 def test_a_sweep_marks_the_poses_beyond_the_limits(tight, tmp_path, capsys):
@@ -63,7 +63,7 @@ def test_a_sweep_marks_the_poses_beyond_the_limits(tight, tmp_path, capsys):
     beyond = [float(r["A.q [deg]"]) for r in rows if r["beyond_limits"] == "B_slider"]
     assert beyond == [a for a in range(30, 391, 20) if math.cos(math.radians(a)) < 0.25]
     assert "10 of 19 poses put joints beyond their URDF <limit>" in capsys.readouterr().err
-    assert main(["sweep", str(tight), "--steps", "19", "--csv", str(out), "--limits", "error"]) == 10
+    assert main(["sweep", str(tight), "--steps", "19", "--csv", str(out), "--limits", "error"]) == 12
     assert "sweep stopped at A = 90 deg: B_slider" in capsys.readouterr().err
 
 

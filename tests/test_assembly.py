@@ -1,0 +1,362 @@
+"""Assembly modes: every pose on the reference's assembly, or a named error.
+
+References are closed forms derived apart from Pinocchio (scripts/closed_form.py for the
+four-bar and the offset slider-crank, scripts/closed_form_six_bar.py for a Stephenson III
+six-bar), each with its assemblies chosen by an explicit side of a line, and the limit
+angle of a non-Grashof four-bar from the law of cosines. Tolerances: positions 1e-12 of
+the mechanism's size (the solver closes to 1e-13 and the poses here are far from
+singular, condition numbers below 1e2); fold locations 1e-9 rad as the issue asks
+(the locator brackets the fold to 1e-12 in its pivot joint, so the driver is right to
+rounding).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+import closed_form
+import pinmech
+from tests._mechanisms import four_bar_urdf, spatial_rsur_urdf, stephenson_six_bar_urdf, write
+from closed_form_six_bar import stephenson_d
+from pinmech import AssemblyError, DriverLimitError, LoopSolver, Mechanism, SingularPoseError
+from pinmech.cli import main
+from pinmech.solve_cycle import solve_range
+
+SIX = dict(a=0.04, b=0.12, c=0.08, d=0.10, cx=0.06, cy=0.04, b2=0.10, c2=0.09, o6=(0.16, 0.10))
+
+
+# ---------------------------------------------------------------------- helpers
+def _four_bar(tmp_path, a, b, c, d) -> Mechanism:
+    return Mechanism.from_urdf(write(tmp_path, "fb.urdf", four_bar_urdf(a, b, c, d)))
+
+
+def _four_bar_guess(mech: Mechanism, theta: float, a, b, c, d, branch: int) -> np.ndarray:
+    ref = closed_form.four_bar(theta, 0.0, 0.0, a, b, c, d, branch)
+    q = mech.neutral()
+    mech.set_coordinate(q, "O2", theta)
+    mech.set_coordinate(q, "A", float(ref.theta3) - theta)
+    mech.set_coordinate(q, "O4", float(ref.theta4))
+    return q
+
+
+def _pin(mech: Mechanism, solver: LoopSolver, q: np.ndarray, name: str) -> np.ndarray:
+    import pinocchio as pin
+
+    pin.framesForwardKinematics(mech.model, solver.data, q)
+    return solver.data.oMf[mech.frame_id(name)].translation[:2].copy()
+
+
+def _rocker_tip(mech, q, c, d) -> np.ndarray:
+    """The four-bar's pin B as the end of the rocker: O4 + c e4 [m]."""
+    t4 = mech.coordinate(q, "O4")
+    return np.array([d + c * math.cos(t4), c * math.sin(t4)])
+
+
+def _six_bar(tmp_path) -> Mechanism:
+    return Mechanism.from_urdf(write(tmp_path, "six.urdf", stephenson_six_bar_urdf(**SIX)))
+
+
+def _six_guess(mech: Mechanism, theta: float, branch: int, branch2: int) -> np.ndarray:
+    p = SIX
+    fb = closed_form.four_bar(theta, 0.0, 0.0, p["a"], p["b"], p["c"], p["d"], branch)
+    D = stephenson_d(theta, **p, branch=branch, branch2=branch2)
+    e3 = np.array([math.cos(fb.theta3), math.sin(fb.theta3)])
+    C = fb.A + p["cx"] * e3 + p["cy"] * np.array([-e3[1], e3[0]])
+    q = mech.neutral()
+    mech.set_coordinate(q, "O2", theta)
+    mech.set_coordinate(q, "A", float(fb.theta3) - theta)
+    mech.set_coordinate(q, "O4", float(fb.theta4))
+    phi5 = math.atan2(D[1] - C[1], D[0] - C[0])
+    mech.set_coordinate(q, "C", phi5 - float(fb.theta3))
+    mech.set_coordinate(q, "O6", math.atan2(D[1] - p["o6"][1], D[0] - p["o6"][0]))
+    return q
+
+
+def _sweep(solver: LoopSolver, values, **kw):
+    chunks = list(solve_range(solver, solver.drivers[0], values, driver_q=np.zeros(1), driver_v=np.ones(1),
+                              driver_a=np.zeros(1), **kw))
+    q = np.concatenate([c.solution.q for c in chunks])
+    errors = {c.start + j: e for c in chunks for j, e in c.errors.items()}
+    return q, errors, [n for c in chunks for n in c.notes.values()]
+
+
+# ---------------------------------------------------------------------- one-off solves
+@pytest.mark.parametrize("branch", [+1, -1])
+def test_one_off_solves_of_a_four_bar_keep_the_reference_assembly(tmp_path, branch):
+    """From a reference at 60 deg, 36 crank angles (every 10 deg, and beyond a turn) land
+    on the reference's assembly: the closed form of the same side of A -> O4."""
+    a, b, c, d = 0.04, 0.12, 0.08, 0.10  # the bundled crank-rocker
+    mech = _four_bar(tmp_path, a, b, c, d)
+    solver = LoopSolver(mech, ["O2"])
+    ref = solver.set_reference([math.radians(60)], _four_bar_guess(mech, math.radians(60), a, b, c, d, branch))
+    for k in range(36):
+        theta = math.radians(60 + 10 * k + (360 if k % 3 == 0 else 0) - (720 if k % 5 == 0 else 0))
+        sol = solver.solve([theta])
+        expected = closed_form.four_bar(theta, 0.0, 0.0, a, b, c, d, branch)
+        assert sol.assembly.signs == ref.signs
+        assert np.allclose(_rocker_tip(mech, sol.q, c, d), expected.B, rtol=0, atol=1e-12 * 0.16)
+        side = "left" if branch > 0 else "right"
+        assert sol.assembly.labels == (f"B {side} of A->O4",)
+
+
+@pytest.mark.parametrize("branch", [+1, -1])
+def test_one_off_solves_of_an_offset_slider_crank_keep_their_side(branch):
+    """The bundled slider-crank, piston right (+1) or left (-1) of the crank pin: 36 crank
+    angles against the closed form."""
+    from pathlib import Path
+
+    mech = Mechanism.from_urdf(Path(__file__).parents[1] / "models" / "slider_crank.urdf")
+    r, l, e = 0.05, 0.15, 0.01
+    theta0 = math.radians(45)
+    ref = closed_form.slider_crank(theta0, 0.0, 0.0, r, l, e, branch)
+    q = mech.neutral()
+    mech.set_coordinate(q, "O", theta0)
+    mech.set_coordinate(q, "A", float(ref.beta) - theta0)
+    mech.set_coordinate(q, "slide", float(ref.x_B))
+    solver = LoopSolver(mech, ["O"])
+    reference = solver.set_reference([theta0], q)
+    for k in range(36):
+        theta = theta0 + math.radians(10 * k)
+        sol = solver.solve([theta])
+        assert sol.assembly.signs == reference.signs
+        assert abs(mech.coordinate(sol.q, "slide") - float(closed_form.slider_crank(theta, 0, 0, r, l, e, branch).x_B)) \
+            < 1e-12 * 0.2
+
+
+@pytest.mark.parametrize("branch,branch2", [(1, 1), (1, -1), (-1, 1), (-1, -1)])
+def test_one_off_solves_of_a_stephenson_six_bar_keep_each_of_its_four_assemblies(tmp_path, branch, branch2):
+    mech = _six_bar(tmp_path)
+    solver = LoopSolver(mech, ["O2"])
+    theta0 = math.radians(30)
+    ref = solver.set_reference([theta0], _six_guess(mech, theta0, branch, branch2))
+    assert len(ref.signs) == 2  # one sign per loop: the blocks B and D
+    for k in range(36):
+        theta = theta0 + math.radians(10 * k)
+        sol = solver.solve([theta])
+        assert sol.assembly.signs == ref.signs
+        D = _pin(mech, solver, sol.q, "D_pin")
+        assert np.allclose(D, stephenson_d(theta, **SIX, branch=branch, branch2=branch2), rtol=0, atol=1e-12 * 0.2)
+
+
+# ---------------------------------------------------------------------- sweeps
+@pytest.mark.parametrize("spacing", [1, 10, 30, 45])
+def test_six_bar_sweeps_at_any_spacing_match_the_closed_form_and_come_back(tmp_path, spacing):
+    """A full turn of the Stephenson six-bar at 1, 10, 30 and 45 degree spacing: every row
+    on the reference's assembly (the closed form of its two sides), the last pose on the
+    first within 1e-12 of the mechanism size."""
+    mech = _six_bar(tmp_path)
+    solver = LoopSolver(mech, ["O2"])
+    theta0 = math.radians(30)
+    solver.set_reference([theta0], _six_guess(mech, theta0, 1, -1))
+    values = theta0 + np.radians(np.arange(0, 360 + spacing, spacing))
+    q, errors, _ = _sweep(solver, values)
+    assert not errors
+    D = np.array([_pin(mech, solver, qi, "D_pin") for qi in q])
+    assert np.allclose(D, stephenson_d(values, **SIX, branch=1, branch2=-1), rtol=0, atol=1e-12 * 0.2)
+    assert np.max(np.abs(D[-1] - D[0])) < 1e-12 * 0.2
+
+
+@pytest.mark.parametrize("spacing", [1, 10, 30, 45])
+def test_four_bar_sweeps_at_any_spacing_give_the_rows_of_a_fine_sweep(tmp_path, spacing):
+    a, b, c, d = 0.04, 0.12, 0.08, 0.10
+    mech = _four_bar(tmp_path, a, b, c, d)
+    solver = LoopSolver(mech, ["O2"])
+    solver.set_reference([0.0], _four_bar_guess(mech, 0.0, a, b, c, d, -1))
+    values = np.radians(np.arange(0, 720 + spacing, spacing))  # two turns
+    q, errors, _ = _sweep(solver, values)
+    assert not errors
+    B = np.array([_rocker_tip(mech, qi, c, d) for qi in q])
+    assert np.allclose(B, closed_form.four_bar(values, 0, 0, a, b, c, d, -1).B, rtol=0, atol=1e-12 * 0.16)
+
+
+# ---------------------------------------------------------------------- folds
+def _non_grashof(tmp_path):
+    """A triple rocker: s + l = 0.04 + 0.09 > p + q = 0.07 + 0.05. Its crank swings
+    between +-theta_lim where |A - O4| = b - c, by the law of cosines."""
+    a, b, c, d = 0.07, 0.09, 0.05, 0.04
+    lim = math.acos((a * a + d * d - (b - c) ** 2) / (2 * a * d))
+    return _four_bar(tmp_path, a, b, c, d), (a, b, c, d), lim
+
+
+@pytest.mark.parametrize("branch", [+1, -1])
+def test_a_non_grashof_crank_stops_at_its_limit_angle_located_to_1e9(tmp_path, branch):
+    mech, dims, lim = _non_grashof(tmp_path)
+    solver = LoopSolver(mech, ["O2"])
+    solver.set_reference([math.pi], _four_bar_guess(mech, math.pi, *dims, branch))
+    for target, limit in ((math.radians(10), lim), (math.radians(350), 2 * math.pi - lim)):
+        with pytest.raises(DriverLimitError) as info:
+            solver.solve([target])
+        assert abs(info.value.limit[0] - limit) < 1e-9
+        assert info.value.exit_code == 11
+    near = solver.solve([lim + 1e-6])  # just before the limit: still its own assembly
+    expected = closed_form.four_bar(lim + 1e-6, 0, 0, *dims, branch)
+    assert np.allclose(_rocker_tip(mech, near.q, dims[2], dims[3]), expected.B, atol=1e-12 * 0.11)
+
+
+def test_a_sweep_past_a_limit_stops_there_or_goes_through_onto_the_other_branch(tmp_path):
+    mech, dims, lim = _non_grashof(tmp_path)
+    solver = LoopSolver(mech, ["O2"])
+    solver.set_reference([math.pi], _four_bar_guess(mech, math.pi, *dims, +1))
+    values = np.radians(np.arange(180, -1, -5.0))  # down to 0 deg, past the limit at 28.96 deg
+    q, errors, _ = _sweep(solver, values)
+    first_bad = min(errors)
+    assert math.degrees(values[first_bad - 1]) > math.degrees(lim) > math.degrees(values[first_bad])
+    assert all(isinstance(errors[i], DriverLimitError) for i in errors)
+    # through the fold: the crank turns back (values mirrored at the limit), the other side
+    solver2 = LoopSolver(mech, ["O2"])
+    solver2.set_reference([math.pi], _four_bar_guess(mech, math.pi, *dims, +1))
+    chunks = list(solve_range(solver2, "O2", values, driver_q=np.zeros(1), driver_v=np.ones(1),
+                              driver_a=np.zeros(1), through_folds=True))
+    got = np.concatenate([c.values for c in chunks])
+    qs = np.concatenate([c.solution.q for c in chunks])
+    past = values < lim
+    assert np.allclose(got[past], 2 * lim - values[past], atol=1e-9)
+    for theta, qi, mirrored in zip(got, qs, past):
+        expected = closed_form.four_bar(theta, 0, 0, *dims, -1 if mirrored else +1)
+        assert np.allclose(_rocker_tip(mech, qi, dims[2], dims[3]), expected.B, atol=1e-11 * 0.11)
+    assert any("fold" in n for c in chunks for n in c.notes.values())
+
+
+def test_the_rsur_near_its_rocker_limit_keeps_its_root_or_names_the_other(tmp_path):
+    """The spatial RSUR driven from its rocker, 1e-6 rad before the rocker's limit: by
+    continuation the pose is on the reference's assembly; a guess 1e-3 rad from the other
+    root is either the right root or an AssemblyError, never the other root in silence."""
+    mech = Mechanism.from_urdf(write(tmp_path, "rsur.urdf", spatial_rsur_urdf()))
+    solver = LoopSolver(mech, ["R4"])
+    # a reference pose from the crank-driven solver (R1 = 0), read off at its rocker angle
+    crank = LoopSolver(mech, ["R1"])
+    q_ref = crank.solve([0.0], guess=mech.neutral()).q
+    r4 = mech.coordinate(q_ref, "R4")
+    ref = solver.set_reference([r4], q_ref)
+    with pytest.raises(DriverLimitError) as info:
+        solver.solve([r4 - 3.0])  # the rocker's limit lies below r4 (3.8 deg)
+    limit = info.value.limit[0]
+    before = limit + 1e-6
+    sol = solver.solve([before])
+    assert sol.assembly.signs == ref.signs
+    assert 1e3 < sol.accuracy.condition < 1e4  # as in the issue: near the limit, under max_condition
+    # the other root at the same rocker angle: the path through the fold, mirrored back to it
+    other = solver.follow(sol.q, np.array([before]), np.array([limit - 1e-6]),
+                          pinmech.Route((0.0,)), through_folds=True)
+    assert abs(mech.coordinate(other, "R4") - before) < 1e-12
+    assert pinmech.LoopSolver(mech, ["R4"]).solve([before], guess=other).assembly.signs != ref.signs
+    bumped = other.copy()
+    bumped[mech.joint("R1").idx_q] += 1e-3
+    try:
+        again = solver.solve([before], guess=bumped)
+    except (AssemblyError, SingularPoseError):
+        return
+    assert again.assembly.signs == ref.signs
+
+
+# ---------------------------------------------------------------------- bifurcation
+def test_a_parallelogram_keeps_its_branch_through_the_change_points(tmp_path):
+    """a = c, b = d: at 0 and 180 deg the parallelogram and the antiparallelogram meet. A
+    sweep through both keeps the coupler parallel to the ground (tangent continuous) and
+    says it passed the change points."""
+    a, b = 0.05, 0.12
+    mech = _four_bar(tmp_path, a, b, a, b)
+    solver = LoopSolver(mech, ["O2"])
+    q = mech.neutral()
+    mech.set_coordinate(q, "O2", math.radians(60))
+    mech.set_coordinate(q, "A", -math.radians(60))
+    mech.set_coordinate(q, "O4", math.radians(60))
+    solver.set_reference([math.radians(60)], q)
+    values = np.radians(np.arange(60.5, 60.5 + 360, 1.0))
+    qs, errors, notes = _sweep(solver, values)
+    assert not errors
+    for theta, qi in zip(values, qs):
+        coupler = math.remainder(mech.coordinate(qi, "O2") + mech.coordinate(qi, "A"), 2 * math.pi)
+        assert abs(coupler) < 1e-12
+        assert abs(math.remainder(mech.coordinate(qi, "O4") - theta, 2 * math.pi)) < 1e-12
+    assert sum("change point" in n for n in notes) == 2
+
+
+# ---------------------------------------------------------------------- hypothesis
+@settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(a=st.floats(0.02, 0.1), b=st.floats(0.05, 0.15), c=st.floats(0.03, 0.12), d=st.floats(0.05, 0.12),
+       start=st.floats(0, 2 * math.pi), step=st.floats(3, 50), branch=st.sampled_from([1, -1]))
+def test_random_four_bar_sweeps_never_change_assembly_in_silence(tmp_path_factory, a, b, c, d, start, step, branch):
+    """Random dimensions (Grashof or not), start angles and spacings: every row is on the
+    reference's side (the closed form of that branch) or a named error. Change-point
+    linkages (s + l = p + q, within 1e-3 of the size), where branches cross and the closed
+    form's side of A -> O4 is not a branch any more, are the parallelogram test's."""
+    lengths = sorted((a, b, c, d))
+    assume(abs(lengths[0] + lengths[3] - lengths[1] - lengths[2]) > 1e-3 * lengths[3])
+    try:
+        closed_form.four_bar(start, 0, 0, a, b, c, d, branch)
+    except ValueError:
+        return  # the start does not close: nothing to follow
+    tmp = tmp_path_factory.mktemp("fb")
+    mech = _four_bar(tmp, a, b, c, d)
+    solver = LoopSolver(mech, ["O2"])
+    try:
+        ref = solver.set_reference([start], _four_bar_guess(mech, start, a, b, c, d, branch))
+    except (SingularPoseError, pinmech.LoopClosureError):
+        return
+    values = start + np.radians(np.arange(0, 370, step))
+    qs, errors, _ = _sweep(solver, values)
+    size = max(a, b, c, d)
+    for i, (theta, qi) in enumerate(zip(values, qs)):
+        if i in errors:
+            assert isinstance(errors[i], (DriverLimitError, SingularPoseError, AssemblyError))
+            continue
+        expected = closed_form.four_bar(theta, 0, 0, a, b, c, d, branch)
+        assert np.allclose(_rocker_tip(mech, qi, c, d), expected.B, rtol=0, atol=1e-9 * size), (i, theta)
+
+
+# ---------------------------------------------------------------------- API and CLI
+def test_a_guess_on_the_other_assembly_is_an_assembly_error_unless_any(tmp_path):
+    a, b, c, d = 0.04, 0.12, 0.08, 0.10
+    mech = _four_bar(tmp_path, a, b, c, d)
+    solver = LoopSolver(mech, ["O2"])
+    solver.set_reference([1.0], _four_bar_guess(mech, 1.0, a, b, c, d, +1))
+    other = _four_bar_guess(mech, 2.0, a, b, c, d, -1)
+    with pytest.raises(AssemblyError) as info:
+        solver.solve([2.0], guess=other)
+    assert info.value.exit_code == 10 and info.value.expected != info.value.found
+    solver.set_reference([1.0], _four_bar_guess(mech, 1.0, a, b, c, d, +1), assembly="any")
+    assert solver.solve([2.0], guess=other).assembly.labels == ("B right of A->O4",)
+
+
+def test_bundled_four_bar_keeps_its_open_assembly_at_every_angle(models_dir, capsys):
+    """The issue's cases: 120 and 150 deg used to fail, 180-240 deg gave the crossed
+    assembly. From the scene's 60 deg, every angle is the scene's assembly."""
+    import json
+
+    for angle in (120, 150, 180, 200, 240, -100, 420):
+        assert main(["solve", str(models_dir / "scenes" / "four_bar.toml"), "--angle", f"{angle} deg", "--json"]) == 0
+        out = json.loads(capsys.readouterr().out)
+        theta = math.radians(angle)
+        expected = closed_form.four_bar(theta, 0, 0, 0.04, 0.12, 0.08, 0.10, +1)
+        assert abs(math.remainder(out["joints"]["O4"]["q"] - float(expected.theta4), 2 * math.pi)) < 1e-12
+        assert out["assembly"]["B"]["label"] == "B left of A->O4"
+        assert out["route"]["from"] == {"O2": pytest.approx(math.radians(60), abs=1e-15)}
+
+
+def test_a_scene_without_guess_says_which_assembly_and_how_to_pin_it(tmp_path, models_dir, capsys):
+    scene = tmp_path / "s.toml"
+    body = '[drivers.O2]\nangle = "60 deg"\n'
+    scene.write_text(f'urdf = "{models_dir / "four_bar.urdf"}"\n{body}')
+    assert main(["solve", str(scene)]) == 0
+    out = capsys.readouterr().out
+    assert "no [guess]" in out and 'assembly = { "B" = ' in out
+    wrong = "+" if '"B" = "-"' in out else "-"
+    top = f'urdf = "{models_dir / "four_bar.urdf"}"\n'
+    scene.write_text(top + f'assembly = {{ B = "{wrong}" }}\n' + body)
+    assert main(["solve", str(scene)]) == 10
+    assert "change [guess]" in capsys.readouterr().err
+    scene.write_text(top + 'assembly = { Q = "+" }\n' + body)
+    assert main(["solve", str(scene)]) == 4
+    scene.write_text(top + 'assembly = "any"\n' + body)
+    assert main(["solve", str(scene)]) == 0
+
+
+def test_cli_sweep_says_it_came_back_after_a_turn(models_dir, capsys):
+    assert main(["sweep", str(models_dir / "scenes" / "four_bar.toml"), "--steps", "9"]) == 0
+    assert "back where it began" in capsys.readouterr().err
