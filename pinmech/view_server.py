@@ -61,6 +61,7 @@ def main() -> None:
     bridge = LoopbackBridge(host=HOST)
     print(f"zmq_url={bridge.zmq_url}", flush=True)
     print(f"web_url={bridge.web_url}", flush=True)
+    os.dup2(sys.stderr.fileno(), sys.stdout.fileno())  # nobody reads stdout now: a full pipe would block
     threading.Thread(target=_exit_when_stdin_closes, daemon=True).start()
     bridge.run()
 
