@@ -111,6 +111,7 @@ def build_parser() -> argparse.ArgumentParser:
     path.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                       help="override a scene value (repeatable)")
     _add_path_arguments(path, required=False)
+    _add_limits_argument(path)
     _add_output_arguments(path)
     path.set_defaults(func=cmd_path)
 
@@ -187,6 +188,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     """`pinmech sweep SCENE`: every pose of a cycle, streamed as CSV (and JSON lines, a plot);
     a task scene is followed in time instead (as `pinmech path`)."""
     from pinmech.analysis import limit_mode
+    from pinmech.limits import limit_violations
     from pinmech.sweep import DriverValues, Sweep, sweep_options
 
     scene = _scene(args)
@@ -220,13 +222,15 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     poses = sweep.poses(DriverValues(start, stop, steps), skip_failures=args.skip_failures,
                         start=mode or "predictor", batch=not args.no_batch and options.get("batch", True),
                         interpolate=interpolate, through_folds=args.through_folds)
-    limits = _SweepLimits(sweep, limit_mode(scene, args.limits))
+    limits = _LimitWatch(limit_mode(scene, args.limits), "poses")
     sinks = _sweep_sinks(args, sweep, steps, figure)
     with sinks:
         for pose in _progress(poses, steps):
             if pose.note:
                 print(f"pinmech: at pose {pose.index}: {pose.note}", file=sys.stderr)
-            limits.check(pose)
+            if pose.motion is not None:
+                limits.check(limit_violations(sweep.mechanism, pose.motion),
+                             f"at {sweep.driver} = {sweep._format(pose.value)}")
             sinks.add(pose)
     limits.summary(steps)
     _say_return(sweep, stop - start)
@@ -251,30 +255,26 @@ def _say_return(sweep, span: float) -> None:
               f"(largest joint gap {gap:.3g} rad or sizes): it returns after more turns", file=sys.stderr)
 
 
-class _SweepLimits:
-    """Poses of a sweep that put a joint beyond its URDF <limit>: counted and summed up in a
-    warning, or the sweep stopped at the first (LimitError) in mode "error"."""
+class _LimitWatch:
+    """Poses (or path points) that put a joint beyond its URDF <limit>: counted and summed
+    up in a warning, or the run stopped at the first (LimitError) in mode "error"."""
 
-    def __init__(self, sweep, mode: str) -> None:
-        self.sweep, self.mode = sweep, mode
+    def __init__(self, mode: str, what: str, column: str = "; see the beyond_limits column") -> None:
+        self.mode, self.what, self.column = mode, what, column
         self.count, self.first = 0, ""
 
-    def check(self, pose) -> None:
-        from pinmech.limits import enforce, limit_violations
+    def check(self, violations: list, at: str) -> None:
+        from pinmech.limits import enforce
 
-        if pose.motion is None:
-            return
-        violations = limit_violations(self.sweep.mechanism, pose.motion)
         if violations:
-            at = f"at {self.sweep.driver} = {self.sweep._format(pose.value)}"
-            enforce(violations, self.mode, f"sweep stopped {at}")
+            enforce(violations, self.mode, f"stopped {at}")
             self.count += 1
             self.first = self.first or f"{at}: " + "; ".join(v.describe() for v in violations)
 
     def summary(self, total: int) -> None:
         if self.count:
-            print(f"pinmech: warning: {self.count} of {total} poses put joints beyond their URDF <limit> (first "
-                  f"{self.first}); see the beyond_limits column", file=sys.stderr)
+            print(f"pinmech: warning: {self.count} of {total} {self.what} put joints beyond their URDF <limit> "
+                  f"(first {self.first}){self.column}", file=sys.stderr)
 
 
 def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | None) -> _Sinks:
@@ -437,8 +437,9 @@ def cmd_path(args: argparse.Namespace) -> int:
 
 def _follow(args: argparse.Namespace, scene) -> int:
     """A task scene followed in time: CSV (JSON lines, a figure) of the joint trajectory."""
-    from pinmech.analysis import load_mechanism
+    from pinmech.analysis import limit_mode, load_mechanism
     from pinmech.analysis_task import scene_pose, scene_tasks
+    from pinmech.limits import limits_at
     from pinmech.path import check_timing, follow_path, step_count
     from pinmech.sweep import sweep_options
     from pinmech.tables import PathCsv
@@ -474,11 +475,14 @@ def _follow(args: argparse.Namespace, scene) -> int:
     if args.json_path:
         sinks.table(_PathJsonLines, mechanism, args.json_path, None)
     worst = 0.0
+    limits = _LimitWatch(limit_mode(scene, getattr(args, "limits", None)), "path points", "")
     with sinks:
         for point in _progress(follow_path(mechanism, scene_tasks(scene), q0, duration=duration, step=step,
                                            gain=gain, scheme=scheme), total):
+            limits.check(limits_at(mechanism, point.q), f"at t = {point.time:.6g} s")
             sinks.add(point)
             worst = max(worst, point.drift)
+    limits.summary(total)
     print(f"largest drift of the path from the one asked: {worst:.3e} m", file=sys.stderr)
     return 0
 

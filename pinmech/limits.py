@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from pinmech.exceptions import LimitError
 from pinmech.mechanism import Mechanism
 from pinmech.motion import Motion
@@ -41,13 +43,25 @@ class LimitViolation:
 def limit_violations(mechanism: Mechanism, motion: Motion) -> list[LimitViolation]:
     """The joints of a solved pose beyond their URDF limits, locked ones included (a margin
     of 1e-9, relative to the bound or absolute below 1, for the rounding of a closed loop)."""
+    values = {n: j.q for n, j in motion.joints.items() if isinstance(j.q, float)}
+    return _beyond(mechanism, values)
+
+
+def limits_at(mechanism: Mechanism, q: np.ndarray) -> list[LimitViolation]:
+    """The joints beyond their URDF limits at configuration q (an arm path's point)."""
+    values = {n: mechanism.coordinate(q, n) for n in mechanism.limits
+              if n in mechanism.mimics or (n in mechanism.joints and mechanism.joints[n].nv == 1)}
+    return _beyond(mechanism, values)
+
+
+def _beyond(mechanism: Mechanism, values: dict[str, float]) -> list[LimitViolation]:
+    """The joints of `values` (and the locked ones) outside their limits."""
     out = []
     for name, limit in mechanism.limits.items():
-        joint = motion.joints.get(name)
         if name in mechanism.locked:  # held where the scene locks it
             value = mechanism.locked[name]
-        elif joint is not None and isinstance(joint.q, float):
-            value = joint.q
+        elif name in values:
+            value = values[name]
         else:
             continue
         margin = 1e-9 * max(1.0, abs(limit.lower), abs(limit.upper))

@@ -64,7 +64,7 @@ def test_a_sweep_marks_the_poses_beyond_the_limits(tight, tmp_path, capsys):
     assert beyond == [a for a in range(30, 391, 20) if math.cos(math.radians(a)) < 0.25]
     assert "10 of 19 poses put joints beyond their URDF <limit>" in capsys.readouterr().err
     assert main(["sweep", str(tight), "--steps", "19", "--csv", str(out), "--limits", "error"]) == 12
-    assert "sweep stopped at A = 90 deg: B_slider" in capsys.readouterr().err
+    assert "stopped at A = 90 deg: B_slider" in capsys.readouterr().err
 
 
 def test_malformed_limits_are_model_errors(tmp_path):
@@ -87,3 +87,22 @@ def test_a_joint_locked_beyond_its_limit_is_reported(tmp_path, capsys):
     [violation] = json.loads(capsys.readouterr().out)["limit_violations"]
     assert violation == {"joint": "C", "value": pytest.approx(math.radians(200)), "lower": -3.14159265,
                          "upper": 3.14159265}
+
+
+def test_an_arm_path_beyond_a_limit_is_a_warning_or_stops(tmp_path, capsys):
+    # The planar arm's D moves at 1 m/s along x: B opens from -65 deg (to -58.2 deg at 19 ms).
+    # Limited to [-65.5, -60] deg, it leaves its range on the way.
+    text = (MODELS / "planar_arm.urdf").read_text()
+    old = '<origin xyz="0.30 0 0"/><axis xyz="0 0 1"/>\n    <limit lower="-3.14159265" upper="3.14159265"'
+    assert text.count(old) == 2
+    head, _, tail = text.partition('<joint name="B" type="revolute">')
+    tail = tail.replace(old, '<origin xyz="0.30 0 0"/><axis xyz="0 0 1"/>\n    <limit lower="-1.1432" upper="-1.0472"', 1)
+    (tmp_path / "arm.urdf").write_text(head + '<joint name="B" type="revolute">' + tail)
+    scene = tmp_path / "arm.toml"
+    scene.write_text((SCENES / "planar_arm.toml").read_text().replace('urdf = "../planar_arm.urdf"',
+                                                                      'urdf = "arm.urdf"'))
+    assert main(["path", str(scene), "--duration", "0.02 s", "--csv", str(tmp_path / "p.csv")]) == 0
+    err = capsys.readouterr().err
+    assert "path points put joints beyond their URDF <limit> (first at t = " in err and ": B = " in err
+    assert main(["path", str(scene), "--duration", "0.02 s", "--csv", str(tmp_path / "p.csv"), "--limits", "error"]) == 12
+    assert "stopped at t = " in capsys.readouterr().err
