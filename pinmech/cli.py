@@ -13,15 +13,15 @@ as NAME.partial.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import signal
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
 from pinmech import __version__
-from pinmech.exceptions import Interrupted, PinmechError
-from pinmech.outputs import OutputFile, check_distinct, plot_path, write_whole
+from pinmech.exceptions import PinmechError
+from pinmech.interrupts import SIGNALS
+from pinmech.outputs import Outputs, check_distinct, plot_path, write_whole
 
 
 def _add_scene_arguments(parser: argparse.ArgumentParser) -> None:
@@ -277,10 +277,10 @@ class _LimitWatch:
                   f"(first {self.first}){self.column}", file=sys.stderr)
 
 
-def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | None) -> _Sinks:
+def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | None) -> Outputs:
     from pinmech.tables import SweepCsv, SweepJsonLines
 
-    sinks = _Sinks()
+    sinks = Outputs()
     if args.plot_path:
         from pinmech.plot import SweepPlot
 
@@ -290,69 +290,6 @@ def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | Non
     if args.json_path:
         sinks.table(SweepJsonLines, sweep, args.json_path, None)
     return sinks
-
-
-class _Sinks:
-    """Where streamed rows go (CSV, JSON lines, a figure), finished together: each file is
-    written through a temporary file and renamed when every row is in (outputs.py); on a
-    failure or a signal, what was written is kept as NAME.partial and the file named on
-    the command line is left as it was. Each output says on stderr what was written."""
-
-    def __init__(self) -> None:
-        self.tables: list = []  # (table, OutputFile or None for stdout, what)
-        self.figures: list = []  # (recorder, OutputFile)
-
-    def table(self, kind, source, path: str | None, what: str | None) -> None:
-        output = OutputFile(path) if path else None
-        stream = output.open() if output else sys.stdout
-        self.tables.append((kind(source, stream), output, what))
-
-    def plot(self, recorder, path: Path) -> None:
-        output = OutputFile(path)
-        output.open(text=False)
-        self.figures.append((recorder, output))
-
-    def add(self, row) -> None:
-        with _SIGNALS.held():  # one row goes to every output or to none
-            for table, _, _ in self.tables:
-                table.add(row)
-            for recorder, _ in self.figures:
-                recorder.add(row)
-
-    def __enter__(self) -> _Sinks:  # noqa: PYI034
-        return self
-
-    def __exit__(self, kind, error, trace) -> None:
-        if error is not None:
-            self._abandon()
-            return
-        try:  # every row is in: the tables are complete, then the figures (which may still fail)
-            with _SIGNALS.held():  # all of them finished before a signal stops the run
-                self._finish()
-        except BaseException:
-            self._abandon()
-            raise
-
-    def _finish(self) -> None:
-        """Close the tables and rename them over their names, then draw and rename the figures."""
-        counts = [table.close() for table, _, _ in self.tables]
-        for (_, output, what), count in zip(self.tables, counts):
-            if output:
-                output.commit()
-                said = f"{count} {what}" if what else "JSON lines"
-                print(f"{said} written to {output.path}", file=sys.stderr)
-        for recorder, output in self.figures:
-            recorder.save(output.temporary)
-            output.commit()
-            print(f"figure written to {output.path}", file=sys.stderr)
-
-    def _abandon(self) -> None:
-        """Keep what was written as NAME.partial, and say so."""
-        for output in [o for _, o, _ in self.tables if o] + [o for _, o in self.figures]:
-            partial = output.abandon()
-            if partial:
-                left = "left as it was" if output.path.exists() else "not written"
-                print(f"pinmech: incomplete output kept in {partial} ({output.path} {left})", file=sys.stderr)
 
 
 def _check_outputs(args: argparse.Namespace, scene) -> Path | None:
@@ -371,50 +308,6 @@ def _urdf_path(scene) -> Path:
         return scene.path
 
 
-class _Signals:
-    """SIGINT, SIGTERM and SIGHUP raised as `Interrupted` (a KeyboardInterrupt) while a
-    command runs, so outputs are finished as partial and servers stop; inside `held()`
-    the signal waits until the block is done."""
-
-    def __init__(self) -> None:
-        self.holding = False
-        self.pending: int | None = None
-
-    def _handle(self, signum, frame) -> None:
-        if self.holding:
-            self.pending = signum
-            return
-        raise Interrupted(signum)
-
-    @contextlib.contextmanager
-    def installed(self):
-        import threading
-
-        if threading.current_thread() is not threading.main_thread():
-            yield
-            return
-        names = [n for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)]
-        saved = {n: signal.signal(getattr(signal, n), self._handle) for n in names}
-        try:
-            yield
-        finally:
-            for n, handler in saved.items():
-                signal.signal(getattr(signal, n), handler)
-            self.holding, self.pending = False, None
-
-    @contextlib.contextmanager
-    def held(self):
-        self.holding = True
-        try:
-            yield
-        finally:
-            self.holding = False
-            pending, self.pending = self.pending, None
-            if pending is not None:
-                raise Interrupted(pending)
-
-
-_SIGNALS = _Signals()
 
 
 def _progress(items, total: int):
@@ -464,7 +357,7 @@ def _follow(args: argparse.Namespace, scene) -> int:
     mechanism = load_mechanism(scene)
     q0, _, _ = scene_pose(scene, mechanism)
     total = step_count(duration, step) + 1
-    sinks = _Sinks()
+    sinks = Outputs()
     if args.plot_path:
         from pinmech.plot import PathPlot
 
@@ -628,7 +521,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        with _SIGNALS.installed():
+        with SIGNALS.installed():
             return args.func(args)
     except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM, SIGHUP: one line, 128 + the signal's number
         signum = getattr(exc, "signum", signal.SIGINT)

@@ -10,11 +10,13 @@ destination is left as it was): a reader cannot take it for a complete result.
 from __future__ import annotations
 
 import os
+import sys
 import tempfile
 from pathlib import Path
 from typing import IO
 
 from pinmech.exceptions import PinmechError
+from pinmech.interrupts import SIGNALS
 
 #: Figure formats `--plot` writes (matplotlib's, by suffix).
 PLOT_FORMATS = ("png", "pdf", "svg")
@@ -154,3 +156,69 @@ def check_distinct(outputs: dict[str, str | Path | None], inputs: dict[str, str 
         key = os.path.realpath(path)
         if key in seen:
             raise PinmechError(f"{seen[key]} {path} would overwrite {what}: write the output elsewhere")
+
+
+class Outputs:
+    """Where streamed rows go (CSV, JSON lines, a figure), finished together: each file is
+    written through a temporary file and renamed when every row is in (OutputFile); on a
+    failure or a signal, what was written is kept as NAME.partial and the file named on
+    the command line is left as it was. Each output says on stderr what was written."""
+
+    def __init__(self) -> None:
+        self.tables: list = []  # (table, OutputFile or None for stdout, what)
+        self.figures: list = []  # (recorder, OutputFile)
+
+    def table(self, kind: type, source: object, path: str | None, what: str | None) -> None:
+        """A table (`kind(source, stream)`: CSV or JSON lines) to `path`, or to stdout."""
+        output = OutputFile(path) if path else None
+        stream = output.open() if output else sys.stdout
+        self.tables.append((kind(source, stream), output, what))
+
+    def plot(self, recorder: object, path: Path) -> None:
+        """A figure `recorder` (add rows, then save) drawn to `path` at the end."""
+        output = OutputFile(path)
+        output.open(text=False)
+        self.figures.append((recorder, output))
+
+    def add(self, row: object) -> None:
+        """One pose or path point to every output."""
+        with SIGNALS.held():  # one row goes to every output or to none
+            for table, _, _ in self.tables:
+                table.add(row)
+            for recorder, _ in self.figures:
+                recorder.add(row)
+
+    def __enter__(self) -> Outputs:  # noqa: PYI034
+        return self
+
+    def __exit__(self, kind, error, trace) -> None:
+        if error is not None:
+            self._abandon()
+            return
+        try:  # every row is in: the tables are complete, then the figures (which may still fail)
+            with SIGNALS.held():  # all of them finished before a signal stops the run
+                self._finish()
+        except BaseException:
+            self._abandon()
+            raise
+
+    def _finish(self) -> None:
+        """Close the tables and rename them over their names, then draw and rename the figures."""
+        counts = [table.close() for table, _, _ in self.tables]
+        for (_, output, what), count in zip(self.tables, counts):
+            if output:
+                output.commit()
+                said = f"{count} {what}" if what else "JSON lines"
+                print(f"{said} written to {output.path}", file=sys.stderr)
+        for recorder, output in self.figures:
+            recorder.save(output.temporary)
+            output.commit()
+            print(f"figure written to {output.path}", file=sys.stderr)
+
+    def _abandon(self) -> None:
+        """Keep what was written as NAME.partial, and say so."""
+        for output in [o for _, o, _ in self.tables if o] + [o for _, o in self.figures]:
+            partial = output.abandon()
+            if partial:
+                left = "left as it was" if output.path.exists() else "not written"
+                print(f"pinmech: incomplete output kept in {partial} ({output.path} {left})", file=sys.stderr)
