@@ -525,10 +525,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             return args.func(args)
     except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM, SIGHUP: one line, 128 + the signal's number
         signum = getattr(exc, "signum", signal.SIGINT)
-        print(f"pinmech: interrupted by {signal.Signals(signum).name}: stopped", file=sys.stderr)
+        print(f"pinmech: interrupted by {signal.Signals(signum).name}: stopped{_kept(exc)}", file=sys.stderr)
         return 128 + int(signum)
     except PinmechError as exc:
-        print(f"pinmech: error: {exc}", file=sys.stderr)
+        print(f"pinmech: error: {exc}{_kept(exc)}", file=sys.stderr)
         return exc.exit_code
     except ImportError as exc:
         print(f"pinmech: error: {exc}", file=sys.stderr)
@@ -536,8 +536,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # `pinmech sweep ... | head`
         return 0
     except OSError as exc:  # an output file that cannot be written (no such folder, no permission)
-        print(f"pinmech: error: {exc}", file=sys.stderr)
+        print(f"pinmech: error: {exc}{_kept(exc)}", file=sys.stderr)
         return 2
+
+
+def _kept(error: BaseException) -> str:
+    """The partial output files a failed run kept (outputs.py), for its one line."""
+    kept = getattr(error, "kept", [])
+    return f"; incomplete output kept in {', '.join(kept)}" if kept else ""
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -193,13 +193,13 @@ class Outputs:
 
     def __exit__(self, kind, error, trace) -> None:
         if error is not None:
-            self._abandon()
+            self._abandon(error)
             return
         try:  # every row is in: the tables are complete, then the figures (which may still fail)
             with SIGNALS.held():  # all of them finished before a signal stops the run
                 self._finish()
-        except BaseException:
-            self._abandon()
+        except BaseException as exc:
+            self._abandon(exc)
             raise
 
     def _finish(self) -> None:
@@ -215,10 +215,18 @@ class Outputs:
             output.commit()
             print(f"figure written to {output.path}", file=sys.stderr)
 
-    def _abandon(self) -> None:
-        """Keep what was written as NAME.partial, and say so."""
+    def _abandon(self, error: BaseException) -> None:
+        """Keep what was written as NAME.partial, and say so: in the error's own line (its
+        `kept` attribute, which the CLI prints with it), else on stderr."""
+        kept = []
         for output in [o for _, o, _ in self.tables if o] + [o for _, o in self.figures]:
             partial = output.abandon()
             if partial:
                 left = "left as it was" if output.path.exists() else "not written"
-                print(f"pinmech: incomplete output kept in {partial} ({output.path} {left})", file=sys.stderr)
+                kept.append(f"{partial} ({output.path} {left})")
+        if not kept:
+            return
+        if isinstance(error, (PinmechError, KeyboardInterrupt, OSError)):
+            error.kept = [*getattr(error, "kept", []), *kept]
+        else:
+            print(f"pinmech: incomplete output kept in {', '.join(kept)}", file=sys.stderr)
