@@ -122,6 +122,7 @@ class Mechanism:
         path = Path(path)
         source = str(path)
         root = _parse_xml(path)
+        _check_locked(locked or {}, source)
         mimics = mimic_joints(root, source)
         full = _build_model(source, root_joint, mimic=bool(mimics))
         locked = with_followers(dict(locked or {}), mimics, source)
@@ -222,6 +223,9 @@ class Mechanism:
         if name in self.mimics:
             leader = self.mimics[name].leader
             raise ModelError(f"joint '{name}' follows '{leader}' (URDF <mimic>): give {leader}'s value instead",
+                             path=self.source)
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.floating)) or not np.isfinite(value):
+            raise ModelError(f"joint '{name}': a coordinate must be a finite number (rad or m), got {value!r:.40}",
                              path=self.source)
         if j.kind == "continuous":
             q[j.idx_q : j.idx_q + 2] = (np.cos(value), np.sin(value))
@@ -360,6 +364,16 @@ def _build_model(source: str, root_joint: str | None = None, *, mimic: bool = Fa
         said = " ".join(sink.read().decode(errors="replace").split())
     detail = f" ({said})" if said else ""
     raise ModelError(f"Pinocchio cannot build the model: {error}{detail}", path=source) from error
+
+
+def _check_locked(locked: dict[str, float], source: str) -> None:
+    """Every locked value is a finite number (SI), else a ModelError naming the joint."""
+    if not isinstance(locked, dict):
+        raise ModelError(f"locked must be a dict of joint name -> value (rad or m), got {locked!r:.60}", path=source)
+    for name, value in locked.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+            raise ModelError(f"locked joint '{name}' must be held at a finite number (rad or m), got {value!r:.40}",
+                             path=source)
 
 
 def _lock_joints(model: pin.Model, locked: dict[str, float], source: str) -> pin.Model:

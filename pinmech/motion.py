@@ -121,6 +121,9 @@ def evaluate_motion(
         links: links to report (default: all that move).
     """
     model = mechanism.model
+    for name, names in (("points", points), ("links", links)):
+        if isinstance(names, (str, bytes)):
+            raise ModelError(f"{name} must be a list of names, got the string {names!r}", path=mechanism.source)
     q, v, a = (_vector(x, n, name, mechanism) for x, n, name in ((q, model.nq, "q"), (v, model.nv, "v"),
                                                                  (a, model.nv, "a")))
     if not isinstance(data, pin.Data) or len(data.oMi) != model.njoints or len(data.oMf) != model.nframes:

@@ -78,7 +78,9 @@ class DriverValues(Sequence):
 
     def __post_init__(self) -> None:
         if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
-            raise ValueError(f"steps must be a positive whole number, got {self.steps!r}")
+            raise ModelError(f"steps must be a positive whole number, got {self.steps!r}")
+        if not (math.isfinite(self.first) and math.isfinite(self.last)):
+            raise ModelError(f"the driver's range must be finite numbers, got {self.first!r} to {self.last!r}")
 
     def __len__(self) -> int:
         return self.steps

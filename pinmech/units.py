@@ -120,6 +120,8 @@ def to_si(value: Any, kind: str, *, where: str = "") -> float:
         UnitError: unknown unit, wrong dimension, missing unit, a decimal comma, two
             numbers, or not finite.
     """
+    if kind not in SI_UNITS:
+        raise UnitError(f"unknown kind of quantity {kind!r}; one of {', '.join(SI_UNITS)}", key=where)
     if isinstance(value, bool) or not isinstance(value, (int, float, str)):
         raise UnitError(f"expected a quantity such as '1.5 {_example(kind)}', got {value!r}", key=where)
     if isinstance(value, (int, float)):

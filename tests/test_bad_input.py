@@ -414,3 +414,40 @@ def test_sweep_driver_values_must_be_numbers(values, message):
     sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(SCENES / "r_rtr.toml"))
     with pytest.raises(pinmech.ModelError, match=message):
         list(sweep.poses(values))
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda m: m.set_coordinate(m.neutral(), "B", "x"), "a coordinate must be a finite number"),
+    (lambda m: m.set_coordinate(m.neutral(), "B", float("nan")), "a coordinate must be a finite number"),
+])
+def test_api_coordinates_must_be_numbers(call, message):
+    from pinmech import Mechanism, ModelError
+
+    with pytest.raises(ModelError, match=message):
+        call(Mechanism.from_urdf(MODELS / "planar_arm.urdf"))
+
+
+@pytest.mark.parametrize("value", ["30 deg", float("nan"), float("inf"), None, True])
+def test_api_locked_values_must_be_finite_numbers(value):
+    from pinmech import Mechanism, ModelError
+
+    with pytest.raises(ModelError, match="locked joint 'B' must be held at a finite number"):
+        Mechanism.from_urdf(MODELS / "planar_arm.urdf", locked={"B": value})
+
+
+def test_api_points_given_as_one_string_are_refused():
+    # "AB" would otherwise be read as the points "A" and "B".
+    import numpy as np
+
+    from pinmech import Mechanism, ModelError, evaluate_motion
+
+    m = Mechanism.from_urdf(MODELS / "planar_arm.urdf")
+    with pytest.raises(ModelError, match="points must be a list of names, got the string 'AB'"):
+        evaluate_motion(m, m.model.createData(), np.zeros(3), np.zeros(3), np.zeros(3), points="AB")
+
+
+def test_an_unknown_kind_of_quantity_is_a_unit_error():
+    from pinmech import UnitError, to_si
+
+    with pytest.raises(UnitError, match="unknown kind of quantity 'lengthh'"):
+        to_si("1 m", "lengthh")
