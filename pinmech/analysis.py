@@ -15,7 +15,7 @@ import numpy as np
 
 from pinmech.branches import parse_assembly
 from pinmech.exceptions import FrameNotFound, MobilityError, ModelError, PinmechError, SceneError
-from pinmech.mechanism import Mechanism, urdf_joint_types
+from pinmech.mechanism import Mechanism, urdf_joint_types, urdf_mimic_leaders
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.results import LoopSolution
 from pinmech.scene import Scene
@@ -74,10 +74,12 @@ def _locked_by_move(scene: Scene, types: dict[str, str], locked: dict[str, float
         if name not in movable:
             raise FrameNotFound("joint (in move)", name, movable, path=str(scene.path))
     pose = scene.section("pose")
+    leaders = urdf_mimic_leaders(scene.urdf)  # a <mimic> follower goes with its leader, moved or locked
     return {
         name: scene.quantity(pose[name], _kind(types, name), "pose", name) if name in pose else 0.0
         for name in movable
-        if name not in move and name not in locked
+        if name not in move and name not in locked and (name not in leaders or name in pose)
+        and leaders.get(name) not in move
     }
 
 

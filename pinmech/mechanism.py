@@ -252,6 +252,11 @@ def urdf_joint_types(path: str | Path) -> dict[str, str]:
     return {j.get("name"): j.get("type") for j in root.findall("joint")}
 
 
+def urdf_mimic_leaders(path: str | Path) -> dict[str, str]:
+    """Follower -> leader of the URDF's `<mimic>` joints, read from the XML."""
+    return {n: m.leader for n, m in mimic_joints(_parse_xml(Path(path)), str(path)).items()}
+
+
 def _parse_xml(path: Path) -> ET.Element:
     if not path.is_file():
         raise ModelError("no such URDF file", path=str(path))

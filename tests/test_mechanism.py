@@ -223,3 +223,19 @@ def test_a_scene_driving_or_guessing_a_mimic_follower_is_told_to_use_its_leader(
         scene = write(tmp_path, "s.toml", f'urdf = "arm.urdf"\n{text}')
         with pytest.raises(SceneError, match="'C' follows 'B' \\(URDF <mimic>\\)"):
             analyse(Scene.load(scene))
+
+
+def test_move_lists_leaders_and_their_mimic_followers_go_with_them(tmp_path, models_dir):
+    """move = ["A", "B"]: C (mimicking B) is neither locked at 0 nor an error: it follows B."""
+    from pinmech import Scene, analyse
+
+    _mimic_arm(tmp_path, models_dir)
+    task = '[[task]]\nframe = "D"\ncomponents = ["x", "y"]\nvelocity = ["1 m/s", "0 m/s"]\n'
+    scene = write(tmp_path, "s.toml", f'urdf = "arm.urdf"\nmove = ["A", "B"]\n[pose]\nA = "10 deg"\nB = "20 deg"\n{task}')
+    analysis = analyse(Scene.load(scene))
+    assert "C" not in analysis.mechanism.locked
+    assert analysis.motion.joints["C"].q == pytest.approx(2 * np.radians(20) + 0.1, abs=1e-15)
+    scene = write(tmp_path, "s.toml", f'urdf = "arm.urdf"\nmove = ["A"]\n[pose]\nA = "10 deg"\nB = "20 deg"\n{task}'
+                  .replace('components = ["x", "y"]', 'components = ["x"]').replace('["1 m/s", "0 m/s"]', '["1 m/s"]'))
+    held = analyse(Scene.load(scene)).mechanism.locked  # B locked at its pose value, C where it follows
+    assert held["C"] == pytest.approx(2 * np.radians(20) + 0.1, abs=1e-15)
