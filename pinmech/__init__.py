@@ -17,6 +17,7 @@ from pinmech.exceptions import (
     CheckMismatch,
     DriverLimitError,
     FrameNotFound,
+    IndeterminateForcesError,
     Interrupted,
     LoopClosureError,
     MobilityError,
@@ -28,6 +29,17 @@ from pinmech.exceptions import (
     TaskError,
     UnitError,
 )
+from pinmech.flywheel import EnergyFluctuation, energy_fluctuation
+from pinmech.forces import (
+    ForceSolution,
+    ForceSolver,
+    Load,
+    PowerBalance,
+    Reaction,
+    mechanical_advantage,
+)
+from pinmech.forces_scene import ForceSettings, force_settings
+from pinmech.forces_sweep import SweepForces
 from pinmech.mechanism import JointInfo, Mechanism
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.path import PathPoint, follow_path
@@ -55,9 +67,15 @@ __all__ = [
     "CoincidentPoint",
     "DriverLimitError",
     "Drivers",
+    "EnergyFluctuation",
+    "ForceSettings",
+    "ForceSolution",
+    "ForceSolver",
     "FrameNotFound",
+    "IndeterminateForcesError",
     "Interrupted",
     "JointInfo",
+    "Load",
     "LoopClosureError",
     "LoopSolution",
     "LoopSolver",
@@ -67,9 +85,11 @@ __all__ = [
     "Motion",
     "PathPoint",
     "PinmechError",
+    "PowerBalance",
     "RangeChunk",
     "RateSolution",
     "RateSolver",
+    "Reaction",
     "Reference",
     "Route",
     "Scene",
@@ -77,6 +97,7 @@ __all__ = [
     "SingularPoseError",
     "Sweep",
     "SweepError",
+    "SweepForces",
     "SweepPose",
     "Task",
     "TaskError",
@@ -84,10 +105,13 @@ __all__ = [
     "__version__",
     "analyse",
     "compare",
+    "energy_fluctuation",
     "evaluate_motion",
     "follow_path",
+    "force_settings",
     "load_hand_file",
     "load_mechanism",
+    "mechanical_advantage",
     "solve_range",
     "to_dict",
     "to_json",

@@ -15,6 +15,8 @@ import numpy as np
 
 from pinmech.branches import parse_assembly
 from pinmech.exceptions import FrameNotFound, MobilityError, ModelError, PinmechError, SceneError
+from pinmech.forces import ForceSolution
+from pinmech.forces_scene import analyse_forces, wants_forces
 from pinmech.mechanism import Mechanism, urdf_joint_types, urdf_mimic_leaders
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.results import LoopSolution
@@ -42,6 +44,7 @@ class Analysis:
     solution: LoopSolution
     motion: Motion
     extra: dict[str, Any] | None = None
+    forces: ForceSolution | None = None  # driver efforts and reactions, when the scene asks (forces.py)
 
 
 def load_mechanism(scene: Scene) -> Mechanism:
@@ -222,13 +225,19 @@ def _frame(mechanism: Mechanism, name: str, kind: str, where: str) -> None:
         raise FrameNotFound(kind, name, exc.known, path=where) from None
 
 
-def analyse(scene: Scene) -> Analysis:
+def analyse(scene: Scene, *, forces: bool = False, static: bool = False, minimum_norm: bool = False) -> Analysis:
     """Load, close the loops, solve the rates and read off the motion of a scene.
 
     A scene with `[[task]]` entries is an end-effector rate problem (see `analyse_task`).
+    Forces (driver efforts, reactions) are computed when asked (`forces`, `static`) or
+    when the scene has a `[forces]`, `[gravity]` or `[[load]]` table (forces_scene.py).
     """
     if "task" in scene.raw:
         from pinmech.analysis_task import analyse_task
+
+        if forces or static or wants_forces(scene):
+            raise SceneError("forces are computed for driven mechanisms ([drivers]), not for [[task]] scenes",
+                             path=str(scene.path), key="forces")
 
         return analyse_task(scene)
     scene.solver_options()  # settings first: a bad one is named before the model is read
@@ -241,4 +250,8 @@ def analyse(scene: Scene) -> Analysis:
     points, links = report_lists(scene)
     motion = evaluate_motion(mechanism, solver.data, solution.q, solution.v, solution.a,
                              points=points, links=links, coincident=coincident_points(scene))
-    return Analysis(scene, mechanism, drivers, solution, motion)
+    if not (forces or static or wants_forces(scene)):
+        return Analysis(scene, mechanism, drivers, solution, motion)
+    force_solution, extra = analyse_forces(scene, mechanism, drivers.names, solution.q, solution.v, solution.a,
+                                           static=static, minimum_norm=minimum_norm)
+    return Analysis(scene, mechanism, drivers, solution, motion, extra=extra, forces=force_solution)

@@ -101,11 +101,17 @@ class AssemblyStructure:
         self.names = tuple(b.name for b in self.blocks)
         self.plane_normal = plane_normal
         self._closures = closures
+        n = len(dep_v)
+        whole = len(self.blocks) == 1 and len(self.blocks[0].rows) == n
+        self._index = None if whole else [np.ix_(b.rows, b.cols) for b in self.blocks]
 
     def signs(self, J_dep: np.ndarray) -> tuple[int, ...]:
         """The sign of each block's determinant (J_dep: dependent columns, any positive
         column scaling)."""
-        return tuple(int(np.sign(_det(J_dep[np.ix_(b.rows, b.cols)]))) for b in self.blocks)
+        if self._index is None:
+            d = _det(J_dep)
+            return (1 if d > 0 else -1 if d < 0 else 0,) if self.blocks else ()
+        return tuple(int(np.sign(_det(J_dep[ix]))) for ix in self._index)
 
     def signs_many(self, J_dep: np.ndarray) -> np.ndarray:
         """(N, blocks) signs for a stack (N, rows, cols) of J_dep."""

@@ -2,10 +2,10 @@
 
 Exit codes: 0 success; 1 hand values mismatch (`check`); 2 usage or other pinmech error;
 3 bad URDF; 4 bad scene or hand file (unknown name, unit, key); 5 drivers do not match
-the mobility; 6 a loop cannot close; 7 singular pose; 8 inconsistent task; 9 a drawing
-input out of range; 10 another assembly than the scene's (or none reachable on it);
-11 the drivers cannot go further (a fold: limit angle, extreme, stroke); 12 a joint beyond
-its URDF <limit> (with --limits error). An output file that cannot be written is 2.
+the mobility; 6 a loop cannot close; 7 singular pose, or forces not determined; 8 inconsistent
+task; 9 a drawing input out of range; 10 another assembly than the scene's (or none reachable
+on it); 11 the drivers cannot go further (a fold: limit angle, extreme, stroke); 12 a joint
+beyond its URDF <limit> (with --limits error). An output file that cannot be written is 2.
 Stopped by a signal: 128 + its number (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP), outputs kept
 as NAME.partial.
 """
@@ -50,6 +50,13 @@ def _add_path_arguments(parser: argparse.ArgumentParser, *, required: bool) -> N
     parser.add_argument("--gain", type=float, help="task scenes: feedback on the drift [1/s] (default 0: open loop)")
 
 
+def _add_force_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--static", action="store_true",
+                        help="statics: forces with zero speeds and accelerations ([forces] static = true)")
+    parser.add_argument("--minimum-norm", dest="minimum_norm", action="store_true",
+                        help="redundant loops: give the minimum-norm reactions instead of an error")
+
+
 def _add_limits_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--limits", choices=("warn", "error"),
                         help="a joint beyond its URDF <limit>: a warning (default) or an error (exit 12)")
@@ -61,8 +68,8 @@ def build_parser() -> argparse.ArgumentParser:
         prog="pinmech",
         description="Kinematics of mechanisms and robot arms from URDF, on Pinocchio.",
         epilog="Exit codes: 0 ok, 1 check mismatch, 2 error, 3 URDF, 4 scene, 5 mobility, "
-        "6 loop cannot close, 7 singular pose, 8 task, 9 drawing, 10 assembly, 11 driver limit, "
-        "12 joint limit (--limits error), 130 Ctrl-C (128 + signal).",
+        "6 loop cannot close, 7 singular pose (or undetermined forces), 8 task, 9 drawing, 10 assembly, "
+        "11 driver limit, 12 joint limit (--limits error), 130 Ctrl-C (128 + signal).",
     )
     parser.add_argument("--version", action="version", version=f"pinmech {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -72,6 +79,12 @@ def build_parser() -> argparse.ArgumentParser:
     solve.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of text")
     _add_limits_argument(solve)
     solve.set_defaults(func=cmd_solve)
+
+    forces = sub.add_parser("forces", help="driver torques and joint reactions at the scene's pose (inverse dynamics)")
+    _add_scene_arguments(forces)
+    _add_force_arguments(forces)
+    forces.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of text")
+    forces.set_defaults(func=cmd_forces)
 
     sweep = sub.add_parser("sweep", help="sweep a driver through a cycle (or follow an arm's task in time): "
                            "CSV, JSON lines and a figure")
@@ -104,6 +117,13 @@ def build_parser() -> argparse.ArgumentParser:
                        help="at a fold of the driver (a limit angle), go on onto the other branch with the "
                        "driver turning back (a whole coupler curve); default: stop there, naming the limit")
     _add_path_arguments(sweep, required=False)
+    sweep.add_argument("--forces", action="store_true",
+                       help="add driver torque and joint reaction columns (on by default when the scene has "
+                       "[forces], [gravity] or [[load]])")
+    _add_force_arguments(sweep)
+    sweep.add_argument("--flywheel", help="flywheel inertia for the coefficient of speed fluctuation, e.g. "
+                       "'0.01 kg*m^2' ([forces] flywheel)")
+    sweep.add_argument("--torque-plot", dest="torque_plot", help="draw the driver's torque curve here (pinmech[plot])")
     sweep.set_defaults(func=cmd_sweep)
 
     path = sub.add_parser("path", help="integrate an arm's task over time: joint trajectory and drift")
@@ -184,6 +204,31 @@ def cmd_solve(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_forces(args: argparse.Namespace) -> int:
+    """`pinmech forces SCENE`: the report with driver efforts and joint reactions (or `--json`)."""
+    from pinmech.analysis import analyse
+    from pinmech.report import to_json, to_text
+
+    analysis = analyse(_scene(args), forces=True, static=args.static, minimum_norm=args.minimum_norm)
+    print(to_json(analysis) if args.json else to_text(analysis), end="" if not args.json else "\n")
+    return 0
+
+
+def _sweep_forces(args: argparse.Namespace, scene, sweep):
+    """The forces of a sweep when asked (flags or the scene's force tables), else None."""
+    from pinmech.forces_scene import wants_forces
+
+    asked = args.forces or args.static or args.minimum_norm or args.flywheel or args.torque_plot
+    if not (asked or wants_forces(scene)):
+        return None
+    from pinmech.forces_sweep import SweepForces
+
+    flywheel = scene.quantity(args.flywheel, "moment_of_inertia", "--flywheel") if args.flywheel else None
+    if flywheel is not None and not flywheel > 0:
+        raise PinmechError(f"--flywheel must be positive, got {args.flywheel}")
+    return SweepForces(sweep, static=args.static, minimum_norm=args.minimum_norm, flywheel=flywheel)
+
+
 def cmd_sweep(args: argparse.Namespace) -> int:
     """`pinmech sweep SCENE`: every pose of a cycle, streamed as CSV (and JSON lines, a plot);
     a task scene is followed in time instead (as `pinmech path`)."""
@@ -222,8 +267,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     poses = sweep.poses(DriverValues(start, stop, steps), skip_failures=args.skip_failures,
                         start=mode or "predictor", batch=not args.no_batch and options.get("batch", True),
                         interpolate=interpolate, through_folds=args.through_folds)
+    forces = _sweep_forces(args, scene, sweep)
     limits = _LimitWatch(limit_mode(scene, args.limits), "poses")
-    sinks = _sweep_sinks(args, sweep, steps, figure)
+    sinks = _sweep_sinks(args, sweep, steps, figure, forces)
     with sinks:
         for pose in _progress(poses, steps):
             if pose.note:
@@ -232,6 +278,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                 limits.check(limit_violations(sweep.mechanism, pose.motion),
                              f"at {sweep.driver} = {sweep._format(pose.value)}")
             sinks.add(pose)
+    for line in forces.summary() if forces else []:
+        print(line, file=sys.stderr)
     limits.summary(steps)
     _say_return(sweep, stop - start)
     return 0
@@ -277,18 +325,26 @@ class _LimitWatch:
                   f"(first {self.first}){self.column}", file=sys.stderr)
 
 
-def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | None) -> Outputs:
+def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | None, forces=None) -> Outputs:
     from pinmech.tables import SweepCsv, SweepJsonLines
 
+    csv_kind, json_kind, source = SweepCsv, SweepJsonLines, sweep
     sinks = Outputs()
+    if forces is not None:
+        from pinmech.forces_sweep import ForceCsv, ForceJsonLines, TorquePlot
+
+        csv_kind, json_kind, source = ForceCsv, ForceJsonLines, forces
+        torque = plot_path(args.torque_plot) if args.torque_plot else None
+        sinks.plot(TorquePlot(forces), torque)  # collects every pose's forces; drawn if a path is given
     if args.plot_path:
         from pinmech.plot import SweepPlot
 
         sinks.plot(SweepPlot(sweep, links=args.links, points=args.points, total=steps), figure)
-    if args.csv_path or not (args.plot_path or args.json_path):
-        sinks.table(SweepCsv, sweep, args.csv_path, "poses")
+    only_figures = args.plot_path or args.json_path or (forces is not None and args.torque_plot)
+    if args.csv_path or not only_figures:
+        sinks.table(csv_kind, source, args.csv_path, "poses")
     if args.json_path:
-        sinks.table(SweepJsonLines, sweep, args.json_path, None)
+        sinks.table(json_kind, source, args.json_path, None)
     return sinks
 
 
@@ -296,7 +352,9 @@ def _check_outputs(args: argparse.Namespace, scene) -> Path | None:
     """Before computing: the figure's format, one file per output, no output over an input.
     Returns the figure's path (".png" added to a name without suffix)."""
     figure = plot_path(args.plot_path) if args.plot_path else None
-    check_distinct({"--csv": args.csv_path, "--json": args.json_path, "--plot": figure},
+    torque = getattr(args, "torque_plot", None)
+    check_distinct({"--csv": args.csv_path, "--json": args.json_path, "--plot": figure,
+                    "--torque-plot": plot_path(torque) if torque else None},
                    {"the scene file": scene.path, "the URDF": _urdf_path(scene)})
     return figure
 
@@ -306,8 +364,6 @@ def _urdf_path(scene) -> Path:
         return scene.urdf
     except PinmechError:
         return scene.path
-
-
 
 
 def _progress(items, total: int):

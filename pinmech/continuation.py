@@ -70,6 +70,7 @@ class Node:
     sigma_min: float = 1.0
     velocity_residual: float = 0.0
     acceleration_residual: float = 0.0
+    residual: float = 0.0  # closure residual left at q (dimensionless)
 
 
 @dataclass
@@ -80,6 +81,7 @@ class Route:
 
     start: tuple[float, ...]
     steps: int = 0
+    iterations: int = 0  # Newton iterations of the correctors of the steps taken
     change_points: list[tuple[float, ...]] = field(default_factory=list)
     folds: list[tuple[float, ...]] = field(default_factory=list)
     fold_p: list[float] = field(default_factory=list)
@@ -109,15 +111,17 @@ class Path:
         return self.x0 + p * self.d
 
     # ------------------------------------------------------------------ nodes
-    def node(self, p: float, q: np.ndarray, *, at_q: bool = False) -> Node:
-        """The path derivatives and signature at a closed q (numerically regular)."""
+    def node(self, p: float, q: np.ndarray, *, at_q: bool = False, residual: float | None = None) -> Node:
+        """The path derivatives and signature at a closed q (numerically regular). With
+        `at_q` the solver's data already holds q's placements and Jacobians, and
+        `residual` is the closure residual measured there."""
         solver = self.solver
-        if not at_q:
-            solver._residual(q)
+        if not at_q or residual is None:
+            residual = max(max(map(abs, solver._residual(q).tolist()), default=0.0), solver._full_residual())
         d1, d2, condition, sigma_min, v_res, a_res, signs = solver._rates(q, self.d, self.zero, limit=math.inf)
         if not condition <= SINGULAR_NODE or 0 in signs:
             raise _Singular
-        return Node(p, q, d1, d2, signs, condition, sigma_min, v_res, a_res)
+        return Node(p, q, d1, d2, signs, condition, sigma_min, v_res, a_res, residual)
 
     # ------------------------------------------------------------------ following
     def follow(self, node: Node, p_target: float, route: Route) -> Node:
@@ -138,6 +142,7 @@ class Path:
                     route.change_points.append(tuple(self.drivers(0.5 * (node.p + new.p))))
                 node = new
                 route.steps += 1
+                route.iterations += self.solver.iterations
                 h *= 2.0
                 continue
             if abs(h) * self.unit > PIVOT_BELOW:
@@ -155,14 +160,14 @@ class Path:
         solver, h = self.solver, p - node.p
         move = node.d1 * h + node.d2 * (0.5 * h * h)
         q_pred = pin.integrate(solver.model, node.q, move)
-        q, ok = solver.correct(q_pred, self.drivers(p), max_iterations=CORRECTOR_ITERATIONS)
-        if not ok:
+        q, residual = solver.correct(q_pred, self.drivers(p), max_iterations=CORRECTOR_ITERATIONS)
+        if residual is None:
             return None, "the corrector did not converge"
-        correction = solver.scaled_norm(pin.difference(solver.model, q_pred, q))
-        if correction > self._trust(h) * solver.scaled_norm(move) + 1e3 * solver.tol:
+        # the corrector's steps bound its displacement from the prediction (triangle inequality)
+        if solver.moved > self._trust(h) * solver.scaled_norm(move) + 1e3 * solver.tol:
             return None, "the corrector left the trust region (another root nearer than the path's)"
         try:
-            new = self.node(p, q, at_q=True)
+            new = self.node(p, q, at_q=True, residual=residual)
         except _Singular:
             return None, "a singular pose"
         turn = self._turn(node, new)
@@ -185,10 +190,11 @@ class Path:
     def _turn(self, a: Node, b: Node) -> float:
         """Angle between the extended tangents (q', 1) of two nodes, dimensionless."""
         s = self.solver._v_scale_inv
-        ta = np.append(a.d1 * s, self.unit)
-        tb = np.append(b.d1 * s, self.unit)
-        cos = float(ta @ tb) / (float(np.linalg.norm(ta) * np.linalg.norm(tb)) or 1.0)
-        return math.acos(max(-1.0, min(1.0, cos)))
+        ta, tb = (a.d1 * s).tolist(), (b.d1 * s).tolist()
+        u2 = self.unit * self.unit
+        dot = sum(x * y for x, y in zip(ta, tb)) + u2
+        norms = math.sqrt((sum(x * x for x in ta) + u2) * (sum(y * y for y in tb) + u2))
+        return math.acos(max(-1.0, min(1.0, dot / norms)))
 
     # ------------------------------------------------------------------ pivot
     def _pivot_follow(self, node: Node, p_target: float, route: Route, why: str) -> tuple[Node, float]:
@@ -228,11 +234,11 @@ class Path:
         w = (p_target - a.p) / (b.p - a.p)
         model = self.solver.model
         guess = pin.integrate(model, a.q, w * pin.difference(model, a.q, b.q))
-        q, ok = self.solver.correct(guess, self.drivers(p_target), max_iterations=50, strict=False)
-        if not ok:
+        q, residual = self.solver.correct(guess, self.drivers(p_target), max_iterations=50, strict=False)
+        if residual is None:
             raise self._stuck(self._plain(a), "the pose at the target did not close")
         try:
-            node = self.node(p_target, q, at_q=True)
+            node = self.node(p_target, q, at_q=True, residual=residual)
         except _Singular:
             self.solver._residual(q)
             self.solver._rates(q, self.d, self.zero)  # raises SingularPoseError, naming the pose

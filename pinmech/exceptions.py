@@ -168,6 +168,21 @@ class DriverLimitError(PinmechError):
         self.drivers = tuple(drivers)
 
 
+class IndeterminateForcesError(SingularPoseError):
+    """The driver efforts and constraint forces are not determined at a pose: redundant
+    (over-constrained) loops, or a dead centre of the drivers. Exit code 7, as a singular pose.
+
+    Attributes:
+        unknowns: driver efforts plus independent cut rows.
+        equations: joint equations (the model's degrees of freedom).
+    """
+
+    def __init__(self, message: str, *, condition: float, sigma_min: float, unknowns: int, equations: int):
+        super().__init__(message, condition=condition, sigma_min=sigma_min)
+        self.unknowns = unknowns
+        self.equations = equations
+
+
 class Interrupted(KeyboardInterrupt):
     """The run was stopped by a signal: Ctrl-C (SIGINT), SIGTERM or SIGHUP (the terminal
     closed). A KeyboardInterrupt, so code that stops on Ctrl-C stops on all three.

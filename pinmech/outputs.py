@@ -174,10 +174,12 @@ class Outputs:
         stream = output.open() if output else sys.stdout
         self.tables.append((kind(source, stream), output, what))
 
-    def plot(self, recorder: object, path: Path) -> None:
-        """A figure `recorder` (add rows, then save) drawn to `path` at the end."""
-        output = OutputFile(path)
-        output.open(text=False)
+    def plot(self, recorder: object, path: Path | None) -> None:
+        """A figure `recorder` (add rows, then save) drawn to `path` at the end; with no
+        path, a recorder that only collects (the forces of a sweep, for their summary)."""
+        output = OutputFile(path) if path is not None else None
+        if output is not None:
+            output.open(text=False)
         self.figures.append((recorder, output))
 
     def add(self, row: object) -> None:
@@ -211,6 +213,8 @@ class Outputs:
                 said = f"{count} {what}" if what else "JSON lines"
                 print(f"{said} written to {output.path}", file=sys.stderr)
         for recorder, output in self.figures:
+            if output is None:
+                continue
             recorder.save(output.temporary)
             output.commit()
             print(f"figure written to {output.path}", file=sys.stderr)
@@ -219,7 +223,7 @@ class Outputs:
         """Keep what was written as NAME.partial, and say so: in the error's own line (its
         `kept` attribute, which the CLI prints with it), else on stderr."""
         kept = []
-        for output in [o for _, o, _ in self.tables if o] + [o for _, o in self.figures]:
+        for output in [o for _, o, _ in self.tables if o] + [o for _, o in self.figures if o]:
             partial = output.abandon()
             if partial:
                 left = "left as it was" if output.path.exists() else "not written"

@@ -197,7 +197,7 @@ def to_text(analysis: Analysis) -> str:
     t.head("Accuracy")
     t.lines.append(
         f"  closure residual {acc.residual:.2g} (of the mechanism size {analysis.mechanism.length_scale:.4g} m), "
-        f"{acc.iterations} {'continuation steps' if analysis.solution.route else 'Newton iterations'}, "
+        f"{acc.iterations} Newton iterations, "
         f"condition number {acc.condition:.4g} "
         "(worst-case relative error about {:.0e} in positions, {:.0e} in velocities, {:.0e} in "
         "accelerations)".format(*(max(b, 1e-16) for b in acc.error_bounds))

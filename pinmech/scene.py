@@ -25,6 +25,7 @@ else:  # pragma: no cover
 KNOWN_KEYS = {
     "title", "urdf", "robot", "drivers", "guess", "pose", "move", "lock", "points", "report", "solver",
     "task", "rates", "sweep", "draw", "assembly",
+    "forces", "gravity", "load",  # forces_scene.py
 }
 #: Accepted `[solver]` values. A closure tolerance (relative to the mechanism's size)
 #: below 1e-16 is tighter than rounding allows; above 1e-3 a "closed" loop is visibly

@@ -170,7 +170,7 @@ class _Cycle:
         self.path = Path(solver, x0, self.unit_v, through_folds=through_folds)  # p = the swept value
         self.mirror = (1.0, 0.0)  # p = a x + b: past each fold crossed, values are mirrored at it
         self.notes: dict[int, str] = {}
-        self._index, self._steps, self._batching = 0, 0, False
+        self._index, self._iterations, self._batching = 0, 0, False
         self.span_scale = 1.0 if solver.mechanism.joint(driver).is_angular else solver.mechanism.length_scale
 
     # ------------------------------------------------------------------ chunks
@@ -326,15 +326,15 @@ class _Cycle:
                 if fail is not None:
                     raise fail from None
                 raise
-        residual = max(max(map(abs, solver._residual(node.q).tolist()), default=0.0), solver._full_residual())
-        accuracy = Accuracy(residual, self._steps, *(getattr(accuracy, f) for f in _ACCURACY[2:]))
+        residual = node.residual
+        accuracy = Accuracy(residual, self._iterations, *(getattr(accuracy, f) for f in _ACCURACY[2:]))
         sol = LoopSolution(node.q, node.d1, node.d2, accuracy, solver.drivers)
         if not actual:
             return sol
         if self.alone:
             return self._scaled(sol)
         v, a, acc = solver.rates(node.q, self.v_drv, self.a_drv)
-        return LoopSolution(node.q, v, a, Accuracy(residual, self._steps, acc.condition, acc.sigma_min,
+        return LoopSolution(node.q, v, a, Accuracy(residual, self._iterations, acc.condition, acc.sigma_min,
                                                    acc.velocity_residual, acc.acceleration_residual),
                             solver.drivers)
 
@@ -343,19 +343,19 @@ class _Cycle:
         solver, path, ref = self.solver, self.path, self.ref
         a, b = self.mirror
         p = a * x + b
-        self._steps = 0
+        self._iterations = 0
         if ref is None:
             return self._first(p)
-        node = Node(ref.value, ref.q, ref.d1, ref.d2, ref.signs, ref.condition, ref.sigma_min)
+        node = Node(ref.value, ref.q, ref.d1, ref.d2, ref.signs, ref.condition, ref.sigma_min)  # rates unused
         if self.start == "predictor":
             route = Route((ref.value,))
             node = path.follow(node, p, route)
-            self._steps = route.steps
+            self._iterations = route.iterations
             self._note(route)
             return node
         guess = ref.q if self.start == "warm" else self._cold_guess()
         self.q_drv[self.k] = p
-        q, self._steps, _ = solver.close(guess, self.q_drv)
+        q, self._iterations, _ = solver.close(guess, self.q_drv)
         new = path.node(p, q, at_q=True) if solver._cuts else path.node(p, q)
         if ref.signs and new.signs != ref.signs:
             raise AssemblyError(
@@ -377,7 +377,7 @@ class _Cycle:
             q = solver.follow(ref.q, ref.driver_q, self.q_drv.copy(), route)
         else:
             q, _, _ = solver.close(self._cold_guess(), self.q_drv)
-        self._steps = route.steps
+        self._iterations = route.iterations
         return self.path.node(p, q)
 
     def _cold_guess(self) -> np.ndarray:

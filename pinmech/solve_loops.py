@@ -156,6 +156,8 @@ class LoopSolver:
         self._zero_a = np.zeros(self.model.nv)
         self.structure = AssemblyStructure(self.model, mechanism.closures, self._dep_v, mechanism.plane_normal)
         self.reference: Reference | None = None
+        self.iterations = 0  # Newton iterations of the last `correct`
+        self.moved = 0.0  # sum of the scaled sizes of its steps: a bound on how far it moved q
 
     def _joint_nv(self, v: int) -> int:
         for joint in self.model.joints[1:]:
@@ -261,8 +263,9 @@ class LoopSolver:
         return q, iterations, max(norm, full)
 
     def correct(self, q_guess: np.ndarray, driver_q: np.ndarray, *, max_iterations: int,
-                strict: bool = True) -> tuple[np.ndarray, bool]:
-        """Newton from a predicted pose with the drivers held: (q, converged).
+                strict: bool = True) -> tuple[np.ndarray, float | None]:
+        """Newton from a predicted pose with the drivers held: (q, the closure residual
+        left, or None where it did not converge). The solver's data is left at q.
 
         strict: full Newton steps only, each at least halving the residual (a corrector
         that does not contract is not close to one root); else as `close`, with the
@@ -270,29 +273,35 @@ class LoopSolver:
         q = self.set_drivers(q_guess, driver_q)
         r = self._residual(q)
         norm = _max_abs(r)
+        self.iterations, self.moved = 0, 0.0
         for _ in range(max_iterations):
             if norm <= self.tol:
                 break
             J_dep = self._residual_jacobian()[:, self._dep]
+            self.iterations += 1
             if strict:
                 step = _solve_square(J_dep, -r) if J_dep.shape[0] == J_dep.shape[1] else np.full(1, np.nan)
                 if not math.isfinite(sum(step.tolist())):
-                    return q, False
+                    return q, None
                 q_new = self._move(q, step)
                 r_new = self._residual(q_new)
                 new_norm = _max_abs(r_new)
                 if new_norm > 0.5 * norm and new_norm > self.tol:
                     self._residual(q)
-                    return q, False
+                    return q, None
                 q, r, norm = q_new, r_new, new_norm
             else:
                 q, r, norm, ok = self._newton_update(q, J_dep, r, norm)
                 if not ok:
-                    return q, False
+                    return q, None
         if POLISH < norm <= self.tol <= DEFAULT_TOL:
             J_dep = self._residual_jacobian()[:, self._dep]
             q, r, norm, _ = self._newton_update(q, J_dep, r, norm)
-        return q, norm <= self.tol and self._full_residual() <= max(self.tol, 1e-12) * 10
+            self.iterations += 1
+        full = self._full_residual()
+        if norm > self.tol or full > max(self.tol, 1e-12) * 10:
+            return q, None
+        return q, max(norm, full)
 
     def scaled_norm(self, dv: np.ndarray) -> float:
         """Largest |component| of a velocity-space vector, prismatic parts in mechanism
@@ -331,9 +340,10 @@ class LoopSolver:
         From a guess where the Jacobian is singular a solve returns steps of 1e16 rad,
         after which no step can move those joints (a unit in the last place of 1e16 is 2).
         """
-        size = np.max(np.abs(step / self._dep_scale), initial=0.0)  # rad, or sizes of the mechanism
+        size = float(np.max(np.abs(step / self._dep_scale), initial=0.0))  # rad, or sizes of the mechanism
         if size > MAX_STEP:
             step = step * (MAX_STEP / size)
+        self.moved += min(size, MAX_STEP)
         self._step[:] = 0.0
         self._step[self._dep_v] = step
         return pin.integrate(self.model, q, self._step)
@@ -484,7 +494,7 @@ class LoopSolver:
             route = Route(tuple(ref.driver_q.tolist()))
             q = self.follow(ref.q, ref.driver_q, dq, route)
             residual = max(_max_abs(self._residual(q)), self._full_residual())
-            return self._solution(q, dv, da, residual, route.steps, route)
+            return self._solution(q, dv, da, residual, route.iterations, route)
         q, iterations, residual = self.close(self._guess(guess), dq)
         return self._solution(q, dv, da, residual, iterations, None)
 

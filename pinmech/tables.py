@@ -84,15 +84,23 @@ class SweepCsv:
             if pose.motion is None:
                 self.pending.append(pose)  # the header waits for the first solved pose
                 return
-            self.header = columns(self.sweep, pose.motion)
+            self.header = self._columns(pose)
             self.writer.writerow(self.header)
             for failed in self.pending:
                 self._write(failed)
             self.pending = []
         self._write(pose)
 
+    def _columns(self, pose: SweepPose) -> list[str]:
+        """The header, from the first solved pose (subclasses add columns)."""
+        return columns(self.sweep, pose.motion)
+
+    def _row(self, pose: SweepPose) -> list[object]:
+        """One row in the units of the header (subclasses add cells)."""
+        return row(self.sweep, pose, len(self.header))
+
     def _write(self, pose: SweepPose) -> None:
-        self.writer.writerow([f"{x:.12g}" if type(x) is float else x for x in row(self.sweep, pose, len(self.header))])
+        self.writer.writerow([f"{x:.12g}" if type(x) is float else x for x in self._row(pose)])
         self.count += 1
 
     def close(self) -> int:
@@ -123,13 +131,17 @@ class SweepJsonLines:
         self.sweep, self.stream = sweep, stream
 
     def add(self, pose: SweepPose) -> None:
+        self.stream.write(json.dumps(self._entry(pose)) + "\n")
+
+    def _entry(self, pose: SweepPose) -> dict:
+        """The pose's JSON object (subclasses add keys)."""
         entry = {"index": pose.index, self.sweep.driver: pose.value, "error": pose.error,
                  "pose": "failed" if pose.motion is None else "interpolated" if pose.interpolated else "solved"}
         if pose.motion is not None:
             entry.update(motion_dict(pose.motion))
             entry["limit_violations"] = [v.as_dict() for v in limit_violations(self.sweep.mechanism, pose.motion)]
             entry["accuracy"] = pose.accuracy.as_dict()
-        self.stream.write(json.dumps(entry) + "\n")
+        return entry
 
     def close(self) -> None:
         self.stream.flush()

@@ -27,6 +27,9 @@ SI_UNITS: dict[str, str] = {
     "velocity": "meter / second",
     "acceleration": "meter / second ** 2",
     "time": "second",
+    "force": "newton",
+    "torque": "newton * meter",
+    "moment_of_inertia": "kilogram * meter ** 2",
 }
 
 #: For a joint coordinate: the kind of q, v and a for a revolute and a prismatic joint.
@@ -44,6 +47,9 @@ _DIMENSIONS: dict[str, dict[str, int]] = {
     "velocity": {"meter": 1, "second": -1},
     "acceleration": {"meter": 1, "second": -2},
     "time": {"second": 1},
+    "force": {"gram": 1, "meter": 1, "second": -2},  # pint's root unit of mass is the gram
+    "torque": {"gram": 1, "meter": 2, "second": -2},
+    "moment_of_inertia": {"gram": 1, "meter": 2},
 }
 
 _DEG = math.pi / 180
@@ -74,6 +80,10 @@ _COMMON_UNITS: dict[str, tuple[float, str]] = {
     **{u: (1e-3, "acceleration") for u in ("mm/s^2", "mm/s**2")},
     **{u: (1.0, "time") for u in ("s", "second", "seconds")},
     "ms": (1e-3, "time"),
+    "N": (1.0, "force"),
+    "kN": (1e3, "force"),
+    "N*m": (1.0, "torque"),
+    **{u: (1.0, "moment_of_inertia") for u in ("kg*m^2", "kg*m**2")},
 }
 
 #: Largest magnitude of a quantity in SI units. Kinematics multiplies speeds and lengths
@@ -184,13 +194,14 @@ def _factor(text: str, unit: str, kind: str, where: str) -> float:
             raise UnitError(_wrong_kind(text, kind, unit_kind.startswith(("angle", "angular"))), key=where)
         return factor
     try:
-        root = _registry().Quantity(1.0, unit).to_root_units()
+        quantity = _registry().Quantity(1.0, unit)
+        root = quantity.to_root_units()
     except Exception as exc:  # pint raises several unrelated classes here
         raise UnitError(f"cannot read quantity {text!r}: {type(exc).__name__} {exc}".rstrip(), key=where) from exc
     powers = {name: int(p) if float(p).is_integer() else float(p) for name, p in root.unit_items()}
     if powers != _DIMENSIONS[kind]:
         raise UnitError(_wrong_kind(text, kind, powers.get("radian", 0) != 0, powers), key=where)
-    return float(root.magnitude)
+    return float(quantity.to(SI_UNITS[kind]).magnitude)  # SI, with kilograms (not pint's root grams)
 
 
 def _wrong_kind(text: str, kind: str, has_angle: bool, powers: dict[str, Any] | None = None) -> str:
@@ -219,6 +230,9 @@ def _example(kind: str) -> str:
         "velocity": "m/s",
         "acceleration": "m/s^2",
         "time": "s",
+        "force": "N",
+        "torque": "N*m",
+        "moment_of_inertia": "kg*m^2",
     }[kind]
 
 
@@ -232,4 +246,7 @@ def format_si(value: float, kind: str) -> str:
         "velocity": "m/s",
         "acceleration": "m/s^2",
         "time": "s",
+        "force": "N",
+        "torque": "N m",
+        "moment_of_inertia": "kg m^2",
     }[kind]

@@ -12,6 +12,7 @@ import pytest
     [
         ("r_rtr_example", None),
         ("closed_form", None),
+        ("closed_form_forces", None),
         ("benchmark_sweep", ["--poses", "40", "--repeats", "1"]),
         ("sweep_memory", ["--poses", "200"]),
         ("singular_accuracy", []),

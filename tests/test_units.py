@@ -130,10 +130,12 @@ def test_the_common_units_table_agrees_with_pint():
     # The table spares importing pint (0.4 s); pint is the independent source of its factors.
     from pinmech.units import _COMMON_UNITS, _DIMENSIONS, _registry
 
+    from pinmech.units import SI_UNITS
+
     for unit, (factor, kind) in _COMMON_UNITS.items():
-        root = _registry().Quantity(1.0, unit).to_root_units()
-        assert dict(root.unit_items()) == _DIMENSIONS[kind], unit
-        assert factor == pytest.approx(root.magnitude, rel=1e-15), unit
+        quantity = _registry().Quantity(1.0, unit)
+        assert dict(quantity.to_root_units().unit_items()) == _DIMENSIONS[kind], unit
+        assert factor == pytest.approx(quantity.to(SI_UNITS[kind]).magnitude, rel=1e-15), unit
 
 
 def test_common_units_are_read_without_importing_pint():
@@ -152,3 +154,17 @@ def test_common_units_are_read_without_importing_pint():
                                             ("5 \u00b5m", "length", 5e-6)])  # the micro sign
 def test_typographic_spellings_of_units(text, kind, si):
     assert to_si(text, kind) == pytest.approx(si, rel=1e-15)
+
+
+@pytest.mark.parametrize("text, kind, si", [("2 kN", "force", 2000.0), ("3 lbf", "force", 3 * 4.4482216152605),
+                                            ("5 N*cm", "torque", 0.05), ("2 g*cm^2", "moment_of_inertia", 2e-7),
+                                            ("1 kg*m^2", "moment_of_inertia", 1.0)])
+def test_forces_torques_and_inertias_in_si_with_kilograms(text, kind, si):
+    # lbf = 4.4482216152605 N exactly (NIST); pint's root mass unit is the gram, SI's the kilogram.
+    assert to_si(text, kind) == pytest.approx(si, rel=1e-12)
+
+
+@pytest.mark.parametrize("text, kind", [("1 N", "torque"), ("1 N*m", "force"), ("1 kg", "moment_of_inertia")])
+def test_forces_torques_and_inertias_of_the_wrong_dimension_are_refused(text, kind):
+    with pytest.raises(UnitError, match="is not a"):
+        to_si(text, kind)

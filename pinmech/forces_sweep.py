@@ -1,0 +1,235 @@
+"""Forces over a sweep: driver effort and reaction columns, the torque curve, the energy
+fluctuation and the coefficient of speed fluctuation for a flywheel.
+
+`SweepForces` solves the forces of each pose a sweep yields (from the pose's joint
+coordinates, rates and accelerations); the CSV and JSON-lines tables and the torque plot
+below read them. The summary (mean torque, energy fluctuation, worst power residual,
+torque zero crossings) is printed once the sweep ends.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+
+from pinmech.exceptions import SceneError
+from pinmech.flywheel import EnergyFluctuation, energy_fluctuation
+from pinmech.forces import ForceSolution, advantage_unit, mechanical_advantage
+from pinmech.forces_report import forces_dict
+from pinmech.forces_scene import ForceSettings, force_settings, force_solver
+from pinmech.sweep import Sweep, SweepPose
+from pinmech.tables import SweepCsv, SweepJsonLines, row
+
+
+class SweepForces:
+    """Forces at every solved pose of a sweep, and what the cycle adds up to.
+
+    Args:
+        sweep: the sweep (its scene gives gravity, loads and massless links).
+        static: zero speeds and accelerations at every pose (statics).
+        minimum_norm: minimum-norm reactions where the loops are redundant.
+        flywheel: flywheel inertia [kg m^2] for the coefficient of speed fluctuation
+            (default: the scene's `[forces] flywheel`).
+
+    Raises:
+        SceneError: a mechanism with joints of more than one degree of freedom.
+    """
+
+    def __init__(self, sweep: Sweep, *, static: bool = False, minimum_norm: bool = False,
+                 flywheel: float | None = None) -> None:
+        self.sweep = sweep
+        mech = sweep.mechanism
+        self.settings: ForceSettings = force_settings(sweep.scene)
+        self.static = static or self.settings.static
+        self.flywheel = flywheel if flywheel is not None else self.settings.flywheel
+        if any(j.nv != 1 for j in mech.joints.values()):
+            raise SceneError("forces over a sweep need one-dof joints only", path=str(sweep.scene.path))
+        self.solver = force_solver(sweep.scene, mech, sweep.drivers.names, self.settings, minimum_norm=minimum_norm)
+        self._last: tuple[int, ForceSolution | None] = (-1, None)
+        self.values: list[float] = []
+        self.efforts: list[float] = []
+        self.worst_power = 0.0
+        self.driver_index = sweep.drivers.names.index(sweep.driver)
+
+    def solve(self, pose: SweepPose) -> ForceSolution | None:
+        """The forces at a pose (None where the pose failed); each pose solved once."""
+        if self._last[0] == pose.index:
+            return self._last[1]
+        result = None
+        if pose.motion is not None:
+            q, v, a = self._state(pose)
+            result = self.solver.solve(q, v, a)
+            self.values.append(pose.value)
+            self.efforts.append(float(result.effort[self.driver_index]))
+            self.worst_power = max(self.worst_power, result.power.residual, result.equation_residual)
+        self._last = (pose.index, result)
+        return result
+
+    def _state(self, pose: SweepPose) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        mech = self.sweep.mechanism
+        q, v, a = mech.neutral(), np.zeros(mech.model.nv), np.zeros(mech.model.nv)
+        for name, joint in pose.motion.joints.items():
+            mech.set_coordinate(q, name, joint.q)
+            idx = mech.joint(name).idx_v
+            v[idx], a[idx] = joint.v, joint.a
+        if self.static:
+            v[:], a[:] = 0.0, 0.0
+        return q, v, a
+
+    # ------------------------------------------------------------------ tables
+    def columns(self, first: ForceSolution) -> list[str]:
+        """CSV columns of the forces, with units."""
+        planar = self._planar_z()
+        cols = [f"{n}.{'torque [N*m]' if self._angular(n) else 'force [N]'}" for n in first.drivers]
+        for name, r in first.reactions.items():
+            if r.kind == "prismatic":
+                cols += [f"{name}.normal [N]", f"{name}.moment [N*m]"]
+            else:
+                cols += [f"{name}.F{c} [N]" for c in ("xy" if planar else "xyz")] + [f"{name}.|F| [N]"]
+        if self._advantage(first) is not None:
+            unit = advantage_unit(self._angular(first.drivers[0]), self.solver.loads[0])
+            cols.append(f"mechanical_advantage [{unit}]")
+        return cols + ["power_residual [1]"]
+
+    def _advantage(self, f: ForceSolution) -> float | None:
+        return mechanical_advantage(f, self.solver.loads) if self.static else None
+
+    def cells(self, f: ForceSolution | None, width: int) -> list[object]:
+        """One row of `columns` (blank where the pose failed)."""
+        if f is None:
+            return [""] * width
+        planar = self._planar_z()
+        normal = self.sweep.mechanism.plane_normal
+        out: list[object] = [float(e) for e in f.effort]
+        for r in f.reactions.values():
+            if r.kind == "prismatic":
+                moment = float(normal @ r.moment) if normal is not None else float(np.linalg.norm(r.moment))
+                out += [float(np.linalg.norm(r.normal_force)), moment]
+            else:
+                out += [float(x) for x in (r.force[:2] if planar else r.force)] + [r.magnitude]
+        advantage = self._advantage(f)
+        if advantage is not None:
+            out.append(advantage)
+        return out + [max(f.power.residual, f.equation_residual)]
+
+    def _planar_z(self) -> bool:
+        normal = self.sweep.mechanism.plane_normal
+        return normal is not None and abs(abs(normal[2]) - 1.0) < 1e-12
+
+    def _angular(self, name: str) -> bool:
+        return self.sweep.mechanism.joint(name).is_angular
+
+    # ------------------------------------------------------------------ cycle
+    def energy(self) -> EnergyFluctuation | None:
+        """Energy fluctuation of the swept driver's torque curve (None for a slider or < 2 poses)."""
+        if not self.sweep.is_angular or len(self.values) < 2 or self.values[0] == self.values[-1]:
+            return None
+        return energy_fluctuation(np.array(self.values), np.array(self.efforts))
+
+    def summary(self) -> list[str]:
+        """Lines for the end of a sweep: the cycle's torque, energy, zero crossings, residual."""
+        name, angular = self.sweep.driver, self.sweep.is_angular
+        unit = "N m" if angular else "N"
+        lines = [(f"forces at {len(self.values)} poses ({'statics' if self.static else 'dynamics'}); "
+                  f"largest power-balance or equation residual {self.worst_power:.1e}")]
+        if self.efforts:
+            e = np.array(self.efforts)
+            lines.append(f"{name}: driver {'torque' if angular else 'force'} from {e.min():.6g} to {e.max():.6g} {unit}")
+            crossings = self._zero_crossings()
+            if crossings:
+                lines.append(f"{name}: the driver effort changes sign (zero: toggle or load reversal) near "
+                             + ", ".join(crossings))
+        energy = None if self.static else self.energy()
+        if energy is not None:
+            lines.append(f"{name}: mean torque {_shown(energy.mean_torque, self.efforts):.6g} N m over {math.degrees(energy.span):.6g} deg; "
+                         f"energy fluctuation {energy.energy_fluctuation:.6g} J (slowest at "
+                         f"{math.degrees(energy.slowest_angle):.4g} deg, fastest at "
+                         f"{math.degrees(energy.fastest_angle):.4g} deg)")
+            speed = abs(float(self.sweep.drivers.v[self.driver_index]))
+            if self.flywheel and speed > 0:
+                lines.append(f"{name}: coefficient of speed fluctuation {energy.speed_fluctuation(self.flywheel, speed):.4g}"
+                             f" with a {self.flywheel:.6g} kg m^2 flywheel at {speed:.6g} rad/s (flywheel inertia only)")
+        return lines
+
+    def _zero_crossings(self) -> list[str]:
+        x, e = np.array(self.values), np.array(self.efforts)
+        out = []
+        for i in np.nonzero(np.sign(e[:-1]) * np.sign(e[1:]) < 0)[0][:12]:
+            at = x[i] - e[i] * (x[i + 1] - x[i]) / (e[i + 1] - e[i])
+            out.append(f"{math.degrees(at):.4g} deg" if self.sweep.is_angular else f"{at:.6g} m")
+        return out
+
+
+class ForceCsv(SweepCsv):
+    """The sweep's CSV with the force columns after the kinematic ones."""
+
+    def __init__(self, forces: SweepForces, stream: IO[str]) -> None:
+        super().__init__(forces.sweep, stream)
+        self.forces = forces
+        self._width = 0
+
+    def _columns(self, pose: SweepPose) -> list[str]:
+        extra = self.forces.columns(self.forces.solve(pose))
+        self._width = len(extra)
+        return super()._columns(pose) + extra
+
+    def _row(self, pose: SweepPose) -> list[object]:
+        base = len(self.header) - self._width
+        return row(self.sweep, pose, base) + self.forces.cells(self.forces.solve(pose), self._width)
+
+
+class ForceJsonLines(SweepJsonLines):
+    """JSON lines with a `forces` object per solved pose (as `pinmech solve --json`)."""
+
+    def __init__(self, forces: SweepForces, stream: IO[str]) -> None:
+        super().__init__(forces.sweep, stream)
+        self.forces = forces
+
+    def _entry(self, pose: SweepPose) -> dict[str, Any]:
+        entry = super()._entry(pose)
+        f = self.forces.solve(pose)
+        if f is not None:
+            entry["forces"] = forces_dict(f, self.sweep.mechanism, static=self.forces.static)
+        return entry
+
+
+class TorquePlot:
+    """The driver's torque (or force) curve with its mean and the energy between them."""
+
+    def __init__(self, forces: SweepForces) -> None:
+        self.forces = forces
+
+    def add(self, pose: SweepPose) -> None:
+        self.forces.solve(pose)
+
+    def save(self, path: str | Path) -> Path:
+        from pinmech.plot import _pyplot, _save
+
+        plt = _pyplot()
+        f = self.forces
+        angular = f.sweep.is_angular
+        x = np.degrees(f.values) if angular else np.array(f.values)
+        y = np.array(f.efforts)
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        ax.plot(x, y, lw=1.5, label=f"{f.sweep.driver} driver {'torque' if angular else 'force'}")
+        energy = f.energy()
+        if energy is not None:
+            mean = _shown(energy.mean_torque, f.efforts)
+            ax.axhline(mean, color="k", lw=0.8, ls="--", label=f"mean {mean:.4g} N m")
+            ax.fill_between(x, y, energy.mean_torque, alpha=0.2,
+                            label=f"energy fluctuation {energy.energy_fluctuation:.4g} J")
+        ax.set_xlabel(f"{f.sweep.driver} [{'deg' if angular else 'm'}]")
+        ax.set_ylabel("N m" if angular else "N")
+        ax.set_title(f"{f.sweep.scene.title}: driver effort over the sweep")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        return _save(plt, fig, path)
+
+
+def _shown(mean: float, efforts: list[float]) -> float:
+    """The mean torque, with rounding noise (below 1e-12 of the largest torque) shown as 0."""
+    return mean if abs(mean) > 1e-12 * max(map(abs, efforts), default=0.0) else 0.0
