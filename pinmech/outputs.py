@@ -124,9 +124,13 @@ def plot_path(path: str) -> Path:
         PinmechError: a suffix matplotlib does not write (only PNG, PDF and SVG).
     """
     target = Path(path)
+    if target.is_dir() or target.name in ("", ".", ".."):
+        raise PinmechError(f"--plot {path} is a folder: give a file name, e.g. fig.png")
+    if _special(target):
+        raise PinmechError(f"--plot {path} is not a regular file: give a file name, e.g. fig.png")
     suffix = target.suffix.lower().lstrip(".")
     if not suffix:
-        return target.with_name(target.name + ".png")
+        return target.with_name(target.name.rstrip(".") + ".png")
     if suffix not in PLOT_FORMATS:
         raise PinmechError(f"--plot {path}: cannot draw a .{suffix} figure; use a name ending in "
                            f"{', '.join('.' + f for f in PLOT_FORMATS)}")

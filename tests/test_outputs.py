@@ -201,3 +201,10 @@ def test_an_output_through_a_symbolic_link_replaces_its_target(r_rtr_scene, tmp_
 def test_animate_refuses_more_frames_than_a_page_can_keep(r_rtr_scene, tmp_path, capsys):
     assert main(["animate", str(r_rtr_scene), "-o", str(tmp_path / "a.html"), "--steps", "10000000000"]) == 2
     assert "--steps must be between 2 and 20000 frames" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("target, message", [("/", "is a folder"), (".", "is a folder"), ("..", "is a folder"),
+                                             ("/dev/null", "is not a regular file")])
+def test_a_figure_that_cannot_be_a_file_is_refused_in_one_line(singular_at_zero, target, message, capsys):
+    code = main(["sweep", str(singular_at_zero), "--from", "0 deg", "--to", "1 deg", "--steps", "2", "--plot", target])
+    assert code == 2 and f"--plot {target} {message}" in capsys.readouterr().err
