@@ -334,7 +334,7 @@ def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | Non
         from pinmech.forces_sweep import ForceCsv, ForceJsonLines, TorquePlot
 
         csv_kind, json_kind, source = ForceCsv, ForceJsonLines, forces
-        torque = plot_path(args.torque_plot) if args.torque_plot else None
+        torque = plot_path(args.torque_plot, "--torque-plot") if args.torque_plot else None
         sinks.plot(TorquePlot(forces), torque)  # collects every pose's forces; drawn if a path is given
     if args.plot_path:
         from pinmech.plot import SweepPlot
@@ -354,7 +354,7 @@ def _check_outputs(args: argparse.Namespace, scene) -> Path | None:
     figure = plot_path(args.plot_path) if args.plot_path else None
     torque = getattr(args, "torque_plot", None)
     check_distinct({"--csv": args.csv_path, "--json": args.json_path, "--plot": figure,
-                    "--torque-plot": plot_path(torque) if torque else None},
+                    "--torque-plot": plot_path(torque, "--torque-plot") if torque else None},
                    {"the scene file": scene.path, "the URDF": _urdf_path(scene)})
     return figure
 

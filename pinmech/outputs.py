@@ -116,7 +116,7 @@ def write_whole(path: str | Path, text: str) -> None:
     output.commit()
 
 
-def plot_path(path: str) -> Path:
+def plot_path(path: str, option: str = "--plot") -> Path:
     """The figure file `--plot PATH` writes: PATH itself, with ".png" added when it has no
     suffix. Checked before anything is computed.
 
@@ -125,14 +125,14 @@ def plot_path(path: str) -> Path:
     """
     target = Path(path)
     if target.is_dir() or target.name in ("", ".", ".."):
-        raise PinmechError(f"--plot {path} is a folder: give a file name, e.g. fig.png")
+        raise PinmechError(f"{option} {path} is a folder: give a file name, e.g. fig.png")
     if _special(target):
-        raise PinmechError(f"--plot {path} is not a regular file: give a file name, e.g. fig.png")
+        raise PinmechError(f"{option} {path} is not a regular file: give a file name, e.g. fig.png")
     suffix = target.suffix.lower().lstrip(".")
     if not suffix:
         return target.with_name(target.name.rstrip(".") + ".png")
     if suffix not in PLOT_FORMATS:
-        raise PinmechError(f"--plot {path}: cannot draw a .{suffix} figure; use a name ending in "
+        raise PinmechError(f"{option} {path}: cannot draw a .{suffix} figure; use a name ending in "
                            f"{', '.join('.' + f for f in PLOT_FORMATS)}")
     return target
 
