@@ -148,15 +148,16 @@ class SweepJsonLines:
 
 
 class PathCsv:
-    """An arm path: time, each one-dof joint's q [deg or m], v, a, the drift, the
-    condition number."""
+    """An arm path: time, each one-dof joint's q [deg or m], v, a (a `<mimic>` follower's
+    from its leader's), the drift, the condition number."""
 
     def __init__(self, mechanism: Mechanism, stream: IO[str]) -> None:
         self.mechanism, self.writer = mechanism, csv.writer(stream)
-        self.joints = [j for j in mechanism.joints.values() if j.nv == 1]
+        self.joints = [j for j in mechanism.joints.values() if j.nv == 1 or j.name in mechanism.mimics]
         header = ["t [s]"]
         for j in self.joints:
-            units = ("deg", "rad/s", "rad/s^2") if j.is_angular else ("m", "m/s", "m/s^2")
+            angular = mechanism.mimics[j.name].kind != "prismatic" if j.name in mechanism.mimics else j.is_angular
+            units = ("deg", "rad/s", "rad/s^2") if angular else ("m", "m/s", "m/s^2")
             header += [f"{j.name}.{x} [{u}]" for x, u in zip(("q", "v", "a"), units)]
         self.writer.writerow(header + ["drift [m]", "angular_drift [rad]", "condition_number [1]"])
         self.count = 0
@@ -165,8 +166,11 @@ class PathCsv:
         cells = [f"{point.time:.9g}"]
         for j in self.joints:
             q = self.mechanism.coordinate(point.q, j.name)
-            cells += [f"{math.degrees(q) if j.is_angular else q:.12g}", f"{point.v[j.idx_v]:.12g}",
-                      f"{point.a[j.idx_v]:.12g}"]
+            mimic = self.mechanism.mimics.get(j.name)
+            scale = mimic.multiplier if mimic else 1.0  # idx_v of a follower is its leader's
+            angular = mimic.kind != "prismatic" if mimic else j.is_angular
+            cells += [f"{math.degrees(q) if angular else q:.12g}", f"{scale * point.v[j.idx_v]:.12g}",
+                      f"{scale * point.a[j.idx_v]:.12g}"]
         self.writer.writerow(cells + [f"{point.drift:.3e}", f"{point.angular_drift:.3e}", f"{point.condition:.6g}"])
         self.count += 1
 

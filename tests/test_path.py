@@ -145,3 +145,20 @@ def test_path_timing_is_checked(arm_task, duration, step, message):
     mech, tasks, q0 = arm_task
     with pytest.raises(TaskError, match=message):
         next(follow_path(mech, tasks, q0, duration=duration, step=step))
+
+
+def test_a_mimic_follower_has_its_columns_in_the_path_csv(tmp_path, models_dir, capsys):
+    import csv
+
+    text = (models_dir / "planar_arm.urdf").read_text().replace(
+        '<joint name="C" type="revolute">', '<joint name="C" type="revolute"><mimic joint="B" multiplier="2" offset="0.1"/>')
+    (tmp_path / "arm.urdf").write_text(text)
+    scene = tmp_path / "arm.toml"
+    scene.write_text('urdf = "arm.urdf"\n[pose]\nA = "50 deg"\nB = "-65 deg"\n[[task]]\nframe = "D"\n'
+                     'components = ["x", "y"]\nvelocity = ["1 m/s", "0 m/s"]\n')
+    assert main(["path", str(scene), "--duration", "0.005 s", "--csv", str(tmp_path / "p.csv")]) == 0
+    for row in csv.DictReader((tmp_path / "p.csv").open()):
+        # q_C = 2 q_B + 0.1 rad, and its rates are twice B's (the <mimic> relation itself)
+        assert float(row["C.q [deg]"]) == pytest.approx(2 * float(row["B.q [deg]"]) + np.degrees(0.1), abs=1e-9)
+        assert float(row["C.v [rad/s]"]) == pytest.approx(2 * float(row["B.v [rad/s]"]), rel=1e-11)
+        assert float(row["C.a [rad/s^2]"]) == pytest.approx(2 * float(row["B.a [rad/s^2]"]), rel=1e-11)
