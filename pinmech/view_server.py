@@ -11,11 +11,15 @@ however it exits (even killed), the pipe closes and the server stops.
 from __future__ import annotations
 
 import os
+import select
 import subprocess
 import sys
 import tempfile
 import threading
+import time
 from typing import IO
+
+from pinmech.exceptions import PinmechError
 
 #: The only address the viewer listens on.
 HOST = "127.0.0.1"
@@ -25,18 +29,24 @@ def start_server(timeout: float = 30.0) -> tuple[subprocess.Popen, str, str]:
     """Start the server in a child process; its process, ZeroMQ address and web address.
 
     Raises:
-        RuntimeError: the server exited before saying where it listens (its stderr quoted).
+        PinmechError: the server stopped, or said nothing within `timeout` [s], before
+            saying where it listens (its stderr quoted).
     """
     errors: IO[bytes] = tempfile.TemporaryFile()
     process = subprocess.Popen([sys.executable, "-u", "-m", "pinmech.view_server"], stdin=subprocess.PIPE,
                                stdout=subprocess.PIPE, stderr=errors, start_new_session=True)
     urls: dict[str, str] = {}
+    deadline = time.monotonic() + timeout
     while len(urls) < 2:
-        line = process.stdout.readline().decode("utf-8", "replace").strip()
-        if not line and process.poll() is not None:
+        ready, _, _ = select.select([process.stdout], [], [], max(0.0, deadline - time.monotonic()))
+        line = process.stdout.readline().decode("utf-8", "replace").strip() if ready else ""
+        if not ready or (not line and process.poll() is not None):
+            process.kill()
+            process.wait(timeout=10)
             errors.seek(0)
             said = " ".join(errors.read().decode("utf-8", "replace").split()[-40:])
-            raise RuntimeError(f"the meshcat server stopped at start (exit code {process.returncode}): {said}")
+            why = "did not start" if not ready else f"stopped at start (exit code {process.returncode})"
+            raise PinmechError(f"the meshcat server {why}: {said or 'it said nothing'}")
         key, _, value = line.partition("=")
         if key in ("zmq_url", "web_url"):
             urls[key] = value
