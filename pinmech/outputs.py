@@ -171,11 +171,14 @@ class Outputs:
     def __init__(self) -> None:
         self.tables: list = []  # (table, OutputFile or None for stdout, what)
         self.figures: list = []  # (recorder, OutputFile)
+        self.stdout: IO[str] | None = None  # a table on standard output, if any
 
     def table(self, kind: type, source: object, path: str | None, what: str | None) -> None:
         """A table (`kind(source, stream)`: CSV or JSON lines) to `path`, or to stdout."""
         output = OutputFile(path) if path else None
         stream = output.open() if output else sys.stdout
+        if output is None:
+            self.stdout = stream
         self.tables.append((kind(source, stream), output, what))
 
     def plot(self, recorder: object, path: Path | None) -> None:
@@ -223,9 +226,22 @@ class Outputs:
             output.commit()
             print(f"figure written to {output.path}", file=sys.stderr)
 
+    def _mark_stdout(self, error: BaseException) -> None:
+        """Rows already sent to standard output cannot be taken back: end them with a line
+        that says the run stopped, so a file they were redirected to reads as incomplete."""
+        if self.stdout is None or isinstance(error, BrokenPipeError):
+            return
+        reason = " ".join(str(error).split()) or type(error).__name__
+        try:
+            self.stdout.write(f"INCOMPLETE: pinmech stopped before the last row ({reason})\n")
+            self.stdout.flush()
+        except (OSError, ValueError):  # stdout closed or gone: nothing more can be said there
+            pass
+
     def _abandon(self, error: BaseException) -> None:
         """Keep what was written as NAME.partial, and say so: in the error's own line (its
         `kept` attribute, which the CLI prints with it), else on stderr."""
+        self._mark_stdout(error)
         kept = []
         for output in [o for _, o, _ in self.tables if o] + [o for _, o in self.figures if o]:
             partial = output.abandon()

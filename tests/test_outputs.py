@@ -208,3 +208,10 @@ def test_animate_refuses_more_frames_than_a_page_can_keep(r_rtr_scene, tmp_path,
 def test_a_figure_that_cannot_be_a_file_is_refused_in_one_line(singular_at_zero, target, message, capsys):
     code = main(["sweep", str(singular_at_zero), "--from", "0 deg", "--to", "1 deg", "--steps", "2", "--plot", target])
     assert code == 2 and f"--plot {target} {message}" in capsys.readouterr().err
+
+
+def test_rows_sent_to_standard_output_end_with_a_mark_when_the_run_stops(singular_at_zero, capsys):
+    assert main(["sweep", str(singular_at_zero), "--from", "-20 deg", "--to", "10 deg", "--steps", "7"]) == 7
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 1 + 4 + 1  # header, the 4 poses before 0 deg, the mark
+    assert lines[-1].startswith("INCOMPLETE: pinmech stopped before the last row (sweep stopped at A = 0 deg")
