@@ -36,12 +36,14 @@ class OutputFile:
         self.target = Path(os.path.realpath(path))  # a symbolic link is written through, not replaced
         self.temporary: Path | None = None
         self.stream: IO[str] | None = None
+        self.direct = False  # a pipe or a device, written as the rows come
 
     def open(self, *, text: bool = True) -> IO[str] | None:
         """Create the temporary file; in text mode return it opened for writing. A pipe or a
         device (/dev/stdout) is written directly: it cannot be renamed over."""
         if text and _special(self.path):
             self.stream = open(self.path, "w", newline="", encoding="utf-8")  # noqa: SIM115
+            self.direct = True
             return self.stream
         handle, name = tempfile.mkstemp(dir=self.target.parent, prefix=f".{self.target.name}.",
                                         suffix=f".tmp{self.target.suffix}")
@@ -227,16 +229,18 @@ class Outputs:
             print(f"figure written to {output.path}", file=sys.stderr)
 
     def _mark_stdout(self, error: BaseException) -> None:
-        """Rows already sent to standard output cannot be taken back: end them with a line
-        that says the run stopped, so a file they were redirected to reads as incomplete."""
-        if self.stdout is None or isinstance(error, BrokenPipeError):
+        """Rows already sent to standard output (or a pipe) cannot be taken back: end them
+        with a line that says the run stopped, so what reads them knows it is incomplete."""
+        streams = [self.stdout] + [o.stream for _, o, _ in self.tables if o and o.direct]
+        if isinstance(error, BrokenPipeError):
             return
         reason = " ".join(str(error).split()) or type(error).__name__
-        try:
-            self.stdout.write(f"INCOMPLETE: pinmech stopped before the last row ({reason})\n")
-            self.stdout.flush()
-        except (OSError, ValueError):  # stdout closed or gone: nothing more can be said there
-            pass
+        for stream in [s for s in streams if s is not None]:
+            try:
+                stream.write(f"INCOMPLETE: pinmech stopped before the last row ({reason})\n")
+                stream.flush()
+            except (OSError, ValueError):  # closed or gone: nothing more can be said there
+                pass
 
     def _abandon(self, error: BaseException) -> None:
         """Keep what was written as NAME.partial, and say so: in the error's own line (its
