@@ -368,7 +368,8 @@ def _build_model(source: str, root_joint: str | None = None, *, mimic: bool = Fa
         sink.seek(0)
         said = " ".join(sink.read().decode(errors="replace").split())
     detail = f" ({said})" if said else ""
-    raise ModelError(f"Pinocchio cannot build the model: {error}{detail}", path=source) from error
+    message = " ".join(f"{error}{detail}".split())  # Pinocchio's messages run over several lines
+    raise ModelError(f"Pinocchio cannot build the model: {message}", path=source) from error
 
 
 def _check_locked(locked: dict[str, float], source: str) -> None:

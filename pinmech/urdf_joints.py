@@ -92,6 +92,10 @@ def mimic_joints(root: ET.Element, source: str) -> dict[str, MimicJoint]:
         if leader == name or types.get(leader) not in ("revolute", "continuous", "prismatic"):
             raise ModelError(f"joint=\"{leader}\" is not another revolute or prismatic joint of the file",
                              path=source, element=where)
+        if "continuous" in (types.get(name), types.get(leader)):
+            raise ModelError(f"'{name if types.get(name) == 'continuous' else leader}' is a continuous joint (its "
+                             "configuration is cos, sin): Pinocchio cannot make one follow another; declare both "
+                             "revolute (with <limit>) or prismatic", path=source, element=where)
         out[name] = MimicJoint(name, leader, numbers["multiplier"], numbers["offset"], str(types.get(name)))
     for m in out.values():
         if m.leader in out:

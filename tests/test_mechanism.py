@@ -239,3 +239,12 @@ def test_move_lists_leaders_and_their_mimic_followers_go_with_them(tmp_path, mod
                   .replace('components = ["x", "y"]', 'components = ["x"]').replace('["1 m/s", "0 m/s"]', '["1 m/s"]'))
     held = analyse(Scene.load(scene)).mechanism.locked  # B locked at its pose value, C where it follows
     assert held["C"] == pytest.approx(2 * np.radians(20) + 0.1, abs=1e-15)
+
+
+def test_a_mimic_pair_with_a_continuous_joint_is_refused_in_one_line(tmp_path, models_dir):
+    # R-RTR: A is continuous (cos, sin); Pinocchio cannot make a one-coordinate slide follow it.
+    text = (models_dir / "r_rtr.urdf").read_text().replace(
+        '<joint name="B_slider" type="prismatic">', '<joint name="B_slider" type="prismatic"><mimic joint="A"/>')
+    with pytest.raises(ModelError, match="'A' is a continuous joint") as info:
+        Mechanism.from_urdf(write(tmp_path, "r.urdf", text))
+    assert "\n" not in str(info.value)
