@@ -584,7 +584,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"pinmech: interrupted by {signal.Signals(signum).name}: stopped{_kept(exc)}", file=sys.stderr)
         return 128 + int(signum)
     except PinmechError as exc:
-        print(f"pinmech: error: {exc}{_kept(exc)}", file=sys.stderr)
+        print(f"pinmech: error: {_one_line(exc)}{_kept(exc)}", file=sys.stderr)
         return exc.exit_code
     except ImportError as exc:
         print(f"pinmech: error: {exc}", file=sys.stderr)
@@ -592,8 +592,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # `pinmech sweep ... | head`
         return 0
     except OSError as exc:  # an output file that cannot be written (no such folder, no permission)
-        print(f"pinmech: error: {exc}{_kept(exc)}", file=sys.stderr)
+        print(f"pinmech: error: {_one_line(exc)}{_kept(exc)}", file=sys.stderr)
         return 2
+
+
+def _one_line(error: BaseException) -> str:
+    """The error's message on one line (a library's message may run over several)."""
+    return " ".join(part.strip() for part in str(error).splitlines() if part.strip())
 
 
 def _kept(error: BaseException) -> str:
