@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from pinmech.exceptions import AssemblyError, DriverLimitError, LoopClosureError, PinmechError
+from pinmech.exceptions import AssemblyError, DriverLimitError, PinmechError
 
 #: Largest step, in radians or mechanism sizes of driver motion.
 MAX_STEP = 0.25
@@ -71,6 +71,7 @@ class Node:
     velocity_residual: float = 0.0
     acceleration_residual: float = 0.0
     residual: float = 0.0  # closure residual left at q (dimensionless)
+    tangent: tuple[np.ndarray, float] | None = None  # (q' scaled, |(q', unit)|): see Path._turn
 
 
 @dataclass
@@ -188,13 +189,17 @@ class Path:
         return min(TRUST, 2.0 * abs(h) * self.unit)
 
     def _turn(self, a: Node, b: Node) -> float:
-        """Angle between the extended tangents (q', 1) of two nodes, dimensionless."""
-        s = self.solver._v_scale_inv
-        ta, tb = (a.d1 * s).tolist(), (b.d1 * s).tolist()
-        u2 = self.unit * self.unit
-        dot = sum(x * y for x, y in zip(ta, tb)) + u2
-        norms = math.sqrt((sum(x * x for x in ta) + u2) * (sum(y * y for y in tb) + u2))
-        return math.acos(max(-1.0, min(1.0, dot / norms)))
+        """Angle between the extended tangents (q', 1) of two nodes, q' in radians or sizes
+        per unit of p and the 1 as `unit` (radians or sizes of driver motion)."""
+        (ta, na), (tb, nb) = self._tangent(a), self._tangent(b)
+        cos = (float(ta @ tb) + self.unit * self.unit) / (na * nb)
+        return math.acos(max(-1.0, min(1.0, cos)))
+
+    def _tangent(self, node: Node) -> tuple[np.ndarray, float]:
+        if node.tangent is None:
+            t = node.d1 * self.solver._v_scale_inv
+            node.tangent = (t, math.sqrt(float(t @ t) + self.unit * self.unit))
+        return node.tangent
 
     # ------------------------------------------------------------------ pivot
     def _pivot_follow(self, node: Node, p_target: float, route: Route, why: str) -> tuple[Node, float]:
@@ -412,5 +417,3 @@ class _Curve:
 def _signs(signs: tuple[int, ...]) -> str:
     return "(" + ", ".join("+" if s > 0 else "-" if s < 0 else "0" for s in signs) + ")"
 
-
-__all__ = ["Node", "Path", "Route", "LoopClosureError"]

@@ -19,7 +19,13 @@ import pinocchio as pin
 from pinmech.branches import AssemblyStructure
 from pinmech.closures import CutEvaluator
 from pinmech.continuation import Path, Route
-from pinmech.exceptions import AssemblyError, LoopClosureError, MobilityError, ModelError, SingularPoseError
+from pinmech.exceptions import (
+    AssemblyError,
+    LoopClosureError,
+    MobilityError,
+    ModelError,
+    SingularPoseError,
+)
 from pinmech.mechanism import Mechanism
 from pinmech.results import Accuracy, LoopSolution
 
@@ -111,6 +117,7 @@ class LoopSolver:
     have. `solve` without a guess then reaches the asked driver values from the reference
     by continuation (continuation.py), never by a cold Newton solve; with a guess it
     solves from the guess and raises AssemblyError if it lands on another assembly.
+    Without `set_reference`, the first pose solved becomes the reference.
 
     Args:
         mechanism: the model with its loop closures.
@@ -495,7 +502,11 @@ class LoopSolver:
             q = self.follow(ref.q, ref.driver_q, dq, route)
             residual = max(_max_abs(self._residual(q)), self._full_residual())
             return self._solution(q, dv, da, residual, route.iterations, route)
+        if guess is None and ref is not None:  # assembly "any": Newton from the reference pose
+            guess = ref.q
         q, iterations, residual = self.close(self._guess(guess), dq)
+        if ref is None:  # the first pose solved names the assembly of the later ones
+            self.set_reference(dq, q)
         return self._solution(q, dv, da, residual, iterations, None)
 
     def follow(self, q0: np.ndarray, x0: np.ndarray, x1: np.ndarray, route: Route, *,
@@ -508,6 +519,8 @@ class LoopSolver:
         x0, x1 = np.asarray(x0, dtype=float), np.asarray(x1, dtype=float)
         if np.array_equal(x0, x1):
             return q0.copy()
+        if not self._cuts:  # an open chain: the drivers are the pose
+            return self.set_drivers(q0, x1)
         turn = 2.0 * math.pi
         moving = np.flatnonzero(x1 != x0)
         if not through_folds and len(moving) == 1 and abs(x1 - x0)[moving[0]] > turn \

@@ -137,6 +137,8 @@ class SweepJsonLines:
         """The pose's JSON object (subclasses add keys)."""
         entry = {"index": pose.index, self.sweep.driver: pose.value, "error": pose.error,
                  "pose": "failed" if pose.motion is None else "interpolated" if pose.interpolated else "solved"}
+        if pose.note:  # a change point passed or a fold crossed on the way to this pose
+            entry["note"] = pose.note
         if pose.motion is not None:
             entry.update(motion_dict(pose.motion))
             entry["limit_violations"] = [v.as_dict() for v in limit_violations(self.sweep.mechanism, pose.motion)]
