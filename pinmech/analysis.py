@@ -17,7 +17,7 @@ from pinmech.branches import parse_assembly
 from pinmech.exceptions import FrameNotFound, MobilityError, ModelError, PinmechError, SceneError
 from pinmech.forces import ForceSolution
 from pinmech.forces_scene import analyse_forces, wants_forces
-from pinmech.mechanism import Mechanism, urdf_joint_types
+from pinmech.mechanism import Mechanism, urdf_joint_types, urdf_mimic_leaders
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.results import LoopSolution
 from pinmech.scene import Scene
@@ -114,10 +114,12 @@ def _locked_by_move(scene: Scene, types: dict[str, str], locked: dict[str, float
         if name not in movable:
             raise FrameNotFound("joint (in move)", name, movable, path=str(scene.path))
     pose = scene.section("pose")
+    leaders = urdf_mimic_leaders(scene.urdf)  # a <mimic> follower goes with its leader, moved or locked
     return {
         name: scene.quantity(pose[name], _kind(types, name), "pose", name) if name in pose else 0.0
         for name in movable
-        if name not in move and name not in locked
+        if name not in move and name not in locked and (name not in leaders or name in pose)
+        and leaders.get(name) not in move
     }
 
 
@@ -144,6 +146,10 @@ def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
         if name in mechanism.locked:
             raise SceneError(f"joint '{name}' is both driven and locked", path=str(scene.path), key=f"drivers.{name}")
         joint = _scene_joint(scene, mechanism, name, "drivers")
+        if name in mechanism.mimics:
+            leader = mechanism.mimics[name].leader
+            raise SceneError(f"joint '{name}' follows '{leader}' (URDF <mimic>): drive {leader} instead",
+                             path=str(scene.path), key=f"drivers.{name}")
         row = [0.0, 0.0, 0.0]
         given = [False, False, False]
         for key, value in spec.items():
@@ -181,6 +187,10 @@ def scene_guess(scene: Scene, mechanism: Mechanism) -> np.ndarray:
     q = mechanism.neutral()
     for name, value in scene.section("guess").items():
         joint = _scene_joint(scene, mechanism, name, "guess")
+        if name in mechanism.mimics:
+            leader = mechanism.mimics[name].leader
+            raise SceneError(f"joint '{name}' follows '{leader}' (URDF <mimic>): give {leader}'s value instead",
+                             path=str(scene.path), key=f"guess.{name}")
         mechanism.set_coordinate(q, name, scene.joint_quantity(value, joint.kind, 0, "guess", name))
     return q
 
@@ -257,11 +267,21 @@ def add_scene_points(scene: Scene, mechanism: Mechanism) -> None:
 def report_lists(scene: Scene) -> tuple[list[str] | None, list[str] | None]:
     """Points and links the scene asks to report (None: all)."""
     report = scene.section("report")
-    unknown = set(report) - {"points", "links"}
+    unknown = set(report) - {"points", "links", "limits"}
     if unknown:
-        raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))} in [report]; known: points, links",
+        raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))} in [report]; known: points, links, limits",
                          path=str(scene.path), key="report")
     return scene.names("report", "points"), scene.names("report", "links")
+
+
+def limit_mode(scene: Scene, asked: str | None = None) -> str:
+    """What a joint beyond its URDF limits is: "warn" (default) or "error"; `asked` (the
+    command line's --limits) overrides the scene's `[report] limits`."""
+    mode = asked or scene.section("report").get("limits", "warn")
+    if mode not in ("warn", "error"):
+        raise SceneError(f"limits must be \"warn\" or \"error\", got {mode!r}", path=str(scene.path),
+                         key="report.limits")
+    return mode
 
 
 def check_scene_names(scene: Scene, mechanism: Mechanism) -> None:

@@ -29,6 +29,7 @@ import pinocchio as pin
 
 from pinmech.closures import CUT_TYPES, Closure
 from pinmech.exceptions import FrameNotFound, ModelError
+from pinmech.urdf_joints import JointLimit, MimicJoint, joint_limits, mimic_joints, with_followers
 
 #: Singular values below this fraction of the largest mark a row as structurally zero.
 STRUCTURAL_RANK_TOL = 1e-9
@@ -82,6 +83,9 @@ class Mechanism:
             (the neutral configuration is the reference).
         motors: the actuated joints a file names (a Gepetto sidecar's name_mot): the
             default drivers.
+        mimics: joints following another one (URDF `<mimic>`) and still moving.
+        limits: name -> position limits of the URDF's `<limit>` [rad or m],
+            for the revolute and prismatic joints that give them (locked ones included).
     """
 
     model: pin.Model
@@ -97,6 +101,8 @@ class Mechanism:
     reference: np.ndarray | None = None
     motors: list[str] = field(default_factory=list)
     _rank: object = field(default=None, repr=False, compare=False)
+    mimics: dict[str, MimicJoint] = field(default_factory=dict)
+    limits: dict[str, JointLimit] = field(default_factory=dict)
 
     # ---------------------------------------------------------------- construction
     @classmethod
@@ -131,8 +137,12 @@ class Mechanism:
         path = Path(path)
         source = str(path)
         root = _parse_xml(path)
-        full = _build_model(source, root_joint)
-        model = _lock_joints(full, locked or {}, source)
+        _check_locked(locked or {}, source)
+        mimics = mimic_joints(root, source)
+        full = _build_model(source, root_joint, mimic=bool(mimics))
+        locked = with_followers(dict(locked or {}), mimics, source)
+        model = _lock_joints(full, locked, source)
+        _check_size(model, source)
         if model.nv == 0:
             held = f" once {', '.join(locked)} are locked" if locked else ""
             raise ModelError(f"no joint of the model moves{held}: nothing to solve", path=source)
@@ -159,7 +169,9 @@ class Mechanism:
             plane_normal=None,
             source=source,
             locked=dict(locked or {}),
+            mimics={n: m for n, m in mimics.items() if n not in (locked or {})},
         )
+        mech.limits = {n: lu for n, lu in joint_limits(root, source).items() if n in mech.joints or n in mech.locked}
         mech.length_scale = _length_scale(model, source)
         mech.closures = [_make_closure(model, c, mech.length_scale) for c in cuts]
         _reduce_rows(mech)
@@ -351,6 +363,13 @@ class Mechanism:
     def set_coordinate(self, q: np.ndarray, name: str, value: float) -> None:
         """Write a joint's coordinate (angle [rad] or length [m]) into q, in place."""
         j = self.joint(name)
+        if name in self.mimics:
+            leader = self.mimics[name].leader
+            raise ModelError(f"joint '{name}' follows '{leader}' (URDF <mimic>): give {leader}'s value instead",
+                             path=self.source)
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.floating)) or not np.isfinite(value):
+            raise ModelError(f"joint '{name}': a coordinate must be a finite number (rad or m), got {value!r:.40}",
+                             path=self.source)
         if j.kind == "continuous":
             q[j.idx_q : j.idx_q + 2] = (np.cos(value), np.sin(value))
         elif j.nq == 1:
@@ -360,6 +379,9 @@ class Mechanism:
 
     def coordinate(self, q: np.ndarray, name: str) -> float:
         """A one-dof joint's coordinate (angle in (-pi, pi] for a continuous joint)."""
+        if name in self.mimics:
+            m = self.mimics[name]
+            return m.multiplier * self.coordinate(q, m.leader) + m.offset
         j = self.joint(name)
         if j.kind == "continuous":
             return float(np.arctan2(q[j.idx_q + 1], q[j.idx_q]))
@@ -371,6 +393,11 @@ def urdf_joint_types(path: str | Path) -> dict[str, str]:
     """Joint name -> URDF joint type ("revolute", "prismatic", ...), read from the XML."""
     root = _parse_xml(Path(path))
     return {j.get("name"): j.get("type") for j in root.findall("joint")}
+
+
+def urdf_mimic_leaders(path: str | Path) -> dict[str, str]:
+    """Follower -> leader of the URDF's `<mimic>` joints, read from the XML."""
+    return {n: m.leader for n, m in mimic_joints(_parse_xml(Path(path)), str(path)).items()}
 
 
 def _parse_xml(path: Path) -> ET.Element:
@@ -462,8 +489,9 @@ def _parse_constraint(el: ET.Element, model: pin.Model, links: list[str], source
 _ROOT_JOINTS = {"free_flyer": pin.JointModelFreeFlyer}
 
 
-def _build_model(source: str, root_joint: str | None = None) -> pin.Model:
-    """pin.buildModelFromUrdf, with urdfdom's own stderr chatter folded into the error."""
+def _build_model(source: str, root_joint: str | None = None, *, mimic: bool = False) -> pin.Model:
+    """pin.buildModelFromUrdf (honouring `<mimic>` when asked), with urdfdom's own stderr
+    chatter folded into the error."""
     if root_joint is not None and root_joint not in _ROOT_JOINTS:
         raise ModelError(f"root_joint must be None or one of {', '.join(_ROOT_JOINTS)}, got {root_joint!r}",
                          path=source)
@@ -474,7 +502,7 @@ def _build_model(source: str, root_joint: str | None = None) -> pin.Model:
             sys.stderr.flush()
             os.dup2(sink.fileno(), 2)
             try:
-                return pin.buildModelFromUrdf(source, *args)
+                return pin.buildModelFromUrdf(source, *args, mimic=mimic)
             except (ValueError, RuntimeError) as exc:
                 error = exc
         finally:
@@ -483,7 +511,18 @@ def _build_model(source: str, root_joint: str | None = None) -> pin.Model:
         sink.seek(0)
         said = " ".join(sink.read().decode(errors="replace").split())
     detail = f" ({said})" if said else ""
-    raise ModelError(f"Pinocchio cannot build the model: {error}{detail}", path=source) from error
+    message = " ".join(f"{error}{detail}".split())  # Pinocchio's messages run over several lines
+    raise ModelError(f"Pinocchio cannot build the model: {message}", path=source) from error
+
+
+def _check_locked(locked: dict[str, float], source: str) -> None:
+    """Every locked value is a finite number (SI), else a ModelError naming the joint."""
+    if not isinstance(locked, dict):
+        raise ModelError(f"locked must be a dict of joint name -> value (rad or m), got {locked!r:.60}", path=source)
+    for name, value in locked.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+            raise ModelError(f"locked joint '{name}' must be held at a finite number (rad or m), got {value!r:.40}",
+                             path=source)
 
 
 def _lock_joints(model: pin.Model, locked: dict[str, float], source: str) -> pin.Model:
@@ -496,14 +535,57 @@ def _lock_joints(model: pin.Model, locked: dict[str, float], source: str) -> pin
             raise FrameNotFound("joint to lock", name, [n for n in model.names[1:]], path=source)
         jid = model.getJointId(name)
         joint = model.joints[jid]
-        if joint.nq == 2 and joint.nv == 1:
+        if joint.nq == 0 and "Mimic" in joint.shortname():
+            pass  # a follower: its leader, locked with it, sets where it is held
+        elif joint.nq == 2 and joint.nv == 1:
             q_ref[joint.idx_q : joint.idx_q + 2] = (np.cos(value), np.sin(value))
         elif joint.nq == 1:
             q_ref[joint.idx_q] = value
         else:
             raise ModelError(f"joint '{name}' has {joint.nq} coordinates and cannot be locked by one value", path=source)
         ids.append(jid)
-    return pin.buildReducedModel(model, ids, q_ref)
+    return _reduced(model, ids, q_ref)
+
+
+def _reduced(model: pin.Model, ids: list[int], q_ref: np.ndarray) -> pin.Model:
+    """pin.buildReducedModel, also when a locked joint has the name of a link (Pinocchio
+    then finds "several frames" by that name): such a joint is renamed while the model
+    is reduced, and its fixed frame named back."""
+    model = pin.Model(model)
+    renamed = {}
+    for jid in ids:
+        name = model.names[jid]
+        if sum(f.name == name for f in model.frames) > 1:
+            renamed[f"{name}__pinmech_locked"] = name
+            model.names[jid] = f"{name}__pinmech_locked"
+            for frame in model.frames:
+                if frame.name == name and frame.type == pin.FrameType.JOINT:
+                    frame.name = f"{name}__pinmech_locked"
+    reduced = pin.buildReducedModel(model, ids, q_ref)
+    for frame in reduced.frames:
+        frame.name = renamed.get(frame.name, frame.name)
+    return reduced
+
+
+#: Most degrees of freedom a model may keep. Pinocchio's `Data` allocates, whatever it is
+#: used for, four nv x nv x nv tensors (second derivatives of the inverse dynamics:
+#: d2tau_dqdq, d2tau_dvdv, d2tau_dqdv, d2tau_dadq; data.hxx) and a 6 x nv x nv one, so its
+#: size grows as nv^3: measured with Pinocchio 4.1, 69 MB at nv = 100, 0.5 GB at 200, 4 GB at
+#: 400 (62.5 bytes per nv^3, chains and stars alike). pinmech makes several Data; past this
+#: a model would exhaust memory (a 1,000-link chain: 62 GB) before anything is solved.
+MAX_DOF = 256
+_DATA_BYTES_PER_DOF_CUBED = 62.5
+
+
+def _check_size(model: pin.Model, source: str) -> None:
+    """Raises ModelError (one line, with the memory it would take) for a model with more
+    degrees of freedom than `MAX_DOF`, before Pinocchio tries to allocate its Data."""
+    if model.nv > MAX_DOF:
+        gigabytes = _DATA_BYTES_PER_DOF_CUBED * model.nv**3 / 1e9
+        raise ModelError(f"the model keeps {model.nv} degrees of freedom ({model.njoints - 1} joints); Pinocchio's "
+                         f"working data for it would take about {gigabytes:.3g} GB (it holds nv x nv x nv tensors of "
+                         f"second derivatives), so pinmech takes at most {MAX_DOF}: lock the joints the scene holds "
+                         "still ([lock], or move = [...])", path=source)
 
 
 def _joint_kind(joint: pin.JointModel) -> str:
@@ -634,8 +716,8 @@ def _plane_normal(mech: Mechanism) -> np.ndarray | None:
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
         for fid in range(model.nframes):
-            # reshaped: for a one-dof model Pinocchio hands back a (6,) vector, not (6, 1)
-            J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED).reshape(6, -1) * columns
+            J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+            J = J.reshape(6, model.nv) * columns  # Pinocchio gives a 6 x 1 Jacobian as a vector
             angular.append(J[3:])
             linear.append(J[:3] / mech.length_scale)
     # A = hstack(angular) is 3 x (frames * nv). A = R^T Q^T, so A's U and s are those of the

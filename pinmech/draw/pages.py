@@ -28,7 +28,16 @@ from pinmech.draw.scene import (
 def load_visuals(
     urdf_path: str | Path, model: pin.Model, package_dirs: Sequence[str | Path] = ()
 ) -> pin.GeometryModel:
-    """The visual geometry of a URDF (meshes included), built only when drawing.
+    """The visual geometry of a URDF (meshes of its own package only), built only when
+    drawing; `package_visuals` also says which meshes were left out."""
+    return package_visuals(urdf_path, model, package_dirs)[0]
+
+
+def package_visuals(
+    urdf_path: str | Path, model: pin.Model, package_dirs: Sequence[str | Path] = ()
+) -> tuple[pin.GeometryModel, list[str]]:
+    """The visual geometry of a URDF, and the mesh files left out of it because they lie
+    outside the model's own package (visual_files.py: a page must carry no other file).
 
     Args:
         urdf_path: the URDF file `model` was built from.
@@ -36,18 +45,21 @@ def load_visuals(
         package_dirs: folders holding `package://NAME/...` meshes; by default the URDF's
             own folder and its parents.
     """
+    from pinmech.visual_files import drop_outside, package_roots
+
     path = Path(urdf_path)
     if not path.is_file():
         raise DrawError(f"no URDF file at {path}", argument="urdf_path", value=str(path))
     dirs = [str(d) for d in package_dirs] or [str(p) for p in path.resolve().parents][:5]
     try:
-        return pin.buildGeomFromUrdf(model, str(path), pin.GeometryType.VISUAL, package_dirs=dirs)
+        visuals = pin.buildGeomFromUrdf(model, str(path), pin.GeometryType.VISUAL, package_dirs=dirs)
     except (ValueError, RuntimeError) as exc:
         raise DrawError(
             f"{path}: cannot build its visual geometry: {exc}",
             argument="urdf_path",
             value=str(path),
         ) from exc
+    return visuals, drop_outside(visuals, model, package_roots(path, dirs))
 
 
 def snapshot_html(
@@ -168,8 +180,17 @@ def live_viewer(
     """
     meshcat = _meshcat()
     q = _configuration(model, q, "q")
-    with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL: the caller decides
-        window = meshcat.Visualizer().window
+    from pinmech.view_server import start_server
+
+    process, zmq_url, _ = start_server()  # on 127.0.0.1 only, and stopping with pinmech (view_server.py)
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL: the caller decides
+            window = meshcat.visualizer.ViewerWindow(zmq_url=zmq_url, start_server=False, server_args=[])
+    except BaseException:
+        process.kill()
+        process.wait(timeout=10)
+        raise
+    window.server_proc = process
     try:
         scene = _Scene(model, visual_model, window, show_grid=show_grid)
         return LiveView(scene.vis, _draw_pose(scene, q, points, arrows, plane_normal))
@@ -199,4 +220,7 @@ def _stop_server(window: Any) -> None:
     if window.server_proc is not None and window.server_proc.poll() is None:
         window.server_proc.kill()
         window.server_proc.wait(timeout=10)
+    for pipe in (window.server_proc.stdin, window.server_proc.stdout) if window.server_proc is not None else ():
+        if pipe is not None:
+            pipe.close()
 

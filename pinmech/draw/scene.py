@@ -86,6 +86,7 @@ def _meshcat() -> Any:
             import meshcat
             import meshcat.animation
             import meshcat.geometry
+            import meshcat.visualizer
     except ImportError as exc:
         raise ImportError(INSTALL_HINT) from exc
     return meshcat
