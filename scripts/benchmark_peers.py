@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import argparse
 import atexit
+import functools
 import gc
 import importlib
 import math
@@ -324,6 +325,16 @@ def _sympy_p2_functions(modules: str):
     """Lambdified (th1, th2, vx, vy) -> (omega_AB, omega_BC) and
     (th1, th2, omega_AB, omega_BC, ax, ay) -> (alpha_AB, alpha_BC), CD fixed in angle."""
     import sympy as sp
+
+    args_v, vel, args_a, acc = _sympy_p2_solved()
+    opts = {"modules": modules, "cse": True}
+    return sp.lambdify(args_v, vel, **opts), sp.lambdify(args_a, acc, **opts)
+
+
+@functools.lru_cache(maxsize=1)
+def _sympy_p2_solved() -> tuple:
+    """The symbolic rates of P2 (derived once for both lambdified variants)."""
+    import sympy as sp
     import sympy.physics.mechanics as me
 
     t = me.dynamicsymbols._t
@@ -344,9 +355,7 @@ def _sympy_p2_functions(modules: str):
           (aD.dot(N.y) - ay).subs(sub).subs({th1: x1, th2: x2})]
     vel = sp.solve(ev, [w1, w2], dict=True)[0]
     acc = sp.solve(ea, [a1, a2], dict=True)[0]
-    opts = {"modules": modules, "cse": True}
-    return (sp.lambdify((x1, x2, vx, vy), [vel[w1], vel[w2]], **opts),
-            sp.lambdify((x1, x2, w1, w2, ax, ay), [acc[a1], acc[a2]], **opts))
+    return (x1, x2, vx, vy), [vel[w1], vel[w2]], (x1, x2, w1, w2, ax, ay), [acc[a1], acc[a2]]
 
 
 def sympy_p2(th1: np.ndarray, th2: np.ndarray):
