@@ -479,7 +479,7 @@ def _pinmech_p1_sweep():
     return pinmech, pinmech.Sweep.from_scene(pinmech.Scene.load(SCENE_P1))
 
 
-def _pinmech_p1_row(pinmech, sweep, motion) -> tuple:
+def _pinmech_p1_row(motion) -> tuple:
     """P1 outputs from a pinmech Motion (B_slider's coordinate is -s)."""
     link3, d, slider = motion.links["link3"], motion.points["D"], motion.joints["B_slider"]
     return (link3.angle, link3.angular_velocity[2], link3.angular_acceleration[2], -slider.v, -slider.a,
@@ -495,7 +495,7 @@ def pinmech_p1_chunks(phi: np.ndarray):
 
     def read(chunks) -> np.ndarray:
         data = sweep.mechanism.model.createData()
-        return np.array([_pinmech_p1_row(pinmech, sweep, pinmech.evaluate_motion(
+        return np.array([_pinmech_p1_row(pinmech.evaluate_motion(
             sweep.mechanism, data, q, v, a, points=["D"], links=["link3"]))
             for Q, V, A in chunks for q, v, a in zip(Q, V, A)])
     return run, read, ""
@@ -510,7 +510,7 @@ def pinmech_p1_motion(phi: np.ndarray):
         rows = []
         for c in sweep.chunks(phi):
             s = c.solution
-            rows += [_pinmech_p1_row(pinmech, sweep, pinmech.evaluate_motion(
+            rows += [_pinmech_p1_row(pinmech.evaluate_motion(
                 mechanism, data, q, v, a, points=["D"], links=["link3"])) for q, v, a in zip(s.q, s.v, s.a)]
         return np.array(rows)
     return run, None, ""
