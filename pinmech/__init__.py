@@ -12,12 +12,14 @@ from pinmech.branches import Assembly
 from pinmech.check import compare, load_hand_file
 from pinmech.closures import Closure
 from pinmech.continuation import Route
+from pinmech.draw.report_page import HtmlPage, report_html, snapshot
 from pinmech.exceptions import (
     AssemblyError,
     CheckMismatch,
     DriverLimitError,
     FrameNotFound,
     IndeterminateForcesError,
+    Interrupted,
     LoopClosureError,
     MobilityError,
     ModelError,
@@ -41,12 +43,16 @@ from pinmech.forces import (
 )
 from pinmech.forces_scene import ForceSettings, force_settings
 from pinmech.forces_sweep import SweepForces
+from pinmech.linkage import build_urdf, load_linkage
 from pinmech.mechanism import JointInfo, Mechanism
+from pinmech.mjcf import load_mjcf
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.path import PathPoint, follow_path
+from pinmech.polygon import Polygon, acceleration_polygon, velocity_polygon
 from pinmech.report import to_dict, to_json, to_text
 from pinmech.results import Accuracy, LoopSolution, RateSolution
 from pinmech.scene import Scene
+from pinmech.sidecar import load_extended_urdf
 from pinmech.solve_batch import BatchSolution, BatchSolver
 from pinmech.solve_cycle import RangeChunk, solve_range
 from pinmech.solve_loops import LoopSolver, Reference
@@ -74,6 +80,8 @@ __all__ = [
     "ForceSolver",
     "FrameNotFound",
     "IndeterminateForcesError",
+    "HtmlPage",
+    "Interrupted",
     "JointInfo",
     "Load",
     "LoopClosureError",
@@ -88,6 +96,7 @@ __all__ = [
     "PinmechError",
     "RateOverflowError",
     "PowerBalance",
+    "Polygon",
     "RangeChunk",
     "RateSolution",
     "RateSolver",
@@ -105,18 +114,26 @@ __all__ = [
     "TaskError",
     "UnitError",
     "__version__",
+    "acceleration_polygon",
     "analyse",
+    "build_urdf",
     "compare",
     "energy_fluctuation",
     "evaluate_motion",
     "follow_path",
     "force_settings",
+    "load_extended_urdf",
     "load_hand_file",
+    "load_linkage",
     "load_mechanism",
+    "load_mjcf",
     "mechanical_advantage",
+    "report_html",
+    "snapshot",
     "solve_range",
     "to_dict",
     "to_json",
     "to_si",
     "to_text",
+    "velocity_polygon",
 ]

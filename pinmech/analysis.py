@@ -17,7 +17,7 @@ from pinmech.branches import parse_assembly
 from pinmech.exceptions import FrameNotFound, MobilityError, ModelError, PinmechError, SceneError
 from pinmech.forces import ForceSolution
 from pinmech.forces_scene import analyse_forces, wants_forces
-from pinmech.mechanism import Mechanism, urdf_joint_types
+from pinmech.mechanism import Mechanism, urdf_joint_types, urdf_mimic_leaders
 from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
 from pinmech.results import LoopSolution
 from pinmech.scene import Scene
@@ -46,18 +46,55 @@ class Analysis:
     extra: dict[str, Any] | None = None
     forces: ForceSolution | None = None  # driver efforts and reactions, when the scene asks (forces.py)
 
+    def _repr_html_(self) -> str:
+        """Jupyter shows the points' and links' motion as tables."""
+        from pinmech.draw.report_page import motion_table_html
+
+        return f"<h4>{self.scene.title}</h4>" + motion_table_html(self)
+
 
 def load_mechanism(scene: Scene) -> Mechanism:
-    """The scene's URDF as a Mechanism, with the scene's `[lock]` joints locked out."""
-    if not scene.urdf.is_file():
-        raise ModelError(f"the scene's urdf = \"{scene.raw['urdf']}\" is not a file", path=str(scene.path))
-    types = urdf_joint_types(scene.urdf)
+    """The scene's model (URDF, linkage, MJCF) as a Mechanism, `[lock]` joints locked out."""
+    kind = scene.model_kind
+    path = scene.urdf if kind in ("urdf", "robot") else scene.model_file(kind)
+    if not path.is_file():
+        raise ModelError(f"the scene's {kind} = \"{scene.raw[kind]}\" is not a file", path=str(scene.path))
+    loader = _model_loader(scene, kind, path)
+    types = loader.joint_types()
     locked = {}
     for name, value in scene.section("lock").items():
         locked[name] = scene.quantity(value, _kind(types, name), "lock", name)
     if "move" in scene.raw:
         locked.update(_locked_by_move(scene, types, locked))
-    return Mechanism.from_urdf(scene.urdf, locked=locked)
+    mechanism = loader.load(locked)
+    add_scene_points(scene, mechanism)
+    return mechanism
+
+
+@dataclass(frozen=True)
+class _Loader:
+    """How to read one kind of model file: its joint types, then the mechanism."""
+
+    joint_types: Any
+    load: Any
+
+
+def _model_loader(scene: Scene, kind: str, path) -> _Loader:
+    if kind == "linkage":
+        from pinmech.linkage import joint_kinds, load_linkage
+
+        return _Loader(lambda: joint_kinds(path), lambda locked: load_linkage(path, locked=locked))
+    if kind == "mjcf":
+        from pinmech.mjcf import load_mjcf, mjcf_joint_types
+
+        return _Loader(lambda: mjcf_joint_types(path), lambda locked: load_mjcf(path, locked=locked))
+    if "sidecar" in scene.raw:
+        from pinmech.sidecar import load_extended_urdf
+
+        sidecar = scene.model_file("sidecar")
+        return _Loader(lambda: urdf_joint_types(path),
+                       lambda locked: load_extended_urdf(path, sidecar, locked=locked))
+    return _Loader(lambda: urdf_joint_types(path), lambda locked: Mechanism.from_urdf(path, locked=locked))
 
 
 def _kind(types: dict[str, str], name: str) -> str:
@@ -77,10 +114,12 @@ def _locked_by_move(scene: Scene, types: dict[str, str], locked: dict[str, float
         if name not in movable:
             raise FrameNotFound("joint (in move)", name, movable, path=str(scene.path))
     pose = scene.section("pose")
+    leaders = urdf_mimic_leaders(scene.urdf)  # a <mimic> follower goes with its leader, moved or locked
     return {
         name: scene.quantity(pose[name], _kind(types, name), "pose", name) if name in pose else 0.0
         for name in movable
-        if name not in move and name not in locked
+        if name not in move and name not in locked and (name not in leaders or name in pose)
+        and leaders.get(name) not in move
     }
 
 
@@ -94,11 +133,23 @@ def _scene_joint(scene: Scene, mechanism: Mechanism, name: str, key: str):
 def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
     """The `[drivers]` table in SI units, checked against the model's joints."""
     table = scene.driver_table()
+    if not table and mechanism.motors:  # a sidecar's motors, at the reference pose, at rest
+        reference = mechanism.neutral()
+        table = {name: {"angle" if mechanism.joint(name).kind != "prismatic" else "position": 0.0}
+                 for name in mechanism.motors}
+        values = [[mechanism.coordinate(reference, name), 0.0, 0.0] for name in mechanism.motors]
+        if len(values) == mechanism.mobility:
+            arr = np.array(values, dtype=float).reshape(-1, 3)
+            return Drivers(tuple(mechanism.motors), arr[:, 0].copy(), arr[:, 1].copy(), arr[:, 2].copy())
     names, values = [], []
     for name, spec in table.items():
         if name in mechanism.locked:
             raise SceneError(f"joint '{name}' is both driven and locked", path=str(scene.path), key=f"drivers.{name}")
         joint = _scene_joint(scene, mechanism, name, "drivers")
+        if name in mechanism.mimics:
+            leader = mechanism.mimics[name].leader
+            raise SceneError(f"joint '{name}' follows '{leader}' (URDF <mimic>): drive {leader} instead",
+                             path=str(scene.path), key=f"drivers.{name}")
         row = [0.0, 0.0, 0.0]
         given = [False, False, False]
         for key, value in spec.items():
@@ -113,10 +164,20 @@ def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
         values.append(row)
     if len(names) != mechanism.mobility:
         given = ", ".join(names) or "none"
+        idle = ""
+        if len(names) < mechanism.mobility:
+            free = mechanism.idle_joints(names)
+            if free:
+                single = [n for n in free if n in mechanism.joints and mechanism.joints[n].nv == 1]
+                advice = ("lock it under [lock] or drive it" if len(single) == len(free) else
+                          "a ball joint cannot be locked by one value: give it two hinges across the rod instead "
+                          "(a universal joint), or lock or drive a one-freedom joint")
+                idle = (f"; with those held, {', '.join(free)} can still move (a joint spinning freely, as a rod "
+                        f"about its own axis): {advice}")
         raise MobilityError(f"{scene.path}, drivers: {mechanism.source} has mobility {mechanism.mobility} "
-                            f"({mechanism.model.nv} joint freedoms, {mechanism.constraint_rows} independent closure "
-                            f"equations): drive that many joints; the scene drives {len(names)} ({given})",
-                            mobility=mechanism.mobility, drivers=len(names))
+                            f"({mechanism.model.nv} joint freedoms, {mechanism.rank_report().rank} independent "
+                            f"closure equations): drive that many joints; the scene drives {len(names)} ({given})"
+                            f"{idle}", mobility=mechanism.mobility, drivers=len(names))
     arr = np.array(values, dtype=float).reshape(-1, 3)
     return Drivers(tuple(names), arr[:, 0].copy(), arr[:, 1].copy(), arr[:, 2].copy())
 
@@ -126,6 +187,10 @@ def scene_guess(scene: Scene, mechanism: Mechanism) -> np.ndarray:
     q = mechanism.neutral()
     for name, value in scene.section("guess").items():
         joint = _scene_joint(scene, mechanism, name, "guess")
+        if name in mechanism.mimics:
+            leader = mechanism.mimics[name].leader
+            raise SceneError(f"joint '{name}' follows '{leader}' (URDF <mimic>): give {leader}'s value instead",
+                             path=str(scene.path), key=f"guess.{name}")
         mechanism.set_coordinate(q, name, scene.joint_quantity(value, joint.kind, 0, "guess", name))
     return q
 
@@ -133,7 +198,8 @@ def scene_guess(scene: Scene, mechanism: Mechanism) -> np.ndarray:
 def scene_solver(scene: Scene, mechanism: Mechanism, drivers: Drivers) -> LoopSolver:
     """A LoopSolver for the scene, its reference set: the scene file's driver values and
     `[guess]` (with `assembly`, if given, checked), so every pose asked is reached on the
-    scene's assembly by continuation.
+    scene's assembly by continuation. A model drawn closed (a linkage file, MJCF's qpos0)
+    without `[guess]` has its drawn pose as the reference.
 
     Raises:
         SceneError: a malformed `assembly`.
@@ -152,7 +218,12 @@ def scene_solver(scene: Scene, mechanism: Mechanism, drivers: Drivers) -> LoopSo
         assembly = "keep" if asked is None else parse_assembly(asked, solver.structure) or "any"
     except ValueError as exc:
         raise SceneError(str(exc), path=str(scene.path), key="assembly") from None
-    solver.set_reference(ref_drivers.q, scene_guess(scene, mechanism), assembly)
+    if mechanism.reference is not None and not scene.section("guess"):
+        # a drawn linkage, an MJCF file at qpos0: the pose as drawn is the reference assembly
+        drawn = [mechanism.coordinate(mechanism.reference, name) for name in drivers.names]
+        solver.set_reference(drawn, mechanism.neutral(), assembly)
+    else:
+        solver.set_reference(ref_drivers.q, scene_guess(scene, mechanism), assembly)
     return solver
 
 
@@ -161,20 +232,56 @@ def coincident_points(scene: Scene) -> list[CoincidentPoint]:
     out = []
     for name, spec in scene.section("points").items():
         if not isinstance(spec, dict) or set(spec) != {"at", "link"}:
-            raise SceneError("a coincident point needs exactly at = \"POINT\" and link = \"LINK\"",
+            raise SceneError("a point needs exactly at = \"POINT\" (the point of LINK under it) or at = [x, y, z] "
+                             "(coordinates in LINK's frame, with units), and link = \"LINK\"",
                              path=str(scene.path), key=f"points.{name}")
-        out.append(CoincidentPoint(name, str(spec["at"]), str(spec["link"])))
+        if not isinstance(spec["at"], list):
+            out.append(CoincidentPoint(name, str(spec["at"]), str(spec["link"])))
     return out
+
+
+def add_scene_points(scene: Scene, mechanism: Mechanism) -> None:
+    """`[points.P] link = "coupler", at = ["60 mm", "30 mm", "0 mm"]`: a point fixed on a link.
+
+    The coordinates are in the link's frame (for a drawn linkage: origin on its parent
+    joint, x from its first listed point to the next). Adds the point to the mechanism.
+    """
+    for name, spec in scene.section("points").items():
+        if not isinstance(spec, dict) or not isinstance(spec.get("at"), list):
+            continue
+        key = f"points.{name}"
+        at = spec["at"]
+        if len(at) != 3:
+            raise SceneError(f"at = {at!r} must be three coordinates [x, y, z] with units", path=str(scene.path),
+                             key=key)
+        xyz = [scene.quantity(value, "length", "points", name, "at") for value in at]
+        link = str(spec["link"])
+        if link not in mechanism.links:
+            raise FrameNotFound(f"link (in [points.{name}])", link, list(mechanism.links), path=str(scene.path))
+        if name in mechanism.points or mechanism.model.existFrame(name):
+            raise SceneError(f"the model already has a frame called '{name}': name the point otherwise",
+                             path=str(scene.path), key=key)
+        mechanism.add_point(name, link, np.array(xyz))
 
 
 def report_lists(scene: Scene) -> tuple[list[str] | None, list[str] | None]:
     """Points and links the scene asks to report (None: all)."""
     report = scene.section("report")
-    unknown = set(report) - {"points", "links"}
+    unknown = set(report) - {"points", "links", "limits"}
     if unknown:
-        raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))} in [report]; known: points, links",
+        raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))} in [report]; known: points, links, limits",
                          path=str(scene.path), key="report")
     return scene.names("report", "points"), scene.names("report", "links")
+
+
+def limit_mode(scene: Scene, asked: str | None = None) -> str:
+    """What a joint beyond its URDF limits is: "warn" (default) or "error"; `asked` (the
+    command line's --limits) overrides the scene's `[report] limits`."""
+    mode = asked or scene.section("report").get("limits", "warn")
+    if mode not in ("warn", "error"):
+        raise SceneError(f"limits must be \"warn\" or \"error\", got {mode!r}", path=str(scene.path),
+                         key="report.limits")
+    return mode
 
 
 def check_scene_names(scene: Scene, mechanism: Mechanism) -> None:

@@ -89,17 +89,27 @@ def _check_frames(scene: Scene, mechanism: Mechanism, tasks: list[Task]) -> None
 def scene_pose(scene: Scene, mechanism: Mechanism) -> tuple[np.ndarray, list[str], np.ndarray]:
     """Configuration from `[guess]` then `[pose]`; also the pose joints and their values (SI)."""
     q = scene_guess(scene, mechanism)
-    names, values = [], []
+    names, values, followers = [], [], {}
     for name, value in scene.section("pose").items():
         if name in mechanism.locked:
             continue
         if name not in mechanism.joints:
             raise FrameNotFound("joint (in [pose])", name, list(mechanism.joints), path=str(scene.path))
+        if name in mechanism.mimics:  # set by its leader; checked below
+            followers[name] = scene.joint_quantity(value, mechanism.mimics[name].kind, 0, "pose", name)
+            continue
         joint = mechanism.joints[name]
         x = scene.joint_quantity(value, joint.kind, 0, "pose", name)
         mechanism.set_coordinate(q, name, x)
         names.append(name)
         values.append(x)
+    for name, x in followers.items():
+        follows = mechanism.coordinate(q, name)
+        if abs(x - follows) > 1e-9 * max(1.0, abs(follows)):
+            m = mechanism.mimics[name]
+            raise SceneError(f"{name} follows {m.leader} (URDF <mimic>: {m.multiplier:g} x {m.leader} + {m.offset:g}) "
+                             f"= {follows:.9g} (SI), not {x:.9g}: give {m.leader}'s value only",
+                             path=str(scene.path), key=f"pose.{name}")
     return q, names, np.array(values)
 
 

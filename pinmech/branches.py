@@ -146,7 +146,7 @@ def parse_assembly(asked: object, structure: AssemblyStructure) -> dict[str, int
     if asked == "any":
         return None
     if not isinstance(asked, dict):
-        raise ValueError(f'must be "any" or a table of loop = "+"/"-" (loops: {", ".join(structure.names)})')
+        raise ValueError(f'must be "any" or a table of loop = "+"/"-" (loops: {", ".join(structure.names)})')  # noqa: TRY004 (one-line reason for the scene error)
     out = {}
     for name, word in asked.items():
         if name not in structure.names:

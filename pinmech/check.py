@@ -20,6 +20,7 @@ A printed value is an interval: "0.386" means [0.3855, 0.3865]. Verdicts:
 from __future__ import annotations
 
 import math
+import re
 import sys
 from dataclasses import dataclass
 from decimal import Decimal, InvalidOperation
@@ -34,9 +35,11 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-#: How many units of the last printed digit count as "rounding" rather than a mismatch.
+#: How many units of the last printed digit count as "rounding" rather than a mismatch,
+#: and the most a user may allow (more would call any value rounding).
 DEFAULT_SLACK = 2.0
-_COMPONENTS = {"x": 0, "y": 1, "z": 2}
+MAX_SLACK = 100.0
+_COMPONENTS: dict[str, int | str] = {"x": 0, "y": 1, "z": 2, "norm": "norm"}
 _KINDS = {
     "position": "length",
     "velocity": "velocity",
@@ -56,7 +59,7 @@ class HandValue:
 
     label: str
     quantity: str
-    component: int | None
+    component: int | str | None  # 0, 1, 2 (x, y, z), "norm" (the vector's magnitude) or None
     printed: str
     unit: str
     kind: str
@@ -136,16 +139,21 @@ def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue
             raise SceneError(f"hand value {printed!r} is not a number", path=path, key=where) from None
         if not finite:
             raise SceneError(f"hand value {printed!r} is not a finite number as printed", path=path, key=where)
+        if component == "norm" and len(hand) > 1:
+            raise SceneError(f"{quantity!r} is a magnitude: give one printed value", path=path, key=where)
         comp = component if component is not None else (i if len(hand) > 1 else None)
         suffix = "" if len(hand) == 1 else f" {'xyz'[i]}"
         out.append(HandValue(label + suffix, base, comp, printed.strip(), str(entry["unit"]), kind))
-    factor = to_si(f"1 {out[0].unit}", kind, where=f"{where}.unit")  # unknown or wrong unit fails here
+    unit = out[0].unit
+    if not unit.strip() or re.search(r"^\s*[-+.\d]|,", unit):
+        raise SceneError(f"unit = {unit!r} is not a unit (e.g. \"m/s\", \"deg\")", path=path, key=f"{where}.unit")
+    factor = to_si(f"1 {unit}", kind, where=f"{where}.unit")  # unknown or wrong unit fails here
     if not factor > 0:
         raise SceneError(f"unit = {out[0].unit!r} is not a unit", path=path, key=f"{where}.unit")
     return out
 
 
-def _split_component(quantity: str) -> tuple[str, int | None]:
+def _split_component(quantity: str) -> tuple[str, int | str | None]:
     head, _, last = quantity.rpartition(".")
     if last in _COMPONENTS:
         return head, _COMPONENTS[last]
@@ -157,7 +165,7 @@ def _kind_of(path: str, declared: str, file: str, where: str) -> str:
         if declared not in SI_UNITS:
             raise SceneError(f"kind = {declared!r} is not one of {', '.join(SI_UNITS)}", path=file, key=where)
         return declared
-    last = path.rsplit(".", 1)[-1]
+    last = path.removesuffix(".norm").rsplit(".", 1)[-1]
     if last in _KINDS:
         return _KINDS[last]
     raise SceneError(f"cannot tell the kind of {path!r}: add kind = \"angle\" (or length, velocity, ...)",
@@ -172,9 +180,15 @@ def lookup(result: dict[str, Any], quantity: str, component: int | None, *, wher
             known = ", ".join(node) if isinstance(node, dict) else "nothing"
             raise SceneError(f"{quantity!r}: no '{part}' in the result (has {known})", key=where)
         node = node[part]
+    if component == "norm":
+        numbers = node if isinstance(node, list) else [node]
+        if not numbers or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in numbers):
+            raise SceneError(f"{quantity!r} has no magnitude: it is not a number or a vector of the result", key=where)
+        return math.hypot(*numbers)
     if isinstance(node, list):
         if component is None:
-            raise SceneError(f"{quantity!r} is a vector: add .x, .y or .z, or give a list of hand values", key=where)
+            raise SceneError(f"{quantity!r} is a vector: add .x, .y, .z or .norm, or give a list of hand values",
+                             key=where)
         node = node[component] if component < len(node) else None
     if isinstance(node, bool) or not isinstance(node, (int, float)):
         raise SceneError(f"{quantity!r} is not a number of the result", key=where)
@@ -182,16 +196,33 @@ def lookup(result: dict[str, Any], quantity: str, component: int | None, *, wher
 
 
 def compare(result: dict[str, Any], values: list[HandValue], slack: float = DEFAULT_SLACK) -> list[Verdict]:
-    """Verdicts of hand values against a result, in the hand values' units."""
+    """Verdicts of hand values against a result, in the hand values' units. An angle is
+    compared with the equivalent of pinmech's nearest it (413.794 deg is 53.794 deg).
+
+    Raises:
+        SceneError: a slack that is not a number from 0 to `MAX_SLACK`.
+    """
+    check_slack(slack)
     out = []
     for hv in values:
         factor = to_si(f"1 {hv.unit}", hv.kind)
         computed = lookup(result, hv.quantity, hv.component, where=hv.label) / factor
+        if hv.kind == "angle" and hv.component != "norm":
+            turn = 2 * math.pi / factor  # a full turn in the hand unit
+            computed += turn * round((hv.value - computed) / turn)
         diff = hv.value - computed
         units = abs(diff) / hv.ulp
         verdict = "ok" if units <= 0.5 + 1e-9 else "rounding" if units <= slack else "MISMATCH"
         out.append(Verdict(hv, computed, diff, verdict))
     return out
+
+
+def check_slack(slack: float, name: str = "slack") -> None:
+    """Raises SceneError unless `slack` is a number from 0 to `MAX_SLACK` (units of the
+    last printed digit; infinity would call any value rounding)."""
+    if isinstance(slack, bool) or not isinstance(slack, (int, float)) or not 0 <= slack <= MAX_SLACK:
+        raise SceneError(f"{name} must be a number from 0 to {MAX_SLACK:g} (units of the last printed digit), "
+                         f"got {slack!r}")
 
 
 def _difference(v: Verdict) -> str:

@@ -4,18 +4,24 @@ Exit codes: 0 success; 1 hand values mismatch (`check`); 2 usage or other pinmec
 3 bad URDF; 4 bad scene or hand file (unknown name, unit, key); 5 drivers do not match
 the mobility; 6 a loop cannot close; 7 singular pose, or forces not determined; 8 inconsistent
 task; 9 a drawing input out of range; 10 another assembly than the scene's (or none reachable
-on it); 11 the drivers cannot go further (a fold: limit angle, extreme, stroke). An output
-file that cannot be written is 2.
+on it); 11 the drivers cannot go further (a fold: limit angle, extreme, stroke); 12 a joint
+beyond its URDF <limit> (with --limits error). An output file that cannot be written is 2.
+Stopped by a signal: 128 + its number (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP), outputs kept
+as NAME.partial.
 """
 
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 from pinmech import __version__
 from pinmech.exceptions import PinmechError
+from pinmech.interrupts import SIGNALS
+from pinmech.outputs import Outputs, check_distinct, plot_path, write_whole
 
 
 def _add_scene_arguments(parser: argparse.ArgumentParser) -> None:
@@ -51,6 +57,11 @@ def _add_force_arguments(parser: argparse.ArgumentParser) -> None:
                         help="redundant loops: give the minimum-norm reactions instead of an error")
 
 
+def _add_limits_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--limits", choices=("warn", "error"),
+                        help="a joint beyond its URDF <limit>: a warning (default) or an error (exit 12)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser, with one sub-parser per subcommand."""
     parser = argparse.ArgumentParser(
@@ -58,7 +69,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Kinematics of mechanisms and robot arms from URDF, on Pinocchio.",
         epilog="Exit codes: 0 ok, 1 check mismatch, 2 error, 3 URDF, 4 scene, 5 mobility, "
         "6 loop cannot close, 7 singular pose (or undetermined forces), 8 task, 9 drawing, 10 assembly, "
-        "11 driver limit.",
+        "11 driver limit, 12 joint limit (--limits error), 130 Ctrl-C (128 + signal).",
     )
     parser.add_argument("--version", action="version", version=f"pinmech {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -66,6 +77,7 @@ def build_parser() -> argparse.ArgumentParser:
     solve = sub.add_parser("solve", help="solve a scene and print the report (or JSON)")
     _add_scene_arguments(solve)
     solve.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of text")
+    _add_limits_argument(solve)
     solve.set_defaults(func=cmd_solve)
 
     forces = sub.add_parser("forces", help="driver torques and joint reactions at the scene's pose (inverse dynamics)")
@@ -84,6 +96,14 @@ def build_parser() -> argparse.ArgumentParser:
     _add_output_arguments(sweep)
     sweep.add_argument("--links", nargs="*", help="links to plot (default: all moving but the driver's)")
     sweep.add_argument("--points", nargs="*", help="points to plot (default: all moving points)")
+    sweep.add_argument("--paths", dest="paths_path",
+                       help="also draw the points' paths, with the mechanism at the scene's pose, here (PNG, PDF, SVG)")
+    sweep.add_argument("--angles", choices=("continuous", "wrapped"), default="continuous",
+                       help="link angles in the figure: continuous (default, no jump at 180 deg) or wrapped "
+                       "to (-180, 180] deg")
+    sweep.add_argument("--path-plane", choices=("xy", "yz", "zx", "3d"),
+                       help="a spatial mechanism's paths projected on this world plane (default xy), or 3d")
+    _add_limits_argument(sweep)
     sweep.add_argument("--skip-failures", action="store_true",
                        help="report a pose that cannot close as a row with its error instead of stopping")
     sweep.add_argument("--start", dest="start_mode", choices=("predictor", "warm", "cold"),
@@ -118,6 +138,7 @@ def build_parser() -> argparse.ArgumentParser:
     path.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                       help="override a scene value (repeatable)")
     _add_path_arguments(path, required=False)
+    _add_limits_argument(path)
     _add_output_arguments(path)
     path.set_defaults(func=cmd_path)
 
@@ -140,9 +161,33 @@ def build_parser() -> argparse.ArgumentParser:
     anim.add_argument("--no-grid", action="store_true", help="hide meshcat's grid and axes")
     anim.set_defaults(func=cmd_animate)
 
+    poly = sub.add_parser("polygon", help="draw the velocity (or acceleration) polygon of a planar pose as SVG")
+    poly.add_argument("scene", help="scene file (TOML), e.g. models/scenes/r_rtr.toml")
+    poly.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                      help="override a scene value, e.g. --set 'drivers.A.acceleration=\"2 rad/s^2\"' (repeatable)")
+    poly.add_argument("--angle", help="shortcut: the (single) driver's angle or position, e.g. '45 deg'")
+    poly.add_argument("--speed", help="shortcut: the driver's speed, e.g. '-50 rpm'")
+    poly.add_argument("-o", "--output", required=True, help="the SVG file to write")
+    poly.add_argument("--acceleration", dest="acceleration_polygon", action="store_true",
+                      help="the acceleration polygon (normal, tangential and Coriolis parts) instead; the "
+                      "driver's acceleration comes from the scene or --set")
+    poly.set_defaults(func=cmd_polygon)
+
+    page = sub.add_parser("report", help="write one offline HTML page: drawing, tables, polygons, sweep figures")
+    _add_scene_arguments(page)
+    page.add_argument("-o", "--output", required=True, help="the HTML file to write")
+    page.add_argument("--hand", help="a hand-value file to check on the page (as pinmech check)")
+    page.add_argument("--steps", type=int, default=121, help="poses of the sweep drawn (default 121; 0: none)")
+    page.set_defaults(func=cmd_report)
+
     live = sub.add_parser("view", help="show the solved pose in a live meshcat server (a browser tab)")
     _add_scene_arguments(live)
     live.set_defaults(func=cmd_view)
+
+    build = sub.add_parser("build", help="write the URDF (with <constraint> loop cuts) of a linkage drawn in TOML")
+    build.add_argument("linkage", help="linkage file (TOML), e.g. models/linkages/jansen.toml")
+    build.add_argument("-o", "--output", required=True, help="the URDF file to write")
+    build.set_defaults(func=cmd_build)
 
     check = sub.add_parser("check", help="compare hand-calculated values with pinmech")
     check.add_argument("hand_file", help="hand-value file (TOML), e.g. models/scenes/r_rtr.hand.toml")
@@ -175,11 +220,18 @@ def _scene(args: argparse.Namespace):
 
 def cmd_solve(args: argparse.Namespace) -> int:
     """`pinmech solve SCENE`: the textbook-ordered report, or `--json`."""
-    from pinmech.analysis import analyse
+    from pinmech.analysis import analyse, limit_mode
+    from pinmech.limits import enforce, limit_violations
     from pinmech.report import to_json, to_text
 
-    analysis = analyse(_scene(args))
+    scene = _scene(args)
+    mode = limit_mode(scene, args.limits)
+    analysis = analyse(scene)
+    violations = limit_violations(analysis.mechanism, analysis.motion)
+    enforce(violations, mode, str(scene.path))
     print(to_json(analysis) if args.json else to_text(analysis), end="" if not args.json else "\n")
+    for v in violations:
+        print(f"pinmech: warning: {v.describe()} (URDF <limit>)", file=sys.stderr)
     return 0
 
 
@@ -211,13 +263,14 @@ def _sweep_forces(args: argparse.Namespace, scene, sweep):
 def cmd_sweep(args: argparse.Namespace) -> int:
     """`pinmech sweep SCENE`: every pose of a cycle, streamed as CSV (and JSON lines, a plot);
     a task scene is followed in time instead (as `pinmech path`)."""
-    import numpy as np
-
-    from pinmech.sweep import Sweep, sweep_options
+    from pinmech.analysis import limit_mode
+    from pinmech.limits import limit_violations
+    from pinmech.sweep import DriverValues, Sweep, sweep_options
 
     scene = _scene(args)
     if "task" in scene.raw:
         return _follow(args, scene)
+    figure = _check_outputs(args, scene)
     options = sweep_options(scene)
     steps = args.steps if args.steps is not None else options.get("steps", 361)
     if steps < 2:
@@ -242,18 +295,23 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         sweep.solver.max_iterations = args.max_iterations
     mode = "cold" if args.cold_start else "warm" if args.no_predictor else args.start_mode or options.get("start")
     interpolate = args.interpolate if args.interpolate is not None else options.get("interpolate", 1)
-    poses = sweep.poses(np.linspace(start, stop, steps), skip_failures=args.skip_failures,
+    poses = sweep.poses(DriverValues(start, stop, steps), skip_failures=args.skip_failures,
                         start=mode or "predictor", batch=not args.no_batch and options.get("batch", True),
                         interpolate=interpolate, through_folds=args.through_folds)
     forces = _sweep_forces(args, scene, sweep)
-    sinks = _sweep_sinks(args, sweep, steps, forces)
+    limits = _LimitWatch(limit_mode(scene, args.limits), "poses")
+    sinks = _sweep_sinks(args, sweep, steps, figure, forces)
     with sinks:
         for pose in _progress(poses, steps):
             if pose.note:
                 print(f"pinmech: at pose {pose.index}: {pose.note}", file=sys.stderr)
+            if pose.motion is not None:
+                limits.check(limit_violations(sweep.mechanism, pose.motion),
+                             f"at {sweep.driver} = {sweep._format(pose.value)}")
             sinks.add(pose)
     for line in forces.summary() if forces else []:
         print(line, file=sys.stderr)
+    limits.summary(steps)
     _say_return(sweep, stop - start)
     return 0
 
@@ -276,21 +334,49 @@ def _say_return(sweep, span: float) -> None:
               f"(largest joint gap {gap:.3g} rad or sizes): it returns after more turns", file=sys.stderr)
 
 
-def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, forces=None) -> _Sinks:
+class _LimitWatch:
+    """Poses (or path points) that put a joint beyond its URDF <limit>: counted and summed
+    up in a warning, or the run stopped at the first (LimitError) in mode "error"."""
+
+    def __init__(self, mode: str, what: str, column: str = "; see the beyond_limits column") -> None:
+        self.mode, self.what, self.column = mode, what, column
+        self.count, self.first = 0, ""
+
+    def check(self, violations: list, at: str) -> None:
+        from pinmech.limits import enforce
+
+        if violations:
+            enforce(violations, self.mode, f"stopped {at}")
+            self.count += 1
+            self.first = self.first or f"{at}: " + "; ".join(v.describe() for v in violations)
+
+    def summary(self, total: int) -> None:
+        if self.count:
+            print(f"pinmech: warning: {self.count} of {total} {self.what} put joints beyond their URDF <limit> "
+                  f"(first {self.first}){self.column}", file=sys.stderr)
+
+
+def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | None, forces=None) -> Outputs:
     from pinmech.tables import SweepCsv, SweepJsonLines
 
     csv_kind, json_kind, source = SweepCsv, SweepJsonLines, sweep
-    sinks = _Sinks()
+    sinks = Outputs()
     if forces is not None:
         from pinmech.forces_sweep import ForceCsv, ForceJsonLines, TorquePlot
 
         csv_kind, json_kind, source = ForceCsv, ForceJsonLines, forces
-        sinks.plot(TorquePlot(forces), args.torque_plot)  # collects every pose's forces; drawn if a path is given
-    if args.plot_path:
+        torque = plot_path(args.torque_plot, "--torque-plot") if args.torque_plot else None
+        sinks.plot(TorquePlot(forces), torque)  # collects every pose's forces; drawn if a path is given
+    if figure is not None or args.paths_path:
         from pinmech.plot import SweepPlot
 
-        sinks.plot(SweepPlot(sweep, links=args.links, points=args.points, total=steps), args.plot_path)
-    only_figures = args.plot_path or args.json_path or (forces is not None and args.torque_plot)
+        recorder = SweepPlot(sweep, links=args.links, points=args.points, total=steps, angles=args.angles,
+                             plane=args.path_plane)
+        if figure is not None:
+            sinks.plot(recorder, figure)
+        if args.paths_path:
+            sinks.plot(_PathsFigure(recorder, feed=figure is None), args.paths_path)
+    only_figures = args.plot_path or args.json_path or args.paths_path or (forces is not None and args.torque_plot)
     if args.csv_path or not only_figures:
         sinks.table(csv_kind, source, args.csv_path, "poses")
     if args.json_path:
@@ -298,50 +384,42 @@ def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, forces=None) -> _S
     return sinks
 
 
-class _Sinks:
-    """Where streamed rows go (CSV, JSON lines, a figure), closed together; each output
-    file says on stderr what was written."""
+class _PathsFigure:
+    """The paths figure of a sweep's recorder (fed once, whoever feeds it)."""
 
-    def __init__(self) -> None:
-        self.tables: list = []
-        self.files: list = []
-        self.figures: list = []
+    def __init__(self, recorder, *, feed: bool) -> None:
+        self.recorder, self.feed = recorder, feed
 
-    def table(self, kind, source, path: str | None, what: str | None) -> None:
-        stream = open(path, "w", newline="", encoding="utf-8") if path else sys.stdout  # noqa: SIM115
-        if path:
-            self.files.append(stream)
-        self.tables.append((kind(source, stream), path, what))
+    def add(self, pose) -> None:
+        if self.feed:
+            self.recorder.add(pose)
 
-    def plot(self, recorder, path: str | None) -> None:
-        self.figures.append((recorder, path))
+    def save(self, path: str):
+        return self.recorder.save_paths(path)
 
-    def add(self, row) -> None:
-        for table, _, _ in self.tables:
-            table.add(row)
-        for recorder, _ in self.figures:
-            recorder.add(row)
 
-    def __enter__(self) -> _Sinks:  # noqa: PYI034
-        return self
+def _check_outputs(args: argparse.Namespace, scene) -> Path | None:
+    """Before computing: the figure's format, one file per output, no output over an input.
+    Returns the figure's path (".png" added to a name without suffix)."""
+    figure = plot_path(args.plot_path) if args.plot_path else None
+    if getattr(args, "paths_path", None):
+        args.paths_path = plot_path(args.paths_path, "--paths")
+    torque = getattr(args, "torque_plot", None)
+    check_distinct({"--csv": args.csv_path, "--json": args.json_path, "--plot": figure,
+                    "--paths": getattr(args, "paths_path", None),
+                    "--torque-plot": plot_path(torque, "--torque-plot") if torque else None},
+                   {"the scene file": scene.path, "the URDF": _urdf_path(scene)})
+    return figure
 
-    def __exit__(self, kind, error, trace) -> None:
-        try:
-            if error is None:
-                for table, path, what in self.tables:
-                    count = table.close()
-                    if path and what:
-                        print(f"{count} {what} written to {path}", file=sys.stderr)
-                    elif path:
-                        print(f"JSON lines written to {path}", file=sys.stderr)
-                for recorder, path in self.figures:
-                    if path is None:  # a recorder that only collects (the forces of a sweep)
-                        continue
-                    recorder.save(path)
-                    print(f"figure written to {path}", file=sys.stderr)
-        finally:
-            for stream in self.files:
-                stream.close()
+
+def _urdf_path(scene) -> Path:
+    """The model file the scene names (a URDF, a drawn linkage, an MJCF file): an input
+    that no output may overwrite."""
+    try:
+        kind = scene.model_kind
+        return scene.urdf if kind in ("urdf", "robot") else scene.model_file(kind)
+    except (PinmechError, StopIteration):
+        return scene.path
 
 
 def _progress(items, total: int):
@@ -364,15 +442,17 @@ def cmd_path(args: argparse.Namespace) -> int:
 
 def _follow(args: argparse.Namespace, scene) -> int:
     """A task scene followed in time: CSV (JSON lines, a figure) of the joint trajectory."""
-    from pinmech.analysis import load_mechanism
+    from pinmech.analysis import limit_mode, load_mechanism
     from pinmech.analysis_task import scene_pose, scene_tasks
-    from pinmech.path import follow_path
+    from pinmech.limits import limits_at
+    from pinmech.path import check_timing, follow_path, step_count
     from pinmech.sweep import sweep_options
     from pinmech.tables import PathCsv
 
     if "task" not in scene.raw:
         raise PinmechError(f"{scene.path}: no [[task]] to follow; a scene with [drivers] is swept: "
                            "pinmech sweep SCENE")
+    figure = _check_outputs(args, scene)
     options = sweep_options(scene)
     duration_text = args.duration or options.get("duration")
     if not duration_text:
@@ -384,25 +464,30 @@ def _follow(args: argparse.Namespace, scene) -> int:
         raise PinmechError(f"need 0 < --step <= --duration, got step {step} s, duration {duration} s")
     scheme = args.scheme or options.get("scheme", "taylor")
     gain = args.gain if args.gain is not None else float(options.get("gain", 0.0))
+    check_timing(duration, step, gain, names=("--duration", "--step", "--gain" if args.gain is not None
+                                              else f"{scene.path}: [sweep] gain"))
     mechanism = load_mechanism(scene)
     q0, _, _ = scene_pose(scene, mechanism)
-    total = round(duration / step) + 1
-    sinks = _Sinks()
+    total = step_count(duration, step) + 1
+    sinks = Outputs()
     if args.plot_path:
         from pinmech.plot import PathPlot
 
         note = f" ({scheme}, step {step:g} s" + (f", feedback {gain:g}/s)" if gain else ")")
-        sinks.plot(PathPlot(mechanism, scene.title, note=note, total=total), args.plot_path)
+        sinks.plot(PathPlot(mechanism, scene.title, note=note, total=total), figure)
     if args.csv_path or not (args.plot_path or args.json_path):
         sinks.table(PathCsv, mechanism, args.csv_path, "path points")
     if args.json_path:
         sinks.table(_PathJsonLines, mechanism, args.json_path, None)
     worst = 0.0
+    limits = _LimitWatch(limit_mode(scene, getattr(args, "limits", None)), "path points", "")
     with sinks:
         for point in _progress(follow_path(mechanism, scene_tasks(scene), q0, duration=duration, step=step,
                                            gain=gain, scheme=scheme), total):
+            limits.check(limits_at(mechanism, point.q), f"at t = {point.time:.6g} s")
             sinks.add(point)
             worst = max(worst, point.drift)
+    limits.summary(total)
     print(f"largest drift of the path from the one asked: {worst:.3e} m", file=sys.stderr)
     return 0
 
@@ -412,10 +497,22 @@ _ARROW_UNITS = {"velocity": "m/s", "acceleration": "m/s^2"}
 
 
 def _visuals(mechanism):
-    """The mechanism's visual geometry, built only when drawing."""
-    from pinmech.draw import load_visuals
+    """The mechanism's visual geometry, built only when drawing: meshes of the model's own
+    package only (the others named on stderr), links without visuals sketched."""
+    from pinmech.draw import package_visuals
+    from pinmech.draw.sketch import sketch_visuals
 
-    return load_visuals(mechanism.source, mechanism.model)
+    path = mechanism.urdf_path or mechanism.source
+    if str(path).endswith(".xml"):
+        from pinmech.mjcf import mjcf_visuals
+
+        visuals = mjcf_visuals(path, mechanism.model)
+    else:
+        visuals, skipped = package_visuals(path, mechanism.model)
+        for mesh in skipped:
+            print(f"pinmech: warning: mesh {mesh} left out of the drawing: it is outside the model's package",
+                  file=sys.stderr)
+    return sketch_visuals(mechanism, visuals)
 
 
 def cmd_snapshot(args: argparse.Namespace) -> int:
@@ -423,7 +520,9 @@ def cmd_snapshot(args: argparse.Namespace) -> int:
     from pinmech.analysis import analyse
     from pinmech.draw import Arrow, snapshot_html
 
-    analysis = analyse(_scene(args))
+    scene = _scene(args)
+    _check_page(args, scene)
+    analysis = analyse(scene)
     points = {n: p.position for n, p in analysis.motion.points.items()}
     arrows = []
     for spec in args.arrows:
@@ -441,22 +540,26 @@ def cmd_snapshot(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Most frames `pinmech animate` puts in one page (each frame keeps every link's placement).
+_MAX_FRAMES = 20_000
+
+
 def cmd_animate(args: argparse.Namespace) -> int:
     """`pinmech animate SCENE -o FILE.html`: a driver cycle, each frame a solved, closed pose."""
-    import numpy as np
-
     from pinmech.draw import animation_html
-    from pinmech.sweep import Sweep
+    from pinmech.sweep import DriverValues, Sweep
 
     scene = _scene(args)
+    _check_page(args, scene)
     sweep = Sweep.from_scene(scene)
     kind = "angle" if sweep.is_angular else "length"
     start = scene.quantity(args.start, kind, "--from") if args.start else sweep.start
     stop = scene.quantity(args.stop, kind, "--to") if args.stop else start + (sweep.default_values(2)[1] - sweep.start)
-    if args.steps < 2:
-        raise PinmechError(f"--steps must be at least 2, got {args.steps}")
+    if not 2 <= args.steps <= _MAX_FRAMES:
+        raise PinmechError(f"--steps must be between 2 and {_MAX_FRAMES} frames (each is kept in the page), "
+                           f"got {args.steps}")
     qs = []
-    for pose in sweep.poses(np.linspace(start, stop, args.steps), skip_failures=args.skip_failures):
+    for pose in sweep.poses(DriverValues(start, stop, args.steps), skip_failures=args.skip_failures):
         if pose.motion is not None:
             qs.append(sweep.last_q.copy())
     if not qs:
@@ -464,6 +567,56 @@ def cmd_animate(args: argparse.Namespace) -> int:
     mechanism = sweep.mechanism
     _write(args.output, animation_html(mechanism.model, _visuals(mechanism), qs, fps=args.fps,
                                        plane_normal=mechanism.plane_normal, show_grid=not args.no_grid))
+    return 0
+
+
+def cmd_polygon(args: argparse.Namespace) -> int:
+    """`pinmech polygon SCENE -o v.svg [--acceleration]`: the graphical method's polygon."""
+    from pinmech.analysis import analyse
+    from pinmech.draw.polygon_svg import polygon_svg
+    from pinmech.polygon import acceleration_polygon, velocity_polygon
+
+    args.acceleration = None  # the flag names the polygon here, not the driver's acceleration
+    analysis = analyse(_scene(args))
+    polygon = (acceleration_polygon if args.acceleration_polygon else velocity_polygon)(analysis)
+    _write_text(args.output, polygon_svg(polygon), "SVG drawing")
+    return 0
+
+
+def cmd_report(args: argparse.Namespace) -> int:
+    """`pinmech report SCENE -o page.html [--hand FILE]`: everything about the scene on one offline page."""
+    from pinmech.analysis import analyse
+    from pinmech.draw.report_page import report_html
+
+    if args.steps < 0 or args.steps == 1:
+        raise PinmechError(f"--steps must be 0 (no sweep) or at least 2, got {args.steps}")
+    hand_text = None
+    analysis = analyse(_scene(args))
+    if args.hand:
+        from pinmech.check import DEFAULT_SLACK, compare, format_verdicts, load_hand_file
+        from pinmech.report import to_dict
+        from pinmech.scene import Scene
+
+        hand = load_hand_file(args.hand)
+        checked = analyse(Scene.load(hand.scene))
+        verdicts = compare(to_dict(checked), hand.values, DEFAULT_SLACK)
+        hand_text = f"{hand.source or hand.path}  vs  pinmech on {hand.scene.name}\n" + format_verdicts(verdicts)
+    _write_text(args.output, report_html(analysis, steps=args.steps, hand_text=hand_text), "offline page")
+    return 0
+
+
+def cmd_build(args: argparse.Namespace) -> int:
+    """`pinmech build LINKAGE -o FILE.urdf`: the URDF of a drawn linkage, written whole or not at all."""
+    from pinmech.linkage import build_urdf
+    from pinmech.linkage_urdf import spanning_tree
+
+    try:
+        linkage = build_urdf(args.linkage, args.output)
+    except OSError as exc:
+        raise PinmechError(f"cannot write {args.output}: {exc.strerror or exc}") from exc
+    cuts = [edge.name for edge in spanning_tree(linkage).cuts]
+    print(f"{args.output} written: {len(linkage.links) - 1} links, {len(linkage.edges) - len(cuts)} tree joints, "
+          f"loop cuts: {', '.join(cuts) or 'none'}")
     return 0
 
 
@@ -485,9 +638,28 @@ def cmd_view(args: argparse.Namespace) -> int:
     return 0
 
 
+def _write_text(path: str, text: str, what: str) -> None:
+    """Write a whole file at once (a failed write leaves no half file behind) and say so."""
+    import os
+    import tempfile
+
+    folder = os.path.dirname(os.path.abspath(path))
+    with tempfile.NamedTemporaryFile("w", encoding="utf-8", dir=folder, delete=False, suffix=".part") as stream:
+        stream.write(text)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(stream.name, 0o666 & ~umask)  # as open() would make it, not the temporary file's 0600
+    os.replace(stream.name, path)
+    print(f"wrote {path} ({what}, {max(1, len(text) // 1024)} KB)", file=sys.stderr)
+
+
+def _check_page(args: argparse.Namespace, scene) -> None:
+    """Before computing: the page's file can be made and is not an input."""
+    check_distinct({"-o": args.output}, {"the scene file": scene.path, "the URDF": _urdf_path(scene)})
+
+
 def _write(path: str, html: str) -> None:
-    with open(path, "w", encoding="utf-8") as stream:
-        stream.write(html)
+    write_whole(path, html)
     print(f"wrote {path} ({len(html) // 1024} KB, offline: open it in any browser)", file=sys.stderr)
 
 
@@ -512,13 +684,18 @@ class _PathJsonLines:
 def cmd_check(args: argparse.Namespace) -> int:
     """`pinmech check HAND_FILE`: hand values against pinmech, non-zero exit on a mismatch."""
     from pinmech.analysis import analyse
-    from pinmech.check import DEFAULT_SLACK, compare, format_verdicts, load_hand_file
+    from pinmech.check import DEFAULT_SLACK, check_slack, compare, format_verdicts, load_hand_file
     from pinmech.report import to_dict
     from pinmech.scene import Scene
 
+    slack = args.slack if args.slack is not None else DEFAULT_SLACK
+    try:
+        check_slack(slack, "--slack")
+    except PinmechError as exc:  # a usage error (2), not a hand file's (4)
+        raise PinmechError(str(exc)) from None
     hand = load_hand_file(args.hand_file)
     analysis = analyse(Scene.load(hand.scene, args.overrides))
-    verdicts = compare(to_dict(analysis), hand.values, args.slack if args.slack is not None else DEFAULT_SLACK)
+    verdicts = compare(to_dict(analysis), hand.values, slack)
     print(f"{hand.source or hand.path}  vs  pinmech on {hand.scene.name}")
     print(format_verdicts(verdicts))
     return 1 if any(v.verdict == "MISMATCH" for v in verdicts) else 0
@@ -529,9 +706,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return args.func(args)
+        with SIGNALS.installed():
+            return args.func(args)
+    except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM, SIGHUP: one line, 128 + the signal's number
+        signum = getattr(exc, "signum", signal.SIGINT)
+        print(f"pinmech: interrupted by {signal.Signals(signum).name}: stopped{_kept(exc)}", file=sys.stderr)
+        return 128 + int(signum)
     except PinmechError as exc:
-        print(f"pinmech: error: {exc}", file=sys.stderr)
+        print(f"pinmech: error: {_one_line(exc)}{_kept(exc)}", file=sys.stderr)
         return exc.exit_code
     except ImportError as exc:
         print(f"pinmech: error: {exc}", file=sys.stderr)
@@ -539,8 +721,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # `pinmech sweep ... | head`
         return 0
     except OSError as exc:  # an output file that cannot be written (no such folder, no permission)
-        print(f"pinmech: error: {exc}", file=sys.stderr)
+        print(f"pinmech: error: {_one_line(exc)}{_kept(exc)}", file=sys.stderr)
         return 2
+
+
+def _one_line(error: BaseException) -> str:
+    """The error's message on one line (a library's message may run over several)."""
+    return " ".join(part.strip() for part in str(error).splitlines() if part.strip())
+
+
+def _kept(error: BaseException) -> str:
+    """The partial output files a failed run kept (outputs.py), for its one line."""
+    kept = getattr(error, "kept", [])
+    return f"; incomplete output kept in {', '.join(kept)}" if kept else ""
 
 
 if __name__ == "__main__":  # pragma: no cover

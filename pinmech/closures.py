@@ -151,8 +151,9 @@ class Closure:
         Needs `pin.computeJointJacobians` and `pin.updateFramePlacements` at q.
         """
         M_P, M_C = data.oMf[self.parent_frame], data.oMf[self.child_frame]
-        J_P = pin.getFrameJacobian(model, data, self.parent_frame, _LWA)
-        J_C = pin.getFrameJacobian(model, data, self.child_frame, _LWA)
+        # (6, nv) even for a one-dof model, where Pinocchio returns a (6,) vector
+        J_P = pin.getFrameJacobian(model, data, self.parent_frame, _LWA).reshape(6, -1)
+        J_C = pin.getFrameJacobian(model, data, self.child_frame, _LWA).reshape(6, -1)
         delta = M_C.translation - M_P.translation
         R_T = M_P.rotation.T
         linear = R_T @ (J_C[:3] - J_P[:3] + pin.skew(delta) @ J_P[3:])
@@ -247,12 +248,14 @@ class CutEvaluator:
             self._ang_axis = ang_axis @ M_P.rotation.T
             self._full_axis = full_axis @ M_P.rotation.T
 
-    def refresh(self) -> None:
+    def refresh(self) -> bool:
         """Fold a ground cut frame's placement again if the model's frame was moved since
-        (nothing is cached that the model can change). Solvers call it once per call of
-        their public methods (under a microsecond), not per pose."""
+        (nothing is cached that the model can change); True when it was. Solvers call it
+        once per call of their public methods (under a microsecond), not per pose."""
         if self._ground and not self._frame.placement == self._M_ground:
             self._fold(self._frame.placement.copy())
+            return True
+        return False
 
     def _set_parent(self, R_P: np.ndarray, p_P: np.ndarray) -> None:
         self._R_P, self._p_P = R_P, p_P

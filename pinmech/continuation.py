@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from pinmech.exceptions import AssemblyError, DriverLimitError, LoopClosureError, PinmechError
+from pinmech.exceptions import AssemblyError, DriverLimitError, PinmechError
 
 #: Largest step, in radians or mechanism sizes of driver motion.
 MAX_STEP = 0.25
@@ -51,6 +51,9 @@ FOLD_TOL = 1e-12
 #: A pose conditioned worse than this is no place to stand on: its tangent is noise (it
 #: sits on a crossing or a fold to within 1e-10), so a step does not end there.
 SINGULAR_NODE = 1e10
+#: Landing on a target from the pivot-parametrized curve: bisection along it until the
+#: bracket is this small in driver motion (radians or sizes).
+LAND_TOL = 1e-12
 #: Pivot-parameter steps taken at most before giving up.
 MAX_PIVOT_STEPS = 20000
 
@@ -71,6 +74,7 @@ class Node:
     velocity_residual: float = 0.0
     acceleration_residual: float = 0.0
     residual: float = 0.0  # closure residual left at q (dimensionless)
+    tangent: tuple[np.ndarray, float] | None = None  # (q' scaled, |(q', unit)|): see Path._turn
 
 
 @dataclass
@@ -188,13 +192,17 @@ class Path:
         return min(TRUST, 2.0 * abs(h) * self.unit)
 
     def _turn(self, a: Node, b: Node) -> float:
-        """Angle between the extended tangents (q', 1) of two nodes, dimensionless."""
-        s = self.solver._v_scale_inv
-        ta, tb = (a.d1 * s).tolist(), (b.d1 * s).tolist()
-        u2 = self.unit * self.unit
-        dot = sum(x * y for x, y in zip(ta, tb)) + u2
-        norms = math.sqrt((sum(x * x for x in ta) + u2) * (sum(y * y for y in tb) + u2))
-        return math.acos(max(-1.0, min(1.0, dot / norms)))
+        """Angle between the extended tangents (q', 1) of two nodes, q' in radians or sizes
+        per unit of p and the 1 as `unit` (radians or sizes of driver motion)."""
+        (ta, na), (tb, nb) = self._tangent(a), self._tangent(b)
+        cos = (float(ta @ tb) + self.unit * self.unit) / (na * nb)
+        return math.acos(max(-1.0, min(1.0, cos)))
+
+    def _tangent(self, node: Node) -> tuple[np.ndarray, float]:
+        if node.tangent is None:
+            t = node.d1 * self.solver._v_scale_inv
+            node.tangent = (t, math.sqrt(float(t @ t) + self.unit * self.unit))
+        return node.tangent
 
     # ------------------------------------------------------------------ pivot
     def _pivot_follow(self, node: Node, p_target: float, route: Route, why: str) -> tuple[Node, float]:
@@ -211,7 +219,7 @@ class Path:
             if nxt.dp * state.dp <= 0:  # the driver turned back: a fold in between
                 fold = curve.locate_fold(state, nxt)
                 if (fold.p - p_target) * sense >= 0:  # the target comes before the fold
-                    return self._land(state, fold, p_target), p_target
+                    return self._land(curve, state, fold, p_target), p_target
                 x_fold = self.drivers(fold.p)
                 if not self.through_folds:
                     raise DriverLimitError(
@@ -225,13 +233,26 @@ class Path:
                 p_target = 2.0 * fold.p - p_target
                 sense = -sense
             elif (nxt.p - p_target) * sense >= 0:  # passed the target: close there
-                return self._land(state, nxt, p_target), p_target
+                return self._land(curve, state, nxt, p_target), p_target
             state = curve.repivot(nxt)
         raise self._stuck(node, why)
 
-    def _land(self, a: _CurvePoint, b: _CurvePoint, p_target: float) -> Node:
-        """The pose at p_target between two curve points that bracket it."""
-        w = (p_target - a.p) / (b.p - a.p)
+    def _land(self, curve: _Curve, a: _CurvePoint, b: _CurvePoint, p_target: float) -> Node:
+        """The pose at p_target between two curve points that bracket it (p monotonic
+        between them): bisection along the curve until the driver is within LAND_TOL
+        of the target, then Newton with the drivers held, from a pose that close to
+        one root only (near a fold the other root is only sqrt(distance) away)."""
+        for _ in range(60):
+            if abs(b.p - a.p) * self.unit <= LAND_TOL:
+                break
+            mid = curve.point_at(a, 0.5 * (a.s + b.s))
+            if mid is None:
+                break
+            if (mid.p - p_target) * (a.p - p_target) > 0:
+                a = mid
+            else:
+                b = mid
+        w = (p_target - a.p) / (b.p - a.p) if b.p != a.p else 0.0
         model = self.solver.model
         guess = pin.integrate(model, a.q, w * pin.difference(model, a.q, b.q))
         q, residual = self.solver.correct(guess, self.drivers(p_target), max_iterations=50, strict=False)
@@ -412,5 +433,3 @@ class _Curve:
 def _signs(signs: tuple[int, ...]) -> str:
     return "(" + ", ".join("+" if s > 0 else "-" if s < 0 else "0" for s in signs) + ")"
 
-
-__all__ = ["Node", "Path", "Route", "LoopClosureError"]

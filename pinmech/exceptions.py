@@ -206,3 +206,34 @@ class RateOverflowError(PinmechError):
 
     exit_code = 2
 
+
+class Interrupted(KeyboardInterrupt):
+    """The run was stopped by a signal: Ctrl-C (SIGINT), SIGTERM or SIGHUP (the terminal
+    closed). A KeyboardInterrupt, so code that stops on Ctrl-C stops on all three.
+
+    Attributes:
+        signum: the signal's number.
+        exit_code: 128 + signum, as a shell reports a process a signal stopped (130 for Ctrl-C).
+    """
+
+    def __init__(self, signum: int):
+        import signal
+
+        self.signum = int(signum)
+        self.exit_code = 128 + self.signum
+        super().__init__(f"interrupted by {signal.Signals(self.signum).name}")
+
+
+class LimitError(PinmechError):
+    """A solved pose puts a joint beyond its URDF `<limit>`, and limits were asked to be
+    errors (`--limits error`); by default they are reported as warnings.
+
+    Attributes:
+        violations: the `LimitViolation`s (joint, value, lower, upper; SI).
+    """
+
+    exit_code = 12
+
+    def __init__(self, message: str, *, violations: list[Any]):
+        super().__init__(message)
+        self.violations = violations

@@ -19,14 +19,17 @@ import os
 import sys
 import tempfile
 import xml.etree.ElementTree as ET
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
 from pinmech.closures import CUT_TYPES, Closure
 from pinmech.exceptions import FrameNotFound, ModelError
+from pinmech.urdf_joints import JointLimit, MimicJoint, joint_limits, mimic_joints, with_followers
 
 #: Singular values below this fraction of the largest mark a row as structurally zero.
 STRUCTURAL_RANK_TOL = 1e-9
@@ -76,6 +79,15 @@ class Mechanism:
             joints and the frames they move; never a frame that closes no loop.
         plane_normal: unit normal of the motion plane for a planar mechanism, else None.
         locked: joints locked out of the model, with their values (SI).
+        urdf_path: the URDF the model was built from, when `source` is another file (a
+            linkage drawn in TOML, an MJCF file): drawings read their visuals from it.
+        reference: the reference configuration (the drawn pose of a linkage), else None
+            (the neutral configuration is the reference).
+        motors: the actuated joints a file names (a Gepetto sidecar's name_mot): the
+            default drivers.
+        mimics: joints following another one (URDF `<mimic>`) and still moving.
+        limits: name -> position limits of the URDF's `<limit>` [rad or m],
+            for the revolute and prismatic joints that give them (locked ones included).
     """
 
     model: pin.Model
@@ -87,6 +99,12 @@ class Mechanism:
     plane_normal: np.ndarray | None
     source: str = "<model>"
     locked: dict[str, float] = field(default_factory=dict)
+    urdf_path: str | None = None
+    reference: np.ndarray | None = None
+    motors: list[str] = field(default_factory=list)
+    _rank: object = field(default=None, repr=False, compare=False)
+    mimics: dict[str, MimicJoint] = field(default_factory=dict)
+    limits: dict[str, JointLimit] = field(default_factory=dict)
 
     # ---------------------------------------------------------------- construction
     @classmethod
@@ -97,6 +115,7 @@ class Mechanism:
         locked: dict[str, float] | None = None,
         package_dirs: list[str] | None = None,
         root_joint: str | None = None,
+        reference: dict[str, float] | None = None,
     ) -> Mechanism:
         """Load a URDF with its `<constraint>` loop cuts.
 
@@ -110,6 +129,8 @@ class Mechanism:
                 (a floating base, joint "root_joint", nq 7 / nv 6, as example-robot-data
                 builds humanoids). A free flyer cannot be locked by one value: leave it
                 out (None) when a scene holds the base still.
+            reference: joint name -> coordinate [rad or m] of a closed reference pose (a
+                linkage's drawn pose); the others stay at zero. Default: all zero.
 
         Raises:
             ModelError: malformed XML or URDF, or a malformed `<constraint>`.
@@ -118,8 +139,12 @@ class Mechanism:
         path = Path(path)
         source = str(path)
         root = _parse_xml(path)
-        full = _build_model(source, root_joint)
-        model = _lock_joints(full, locked or {}, source)
+        _check_locked(locked or {}, source)
+        mimics = mimic_joints(root, source)
+        full = _build_model(source, root_joint, mimic=bool(mimics))
+        locked = with_followers(dict(locked or {}), mimics, source)
+        model = _lock_joints(full, locked, source)
+        _check_size(model, source)
         if model.nv == 0:
             held = f" once {', '.join(locked)} are locked" if locked else ""
             raise ModelError(f"no joint of the model moves{held}: nothing to solve", path=source)
@@ -146,12 +171,115 @@ class Mechanism:
             plane_normal=None,
             source=source,
             locked=dict(locked or {}),
+            mimics={n: m for n, m in mimics.items() if n not in (locked or {})},
         )
+        mech.limits = {n: lu for n, lu in joint_limits(root, source).items() if n in mech.joints or n in mech.locked}
         mech.closures = [_make_closure(model, c) for c in cuts]
         mech.length_scale = _length_scale(model, mech.closures, source)
         _reduce_rows(mech)
         mech.plane_normal = _plane_normal(mech)
+        if reference:
+            q = pin.neutral(model)
+            for name, value in reference.items():
+                if name in mech.joints:
+                    mech.set_coordinate(q, name, value)
+            mech.reference = q
         return mech
+
+    @classmethod
+    def from_model(
+        cls,
+        model: pin.Model,
+        constraints: Sequence[Any] = (),
+        *,
+        names: Sequence[str] | None = None,
+        points: Sequence[str] | None = None,
+        source: str = "<model>",
+        reference: np.ndarray | None = None,
+        urdf_path: str | None = None,
+        locked: dict[str, float] | None = None,
+    ) -> Mechanism:
+        """A mechanism from a `pin.Model` and Pinocchio constraint models, as built in code.
+
+        Args:
+            model: the kinematic tree (copied: frames are added to the copy, not to it).
+            constraints: `pin.PointAnchorConstraintModel` (a ball joint: spherical cut),
+                `pin.FrameAnchorConstraintModel` (a weld: fixed cut), or the legacy
+                `pin.RigidConstraintModel` of type CONTACT_3D or CONTACT_6D.
+            names: the loop cuts' names (default: each constraint's name, else "loop1", ...).
+            points: frames reported as named points (default: every OP_FRAME, e.g. MJCF sites).
+            source: what to call the model in messages (its file).
+            reference: a configuration at which the loops close (default: neutral).
+            urdf_path: a URDF with the visuals, if any (for drawings).
+            locked: one-freedom joints to lock out, name -> value [rad or m]; the cuts on
+                them move to the nearest joint left moving.
+
+        Raises:
+            ModelError: an unknown constraint class or type, a joint id out of range, a
+                locked joint with several freedoms.
+            FrameNotFound: a locked joint the model lacks.
+        """
+        model = pin.Model(model)
+        from pinmech.anchors import anchor_closure, anchor_cut, lock_anchored
+
+        cuts = [anchor_cut(c, i, names, model, source) for i, c in enumerate(constraints)]
+        if locked:
+            model, cuts, reference = lock_anchored(model, cuts, locked, reference, source)
+        listed = [c.name for c in cuts]
+        for name in listed:
+            if listed.count(name) > 1:
+                raise ModelError(f"two constraints share the name '{name}'", path=source)
+        bodies = [f.name for f in model.frames if f.type == pin.FrameType.BODY]
+        joint_links = {}
+        for jid in range(1, model.njoints):
+            child = next((f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == jid),
+                         model.names[jid])
+            parent = next((f.name for f in model.frames if f.type == pin.FrameType.BODY
+                           and f.parentJoint == model.parents[jid]), "universe")
+            joint_links[model.names[jid]] = (parent, child)
+        if points is None:
+            points = [f.name for f in model.frames if f.type == pin.FrameType.OP_FRAME]
+        mech = cls(model=model, closures=[], joints=_joint_infos(model, joint_links),
+                   links={n: _body_frame(model, n) for n in bodies},
+                   points={n: model.getFrameId(n) for n in points}, length_scale=1.0, plane_normal=None,
+                   source=source, urdf_path=urdf_path, locked=dict(locked or {}))
+        mech.closures = [anchor_closure(model, cut, 1.0) for cut in cuts]  # each loop's size: below
+        mech.length_scale = _length_scale(model, mech.closures, source)
+        _reduce_rows(mech)
+        mech.plane_normal = _plane_normal(mech)
+        if reference is not None:
+            mech.reference = np.array(reference, dtype=float)
+            if mech.reference.shape != (model.nq,):
+                raise ModelError(f"reference has {mech.reference.size} coordinates, the model nq = {model.nq}",
+                                 path=source)
+        return mech
+
+    def check_independent(self) -> None:
+        """Refuse loops whose equations repeat each other: the loop solver needs them independent.
+
+        Raises:
+            ModelError: naming the cuts, the row count, the rank and the true mobility.
+        """
+        report = self.rank_report()
+        if report.rank < report.rows:
+            names = ", ".join(report.redundant) or ", ".join(c.name for c in self.closures)
+            raise ModelError(f"the loop cuts {names} repeat each other's equations ({report.rows} closure rows of "
+                             f"rank {report.rank} on the closed poses), so the mobility is {self.model.nv - report.rank}, "
+                             f"not {self.model.nv - report.rows}; pinmech's loop solver needs independent "
+                             f"equations: leave out one of {names} (and a link only it held, whose motion "
+                             f"repeats the others')", path=self.source)
+
+    def add_point(self, name: str, link: str, xyz: np.ndarray) -> int:
+        """Fix a named point on a link, at `xyz` [m] in the link's frame; its frame id.
+
+        Call before creating solvers: a `pin.Data` made earlier lacks the new frame.
+        """
+        body_id = self.links[link]
+        body = self.model.frames[body_id]
+        frame = pin.Frame(name, body.parentJoint, body_id, body.placement * pin.SE3(np.eye(3), np.asarray(xyz, float)),
+                          pin.FrameType.OP_FRAME)
+        self.points[name] = self.model.addFrame(frame, False)
+        return self.points[name]
 
     # ---------------------------------------------------------------- look-ups
     def joint(self, name: str) -> JointInfo:
@@ -187,8 +315,33 @@ class Mechanism:
 
     @property
     def mobility(self) -> int:
-        """Degrees of freedom left once every loop is closed (Gruebler, from ranks)."""
-        return self.model.nv - self.constraint_rows
+        """Degrees of freedom left once every loop is closed: what the drivers must number.
+
+        The joint freedoms minus the rank of the closure rows on the closed poses near the
+        reference configuration (see `pinmech.mobility`): loops that repeat each other
+        (a double parallelogram) do not lower it twice.
+
+        Raises:
+            ModelError: the loops repeat each other's equations, which the loop solver cannot
+                take (the message gives the true mobility and the cuts to remove). A mechanism
+                with redundant loops still loads, for force analysis (`ForceSolver`).
+        """
+        self.check_independent()
+        return self.model.nv - self.rank_report().rank
+
+    def rank_report(self):
+        """The closure rows' rank on closed poses (computed once, then kept)."""
+        if self._rank is None:
+            from pinmech.mobility import constraint_rank
+
+            self._rank = constraint_rank(self)
+        return self._rank
+
+    def idle_joints(self, drivers: list[str]) -> list[str]:
+        """Joints the loops leave free to move while `drivers` are held (a spinning rod)."""
+        from pinmech.mobility import idle_joints
+
+        return idle_joints(self, drivers, self.rank_report().q)
 
     def velocity_scale(self) -> np.ndarray:
         """Per degree of freedom: a length [m] for translational freedoms, 1 for the others.
@@ -211,12 +364,21 @@ class Mechanism:
         return scale
 
     def neutral(self) -> np.ndarray:
-        """The model's neutral configuration (all joint coordinates zero)."""
+        """The reference configuration: a linkage's drawn pose, else all joint coordinates zero."""
+        if self.reference is not None:
+            return self.reference.copy()
         return pin.neutral(self.model)
 
     def set_coordinate(self, q: np.ndarray, name: str, value: float) -> None:
         """Write a joint's coordinate (angle [rad] or length [m]) into q, in place."""
         j = self.joint(name)
+        if name in self.mimics:
+            leader = self.mimics[name].leader
+            raise ModelError(f"joint '{name}' follows '{leader}' (URDF <mimic>): give {leader}'s value instead",
+                             path=self.source)
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.floating)) or not np.isfinite(value):
+            raise ModelError(f"joint '{name}': a coordinate must be a finite number (rad or m), got {value!r:.40}",
+                             path=self.source)
         if j.kind == "continuous":
             q[j.idx_q : j.idx_q + 2] = (np.cos(value), np.sin(value))
         elif j.nq == 1:
@@ -226,6 +388,9 @@ class Mechanism:
 
     def coordinate(self, q: np.ndarray, name: str) -> float:
         """A one-dof joint's coordinate (angle in (-pi, pi] for a continuous joint)."""
+        if name in self.mimics:
+            m = self.mimics[name]
+            return m.multiplier * self.coordinate(q, m.leader) + m.offset
         j = self.joint(name)
         if j.kind == "continuous":
             return float(np.arctan2(q[j.idx_q + 1], q[j.idx_q]))
@@ -237,6 +402,11 @@ def urdf_joint_types(path: str | Path) -> dict[str, str]:
     """Joint name -> URDF joint type ("revolute", "prismatic", ...), read from the XML."""
     root = _parse_xml(Path(path))
     return {j.get("name"): j.get("type") for j in root.findall("joint")}
+
+
+def urdf_mimic_leaders(path: str | Path) -> dict[str, str]:
+    """Follower -> leader of the URDF's `<mimic>` joints, read from the XML."""
+    return {n: m.leader for n, m in mimic_joints(_parse_xml(Path(path)), str(path)).items()}
 
 
 def _parse_xml(path: Path) -> ET.Element:
@@ -328,8 +498,9 @@ def _parse_constraint(el: ET.Element, model: pin.Model, links: list[str], source
 _ROOT_JOINTS = {"free_flyer": pin.JointModelFreeFlyer}
 
 
-def _build_model(source: str, root_joint: str | None = None) -> pin.Model:
-    """pin.buildModelFromUrdf, with urdfdom's own stderr chatter folded into the error."""
+def _build_model(source: str, root_joint: str | None = None, *, mimic: bool = False) -> pin.Model:
+    """pin.buildModelFromUrdf (honouring `<mimic>` when asked), with urdfdom's own stderr
+    chatter folded into the error."""
     if root_joint is not None and root_joint not in _ROOT_JOINTS:
         raise ModelError(f"root_joint must be None or one of {', '.join(_ROOT_JOINTS)}, got {root_joint!r}",
                          path=source)
@@ -340,7 +511,7 @@ def _build_model(source: str, root_joint: str | None = None) -> pin.Model:
             sys.stderr.flush()
             os.dup2(sink.fileno(), 2)
             try:
-                return pin.buildModelFromUrdf(source, *args)
+                return pin.buildModelFromUrdf(source, *args, mimic=mimic)
             except (ValueError, RuntimeError) as exc:
                 error = exc
         finally:
@@ -349,7 +520,18 @@ def _build_model(source: str, root_joint: str | None = None) -> pin.Model:
         sink.seek(0)
         said = " ".join(sink.read().decode(errors="replace").split())
     detail = f" ({said})" if said else ""
-    raise ModelError(f"Pinocchio cannot build the model: {error}{detail}", path=source) from error
+    message = " ".join(f"{error}{detail}".split())  # Pinocchio's messages run over several lines
+    raise ModelError(f"Pinocchio cannot build the model: {message}", path=source) from error
+
+
+def _check_locked(locked: dict[str, float], source: str) -> None:
+    """Every locked value is a finite number (SI), else a ModelError naming the joint."""
+    if not isinstance(locked, dict):
+        raise ModelError(f"locked must be a dict of joint name -> value (rad or m), got {locked!r:.60}", path=source)
+    for name, value in locked.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+            raise ModelError(f"locked joint '{name}' must be held at a finite number (rad or m), got {value!r:.40}",
+                             path=source)
 
 
 def _lock_joints(model: pin.Model, locked: dict[str, float], source: str) -> pin.Model:
@@ -362,17 +544,57 @@ def _lock_joints(model: pin.Model, locked: dict[str, float], source: str) -> pin
             raise FrameNotFound("joint to lock", name, [n for n in model.names[1:]], path=source)
         jid = model.getJointId(name)
         joint = model.joints[jid]
-        if not isinstance(value, (int, float, np.number)) or not np.isfinite(value):
-            raise ModelError(f"joint '{name}' cannot be locked at {value!r}: give a finite number (rad or m)",
-                             path=source)
-        if joint.nq == 2 and joint.nv == 1:
+        if joint.nq == 0 and "Mimic" in joint.shortname():
+            pass  # a follower: its leader, locked with it, sets where it is held
+        elif joint.nq == 2 and joint.nv == 1:
             q_ref[joint.idx_q : joint.idx_q + 2] = (np.cos(value), np.sin(value))
         elif joint.nq == 1:
             q_ref[joint.idx_q] = value
         else:
             raise ModelError(f"joint '{name}' has {joint.nq} coordinates and cannot be locked by one value", path=source)
         ids.append(jid)
-    return pin.buildReducedModel(model, ids, q_ref)
+    return _reduced(model, ids, q_ref)
+
+
+def _reduced(model: pin.Model, ids: list[int], q_ref: np.ndarray) -> pin.Model:
+    """pin.buildReducedModel, also when a locked joint has the name of a link (Pinocchio
+    then finds "several frames" by that name): such a joint is renamed while the model
+    is reduced, and its fixed frame named back."""
+    model = pin.Model(model)
+    renamed = {}
+    for jid in ids:
+        name = model.names[jid]
+        if sum(f.name == name for f in model.frames) > 1:
+            renamed[f"{name}__pinmech_locked"] = name
+            model.names[jid] = f"{name}__pinmech_locked"
+            for frame in model.frames:
+                if frame.name == name and frame.type == pin.FrameType.JOINT:
+                    frame.name = f"{name}__pinmech_locked"
+    reduced = pin.buildReducedModel(model, ids, q_ref)
+    for frame in reduced.frames:
+        frame.name = renamed.get(frame.name, frame.name)
+    return reduced
+
+
+#: Most degrees of freedom a model may keep. Pinocchio's `Data` allocates, whatever it is
+#: used for, four nv x nv x nv tensors (second derivatives of the inverse dynamics:
+#: d2tau_dqdq, d2tau_dvdv, d2tau_dqdv, d2tau_dadq; data.hxx) and a 6 x nv x nv one, so its
+#: size grows as nv^3: measured with Pinocchio 4.1, 69 MB at nv = 100, 0.5 GB at 200, 4 GB at
+#: 400 (62.5 bytes per nv^3, chains and stars alike). pinmech makes several Data; past this
+#: a model would exhaust memory (a 1,000-link chain: 62 GB) before anything is solved.
+MAX_DOF = 256
+_DATA_BYTES_PER_DOF_CUBED = 62.5
+
+
+def _check_size(model: pin.Model, source: str) -> None:
+    """Raises ModelError (one line, with the memory it would take) for a model with more
+    degrees of freedom than `MAX_DOF`, before Pinocchio tries to allocate its Data."""
+    if model.nv > MAX_DOF:
+        gigabytes = _DATA_BYTES_PER_DOF_CUBED * model.nv**3 / 1e9
+        raise ModelError(f"the model keeps {model.nv} degrees of freedom ({model.njoints - 1} joints); Pinocchio's "
+                         f"working data for it would take about {gigabytes:.3g} GB (it holds nv x nv x nv tensors of "
+                         f"second derivatives), so pinmech takes at most {MAX_DOF}: lock the joints the scene holds "
+                         "still ([lock], or move = [...])", path=source)
 
 
 def _joint_kind(joint: pin.JointModel) -> str:
@@ -425,6 +647,8 @@ def _translational(model: pin.Model, jid: int) -> list[int]:
     the neutral configuration): a prismatic joint's one, a planar joint's two, a floating
     joint's three."""
     joint = model.joints[jid]
+    if joint.nv == 0:  # a mimic follower: no freedom of its own
+        return []
     data = joint.createData()
     joint.calc(data, pin.neutral(model))
     S = np.array(data.S).reshape(6, joint.nv)
@@ -437,7 +661,7 @@ def _box(points: np.ndarray) -> float:
         return float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))) if len(points) else 0.0
 
 
-def _check_size(size: float, source: str) -> None:
+def _check_range(size: float, source: str) -> None:
     if not SIZE_RANGE[0] <= size <= SIZE_RANGE[1]:
         raise ModelError(f"the mechanism's size is {size:.3g} m, outside the {SIZE_RANGE[0]:g} to "
                          f"{SIZE_RANGE[1]:g} m pinmech can compute with (check the <origin> numbers)", path=source)
@@ -459,14 +683,14 @@ def _length_scale(model: pin.Model, closures: list[Closure], source: str) -> flo
     pin.framesForwardKinematics(model, data, pin.neutral(model))
     every = _box(np.array([f.translation for f in data.oMf]))
     if every != 0:
-        _check_size(every, source)
+        _check_range(every, source)
     for closure in closures:
         closure.joints = _loop_joints(model, closure)
         points = [data.oMi[j].translation for j in closure.joints]
         points += [data.oMf[closure.parent_frame].translation, data.oMf[closure.child_frame].translation]
         size = _box(np.array(points))
         closure.length_scale = size if size > 0 else (every or 1.0)
-        _check_size(closure.length_scale, source)
+        _check_range(closure.length_scale, source)
     if closures:
         return max(c.length_scale for c in closures)
     moving = [data.oMi[j].translation for j in range(1, model.njoints)]
@@ -556,7 +780,8 @@ def _plane_normal(mech: Mechanism) -> np.ndarray | None:
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
         for fid in range(model.nframes):
-            J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED) * columns
+            J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+            J = J.reshape(6, model.nv) * columns  # Pinocchio gives a 6 x 1 Jacobian as a vector
             angular.append(J[3:])
             linear.append(J[:3] / mech.length_scale)
     # A = hstack(angular) is 3 x (frames * nv). A = R^T Q^T, so A's U and s are those of the

@@ -12,12 +12,13 @@ import functools
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
 from pinmech.closures import _cross
-from pinmech.exceptions import FrameNotFound
+from pinmech.exceptions import FrameNotFound, ModelError
 from pinmech.mechanism import Mechanism
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -38,22 +39,28 @@ class LinkMotion:
     """Orientation, angular velocity [rad/s] and angular acceleration [rad/s^2] of a link.
 
     `angle` is the rotation about the mechanism's plane normal [rad] (planar mechanisms
-    only, else None): the angle of the link's x axis, as a textbook's phi.
+    only, else None): the angle of the link's x axis, as a textbook's phi, measured in the
+    plane. A link whose x axis is (nearly) normal to the plane has no such angle: its y
+    axis is measured instead (its z axis if y is too), and `angle_axis` says which.
     """
 
     rotation: np.ndarray
     angular_velocity: np.ndarray
     angular_acceleration: np.ndarray
     angle: float | None
+    angle_axis: str = "x"
 
 
 @dataclass(frozen=True)
 class JointMotion:
-    """Coordinate [rad or m], rate and acceleration of a one-dof joint."""
+    """Coordinate [rad or m], rate and acceleration of a one-dof joint; arrays for a joint of
+    several freedoms: a planar joint's (x [m], y [m], theta [rad]) and their rates, else
+    Pinocchio's configuration (a quaternion for a spherical or floating joint) and its
+    tangent rates (linear then angular, in the joint's frame)."""
 
-    q: float
-    v: float
-    a: float
+    q: float | np.ndarray
+    v: float | np.ndarray
+    a: float | np.ndarray
     kind: str
 
 
@@ -114,6 +121,14 @@ def evaluate_motion(
         links: links to report (default: all that move).
     """
     model = mechanism.model
+    for name, names in (("points", points), ("links", links)):
+        if isinstance(names, (str, bytes)):
+            raise ModelError(f"{name} must be a list of names, got the string {names!r}", path=mechanism.source)
+    q, v, a = (_vector(x, n, name, mechanism) for x, n, name in ((q, model.nq, "q"), (v, model.nv, "v"),
+                                                                 (a, model.nv, "a")))
+    if not isinstance(data, pin.Data) or len(data.oMi) != model.njoints or len(data.oMf) != model.nframes:
+        raise ModelError("data must be a pin.Data of the mechanism's model (mechanism.model.createData())",
+                         path=mechanism.source)
     pin.forwardKinematics(model, data, q, v, a)
     pin.updateFramePlacements(model, data)
     link_names = list(links) if links is not None else _moving_links(mechanism)
@@ -127,13 +142,58 @@ def evaluate_motion(
     for c in coincident:
         point_motion.setdefault(c.name, _coincident(mechanism, data, c))
     return Motion(
-        joints={n: JointMotion(mechanism.coordinate(q, n), float(v[j.idx_v]), float(a[j.idx_v]), j.kind)
-                for n, j in mechanism.joints.items() if j.nv == 1},
+        joints=_joint_motions(mechanism, q, v, a),
         links=link_motion,
         points=point_motion,
         sliders={n: _slider(mechanism, data, n, float(v[j.idx_v]), float(a[j.idx_v]))
                  for n, j in mechanism.joints.items() if j.kind == "prismatic"},
     )
+
+
+def _vector(x: Any, size: int, name: str, mechanism: Mechanism) -> np.ndarray:
+    """x as `size` finite floats, else a ModelError naming the argument and what it got."""
+    try:
+        out = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"{name} must be {size} numbers (SI), got {x!r:.80}", path=mechanism.source) from None
+    if out.shape != (size,) or not np.all(np.isfinite(out)):
+        raise ModelError(f"{name} must be {size} finite numbers (SI), got shape {out.shape}"
+                         + ("" if out.shape != (size,) else " with a non-finite number"), path=mechanism.source)
+    return out
+
+
+def _joint_motions(mechanism: Mechanism, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict[str, JointMotion]:
+    """Every one-dof joint's coordinate and rates; a `<mimic>` follower's from its leader's."""
+    out = {}
+    for name, joint in mechanism.joints.items():
+        if name in mechanism.mimics:
+            m = mechanism.mimics[name]
+            leader = mechanism.joints[m.leader]
+            kind = m.kind if m.kind in ("revolute", "continuous", "prismatic") else leader.kind
+            out[name] = JointMotion(mechanism.coordinate(q, name), m.multiplier * float(v[leader.idx_v]),
+                                    m.multiplier * float(a[leader.idx_v]), kind)
+        elif joint.nv == 1:
+            out[name] = JointMotion(mechanism.coordinate(q, name), float(v[joint.idx_v]), float(a[joint.idx_v]),
+                                    joint.kind)
+        elif joint.nv > 1:
+            out[name] = _multi_dof(mechanism, joint.id, q, v, a)
+    return out
+
+
+_MULTI_DOF_KINDS = {"JointModelPlanar": "planar", "JointModelSpherical": "spherical",
+                    "JointModelSphericalZYX": "spherical_zyx", "JointModelFreeFlyer": "floating",
+                    "JointModelTranslation": "translation"}
+
+
+def _multi_dof(mechanism: Mechanism, jid: int, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> JointMotion:
+    """A joint of several freedoms; a planar joint's (cos, sin) pair becomes its angle."""
+    joint = mechanism.model.joints[jid]
+    kind = _MULTI_DOF_KINDS.get(joint.shortname(), "other")
+    qj = q[joint.idx_q : joint.idx_q + joint.nq].copy()
+    vj, aj = v[joint.idx_v : joint.idx_v + joint.nv].copy(), a[joint.idx_v : joint.idx_v + joint.nv].copy()
+    if kind == "planar":
+        qj = np.array([qj[0], qj[1], math.atan2(qj[3], qj[2])])
+    return JointMotion(qj, vj, aj, kind)
 
 
 def _moving_links(mechanism: Mechanism) -> list[str]:
@@ -158,21 +218,35 @@ def _link_motion(mechanism: Mechanism, data: pin.Data, name: str) -> LinkMotion:
     fid = mechanism.links[name]
     model = mechanism.model
     rotation = data.oMf[fid].rotation.copy()
+    angle, axis = _plane_angle(rotation, mechanism.plane_normal)
     return LinkMotion(
         rotation=rotation,
         angular_velocity=pin.getFrameVelocity(model, data, fid, _LWA).angular.copy(),
         angular_acceleration=pin.getFrameAcceleration(model, data, fid, _LWA).angular.copy(),
-        angle=_plane_angle(rotation, mechanism.plane_normal),
+        angle=angle,
+        angle_axis=axis,
     )
 
 
-def _plane_angle(rotation: np.ndarray, normal: np.ndarray | None) -> float | None:
-    """Angle of the link's x axis about the plane normal, measured from the world x axis."""
+#: A link axis is measured in the plane when its projection on the plane is at least this
+#: long (it is within 60 deg of the plane): its in-plane direction is then exact to
+#: rounding. Of x, y and z one always qualifies (their squared projections add up to 2).
+_IN_PLANE = 0.5
+
+
+def _plane_angle(rotation: np.ndarray, normal: np.ndarray | None) -> tuple[float | None, str]:
+    """Angle about the plane normal of the link's x axis (else y, else z: the first that
+    lies within 60 deg of the plane), from the world x axis projected on the plane; and
+    which axis was measured."""
     if normal is None:
-        return None
+        return None, "x"
     ref = _plane_reference(*normal.tolist())
-    x_axis = rotation[:, 0]
-    return math.atan2(float(normal @ _cross(ref, x_axis)), float(ref @ x_axis))
+    for k, name in enumerate("xyz"):
+        axis = rotation[:, k]
+        in_plane = axis - normal * float(normal @ axis)
+        if math.hypot(*in_plane.tolist()) >= _IN_PLANE or name == "z":
+            return math.atan2(float(normal @ _cross(ref, in_plane)), float(ref @ in_plane)), name
+    raise AssertionError("unreachable")  # pragma: no cover
 
 
 @functools.lru_cache(maxsize=8)

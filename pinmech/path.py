@@ -130,6 +130,7 @@ def follow_path(mechanism: Mechanism, tasks: list[Task], q0: np.ndarray, *, dura
     """
     if scheme not in SCHEMES:
         raise TaskError(f"scheme must be one of {', '.join(SCHEMES)}, got {scheme!r}")
+    check_timing(duration, step, gain)
     if mechanism.closures:
         raise TaskError(f"{mechanism.source}: the path mode follows arms (open chains); a mechanism "
                         "with loop cuts is swept through its drivers (pinmech sweep)")
@@ -137,8 +138,9 @@ def follow_path(mechanism: Mechanism, tasks: list[Task], q0: np.ndarray, *, dura
     tracker = _Tracker(mechanism, solver, q0)
     model = mechanism.model
     q = np.array(q0, dtype=float)
-    for k in range(round(duration / step) + 1):
-        t = k * step
+    count = step_count(duration, step)
+    for k in range(count + 1):
+        t = _time(k, count, duration, step)
         rates, drift, angular = _rates(solver, tracker, q, t, gain)
         if drift > max_drift * mechanism.length_scale or angular > max_drift:
             raise TaskError(
@@ -147,12 +149,43 @@ def follow_path(mechanism: Mechanism, tasks: list[Task], q0: np.ndarray, *, dura
                 "passes a singularity; shorten --duration or the --step"
             )
         yield PathPoint(t, q.copy(), rates.v, rates.a, drift, angular, rates.condition)
+        if k == count:
+            break
+        step = _time(k + 1, count, duration, step) - t  # the last step ends at `duration` exactly
         if scheme == "euler":
             q = pin.integrate(model, q, rates.v * step)
         elif scheme == "taylor":
             q = pin.integrate(model, q, rates.v * step + 0.5 * rates.a * step * step)
         else:
             q = _rk4(solver, tracker, q, t, step, gain, rates.v)
+
+
+def step_count(duration: float, step: float) -> int:
+    """Steps of a path over `duration` [s]: whole steps of `step` [s], the last one shorter
+    when `step` does not divide `duration` (a path asked for 0.0815 s ends at 0.0815 s)."""
+    return max(1, math.ceil(duration / step * (1 - 1e-12)))
+
+
+def _time(k: int, count: int, duration: float, step: float) -> float:
+    return duration if k == count else k * step
+
+
+def check_timing(duration: float, step: float, gain: float, *, names: tuple[str, str, str] = (
+        "duration", "step", "gain")) -> None:
+    """A path's duration and step [s] are finite and positive, step <= duration; the gain
+    [1/s] is finite, not negative, and at most 1/step (a larger one overshoots in one step).
+
+    Raises:
+        TaskError: naming the argument (`names`: as the caller spells them, e.g. "--gain").
+    """
+    for value, name in ((duration, names[0]), (step, names[1])):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value < math.inf:
+            raise TaskError(f"{name} must be a positive, finite time [s], got {value!r}")
+    if step > duration:
+        raise TaskError(f"{names[1]} ({step:g} s) must not be longer than {names[0]} ({duration:g} s)")
+    if isinstance(gain, bool) or not isinstance(gain, (int, float)) or not 0 <= gain <= 1 / step:
+        raise TaskError(f"{names[2]} must be a number from 0 to 1/{names[1]} = {1 / step:.6g} [1/s] "
+                        f"(a larger feedback overshoots within one step), got {gain!r}")
 
 
 def _rates(solver: RateSolver, tracker: _Tracker, q: np.ndarray, t: float,

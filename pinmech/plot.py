@@ -1,10 +1,12 @@
 """Figures of sweeps and arm paths (matplotlib, extra `plot`): what a report shows.
 
 A sweep's figure: link angles, angular velocities and accelerations, the sliders'
-relative velocity and acceleration, and the speed and acceleration magnitudes of chosen
-points, against the driver, with the scene's own pose marked (dashed line, dots, and
-its values in the legends). A path's figure: joint coordinates, rates, accelerations
-and the drift against time.
+position, velocity and acceleration along their guide, and the speed and acceleration
+magnitudes of chosen points, against the driver (0 to 360 deg for a whole turn, whatever
+angle it starts at), with the scene's own pose marked (dashed line, dots, and its values in
+a panel), the driver's rates in the title, constant quantities named instead of drawn, and
+a last panel with the points' paths (`pinmech.plot_paths`). A path's figure: joint
+coordinates, rates, accelerations and the drift against time.
 
 The recorders (`SweepPlot`, `PathPlot`) take poses one at a time while a sweep streams
 and keep at most `max_points` of them (every n-th), so memory stays bounded.
@@ -21,6 +23,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from pinmech.exceptions import PinmechError
+from pinmech.plot_paths import PathRecorder
 
 if TYPE_CHECKING:
     from pinmech.mechanism import Mechanism
@@ -28,6 +31,8 @@ if TYPE_CHECKING:
     from pinmech.sweep import Sweep, SweepPose
 
 MAX_POINTS = 20_000
+ANGLE_STYLES = ("continuous", "wrapped")
+_STYLES = ("-", "--", "-.", ":")  # one a curve: a curve under another still shows
 
 
 def _pyplot():
@@ -49,13 +54,22 @@ class SweepPlot:
             every moving link but the driver's, and every moving point).
         total: the number of poses to come, to keep every n-th when there are more
             than `max_points`.
+        angles: "continuous" (no jump where a link passes 180 deg) or "wrapped" to
+            (-180, 180] deg, with a gap where an angle wraps.
+        plane: the world plane ("xy", "yz", "zx") a spatial mechanism's paths are
+            projected on (None: the mechanism's own plane, or xy), or "3d": a 3-D view.
     """
 
     def __init__(self, sweep: Sweep, *, links: list[str] | None = None, points: list[str] | None = None,
-                 total: int | None = None, max_points: int = MAX_POINTS) -> None:
+                 total: int | None = None, max_points: int = MAX_POINTS, angles: str = "continuous",
+                 plane: str | None = None) -> None:
         _pyplot()  # fail early, before the sweep runs, when matplotlib is missing
+        if angles not in ANGLE_STYLES:
+            raise PinmechError(f"angles must be one of {', '.join(ANGLE_STYLES)}, got {angles!r}")
         chosen = sweep.scene.section("sweep")
-        self.sweep = sweep
+        self.sweep, self.angles = sweep, angles
+        self.paths = PathRecorder(sweep.mechanism, plane)
+        self.mark_q = None  # configuration of the pose nearest the scene's (drawn under the paths)
         self.links, self.points = links or chosen.get("links"), points or chosen.get("points")
         self.every = max(1, math.ceil(total / max_points)) if total else 1
         self.normal = sweep.mechanism.plane_normal
@@ -72,6 +86,7 @@ class SweepPlot:
             self.failed.append(self._x(pose.value))
             if self.series:
                 self.x.append(self._x(pose.value))  # a gap in every curve
+                self.paths.add({p: np.full(3, math.nan) for p in self.points})
                 for panel in self.series.values():
                     for values in panel.values():
                         values.append(math.nan)
@@ -85,8 +100,10 @@ class SweepPlot:
         values = self._values(pose)
         if nearer:
             self.mark = (pose.value, values)
+            self.mark_q = None if self.sweep.last_q is None else self.sweep.last_q.copy()
         if not kept:
             return
+        self.paths.add({p: pose.motion.points[p].position for p in self.points})
         self.x.append(self._x(pose.value))
         for title, panel in values.items():
             for name, value in panel.items():
@@ -114,6 +131,7 @@ class SweepPlot:
         panels["angular velocity, ω [rad/s]" if planar else "angular speed, |ω| [rad/s]"] = self.links
         panels["angular acceleration, α [rad/s²]" if planar else "angular acceleration, |α| [rad/s²]"] = self.links
         if self.sliders:
+            panels["position along its guide, s [m]"] = self.sliders
             panels["velocity along its guide, v_rel [m/s]"] = self.sliders
             panels["acceleration along its guide, a_rel [m/s²]"] = self.sliders
         if self.points:
@@ -136,7 +154,8 @@ class SweepPlot:
             columns.append([math.degrees(link.angle) for link in links])
         columns += [w, alpha]
         if self.sliders:
-            columns += [[m.joints[s].v for s in self.sliders], [m.joints[s].a for s in self.sliders]]
+            columns += [[m.joints[s].q for s in self.sliders], [m.joints[s].v for s in self.sliders],
+                        [m.joints[s].a for s in self.sliders]]
         if self.points:
             columns += [[float(np.linalg.norm(m.points[p].velocity)) for p in self.points],
                         [float(np.linalg.norm(m.points[p].acceleration)) for p in self.points]]
@@ -145,42 +164,38 @@ class SweepPlot:
         return out
 
     def save(self, path: str | Path) -> Path:
-        """Draw and save the figure (PNG, PDF or SVG, from the suffix)."""
+        """Draw and save the figure (PNG, PDF or SVG, from the suffix): one panel per
+        quantity against the driver, and the paths of the points with the mechanism."""
         if not self.series:
             raise PinmechError(f"no pose of the sweep could be solved: nothing to plot in {path}")
         plt = _pyplot()
         sweep, unit = self.sweep, "deg" if self.sweep.is_angular else "m"
-        x = np.array(self.x)
+        x, order, turn = _driver_axis(np.array(self.x), self.sweep.is_angular and self._comes_back())
+        mark_x = self._x(self.mark[0]) % 360.0 if turn else self._x(self.mark[0])
         lo, hi = np.nanmin(x), np.nanmax(x)
-        mark_x = self._x(self.mark[0])
-        marked = lo - 1e-9 * abs(lo) <= self._x(sweep.start) <= hi + 1e-9 * abs(hi)  # the scene's pose is swept
+        marked = lo - 1e-9 * abs(lo) <= mark_x <= hi + 1e-9 * abs(hi)  # the scene's pose is swept
         panels = list(self.series.items())
+        drawn_paths = bool(self.points) and self.paths.count > 0
         cols = 2
-        rows = math.ceil(len(panels) / cols)
-        fig, axes = plt.subplots(rows, cols, figsize=(11, 2.9 * rows), sharex=True, squeeze=False)
+        rows = math.ceil((len(panels) + drawn_paths) / cols)
+        fig, axes = plt.subplots(rows, cols, figsize=(13, 3.2 * rows), squeeze=False)
         for ax, (title, series) in zip(axes.flat, panels):
-            for name, values in series.items():
-                y = np.array(values)
-                if title.startswith("angle"):  # unwrapped: no jump where a link passes 180 deg
-                    ok = np.isfinite(y)
-                    y[ok] = np.degrees(np.unwrap(np.radians(y[ok])))
-                (line,) = ax.plot(x, y, linewidth=1.5, label=name)
-                if marked:
-                    at = self.mark[1][title][name]
-                    ax.plot([mark_x], [_nearest(x, y, mark_x, at) if title.startswith("angle") else at], "o",
-                            color=line.get_color(), markersize=5)
-            if marked:
-                ax.axvline(mark_x, color="0.35", linestyle="--", linewidth=1)
+            self._panel(ax, title, series, x, order, mark_x if marked else None)
+            ax.set_xlim(lo, hi)
+            if turn:
+                ax.set_xticks(np.arange(0, 361, 60))
+            ax.set_xlabel(f"{sweep.driver} [{unit}]", fontsize=9)
             if self.failed:
-                ax.plot(self.failed, np.zeros(len(self.failed)), "x", color="red", markersize=6,
+                failed = np.mod(self.failed, 360.0) if turn else self.failed
+                ax.plot(failed, np.zeros(len(failed)), "x", color="red", markersize=6,
                         transform=ax.get_xaxis_transform(), clip_on=False)
-            quantity, label = title.split(", ")
-            ax.set_title(f"{next(iter(series))}: {quantity}" if len(series) == 1 else quantity, fontsize=10)
-            ax.set_ylabel(label)
-            ax.grid(True, alpha=0.35)
-            if len(series) > 1:
-                ax.legend(fontsize=8, loc="best")
-        spare = list(axes.flat[len(panels):])
+        if drawn_paths:
+            ax = axes.flat[len(panels)]
+            if self.paths.is_3d:  # a 3-D panel in the same place
+                ax.remove()
+                ax = fig.add_subplot(rows, cols, len(panels) + 1, projection="3d")
+            self.paths.draw(ax, self.mark_q, self._travel())
+        spare = list(axes.flat[len(panels) + drawn_paths:])
         for ax in spare:
             ax.set_visible(False)
         if spare and marked:  # the scene's pose, as numbers, where a panel is missing
@@ -188,17 +203,88 @@ class SweepPlot:
             spare[0].axis("off")
             spare[0].text(0.02, 0.95, self._summary(mark_x, unit), va="top", ha="left", family="monospace",
                           fontsize=8.5, transform=spare[0].transAxes)
-        for column in range(cols):  # x labels under the lowest drawn panel of each column
-            shown = [ax for ax in axes[:, column] if ax.get_visible() and ax.axison]
-            if shown:
-                shown[-1].set_xlabel(f"{sweep.driver} [{unit}]")
-                shown[-1].xaxis.set_tick_params(labelbottom=True)
+        fig.suptitle(self._title(marked, mark_x, unit), fontsize=11)
+        fig.tight_layout()
+        return _save(plt, fig, path)
+
+    def _comes_back(self) -> bool:
+        """Whether every drawn quantity ends where it began (angles modulo 360 deg): only
+        then is a whole turn drawn from 0 to 360 deg without a jump where it began."""
+        for title, panel in self.series.items():
+            for values in panel.values():
+                y = np.array(values)
+                y = y[np.isfinite(y)]
+                if y.size < 2:
+                    continue
+                gap = abs(y[-1] - y[0])
+                if title.startswith("angle"):
+                    gap = abs((gap + 180.0) % 360.0 - 180.0)
+                if gap > 1e-6 * max(float(np.max(np.abs(y))), 1e-9):
+                    return False
+        return True
+
+    def save_paths(self, path: str | Path) -> Path:
+        """Only the paths of the points, with the mechanism at the scene's pose, in a figure."""
+        if not self.points or self.paths.count == 0:
+            raise PinmechError(f"no point to trace: nothing to draw in {path} (name points with --points)")
+        plt = _pyplot()
+        fig = plt.figure(figsize=(8, 6.5))
+        ax = fig.add_subplot(projection="3d" if self.paths.is_3d else None)
+        self.paths.draw(ax, self.mark_q, self._travel())
+        fig.suptitle(f"{self.sweep.scene.title}: paths over the sweep", fontsize=11)
+        fig.tight_layout()
+        return _save(plt, fig, path)
+
+    def _travel(self) -> str:
+        unit = "deg" if self.sweep.is_angular else "m"
+        x = np.array(self.x)
+        increasing = np.nanmean(np.diff(x)) > 0 if len(x) > 1 else True
+        return f"arrows: travel as {self.sweep.driver} {'grows' if increasing else 'falls'} [{unit}]"
+
+    def _panel(self, ax, title: str, series: dict[str, array], x: np.ndarray, order: np.ndarray,
+               mark_x: float | None) -> None:
+        """One quantity against the driver: a curve per name, constant ones said in words."""
+        quantity, label = title.split(", ")
+        symbol, dim = label.split(" [")
+        angle = title.startswith("angle")
+        constants = []
+        curves = {name: _angles(np.array(v)[order], self.angles) if angle else np.array(v)[order]
+                  for name, v in series.items()}
+        largest = max((float(np.nanmax(np.abs(y))) for y in curves.values() if np.any(np.isfinite(y))), default=0.0)
+        flat = max(1e-9 * largest, 1e-12)  # changes below this are rounding (1e-12: noise about an exact 0)
+        for k, (name, y) in enumerate(curves.items()):
+            finite = y[np.isfinite(y)]
+            if finite.size and np.ptp(finite) <= flat:
+                constants.append(f"{name}: {symbol} = {finite[0]:.6g} {dim.rstrip(']')} (constant, not drawn)")
+                continue
+            (line,) = ax.plot(x, y, linewidth=1.6, color=f"C{k % 10}", linestyle=_STYLES[k % len(_STYLES)],
+                              label=name)  # a name keeps its colour and dash from panel to panel
+            if mark_x is not None:
+                at = _nearest(x, y, mark_x, self.mark[1][title][name])
+                ax.plot([mark_x], [at], "o", color=line.get_color(), markersize=5)
+        if mark_x is not None:
+            ax.axvline(mark_x, color="0.35", linestyle="--", linewidth=1)
+        if constants:
+            ax.text(0.02, 0.04, "\n".join(constants), transform=ax.transAxes, fontsize=8, color="0.25", zorder=6,
+                    bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "0.8", "boxstyle": "round"})
+        drawn = len(series) - len(constants)
+        name = next(iter(series))
+        ax.set_title(f"{name}: {quantity}" if len(series) == 1 else quantity, fontsize=10)
+        ax.set_ylabel(label + (f", {self.angles}" if angle else ""))
+        ax.grid(True, alpha=0.35)
+        if drawn > 1:
+            ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+
+    def _title(self, marked: bool, mark_x: float, unit: str) -> str:
+        sweep = self.sweep
+        spec = sweep.scene.section("drivers").get(sweep.driver, {})
+        rate = "speed" if sweep.is_angular else "velocity"
+        speed = spec.get("speed", spec.get("velocity", "0"))  # as the scene writes them; absent: 0
         note = f"dashed: the scene's pose, {mark_x:.4g} {unit}" if marked else ""
         if self.failed:
             note += ("; " if note else "") + f"{len(self.failed)} pose(s) failed (red x)"
-        fig.suptitle(f"{sweep.scene.title}: {sweep.driver} swept" + (f" ({note})" if note else ""), fontsize=11)
-        fig.tight_layout()
-        return _save(plt, fig, path)
+        driven = f"driver {sweep.driver} at {rate} {speed}, acceleration {spec.get('acceleration', '0')}"
+        return f"{sweep.scene.title}: {driven}" + (f"\n({note})" if note else "")
 
     def _summary(self, mark_x: float, unit: str) -> str:
         lines = [f"At the scene's pose, {self.sweep.driver} = {mark_x:.4g} {unit}:", ""]
@@ -207,6 +293,38 @@ class SweepPlot:
             for name, value in values.items():
                 lines.append(f"  {name + ' ' + symbol:<18} {value: .5g} {dim.rstrip(']')}")
         return "\n".join(lines)
+
+
+def _driver_axis(x: np.ndarray, angular: bool) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The driver values as drawn, the order of the poses along them, and whether they
+    make one whole turn (then drawn from 0 to 360 deg, whatever angle the sweep began at;
+    `angular` False: as swept)."""
+    finite = x[np.isfinite(x)]
+    turn = angular and finite.size > 1 and abs(np.ptp(finite) - 360.0) <= 1e-9 * 360.0
+    if not turn:
+        return x, np.arange(len(x)), False
+    wrapped = np.mod(x, 360.0)
+    order = np.argsort(wrapped, kind="stable")
+    wrapped = wrapped[order]
+    at_zero = np.nonzero(np.isclose(wrapped, 0.0, atol=1e-9))[0]
+    if at_zero.size:  # the pose at 0 deg closes the turn at 360 deg too
+        order = np.append(order, order[at_zero[0]])
+        wrapped = np.append(wrapped, 360.0)
+    return wrapped, order, True
+
+
+def _angles(y: np.ndarray, style: str) -> np.ndarray:
+    """Angles [deg] along the driver: continuous (no jump at +-180, starting in (-180, 180]),
+    or wrapped to (-180, 180] with a gap where they jump."""
+    y = y.copy()
+    ok = np.isfinite(y)
+    if style == "continuous":
+        y[ok] = np.degrees(np.unwrap(np.radians(y[ok])))
+        y[ok] -= 360.0 * math.ceil((y[ok][0] - 180.0) / 360.0) if y[ok].size else 0.0
+        return y
+    y[ok] = 180.0 - np.mod(180.0 - y[ok], 360.0)
+    y[np.nonzero(np.abs(np.diff(y)) > 180.0)[0]] = math.nan  # no vertical line where it wraps
+    return y
 
 
 def _nearest(x: np.ndarray, y: np.ndarray, at_x: float, fallback: float) -> float:

@@ -9,11 +9,16 @@ from typing import Any
 import numpy as np
 
 from pinmech.analysis import Analysis
+from pinmech.limits import limit_violations
 from pinmech.motion import Motion
 
 
 def _vec(x: np.ndarray) -> list[float]:
     return [float(c) for c in np.asarray(x).reshape(-1)]
+
+
+def _number(x: float | np.ndarray) -> float | list[float]:
+    return x if isinstance(x, float) else _vec(x)
 
 
 def motion_dict(motion: Motion) -> dict[str, Any]:
@@ -26,9 +31,12 @@ def motion_dict(motion: Motion) -> dict[str, Any]:
         }
         if link.angle is not None:
             entry["angle"] = link.angle
+            if link.angle_axis != "x":
+                entry["angle_axis"] = link.angle_axis  # the link's x axis is normal to the plane
         links[name] = entry
     return {
-        "joints": {n: {"q": j.q, "v": j.v, "a": j.a, "type": j.kind} for n, j in motion.joints.items()},
+        "joints": {n: {"q": _number(j.q), "v": _number(j.v), "a": _number(j.a), "type": j.kind}
+                   for n, j in motion.joints.items()},
         "links": links,
         "points": {
             n: {"position": _vec(p.position), "velocity": _vec(p.velocity), "acceleration": _vec(p.acceleration),
@@ -61,6 +69,7 @@ def to_dict(analysis: Analysis) -> dict[str, Any]:
         },
     }
     out.update(motion_dict(analysis.motion))
+    out["limit_violations"] = [v.as_dict() for v in limit_violations(analysis.mechanism, analysis.motion)]
     out.update(assembly_dict(analysis))
     out["accuracy"] = analysis.solution.accuracy.as_dict()
     if analysis.extra:
@@ -158,7 +167,8 @@ def to_text(analysis: Analysis) -> str:
         t.head("Link angles (x axis from world x)")
         for name, link in m.links.items():
             if link.angle is not None:
-                t.row(name, f"phi = {_num(math.degrees(link.angle))} deg = {_num(link.angle)} rad")
+                axis = "" if link.angle_axis == "x" else f"   (its {link.angle_axis} axis: x is normal to the plane)"
+                t.row(name, f"phi = {_num(math.degrees(link.angle))} deg = {_num(link.angle)} rad{axis}")
     t.head("Angular velocities and accelerations")
     for name, link in m.links.items():
         t.row(name, "omega = " + t.spin(link.angular_velocity, "rad/s"), "alpha = " + t.spin(link.angular_acceleration, "rad/s^2"))
@@ -178,6 +188,10 @@ def to_text(analysis: Analysis) -> str:
     t.head("Joints")
     for name, j in m.joints.items():
         t.row(name, *_joint_cells(j.kind, j.q, j.v, j.a))
+    violations = limit_violations(analysis.mechanism, analysis.motion)
+    if violations:
+        t.head("Joint limits (URDF <limit>)")
+        t.lines += [f"  WARNING: {v.describe()}" for v in violations]
     _assembly_lines(t, analysis)
     acc = analysis.solution.accuracy
     t.head("Accuracy")
@@ -222,7 +236,14 @@ def _angle_or_length(analysis: Analysis, name: str, q: float) -> str:
     return f"{math.degrees(q):.6g} deg" if joint.is_angular else f"{q:.6g} m"
 
 
-def _joint_cells(kind: str, q: float, v: float, a: float) -> list[str]:
+def _joint_cells(kind: str, q, v, a) -> list[str]:
+    if kind == "planar":
+        return [f"x, y = ({_num(q[0])}, {_num(q[1])}) m, theta = {_num(math.degrees(q[2]))} deg",
+                f"v = ({_num(v[0])}, {_num(v[1])}) m/s (joint frame), omega = {_num(v[2])} rad/s",
+                f"a = ({_num(a[0])}, {_num(a[1])}) m/s^2 (joint frame), alpha = {_num(a[2])} rad/s^2"]
+    if not isinstance(q, float):
+        return [f"{kind}: q = ({', '.join(_num(x) for x in q)})", f"v = ({', '.join(_num(x) for x in v)})",
+                f"a = ({', '.join(_num(x) for x in a)}) (Pinocchio's configuration and tangent rates, SI)"]
     if kind == "prismatic":
         return [f"q = {_num(q)} m", f"v = {_num(v)} m/s", f"a = {_num(a)} m/s^2"]
     return [

@@ -44,16 +44,16 @@ class Accuracy:
         """Relative errors to expect of positions, velocities and accelerations.
 
         With m = max(residual, eps) (what the loop closure left, or rounding) and k the
-        condition number: positions 2 k m (the residual left along the Jacobian's soft
+        condition number: positions 4 k m (the residual left along the Jacobian's soft
         direction), velocities 4 k^2 m, accelerations 16 k^3 m. Accelerations reach k^3 m
         where the rates stay finite while k grows (an R-RTR whose guide passes through its
         pivot: 3.1 k^3 m, the worst measured); where the rates grow with k (a four-bar's
         toggle or dead centres) they do better, about k^2 m, and an open arm's rate problem
         gives k eps for both. An interpolated pose adds its `interpolation` errors. The
-        factors 4 and 16 are margins of about 5 over the worst
-        ratios measured against extended-precision closed forms (tests/test_singular.py,
-        scripts/singular_accuracy.py): k depends on how lengths are made dimensionless (by
-        the loops' sizes), which no law fixes to better than a small factor.
+        factors are margins of 2 to 5 over the worst ratios measured against
+        extended-precision closed forms (tests/test_singular.py, scripts/singular_accuracy.py):
+        k depends on how lengths are made dimensionless (by the loops' sizes), which no law
+        fixes to better than a small factor.
         """
         m = max(self.residual, EPS)
         k = self.condition

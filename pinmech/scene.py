@@ -23,14 +23,16 @@ else:  # pragma: no cover
 
 #: Top-level keys a scene may have; other modules (tasks, sweeps) register theirs here.
 KNOWN_KEYS = {
-    "title", "urdf", "robot", "drivers", "guess", "pose", "move", "lock", "points", "report", "solver",
-    "task", "rates", "sweep", "draw", "assembly",
+    "title", "urdf", "robot", "linkage", "mjcf", "sidecar", "drivers", "guess", "pose", "move", "lock", "points",
+    "report", "solver", "task", "rates", "sweep", "draw", "assembly",
     "forces", "gravity", "load",  # forces_scene.py
 }
 #: Accepted `[solver]` values. A closure tolerance (relative to the mechanism's size)
 #: below 1e-16 is tighter than rounding allows; above 1e-3 a "closed" loop is visibly
 #: open. A singular limit below 1 would refuse every pose.
 SOLVER_RANGES = {"tol": (1e-16, 1e-3), "max_iterations": (1, 1000), "max_condition": (1.0, float("inf"))}
+#: The keys that name the model file; a scene gives exactly one.
+MODEL_KEYS = ("urdf", "robot", "linkage", "mjcf")
 _DRIVER_KEYS = {"angle": 0, "position": 0, "speed": 1, "velocity": 1, "acceleration": 2}
 
 
@@ -93,14 +95,17 @@ class Scene:
         if unknown:
             raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(KNOWN_KEYS))}",
                              path=str(self.path))
-        for key in ("urdf", "robot", "title"):
+        for key in ("urdf", "robot", "linkage", "mjcf", "sidecar", "title"):
             if key in self.raw and not isinstance(self.raw[key], str):
                 raise SceneError(f"must be a string, got {self.raw[key]!r}", path=str(self.path), key=key)
-        has_urdf = isinstance(self.raw.get("urdf"), str)
-        has_robot = isinstance(self.raw.get("robot"), str)
-        if has_urdf == has_robot:
-            raise SceneError("give exactly one of urdf = \"path/to/model.urdf\" or robot = \"ur5\" "
-                             "(an example-robot-data name)", path=str(self.path), key="urdf")
+        given = [key for key in MODEL_KEYS if key in self.raw]
+        if len(given) != 1:
+            raise SceneError("give exactly one of urdf = \"path/to/model.urdf\", robot = \"ur5\" "
+                             "(an example-robot-data name), linkage = \"leg.toml\" (a linkage as drawn) or "
+                             "mjcf = \"leg.xml\"", path=str(self.path), key="urdf")
+        if "sidecar" in self.raw and "urdf" not in self.raw:
+            raise SceneError("sidecar = \"robot.yaml\" goes with urdf = \"robot.urdf\" (Gepetto's extended URDF)",
+                             path=str(self.path), key="sidecar")
         for name in ("drivers", "guess", "pose", "lock", "points", "report", "solver", "rates"):
             if name in self.raw and not isinstance(self.raw[name], dict):
                 raise SceneError(f"[{name}] must be a table", path=str(self.path), key=name)
@@ -118,6 +123,15 @@ class Scene:
 
             return robot_urdf(self.raw["robot"], where=str(self.path))
         return (self.path.parent / self.raw["urdf"]).resolve()
+
+    @property
+    def model_kind(self) -> str:
+        """Which key names the model: "urdf", "robot", "linkage" or "mjcf"."""
+        return next(key for key in MODEL_KEYS if key in self.raw)
+
+    def model_file(self, key: str) -> Path:
+        """A file the scene names (`linkage`, `mjcf`, `sidecar`), relative to the scene's folder."""
+        return (self.path.parent / self.raw[key]).resolve()
 
     def where(self, *keys: str) -> str:
         return ".".join(keys)

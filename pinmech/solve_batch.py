@@ -92,8 +92,9 @@ class BatchSolver:
         Returns:
             The solved poses, or None when one of them needs the pose-by-pose solver: a
             guess too far from its solution (a Newton step over `max_step`), a loop
-            that does not close within the iteration cap, or a singular Jacobian. That
-            solver then says which pose, and why, in its own words.
+            that does not close within the iteration cap, a singular Jacobian, or a pose
+            on another assembly than the solver's reference (branches.py). That solver
+            then says which pose, and why, in its own words.
         """
         s = self.solver
         n = len(guesses)
@@ -122,7 +123,11 @@ class BatchSolver:
         full = np.max([c.full_residual() for c in self._cuts], axis=0)
         if np.any(full > max(s.tol, 1e-12) * 10):
             return None
-        return self._rates(Q, driver_v, driver_a, np.maximum(error, full), iterations)
+        out = self._rates(Q, driver_v, driver_a, np.maximum(error, full), iterations)
+        ref = s.reference
+        if out is not None and ref is not None and ref.keep and np.any(out.signs != np.array(ref.signs)):
+            return None  # a pose on another assembly than the solver's reference
+        return out
 
     @serialized
     def measure(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> BatchSolution:

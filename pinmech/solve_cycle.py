@@ -33,7 +33,6 @@ from dataclasses import dataclass, field
 from itertools import islice
 
 import numpy as np
-import pinocchio as pin
 
 from pinmech.continuation import Node, Path, Route
 from pinmech.exceptions import (
@@ -191,6 +190,7 @@ class _Cycle:
         self.mirror = (1.0, 0.0)  # p = a x + b: past each fold crossed, values are mirrored at it
         self.notes: dict[int, str] = {}
         self._index, self._iterations, self._batching = 0, 0, False
+        self.node: Node | None = None  # the last pose solved one by one (self.ref's, when current)
         self.span_scale = float(solver.mechanism.velocity_scale()[solver.mechanism.joint(driver).idx_v])  # 1: a turn
 
     # ------------------------------------------------------------------ chunks
@@ -337,6 +337,7 @@ class _Cycle:
             raise
         solver = self.solver
         self.ref = _Exact(node.p, node.q, node.d1, node.d2, node.condition, node.sigma_min, node.signs)
+        self.node = node
         self.q_drv[self.k] = node.p
         accuracy = Accuracy(0.0, 0, node.condition, node.sigma_min, node.velocity_residual,
                             node.acceleration_residual)
@@ -368,7 +369,8 @@ class _Cycle:
         self._iterations = 0
         if ref is None:
             return self._first(p)
-        node = Node(ref.value, ref.q, ref.d1, ref.d2, ref.signs, ref.condition, ref.sigma_min)  # rates unused
+        node = self.node if self.node is not None and self.node.p == ref.value and self.node.q is ref.q else \
+            Node(ref.value, ref.q, ref.d1, ref.d2, ref.signs, ref.condition, ref.sigma_min)
         if self.start == "predictor":
             route = Route((ref.value,))
             node = path.follow(node, p, route)

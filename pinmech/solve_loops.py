@@ -169,6 +169,7 @@ class LoopSolver:
     have. `solve` without a guess then reaches the asked driver values from the reference
     by continuation (continuation.py), never by a cold Newton solve; with a guess it
     solves from the guess and raises AssemblyError if it lands on another assembly.
+    Without `set_reference`, the first pose solved becomes the reference.
 
     Args:
         mechanism: the model with its loop closures.
@@ -254,9 +255,14 @@ class LoopSolver:
 
     def refresh(self) -> None:
         """Read again the placements of ground cut frames, which the user may have moved in
-        the model since the last call (the hot path folds them into its row matrices)."""
-        for cut in self._cuts:
-            cut.refresh()
+        the model since the last call (the hot path folds them into its row matrices); the
+        reference pose, closed for the old placement, is then closed again from itself."""
+        moved = [cut.refresh() for cut in self._cuts]
+        ref = self.reference
+        if any(moved) and ref is not None:
+            q, _, _ = self.close(ref.q, ref.driver_q)
+            signs = self._rates(q, np.zeros(len(self.drivers)), np.zeros(len(self.drivers)))[-1]
+            self.reference = Reference(ref.driver_q, q, signs, ref.keep)
 
     def _joint_nv(self, v: int) -> int:
         for joint in self.model.joints[1:]:
@@ -601,7 +607,11 @@ class LoopSolver:
             q = self.follow(ref.q, ref.driver_q, dq, route)
             residual = max(_max_abs(self._residual(q)), self._full_residual())
             return self._solution(q, dv, da, residual, route.iterations, route)
+        if guess is None and ref is not None:  # assembly "any": Newton from the reference pose
+            guess = ref.q
         q, iterations, residual = self.close(self._guess(guess), dq)
+        if ref is None:  # the first pose solved names the assembly of the later ones
+            self.set_reference(dq, q)
         return self._solution(q, dv, da, residual, iterations, None)
 
     @serialized
@@ -615,6 +625,8 @@ class LoopSolver:
         x0, x1 = np.asarray(x0, dtype=float), np.asarray(x1, dtype=float)
         if np.array_equal(x0, x1):
             return q0.copy()
+        if not self._cuts:  # an open chain: the drivers are the pose
+            return self.set_drivers(q0, x1)
         turn = 2.0 * math.pi
         moving = np.flatnonzero(x1 != x0)
         if not through_folds and len(moving) == 1 and abs(x1 - x0)[moving[0]] > turn \

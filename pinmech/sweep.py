@@ -21,7 +21,7 @@ Scene keys, all optional:
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -36,7 +36,7 @@ from pinmech.analysis import (
     scene_drivers,
     scene_solver,
 )
-from pinmech.exceptions import SceneError, SweepError
+from pinmech.exceptions import ModelError, SceneError, SweepError
 from pinmech.mechanism import Mechanism
 from pinmech.motion import Motion, evaluate_motion
 from pinmech.results import Accuracy
@@ -64,6 +64,46 @@ class SweepPose:
     error: str = ""
     interpolated: bool = False
     note: str = ""
+
+
+@dataclass(frozen=True)
+class DriverValues(Sequence):
+    """`steps` evenly spaced driver values from `first` to `last` [rad or m], both ends
+    included, as `np.linspace` gives them but computed when read: a sweep of 1e10 poses
+    streams in constant memory."""
+
+    first: float
+    last: float
+    steps: int
+
+    def __post_init__(self) -> None:
+        if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
+            raise ModelError(f"steps must be a positive whole number, got {self.steps!r}")
+        if not (math.isfinite(self.first) and math.isfinite(self.last)):
+            raise ModelError(f"the driver's range must be finite numbers, got {self.first!r} to {self.last!r}")
+
+    def __len__(self) -> int:
+        return self.steps
+
+    def __getitem__(self, index):  # int -> float, slice -> array
+        if isinstance(index, slice):
+            return np.array([self._at(i) for i in range(*index.indices(self.steps))])
+        i = index + self.steps if index < 0 else index
+        if not 0 <= i < self.steps:
+            raise IndexError(f"pose {index} of {self.steps}")
+        return self._at(i)
+
+    def __iter__(self) -> Iterator[float]:
+        return (self._at(i) for i in range(self.steps))
+
+    def __array__(self, dtype=None, copy=None) -> np.ndarray:
+        return np.linspace(self.first, self.last, self.steps, dtype=dtype)
+
+    def _at(self, i: int) -> float:
+        if i == self.steps - 1 and self.steps > 1:
+            return float(self.last)
+        step = (self.last - self.first) / (self.steps - 1) if self.steps > 1 else 0.0
+        return float(self.first + i * step)
 
 
 def sweep_options(scene: Scene) -> dict[str, Any]:
@@ -126,17 +166,18 @@ class Sweep:
     def is_angular(self) -> bool:
         return self.mechanism.joint(self.driver).is_angular
 
-    def default_values(self, steps: int = 361) -> np.ndarray:
-        """One full turn from the scene's angle (both ends included), or +-the mechanism's size."""
+    def default_values(self, steps: int = 361) -> DriverValues:
+        """One full turn from the scene's angle (both ends included), or +-the mechanism's
+        size; computed when read (a `DriverValues`)."""
         span = 2 * math.pi if self.is_angular else self.mechanism.length_scale
-        return np.linspace(self.start, self.start + span, steps)
+        return DriverValues(self.start, self.start + span, steps)
 
     def chunks(self, values: Iterable[float], *, start: str = "predictor", batch: bool = True,
                interpolate: int = 1, through_folds: bool = False) -> Iterator[RangeChunk]:
         """The poses' q, v, a and accuracy as arrays, a chunk at a time (no motion read-out):
         the quickest way through a long sweep. Options: see `poses`."""
         d = self.drivers
-        return solve_range(self.solver, self.driver, values, driver_q=d.q, driver_v=d.v, driver_a=d.a,
+        return solve_range(self.solver, self.driver, self._checked(values), driver_q=d.q, driver_v=d.v, driver_a=d.a,
                            start=start, batch=batch, interpolate=interpolate, through_folds=through_folds)
 
     def poses(self, values: Iterable[float], *, skip_failures: bool = False, start: str = "predictor",
@@ -200,6 +241,22 @@ class Sweep:
         if self.first_q is None or self.last_q is None:
             return math.nan
         return self.solver.turn_gap(self.first_q, self.last_q)
+
+    def _checked(self, values: Iterable[float]) -> Iterator[float]:
+        """The driver values as floats, or a ModelError naming the first that is not a finite number."""
+        unit = "rad" if self.is_angular else "m"
+        if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
+            raise ModelError(f"values of {self.driver} must be numbers [{unit}], got {values!r:.80}",
+                             path=self.mechanism.source)
+        for index, value in enumerate(values):
+            try:
+                number = float(value)
+            except (TypeError, ValueError):
+                number = math.nan
+            if isinstance(value, (str, bytes, bool)) or not math.isfinite(number):
+                raise ModelError(f"value {index} of {self.driver} is {value!r:.40}, not a finite number [{unit}]",
+                                 path=self.mechanism.source)
+            yield number
 
     def _format(self, value: float) -> str:
         return f"{math.degrees(value):.6g} deg" if self.is_angular else f"{value:.6g} m"

@@ -15,6 +15,7 @@ from typing import IO, TYPE_CHECKING
 
 import numpy as np
 
+from pinmech.limits import limit_violations
 from pinmech.motion import Motion
 from pinmech.report import motion_dict
 
@@ -29,9 +30,10 @@ def columns(sweep: Sweep, first: Motion) -> list[str]:
     unit = "deg" if sweep.is_angular else "m"
     cols = [f"{sweep.driver}.q [{unit}]"]
     planar = sweep.mechanism.plane_normal is not None
-    for name in first.links:
+    for name, link in first.links.items():
         if planar:
-            cols += [f"{name}.angle [deg]", f"{name}.omega [rad/s]", f"{name}.alpha [rad/s^2]"]
+            angle = "angle" if link.angle_axis == "x" else f"angle_of_{link.angle_axis}_axis"  # x normal to the plane
+            cols += [f"{name}.{angle} [deg]", f"{name}.omega [rad/s]", f"{name}.alpha [rad/s^2]"]
         else:
             cols += [f"{name}.|omega| [rad/s]", f"{name}.|alpha| [rad/s^2]"]
     for name in first.points:
@@ -39,8 +41,9 @@ def columns(sweep: Sweep, first: Motion) -> list[str]:
         cols += [f"{name}.v{c} [m/s]" for c in "xyz"] + [f"{name}.|v| [m/s]"]
         cols += [f"{name}.a{c} [m/s^2]" for c in "xyz"] + [f"{name}.|a| [m/s^2]"]
     for name in first.sliders:
-        cols += [f"{name}.v_rel [m/s]", f"{name}.a_rel [m/s^2]", f"{name}.|a_cor| [m/s^2]"]
-    return cols + ["closure_residual [1]", "condition_number [1]", "newton_iterations [1]", "pose", "error"]
+        cols += [f"{name}.s [m]", f"{name}.v_rel [m/s]", f"{name}.a_rel [m/s^2]", f"{name}.|a_cor| [m/s^2]"]
+    return cols + ["closure_residual [1]", "condition_number [1]", "newton_iterations [1]", "beyond_limits", "pose",
+                   "error"]
 
 
 def row(sweep: Sweep, pose: SweepPose, width: int) -> list[object]:
@@ -60,9 +63,11 @@ def row(sweep: Sweep, pose: SweepPose, width: int) -> list[object]:
         v, a = p.velocity.tolist(), p.acceleration.tolist()
         out += p.position.tolist() + v + [math.hypot(*v)] + a + [math.hypot(*a)]
     for name, s in m.sliders.items():
-        out += [m.joints[name].v, m.joints[name].a, _norm(s.coriolis_acceleration)]
+        out += [m.joints[name].q, m.joints[name].v, m.joints[name].a, _norm(s.coriolis_acceleration)]
     acc = pose.accuracy
-    return out + [acc.residual, acc.condition, acc.iterations, "interpolated" if pose.interpolated else "solved", ""]
+    beyond = " ".join(v.joint for v in limit_violations(sweep.mechanism, m))
+    return out + [acc.residual, acc.condition, acc.iterations, beyond, "interpolated" if pose.interpolated else "solved",
+                  ""]
 
 
 class SweepCsv:
@@ -132,8 +137,11 @@ class SweepJsonLines:
         """The pose's JSON object (subclasses add keys)."""
         entry = {"index": pose.index, self.sweep.driver: pose.value, "error": pose.error,
                  "pose": "failed" if pose.motion is None else "interpolated" if pose.interpolated else "solved"}
+        if pose.note:  # a change point passed or a fold crossed on the way to this pose
+            entry["note"] = pose.note
         if pose.motion is not None:
             entry.update(motion_dict(pose.motion))
+            entry["limit_violations"] = [v.as_dict() for v in limit_violations(self.sweep.mechanism, pose.motion)]
             entry["accuracy"] = pose.accuracy.as_dict()
         return entry
 
@@ -142,15 +150,16 @@ class SweepJsonLines:
 
 
 class PathCsv:
-    """An arm path: time, each one-dof joint's q [deg or m], v, a, the drift, the
-    condition number."""
+    """An arm path: time, each one-dof joint's q [deg or m], v, a (a `<mimic>` follower's
+    from its leader's), the drift, the condition number."""
 
     def __init__(self, mechanism: Mechanism, stream: IO[str]) -> None:
         self.mechanism, self.writer = mechanism, csv.writer(stream)
-        self.joints = [j for j in mechanism.joints.values() if j.nv == 1]
+        self.joints = [j for j in mechanism.joints.values() if j.nv == 1 or j.name in mechanism.mimics]
         header = ["t [s]"]
         for j in self.joints:
-            units = ("deg", "rad/s", "rad/s^2") if j.is_angular else ("m", "m/s", "m/s^2")
+            angular = mechanism.mimics[j.name].kind != "prismatic" if j.name in mechanism.mimics else j.is_angular
+            units = ("deg", "rad/s", "rad/s^2") if angular else ("m", "m/s", "m/s^2")
             header += [f"{j.name}.{x} [{u}]" for x, u in zip(("q", "v", "a"), units)]
         self.writer.writerow(header + ["drift [m]", "angular_drift [rad]", "condition_number [1]"])
         self.count = 0
@@ -159,8 +168,11 @@ class PathCsv:
         cells = [f"{point.time:.9g}"]
         for j in self.joints:
             q = self.mechanism.coordinate(point.q, j.name)
-            cells += [f"{math.degrees(q) if j.is_angular else q:.12g}", f"{point.v[j.idx_v]:.12g}",
-                      f"{point.a[j.idx_v]:.12g}"]
+            mimic = self.mechanism.mimics.get(j.name)
+            scale = mimic.multiplier if mimic else 1.0  # idx_v of a follower is its leader's
+            angular = mimic.kind != "prismatic" if mimic else j.is_angular
+            cells += [f"{math.degrees(q) if angular else q:.12g}", f"{scale * point.v[j.idx_v]:.12g}",
+                      f"{scale * point.a[j.idx_v]:.12g}"]
         self.writer.writerow(cells + [f"{point.drift:.3e}", f"{point.angular_drift:.3e}", f"{point.condition:.6g}"])
         self.count += 1
 

@@ -1,13 +1,19 @@
 """Users' units in, SI out: the only place where "30 deg" or "-50 rpm" becomes a float.
 
-Parsing is done by pint (one shared registry, built on first use). Scene files and the
-CLI call `to_si`; everything inside pinmech is SI (m, rad, s).
+A quantity is one number and one unit ("1.5 mm", "-50 rpm", "10 deg/s^2"), or an angle
+in degrees, minutes and seconds ("30° 20' 15\""). The number is read here (a decimal
+point, never a comma); the unit is looked up in a small table of the units users write
+most, else parsed by pint (imported only then: it costs about 0.4 s). The unit must have
+exactly the dimension asked for, radians counted: "1 deg**2" is not an angle and "1 Hz"
+is not an angular velocity. Scene files and the CLI call `to_si`; everything inside
+pinmech is SI (m, rad, s).
 """
 
 from __future__ import annotations
 
 import functools
 import math
+import re
 from typing import Any
 
 from pinmech.exceptions import UnitError
@@ -32,10 +38,69 @@ JOINT_KINDS: dict[str, tuple[str, str, str]] = {
     "prismatic": ("length", "velocity", "acceleration"),
 }
 
+#: Each kind as powers of pint's root units: the exact dimension a unit must have.
+_DIMENSIONS: dict[str, dict[str, int]] = {
+    "angle": {"radian": 1},
+    "angular_velocity": {"radian": 1, "second": -1},
+    "angular_acceleration": {"radian": 1, "second": -2},
+    "length": {"meter": 1},
+    "velocity": {"meter": 1, "second": -1},
+    "acceleration": {"meter": 1, "second": -2},
+    "time": {"second": 1},
+    "force": {"gram": 1, "meter": 1, "second": -2},  # pint's root unit of mass is the gram
+    "torque": {"gram": 1, "meter": 2, "second": -2},
+    "moment_of_inertia": {"gram": 1, "meter": 2},
+}
+
+_DEG = math.pi / 180
+_REV = 2 * math.pi
+#: The units users write most, with their SI factor and kind (checked against pint by the
+#: tests), so that a scene is read without importing pint. Anything else goes to pint.
+_COMMON_UNITS: dict[str, tuple[float, str]] = {
+    **{u: (1.0, "angle") for u in ("rad", "radian", "radians")},
+    **{u: (_DEG, "angle") for u in ("deg", "degree", "degrees", "°")},
+    **{u: (_REV, "angle") for u in ("rev", "revolution", "revolutions", "turn", "turns")},
+    **{u: (1.0, "angular_velocity") for u in ("rad/s", "radian/second")},
+    "deg/s": (_DEG, "angular_velocity"),
+    "rpm": (_REV / 60, "angular_velocity"),
+    "rev/s": (_REV, "angular_velocity"),
+    "turn/s": (_REV, "angular_velocity"),
+    **{u: (1.0, "angular_acceleration") for u in ("rad/s^2", "rad/s**2")},
+    **{u: (_DEG, "angular_acceleration") for u in ("deg/s^2", "deg/s**2")},
+    **{u: (1.0, "length") for u in ("m", "meter", "meters", "metre", "metres")},
+    "mm": (1e-3, "length"),
+    "cm": (1e-2, "length"),
+    "km": (1e3, "length"),
+    "um": (1e-6, "length"),
+    "µm": (1e-6, "length"),
+    "m/s": (1.0, "velocity"),
+    "mm/s": (1e-3, "velocity"),
+    "cm/s": (1e-2, "velocity"),
+    **{u: (1.0, "acceleration") for u in ("m/s^2", "m/s**2")},
+    **{u: (1e-3, "acceleration") for u in ("mm/s^2", "mm/s**2")},
+    **{u: (1.0, "time") for u in ("s", "second", "seconds")},
+    "ms": (1e-3, "time"),
+    "N": (1.0, "force"),
+    "kN": (1e3, "force"),
+    "N*m": (1.0, "torque"),
+    **{u: (1.0, "moment_of_inertia") for u in ("kg*m^2", "kg*m**2")},
+}
 
 #: Largest magnitude of a quantity in SI units. Kinematics multiplies speeds and lengths
 #: (a = omega^2 r) and squares the results (norms), which must stay below 1.8e308.
 MAX_MAGNITUDE = 1e50
+
+_NUMBER = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?(?:infinity|inf|nan)\b)\s*(.*)",
+                     re.IGNORECASE | re.DOTALL)
+#: Typographic spellings of a unit: s² is s^2, m·s is m*s, μ (Greek mu) is µ (micro sign).
+_TYPOGRAPHY = str.maketrans({"²": "^2", "³": "^3", "·": "*", "⋅": "*", "\u03bc": "\u00b5"})
+_EXPONENT = re.compile(r"(\^|\*\*)\s*[+-]?\d+")
+_DMS = re.compile(
+    r"([+-]?)\s*(\d+)\s*(?:°|deg|degrees?)\s*"
+    r"(?:(\d+(?:\.\d*)?)\s*(?:'|′|arcmin|arcminutes?)\s*)"
+    r"(?:(\d+(?:\.\d*)?)\s*(?:\"|″|''|arcsec|arcseconds?))?",
+    re.IGNORECASE,
+)
 
 
 @functools.lru_cache(maxsize=1)
@@ -62,52 +127,94 @@ def to_si(value: Any, kind: str, *, where: str = "") -> float:
         The value in the SI unit of `kind` (rad, rad/s, rad/s^2, m, m/s, m/s^2, s).
 
     Raises:
-        UnitError: unknown unit, wrong dimension, missing unit, or not finite.
+        UnitError: unknown unit, wrong dimension, missing unit, a decimal comma, two
+            numbers, or not finite.
     """
-    si = SI_UNITS[kind]
+    if kind not in SI_UNITS:
+        raise UnitError(f"unknown kind of quantity {kind!r}; one of {', '.join(SI_UNITS)}", key=where)
     if isinstance(value, bool) or not isinstance(value, (int, float, str)):
         raise UnitError(f"expected a quantity such as '1.5 {_example(kind)}', got {value!r}", key=where)
     if isinstance(value, (int, float)):
         if value == 0:
             return 0.0
-        raise UnitError(
-            f"{value!r} has no unit: write it as '{value} {_example(kind)}' ({kind.replace('_', ' ')})",
-            key=where,
-        )
-    ureg = _registry()
-    try:
-        quantity = ureg.Quantity(value.strip())
-    except Exception as exc:  # pint raises several unrelated classes here
-        raise UnitError(f"cannot read quantity {value!r}: {exc}", key=where) from exc
-    if not hasattr(quantity, "to"):
-        quantity = ureg.Quantity(float(quantity), "dimensionless")
-    if quantity.unitless:
-        if float(quantity.magnitude) == 0:
+        raise UnitError(_no_unit(value, kind), key=where)
+    number, unit = _split(value, kind, where)
+    if not unit:
+        if number == 0:
             return 0.0
-        raise UnitError(
-            f"{value!r} has no unit: write it as '{value} {_example(kind)}' ({kind.replace('_', ' ')})",
-            key=where,
-        )
-    # pint treats the radian as dimensionless: "1 Hz" would pass as 1 rad/s. Insist on an
-    # angle unit (rad, deg, rev, rpm, ...) in the expression of an angular quantity.
-    if kind.startswith(("angle", "angular")) and "radian" not in str(quantity.to_root_units().units):
-        raise UnitError(
-            f"{value!r} has no angle unit, so it is not an {kind.replace('_', ' ')} (use e.g. {_example(kind)})",
-            key=where,
-        )
-    try:
-        number = float(quantity.to(si).magnitude)
-    except Exception as exc:
-        raise UnitError(
-            f"{value!r} is not {_article(kind)} {kind.replace('_', ' ')} (use e.g. {_example(kind)})",
-            key=where,
-        ) from exc
-    if not math.isfinite(number):
+        raise UnitError(_no_unit(value, kind), key=where)
+    result = number * _factor(value, unit, kind, where)
+    if not math.isfinite(result):
         raise UnitError(f"{value!r} is not a finite number", key=where)
-    if abs(number) > MAX_MAGNITUDE:
-        raise UnitError(f"{value!r} is {number:.3g} {format_si(number, kind)}, beyond the {MAX_MAGNITUDE:g} (SI) "
+    if abs(result) > MAX_MAGNITUDE:
+        raise UnitError(f"{value!r} is {result:.3g} {format_si(result, kind)}, beyond the {MAX_MAGNITUDE:g} (SI) "
                         "pinmech computes with: its squares would overflow", key=where)
-    return number
+    return result
+
+
+def _split(text: str, kind: str, where: str) -> tuple[float, str]:
+    """The number and the unit expression of "1.5 mm" (an angle in degrees, minutes and
+    seconds becomes degrees); a decimal comma or a second number is refused."""
+    stripped = text.strip().replace("\u2212", "-")  # a typographic minus sign is a minus sign
+    if "," in stripped:
+        hint = re.sub(r"(\d),(\d)", r"\1.\2", stripped)
+        said = f"write '{hint}' (a decimal point)" if hint != stripped else "write one number and one unit"
+        raise UnitError(f"{text!r} has a comma, which pinmech does not read as a decimal mark: {said}", key=where)
+    if kind == "angle" and (dms := _DMS.fullmatch(stripped)):
+        return _degrees(text, dms, where), "deg"
+    match = _NUMBER.fullmatch(stripped)
+    if match is None:
+        raise UnitError(f"cannot read quantity {text!r}: expected a number then a unit, e.g. "
+                        f"'1.5 {_example(kind)}'", key=where)
+    unit = match.group(2).strip().translate(_TYPOGRAPHY)
+    unit = re.sub(r"\s*(\*\*|[/*^])\s*", r"\1", unit)
+    if re.search(r"\d", _EXPONENT.sub("", unit)):
+        angles = " (an angle may be written 30° 20' 15\")" if kind.startswith(("angle", "angular")) else ""
+        raise UnitError(f"{text!r} holds more than one number: write one number and one unit, e.g. "
+                        f"'1.5 {_example(kind)}'{angles}", key=where)
+    return float(match.group(1)), unit
+
+
+def _degrees(text: str, dms: re.Match, where: str) -> float:
+    """Degrees of an angle written as degrees, minutes and optional seconds."""
+    sign = -1.0 if dms.group(1) == "-" else 1.0
+    degrees, minutes = float(dms.group(2)), float(dms.group(3))
+    seconds = float(dms.group(4) or 0.0)
+    if not (minutes < 60 and seconds < 60) or (dms.group(4) and not minutes.is_integer()):
+        raise UnitError(f"{text!r}: minutes and seconds of arc must be below 60, and only the last part may "
+                        "have decimals", key=where)
+    return sign * (degrees + minutes / 60 + seconds / 3600)
+
+
+def _factor(text: str, unit: str, kind: str, where: str) -> float:
+    """SI value of one `unit`, which must have the dimension of `kind` exactly."""
+    if unit in _COMMON_UNITS:
+        factor, unit_kind = _COMMON_UNITS[unit]
+        if unit_kind != kind:
+            raise UnitError(_wrong_kind(text, kind, unit_kind.startswith(("angle", "angular"))), key=where)
+        return factor
+    try:
+        quantity = _registry().Quantity(1.0, unit)
+        root = quantity.to_root_units()
+    except Exception as exc:  # pint raises several unrelated classes here
+        raise UnitError(f"cannot read quantity {text!r}: {type(exc).__name__} {exc}".rstrip(), key=where) from exc
+    powers = {name: int(p) if float(p).is_integer() else float(p) for name, p in root.unit_items()}
+    if powers != _DIMENSIONS[kind]:
+        raise UnitError(_wrong_kind(text, kind, powers.get("radian", 0) != 0, powers), key=where)
+    return float(quantity.to(SI_UNITS[kind]).magnitude)  # SI, with kilograms (not pint's root grams)
+
+
+def _wrong_kind(text: str, kind: str, has_angle: bool, powers: dict[str, Any] | None = None) -> str:
+    name = kind.replace("_", " ")
+    if kind.startswith(("angle", "angular")) and not has_angle:
+        return f"{text!r} has no angle unit, so it is not an {name} (use e.g. {_example(kind)})"
+    dimension = "" if powers is None else " (its unit is " + (" ".join(
+        f"{n}^{p}" for n, p in powers.items()) or "dimensionless") + ")"
+    return f"{text!r} is not {_article(kind)} {name}{dimension} (use e.g. {_example(kind)})"
+
+
+def _no_unit(value: Any, kind: str) -> str:
+    return f"{value!r} has no unit: write it as '{value} {_example(kind)}' ({kind.replace('_', ' ')})"
 
 
 def _article(kind: str) -> str:

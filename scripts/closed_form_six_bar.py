@@ -11,7 +11,6 @@ intersection of the circles (C, b2) and (O6, c2).
 from __future__ import annotations
 
 import numpy as np
-
 from closed_form import four_bar, perp
 
 

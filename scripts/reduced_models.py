@@ -68,7 +68,7 @@ def measure(scene_name: str, robot: str) -> list[dict]:
         q, _, _ = scene_pose(scene, mech)
         solver = pinmech.RateSolver(mech, scene_tasks(scene))
         solution = solver.solve(q)
-        held = [solution.v[j.idx_v : j.idx_v + j.nv] for n, j in mech.joints.items() if n not in moved]
+        held = [solution.v[j.idx_v : j.idx_v + j.nv] for n, j in mech.joints.items() if n not in moved and j.nv]
         rows.append({
             "held_rate": max((float(abs(x).max()) for x in held), default=0.0),
             "model": label, "nq": mech.model.nq, "nv": mech.model.nv, "joints": mech.model.njoints - 1,

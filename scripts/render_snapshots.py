@@ -7,8 +7,17 @@ route as the browser tests (tests/browser.py).
 - `docs/images/planar_arm.png`: the 3R arm of text 17.110 at (50, -65, -75) deg, D moving
   at 1 m/s along x while CD does not turn: velocities of B, C and D (one scale).
 
-Poses and rates come from the independent closed forms in scripts/closed_form.py; the models
-are built from the URDF files directly.
+- `docs/images/four_bar.png`, `docs/images/slider_crank.png`: the bundled scenes as
+  `pinmech snapshot` draws them; `docs/images/four_bar_bare.png`: the four-bar with every
+  `<visual>` taken out (a user's model), and `docs/images/jansen_leg.png`, a model written
+  without any: their links sketched from their joints and points.
+- `docs/images/sweep_r_rtr.png`, `docs/images/paths_four_bar.png`, `paths_jansen_leg.png`:
+  `pinmech sweep --plot` and `--paths`; `docs/images/polygon_v_r_rtr.png`,
+  `polygon_a_r_rtr.png`: `pinmech polygon`.
+
+Poses and rates of the first two come from the independent closed forms in
+scripts/closed_form.py; the models are built from the URDF files directly. The others run
+pinmech's own commands on the bundled scenes.
 
 Run: python scripts/render_snapshots.py   (needs pinmech[viz] and Debian's chromium)
 """
@@ -16,8 +25,6 @@ Run: python scripts/render_snapshots.py   (needs pinmech[viz] and Debian's chrom
 from __future__ import annotations
 
 import math
-import shutil
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -28,19 +35,6 @@ ROOT = Path(__file__).resolve().parents[1]
 IMAGES = ROOT / "docs" / "images"
 MODELS = ROOT / "models"
 SCENES = {"r_rtr": ["v_D", "a_D"], "planar_arm": ["v_B", "v_C", "v_D"]}  # picture: arrows drawn
-FLAGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--enable-unsafe-swiftshader",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--virtual-time-budget=3000",
-    "--window-size=800,600",
-]  # as tests/browser.py
 BLUE, ORANGE = (0.1, 0.2, 0.9), (0.9, 0.5, 0.0)
 Z = np.array([0.0, 0.0, 1.0])
 
@@ -114,19 +108,45 @@ def page(name: str, arrow_labels: list[str]) -> str:
     )
 
 
-def photograph(chromium: str, html: Path, png: Path, profile: Path) -> None:
-    """Headless chromium's screenshot of a page (800 x 600 pixels)."""
-    subprocess.run(
-        [chromium, *FLAGS, f"--user-data-dir={profile}", f"--screenshot={png}", html.as_uri()],
-        capture_output=True,
-        timeout=120,
-        check=True,
-    )
+def cli_pictures(chromium: str, tmp: Path) -> None:
+    """The pictures pinmech's own commands make: snapshots, a bare model, figures, polygons."""
+    import re
+
+    from pinmech.cli import main as pinmech
+    from pinmech.draw.browser import photograph
+
+    scenes = MODELS / "scenes"
+    bare = tmp / "four_bar_bare.urdf"
+    bare.write_text(re.sub(r"<visual>.*?</visual>", "", (MODELS / "four_bar.urdf").read_text(), flags=re.DOTALL))
+    scene = (scenes / "four_bar.toml").read_text()
+    (tmp / "four_bar_bare.toml").write_text(re.sub(r'urdf = ".*"', 'urdf = "four_bar_bare.urdf"', scene))
+    for name, scene_file in (("four_bar", scenes / "four_bar.toml"), ("slider_crank", scenes / "slider_crank.toml"),
+                             ("four_bar_bare", tmp / "four_bar_bare.toml"), ("jansen_leg", scenes / "jansen_leg.toml")):
+        html = tmp / f"{name}.html"
+        pinmech(["snapshot", str(scene_file), "-o", str(html), "--no-grid"])
+        photograph(chromium, html, IMAGES / f"{name}.png")
+    pinmech(["sweep", str(scenes / "r_rtr.toml"), "--plot", str(IMAGES / "sweep_r_rtr.png"), "--csv", str(tmp / "s.csv")])
+    for name in ("four_bar", "jansen_leg"):
+        pinmech(["sweep", str(scenes / f"{name}.toml"), "--paths", str(IMAGES / f"paths_{name}.png")])
+    for kind in ("v", "a"):
+        svg = tmp / f"polygon_{kind}.svg"
+        pinmech(["polygon", str(scenes / "r_rtr.toml"), "-o", str(svg)] + (["--acceleration"] if kind == "a" else []))
+        photograph(chromium, svg, IMAGES / f"polygon_{kind}_r_rtr.png", window=_svg_pixels(svg))
+
+
+def _svg_pixels(svg: Path) -> tuple[int, int]:
+    """The size of an SVG drawing given in millimetres, in CSS pixels (96 per inch)."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(svg).getroot()
+    return tuple(round(float(root.get(k).removesuffix("mm")) * 96 / 25.4) + 1 for k in ("width", "height"))
 
 
 def main() -> None:
     """Write docs/images/NAME.png for every picture in SCENES."""
-    chromium = shutil.which("chromium")
+    from pinmech.draw.browser import find_chromium, photograph
+
+    chromium = find_chromium()
     if chromium is None:
         print("this script needs Debian's chromium: apt-get install chromium")
         return
@@ -141,8 +161,9 @@ def main() -> None:
         for name, arrow_labels in SCENES.items():
             html = Path(tmp) / f"{name}.html"
             html.write_text(page(name, arrow_labels), encoding="utf-8")
-            photograph(chromium, html, IMAGES / f"{name}.png", Path(tmp) / "profile")
+            photograph(chromium, html, IMAGES / f"{name}.png")
             print(f"wrote {IMAGES / f'{name}.png'}")
+        cli_pictures(chromium, Path(tmp))
 
 
 if __name__ == "__main__":

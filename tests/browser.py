@@ -1,40 +1,21 @@
-"""A real browser for page tests: Debian's chromium, headless, takes a screenshot of a saved
-HTML file, and the pixels say whether something is drawn, how much of the view it spans and
-whether a colour is there.
-
-The command line that works here (chromium 156, no GPU, no network, root):
-software WebGL through SwiftShader (`--enable-unsafe-swiftshader`; `--use-gl=swiftshader`
-gives a blank page), no background networking, and a virtual time budget that lets the
-page draw and then exits (a budget of 0 or 100 ms hangs, so a subprocess timeout guards).
+"""A real browser for page tests: Debian's chromium, headless (`pinmech.draw.browser`, the
+route the README's pictures take too), takes a screenshot of a saved HTML file, and the
+pixels say whether something is drawn, how much of the view it spans and whether a colour
+is there.
 """
 
 from __future__ import annotations
 
 import colorsys
 import os
-import shutil
-import subprocess
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-CHROMIUM = shutil.which("chromium")
-FLAGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--enable-unsafe-swiftshader",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--window-size=800,600",
-]
-BUDGET_MS = 3000  # virtual time for the page to load and draw [ms]
-TIMEOUT_S = 90  # wall-clock limit of one screenshot [s]
+from pinmech.draw.browser import find_chromium, photograph
+
+CHROMIUM = find_chromium()
 BACKGROUND = 0.9  # a pixel with every channel above this is the white page
 UI_BOXES = (
     (slice(0, 30), slice(-260, None)),  # meshcat's "Open Controls" bar, top right
@@ -54,30 +35,9 @@ def require_browser() -> str:
     return CHROMIUM
 
 
-def chromium_command(
-    html_file: Path, png: Path, profile: Path, *, fragment: str = "", budget_ms: int = BUDGET_MS
-) -> list[str]:
-    """The command line that draws `html_file` (address `#fragment` appended) into `png`."""
-    url = html_file.resolve().as_uri() + (f"#{fragment}" if fragment else "")
-    return [
-        require_browser(),
-        *FLAGS,
-        f"--user-data-dir={profile}",
-        f"--virtual-time-budget={budget_ms}",
-        f"--screenshot={png}",
-        url,
-    ]
-
-
-def screenshot(html_file: Path, png: Path, *, fragment: str = "") -> np.ndarray:
-    """RGB pixels (floats in [0, 1], shape (600, 800, 3)) of the page as chromium draws it."""
-    with tempfile.TemporaryDirectory() as profile:
-        subprocess.run(
-            chromium_command(html_file, png, Path(profile), fragment=fragment),
-            capture_output=True,
-            timeout=TIMEOUT_S,
-            check=True,
-        )
+def screenshot(html_file: Path, png: Path, *, fragment: str = "", window: tuple[int, int] = (800, 600)) -> np.ndarray:
+    """RGB pixels (floats in [0, 1], shape (height, width, 3)) of the page as chromium draws it."""
+    photograph(require_browser(), html_file, png, fragment=fragment, window=window)
     return read_png(png)
 
 

@@ -14,20 +14,20 @@ from __future__ import annotations
 
 import math
 
+import closed_form
 import numpy as np
 import pytest
+from closed_form_six_bar import stephenson_d
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-import closed_form
 import pinmech
-from tests._mechanisms import four_bar_urdf, spatial_rsur_urdf, stephenson_six_bar_urdf, write
-from closed_form_six_bar import stephenson_d
 from pinmech import AssemblyError, DriverLimitError, LoopSolver, Mechanism, SingularPoseError
 from pinmech.cli import main
 from pinmech.solve_cycle import solve_range
+from tests._mechanisms import four_bar_urdf, spatial_rsur_urdf, stephenson_six_bar_urdf, write
 
-SIX = dict(a=0.04, b=0.12, c=0.08, d=0.10, cx=0.06, cy=0.04, b2=0.10, c2=0.09, o6=(0.16, 0.10))
+SIX = {"a": 0.04, "b": 0.12, "c": 0.08, "d": 0.10, "cx": 0.06, "cy": 0.04, "b2": 0.10, "c2": 0.09, "o6": (0.16, 0.10)}
 
 
 # ---------------------------------------------------------------------- helpers
@@ -203,7 +203,7 @@ def test_a_sweep_past_a_limit_stops_there_or_goes_through_onto_the_other_branch(
     solver = LoopSolver(mech, ["O2"])
     solver.set_reference([math.pi], _four_bar_guess(mech, math.pi, *dims, +1))
     values = np.radians(np.arange(180, -1, -5.0))  # down to 0 deg, past the limit at 28.96 deg
-    q, errors, _ = _sweep(solver, values)
+    _q, errors, _ = _sweep(solver, values)
     first_bad = min(errors)
     assert math.degrees(values[first_bad - 1]) > math.degrees(lim) > math.degrees(values[first_bad])
     assert all(isinstance(errors[i], DriverLimitError) for i in errors)
@@ -296,7 +296,7 @@ def test_random_four_bar_sweeps_never_change_assembly_in_silence(tmp_path_factor
     mech = _four_bar(tmp, a, b, c, d)
     solver = LoopSolver(mech, ["O2"])
     try:
-        ref = solver.set_reference([start], _four_bar_guess(mech, start, a, b, c, d, branch))
+        solver.set_reference([start], _four_bar_guess(mech, start, a, b, c, d, branch))
     except (SingularPoseError, pinmech.LoopClosureError):
         return
     values = start + np.radians(np.arange(0, 370, step))
@@ -360,3 +360,69 @@ def test_a_scene_without_guess_says_which_assembly_and_how_to_pin_it(tmp_path, m
 def test_cli_sweep_says_it_came_back_after_a_turn(models_dir, capsys):
     assert main(["sweep", str(models_dir / "scenes" / "four_bar.toml"), "--steps", "9"]) == 0
     assert "back where it began" in capsys.readouterr().err
+
+
+def test_a_slider_crank_driven_at_its_piston_stops_at_the_end_of_its_stroke(models_dir):
+    """Driven from the piston, the offset slider-crank's outer dead centre is a fold: the
+    stroke ends at x = sqrt((r + l)^2 - e^2), located to 1e-9 of the size."""
+    mech = Mechanism.from_urdf(models_dir / "slider_crank.urdf")
+    r, l, e = 0.05, 0.15, 0.01
+    theta = math.radians(100)
+    ref = closed_form.slider_crank(theta, 0, 0, r, l, e, +1)
+    q = mech.neutral()
+    mech.set_coordinate(q, "O", theta)
+    mech.set_coordinate(q, "A", float(ref.beta) - theta)
+    mech.set_coordinate(q, "slide", float(ref.x_B))
+    solver = LoopSolver(mech, ["slide"])
+    solver.set_reference([float(ref.x_B)], q)
+    with pytest.raises(DriverLimitError) as info:
+        solver.solve([0.25])
+    assert abs(info.value.limit[0] - math.sqrt((r + l) ** 2 - e**2)) < 1e-9 * 0.2
+    assert "slide = 0.1997" in str(info.value)
+
+
+def test_sweep_json_lines_say_where_a_fold_was_crossed(tmp_path, models_dir, capsys):
+    import json
+
+    text = four_bar_urdf(0.07, 0.09, 0.05, 0.04)  # the triple rocker of the fold tests
+    urdf = write(tmp_path, "ng.urdf", text)
+    scene = tmp_path / "s.toml"
+    scene.write_text(f'urdf = "{urdf}"\n[drivers.O2]\nangle = "180 deg"\nspeed = "1 rad/s"\n'
+                     '[guess]\nA = "-150 deg"\nO4 = "100 deg"\n')
+    out = tmp_path / "rows.jsonl"
+    assert main(["sweep", str(scene), "--from", "180 deg", "--to", "0 deg", "--steps", "19",
+                 "--through-folds", "--json", str(out)]) == 0
+    rows = [json.loads(line) for line in out.read_text().splitlines()]
+    assert sum("fold" in r.get("note", "") for r in rows) == 1
+    assert "crossed a fold at O2 = 28.955" in capsys.readouterr().err
+    assert main(["sweep", str(scene), "--from", "180 deg", "--to", "0 deg", "--steps", "19"]) == 11
+    assert "cannot go past O2 = 28.955" in capsys.readouterr().err
+
+
+def test_a_solver_without_reference_takes_its_first_pose_as_one(tmp_path):
+    a, b, c, d = 0.04, 0.12, 0.08, 0.10
+    mech = _four_bar(tmp_path, a, b, c, d)
+    solver = LoopSolver(mech, ["O2"])
+    first = solver.solve([1.0], guess=_four_bar_guess(mech, 1.0, a, b, c, d, -1))
+    assert solver.reference is not None and solver.reference.signs == first.assembly.signs
+    later = solver.solve([4.0])  # by continuation from the first pose
+    assert np.allclose(_rocker_tip(mech, later.q, c, d), closed_form.four_bar(4.0, 0, 0, a, b, c, d, -1).B,
+                       atol=1e-12 * 0.16)
+    with pytest.raises(AssemblyError):
+        solver.solve([4.0], guess=_four_bar_guess(mech, 4.0, a, b, c, d, +1))
+
+
+def test_the_batch_mode_hands_back_poses_of_another_assembly(tmp_path):
+    """BatchSolver from guesses on the other side: None (the pose-by-pose solver then
+    names the pose), never those poses."""
+    a, b, c, d = 0.04, 0.12, 0.08, 0.10
+    mech = _four_bar(tmp_path, a, b, c, d)
+    solver = LoopSolver(mech, ["O2"])
+    solver.set_reference([1.0], _four_bar_guess(mech, 1.0, a, b, c, d, +1))
+    thetas = np.linspace(1.0, 1.1, 5)
+    batch = pinmech.BatchSolver(solver)
+    same = np.array([_four_bar_guess(mech, t, a, b, c, d, +1) for t in thetas])
+    other = np.array([_four_bar_guess(mech, t, a, b, c, d, -1) for t in thetas])
+    zeros = np.zeros((5, 1))
+    assert batch.try_solve(same, thetas[:, None], zeros, zeros) is not None
+    assert batch.try_solve(other, thetas[:, None], zeros, zeros) is None

@@ -365,3 +365,89 @@ def test_an_output_file_that_cannot_be_written(r_rtr_scene, tmp_path, capsys, op
     target = tmp_path / "no such folder" / "out.csv"
     code, err = _run(capsys, "sweep", r_rtr_scene, "--steps", "3", option, target)
     assert code == 2 and err.startswith("pinmech: error: ") and err.count("\n") == 1 and "no such folder" in err
+
+
+# ---------------------------------------------------------------- the Python API's arguments
+@pytest.fixture(scope="module")
+def r_rtr_analysis():
+    import pinmech
+
+    return pinmech.analyse(pinmech.Scene.load(SCENES / "r_rtr.toml"))
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (lambda q, v, a: (q[:2], v, a), r"q must be 5 finite numbers \(SI\), got shape \(2,\)"),
+        (lambda q, v, a: (q.reshape(1, -1), v, a), r"q must be 5 finite numbers \(SI\), got shape \(1, 5\)"),
+        (lambda q, v, a: (q, ["x"] * 3, a), "v must be 3 numbers"),
+        (lambda q, v, a: (q, v, [0.0, float("nan"), 0.0]), "a must be 3 finite numbers.*non-finite"),
+        (lambda q, v, a: (q, v, "0 0 0"), "a must be 3"),
+    ],
+)
+def test_evaluate_motion_names_a_wrong_argument(r_rtr_analysis, change, message):
+    from pinmech import ModelError, evaluate_motion
+
+    m, sol = r_rtr_analysis.mechanism, r_rtr_analysis.solution
+    with pytest.raises(ModelError, match=message):
+        evaluate_motion(m, m.model.createData(), *change(sol.q, sol.v, sol.a))
+
+
+def test_evaluate_motion_wants_a_data_of_the_model(r_rtr_analysis, models_dir):
+    import pinocchio as pin
+
+    from pinmech import Mechanism, ModelError, evaluate_motion
+
+    m, sol = r_rtr_analysis.mechanism, r_rtr_analysis.solution
+    other = Mechanism.from_urdf(models_dir / "four_bar.urdf").model.createData()
+    for data in (None, other, pin.Model().createData()):
+        with pytest.raises(ModelError, match="data must be a pin.Data of the mechanism's model"):
+            evaluate_motion(m, data, sol.q, sol.v, sol.a)
+
+
+@pytest.mark.parametrize("values, message", [(["30 deg"], "value 0 of A is '30 deg'"),
+                                             ([0.1, float("inf")], "value 1 of A is inf"),
+                                             ("30", "values of A must be numbers")])
+def test_sweep_driver_values_must_be_numbers(values, message):
+    import pinmech
+
+    sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(SCENES / "r_rtr.toml"))
+    with pytest.raises(pinmech.ModelError, match=message):
+        list(sweep.poses(values))
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda m: m.set_coordinate(m.neutral(), "B", "x"), "a coordinate must be a finite number"),
+    (lambda m: m.set_coordinate(m.neutral(), "B", float("nan")), "a coordinate must be a finite number"),
+])
+def test_api_coordinates_must_be_numbers(call, message):
+    from pinmech import Mechanism, ModelError
+
+    with pytest.raises(ModelError, match=message):
+        call(Mechanism.from_urdf(MODELS / "planar_arm.urdf"))
+
+
+@pytest.mark.parametrize("value", ["30 deg", float("nan"), float("inf"), None, True])
+def test_api_locked_values_must_be_finite_numbers(value):
+    from pinmech import Mechanism, ModelError
+
+    with pytest.raises(ModelError, match="locked joint 'B' must be held at a finite number"):
+        Mechanism.from_urdf(MODELS / "planar_arm.urdf", locked={"B": value})
+
+
+def test_api_points_given_as_one_string_are_refused():
+    # "AB" would otherwise be read as the points "A" and "B".
+    import numpy as np
+
+    from pinmech import Mechanism, ModelError, evaluate_motion
+
+    m = Mechanism.from_urdf(MODELS / "planar_arm.urdf")
+    with pytest.raises(ModelError, match="points must be a list of names, got the string 'AB'"):
+        evaluate_motion(m, m.model.createData(), np.zeros(3), np.zeros(3), np.zeros(3), points="AB")
+
+
+def test_an_unknown_kind_of_quantity_is_a_unit_error():
+    from pinmech import UnitError, to_si
+
+    with pytest.raises(UnitError, match="unknown kind of quantity 'lengthh'"):
+        to_si("1 m", "lengthh")

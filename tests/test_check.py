@@ -94,3 +94,46 @@ def test_an_unknown_quantity_path_names_what_exists():
     hv = HandValue("x", "points.Q.position", 0, "1.0", "m", "length")
     with pytest.raises(SceneError, match=r"no 'Q' in the result \(has B\)"):
         compare({"points": {"B": {"position": [1, 0, 0]}}}, [hv])
+
+
+@pytest.mark.parametrize("printed, si", [("413.794", 0.938892), ("-330", 0.523599), ("30", 0.523599 - 2 * 3.14159265),
+                                         ("180", -3.14159265), ("53.794", 0.938892 + 4 * 3.14159265)])
+def test_an_angle_and_its_equivalent_a_turn_away_agree(printed, si):
+    # 413.794 deg = 53.794 deg + 360 deg; 53.794 deg = 0.938892 rad (to the 6 digits given here).
+    hv = HandValue("phi", "links.L.angle", None, printed, "deg", "angle")
+    [verdict] = compare({"links": {"L": {"angle": si}}}, [hv], slack=100)
+    assert verdict.verdict != "MISMATCH" and abs(verdict.difference) < 1e-3
+
+
+def test_angles_a_fraction_of_a_turn_apart_still_mismatch():
+    hv = HandValue("phi", "links.L.angle", None, "233.794", "deg", "angle")  # 180 deg off
+    [verdict] = compare({"links": {"L": {"angle": 0.938892}}}, [hv])
+    assert verdict.verdict == "MISMATCH"
+
+
+def test_a_magnitude_is_checked_as_the_norm_of_the_vector(tmp_path):
+    # The program prints vD = (0.935792, -0.685048) m/s: |vD| = sqrt(0.935792^2 + 0.685048^2) = 1.159740.
+    from tests.conftest import SCENES
+
+    hand = tmp_path / "h.toml"
+    hand.write_text(f'scene = "{SCENES / "r_rtr.toml"}"\n[[value]]\nquantity = "points.D.velocity.norm"\n'
+                    'hand = "1.1597"\nunit = "m/s"\n[[value]]\nquantity = "points.D.velocity.norm"\n'
+                    'hand = "1.2"\nunit = "mm/s"\n')
+    values = load_hand_file(hand).values
+    assert values[0].kind == "velocity" and values[0].component == "norm"
+    ok, wrong = compare(to_dict(analyse(Scene.load(SCENES / "r_rtr.toml"))), values)
+    assert ok.verdict == "ok" and wrong.verdict == "MISMATCH"
+    [three_four] = compare({"points": {"D": {"velocity": [3.0, -4.0, 0.0]}}},
+                           [HandValue("v", "points.D.velocity", "norm", "5.00", "m/s", "velocity")])
+    assert three_four.verdict == "ok" and three_four.computed == 5.0
+
+
+@pytest.mark.parametrize("slack", ["nan", "-1", "inf", "1e9"])
+def test_a_slack_that_is_not_a_small_number_of_digits_is_refused(slack, capsys):
+    from pinmech.cli import main
+    from tests.conftest import SCENES
+
+    assert main(["check", str(SCENES / "r_rtr.hand.toml"), "--slack", slack]) == 2
+    assert "--slack must be a number from 0 to 100" in capsys.readouterr().err
+    with pytest.raises(SceneError, match="slack must be"):
+        compare({}, [], float(slack))

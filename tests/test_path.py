@@ -113,3 +113,52 @@ def test_cli_path_figure_and_json_lines(scenes_dir, tmp_path):
 
     entries = [json.loads(line) for line in lines.read_text().splitlines()]
     assert len(entries) == 21 and entries[-1]["t"] == pytest.approx(0.02) and entries[-1]["drift"] < 1e-9
+
+
+def test_a_path_ends_at_the_duration_asked_even_between_steps(arm_task):
+    """0.0815 s in steps of 1 ms: 81 whole steps and a last one of 0.5 ms, not a run to 0.082 s."""
+    mech, tasks, q0 = arm_task
+    points = list(follow_path(mech, tasks, q0, duration=0.0815, step=1e-3))
+    assert len(points) == 83 and points[-1].time == 0.0815 and points[-2].time == pytest.approx(0.081, abs=1e-15)
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, points[-1].q)
+    d = data.oMf[mech.frame_id("D")].translation
+    x0 = 0.3 * np.cos(np.radians(50)) + 0.3 * np.cos(np.radians(15))
+    # D moves at 1 m/s along x: at 0.0815 s it is 81.5 mm on. The drift at a 1 ms step is below
+    # 1e-5 m (test above); the 0.5 mm of a run to 0.082 s would fail this.
+    assert d[0] == pytest.approx(x0 + 0.0815, abs=2e-5)
+
+
+@pytest.mark.parametrize("gain", [float("nan"), 1e300, -1.0, float("inf"), 1001.0])
+def test_a_gain_that_cannot_work_is_refused_naming_it(arm_task, scenes_dir, capsys, gain):
+    mech, tasks, q0 = arm_task
+    with pytest.raises(TaskError, match="gain must be a number from 0 to 1/step = 1000"):
+        next(follow_path(mech, tasks, q0, duration=0.01, step=1e-3, gain=gain))
+    assert main(["path", str(scenes_dir / "planar_arm.toml"), "--duration", "0.01 s", "--gain", str(gain)]) == 8
+    assert "--gain must be a number from 0 to 1/--step" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("duration, step, message", [(float("nan"), 1e-3, "duration must be a positive, finite"),
+                                                     (0.01, 0.0, "step must be a positive, finite"),
+                                                     (0.01, 0.02, "must not be longer than duration")])
+def test_path_timing_is_checked(arm_task, duration, step, message):
+    mech, tasks, q0 = arm_task
+    with pytest.raises(TaskError, match=message):
+        next(follow_path(mech, tasks, q0, duration=duration, step=step))
+
+
+def test_a_mimic_follower_has_its_columns_in_the_path_csv(tmp_path, models_dir, capsys):
+    import csv
+
+    text = (models_dir / "planar_arm.urdf").read_text().replace(
+        '<joint name="C" type="revolute">', '<joint name="C" type="revolute"><mimic joint="B" multiplier="2" offset="0.1"/>')
+    (tmp_path / "arm.urdf").write_text(text)
+    scene = tmp_path / "arm.toml"
+    scene.write_text('urdf = "arm.urdf"\n[pose]\nA = "50 deg"\nB = "-65 deg"\n[[task]]\nframe = "D"\n'
+                     'components = ["x", "y"]\nvelocity = ["1 m/s", "0 m/s"]\n')
+    assert main(["path", str(scene), "--duration", "0.005 s", "--csv", str(tmp_path / "p.csv")]) == 0
+    for row in csv.DictReader((tmp_path / "p.csv").open()):
+        # q_C = 2 q_B + 0.1 rad, and its rates are twice B's (the <mimic> relation itself)
+        assert float(row["C.q [deg]"]) == pytest.approx(2 * float(row["B.q [deg]"]) + np.degrees(0.1), abs=1e-9)
+        assert float(row["C.v [rad/s]"]) == pytest.approx(2 * float(row["B.v [rad/s]"]), rel=1e-11)
+        assert float(row["C.a [rad/s^2]"]) == pytest.approx(2 * float(row["B.a [rad/s^2]"]), rel=1e-11)

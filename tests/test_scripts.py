@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import importlib
+import sys
 
+import numpy as np
 import pytest
 
 
@@ -29,6 +31,82 @@ def test_render_snapshots_script_runs(tmp_path, monkeypatch, capsys):
     module = importlib.import_module("render_snapshots")
     monkeypatch.setattr(module, "IMAGES", tmp_path)
     monkeypatch.setattr(module, "SCENES", {"r_rtr": []})
+    monkeypatch.setattr(module, "cli_pictures", lambda chromium, tmp: None)  # pinmech's commands: tested apart
     module.main()
     out = capsys.readouterr().out
     assert "needs Debian's chromium" in out or (tmp_path / "r_rtr.png").stat().st_size > 1000
+
+
+# ---------------------------------------------------------------- speed measurements (issue 13)
+@pytest.mark.slow
+def test_benchmark_peers_runs_and_agrees_with_the_closed_form(tmp_path, capsys):
+    """The peer benchmark at 10 poses (pinmech also at 100), one round: every method that
+    runs reproduces scripts/closed_form.py, a peer that is not installed says so.
+
+    Tolerances, absolute in SI units on outputs of size 0.1-35 (alpha3 reaches 35 rad/s^2):
+    1e-9 for every method, as the peers' Newton stops at a residual below 1e-13 m without a
+    last step (5.7e-11 seen at 36 degrees apart), while a wrong sign, a missing term or a
+    pose on the other assembly branch is an error of 1e-2 or more; 1e-12 for pinmech, whose
+    tolerance is 1e-13 relative to the mechanism's size (2e-14 and 6e-14 seen here).
+    """
+    module = importlib.import_module("benchmark_peers")
+    out = tmp_path / "peers.md"
+    rows = module.main(["--poses", "10", "--rounds", "1", "--sample-time", "0", "--out", str(out)])
+    assert out.read_text() == capsys.readouterr().out.rstrip("\n") + "\n"
+    by_name = {(r.problem, r.method, r.poses): r for r in rows}
+    for problem in ("P1", "P2"):
+        for needed in ("closed form", "Pinocchio", "pinmech"):  # pin is a core dependency
+            assert any(p == problem and m.startswith(needed) and r.times for (p, m, _), r in by_name.items())
+    assert {r.poses for r in rows if r.is_pinmech and r.problem == "P1"} == {10, 100}
+    for row in rows:
+        if row.status:
+            assert row.status.startswith(("not installed", "no inverse-rate API")), row.status
+            continue
+        assert len(row.times) == 1 and row.times[0] > 0, row
+        assert row.error <= (1e-12 if row.is_pinmech else 1e-9), (row.method, row.error)
+    text = out.read_text()
+    assert "| P1 | pinmech Sweep.chunks + evaluate_motion | 100 |" in text
+    assert text.count("Target (faster than every peer at <= 1e-13)") == 2
+
+
+def test_benchmark_peers_reports_missing_and_failing_peers(monkeypatch):
+    """A peer whose package is missing, or that fails, is a row that says so: no crash."""
+    module = importlib.import_module("benchmark_peers")
+    monkeypatch.setitem(sys.modules, "sympy", None)  # import sympy -> ImportError
+    missing = module.build(module.Row("P1", "sympy", 10), "sympy", lambda: module.sympy_p1(module.p1_angles(10)))
+    assert missing.run is None and missing.status.startswith("not installed (sympy")
+    failing = module.build(module.Row("P1", "broken", 10), None, lambda: 1 / 0)
+    assert failing.run is None and failing.status == "failed: ZeroDivisionError: division by zero"
+    row = module.Row("P1", "fails later", 10, run=lambda: 1 / 0)
+    module.warm_up(row, module.p1_closed_form(module.p1_angles(10)), 0.0)
+    assert row.run is None and row.status.startswith("failed: ZeroDivisionError")
+    module.time_rounds([row], rounds=2)
+    assert row.times == []
+
+
+def test_benchmark_peers_error_measure():
+    """Angles compare modulo a turn; a missing or non-finite output is an infinite error."""
+    module = importlib.import_module("benchmark_peers")
+    ref = module.p1_closed_form(module.p1_angles(4))
+    turned = ref.copy()
+    turned[:, 0] += 2 * np.pi
+    assert module.largest_error(turned, ref, angle_columns=(0,)) < 1e-15
+    assert module.largest_error(turned, ref) == pytest.approx(2 * np.pi)
+    off = ref.copy()
+    off[2, 4] += 1e-3
+    assert module.largest_error(off, ref, angle_columns=(0,)) == pytest.approx(1e-3)
+    off[1, 1] = np.nan
+    assert module.largest_error(off, ref) == np.inf
+    assert module.largest_error(ref[:, :8], ref) == np.inf
+
+
+@pytest.mark.slow
+def test_startup_time_runs(capsys):
+    """One interleaved run of each command, the import costs and the profile, reported."""
+    module = importlib.import_module("startup_time")
+    ratio = module.main(["--runs", "1", "--top", "3"])
+    out = capsys.readouterr().out
+    assert 0 < ratio < 100 and f"takes {ratio:.2f} x" in out
+    assert out.count("| `") == 3 and "pinmech solve models/scenes/r_rtr.toml" in out
+    assert "pinocchio" in out.split("self time summed by top-level package")[1]
+    assert len([ln for ln in out.splitlines() if ln.startswith("- ")]) == 6

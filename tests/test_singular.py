@@ -6,7 +6,7 @@ are right to the stated bounds, and where it stops (SingularPoseError past the d
 limit k = 1e4, LoopClosureError where the loop cannot close).
 
 The bounds (`Accuracy.error_bounds`), with m = max(closure residual, eps), eps = 2.2e-16:
-relative error of positions <= 2 k m, of velocities <= 4 k^2 m, of accelerations <= 16 k^3 m.
+relative error of positions <= 4 k m, of velocities <= 4 k^2 m, of accelerations <= 16 k^3 m.
 The residual enters because Newton stops as soon as it is below its tolerance (1e-13),
 and near a singularity that residual, not rounding, sets the error. Each guess is 1e-3 rad
 off the answer, as a sweep's previous pose would be, so Newton really runs.

@@ -196,11 +196,18 @@ def test_one_sweep_shared_by_two_threads(r_rtr_scene, fast_switching):
 # ------------------------------------------------------------------ more of the same kind
 @pytest.mark.parametrize("values", [[0.1, float("nan"), 0.3], [0.1, float("inf")], [float("-inf")]])
 def test_a_range_with_a_value_that_is_not_finite_is_refused(r_rtr_scene, values):
-    """Before: an infinite value hung the continuation; NaN read as an assembly change."""
+    """Before: an infinite value hung the continuation; NaN read as an assembly change.
+    Through `solve_range` an OptionError; `Sweep.poses` and `chunks` check first and say
+    ModelError."""
+    from pinmech import ModelError
+
     sweep = Sweep.from_scene(Scene.load(r_rtr_scene))
+    d = sweep.drivers
     with pytest.raises(OptionError, match="must be a finite number") as info:
-        list(sweep.poses(values))
+        list(solve_range(sweep.solver, sweep.driver, values, driver_q=d.q, driver_v=d.v, driver_a=d.a))
     assert info.value.option == "values"
+    with pytest.raises((OptionError, ModelError), match="finite"):
+        list(sweep.poses(values))
 
 
 @pytest.mark.parametrize("chunk", [0, -1, 2.5, True])
@@ -229,7 +236,7 @@ def test_rate_and_force_solvers_check_their_options(models_dir, four_bar):
 def test_a_joint_locked_at_nan_is_named(models_dir):
     from pinmech import ModelError
 
-    with pytest.raises(ModelError, match="joint 'O4' cannot be locked at nan"):
+    with pytest.raises(ModelError, match="locked joint 'O4' must be held at a finite number"):
         Mechanism.from_urdf(models_dir / "four_bar.urdf", locked={"O4": float("nan")})
 
 

@@ -49,3 +49,122 @@ def test_users_units_become_si(text, kind, si):
 def test_ambiguous_or_wrong_quantities_are_refused(text, kind, message):
     with pytest.raises(UnitError, match=message):
         to_si(text, kind, where="drivers.A.angle")
+
+
+@pytest.mark.parametrize(
+    "text, kind, hint",
+    [
+        ("1,5 deg", "angle", "'1.5 deg'"),
+        ("0,5 rad/s", "angular_velocity", "'0.5 rad/s'"),
+        ("2,5 rpm", "angular_velocity", "'2.5 rpm'"),
+        ("1,5 mm", "length", "'1.5 mm'"),
+        ("1,000 mm", "length", "'1.000 mm'"),  # a thousands separator is as ambiguous
+        ("1, 5 mm", "length", "one number and one unit"),
+    ],
+)
+def test_a_decimal_comma_is_refused_with_the_point_suggested(text, kind, hint):
+    # pint reads "1,5 deg" as 15 deg; pinmech must never guess which the user meant.
+    with pytest.raises(UnitError, match=f"comma.*{hint}"):
+        to_si(text, kind, where="--angle")
+
+
+@pytest.mark.parametrize(
+    "text, degrees",
+    [
+        ("30° 20'", 30 + 20 / 60),
+        ("30 deg 20 arcmin", 30 + 20 / 60),
+        ("30°20′15″", 30 + 20 / 60 + 15 / 3600),
+        ("-30° 20' 30\"", -(30 + 20 / 60 + 30 / 3600)),
+        ("12 degrees 7.5 arcminutes", 12 + 7.5 / 60),
+    ],
+)
+def test_an_angle_in_degrees_minutes_and_seconds_is_their_sum(text, degrees):
+    # the sum d + m/60 + s/3600 is the definition of sexagesimal notation; pint multiplies them.
+    assert to_si(text, "angle") == pytest.approx(math.radians(degrees), rel=1e-15)
+
+
+@pytest.mark.parametrize(
+    "text, kind, message",
+    [
+        ("30° 75'", "angle", "below 60"),
+        ("30° 20.5' 10\"", "angle", "only the last part"),
+        ("30 deg 20 arcmin", "angular_velocity", "more than one number"),
+        ("1/2 deg", "angle", "more than one number"),
+        ("2 3 mm", "length", "more than one number"),
+        ("10 deg deg", "angle", r"not an angle \(its unit is radian\^2\)"),
+        ("1 deg**2", "angle", "not an angle"),
+        ("1 sr", "angle", "not an angle"),  # a solid angle is rad^2
+        ("2 m m", "length", "not a length"),  # m^2, not 2 mm
+        ("1 m*rad", "length", "not a length"),
+        ("1 rad*rad/s", "angular_velocity", "not an angular velocity"),
+        ("1 deg", "angular_velocity", "not an angular velocity"),
+        ("1 rpm", "angle", "not an angle"),
+        ("5 mm", "time", "not a time"),
+        ("2*pi rad", "angle", "cannot read quantity"),
+        ("deg", "angle", "cannot read quantity"),
+    ],
+)
+def test_quantities_of_the_wrong_exact_dimension_or_shape_are_refused(text, kind, message):
+    with pytest.raises(UnitError, match=message):
+        to_si(text, kind, where="drivers.A.angle")
+
+
+@pytest.mark.parametrize(
+    "text, kind, si",
+    [
+        ("90deg", "angle", math.pi / 2),
+        ("3.5e2mm", "length", 0.35),
+        ("\u22125 mm", "length", -0.005),  # a typographic minus
+        ("1 turn/s", "angular_velocity", 2 * math.pi),
+        ("1 rad / s", "angular_velocity", 1.0),
+        ("36 km/h", "velocity", 10.0),  # not in the common table: pint reads it
+        ("1 arcmin", "angle", math.radians(1 / 60)),
+        ("1 deg*percent", "angle", math.radians(0.01)),
+    ],
+)
+def test_other_spellings_of_one_number_and_one_unit(text, kind, si):
+    assert to_si(text, kind) == pytest.approx(si, rel=1e-15)
+
+
+def test_the_common_units_table_agrees_with_pint():
+    # The table spares importing pint (0.4 s); pint is the independent source of its factors.
+    from pinmech.units import _COMMON_UNITS, _DIMENSIONS, _registry
+
+    from pinmech.units import SI_UNITS
+
+    for unit, (factor, kind) in _COMMON_UNITS.items():
+        quantity = _registry().Quantity(1.0, unit)
+        assert dict(quantity.to_root_units().unit_items()) == _DIMENSIONS[kind], unit
+        assert factor == pytest.approx(quantity.to(SI_UNITS[kind]).magnitude, rel=1e-15), unit
+
+
+def test_common_units_are_read_without_importing_pint():
+    import subprocess
+    import sys
+
+    code = ("import sys; from pinmech.units import to_si; "
+            "[to_si(t, k) for t, k in (('30 deg', 'angle'), ('-50 rpm', 'angular_velocity'), ('150 mm', 'length'))]; "
+            "sys.exit('pint' in sys.modules)")
+    assert subprocess.run([sys.executable, "-c", code], check=False).returncode == 0
+
+
+@pytest.mark.parametrize("text, kind, si", [("1 rad/s²", "angular_acceleration", 1.0),
+                                            ("2 m·s^-2", "acceleration", 2.0),
+                                            ("5 \u03bcm", "length", 5e-6),  # Greek mu, as keyboards type it
+                                            ("5 \u00b5m", "length", 5e-6)])  # the micro sign
+def test_typographic_spellings_of_units(text, kind, si):
+    assert to_si(text, kind) == pytest.approx(si, rel=1e-15)
+
+
+@pytest.mark.parametrize("text, kind, si", [("2 kN", "force", 2000.0), ("3 lbf", "force", 3 * 4.4482216152605),
+                                            ("5 N*cm", "torque", 0.05), ("2 g*cm^2", "moment_of_inertia", 2e-7),
+                                            ("1 kg*m^2", "moment_of_inertia", 1.0)])
+def test_forces_torques_and_inertias_in_si_with_kilograms(text, kind, si):
+    # lbf = 4.4482216152605 N exactly (NIST); pint's root mass unit is the gram, SI's the kilogram.
+    assert to_si(text, kind) == pytest.approx(si, rel=1e-12)
+
+
+@pytest.mark.parametrize("text, kind", [("1 N", "torque"), ("1 N*m", "force"), ("1 kg", "moment_of_inertia")])
+def test_forces_torques_and_inertias_of_the_wrong_dimension_are_refused(text, kind):
+    with pytest.raises(UnitError, match="is not a"):
+        to_si(text, kind)

@@ -1,0 +1,172 @@
+"""Mobility from the rank of the loop constraint Jacobian on the closed configurations.
+
+Counting rows (joint freedoms minus closure equations) is wrong when loops repeat each
+other: a double parallelogram has 4 freedoms and 4 closure rows, yet it moves (mobility
+1), because on its closed poses the rows have rank 3. Rank is a property of the closed
+configurations, not of arbitrary ones, so this module first closes the loops (least
+squares from the reference configuration), then takes the largest rank of the scaled
+constraint Jacobian over a few closed poses around it (an isolated singular pose has a
+lower rank than its neighbours; a structural redundancy has it everywhere).
+
+It also finds idle freedoms: motions the closures allow with every driver held, such as a
+rod with ball joints at both ends spinning about its own axis.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+#: Singular values below this fraction of the largest count as zero (dimensionless rows).
+RANK_TOL = 1e-8
+_CLOSE_TOL = 1e-12
+_NEIGHBOURS = 3
+_STEP = 0.05  # [rad, or sizes of the mechanism]: how far the neighbouring poses lie
+
+
+@dataclass(frozen=True)
+class RankReport:
+    """The constraint Jacobian's rank on the closed configurations.
+
+    Attributes:
+        rank: largest rank over the closed poses sampled (the generic rank).
+        rows: number of closure rows (after each cut's own reduction).
+        q: a closed configuration (None when none could be found: then rank = rows).
+        redundant: names of the cuts whose rows repeat the others' (some row of theirs
+            adds nothing to the rank).
+    """
+
+    rank: int
+    rows: int
+    q: np.ndarray | None
+    redundant: tuple[str, ...] = ()
+
+
+def stacked_jacobian(mech, data: pin.Data, q: np.ndarray) -> np.ndarray:
+    """Every closure's rows, stacked, with dimensionless columns (prismatic x size) at q."""
+    pin.computeJointJacobians(mech.model, data, q)
+    pin.updateFramePlacements(mech.model, data)
+    rows = [c.jacobian(mech.model, data) for c in mech.closures]
+    J = np.vstack(rows) if rows else np.zeros((0, mech.model.nv))
+    return J * mech.velocity_scale()
+
+
+def _residual(mech, data: pin.Data, q: np.ndarray) -> np.ndarray:
+    pin.framesForwardKinematics(mech.model, data, q)
+    parts = [c.residual(data) for c in mech.closures]
+    return np.concatenate(parts) if parts else np.zeros(0)
+
+
+def close_least_squares(mech, data: pin.Data, q: np.ndarray, iterations: int = 60) -> np.ndarray | None:
+    """Gauss-Newton with minimum-norm steps: a closed configuration near q, or None."""
+    scale = mech.velocity_scale()
+    for _ in range(iterations):
+        r = _residual(mech, data, q)
+        if np.max(np.abs(r), initial=0.0) < _CLOSE_TOL:
+            return q
+        J = stacked_jacobian(mech, data, q)
+        step = np.linalg.lstsq(J, -r, rcond=1e-10)[0]
+        size = np.max(np.abs(step), initial=0.0)
+        if size > 0.5:
+            step *= 0.5 / size
+        q = pin.integrate(mech.model, q, step * scale)
+    return None
+
+
+def _rank(J: np.ndarray) -> int:
+    if J.size == 0:
+        return 0
+    s = np.linalg.svd(J, compute_uv=False)
+    return int(np.sum(s > RANK_TOL * max(s[0], 1e-300)))
+
+
+def constraint_rank(mech) -> RankReport:
+    """The generic rank of the closure rows on the closed poses near the reference."""
+    rows = sum(c.rows for c in mech.closures)
+    if rows == 0:
+        return RankReport(0, 0, mech.neutral())
+    data = mech.model.createData()
+    q0 = _closed_start(mech, data)
+    if q0 is None:
+        return RankReport(rows, rows, None)
+    rng = np.random.default_rng(20261122)
+    poses = [q0]
+    for _ in range(_NEIGHBOURS):
+        J = stacked_jacobian(mech, data, q0)
+        null = _null_space(J)
+        if null.shape[1] == 0:
+            break
+        step = null @ rng.normal(size=null.shape[1])
+        step *= _STEP / max(np.max(np.abs(step)), 1e-300)
+        q = close_least_squares(mech, data, pin.integrate(mech.model, q0, step * mech.velocity_scale()))
+        if q is not None:
+            poses.append(q)
+    if len(poses) == 1:  # no neighbour closed: other closed poses, so one singular pose cannot decide
+        seeds = np.random.default_rng(11)
+        for _ in range(4):
+            start = pin.integrate(mech.model, q0, seeds.normal(size=mech.model.nv) * mech.velocity_scale())
+            q = close_least_squares(mech, data, start)
+            if q is not None:
+                poses.append(q)
+    jacobians = [stacked_jacobian(mech, data, q) for q in poses]
+    ranks = [_rank(J) for J in jacobians]
+    best = int(np.argmax(ranks))
+    rank = ranks[best]
+    redundant = ()
+    if rank < rows:
+        J, start, names = jacobians[best], 0, []
+        for c in mech.closures:
+            others = np.vstack([J[:start], J[start + c.rows:]])
+            if _rank(others) + c.rows > rank:
+                names.append(c.name)
+            start += c.rows
+        redundant = tuple(names)
+    return RankReport(rank, rows, poses[best], redundant)
+
+
+def _closed_start(mech, data: pin.Data) -> np.ndarray | None:
+    """The reference configuration, closed; else a few seeded starts around it."""
+    q = close_least_squares(mech, data, mech.neutral())
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        if q is not None:
+            return q
+        start = pin.integrate(mech.model, mech.neutral(), rng.normal(size=mech.model.nv) * mech.velocity_scale())
+        q = close_least_squares(mech, data, start)
+    return q
+
+
+def _null_space(J: np.ndarray) -> np.ndarray:
+    if J.shape[0] == 0:
+        return np.eye(J.shape[1])
+    _, s, Vt = np.linalg.svd(J)
+    rank = int(np.sum(s > RANK_TOL * max(s[0], 1e-300))) if s.size else 0
+    return Vt[rank:].T
+
+
+def idle_joints(mech, drivers: list[str], q: np.ndarray | None) -> list[str]:
+    """Joints that can move while every driver is held, largest share first.
+
+    Each motion of the null space of the dependent columns of the constraint Jacobian is
+    named by the joint carrying most of it (e.g. the ball joint of a spinning rod).
+    """
+    if q is None:
+        return []
+    data = mech.model.createData()
+    J = stacked_jacobian(mech, data, q)
+    held = {mech.joints[n].idx_v for n in drivers if n in mech.joints}
+    free = [i for i in range(mech.model.nv) if i not in held]
+    null = _null_space(J[:, free])
+    names: list[str] = []
+    owner = {}
+    for joint in mech.joints.values():
+        for k in range(joint.nv):
+            owner[joint.idx_v + k] = joint.name
+    for column in null.T:
+        share = np.abs(column)
+        name = owner.get(free[int(np.argmax(share))], "?")
+        if name not in names:
+            names.append(name)
+    return names

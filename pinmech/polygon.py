@@ -1,0 +1,209 @@
+"""Velocity and acceleration polygons of a solved planar pose, as the graphical method draws them.
+
+Every point P has an image p (p' for accelerations) drawn from the pole o (o'): the vector
+o->p is v_P. Points of one rigid link are joined by their relative velocity b->p = v_PB =
+w x BP; in the acceleration polygon the relative acceleration is drawn as its normal part
+a^n_PB = -w^2 BP (towards B) then its tangential part a^t_PB = alpha x BP. A point of one
+link under a point of another (B3 of the guide under the slider pin B) is joined by the
+sliding velocity v_rel = v_B - v_B3, and in accelerations by the Coriolis part
+2 w x v_rel (w of the guide) then the sliding acceleration a_rel. The points of a link are
+taken in a chain, a fixed pivot first: C, then B3 about C, then D about B3.
+
+Which points share a link: the link a point hangs on, and the links a pin at its place
+joins (`pinmech.link_nodes`). The numbers are pinmech's (`Analysis.motion`); the polygon is
+their picture, and `Polygon.closure_error` says how well the chains of components land on
+the images (the rigid-body formulas against Pinocchio's point accelerations).
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from pinmech.analysis import Analysis, coincident_points
+from pinmech.draw.inputs import DrawError
+from pinmech.link_nodes import pin_links, sketch_links
+from pinmech.motion import _plane_reference, evaluate_motion
+
+KINDS = {
+    "absolute": "from the pole",
+    "relative": "relative, points of one link",
+    "sliding": "sliding, relative to the guide",
+    "normal": "normal part, -ω² r",
+    "tangential": "tangential part, α × r",
+    "coriolis": "Coriolis part, 2 ω × v_rel",
+}
+
+
+@dataclass(frozen=True)
+class PolygonVector:
+    """One drawn vector, in plane coordinates [m/s or m/s^2].
+
+    Attributes:
+        kind: one of KINDS.
+        tail, head: its ends, shape (2,), from the pole.
+        start, end: labels of the image points it joins ("" for a point between components).
+        label: the textbook's name of the vector (v_B, v_DC, a^n_DC, ...).
+    """
+
+    kind: str
+    tail: np.ndarray
+    head: np.ndarray
+    start: str
+    end: str
+    label: str
+
+
+@dataclass(frozen=True)
+class Polygon:
+    """A velocity or acceleration polygon.
+
+    Attributes:
+        quantity: "velocity" or "acceleration".
+        unit: "m/s" or "m/s^2".
+        images: image label (o, a, b, ... or o', a', ...) -> its place, shape (2,).
+        labels: point name -> its image label.
+        vectors: what is drawn, absolute vectors first.
+        axes: the plane's x and y axes in world coordinates, shape (2, 3).
+        title: what the polygon shows (scene, driver value and rates).
+    """
+
+    quantity: str
+    unit: str
+    images: dict[str, np.ndarray]
+    labels: dict[str, str]
+    vectors: list[PolygonVector]
+    axes: np.ndarray
+    title: str
+
+    @property
+    def closure_error(self) -> float:
+        """Largest gap between a chain of relative components and the image it should reach
+        [m/s or m/s^2]: 0 up to rounding when the rigid-body relations hold."""
+        gaps = [np.linalg.norm(v.head - self.images[v.end]) for v in self.vectors if v.end]
+        return float(max(gaps, default=0.0))
+
+
+def velocity_polygon(analysis: Analysis) -> Polygon:
+    """The velocity polygon of a solved planar pose."""
+    return _polygon(analysis, "velocity")
+
+
+def acceleration_polygon(analysis: Analysis) -> Polygon:
+    """The acceleration polygon of a solved planar pose (normal, tangential, Coriolis parts)."""
+    return _polygon(analysis, "acceleration")
+
+
+def _polygon(analysis: Analysis, quantity: str) -> Polygon:
+    mech, motion = analysis.mechanism, analysis.motion
+    normal = mech.plane_normal
+    if normal is None:
+        raise DrawError(f"{analysis.scene.path}: velocity and acceleration polygons are drawn for planar "
+                        f"mechanisms; {mech.source} moves in space", argument="scene", value=str(analysis.scene.path))
+    e1 = _plane_reference(*normal.tolist())
+    axes = np.array([e1, np.cross(normal, e1)])
+    acc = quantity == "acceleration"
+    prime = "'" if acc else ""
+    labels = {name: name.lower() + prime for name in motion.points}
+    images = {"o" + prime: np.zeros(2)}
+    for name, p in motion.points.items():
+        images[labels[name]] = axes @ (p.acceleration if acc else p.velocity)
+    vectors = [PolygonVector("absolute", np.zeros(2), images[labels[n]], "o" + prime, labels[n], f"{quantity[0]}_{n}")
+               for n in motion.points if np.linalg.norm(images[labels[n]]) > 0]
+    members = _link_members(analysis)
+    coincident = [c for c in coincident_points(analysis.scene) if c.name in labels and c.at in labels]
+    rates = _link_rates(analysis, [*members, *(c.link for c in coincident)])
+    for link, names in members.items():
+        for base, name in itertools.pairwise(names):  # a chain: each point about the one before
+            vectors += _relative(analysis, axes, labels, images, base, name, *rates[link], acc)
+    for c in coincident:
+        vectors += _sliding(analysis, axes, labels, images, c, rates[c.link][0], acc)
+    drawn = _drawn(vectors, images)
+    if not drawn:
+        raise DrawError(f"{analysis.scene.path}: no reported point has a {quantity}: nothing to draw in the "
+                        f"{quantity} polygon; report moving points ([report] points)", argument="scene",
+                        value=list(labels))
+    return Polygon(quantity, "m/s^2" if acc else "m/s", images, labels, drawn, axes, _title(analysis, quantity))
+
+
+def _drawn(vectors: list[PolygonVector], images: dict[str, np.ndarray]) -> list[PolygonVector]:
+    """The vectors worth drawing: none of zero length, and none drawn twice (a relative
+    vector from a fixed pivot's image is the absolute one: o->b is v_B and v_BA)."""
+    tol = 1e-9 * max((np.linalg.norm(v) for v in images.values()), default=0.0)
+    absolute = [v for v in vectors if v.kind == "absolute"]
+
+    def twice(v: PolygonVector) -> bool:
+        return v.kind != "absolute" and any(
+            np.linalg.norm(v.tail - a.tail) <= tol and np.linalg.norm(v.head - a.head) <= tol for a in absolute)
+
+    return [v for v in vectors if np.linalg.norm(v.head - v.tail) > tol and not twice(v)]
+
+
+def _link_members(analysis: Analysis) -> dict[str, list[str]]:
+    """Moving link -> the reported points on it (a pin's point on both links), fixed ones
+    first, then in the report's order."""
+    mech, motion = analysis.mechanism, analysis.motion
+    coincident = {c.name for c in coincident_points(analysis.scene)}
+    data = mech.model.createData()
+    pin.forwardKinematics(mech.model, data, analysis.solution.q)
+    sketches = sketch_links(mech)
+    joint_of = {name: sketch.joint for name, sketch in sketches.items()}
+    members: dict[str, list[str]] = {}
+    for name, p in motion.points.items():
+        on = {p.link} if name in coincident else {p.link, *pin_links(sketches, data, p.position, mech.length_scale)}
+        for link in on:
+            if joint_of.get(link, 0) != 0 and link in mech.links:
+                members.setdefault(link, []).append(name)
+    for names in members.values():
+        names.sort(key=lambda n: np.linalg.norm(motion.points[n].velocity) > 0)  # stable: fixed pivots first
+    return {link: names for link, names in members.items() if len(names) > 1}
+
+
+def _link_rates(analysis: Analysis, links: list[str]) -> dict[str, tuple[float, float]]:
+    """Link -> its angular velocity [rad/s] and acceleration [rad/s^2] about the plane normal,
+    read off the solved pose (also for links the scene does not report)."""
+    mech, sol = analysis.mechanism, analysis.solution
+    motion = evaluate_motion(mech, mech.model.createData(), sol.q, sol.v, sol.a, points=[], links=sorted(set(links)))
+    n = mech.plane_normal
+    return {name: (float(n @ m.angular_velocity), float(n @ m.angular_acceleration))
+            for name, m in motion.links.items()}
+
+
+def _relative(analysis, axes, labels, images, base: str, name: str, w: float, alpha: float,
+              acc: bool) -> list[PolygonVector]:
+    """The relative motion of `name` about `base`, points of one link turning at w [rad/s],
+    alpha [rad/s^2]."""
+    points = analysis.motion.points
+    r = axes @ (points[name].position - points[base].position)
+    tail, end = images[labels[base]], labels[name]
+    pair = f"{name}{base}"
+    if not acc:
+        return [PolygonVector("relative", tail, images[end], labels[base], end, f"v_{pair}")]
+    normal = -w * w * r
+    tangential = alpha * np.array([-r[1], r[0]])
+    return [PolygonVector("normal", tail, tail + normal, labels[base], "", f"a^n_{pair}"),
+            PolygonVector("tangential", tail + normal, tail + normal + tangential, "", end, f"a^t_{pair}")]
+
+
+def _sliding(analysis, axes, labels, images, c, w: float, acc: bool) -> list[PolygonVector]:
+    """The point `c.at` about the point `c.name` of the guide link under it (turning at w [rad/s])."""
+    motion = analysis.motion
+    on_guide, moving = motion.points[c.name], motion.points[c.at]
+    v_rel = axes @ (moving.velocity - on_guide.velocity)
+    tail, end = images[labels[c.name]], labels[c.at]
+    pair = f"{c.at}{c.name}"
+    if not acc:
+        return [PolygonVector("sliding", tail, images[end], labels[c.name], end, f"v_{pair}")]
+    coriolis = 2.0 * w * np.array([-v_rel[1], v_rel[0]])
+    return [PolygonVector("coriolis", tail, tail + coriolis, labels[c.name], "", f"a^c_{pair}"),
+            PolygonVector("sliding", tail + coriolis, images[end], "", end, f"a^r_{pair}")]
+
+
+def _title(analysis: Analysis, quantity: str) -> str:
+    scene = analysis.scene
+    spec = scene.section("drivers")
+    drivers = "; ".join(f"{n}: " + ", ".join(str(v) for v in spec[n].values()) for n in spec)
+    return f"{quantity.capitalize()} polygon: {scene.title}" + (f" ({drivers})" if drivers else "")

@@ -1,0 +1,108 @@
+"""Joint limits: a pose beyond a URDF <limit> is reported (text, JSON, CSV), a warning by
+default and an error (exit 12) on request.
+
+The R-RTR's slide coordinate is minus the distance CB (B on the crank, AB = 0.1 m; C on
+the ground, AC = 0.05 m): q = -sqrt(AB^2 + AC^2 - 2 AB AC cos A). With the slide's limits
+made +-0.1 m, it is beyond them exactly where cos A < 0.25 (A between 75.5 and 284.5 deg).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+
+import pytest
+
+from pinmech.cli import main
+from tests.conftest import MODELS, SCENES
+
+
+def _cb(angle_deg: float) -> float:
+    return math.sqrt(0.1**2 + 0.05**2 - 2 * 0.1 * 0.05 * math.cos(math.radians(angle_deg)))
+
+
+@pytest.fixture
+def tight(tmp_path):
+    text = (MODELS / "r_rtr.urdf").read_text()
+    assert 'lower="-0.15" upper="0.15"' in text
+    (tmp_path / "tight.urdf").write_text(text.replace('lower="-0.15" upper="0.15"', 'lower="-0.1" upper="0.1"'))
+    scene = tmp_path / "tight.toml"
+    scene.write_text((SCENES / "r_rtr.toml").read_text().replace('urdf = "../r_rtr.urdf"', 'urdf = "tight.urdf"'))
+    return scene
+
+
+def test_a_pose_beyond_a_limit_is_a_warning_in_text_json_and_stderr(tight, capsys):
+    assert main(["solve", str(tight), "--angle", "90 deg"]) == 0
+    out, err = capsys.readouterr()
+    assert "WARNING: B_slider = -0.111803 m is below its lower limit -0.1 m" in out
+    assert "warning: B_slider = -0.111803 m is below its lower limit -0.1 m" in err
+    assert main(["solve", str(tight), "--angle", "90 deg", "--json"]) == 0
+    [violation] = json.loads(capsys.readouterr().out)["limit_violations"]
+    assert violation["joint"] == "B_slider" and violation["lower"] == -0.1
+    assert violation["value"] == pytest.approx(-_cb(90), abs=1e-12)  # the closed form, to rounding
+
+
+def test_a_pose_within_the_limits_says_nothing(tight, capsys):
+    assert main(["solve", str(tight), "--angle", "30 deg", "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert json.loads(out)["limit_violations"] == [] and "warning" not in err and _cb(30) < 0.1
+
+
+def test_limits_as_errors_exit_12_naming_the_joint(tight, capsys):
+    assert main(["solve", str(tight), "--angle", "90 deg", "--limits", "error"]) == 12
+    err = capsys.readouterr().err
+    assert "B_slider = -0.111803 m is below its lower limit -0.1 m (URDF <limit>)" in err and "Traceback" not in err
+    assert main(["solve", str(tight), "--angle", "90 deg", "--set", 'report.limits="error"']) == 12
+
+
+def test_a_sweep_marks_the_poses_beyond_the_limits(tight, tmp_path, capsys):
+    out = tmp_path / "s.csv"
+    assert main(["sweep", str(tight), "--steps", "19", "--csv", str(out)]) == 0  # 30 to 390 deg by 20 deg
+    rows = list(csv.DictReader(out.open()))
+    beyond = [float(r["A.q [deg]"]) for r in rows if r["beyond_limits"] == "B_slider"]
+    assert beyond == [a for a in range(30, 391, 20) if math.cos(math.radians(a)) < 0.25]
+    assert "10 of 19 poses put joints beyond their URDF <limit>" in capsys.readouterr().err
+    assert main(["sweep", str(tight), "--steps", "19", "--csv", str(out), "--limits", "error"]) == 12
+    assert "stopped at A = 90 deg: B_slider" in capsys.readouterr().err
+
+
+def test_malformed_limits_are_model_errors(tmp_path):
+    from pinmech import Mechanism, ModelError
+
+    text = (MODELS / "r_rtr.urdf").read_text()
+    for bad, message in (('lower="x" upper="0.15"', 'lower value \\(x\\) is not a valid float'),  # urdfdom's
+                         ('lower="0.2" upper="0.15"', 'lower="0.2" is above upper="0.15"')):
+        (tmp_path / "bad.urdf").write_text(text.replace('lower="-0.15" upper="0.15"', bad))
+        with pytest.raises(ModelError, match=message):
+            Mechanism.from_urdf(tmp_path / "bad.urdf")
+
+
+def test_a_joint_locked_beyond_its_limit_is_reported(tmp_path, capsys):
+    # The planar arm's joints are limited to +-3.14159265 rad; C locked at 200 deg is beyond.
+    scene = tmp_path / "arm.toml"
+    scene.write_text(f'urdf = "{MODELS / "planar_arm.urdf"}"\n[lock]\nC = "200 deg"\n[pose]\nA = "50 deg"\n'
+                     'B = "-65 deg"\n[[task]]\nframe = "D"\ncomponents = ["x", "y"]\nvelocity = ["1 m/s", "0 m/s"]\n')
+    assert main(["solve", str(scene), "--json"]) == 0
+    [violation] = json.loads(capsys.readouterr().out)["limit_violations"]
+    assert violation == {"joint": "C", "value": pytest.approx(math.radians(200)), "lower": -3.14159265,
+                         "upper": 3.14159265}
+
+
+def test_an_arm_path_beyond_a_limit_is_a_warning_or_stops(tmp_path, capsys):
+    # The planar arm's D moves at 1 m/s along x: B opens from -65 deg (to -58.2 deg at 19 ms).
+    # Limited to [-65.5, -60] deg, it leaves its range on the way.
+    text = (MODELS / "planar_arm.urdf").read_text()
+    old = '<origin xyz="0.30 0 0"/><axis xyz="0 0 1"/>\n    <limit lower="-3.14159265" upper="3.14159265"'
+    assert text.count(old) == 2
+    head, _, tail = text.partition('<joint name="B" type="revolute">')
+    tail = tail.replace(old, '<origin xyz="0.30 0 0"/><axis xyz="0 0 1"/>\n    <limit lower="-1.1432" upper="-1.0472"', 1)
+    (tmp_path / "arm.urdf").write_text(head + '<joint name="B" type="revolute">' + tail)
+    scene = tmp_path / "arm.toml"
+    scene.write_text((SCENES / "planar_arm.toml").read_text().replace('urdf = "../planar_arm.urdf"',
+                                                                      'urdf = "arm.urdf"'))
+    assert main(["path", str(scene), "--duration", "0.02 s", "--csv", str(tmp_path / "p.csv")]) == 0
+    err = capsys.readouterr().err
+    assert "path points put joints beyond their URDF <limit> (first at t = " in err and ": B = " in err
+    assert main(["path", str(scene), "--duration", "0.02 s", "--csv", str(tmp_path / "p.csv"), "--limits", "error"]) == 12
+    assert "stopped at t = " in capsys.readouterr().err

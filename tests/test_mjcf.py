@@ -1,0 +1,302 @@
+"""MJCF loops against MuJoCo itself: placements, MuJoCo's own constraint solve, rates.
+
+MuJoCo (a test dependency) is the independent source: its compiler places every body and
+site, its soft constraint solver closes the loops with the driver held by a stiff joint
+equality (gravity off, contacts off, light damping), and its kinematics at pinmech's poses
+give the points whose finite differences check pinmech's velocities.
+
+Tolerances: placements at qpos0 are the same arithmetic on the same numbers (1e-12 m);
+MuJoCo's solve stops at a constraint residual of ~1e-11 m with joint coordinates converged
+to ~1e-10, so poses agree to 1e-8 m (a wrong loop, branch or dropped body is off by mm);
+central differences with h = 1e-6 rad have truncation ~h^2 |x'''| ~ 1e-13 and round-off
+~1e-16 / 1e-6 = 1e-10 m/s, so velocities agree to 1e-7 of their scale.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from pinmech.cli import main
+from pinmech.exceptions import ModelError
+from pinmech.mjcf import load_mjcf
+from pinmech.solve_loops import LoopSolver
+
+mujoco = pytest.importorskip("mujoco")
+
+MJCF = Path(__file__).resolve().parents[1] / "models" / "mjcf"
+SOLVABLE = {"four_bar": ("O2", [0.3, 0.8, 1.4]), "slider_crank": ("O", [0.4, 1.2, 2.0]),
+            "ball_loop": ("O2", [0.2, 0.4]), "leg": ("hip", [-0.1, -0.25])}
+
+
+def mujoco_model(name: str, driver: str | None = None, value: float = 0.0):
+    text = (MJCF / f"{name}.xml").read_text()
+    if driver is not None:
+        text = text.replace("<worldbody>", '<option gravity="0 0 0" timestep="0.002"><flag contact="disable"/>'
+                            '</option><default><joint damping="0.002"/></default><worldbody>', 1)
+        text = text.replace("</equality>", f'<joint joint1="{driver}" polycoef="{value!r} 0 0 0 0"/></equality>')
+    m = mujoco.MjModel.from_xml_string(text)
+    return m, mujoco.MjData(m)
+
+
+def mujoco_solve(name: str, driver: str, value: float):
+    m, d = mujoco_model(name, driver, value)
+    for _ in range(8000):
+        mujoco.mj_step(m, d)
+    mujoco.mj_forward(m, d)
+    return m, d
+
+
+def set_qpos(mech, q, m, d) -> None:
+    """pinmech's q into MuJoCo's qpos: same joint order (depth first in the file), a ball's
+    quaternion x y z w -> w x y z; a body's several hinges are one composite joint in Pinocchio."""
+    parts = []
+    for joint in sorted(mech.joints.values(), key=lambda j: j.idx_q):
+        part = q[joint.idx_q: joint.idx_q + joint.nq]
+        parts.append(np.roll(part, 1) if joint.nq == 4 else part)
+    assert m.nq == mech.model.nq
+    d.qpos[:] = np.concatenate(parts)
+    mujoco.mj_forward(m, d)
+
+
+def sites(mech, data, m, d):
+    names = [m.site(i).name for i in range(m.nsite)]
+    ours = np.array([data.oMf[mech.model.getFrameId(n)].translation for n in names])
+    return ours, np.array(d.site_xpos)
+
+
+@pytest.mark.parametrize("name", ["four_bar", "slider_crank", "ball_loop", "leg", "leg_ball"])
+def test_bodies_and_sites_sit_where_mujoco_puts_them_at_qpos0(name):
+    mech = load_mjcf(MJCF / f"{name}.xml")
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, mech.neutral())
+    m, d = mujoco_model(name)
+    mujoco.mj_forward(m, d)
+    for i in range(1, m.nbody):
+        body = m.body(i).name
+        frame = data.oMf[mech.model.getFrameId(body, pin.FrameType.BODY)]
+        np.testing.assert_allclose(frame.translation, d.xpos[i], atol=1e-12, err_msg=body)
+        np.testing.assert_allclose(frame.rotation, d.xmat[i].reshape(3, 3), atol=1e-12, err_msg=body)
+    ours, theirs = sites(mech, data, m, d)
+    np.testing.assert_allclose(ours, theirs, atol=1e-12)
+
+
+def test_pinocchio_alone_drops_the_second_top_body_and_pinmech_keeps_it():
+    """stack-of-tasks/pinocchio#2364: the rocker (second body of <worldbody>) vanishes."""
+    bare = pin.buildModelFromMJCF(str(MJCF / "four_bar.xml"))
+    assert "O4" not in list(bare.names)  # the trap, as the installed Pinocchio has it
+    assert "O4" in load_mjcf(MJCF / "four_bar.xml").joints
+
+
+def test_a_fixed_top_body_keeps_its_pos():
+    """The leg's pelvis sits at z = 1 m: Pinocchio alone puts it at the origin."""
+    bare = pin.buildModelFromMJCF(str(MJCF / "leg.xml"))
+    bare_data = bare.createData()
+    pin.framesForwardKinematics(bare, bare_data, pin.neutral(bare))
+    assert bare_data.oMf[bare.getFrameId("pelvis")].translation[2] == 0.0  # the trap, as installed
+    mech = load_mjcf(MJCF / "leg.xml")
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, mech.neutral())
+    assert data.oMf[mech.model.getFrameId("pelvis", pin.FrameType.BODY)].translation[2] == pytest.approx(1.0, abs=1e-15)
+
+
+@pytest.mark.parametrize("name", sorted(SOLVABLE))
+def test_poses_match_mujocos_own_constraint_solve(name):
+    driver, values = SOLVABLE[name]
+    mech = load_mjcf(MJCF / f"{name}.xml")
+    solver = LoopSolver(mech, [driver])
+    q = mech.neutral()
+    for value in values:
+        sol = solver.solve([value], [0.0], [0.0], guess=q)
+        q = sol.q
+        pin.framesForwardKinematics(mech.model, solver.data, q)
+        m, d = mujoco_solve(name, driver, value)
+        eq = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+        assert np.max(np.abs(d.efc_pos[eq])) < 1e-9  # MuJoCo did close its loop
+        ours, theirs = sites(mech, solver.data, m, d)
+        np.testing.assert_allclose(ours, theirs, atol=1e-8)
+        np.testing.assert_allclose([solver.data.oMf[mech.links[m.body(i).name]].translation
+                                    for i in range(1, m.nbody)], d.xpos[1:], atol=1e-8)
+        # and MuJoCo finds pinmech's pose closed: its equality residual at our q
+        m0, d0 = mujoco_model(name)
+        set_qpos(mech, q, m0, d0)
+        eq0 = d0.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+        np.testing.assert_allclose(d0.efc_pos[eq0], 0.0, atol=1e-13)
+
+
+@pytest.mark.parametrize("name", sorted(SOLVABLE))
+def test_point_velocities_are_finite_differences_of_mujoco_positions(name):
+    driver, values = SOLVABLE[name]
+    mech = load_mjcf(MJCF / f"{name}.xml")
+    solver = LoopSolver(mech, [driver])
+    m, d = mujoco_model(name)
+    h, omega = 1e-6, 2.0
+    q = solver.solve([values[0]], guess=mech.neutral()).q
+    sol = solver.solve([values[0]], [omega], [0.0], guess=q)
+    pin.forwardKinematics(mech.model, solver.data, sol.q, sol.v)
+    pin.updateFramePlacements(mech.model, solver.data)
+    names = [m.site(i).name for i in range(m.nsite)]
+    ours = np.array([pin.getFrameVelocity(mech.model, solver.data, mech.model.getFrameId(n),
+                                          pin.ReferenceFrame.LOCAL_WORLD_ALIGNED).linear for n in names])
+    ends = []
+    for step in (-h, h):
+        q_step = solver.solve([values[0] + step], guess=sol.q).q
+        set_qpos(mech, q_step, m, d)
+        ends.append(np.array(d.site_xpos))
+    fd = (ends[1] - ends[0]) / (2 * h) * omega
+    np.testing.assert_allclose(ours, fd, atol=1e-7 * max(1.0, np.max(np.abs(fd))))
+
+
+def test_cassie_like_rod_spin_is_named(tmp_path, capsys):
+    """Hip driven, the rod hangs on a ball: mobility 2, and the ball joint is the idle one."""
+    mech = load_mjcf(MJCF / "leg_ball.xml")
+    assert mech.mobility == 2 and mech.idle_joints(["hip"]) == ["rod_ball"]
+    scene = tmp_path / "leg.toml"
+    scene.write_text(f'mjcf = "{MJCF / "leg_ball.xml"}"\n[drivers.hip]\nangle = "10 deg"\n')
+    assert main(["solve", str(scene)]) == 5
+    err = capsys.readouterr().err
+    assert "rod_ball" in err and "universal joint" in err and len(err.strip().splitlines()) == 1
+
+
+def _variant(tmp_path, old: str, new: str, name: str = "four_bar") -> Path:
+    text = (MJCF / f"{name}.xml").read_text()
+    assert old in text
+    path = tmp_path / "v.xml"
+    path.write_text(text.replace(old, new))
+    return path
+
+
+@pytest.mark.parametrize("old, new, words", [
+    ('<connect name="B"', '<joint name="J" joint1="O2" joint2="O4"/><connect name="B"', ["<joint", "connect and weld"]),
+    ('<connect name="B"', '<connect active="false" name="B"', ["active"]),
+    ('anchor="0.12 0 0"/>', 'anchor="0.12 0 0"/><weld body1="coupler" body2="rocker" relpose="0 0 0 1 0 0 0"/>',
+     ["relpose"]),
+    ("</mujoco>", "", ["malformed XML"]),
+    ('body2="rocker"', 'body2="rockr"', ["Pinocchio cannot build", "rockr"]),
+])
+def test_refusals_are_one_line_naming_file_and_element(tmp_path, capsys, old, new, words):
+    path = _variant(tmp_path, old, new)
+    with pytest.raises(ModelError) as err:
+        load_mjcf(path)
+    message = str(err.value)
+    assert str(path) in message and "\n" not in message
+    for word in words:
+        assert word in message, message
+
+
+def test_connect_sites_apart_at_qpos0_are_refused(tmp_path):
+    """MuJoCo pulls two sites together; Pinocchio's parser would keep them where they are."""
+    path = _variant(tmp_path, '<connect name="B" body1="coupler" body2="rocker" anchor="0.12 0 0"/>',
+                    '<connect name="B" site1="P" site2="Q"/>')
+    text = path.read_text().replace('<joint name="O4" type="hinge" axis="0 0 1"/>',
+                                    '<joint name="O4" type="hinge" axis="0 0 1"/><site name="Q" pos="0.08 0 0"/>')
+    path.write_text(text)
+    with pytest.raises(ModelError) as err:
+        load_mjcf(path)
+    message = str(err.value)
+    assert str(path) in message and "\n" not in message
+    assert "apart at qpos0" in message or "Pinocchio" in message, message
+
+
+def test_mjcf_scene_solves_like_the_urdf_one(scenes_dir, capsys):
+    assert main(["solve", str(scenes_dir / "four_bar_mjcf.toml"), "--json"]) == 0
+    import json
+
+    ours = json.loads(capsys.readouterr().out)
+    assert main(["solve", str(scenes_dir / "four_bar.toml"), "--json"]) == 0
+    theirs = json.loads(capsys.readouterr().out)
+    for link in ("coupler", "rocker"):
+        np.testing.assert_allclose(ours["links"][link]["angular_velocity"], theirs["links"][link]["angular_velocity"],
+                                   atol=1e-12)
+    np.testing.assert_allclose(ours["points"]["P"]["position"], theirs["points"]["P"]["position"], atol=1e-14)
+
+
+def test_joint_ref_values_make_qpos0_the_reference(tmp_path):
+    """A hinge with ref="0.2": the drawn pose is qpos0 = 0.2, not 0, in MuJoCo and in pinmech."""
+    path = _variant(tmp_path, '<joint name="O4" type="hinge" axis="0 0 1"/>',
+                    '<joint name="O4" type="hinge" axis="0 0 1" ref="0.2"/>')
+    mech = load_mjcf(path)
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    np.testing.assert_allclose(mech.neutral(), m.qpos0, atol=0)
+    solver = LoopSolver(mech, ["O2"])
+    sol = solver.solve([0.7], guess=mech.neutral())
+    set_qpos(mech, sol.q, m, d)
+    eq = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+    np.testing.assert_allclose(d.efc_pos[eq], 0.0, atol=1e-13)
+
+
+def test_a_floating_base_is_held_at_qpos0(tmp_path):
+    """Cassie's pelvis floats (<freejoint/>): the leg moves relative to it, as with a fixed one."""
+    path = _variant(tmp_path, '<geom type="box" size="0.05 0.05 0.03" rgba="0.5 0.5 0.5 1"/>',
+                    '<freejoint name="root"/><geom type="box" size="0.05 0.05 0.03" rgba="0.5 0.5 0.5 1"/>',
+                    name="leg")
+    floating, fixed = load_mjcf(path), load_mjcf(MJCF / "leg.xml")
+    assert "root" not in floating.joints and floating.mobility == fixed.mobility == 1
+    ours = LoopSolver(floating, ["hip"]).solve([-0.2], [1.0])
+    theirs = LoopSolver(fixed, ["hip"]).solve([-0.2], [1.0])
+    np.testing.assert_allclose(ours.q, theirs.q, atol=1e-14)
+    np.testing.assert_allclose(ours.v, theirs.v, atol=1e-14)
+
+
+@pytest.mark.parametrize("attr", ['axisangle="0.3 0.5 0.8 40"', 'xyaxes="1 1 0 -1 1 0.3"', 'zaxis="0.2 0.4 1"',
+                                  'quat="2 0.2 0.6 0.4"', 'euler="10 20 30"'])
+def test_every_way_of_turning_a_body_agrees_with_mujoco(tmp_path, attr):
+    """Pinocchio's parser takes axisangle's axis unnormalised (0.15 rad off for this one)."""
+    xml = f"""<mujoco><worldbody><body name="a" pos="0.1 0.2 0.3" {attr}><joint name="j" type="hinge" axis="0 1 0"/>
+      <geom type="sphere" size="0.01"/><body name="b" pos="0.1 0 0" {attr}><joint name="k" type="slide" axis="0 2 1"/>
+      <geom type="sphere" size="0.01"/><site name="s" pos="0 0.1 0"/></body></body></worldbody></mujoco>"""
+    path = tmp_path / "turned.xml"
+    path.write_text(xml)
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    mech = load_mjcf(path)
+    q = np.array([0.7, 0.05])
+    d.qpos[:] = q
+    mujoco.mj_forward(m, d)
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, q)
+    for i in range(1, m.nbody):
+        np.testing.assert_allclose(data.oMf[mech.links[m.body(i).name]].rotation, d.xmat[i].reshape(3, 3), atol=1e-12)
+    np.testing.assert_allclose(data.oMf[mech.points["s"]].translation, d.site_xpos[0], atol=1e-12)
+
+
+def test_a_frame_element_is_refused_not_dropped(tmp_path):
+    """Pinocchio's parser drops <frame> and every body in it (the model lost body b here)."""
+    path = tmp_path / "framed.xml"
+    path.write_text("""<mujoco><worldbody><body name="a"><joint name="j" type="hinge" axis="0 0 1"/>
+      <geom type="sphere" size="0.01"/><frame pos="0.1 0 0" euler="0 0 30"><body name="b" pos="0.1 0 0">
+      <joint name="k" type="hinge" axis="0 1 0"/><geom type="sphere" size="0.01"/></body></frame></body>
+      </worldbody></mujoco>""")
+    assert "k" not in list(pin.buildModelFromMJCF(str(path)).names)  # the trap, as installed
+    with pytest.raises(ModelError, match="<frame>"):
+        load_mjcf(path)
+
+
+def test_a_one_joint_model_loads(tmp_path):
+    """A single hinge: Pinocchio returns (6,) Jacobians for one freedom; pinmech keeps (6, 1)."""
+    path = tmp_path / "one.xml"
+    path.write_text("""<mujoco><worldbody><body name="a"><joint name="j" type="hinge" axis="0 0 1"/>
+      <geom type="sphere" size="0.01"/><site name="tip" pos="0.1 0 0"/></body></worldbody></mujoco>""")
+    mech = load_mjcf(path)
+    assert mech.mobility == 1 and mech.plane_normal is not None
+
+
+def test_lock_in_an_mjcf_scene(tmp_path):
+    """[lock] O2 = 0.5 rad on the MJCF four-bar: nothing left to drive, and the pose is the one
+    the unlocked four-bar has with O2 driven to 0.5 rad; a ball joint cannot be locked."""
+    locked = load_mjcf(MJCF / "four_bar.xml", locked={"O2": 0.5})
+    assert locked.mobility == 0 and locked.locked == {"O2": 0.5}
+    q = LoopSolver(locked, []).solve([], guess=locked.neutral()).q
+    free = load_mjcf(MJCF / "four_bar.xml")
+    q_free = LoopSolver(free, ["O2"]).solve([0.5], guess=free.neutral()).q
+    data, data_free = locked.model.createData(), free.model.createData()
+    pin.framesForwardKinematics(locked.model, data, q)
+    pin.framesForwardKinematics(free.model, data_free, q_free)
+    np.testing.assert_allclose(data.oMf[locked.points["P"]].translation, data_free.oMf[free.points["P"]].translation,
+                               atol=1e-12)
+    with pytest.raises(ModelError, match="rod_ball.*3 freedoms"):
+        load_mjcf(MJCF / "leg_ball.xml", locked={"rod_ball": 0.0})

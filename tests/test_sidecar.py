@@ -1,0 +1,174 @@
+"""Gepetto's extended URDF (URDF + robot.yaml): a five-bar and a Delta against closed forms.
+
+Five-bar: the end effector is the intersection of two circles of the distal lengths about
+the elbows (the elbows from the motor angles); its velocity is the central difference of
+that construction. Delta: the motor angles come from the closed-form inverse kinematics of a
+chosen platform position (each leg: a cos + b sin = K); pinmech, driving the motors, must put
+the platform there. Tolerances: loops close to 1e-13 of the size (~0.3 m) and the condition
+numbers stay below 1e2 here, so positions agree to 1e-12 m (1e-10 allowed); central
+differences with h = 1e-6 carry ~1e-10 m/s round-off (1e-7 of the speed allowed).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from pinmech import Scene, analyse
+from pinmech.cli import main
+from pinmech.exceptions import ModelError
+from pinmech.sidecar import load_extended_urdf
+from pinmech.solve_loops import LoopSolver
+
+MODELS = Path(__file__).resolve().parents[1] / "models"
+FIVE = (MODELS / "five_bar" / "robot.urdf", MODELS / "five_bar" / "robot.yaml")
+DELTA = (MODELS / "delta" / "robot.urdf", MODELS / "delta" / "robot.yaml")
+L1, L2, D = 0.06, 0.09, 0.10
+
+
+def five_bar_end(t1: float, t2: float) -> np.ndarray:
+    """End effector from absolute motor angles: circles (B1, L2) and (B2, L2), P above B1 -> B2."""
+    B1 = L1 * np.array([math.cos(t1), math.sin(t1)])
+    B2 = np.array([D, 0.0]) + L1 * np.array([math.cos(t2), math.sin(t2)])
+    d = np.linalg.norm(B2 - B1)
+    u = (B2 - B1) / d
+    return B1 + d / 2 * u + math.sqrt(L2**2 - d * d / 4) * np.array([-u[1], u[0]])
+
+
+def test_five_bar_end_effector_is_the_circle_intersection():
+    mech = load_extended_urdf(*FIVE)
+    assert mech.motors == ["mot1", "mot2"] and mech.mobility == 2
+    solver = LoopSolver(mech, ["mot1", "mot2"])
+    q = mech.neutral()
+    h = 1e-6
+    frame = mech.points["closedloop1_A"]
+    for q1, q2 in [(-0.1, 0.1), (-0.2, 0.3), (0.1, 0.35), (0.3, 0.5)]:
+        w1, w2 = 2.0, -1.0
+        sol = solver.solve([q1, q2], [w1, w2], [0.0, 0.0], guess=q)
+        q = sol.q
+        pin.forwardKinematics(mech.model, solver.data, sol.q, sol.v)
+        pin.updateFramePlacements(mech.model, solver.data)
+        t1, t2 = 2 * math.pi / 3 + q1, math.pi / 3 + q2
+        np.testing.assert_allclose(solver.data.oMf[frame].translation[:2], five_bar_end(t1, t2), atol=1e-10)
+        fd = (five_bar_end(t1 + h * w1, t2 + h * w2) - five_bar_end(t1 - h * w1, t2 - h * w2)) / (2 * h)
+        v = pin.getFrameVelocity(mech.model, solver.data, frame, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED).linear
+        np.testing.assert_allclose(v[:2], fd, atol=1e-7 * np.linalg.norm(fd))
+
+
+R, r, LA, LB, Z0 = 0.10, 0.03, 0.10, 0.25, -0.20
+THETA0 = 0.1563663122422725  # the URDF's arm angle at q = 0 (its comment), checked below
+
+
+def delta_angle(P: np.ndarray, gamma: float) -> float:
+    """Arm angle below horizontal of the leg at gamma for the platform at P (elbow out)."""
+    rh = np.array([math.cos(gamma), math.sin(gamma), 0.0])
+    Dv = P + (r - R) * rh
+    a, b = Dv @ rh, -Dv[2]
+    K = (LA**2 + Dv @ Dv - LB**2) / (2 * LA)
+    return math.atan2(b, a) - math.acos(K / math.hypot(a, b))
+
+
+def test_delta_reference_matches_its_inverse_kinematics():
+    assert delta_angle(np.array([0.0, 0.0, Z0]), 0.0) == pytest.approx(THETA0, abs=1e-15)
+
+
+@pytest.mark.parametrize("target", [(0.02, -0.01, -0.21), (-0.04, 0.03, -0.18), (0.0, 0.05, -0.25)])
+def test_delta_platform_goes_where_inverse_kinematics_says(target):
+    mech = load_extended_urdf(*DELTA)
+    assert mech.mobility == 3 and mech.idle_joints(mech.motors) == []
+    P = np.array(target)
+    gammas = [0.0, 2 * math.pi / 3, 4 * math.pi / 3]
+    q_motors = [delta_angle(P, g) - THETA0 for g in gammas]
+    Pdot = np.array([0.1, -0.2, 0.05])
+    h = 1e-6
+    w = [(delta_angle(P + h * Pdot, g) - delta_angle(P - h * Pdot, g)) / (2 * h) for g in gammas]
+    solver = LoopSolver(mech, mech.motors)
+    q = mech.neutral()
+    for k in (0.5, 1.0):  # two steps from the reference pose
+        q = solver.solve([k * x for x in q_motors], guess=q).q
+    sol = solver.solve(q_motors, w, [0.0] * 3, guess=q)
+    pin.forwardKinematics(mech.model, solver.data, sol.q, sol.v)
+    pin.updateFramePlacements(mech.model, solver.data)
+    tool = mech.points["tool"]
+    np.testing.assert_allclose(solver.data.oMf[tool].translation, P, atol=1e-10)
+    v = pin.getFrameVelocity(mech.model, solver.data, tool, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED).linear
+    np.testing.assert_allclose(v, Pdot, atol=1e-7)
+
+
+def test_motors_are_the_default_drivers(scenes_dir):
+    analysis = analyse(Scene.load(scenes_dir / "delta.toml"))
+    assert analysis.drivers.names == ("mot1", "mot2", "mot3")
+    np.testing.assert_allclose(analysis.motion.points["tool"].position, [0.0, 0.0, Z0], atol=1e-12)
+
+
+def test_five_bar_scene_and_snapshot(scenes_dir, tmp_path):
+    assert main(["solve", str(scenes_dir / "five_bar.toml")]) == 0
+    out = tmp_path / "five.html"
+    assert main(["snapshot", str(scenes_dir / "five_bar.toml"), "-o", str(out)]) == 0
+    assert out.stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("yaml_text, words", [
+    ("closed_loop: [['closedloop1_A', 'nowhere']]\ntype: ['3d']\nname_mot: ['mot1', 'mot2']\n",
+     ["closed_loop", "nowhere"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\ntype: ['4d']\nname_mot: ['mot1', 'mot2']\n", ["type", "4d"]),
+    ("closed_loop: [['closedloop1_A']]\nname_mot: []\n", ["closed_loop", "two frame names"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\nname_mot: ['motor9']\n", ["name_mot", "motor9"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\nmotors: ['mot1']\n", ["unknown key", "motors"]),
+    ("closed_loop: [[\n", ["malformed YAML"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\njoint_name: ['elbow9']\njoint_type: ['CARDAN']\n",
+     ["joint_name", "elbow9"]),
+])
+def test_sidecar_errors_name_the_file_and_key(tmp_path, yaml_text, words):
+    sidecar = tmp_path / "robot.yaml"
+    sidecar.write_text(yaml_text)
+    with pytest.raises(ModelError) as err:
+        load_extended_urdf(FIVE[0], sidecar)
+    message = str(err.value)
+    assert str(sidecar) in message and "\n" not in message
+    for word in words:
+        assert word in message, message
+
+
+def test_a_6d_closure_on_a_planar_five_bar_locks_it(tmp_path):
+    """6d welds the two distal ends (3 planar rows instead of 2): mobility 4 - 3 = 1, one motor."""
+    sidecar = tmp_path / "robot.yaml"
+    sidecar.write_text("closed_loop: [['closedloop1_A', 'closedloop1_B']]\ntype: ['6d']\nname_mot: ['mot1']\n")
+    mech = load_extended_urdf(FIVE[0], sidecar)
+    assert mech.mobility == 1 and mech.constraint_rows == 3 and mech.motors == ["mot1"]
+
+
+def test_joint_changes_fixed_and_spherical(tmp_path):
+    """FIXED elbow2: a four-bar (mobility 1). SPHERICAL elbow1: distal1 spins idle between two
+    ball joints (3 = 2 + 1 idle), and pinmech names elbow1 when the two motors are driven."""
+    sidecar = tmp_path / "robot.yaml"
+    base = "closed_loop: [['closedloop1_A', 'closedloop1_B']]\ntype: ['3d']\nname_mot: ['mot1']\n"
+    sidecar.write_text(base + "joint_name: ['elbow2']\njoint_type: ['FIXED']\n")
+    fixed = load_extended_urdf(FIVE[0], sidecar)
+    assert "elbow2" not in fixed.joints and fixed.mobility == 1
+    q = LoopSolver(fixed, ["mot1"]).solve([-0.1], guess=fixed.neutral()).q  # the four-bar closes
+    assert np.isfinite(q).all()
+    sidecar.write_text(base + "joint_name: ['elbow1']\njoint_type: ['SPHERICAL']\n")
+    ball = load_extended_urdf(FIVE[0], sidecar)
+    assert ball.joints["elbow1"].nq == 4 and ball.mobility == 3
+    assert ball.idle_joints(["mot1", "mot2"]) == ["elbow1"]
+
+
+def test_locking_the_joint_that_carries_a_cut_moves_the_cut_onto_its_parent():
+    """elbow2 locked at 0.2 rad: distal2 (which carries closedloop1_B) joins proximal2. Driving
+    mot1 must give the pose of the unlocked five-bar driven by mot1 and elbow2 = 0.2."""
+    locked = load_extended_urdf(*FIVE, locked={"elbow2": 0.2})
+    assert "elbow2" not in locked.joints and locked.mobility == 1
+    free = load_extended_urdf(*FIVE)
+    q_free = LoopSolver(free, ["mot1", "elbow2"]).solve([-0.1, 0.2], guess=free.neutral()).q
+    q_locked = LoopSolver(locked, ["mot1"]).solve([-0.1], guess=locked.neutral()).q
+    d_free, d_locked = free.model.createData(), locked.model.createData()
+    pin.framesForwardKinematics(free.model, d_free, q_free)
+    pin.framesForwardKinematics(locked.model, d_locked, q_locked)
+    for point in ("closedloop1_A", "closedloop1_B"):
+        np.testing.assert_allclose(d_locked.oMf[locked.points[point]].translation,
+                                   d_free.oMf[free.points[point]].translation, atol=1e-12)
