@@ -61,6 +61,8 @@ def serialized(method: _Method) -> _Method:
     the solver has one)."""
     @functools.wraps(method)
     def locked(self, *args, **kwargs):
+        if self.lock._is_owned():  # called from within the solver: held and refreshed already
+            return method(self, *args, **kwargs)
         with self.lock:
             refresh = getattr(self, "refresh", None)
             if refresh is not None:
