@@ -219,6 +219,13 @@ class ForceSolver:
         self.data = self.model.createData()
         self.drivers = tuple(drivers)
         self.loads = tuple(loads)
+        for load in self.loads:  # NaN or misshapen loads would give NaN efforts in silence
+            vectors = [np.asarray(x, dtype=float) for x in (load.force, load.torque)]
+            if any(x.shape != (3,) or not np.all(np.isfinite(x)) for x in vectors) \
+                    or not 0 <= load.frame < self.model.nframes:
+                raise OptionError(f"load '{load.name}' needs a frame of the model and a force and a torque of "
+                                  f"three finite numbers [N, N m], got frame {load.frame!r}, force {load.force!r}, "
+                                  f"torque {load.torque!r}", option="loads", value=load)
         self.minimum_norm = minimum_norm
         self.max_condition = checked_option("max_condition", max_condition)
         self._drv_v = np.array([self._driver_index(n) for n in self.drivers], dtype=int)

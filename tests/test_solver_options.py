@@ -275,3 +275,13 @@ def test_a_closure_in_use_cannot_change_under_its_solver(four_bar):
     with pytest.raises(ValueError):
         c.axis[0] = 1.0  # read-only
     assert solver.solve([1.0]).accuracy.residual <= 1e-13
+
+
+@pytest.mark.parametrize("force, torque", [((0.0, float("nan"), 0.0), (0.0, 0.0, 0.0)),
+                                           ((0.0, 0.0, 0.0), (0.0, 0.0, float("inf"))), ((1.0, 2.0), (0.0, 0.0, 0.0))])
+def test_a_load_that_is_not_three_finite_numbers_is_refused(four_bar, force, torque):
+    from pinmech import ForceSolver, Load
+
+    load = Load("push", four_bar.frame_id("P"), np.array(force), np.array(torque))
+    with pytest.raises(OptionError, match="load 'push'"):
+        ForceSolver(four_bar, ["O2"], loads=[load])
