@@ -234,9 +234,8 @@ class CutEvaluator:
             self._full_axis = self._full_ang @ pin.skew(closure.axis)
         self._ground = model.frames[closure.parent_frame].parentJoint == 0
         if self._ground:  # a frame on the universe joint: its placement is the world one
-            self._frame = model.frames[closure.parent_frame]  # the model's own frame, read live
             self._row_mats = (self._full_lin, self._ang_axis, self._full_axis)
-            self._fold(self._frame.placement.copy())
+            self._fold(model.frames[closure.parent_frame].placement.copy())
 
     def _fold(self, M_P: pin.SE3) -> None:
         """A ground cut frame's placement folded into the row matrices (R_P^T once)."""
@@ -252,10 +251,13 @@ class CutEvaluator:
         """Fold a ground cut frame's placement again if the model's frame was moved since
         (nothing is cached that the model can change); True when it was. Solvers call it
         once per call of their public methods (under a microsecond), not per pose."""
-        if self._ground and not self._frame.placement == self._M_ground:
-            self._fold(self._frame.placement.copy())
-            return True
-        return False
+        if not self._ground:
+            return False
+        placement = self.model.frames[self.closure.parent_frame].placement  # by index: frames may be added
+        if placement == self._M_ground:
+            return False
+        self._fold(placement.copy())
+        return True
 
     def _set_parent(self, R_P: np.ndarray, p_P: np.ndarray) -> None:
         self._R_P, self._p_P = R_P, p_P
