@@ -7,7 +7,7 @@ A user's script imports from here only:
     print(pinmech.to_text(analysis))
 """
 
-from pinmech.analysis import Analysis, Drivers, analyse, load_mechanism
+from pinmech.analysis import Analysis, analyse
 from pinmech.branches import Assembly
 from pinmech.check import compare, load_hand_file
 from pinmech.closures import Closure
@@ -52,6 +52,7 @@ from pinmech.polygon import Polygon, acceleration_polygon, velocity_polygon
 from pinmech.report import to_dict, to_json, to_text
 from pinmech.results import Accuracy, LoopSolution, RateSolution
 from pinmech.scene import Scene
+from pinmech.scene_model import Drivers, load_mechanism
 from pinmech.sidecar import load_extended_urdf
 from pinmech.solve_batch import BatchSolution, BatchSolver
 from pinmech.solve_cycle import RangeChunk, solve_range

@@ -19,8 +19,12 @@ from typing import Any
 
 import numpy as np
 
-from pinmech.analysis import (
-    Analysis,
+from pinmech.exceptions import FrameNotFound, SceneError
+from pinmech.mechanism import Mechanism
+from pinmech.motion import evaluate_motion
+from pinmech.results import Accuracy, Analysis, LoopSolution, RateSolution
+from pinmech.scene import Scene
+from pinmech.scene_model import (
     Drivers,
     check_scene_names,
     coincident_points,
@@ -28,11 +32,6 @@ from pinmech.analysis import (
     report_lists,
     scene_guess,
 )
-from pinmech.exceptions import FrameNotFound, SceneError
-from pinmech.mechanism import Mechanism
-from pinmech.motion import evaluate_motion
-from pinmech.results import Accuracy, LoopSolution, RateSolution
-from pinmech.scene import Scene
 from pinmech.solve_loops import LoopSolver
 from pinmech.solve_rates import COMPONENTS, RateSolver, Task
 

@@ -220,9 +220,10 @@ def _scene(args: argparse.Namespace):
 
 def cmd_solve(args: argparse.Namespace) -> int:
     """`pinmech solve SCENE`: the textbook-ordered report, or `--json`."""
-    from pinmech.analysis import analyse, limit_mode
+    from pinmech.analysis import analyse
     from pinmech.limits import enforce, limit_violations
     from pinmech.report import to_json, to_text
+    from pinmech.scene_model import limit_mode
 
     scene = _scene(args)
     mode = limit_mode(scene, args.limits)
@@ -263,8 +264,8 @@ def _sweep_forces(args: argparse.Namespace, scene, sweep):
 def cmd_sweep(args: argparse.Namespace) -> int:
     """`pinmech sweep SCENE`: every pose of a cycle, streamed as CSV (and JSON lines, a plot);
     a task scene is followed in time instead (as `pinmech path`)."""
-    from pinmech.analysis import limit_mode
     from pinmech.limits import limit_violations
+    from pinmech.scene_model import limit_mode
     from pinmech.sweep import DriverValues, Sweep, sweep_options
 
     scene = _scene(args)
@@ -442,10 +443,10 @@ def cmd_path(args: argparse.Namespace) -> int:
 
 def _follow(args: argparse.Namespace, scene) -> int:
     """A task scene followed in time: CSV (JSON lines, a figure) of the joint trajectory."""
-    from pinmech.analysis import limit_mode, load_mechanism
     from pinmech.analysis_task import scene_pose, scene_tasks
     from pinmech.limits import limits_at
     from pinmech.path import check_timing, follow_path, step_count
+    from pinmech.scene_model import limit_mode, load_mechanism
     from pinmech.sweep import sweep_options
     from pinmech.tables import PathCsv
 

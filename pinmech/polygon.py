@@ -23,10 +23,11 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from pinmech.analysis import Analysis, coincident_points
 from pinmech.draw.inputs import DrawError
 from pinmech.link_nodes import pin_links, sketch_links
 from pinmech.motion import _plane_reference, evaluate_motion
+from pinmech.results import Analysis
+from pinmech.scene_model import coincident_points
 
 KINDS = {
     "absolute": "from the pole",

@@ -8,9 +8,9 @@ from typing import Any
 
 import numpy as np
 
-from pinmech.analysis import Analysis
 from pinmech.limits import limit_violations
 from pinmech.motion import Motion
+from pinmech.results import Analysis
 
 
 def _vec(x: np.ndarray) -> list[float]:

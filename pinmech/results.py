@@ -3,9 +3,16 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:  # types of the scene-level result only; results.py imports no pinmech module
+    from pinmech.forces import ForceSolution
+    from pinmech.mechanism import Mechanism
+    from pinmech.motion import Motion
+    from pinmech.scene import Scene
+    from pinmech.scene_model import Drivers
 
 #: Machine epsilon of float64, the rounding of every number pinmech computes.
 EPS = float(np.finfo(float).eps)
@@ -170,3 +177,22 @@ class RateSolution:
         scale_v = max(1.0, float(np.max(np.abs(self.requested_velocity), initial=0.0)))
         scale_a = max(1.0, float(np.max(np.abs(self.requested_acceleration), initial=0.0)))
         return self.velocity_error <= tol * scale_v and self.acceleration_error <= tol * scale_a
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """Everything `pinmech solve` reports for one scene."""
+
+    scene: Scene
+    mechanism: Mechanism
+    drivers: Drivers
+    solution: LoopSolution
+    motion: Motion
+    extra: dict[str, Any] | None = None
+    forces: ForceSolution | None = None  # driver efforts and reactions, when the scene asks (forces.py)
+
+    def _repr_html_(self) -> str:
+        """Jupyter shows the points' and links' motion as tables."""
+        from pinmech.draw.report_page import motion_table_html
+
+        return f"<h4>{self.scene.title}</h4>" + motion_table_html(self)

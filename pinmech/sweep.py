@@ -27,7 +27,12 @@ from typing import Any
 
 import numpy as np
 
-from pinmech.analysis import (
+from pinmech.exceptions import ModelError, SceneError, SweepError
+from pinmech.mechanism import Mechanism
+from pinmech.motion import Motion, evaluate_motion
+from pinmech.results import Accuracy
+from pinmech.scene import Scene
+from pinmech.scene_model import (
     Drivers,
     check_scene_names,
     coincident_points,
@@ -36,11 +41,6 @@ from pinmech.analysis import (
     scene_drivers,
     scene_solver,
 )
-from pinmech.exceptions import ModelError, SceneError, SweepError
-from pinmech.mechanism import Mechanism
-from pinmech.motion import Motion, evaluate_motion
-from pinmech.results import Accuracy
-from pinmech.scene import Scene
 from pinmech.solve_cycle import STARTS, RangeChunk, solve_range
 from pinmech.solve_loops import LoopSolver
 

@@ -40,6 +40,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import closed_form
 
 import pinmech
+import pinmech.scene_model
 from pinmech.solve_batch import difference_many
 from pinmech.sweep import Sweep
 
@@ -64,7 +65,7 @@ def finite_differences(sweep: Sweep, phis: np.ndarray):
     accelerations by central differences in time of q on the manifold (periodic cycle)."""
     solver, model = sweep.solver, sweep.mechanism.model
     omega = float(sweep.drivers.v[0])
-    q = pinmech.analysis.scene_guess(sweep.scene, sweep.mechanism)
+    q = pinmech.scene_model.scene_guess(sweep.scene, sweep.mechanism)
     Q = np.empty((len(phis), model.nq))
     for i, phi in enumerate(phis):
         q, _, _ = solver.close(q, [phi])
@@ -198,7 +199,7 @@ def verdicts(rows: list[dict]) -> str:
 
 def path_rows(repeats: int) -> list[dict]:
     """Text 17.110's task followed for 0.08 s with each scheme, step and gain."""
-    from pinmech.analysis import load_mechanism
+    from pinmech.scene_model import load_mechanism
     from pinmech.analysis_task import scene_pose, scene_tasks
     from pinmech.path import follow_path
 

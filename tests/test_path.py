@@ -8,7 +8,7 @@ import pinocchio as pin
 import pytest
 
 from pinmech import Scene, TaskError
-from pinmech.analysis import load_mechanism
+from pinmech.scene_model import load_mechanism
 from pinmech.analysis_task import scene_pose, scene_tasks
 from pinmech.cli import main
 from pinmech.path import follow_path

@@ -16,7 +16,14 @@ page), `inputs` (checks, `DrawError`), `geometry` (boxes, axes, transforms).
 """
 
 from pinmech.draw.inputs import DrawError
-from pinmech.draw.pages import LiveView, animation_html, live_viewer, load_visuals, package_visuals, snapshot_html
+from pinmech.draw.pages import (
+    LiveView,
+    animation_html,
+    live_viewer,
+    load_visuals,
+    package_visuals,
+    snapshot_html,
+)
 from pinmech.draw.scene import INSTALL_HINT, ROOT, Arrow, arrow_scales
 
 __all__ = [

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.analysis import Analysis
 from pinmech.exceptions import PinmechError
+from pinmech.results import Analysis
 
 
 def report_html(analysis: Analysis, *, steps: int = 121, hand_text: str | None = None) -> str:
