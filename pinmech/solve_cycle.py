@@ -531,11 +531,13 @@ class _Cycle:
         """Absolute interpolation errors (positions, q', q'') as relative errors of each
         pose's positions, velocities and accelerations in the scene's rates: the velocity
         error over the pose's largest velocity (lengths in loop sizes), likewise for the
-        acceleration q'' w^2 + q' alpha."""
+        acceleration q'' w^2 + q' alpha (over w^2 |q'| where every joint's is zero: a
+        mechanism whose joints move in proportion has no acceleration to be relative to)."""
         w, alpha = abs(float(self.v_drv[self.k])), float(self.a_drv[self.k])
         inv = self.solver._v_scale_inv
         v = np.abs(d1 * inv).max(axis=1)
         a = np.abs((d2 * (w * w) + d1 * alpha) * inv).max(axis=1)
+        a = np.where(a > 0, a, w * w * v)
         error_a = absolute[:, 2] * (w * w) + absolute[:, 1] * abs(alpha)
         with np.errstate(divide="ignore", invalid="ignore"):
             rel_v = np.where(absolute[:, 1] > 0, absolute[:, 1] / v, 0.0)
