@@ -72,7 +72,9 @@ class Closure:
         axis: joint axis in P (unit), for revolute and prismatic cuts.
         child_axis: joint axis in C (unit); equals `axis` once the loop is closed.
         basis: (k, n_sel) constant row basis of the independent rows (set by mechanism.py).
-        length_scale: position rows are divided by this [m] so rows are dimensionless.
+        length_scale: the loop's size [m] (mechanism.py): position rows are divided by it
+            so rows are dimensionless, and the closure tolerance is relative to it.
+        joints: ids of the Pinocchio joints on the loop (set by mechanism.py).
     """
 
     name: str
@@ -85,14 +87,22 @@ class Closure:
     child_link: str = ""
     basis: np.ndarray | None = None
     length_scale: float = 1.0
+    joints: tuple[int, ...] = ()
     _select: np.ndarray = field(init=False, repr=False)
     _rows6: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        for name in ("axis", "child_axis"):  # own read-only copies: the rows are built from them
+            axis = np.array(getattr(self, name), dtype=float)
+            axis.flags.writeable = False
+            super().__setattr__(name, axis)
         self._select = selection_matrix(self.cut_type, self.axis)
         self.basis = np.eye(self._select.shape[0]) if self.basis is None else self.basis  # sets _rows6
 
     def __setattr__(self, name: str, value: object) -> None:
+        if self.__dict__.get("_in_use"):
+            raise AttributeError(f"closure '{self.name}' is in use by a solver: its {name} cannot change "
+                                 "(the solver's rows are built from it); load the mechanism again instead")
         super().__setattr__(name, value)
         if name in ("basis", "length_scale") and hasattr(self, "_select") and self.basis is not None:
             # basis @ selection @ diag(scale), once: the map from a relative 6-vector to rows
@@ -208,6 +218,7 @@ class CutEvaluator:
     """
 
     def __init__(self, closure: Closure, model: pin.Model) -> None:
+        closure.__dict__["_in_use"] = True  # what the rows below are built from stays as it is
         self.closure = closure
         self.model = model
         rows6 = closure._rows6
@@ -223,12 +234,30 @@ class CutEvaluator:
             self._full_axis = self._full_ang @ pin.skew(closure.axis)
         self._ground = model.frames[closure.parent_frame].parentJoint == 0
         if self._ground:  # a frame on the universe joint: its placement is the world one
-            M_P = model.frames[closure.parent_frame].placement
-            self._set_parent(M_P.rotation.copy(), M_P.translation.copy())
-            self._full_lin = self._full_lin @ M_P.rotation.T  # R_P^T folded in once
-            if self._revolute:
-                self._ang_axis = self._ang_axis @ M_P.rotation.T
-                self._full_axis = self._full_axis @ M_P.rotation.T
+            self._row_mats = (self._full_lin, self._ang_axis, self._full_axis)
+            self._fold(model.frames[closure.parent_frame].placement.copy())
+
+    def _fold(self, M_P: pin.SE3) -> None:
+        """A ground cut frame's placement folded into the row matrices (R_P^T once)."""
+        self._M_ground = M_P
+        self._set_parent(M_P.rotation.copy(), M_P.translation.copy())
+        full_lin, ang_axis, full_axis = self._row_mats
+        self._full_lin = full_lin @ M_P.rotation.T
+        if self._revolute:
+            self._ang_axis = ang_axis @ M_P.rotation.T
+            self._full_axis = full_axis @ M_P.rotation.T
+
+    def refresh(self) -> bool:
+        """Fold a ground cut frame's placement again if the model's frame was moved since
+        (nothing is cached that the model can change); True when it was. Solvers call it
+        once per call of their public methods (under a microsecond), not per pose."""
+        if not self._ground:
+            return False
+        placement = self.model.frames[self.closure.parent_frame].placement  # by index: frames may be added
+        if placement == self._M_ground:
+            return False
+        self._fold(placement.copy())
+        return True
 
     def _set_parent(self, R_P: np.ndarray, p_P: np.ndarray) -> None:
         self._R_P, self._p_P = R_P, p_P

@@ -183,6 +183,30 @@ class IndeterminateForcesError(SingularPoseError):
         self.equations = equations
 
 
+class OptionError(PinmechError):
+    """A solver option given through the Python API is out of its range (as the scene's
+    [solver] table is checked): a NaN, an infinity or a tolerance that closes nothing.
+
+    Attributes:
+        option: the option's name ("tol", "max_iterations", "max_condition").
+        value: the value given.
+    """
+
+    exit_code = 2
+
+    def __init__(self, message: str, *, option: str, value: Any):
+        super().__init__(message)
+        self.option = option
+        self.value = value
+
+
+class RateOverflowError(PinmechError):
+    """Driver rates so large that velocities or accelerations overflow float64 (a speed of
+    1e160 rad/s squares to infinity): nothing finite can be stated."""
+
+    exit_code = 2
+
+
 class Interrupted(KeyboardInterrupt):
     """The run was stopped by a signal: Ctrl-C (SIGINT), SIGTERM or SIGHUP (the terminal
     closed). A KeyboardInterrupt, so code that stops on Ctrl-C stops on all three.

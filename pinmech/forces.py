@@ -29,6 +29,7 @@ mechanism is at rest (statics: the principle of virtual work).
 from __future__ import annotations
 
 import math
+import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -36,8 +37,9 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.closures import _cross
-from pinmech.exceptions import IndeterminateForcesError, ModelError
+from pinmech.exceptions import IndeterminateForcesError, ModelError, OptionError
 from pinmech.mechanism import Mechanism
+from pinmech.solve_loops import checked_option, describe_joint_values, serialized
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 #: Default largest condition number of the (dimensionless) force equations: as for velocities.
@@ -209,12 +211,23 @@ class ForceSolver:
         self.mechanism = mechanism
         self.model = pin.Model(mechanism.model)  # a copy: its gravity is ours, not the user's
         self.gravity = np.asarray(gravity, dtype=float).reshape(3)
+        if not np.all(np.isfinite(self.gravity)):
+            raise OptionError(f"gravity = {tuple(gravity)!r} must be three finite numbers [m/s^2]",
+                              option="gravity", value=gravity)
         self.model.gravity = pin.Motion(self.gravity, np.zeros(3))
+        self.lock = threading.RLock()  # one Data: threads sharing the solver take turns
         self.data = self.model.createData()
         self.drivers = tuple(drivers)
         self.loads = tuple(loads)
+        for load in self.loads:  # NaN or misshapen loads would give NaN efforts in silence
+            vectors = [np.asarray(x, dtype=float) for x in (load.force, load.torque)]
+            if any(x.shape != (3,) or not np.all(np.isfinite(x)) for x in vectors) \
+                    or not 0 <= load.frame < self.model.nframes:
+                raise OptionError(f"load '{load.name}' needs a frame of the model and a force and a torque of "
+                                  f"three finite numbers [N, N m], got frame {load.frame!r}, force {load.force!r}, "
+                                  f"torque {load.torque!r}", option="loads", value=load)
         self.minimum_norm = minimum_norm
-        self.max_condition = max_condition
+        self.max_condition = checked_option("max_condition", max_condition)
         self._drv_v = np.array([self._driver_index(n) for n in self.drivers], dtype=int)
         self._scale = mechanism.velocity_scale()
         self._check_masses(set(massless))
@@ -242,6 +255,7 @@ class ForceSolver:
                              "massless: [forces] massless = [...])", path=mech.source)
 
     # ------------------------------------------------------------------ solve
+    @serialized
     def solve(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> ForceSolution:
         """Driver efforts and reactions at a solved pose (q closed, v and a consistent).
 
@@ -257,7 +271,13 @@ class ForceSolver:
         power_terms = self._power_terms(q, v, a, virtual)
         load_wrenches = self._load_wrenches()
         b = pin.rnea(model, data, q, v, a, load_wrenches).copy()
-        x, condition, method = self._solve_system(J_c, b)
+        try:
+            x, condition, method = self._solve_system(J_c, b)
+        except IndeterminateForcesError as exc:  # name the pose, in the user's units
+            at = describe_joint_values(self.mechanism, self.drivers, [self.mechanism.coordinate(q, n) for n in self.drivers])
+            said = str(exc).replace("at this pose", f"at {at}") if "at this pose" in str(exc) else f"{exc} (at {at})"
+            raise IndeterminateForcesError(said, condition=exc.condition, sigma_min=exc.sigma_min,
+                                           unknowns=exc.unknowns, equations=exc.equations) from None
         effort, lam = x[: len(self.drivers)], x[len(self.drivers) :]
         cut_wrenches = self._cut_wrenches(lam)
         total = [f + g for f, g in zip(load_wrenches, self._as_external(cut_wrenches))]

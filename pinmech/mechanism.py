@@ -74,7 +74,9 @@ class Mechanism:
         joints: name -> JointInfo of every joint that moves.
         links: name -> Pinocchio BODY frame id, for every link that is not a point.
         points: name -> frame id of every named point.
-        length_scale: size of the mechanism [m]; position tolerances are relative to it.
+        length_scale: size of the mechanism [m]: its largest loop's (each closure's own
+            `length_scale` sets that loop's tolerance), or for an open chain the box of its
+            joints and the frames they move; never a frame that closes no loop.
         plane_normal: unit normal of the motion plane for a planar mechanism, else None.
         locked: joints locked out of the model, with their values (SI).
         urdf_path: the URDF the model was built from, when `source` is another file (a
@@ -172,8 +174,8 @@ class Mechanism:
             mimics={n: m for n, m in mimics.items() if n not in (locked or {})},
         )
         mech.limits = {n: lu for n, lu in joint_limits(root, source).items() if n in mech.joints or n in mech.locked}
-        mech.length_scale = _length_scale(model, source)
-        mech.closures = [_make_closure(model, c, mech.length_scale) for c in cuts]
+        mech.closures = [_make_closure(model, c) for c in cuts]
+        mech.length_scale = _length_scale(model, mech.closures, source)
         _reduce_rows(mech)
         mech.plane_normal = _plane_normal(mech)
         if reference:
@@ -241,8 +243,8 @@ class Mechanism:
                    links={n: _body_frame(model, n) for n in bodies},
                    points={n: model.getFrameId(n) for n in points}, length_scale=1.0, plane_normal=None,
                    source=source, urdf_path=urdf_path, locked=dict(locked or {}))
-        mech.length_scale = _length_scale(model, source)
-        mech.closures = [anchor_closure(model, cut, mech.length_scale) for cut in cuts]
+        mech.closures = [anchor_closure(model, cut, 1.0) for cut in cuts]  # each loop's size: below
+        mech.length_scale = _length_scale(model, mech.closures, source)
         _reduce_rows(mech)
         mech.plane_normal = _plane_normal(mech)
         if reference is not None:
@@ -342,16 +344,23 @@ class Mechanism:
         return idle_joints(self, drivers, self.rank_report().q)
 
     def velocity_scale(self) -> np.ndarray:
-        """Per degree of freedom: the length scale for prismatic joints, 1 for the others.
+        """Per degree of freedom: a length [m] for translational freedoms, 1 for the others.
 
-        Multiplying Jacobian columns by it makes them dimensionless (a slide of one
-        mechanism size weighs as a turn of one radian), so condition numbers do not depend
-        on the units or the size of the mechanism.
+        Translational freedoms are those of prismatic joints and the translations of planar
+        and floating joints; each is scaled by the size of the loops its joint closes (the
+        largest, `Closure.length_scale`), or the mechanism's size outside every loop.
+        Multiplying Jacobian columns by it makes them dimensionless (a slide of one loop
+        size weighs as a turn of one radian), so condition numbers do not depend on the
+        units or the size of the mechanism, nor on frames that close no loop.
         """
+        if self.__dict__.get("_slides") is None:  # the joints' kinds are fixed: found once
+            self._slides = [(jid, [self.model.joints[jid].idx_v + i for i in _translational(self.model, jid)])
+                            for jid in range(1, self.model.njoints)]
         scale = np.ones(self.model.nv)
-        for joint in self.joints.values():
-            if joint.kind == "prismatic":
-                scale[joint.idx_v] = self.length_scale
+        for jid, slides in self._slides:
+            if slides:
+                sizes = [c.length_scale for c in self.closures if jid in c.joints]
+                scale[slides] = max(sizes) if sizes else self.length_scale
         return scale
 
     def neutral(self) -> np.ndarray:
@@ -633,26 +642,81 @@ def _body_frame(model: pin.Model, link: str) -> int:
 SIZE_RANGE = (1e-50, 1e50)
 
 
-def _length_scale(model: pin.Model, source: str) -> float:
-    """Diagonal of the box around every frame origin at the neutral configuration [m].
+def _translational(model: pin.Model, jid: int) -> list[int]:
+    """Velocity components of a joint that translate (motion subspace without rotation, at
+    the neutral configuration): a prismatic joint's one, a planar joint's two, a floating
+    joint's three."""
+    joint = model.joints[jid]
+    if joint.nv == 0:  # a mimic follower: no freedom of its own
+        return []
+    data = joint.createData()
+    joint.calc(data, pin.neutral(model))
+    S = np.array(data.S).reshape(6, joint.nv)
+    return [i for i in range(joint.nv) if not np.any(S[3:, i]) and np.any(S[:3, i])]
+
+
+def _box(points: np.ndarray) -> float:
+    """Diagonal of the box around points (rows) [m]."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))) if len(points) else 0.0
+
+
+def _check_range(size: float, source: str) -> None:
+    if not SIZE_RANGE[0] <= size <= SIZE_RANGE[1]:
+        raise ModelError(f"the mechanism's size is {size:.3g} m, outside the {SIZE_RANGE[0]:g} to "
+                         f"{SIZE_RANGE[1]:g} m pinmech can compute with (check the <origin> numbers)", path=source)
+
+
+def _length_scale(model: pin.Model, closures: list[Closure], source: str) -> float:
+    """The mechanism's size [m]: the largest of its loops' sizes; without loops (an arm),
+    the box around its joints and the frames they move, at the neutral configuration
+    (frames fixed to the ground, however far, do not count).
+
+    Each loop's size (its `length_scale`, the scale of its closure tolerance) is the box
+    around what closes it: the origins of the joints on its path through the tree and the
+    two cut frames. A named point or a frame that closes no loop does not change it.
 
     Raises:
         ModelError: a size outside `SIZE_RANGE` (numbers that overflow, as 1e308 in an origin).
     """
     data = model.createData()
     pin.framesForwardKinematics(model, data, pin.neutral(model))
-    pts = np.array([f.translation for f in data.oMf])
-    with np.errstate(over="ignore", invalid="ignore"):
-        size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))) if len(pts) else 0.0
-    if size == 0:
-        return 1.0
-    if not SIZE_RANGE[0] <= size <= SIZE_RANGE[1]:
-        raise ModelError(f"the mechanism's size is {size:.3g} m, outside the {SIZE_RANGE[0]:g} to "
-                         f"{SIZE_RANGE[1]:g} m pinmech can compute with (check the <origin> numbers)", path=source)
-    return size
+    every = _box(np.array([f.translation for f in data.oMf]))
+    if every != 0:
+        _check_range(every, source)
+    for closure in closures:
+        closure.joints = _loop_joints(model, closure)
+        points = [data.oMi[j].translation for j in closure.joints]
+        points += [data.oMf[closure.parent_frame].translation, data.oMf[closure.child_frame].translation]
+        size = _box(np.array(points))
+        closure.length_scale = size if size > 0 else (every or 1.0)
+        _check_range(closure.length_scale, source)
+    if closures:
+        return max(c.length_scale for c in closures)
+    moving = [data.oMi[j].translation for j in range(1, model.njoints)]
+    moving += [data.oMf[i].translation for i in range(model.nframes) if model.frames[i].parentJoint != 0]
+    size = _box(np.array(moving))
+    return size if size > 0 else (every or 1.0)
 
 
-def _make_closure(model: pin.Model, cut: _Cut, length_scale: float) -> Closure:
+def _loop_joints(model: pin.Model, closure: Closure) -> tuple[int, ...]:
+    """Ids of the joints on the loop of a cut: the tree paths from both cut frames' joints
+    up to (not including) their common ancestor."""
+    def ancestors(j: int) -> list[int]:
+        out = [j]
+        while j != 0:
+            j = model.parents[j]
+            out.append(j)
+        return out
+
+    a = ancestors(model.frames[closure.parent_frame].parentJoint)
+    b = ancestors(model.frames[closure.child_frame].parentJoint)
+    common = set(a) & set(b)
+    return tuple(j for j in a + b if j not in common and j != 0)
+
+
+def _make_closure(model: pin.Model, cut: _Cut) -> Closure:
+    """The closure of a cut, with one frame added per side; its size is set by `_length_scale`."""
     frame_ids = []
     for side, link, origin in (("parent", cut.parent_link, cut.parent_origin), ("child", cut.child_link, cut.child_origin)):
         body_id = _body_frame(model, link)
@@ -661,7 +725,7 @@ def _make_closure(model: pin.Model, cut: _Cut, length_scale: float) -> Closure:
                           pin.FrameType.OP_FRAME)
         frame_ids.append(model.addFrame(frame, False))
     return Closure(cut.name, cut.cut_type, frame_ids[0], frame_ids[1], cut.parent_axis, cut.child_axis,
-                   parent_link=cut.parent_link, child_link=cut.child_link, length_scale=length_scale)
+                   parent_link=cut.parent_link, child_link=cut.child_link)
 
 
 def _sample_configurations(model: pin.Model, count: int, scale: np.ndarray | float = 1.0) -> list[np.ndarray]:

@@ -16,6 +16,8 @@ if TYPE_CHECKING:  # types of the scene-level result only; results.py imports no
 
 #: Machine epsilon of float64, the rounding of every number pinmech computes.
 EPS = float(np.finfo(float).eps)
+#: Constants of the position, velocity and acceleration bounds (`Accuracy.error_bounds`).
+BOUND_FACTORS = (4.0, 4.0, 16.0)
 
 
 @dataclass(frozen=True)
@@ -30,6 +32,10 @@ class Accuracy:
         sigma_min: smallest singular value of that Jacobian (dimensionless rows).
         velocity_residual: max |J q_dot| of the velocity equations, per second.
         acceleration_residual: max |J q_ddot + Jdot q_dot| of the acceleration equations.
+        interpolation: for a pose interpolated between solved ones (a sweep's
+            `interpolate`), the relative errors of its positions, velocities and
+            accelerations that interpolation adds, measured against poses solved where
+            the interpolation error peaks (solve_cycle.py); (0, 0, 0) for a solved pose.
     """
 
     residual: float
@@ -38,22 +44,28 @@ class Accuracy:
     sigma_min: float
     velocity_residual: float = 0.0
     acceleration_residual: float = 0.0
+    interpolation: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     @property
     def error_bounds(self) -> tuple[float, float, float]:
         """Relative errors to expect of positions, velocities and accelerations.
 
         With m = max(residual, eps) (what the loop closure left, or rounding) and k the
-        condition number: positions 2 k m (the residual left along the Jacobian's soft
-        direction), velocities k^2 m, accelerations k^3 m. Accelerations reach k^3 m where
-        the rates stay finite while k grows (an R-RTR whose guide passes through its pivot);
-        where the rates grow with k (a four-bar's toggle or dead centres) they do better,
-        about k^2 m, and an open arm's rate problem gives k eps for both. Measured against
-        extended-precision closed forms in tests/test_singular.py.
+        condition number: positions 4 k m (the residual left along the Jacobian's soft
+        direction), velocities 4 k^2 m, accelerations 16 k^3 m. Accelerations reach k^3 m
+        where the rates stay finite while k grows (an R-RTR whose guide passes through its
+        pivot: 3.1 k^3 m, the worst measured); where the rates grow with k (a four-bar's
+        toggle or dead centres) they do better, about k^2 m, and an open arm's rate problem
+        gives k eps for both. An interpolated pose adds its `interpolation` errors. The
+        factors are margins of 2 to 5 over the worst ratios measured against
+        extended-precision closed forms (tests/test_singular.py, scripts/singular_accuracy.py):
+        k depends on how lengths are made dimensionless (by the loops' sizes), which no law
+        fixes to better than a small factor.
         """
         m = max(self.residual, EPS)
         k = self.condition
-        return 2 * k * m, k**2 * m, k**3 * m
+        p, v, a = self.interpolation
+        return (BOUND_FACTORS[0] * k * m + p, BOUND_FACTORS[1] * k**2 * m + v, BOUND_FACTORS[2] * k**3 * m + a)
 
     @property
     def error_estimate(self) -> float:

@@ -20,7 +20,7 @@ import pinocchio as pin
 
 from pinmech.cut_arrays import ArrayCut, RowCut
 from pinmech.results import Accuracy, LoopSolution
-from pinmech.solve_loops import DEFAULT_TOL, POLISH, LoopSolver
+from pinmech.solve_loops import DEFAULT_TOL, POLISH, LoopSolver, serialized
 
 #: A guess needing a Newton step larger than this (dimensionless: of the mechanism's size,
 #: or radians) is not "close": the batch hands the poses back to the pose-by-pose solver.
@@ -36,6 +36,7 @@ class BatchSolution:
             accelerations [rad/s^2 or m/s^2].
         residual, iterations, condition, sigma_min, velocity_residual,
         acceleration_residual: (N,) the fields of `Accuracy`, per pose.
+        interpolation: (N, 3) `Accuracy.interpolation` per pose, or None (every pose solved).
     """
 
     q: np.ndarray
@@ -49,14 +50,16 @@ class BatchSolution:
     acceleration_residual: np.ndarray
     drivers: tuple[str, ...] = ()
     signs: np.ndarray | None = None  # (N, blocks) assembly signatures (branches.py), where computed
+    interpolation: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.q)
 
     def accuracy(self, i: int) -> Accuracy:
+        added = (0.0, 0.0, 0.0) if self.interpolation is None else tuple(map(float, self.interpolation[i]))
         return Accuracy(float(self.residual[i]), int(self.iterations[i]), float(self.condition[i]),
                         float(self.sigma_min[i]), float(self.velocity_residual[i]),
-                        float(self.acceleration_residual[i]))
+                        float(self.acceleration_residual[i]), added)
 
     def solution(self, i: int) -> LoopSolution:
         """Pose i as the `LoopSolution` that `LoopSolver.solve` returns."""
@@ -78,14 +81,17 @@ class BatchSolver:
         self.model = solver.model
         self._cuts = [(ArrayCut if not ev._has_angular else RowCut)(ev) for ev in solver._cuts]
         self._zero = np.zeros(self.model.nv)
+        self.lock = solver.lock  # one Pinocchio Data: the solver's
+        self.refresh = solver.refresh
 
+    @serialized
     def try_solve(self, guesses: np.ndarray, driver_q: np.ndarray, driver_v: np.ndarray,
-                  driver_a: np.ndarray) -> BatchSolution | None:
+                  driver_a: np.ndarray, max_step: float = MAX_BATCH_STEP) -> BatchSolution | None:
         """Solve N poses: guesses (N, nq), drivers' q, v, a (N, number of drivers).
 
         Returns:
             The solved poses, or None when one of them needs the pose-by-pose solver: a
-            guess too far from its solution (a Newton step over `MAX_BATCH_STEP`), a loop
+            guess too far from its solution (a Newton step over `max_step`), a loop
             that does not close within the iteration cap, a singular Jacobian, or a pose
             on another assembly than the solver's reference (branches.py). That solver
             then says which pose, and why, in its own words.
@@ -103,13 +109,13 @@ class BatchSolver:
             bad = np.flatnonzero(error > s.tol)
             if not bad.size:
                 break
-            if iterations.max(initial=0) >= s.max_iterations or not self._newton(Q, bad, r):
+            if iterations.max(initial=0) >= s.max_iterations or not self._newton(Q, bad, r, max_step):
                 return None
             iterations[bad] += 1
             r = self._rows("residual")
             error = np.abs(r).max(axis=1, initial=0.0)
         polish = np.flatnonzero(error > POLISH) if s.tol <= DEFAULT_TOL else ()  # as LoopSolver.close
-        if len(polish) and self._newton(Q, polish, r):
+        if len(polish) and self._newton(Q, polish, r, max_step):
             iterations[polish] += 1
             error = np.abs(self._rows("residual")).max(axis=1, initial=0.0)
             if np.any(error > s.tol):
@@ -123,6 +129,7 @@ class BatchSolver:
             return None  # a pose on another assembly than the solver's reference
         return out
 
+    @serialized
     def measure(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> BatchSolution:
         """The accuracy of given poses (N rows of q, v, a), e.g. interpolated ones: closure
         residual, condition number, and the residuals of the velocity and acceleration
@@ -174,13 +181,13 @@ class BatchSolver:
         parts = [getattr(c, name)() for c in self._cuts]
         return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1)
 
-    def _newton(self, Q: np.ndarray, bad: np.ndarray, r: np.ndarray) -> bool:
+    def _newton(self, Q: np.ndarray, bad: np.ndarray, r: np.ndarray, max_step: float = MAX_BATCH_STEP) -> bool:
         """One Newton step on the poses `bad`; False when a step is not small or finite."""
         s = self.solver
         J_dep = self._rows("newton_jacobian")[bad][:, :, s._dep]
         step = solve_batch(J_dep, -r[bad])
         size = np.abs(step * s._dep_scale).max(initial=0.0)
-        if not np.isfinite(size) or size > MAX_BATCH_STEP:
+        if not np.isfinite(size) or size > max_step:
             return False
         full = np.zeros((len(bad), self.model.nv))
         full[:, s._dep] = step
@@ -202,6 +209,8 @@ class BatchSolver:
         V[:, s._dep] = solve_batch(J_dep, -np.einsum("nkj,nj->nk", J_drv, driver_v))
         drift = self._drift(Q, V)
         A[:, s._dep] = solve_batch(J_dep, -np.einsum("nkj,nj->nk", J_drv, driver_a) - drift)
+        if not (np.isfinite(V).all() and np.isfinite(A).all()):
+            return None  # the pose-by-pose solver names the pose (RateOverflowError)
         return BatchSolution(Q, V, A, residual, iterations, condition, sigma_min,
                              *self._equation_residuals(J, V, A, drift), s.drivers, s.structure.signs_many(J_dep))
 

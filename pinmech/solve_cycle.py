@@ -16,7 +16,9 @@ How each pose is found is the user's accuracy choice (README, "Speed and accurac
         tolerance, with its accuracy measured).
     interpolate=n: solve every n-th pose exactly (as above) and interpolate the poses
         between (quintic Hermite); their accuracy is measured at the points of each
-        interval where the interpolation error peaks.
+        interval where the interpolation error peaks: there the poses are also solved
+        exactly, and the difference, times INTERPOLATION_SAFETY, is the error bound that
+        interpolation adds to each pose of the interval (`Accuracy.interpolation`).
 
 With the other drivers at rest, velocities and accelerations follow from the path
 derivatives exactly: q_dot = q' x_dot and q_ddot = q'' x_dot^2 + q' x_ddot.
@@ -37,12 +39,13 @@ from pinmech.exceptions import (
     AssemblyError,
     DriverLimitError,
     LoopClosureError,
+    OptionError,
     PinmechError,
     SingularPoseError,
 )
 from pinmech.hermite import interpolate_poses
 from pinmech.results import Accuracy, LoopSolution
-from pinmech.solve_batch import BatchSolution, BatchSolver
+from pinmech.solve_batch import BatchSolution, BatchSolver, difference_many
 from pinmech.solve_loops import LoopSolver
 
 STARTS = ("predictor", "warm", "cold")
@@ -57,6 +60,15 @@ MAX_SPAN = 0.12
 #: leading order, s^3 (1 - s)^3 and its derivatives): the middle for positions and
 #: accelerations, (1 - 1/sqrt 5) / 2 for velocities (and its mirror image, as large).
 PEAKS = (0.5, 0.5 - 0.5 / math.sqrt(5.0))
+#: An interpolated pose's error bound: this factor times the largest interpolation error
+#: measured at its interval's peaks (exact poses solved there). The leading-order error
+#: peaks there; higher orders shift the peak and change its height
+#: (tests/test_interpolation_bounds.py checks it against the R-RTR's closed form).
+INTERPOLATION_SAFETY = 4.0
+#: Largest Newton step (rad, or loop sizes) from an interpolated guess to the exact pose it
+#: is measured against: the guess is as good as the interpolation, and the assembly is
+#: checked after (a step to another branch is refused by its signature).
+MEASURE_STEP = 0.05
 _FAILURES = (LoopClosureError, SingularPoseError, AssemblyError, DriverLimitError)
 
 
@@ -113,7 +125,11 @@ def solve_range(solver: LoopSolver, driver: str, values: Iterable[float], *, dri
     Raises:
         PinmechError: an unknown start, or interpolation or batches asked with the other
             drivers moving (their path is then not the swept driver's alone).
+        OptionError: a chunk size that is not a whole number >= 1, or a value of the
+            range that is not finite (raised when the range reaches it).
     """
+    if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
+        raise OptionError(f"chunk = {chunk!r} must be a whole number of poses, at least 1", option="chunk", value=chunk)
     cycle = _Cycle(solver, driver, driver_q, driver_v, driver_a, guess, start, batch, interpolate, through_folds)
     values = iter(values)
     index = 0
@@ -121,6 +137,10 @@ def solve_range(solver: LoopSolver, driver: str, values: Iterable[float], *, dri
         xs = np.fromiter(islice(values, chunk), dtype=float)
         if not xs.size:
             return
+        if not np.all(np.isfinite(xs)):
+            bad = int(np.flatnonzero(~np.isfinite(xs))[0])
+            raise OptionError(f"the driver value at position {index + bad} of the range is {float(xs[bad])}: "
+                              f"every value of {driver} must be a finite number", option="values", value=float(xs[bad]))
         yield cycle.chunk(index, xs)
         index += len(xs)
 
@@ -171,12 +191,14 @@ class _Cycle:
         self.notes: dict[int, str] = {}
         self._index, self._iterations, self._batching = 0, 0, False
         self.node: Node | None = None  # the last pose solved one by one (self.ref's, when current)
-        self.span_scale = 1.0 if solver.mechanism.joint(driver).is_angular else solver.mechanism.length_scale
+        self.span_scale = float(solver.mechanism.velocity_scale()[solver.mechanism.joint(driver).idx_v])  # 1: a turn
 
     # ------------------------------------------------------------------ chunks
     def chunk(self, index: int, xs: np.ndarray) -> RangeChunk:
-        """Solve the poses xs that follow the last solved pose."""
-        out = self._chunk(index, xs)
+        """Solve the poses xs that follow the last solved pose (holding the solver's lock)."""
+        with self.solver.lock:
+            self.solver.refresh()
+            out = self._chunk(index, xs)
         notes = {j - index: n for j, n in self.notes.items() if index <= j < index + len(xs)}
         if notes:
             out = RangeChunk(out.start, out.values, out.solution, out.interpolated, out.errors, notes)
@@ -409,16 +431,25 @@ class _Cycle:
         accuracy = Accuracy(acc.residual, acc.iterations, acc.condition, acc.sigma_min,
                             abs(w) * acc.velocity_residual,
                             w * w * acc.acceleration_residual + abs(alpha) * acc.velocity_residual)
-        return LoopSolution(sol.q, sol.v * w, sol.a * (w * w) + sol.v * alpha, accuracy, sol.drivers)
+        with np.errstate(over="ignore", invalid="ignore"):
+            v, a = sol.v * w, sol.a * (w * w) + sol.v * alpha
+        if not math.isfinite(sum(v.tolist()) + sum(a.tolist())):
+            raise self.solver._overflow(sol.q, self.v_drv, self.a_drv)
+        return LoopSolution(sol.q, v, a, accuracy, sol.drivers)
 
     def _actual(self, index: int, xs: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray,
                 acc: dict[str, np.ndarray], interpolated: np.ndarray) -> RangeChunk:
         """A chunk in the scene's rates, from path derivatives (as `_scaled`)."""
         w, alpha = float(self.v_drv[self.k]), float(self.a_drv[self.k])
+        with np.errstate(over="ignore", invalid="ignore"):
+            v, a = d1 * w, d2 * (w * w) + d1 * alpha
+        if not (np.isfinite(v).all() and np.isfinite(a).all()):
+            raise self.solver._overflow(q[0], self.v_drv, self.a_drv)
         solution = BatchSolution(
-            q, d1 * w, d2 * (w * w) + d1 * alpha, acc["residual"], acc["iterations"], acc["condition"],
+            q, v, a, acc["residual"], acc["iterations"], acc["condition"],
             acc["sigma_min"], abs(w) * acc["velocity_residual"],
-            w * w * acc["acceleration_residual"] + abs(alpha) * acc["velocity_residual"], self.solver.drivers)
+            w * w * acc["acceleration_residual"] + abs(alpha) * acc["velocity_residual"], self.solver.drivers,
+            interpolation=acc["interpolation"] if interpolated.any() else None)
         return RangeChunk(index, xs, solution, interpolated)
 
     def _hermite(self, x: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray, solved: np.ndarray,
@@ -458,6 +489,60 @@ class _Cycle:
             cond = np.maximum(cond, np.max(m.condition.reshape(reps, -1), axis=0))
             sigma = np.minimum(sigma, np.min(m.sigma_min.reshape(reps, -1), axis=0))
         acc["condition"][targets], acc["sigma_min"][targets] = cond[where], sigma[where]
+        if m is not None:
+            absolute = np.max(self._interpolation_errors(at, probe).reshape(reps, -1, 3), axis=0)[where]
+            acc["interpolation"][targets] = INTERPOLATION_SAFETY * self._relative(absolute, d1[targets], d2[targets])
+
+    def _interpolation_errors(self, at: np.ndarray, probe: tuple) -> np.ndarray:
+        """(N, 3) largest differences between interpolated poses (q, q', q'') and the exact
+        poses at the same driver values: positions [rad, or sizes of the loops], then q'
+        and q'' in the same units per unit of the driver. _Fallback where an exact pose
+        cannot be had (the chunk is then solved pose by pose)."""
+        q, d1, d2 = self._exact_at(at, probe[0])
+        solver = self.solver
+        inv = solver._v_scale_inv
+        dq = difference_many(solver.model, q, probe[0]) * inv
+        return np.stack([np.abs(dq).max(axis=1), np.abs((probe[1] - d1) * inv).max(axis=1),
+                         np.abs((probe[2] - d2) * inv).max(axis=1)], axis=1)
+
+    def _exact_at(self, at: np.ndarray, guesses: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Exact q, q', q'' at driver values `at`, from interpolated guesses: batched, else
+        pose by pose (a guess too far for the batch)."""
+        n, ref = len(at), self.ref
+        out = self.measurer.try_solve(guesses, self._drivers(at), np.tile(self.unit_v, (n, 1)),
+                                      np.tile(self.zero, (n, 1)), max_step=MEASURE_STEP)
+        if out is not None and not (ref.signs and np.any(out.signs != np.array(ref.signs))):
+            return out.q, out.v, out.a
+        solver = self.solver
+        q, d1, d2 = np.empty_like(guesses), np.empty((n, solver.model.nv)), np.empty((n, solver.model.nv))
+        for i, (x, guess) in enumerate(zip(self._drivers(at), guesses)):
+            q[i], residual = solver.correct(guess, x, max_iterations=solver.max_iterations, strict=False)
+            if residual is None:
+                raise _Fallback
+            try:
+                d1[i], d2[i], *_, signs = solver._rates(q[i], self.unit_v, self.zero)
+            except SingularPoseError:
+                raise _Fallback from None
+            if ref.signs and signs != ref.signs:
+                raise _Fallback
+        return q, d1, d2
+
+    def _relative(self, absolute: np.ndarray, d1: np.ndarray, d2: np.ndarray) -> np.ndarray:
+        """Absolute interpolation errors (positions, q', q'') as relative errors of each
+        pose's positions, velocities and accelerations in the scene's rates: the velocity
+        error over the pose's largest velocity (lengths in loop sizes), likewise for the
+        acceleration q'' w^2 + q' alpha (over w^2 |q'| where every joint's is zero: a
+        mechanism whose joints move in proportion has no acceleration to be relative to)."""
+        w, alpha = abs(float(self.v_drv[self.k])), float(self.a_drv[self.k])
+        inv = self.solver._v_scale_inv
+        v = np.abs(d1 * inv).max(axis=1)
+        a = np.abs((d2 * (w * w) + d1 * alpha) * inv).max(axis=1)
+        a = np.where(a > 0, a, w * w * v)
+        error_a = absolute[:, 2] * (w * w) + absolute[:, 1] * abs(alpha)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rel_v = np.where(absolute[:, 1] > 0, absolute[:, 1] / v, 0.0)
+            rel_a = np.where(error_a > 0, error_a / a, 0.0)
+        return np.stack([absolute[:, 0], rel_v, rel_a], axis=1)
 
 
 class _Fallback(Exception):
@@ -470,6 +555,7 @@ _ACCURACY = ("residual", "iterations", "condition", "sigma_min", "velocity_resid
 def _accuracy_arrays(n: int) -> dict[str, np.ndarray]:
     acc = {name: np.zeros(n) for name in _ACCURACY}
     acc["iterations"] = np.zeros(n, dtype=int)
+    acc["interpolation"] = np.zeros((n, 3))
     return acc
 
 
@@ -497,7 +583,11 @@ def _concat(a: RangeChunk, b: RangeChunk) -> RangeChunk:
     """Two consecutive chunks as one."""
     sa, sb = a.solution, b.solution
     fields = ("q", "v", "a", *_ACCURACY)
-    solution = BatchSolution(*(np.concatenate((getattr(sa, f), getattr(sb, f))) for f in fields), sa.drivers)
+    added = None
+    if sa.interpolation is not None or sb.interpolation is not None:
+        added = np.concatenate([np.zeros((len(x), 3)) if x.interpolation is None else x.interpolation for x in (sa, sb)])
+    solution = BatchSolution(*(np.concatenate((getattr(sa, f), getattr(sb, f))) for f in fields), sa.drivers,
+                             interpolation=added)
     errors = {**a.errors, **{len(a) + j: e for j, e in b.errors.items()}}
     return RangeChunk(a.start, np.concatenate((a.values, b.values)), solution,
                       np.concatenate((a.interpolated, b.interpolated)), errors)

@@ -9,9 +9,12 @@ Nothing here knows which mechanism it solves.
 
 from __future__ import annotations
 
+import functools
 import math
-from collections.abc import Mapping, Sequence
+import threading
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any, TypeVar
 
 import numpy as np
 import pinocchio as pin
@@ -24,6 +27,8 @@ from pinmech.exceptions import (
     LoopClosureError,
     MobilityError,
     ModelError,
+    OptionError,
+    RateOverflowError,
     SingularPoseError,
 )
 from pinmech.mechanism import Mechanism
@@ -37,12 +42,61 @@ ROUNDING_LEVEL = 1e-14
 MAX_STEP = 1.0
 #: Default largest condition number accepted before a pose is called singular. Near a
 #: singularity accelerations lose accuracy like eps x condition^3 (tests/test_singular.py),
-#: so 1e4 keeps every acceleration pinmech gives to about 2e-4 relative or better.
+#: so 1e4 keeps every acceleration pinmech gives to about 1e-3 relative or better.
 DEFAULT_MAX_CONDITION = 1e4
 #: With the default tolerance or a tighter one, a pose that ends between this residual and
 #: the tolerance gets one more Newton step: it costs one kinematics pass and lands at
 #: rounding level, so results do not depend on how close the guess happened to be.
 POLISH = 1e-15
+#: The ranges of the solver's options, for the Python API as for a scene's [solver] table.
+SOLVER_RANGES = {"tol": (1e-16, 1e-3), "max_iterations": (1, 1000), "max_condition": (1.0, math.inf)}
+
+_Method = TypeVar("_Method", bound=Callable[..., Any])
+
+
+def serialized(method: _Method) -> _Method:
+    """A solver method that holds the solver's lock: threads sharing one solver take turns
+    (its Pinocchio `Data` and buffers hold one pose at a time), the same thread re-enters.
+    It first reads again what the user may have changed in the model (`refresh`, where
+    the solver has one)."""
+    @functools.wraps(method)
+    def locked(self, *args, **kwargs):
+        if self.lock._is_owned():  # called from within the solver: held and refreshed already
+            return method(self, *args, **kwargs)
+        with self.lock:
+            refresh = getattr(self, "refresh", None)
+            if refresh is not None:
+                refresh()
+            return method(self, *args, **kwargs)
+    return locked  # type: ignore[return-value]
+
+
+def checked_option(name: str, value: Any) -> float | int:
+    """A solver option within `SOLVER_RANGES` (a number, not NaN; max_iterations whole).
+
+    Raises:
+        OptionError: naming the option, the value and the range.
+    """
+    low, high = SOLVER_RANGES[name]
+    whole = name == "max_iterations"
+    number = float(value) if isinstance(value, (int, float, np.number)) and not isinstance(value, bool) else math.nan
+    ok = low <= number <= high and (not whole or number == int(number))  # NaN is in no range
+    if not ok:
+        kind = "a whole number" if whole else "a number"
+        raise OptionError(f"{name} = {value!r} must be {kind} in [{low:g}, {high:g}]", option=name, value=value)
+    return int(number) if whole else number
+
+
+def describe_joint_values(mechanism: Mechanism, names: Sequence[str], values: Sequence[float]) -> str:
+    """One-dof joints' values as a user reads them in an error: angles in degrees, lengths
+    in metres ("O2 = 90 deg, slide = 0.15 m")."""
+    out = []
+    for name, value in zip(names, values):
+        if mechanism.joint(name).is_angular:
+            out.append(f"{name} = {math.degrees(value):.10g} deg")
+        else:
+            out.append(f"{name} = {value:.10g} m")
+    return ", ".join(out)
 
 
 def _max_abs(x: np.ndarray) -> float:
@@ -122,15 +176,21 @@ class LoopSolver:
     Args:
         mechanism: the model with its loop closures.
         drivers: names of the joints whose motion is given (as many as the mobility).
-        tol: closure tolerance, relative to the mechanism's length scale.
-        max_iterations: Newton iteration cap.
-        max_condition: a constraint Jacobian worse conditioned than this is singular.
+        tol: closure tolerance, relative to each loop's size (SOLVER_RANGES: 1e-16 to 1e-3).
+        max_iterations: Newton iteration cap (1 to 1000).
+        max_condition: a constraint Jacobian worse conditioned than this is singular (>= 1).
 
     After `solve`, `data` holds the joint placements and Jacobians at the solution and
     the placements of the cut frames (call `pin.updateFramePlacements` for the others).
 
+    Threads: the public methods hold `lock` (re-entrant), so threads sharing one solver
+    take turns and each gets its own right answer; a thread reading `data` itself holds
+    `lock` meanwhile. To solve in parallel, give each thread its own solver.
+
     Raises:
         FrameNotFound: a driver that is not a joint of the model.
+        OptionError: tol, max_iterations or max_condition out of SOLVER_RANGES (also when
+            set later).
         MobilityError: more or fewer drivers than the mechanism's mobility.
     """
 
@@ -147,6 +207,7 @@ class LoopSolver:
         self.model = mechanism.model
         self.data = self.model.createData()
         self.drivers = tuple(drivers)
+        self.lock = threading.RLock()
         self.tol = tol
         self.max_iterations = max_iterations
         self.max_condition = max_condition
@@ -165,6 +226,45 @@ class LoopSolver:
         self.reference: Reference | None = None
         self.iterations = 0  # Newton iterations of the last `correct`
         self.moved = 0.0  # sum of the scaled sizes of its steps: a bound on how far it moved q
+
+    # ------------------------------------------------------------------ options
+    @property
+    def tol(self) -> float:
+        """Closure tolerance (dimensionless, of each loop's size), in SOLVER_RANGES."""
+        return self._tol
+
+    @tol.setter
+    def tol(self, value: float) -> None:
+        self._tol = checked_option("tol", value)
+
+    @property
+    def max_iterations(self) -> int:
+        """Newton iteration cap, in SOLVER_RANGES."""
+        return self._max_iterations
+
+    @max_iterations.setter
+    def max_iterations(self, value: int) -> None:
+        self._max_iterations = checked_option("max_iterations", value)
+
+    @property
+    def max_condition(self) -> float:
+        """Largest condition number accepted before a pose is singular, in SOLVER_RANGES."""
+        return self._max_condition
+
+    @max_condition.setter
+    def max_condition(self, value: float) -> None:
+        self._max_condition = checked_option("max_condition", value)
+
+    def refresh(self) -> None:
+        """Read again the placements of ground cut frames, which the user may have moved in
+        the model since the last call (the hot path folds them into its row matrices); the
+        reference pose, closed for the old placement, is then closed again from itself."""
+        moved = [cut.refresh() for cut in self._cuts]
+        ref = self.reference
+        if any(moved) and ref is not None:
+            q, _, _ = self.close(ref.q, ref.driver_q)
+            signs = self._rates(q, np.zeros(len(self.drivers)), np.zeros(len(self.drivers)))[-1]
+            self.reference = Reference(ref.driver_q, q, signs, ref.keep)
 
     def _joint_nv(self, v: int) -> int:
         for joint in self.model.joints[1:]:
@@ -239,6 +339,7 @@ class LoopSolver:
         return q
 
     # ------------------------------------------------------------------ solves
+    @serialized
     def close(self, q_guess: np.ndarray, driver_q: Sequence[float]) -> tuple[np.ndarray, int, float]:
         """Newton on the closure residual with the drivers held.
 
@@ -254,18 +355,18 @@ class LoopSolver:
         r = self._residual(q)
         norm = _max_abs(r)
         iterations = 0
-        while norm > self.tol and iterations < self.max_iterations:
+        while norm > self._tol and iterations < self._max_iterations:
             J_dep = self._residual_jacobian()[:, self._dep]
             q, r, norm, ok = self._newton_update(q, J_dep, r, norm)
             iterations += 1
             if not ok:
                 break
-        if POLISH < norm <= self.tol <= DEFAULT_TOL and iterations < self.max_iterations:
+        if POLISH < norm <= self._tol <= DEFAULT_TOL and iterations < self._max_iterations:
             J_dep = self._residual_jacobian()[:, self._dep]
             q, r, norm, _ = self._newton_update(q, J_dep, r, norm)  # kept only if it helps
             iterations += 1
         full = self._full_residual()
-        if norm > self.tol or full > max(self.tol, 1e-12) * 10:
+        if norm > self._tol or full > max(self._tol, 1e-12) * 10:
             self._raise_not_closed(q, max(norm, full), iterations, driver_q)
         return q, iterations, max(norm, full)
 
@@ -282,7 +383,7 @@ class LoopSolver:
         norm = _max_abs(r)
         self.iterations, self.moved = 0, 0.0
         for _ in range(max_iterations):
-            if norm <= self.tol:
+            if norm <= self._tol:
                 break
             J_dep = self._residual_jacobian()[:, self._dep]
             self.iterations += 1
@@ -293,7 +394,7 @@ class LoopSolver:
                 q_new = self._move(q, step)
                 r_new = self._residual(q_new)
                 new_norm = _max_abs(r_new)
-                if new_norm > 0.5 * norm and new_norm > self.tol:
+                if new_norm > 0.5 * norm and new_norm > self._tol:
                     self._residual(q)
                     return q, None
                 q, r, norm = q_new, r_new, new_norm
@@ -301,12 +402,12 @@ class LoopSolver:
                 q, r, norm, ok = self._newton_update(q, J_dep, r, norm)
                 if not ok:
                     return q, None
-        if POLISH < norm <= self.tol <= DEFAULT_TOL:
+        if POLISH < norm <= self._tol <= DEFAULT_TOL:
             J_dep = self._residual_jacobian()[:, self._dep]
             q, r, norm, _ = self._newton_update(q, J_dep, r, norm)
             self.iterations += 1
         full = self._full_residual()
-        if norm > self.tol or full > max(self.tol, 1e-12) * 10:
+        if norm > self._tol or full > max(self._tol, 1e-12) * 10:
             return q, None
         return q, max(norm, full)
 
@@ -317,13 +418,7 @@ class LoopSolver:
 
     def describe_drivers(self, values: Sequence[float]) -> str:
         """Driver values as a user reads them: angles in degrees, lengths in metres."""
-        out = []
-        for name, value in zip(self.drivers, values):
-            if self.mechanism.joint(name).is_angular:
-                out.append(f"{name} = {math.degrees(value):.10g} deg")
-            else:
-                out.append(f"{name} = {value:.10g} m")
-        return ", ".join(out)
+        return describe_joint_values(self.mechanism, self.drivers, values)
 
     def _newton_update(self, q: np.ndarray, J_dep: np.ndarray, r: np.ndarray,
                        norm: float) -> tuple[np.ndarray, np.ndarray, float, bool]:
@@ -368,7 +463,7 @@ class LoopSolver:
         return q, self._residual(q), norm, False  # data back at q
 
     def _raise_not_closed(self, q: np.ndarray, norm: float, iterations: int, driver_q: Sequence[float]) -> None:
-        drivers = ", ".join(f"{n} = {v:.6g}" for n, v in zip(self.drivers, driver_q))
+        drivers = self.describe_drivers(driver_q)
         names = ", ".join(c.name for c in self.mechanism.closures)
         solved = float(np.max(np.abs(self._residual(q)), initial=0.0))  # the rows Newton solves
         if norm <= ROUNDING_LEVEL:
@@ -380,12 +475,13 @@ class LoopSolver:
             why = "the pose is out of reach for these dimensions, or the guess is on no branch"
         raise LoopClosureError(
             f"{self.mechanism.source}: loop(s) {names} cannot be closed at {drivers} "
-            f"(residual {norm:.3g} of the mechanism size after {iterations} Newton iterations): {why}",
+            f"(residual {norm:.3g} of the loop's size after {iterations} Newton iterations): {why}",
             residual=float(norm),
             iterations=iterations,
             partial=q,
         )
 
+    @serialized
     def rates(self, q: np.ndarray, driver_v: Sequence[float], driver_a: Sequence[float], *,
               at_q: bool = False) -> tuple[np.ndarray, np.ndarray, Accuracy]:
         """Velocities and accelerations at a closed configuration q.
@@ -430,7 +526,16 @@ class LoopSolver:
         pin.forwardKinematics(self.model, self.data, q, v, self._zero_a)
         drift = self._drift()
         a[self._dep] = _solve_square(J_dep, -(J_drv @ a[self._drv]) - drift)
+        if condition <= self.max_condition and not math.isfinite(sum(v.tolist()) + sum(a.tolist())):
+            raise self._overflow(q, driver_v, driver_a)  # a regular pose: the driver rates are too large
         return v, a, condition, sigma_min, _max_abs(J @ v), _max_abs(J @ a + drift), signs
+
+    def _overflow(self, q: np.ndarray, driver_v, driver_a) -> RateOverflowError:
+        return RateOverflowError(
+            f"{self.mechanism.source}: at {self.describe_drivers(self._driver_values(q))} the rates overflow "
+            f"float64 (driver speeds {', '.join(f'{x:.3g}' for x in np.ravel(driver_v))}, accelerations "
+            f"{', '.join(f'{x:.3g}' for x in np.ravel(driver_a))} in rad/s, m/s and their squares): "
+            f"nothing finite can be stated; give speeds whose squares stay far below 1e308")
 
     def _driver_values(self, q: np.ndarray) -> list[float]:
         out = []
@@ -438,6 +543,7 @@ class LoopSolver:
             out.append(math.atan2(q[i + 1], q[i]) if continuous else float(q[i]))
         return out
 
+    @serialized
     def set_reference(self, driver_q: Sequence[float] | Mapping[str, float], guess: np.ndarray | None = None,
                       assembly: Mapping[str, int] | None | str = "keep") -> Reference:
         """Close the loops at `driver_q` from `guess` (default: neutral) and make that pose
@@ -469,6 +575,7 @@ class LoopSolver:
         self.reference = Reference(dq.copy(), q, signs, keep=assembly != "any")
         return self.reference
 
+    @serialized
     def solve(
         self,
         driver_q: Sequence[float] | Mapping[str, float],
@@ -509,6 +616,7 @@ class LoopSolver:
             self.set_reference(dq, q)
         return self._solution(q, dv, da, residual, iterations, None)
 
+    @serialized
     def follow(self, q0: np.ndarray, x0: np.ndarray, x1: np.ndarray, route: Route, *,
                through_folds: bool = False) -> np.ndarray:
         """The closed q at driver values x1, followed from the closed pose q0 at x0.
@@ -540,13 +648,13 @@ class LoopSolver:
 
     def turn_gap(self, q0: np.ndarray, q1: np.ndarray) -> float:
         """Largest joint difference between two poses, angles modulo a turn [rad], slides
-        in mechanism sizes: 0 where q1 is q0 after whole turns."""
+        in sizes of their loops: 0 where q1 is q0 after whole turns."""
         dv = pin.difference(self.model, q0, q1)
         gap = 0.0
         for joint in self.mechanism.joints.values():
             for i in range(joint.idx_v, joint.idx_v + joint.nv):
                 d = float(dv[i])
-                d = math.remainder(d, 2 * math.pi) if joint.is_angular else d / self.mechanism.length_scale
+                d = math.remainder(d, 2 * math.pi) if joint.is_angular else d * float(self._v_scale_inv[i])
                 gap = max(gap, abs(d))
         return gap
 

@@ -25,6 +25,7 @@ rows cannot all hold is a TaskError and a singular pose a SingularPoseError.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -34,7 +35,7 @@ import pinocchio as pin
 from pinmech.exceptions import SingularPoseError, TaskError
 from pinmech.mechanism import Mechanism
 from pinmech.results import RateSolution
-from pinmech.solve_loops import DEFAULT_MAX_CONDITION
+from pinmech.solve_loops import DEFAULT_MAX_CONDITION, checked_option, describe_joint_values, serialized
 
 COMPONENTS = ("x", "y", "z", "wx", "wy", "wz")
 METHODS = ("exact", "least_squares", "damped")
@@ -113,12 +114,13 @@ class RateSolver:
             raise TaskError(f"damping must be a positive number, got {damping!r}")
         self.mechanism = mechanism
         self.model = mechanism.model
+        self.lock = threading.RLock()  # one Data: threads sharing the solver take turns
         self.data = self.model.createData()
         self.tasks = tuple(tasks)
         self.frames = [mechanism.frame_id(t.frame) for t in self.tasks]
         self.method = method
         self.damping = float(damping)
-        self.max_condition = max_condition
+        self.max_condition = checked_option("max_condition", max_condition)  # NaN would turn the check off
         self.x_dot = np.concatenate([t.velocity for t in self.tasks])
         self.x_ddot = np.concatenate([t.acceleration for t in self.tasks])
         self.row_names = [f"{t.frame}.{c}" for t in self.tasks for c in t.components]
@@ -127,6 +129,7 @@ class RateSolver:
         self._generic: tuple[int, np.ndarray, list[int]] | None = None  # rank, rows, dependent rows
 
     # ------------------------------------------------------------------ solve
+    @serialized
     def solve(self, q: np.ndarray, velocity: np.ndarray | None = None,
               acceleration: np.ndarray | None = None) -> RateSolution:
         """Joint rates and accelerations at configuration q (loops already closed).
@@ -274,9 +277,8 @@ class RateSolver:
                          f"drop those rows {hint}")
 
     def _pose(self, q: np.ndarray) -> str:
-        values = ", ".join(f"{name} = {self.mechanism.coordinate(q, name):.6g}"
-                           for name, j in self.mechanism.joints.items() if j.nv == 1)
-        return f"{values} (rad, m)"
+        names = [name for name, j in self.mechanism.joints.items() if j.nv == 1]
+        return describe_joint_values(self.mechanism, names, [self.mechanism.coordinate(q, n) for n in names])
 
     def _apply(self, J: np.ndarray, rhs: np.ndarray, method: str, rank: int) -> np.ndarray:
         """Solve J x = rhs by `method`, in dimensionless rows and columns (see `_dimensionless`),

@@ -228,8 +228,9 @@ class Sweep:
                 self.last_q = sol.q[j]
                 if self.first_q is None:
                     self.first_q = sol.q[j]
-                motion = evaluate_motion(self.mechanism, self.solver.data, sol.q[j], sol.v[j], sol.a[j],
-                                         points=points, links=links, coincident=coincident)
+                with self.solver.lock:  # the solver's Data, which another thread may be using
+                    motion = evaluate_motion(self.mechanism, self.solver.data, sol.q[j], sol.v[j], sol.a[j],
+                                             points=points, links=links, coincident=coincident)
                 yield SweepPose(index, value, motion, sol.accuracy(j), interpolated=bool(chunk.interpolated[j]),
                                 note=chunk.notes.get(j, ""))
 

@@ -15,7 +15,8 @@ def test_r_rtr_names(models_dir):
     assert set(mech.links) == {"ground", "link1", "link2", "link3"}
     assert {n: j.kind for n, j in mech.joints.items()} == {"A": "continuous", "B": "continuous", "B_slider": "prismatic"}
     assert mech.joint("B_slider").parent_link == "link2" and mech.joint("B_slider").child_link == "link3"
-    assert mech.length_scale == pytest.approx(0.25)  # A at 0 to D at 0.25 m when all joints are zero
+    # the loop A-B-C: A at 0, B at 0.1 m, C at 0.05 m when all joints are zero (D closes no loop)
+    assert mech.length_scale == pytest.approx(0.1)
 
 
 def test_a_point_and_a_joint_may_share_a_name(models_dir):

@@ -2,8 +2,8 @@
 slider-cranks and planar arm tasks, each against its closed form and against finite
 differences in time; random mechanisms whose loop cannot close must raise, never answer.
 
-Tolerances: the answers are held to `Accuracy.error_bounds` (2 k m for positions, k^2 m for
-velocities, k^3 m for accelerations, m = max(closure residual, eps), k the condition
+Tolerances: the answers are held to `Accuracy.error_bounds` (4 k m for positions, 4 k^2 m for
+velocities, 16 k^3 m for accelerations, m = max(closure residual, eps), k the condition
 number) plus 1e-12, relative to the mechanism's scale (its size times its fastest link's
 angular velocity, or that squared or its largest angular acceleration); poses pinmech refuses as singular
 (k > 1e4) may raise SingularPoseError instead. Finite differences: the driver moves as

@@ -6,7 +6,7 @@ are right to the stated bounds, and where it stops (SingularPoseError past the d
 limit k = 1e4, LoopClosureError where the loop cannot close).
 
 The bounds (`Accuracy.error_bounds`), with m = max(closure residual, eps), eps = 2.2e-16:
-relative error of positions <= 2 k m, of velocities <= k^2 m, of accelerations <= k^3 m.
+relative error of positions <= 4 k m, of velocities <= 4 k^2 m, of accelerations <= 16 k^3 m.
 The residual enters because Newton stops as soon as it is below its tolerance (1e-13),
 and near a singularity that residual, not rounding, sets the error. Each guess is 1e-3 rad
 off the answer, as a sweep's previous pose would be, so Newton really runs.
@@ -92,13 +92,14 @@ def test_r_rtr_guide_through_its_pivot_approached(ab_equals_ac, phi):
     sol, motion = _r_rtr_at(ab_equals_ac, phi)
     phi3, D, vD, aD = _isosceles(phi, 1.0, 0.5)
     d = motion.points["D"]
-    assert sol.accuracy.condition == pytest.approx(2.5 / abs(phi), rel=0.05)  # grows like 1 / phi
+    # grows like 1 / phi; 1.0 / phi with the guide's slide measured in sizes of the loop A-B-C (0.1 m)
+    assert sol.accuracy.condition == pytest.approx(1.0 / abs(phi), rel=0.05)
     assert sol.accuracy.iterations > 0
     _within_bounds(sol.accuracy, max(_angle_error(motion.links["link3"].angle, phi3), _relative(d.position[:2], D)),
                    _relative(d.velocity[:2], vD), _relative(d.acceleration[:2], aD))
 
 
-@pytest.mark.parametrize("phi", [1e-4, -1e-4])
+@pytest.mark.parametrize("phi", [4e-5, -4e-5])
 def test_r_rtr_too_close_to_its_pivot_is_refused(ab_equals_ac, phi):
     with pytest.raises(SingularPoseError, match=r"condition number 2\.5\d*e\+04 > 1e\+04") as info:
         _r_rtr_at(ab_equals_ac, phi)
@@ -106,9 +107,9 @@ def test_r_rtr_too_close_to_its_pivot_is_refused(ab_equals_ac, phi):
 
 
 def test_r_rtr_through_its_pivot_is_refused_or_answered_within_bounds(ab_equals_ac):
-    """With the limit raised, phi = 1e-4 answers, and its bounds say how little to trust it."""
-    sol, motion = _r_rtr_at(ab_equals_ac, 1e-4, max_condition=1e6)
-    _, _, _, aD = _isosceles(1e-4, 1.0, 0.5)
+    """With the limit raised, phi = 4e-5 answers, and its bounds say how little to trust it."""
+    sol, motion = _r_rtr_at(ab_equals_ac, 4e-5, max_condition=1e6)
+    _, _, _, aD = _isosceles(4e-5, 1.0, 0.5)
     error = _relative(motion.points["D"].acceleration[:2], aD)
     assert error <= sol.accuracy.error_bounds[2]
     assert sol.accuracy.error_bounds[2] > 1e-4  # k^3 eps at k = 2.5e4: no digits to spare
@@ -157,7 +158,7 @@ def test_four_bar_closer_to_its_limit_is_refused(toggle_four_bar):
 
 
 def test_four_bar_past_its_limit_cannot_close(toggle_four_bar):
-    with pytest.raises(LoopClosureError, match="cannot be closed at O2 = 1.2997"):
+    with pytest.raises(LoopClosureError, match=r"cannot be closed at O2 = 74\.4\d* deg"):
         LoopSolver(toggle_four_bar, ["O2"]).solve([float(THETA_LIMIT) + 1e-3])
 
 
@@ -251,7 +252,7 @@ def test_slider_crank_dead_centres_approached_from_the_piston(bundled_slider_cra
 
 
 def test_slider_crank_piston_past_its_stroke_cannot_close(bundled_slider_crank):
-    with pytest.raises(LoopClosureError, match=r"cannot be closed at slide = 0\.1998"):
+    with pytest.raises(LoopClosureError, match=r"cannot be closed at slide = 0\.1998\d* m"):
         LoopSolver(bundled_slider_crank, ["slide"]).solve([float(X_OUTER) + 1e-4])
 
 
@@ -282,7 +283,7 @@ def test_planar_arm_stretched_is_refused(models_dir):
     arm = Mechanism.from_urdf(models_dir / "planar_arm.urdf")
     q = arm.neutral()
     arm.set_coordinate(q, "C", -np.pi / 2)
-    with pytest.raises(SingularPoseError, match="A = 0, B = 0, C = -1.5708"):
+    with pytest.raises(SingularPoseError, match="A = 0 deg, B = 0 deg, C = -90 deg"):
         RateSolver(arm, _arm_tasks()).solve(q)
 
 
@@ -301,6 +302,6 @@ def test_the_report_shows_the_condition_number_and_the_bounds(scenes_dir, capsys
     accuracy = json.loads(capsys.readouterr().out)["accuracy"]
     k, m = accuracy["condition_number"], max(accuracy["closure_residual"], EPS)
     assert k == pytest.approx(5.0 / np.sqrt(1e-4), rel=0.05)
-    assert accuracy["relative_error_bound_velocity"] == pytest.approx(k**2 * m)
-    assert accuracy["relative_error_bound_acceleration"] == pytest.approx(k**3 * m)
+    assert accuracy["relative_error_bound_velocity"] == pytest.approx(4 * k**2 * m)
+    assert accuracy["relative_error_bound_acceleration"] == pytest.approx(16 * k**3 * m)
     assert accuracy["estimated_relative_error"] == accuracy["relative_error_bound_acceleration"]

@@ -164,7 +164,7 @@ def test_a_four_bar_whose_links_cannot_reach_does_not_close(tmp_path):
     """Crank 0.2 m, coupler and rocker 0.05 m, ground 0.1 m: at 90 deg the coupler end
     is 0.22 m from the rocker pivot, beyond the 0.1 m the two links span."""
     mech = Mechanism.from_urdf(write(tmp_path, "bad.urdf", four_bar_urdf(a=0.2, b=0.05, c=0.05, d=0.1)))
-    with pytest.raises(LoopClosureError, match=r"loop\(s\) B cannot be closed at O2 = 1\.5708") as info:
+    with pytest.raises(LoopClosureError, match=r"loop\(s\) B cannot be closed at O2 = 90 deg") as info:
         LoopSolver(mech, ["O2"]).solve([np.pi / 2])
     assert info.value.residual > 0.1
     assert info.value.partial.shape == (mech.model.nq,)

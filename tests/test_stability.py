@@ -82,7 +82,7 @@ def test_slider_crank_same_dimensionless_answers(tmp_path, k, rpm):
     ours = [sol.q[j.idx_q] / k, sol.v[j.idx_v] / (w * k), sol.a[j.idx_v] / (w**2 * k)]
     cf = closed_form.slider_crank(THETA, 1.0, 0.5, 0.05, 0.15, 0.01)
     np.testing.assert_allclose(ours, [cf.x_B, cf.v_B, cf.a_B], rtol=1e-10)
-    assert sol.accuracy.condition == pytest.approx(2.9694244184847, rel=1e-9)
+    assert sol.accuracy.condition == pytest.approx(1.3693654102026, rel=1e-9)  # slide in sizes of the loop
 
 
 @pytest.mark.parametrize("k", [1e-9, 1e-6, 1.0, 1e3, 1e6])
