@@ -30,6 +30,7 @@ from pinmech.exceptions import (
     OptionError,
     RateOverflowError,
     SingularPoseError,
+    UnitError,
 )
 from pinmech.mechanism import Mechanism
 from pinmech.results import Accuracy, LoopSolution
@@ -693,7 +694,12 @@ class LoopSolver:
                 raise MobilityError(f"{', '.join(sorted(unknown))} is not a driver ({', '.join(self.drivers)})",
                                     mobility=self.mechanism.mobility, drivers=len(self.drivers))
             values = [values.get(n, 0.0) for n in self.drivers]
-        out = np.asarray(values, dtype=float).reshape(-1)
+        try:
+            out = np.asarray(values, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            raise UnitError(f"driver values of {', '.join(self.drivers)} must be numbers in SI (rad or m), "
+                            f"got {values!r:.80}: convert quantities first, e.g. pinmech.to_si('30 deg', "
+                            f"'angle')") from None
         if out.shape != (len(self.drivers),) or not math.isfinite(sum(out.tolist())):
             raise MobilityError(f"expected {len(self.drivers)} finite driver value(s), got {values!r}",
                                 mobility=self.mechanism.mobility, drivers=len(self.drivers))

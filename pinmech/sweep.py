@@ -177,8 +177,10 @@ class Sweep:
         """The poses' q, v, a and accuracy as arrays, a chunk at a time (no motion read-out):
         the quickest way through a long sweep. Options: see `poses`."""
         d = self.drivers
-        return solve_range(self.solver, self.driver, self._checked(values), driver_q=d.q, driver_v=d.v, driver_a=d.a,
-                           start=start, batch=batch, interpolate=interpolate, through_folds=through_folds)
+        numeric = isinstance(values, np.ndarray) and values.dtype.kind in "fiu"  # solve_range checks finiteness
+        return solve_range(self.solver, self.driver, values if numeric else self._checked(values), driver_q=d.q,
+                           driver_v=d.v, driver_a=d.a, start=start, batch=batch, interpolate=interpolate,
+                           through_folds=through_folds)
 
     def poses(self, values: Iterable[float], *, skip_failures: bool = False, start: str = "predictor",
               batch: bool = True, interpolate: int = 1, warm_start: bool | None = None,

@@ -426,3 +426,10 @@ def test_the_batch_mode_hands_back_poses_of_another_assembly(tmp_path):
     zeros = np.zeros((5, 1))
     assert batch.try_solve(same, thetas[:, None], zeros, zeros) is not None
     assert batch.try_solve(other, thetas[:, None], zeros, zeros) is None
+
+
+def test_a_driver_value_with_its_unit_is_a_named_error_in_the_api(models_dir):
+    """Issue 11 item 19: a string driver value is a UnitError naming SI and to_si, not numpy's ValueError."""
+    solver = LoopSolver(Mechanism.from_urdf(models_dir / "r_rtr.urdf"), ["A"])
+    with pytest.raises(pinmech.UnitError, match="to_si"):
+        solver.solve(["30 deg"])
