@@ -69,6 +69,9 @@ INTERPOLATION_SAFETY = 4.0
 #: is measured against: the guess is as good as the interpolation, and the assembly is
 #: checked after (a step to another branch is refused by its signature).
 MEASURE_STEP = 0.05
+#: Driver rates (|w|, w^2, |alpha|) below which scaling path derivatives cannot overflow
+#: float64: q' and q'' of a pose conditioned under any accepted limit stay far below 1e200.
+_SAFE_RATE = 1e100
 _FAILURES = (LoopClosureError, SingularPoseError, AssemblyError, DriverLimitError)
 
 
@@ -431,8 +434,11 @@ class _Cycle:
         accuracy = Accuracy(acc.residual, acc.iterations, acc.condition, acc.sigma_min,
                             abs(w) * acc.velocity_residual,
                             w * w * acc.acceleration_residual + abs(alpha) * acc.velocity_residual)
-        with np.errstate(over="ignore", invalid="ignore"):
+        if max(abs(w), w * w, abs(alpha)) < _SAFE_RATE:  # path derivatives of a regular pose: no overflow
             v, a = sol.v * w, sol.a * (w * w) + sol.v * alpha
+        else:
+            with np.errstate(over="ignore", invalid="ignore"):
+                v, a = sol.v * w, sol.a * (w * w) + sol.v * alpha
         if not math.isfinite(sum(v.tolist()) + sum(a.tolist())):
             raise self.solver._overflow(sol.q, self.v_drv, self.a_drv)
         return LoopSolution(sol.q, v, a, accuracy, sol.drivers)
