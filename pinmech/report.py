@@ -196,7 +196,7 @@ def to_text(analysis: Analysis) -> str:
     acc = analysis.solution.accuracy
     t.head("Accuracy")
     t.lines.append(
-        f"  closure residual {acc.residual:.2g} (of the mechanism size {analysis.mechanism.length_scale:.4g} m), "
+        f"  closure residual {acc.residual:.2g} (of each loop's size; the largest loop spans {analysis.mechanism.length_scale:.4g} m), "
         f"{acc.iterations} Newton iterations, "
         f"condition number {acc.condition:.4g} "
         "(worst-case relative error about {:.0e} in positions, {:.0e} in velocities, {:.0e} in "

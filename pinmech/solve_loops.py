@@ -156,12 +156,14 @@ def _index(indices: np.ndarray) -> slice | np.ndarray:
 @dataclass(frozen=True)
 class Reference:
     """The pose that names the assembly: the drivers' values [rad or m], the closed q,
-    its assembly signature, and whether other poses must keep it (False: "any")."""
+    its assembly signature, whether other poses must keep it (False: "any"), and the
+    Newton iterations that closed it from its guess."""
 
     driver_q: np.ndarray
     q: np.ndarray
     signs: tuple[int, ...]
     keep: bool = True
+    iterations: int = 0
 
 
 class LoopSolver:
@@ -561,7 +563,7 @@ class LoopSolver:
             AssemblyError: the guess closes on another assembly than `assembly` asks.
         """
         dq = self._ordered(driver_q)
-        q, _, _ = self.close(self._guess(guess), dq)
+        q, iterations, _ = self.close(self._guess(guess), dq)
         signs = self._rates(q, np.zeros(len(dq)), np.zeros(len(dq)))[-1]
         if isinstance(assembly, Mapping):
             wrong = [n for n, s in zip(self.structure.names, signs) if n in assembly and assembly[n] != s]
@@ -573,7 +575,7 @@ class LoopSolver:
                     f"(a guess nearer the assembly asked) or [assembly]",
                     expected=tuple(assembly.get(n, s) for n, s in zip(self.structure.names, signs)),
                     found=signs, drivers=self.drivers, value=tuple(dq.tolist()))
-        self.reference = Reference(dq.copy(), q, signs, keep=assembly != "any")
+        self.reference = Reference(dq.copy(), q, signs, keep=assembly != "any", iterations=iterations)
         return self.reference
 
     @serialized
@@ -609,7 +611,8 @@ class LoopSolver:
             route = Route(tuple(ref.driver_q.tolist()))
             q = self.follow(ref.q, ref.driver_q, dq, route)
             residual = max(_max_abs(self._residual(q)), self._full_residual())
-            return self._solution(q, dv, da, residual, route.iterations, route)
+            iterations = route.iterations if route.steps else ref.iterations  # the reference itself: its Newton
+            return self._solution(q, dv, da, residual, iterations, route)
         if guess is None and ref is not None:  # assembly "any": Newton from the reference pose
             guess = ref.q
         q, iterations, residual = self.close(self._guess(guess), dq)
