@@ -228,16 +228,9 @@ class ForceSolver:
                                   f"torque {load.torque!r}", option="loads", value=load)
         self.minimum_norm = minimum_norm
         self.max_condition = checked_option("max_condition", max_condition)
-        self._drv_v = np.array([self._driver_index(n) for n in self.drivers], dtype=int)
+        self._drv_v = np.array([self.mechanism.driver_index(n) for n in self.drivers], dtype=int)
         self._scale = mechanism.velocity_scale()
         self._check_masses(set(massless))
-
-    def _driver_index(self, name: str) -> int:
-        joint = self.mechanism.joint(name)
-        if joint.nv != 1:
-            raise ModelError(f"driver '{name}' has {joint.nv} degrees of freedom; drive one-dof joints",
-                             path=self.mechanism.source)
-        return joint.idx_v
 
     def _check_masses(self, massless: set[str]) -> None:
         """Every moving body has a mass, unless all its links are declared massless."""

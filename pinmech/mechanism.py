@@ -289,6 +289,18 @@ class Mechanism:
         except KeyError:
             raise FrameNotFound("joint", name, list(self.joints), path=self.source) from None
 
+    def driver_index(self, name: str) -> int:
+        """Velocity index of a joint that can be driven (one degree of freedom).
+
+        Raises:
+            FrameNotFound: no such joint. ModelError: a joint of several freedoms.
+        """
+        joint = self.joint(name)
+        if joint.nv != 1:
+            raise ModelError(f"driver '{name}' has {joint.nv} degrees of freedom; drive one-dof joints",
+                             path=self.source)
+        return joint.idx_v
+
     def frame_id(self, name: str) -> int:
         """Frame id of a point, a link, or any other frame of the model, by name."""
         if name in self.points:
@@ -409,16 +421,25 @@ def urdf_mimic_leaders(path: str | Path) -> dict[str, str]:
     return {n: m.leader for n, m in mimic_joints(_parse_xml(Path(path)), str(path)).items()}
 
 
-def _parse_xml(path: Path) -> ET.Element:
+def read_xml(path: Path, root_tag: str, kind: str) -> ET.Element:
+    """The root element of a model file (`kind`: "URDF", "MJCF"), checked to be <root_tag>.
+
+    Raises:
+        ModelError: a missing file, malformed XML or another root element, naming the file.
+    """
     if not path.is_file():
-        raise ModelError("no such URDF file", path=str(path))
+        raise ModelError(f"no such {kind} file", path=str(path))
     try:
         root = ET.parse(path).getroot()
     except ET.ParseError as exc:
         raise ModelError(f"malformed XML: {exc}", path=str(path)) from exc
-    if root.tag != "robot":
-        raise ModelError(f"root element is <{root.tag}>, expected <robot>", path=str(path))
+    if root.tag != root_tag:
+        raise ModelError(f"root element is <{root.tag}>, expected <{root_tag}>", path=str(path))
     return root
+
+
+def _parse_xml(path: Path) -> ET.Element:
+    return read_xml(path, "robot", "URDF")
 
 
 def _link_names(root: ET.Element) -> list[str]:

@@ -33,7 +33,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import ModelError
-from pinmech.mechanism import Mechanism
+from pinmech.mechanism import Mechanism, read_xml
 
 _CLOSE_TOL = 1e-9  # [m] gap of a connect at qpos0 read as open (parsers print 6-9 digits)
 _TYPES = {"hinge": "revolute", "slide": "prismatic", "ball": "ball", "free": "free"}
@@ -41,14 +41,7 @@ WRAPPER = "pinmech_world"
 
 
 def _parse(path: Path) -> ET.Element:
-    if not path.is_file():
-        raise ModelError("no such MJCF file", path=str(path))
-    try:
-        root = ET.parse(path).getroot()
-    except ET.ParseError as exc:
-        raise ModelError(f"malformed XML: {exc}", path=str(path)) from exc
-    if root.tag != "mujoco":
-        raise ModelError(f"root element is <{root.tag}>, expected <mujoco>", path=str(path))
+    root = read_xml(path, "mujoco", "MJCF")
     if root.find("include") is not None or root.find(".//include") is not None:
         raise ModelError("<include> is not supported: give pinmech the whole model in one file", path=str(path))
     return root

@@ -214,7 +214,7 @@ class LoopSolver:
         self.tol = tol
         self.max_iterations = max_iterations
         self.max_condition = max_condition
-        self._drv_v = np.array([self._driver_index(n) for n in self.drivers], dtype=int)
+        self._drv_v = np.array([self.mechanism.driver_index(n) for n in self.drivers], dtype=int)
         self._dep_v = np.setdiff1d(np.arange(self.model.nv), self._drv_v)
         self._check_mobility()
         self._drv, self._dep = _index(self._drv_v), _index(self._dep_v)
@@ -276,13 +276,6 @@ class LoopSolver:
         return 0
 
     # ------------------------------------------------------------------ set-up
-    def _driver_index(self, name: str) -> int:
-        joint = self.mechanism.joint(name)
-        if joint.nv != 1:
-            raise ModelError(f"driver '{name}' has {joint.nv} degrees of freedom; drive one-dof joints",
-                             path=self.mechanism.source)
-        return joint.idx_v
-
     def _check_mobility(self) -> None:
         if len(set(self.drivers)) != len(self.drivers):
             raise MobilityError(f"a joint is driven twice: {', '.join(self.drivers)}",
