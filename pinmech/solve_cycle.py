@@ -148,20 +148,6 @@ def solve_range(solver: LoopSolver, driver: str, values: Iterable[float], *, dri
         index += len(xs)
 
 
-@dataclass
-class _Exact:
-    """The last solved pose: its path derivatives (rates at unit driver speed), and its
-    condition number."""
-
-    value: float
-    q: np.ndarray
-    d1: np.ndarray | None
-    d2: np.ndarray | None
-    condition: float = 1.0
-    sigma_min: float = 1.0
-    signs: tuple[int, ...] = ()
-
-
 class _Cycle:
     def __init__(self, solver: LoopSolver, driver: str, driver_q: np.ndarray, driver_v: np.ndarray,
                  driver_a: np.ndarray, guess: np.ndarray | None, start: str, batch: bool, interpolate: int,
@@ -183,7 +169,7 @@ class _Cycle:
         self.batch = BatchSolver(solver) if batch and start == "predictor" and solver._cuts else None
         self.measurer = (self.batch or BatchSolver(solver)) if interpolate > 1 and solver._cuts else None
         self.guess = None if guess is None else np.asarray(guess, dtype=float)
-        self.ref: _Exact | None = None
+        self.ref: Node | None = None  # the last pose solved: p is the swept value, d1 and d2 its path derivatives
         self.unit_v = np.zeros_like(self.v_drv)
         self.unit_v[self.k] = 1.0
         self.zero = np.zeros_like(self.v_drv)
@@ -193,7 +179,6 @@ class _Cycle:
         self.mirror = (1.0, 0.0)  # p = a x + b: past each fold crossed, values are mirrored at it
         self.notes: dict[int, str] = {}
         self._index, self._iterations, self._batching = 0, 0, False
-        self.node: Node | None = None  # the last pose solved one by one (self.ref's, when current)
         self.span_scale = float(solver.mechanism.velocity_scale()[solver.mechanism.joint(driver).idx_v])  # 1: a turn
 
     # ------------------------------------------------------------------ chunks
@@ -230,7 +215,7 @@ class _Cycle:
         """The batched levels this chunk's spacing allows (LEVELS, MAX_SPAN)."""
         if self.batch is None or len(xs) < 2:
             return (1,)
-        steps = np.abs(np.diff(np.concatenate(([self.ref.value], xs))))
+        steps = np.abs(np.diff(np.concatenate(([self.ref.p], xs))))
         step = float(steps.max()) / self.span_scale
         for first in range(len(LEVELS) - 1):
             if LEVELS[first] * step <= MAX_SPAN:
@@ -244,7 +229,7 @@ class _Cycle:
             self._index = index + j
             try:
                 rows.append(self._solve(x, actual=True))
-                values[j] = self.ref.value
+                values[j] = self.ref.p
             except _FAILURES as exc:
                 errors[j] = exc
                 rows.append(None)
@@ -260,7 +245,7 @@ class _Cycle:
         ref = self.ref
         q, d1, d2 = np.empty((n + 1, nq)), np.empty((n + 1, nv)), np.empty((n + 1, nv))
         q[0], d1[0], d2[0] = ref.q, ref.d1, ref.d2  # slot 0: the pose before the chunk
-        x = np.concatenate(([ref.value], xs))
+        x = np.concatenate(([ref.p], xs))
         acc = _accuracy_arrays(n + 1)
         solved = np.zeros(n + 1, dtype=bool)
         solved[0] = True
@@ -284,8 +269,8 @@ class _Cycle:
             for name in _ACCURACY:
                 acc[name][targets] = getattr(out, name)
             solved[targets] = True
-        self.ref = _Exact(float(x[n]), q[n].copy(), d1[n].copy(), d2[n].copy(), acc["condition"][n],
-                          acc["sigma_min"][n], self.ref.signs)
+        self.ref = Node(float(x[n]), q[n].copy(), d1[n].copy(), d2[n].copy(), self.ref.signs, acc["condition"][n],
+                        acc["sigma_min"][n])
         return q[1:], d1[1:], d2[1:], {k: v[1:] for k, v in acc.items()}
 
     def _solve_level(self, x: np.ndarray, j: int, q: np.ndarray, d1: np.ndarray, d2: np.ndarray,
@@ -313,7 +298,7 @@ class _Cycle:
         solved = np.zeros(n + 1, dtype=bool)
         solved[0] = True
         solved[slots] = True
-        x = np.concatenate(([ref.value], xs))
+        x = np.concatenate(([ref.p], xs))
         targets = np.flatnonzero(~solved)
         if targets.size:
             q[targets], d1[targets], d2[targets] = self._hermite(x, q, d1, d2, solved, targets)
@@ -339,8 +324,7 @@ class _Cycle:
                 raise fail from None
             raise
         solver = self.solver
-        self.ref = _Exact(node.p, node.q, node.d1, node.d2, node.condition, node.sigma_min, node.signs)
-        self.node = node
+        self.ref = node
         self.q_drv[self.k] = node.p
         accuracy = Accuracy(0.0, 0, node.condition, node.sigma_min, node.velocity_residual,
                             node.acceleration_residual)
@@ -372,11 +356,9 @@ class _Cycle:
         self._iterations = 0
         if ref is None:
             return self._first(p)
-        node = self.node if self.node is not None and self.node.p == ref.value and self.node.q is ref.q else \
-            Node(ref.value, ref.q, ref.d1, ref.d2, ref.signs, ref.condition, ref.sigma_min)
         if self.start == "predictor":
-            route = Route((ref.value,))
-            node = path.follow(node, p, route)
+            route = Route((ref.p,))
+            node = path.follow(ref, p, route)
             self._iterations = route.iterations
             self._note(route)
             return node
