@@ -526,13 +526,19 @@ def _build_model(source: str, root_joint: str | None = None, *, mimic: bool = Fa
         raise ModelError(f"root_joint must be None or one of {', '.join(_ROOT_JOINTS)}, got {root_joint!r}",
                          path=source)
     args = (_ROOT_JOINTS[root_joint](),) if root_joint else ()
+    return pinocchio_build(lambda: pin.buildModelFromUrdf(source, *args, mimic=mimic), source)
+
+
+def pinocchio_build(build, source: str):
+    """Call one of Pinocchio's model builders with the C++ parsers' stderr chatter caught,
+    and fold that chatter into a one-line ModelError when the builder fails."""
     with tempfile.TemporaryFile(mode="w+b") as sink:
         saved = os.dup(2)
         try:
             sys.stderr.flush()
             os.dup2(sink.fileno(), 2)
             try:
-                return pin.buildModelFromUrdf(source, *args, mimic=mimic)
+                return build()
             except (ValueError, RuntimeError) as exc:
                 error = exc
         finally:

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import hashlib
 import os
-import sys
 import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -33,7 +32,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import ModelError
-from pinmech.mechanism import Mechanism, read_xml
+from pinmech.mechanism import Mechanism, pinocchio_build, read_xml
 
 _CLOSE_TOL = 1e-9  # [m] gap of a connect at qpos0 read as open (parsers print 6-9 digits)
 _TYPES = {"hinge": "revolute", "slide": "prismatic", "ball": "ball", "free": "free"}
@@ -138,23 +137,8 @@ def _normalise_axisangles(root: ET.Element, source: str) -> None:
 
 
 def _build(path: Path, source: str) -> tuple[pin.Model, list, list]:
-    with tempfile.TemporaryFile(mode="w+b") as sink:
-        saved = os.dup(2)
-        try:
-            sys.stderr.flush()
-            os.dup2(sink.fileno(), 2)
-            try:
-                model, points, frames = pin.buildModelAndConstraintsFromMJCF(str(path))
-                return model, list(points), list(frames)
-            except (ValueError, RuntimeError) as exc:
-                error = exc
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-        sink.seek(0)
-        said = " ".join(sink.read().decode(errors="replace").split())
-    detail = f" ({said})" if said else ""
-    raise ModelError(f"Pinocchio cannot build the model: {error}{detail}", path=source) from error
+    model, points, frames = pinocchio_build(lambda: pin.buildModelAndConstraintsFromMJCF(str(path)), source)
+    return model, list(points), list(frames)
 
 
 def load_mjcf(path: str | Path, *, locked: dict[str, float] | None = None) -> Mechanism:
