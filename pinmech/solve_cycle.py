@@ -35,6 +35,7 @@ from itertools import islice
 import numpy as np
 
 from pinmech.continuation import Node, Path, Route
+from pinmech.core import core_for
 from pinmech.exceptions import (
     AssemblyError,
     DriverLimitError,
@@ -241,6 +242,9 @@ class _Cycle:
         The poses of the first level one by one from the predictor, the others batched
         from Hermite guesses between the poses of the level before (see LEVELS).
         """
+        compiled = core_for(self.solver)
+        if compiled is not None:
+            return self._compiled(compiled, xs)
         n, nq, nv = len(xs), self.solver.model.nq, self.solver.model.nv
         ref = self.ref
         q, d1, d2 = np.empty((n + 1, nq)), np.empty((n + 1, nv)), np.empty((n + 1, nv))
@@ -272,6 +276,38 @@ class _Cycle:
         self.ref = Node(float(x[n]), q[n].copy(), d1[n].copy(), d2[n].copy(), self.ref.signs, acc["condition"][n],
                         acc["sigma_min"][n])
         return q[1:], d1[1:], d2[1:], {k: v[1:] for k, v in acc.items()}
+
+    def _compiled(self, compiled, xs: np.ndarray):
+        """Every pose exact, as `_exact`, followed by the compiled core (core.py) from the
+        last pose; a pose it hands back (a change point, a fold, a singular or too
+        ill-conditioned pose) is taken by the Python path, then the core goes on."""
+        n, solver, path = len(xs), self.solver, self.path
+        q, d1, d2 = np.empty((n, solver.model.nq)), np.empty((n, solver.model.nv)), np.empty((n, solver.model.nv))
+        acc = _accuracy_arrays(n)
+        j = 0
+        while j < n:
+            ref = self.ref
+            done, _, Q, D1, D2, numbers = compiled.follow(
+                ref.p, ref.q, ref.d1, ref.d2, list(ref.signs), ref.condition, path.x0, path.d, path.unit, xs[j:],
+                solver.max_condition)
+            if done:
+                q[j:j + done], d1[j:j + done], d2[j:j + done] = Q, D1, D2
+                for col, name in enumerate(_ACCURACY):
+                    acc[name][j:j + done] = numbers[:, col]
+                last = numbers[-1]
+                self.ref = Node(float(xs[j + done - 1]), Q[-1].copy(), D1[-1].copy(), D2[-1].copy(), ref.signs,
+                                float(last[2]), float(last[3]), float(last[4]), float(last[5]), float(last[0]))
+                j += done
+            if j < n:  # the Python path names what the core met
+                self._batching = True
+                try:
+                    sol = self._solve(xs[j], actual=False, fail=_Fallback)
+                finally:
+                    self._batching = False
+                q[j], d1[j], d2[j] = sol.q, sol.v, sol.a
+                _store(acc, j, sol.accuracy)
+                j += 1
+        return q, d1, d2, acc
 
     def _solve_level(self, x: np.ndarray, j: int, q: np.ndarray, d1: np.ndarray, d2: np.ndarray,
                      acc: dict[str, np.ndarray], solved: np.ndarray) -> None:

@@ -1,0 +1,117 @@
+"""The bridge to pinmech's compiled core (pinmech/csrc/core.cpp): a `LoopSolver`'s model,
+closure rows and assembly blocks handed over as arrays, once per solver.
+
+The core follows a sweep pose by pose with the rules of continuation.py; where a step
+needs more than a regular predictor-corrector step (a change point, a fold, a singular
+or too ill-conditioned pose), it stops and the Python path takes that pose (solve_cycle.py).
+Models with joints the core does not rebuild (mimic, composite, helical, universal,
+ellipsoid joints) are solved by the Python path throughout: `core_for` returns None.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pinocchio as pin
+
+from pinmech import _core
+
+#: Pinocchio joint types the core rebuilds, by shortname -> its code in core.cpp.
+JOINT_CODES = {
+    "JointModelRX": 0, "JointModelRY": 1, "JointModelRZ": 2, "JointModelRevoluteUnaligned": 3,
+    "JointModelRUBX": 4, "JointModelRUBY": 5, "JointModelRUBZ": 6, "JointModelRevoluteUnboundedUnaligned": 7,
+    "JointModelPX": 8, "JointModelPY": 9, "JointModelPZ": 10, "JointModelPrismaticUnaligned": 11,
+    "JointModelSpherical": 12, "JointModelPlanar": 13, "JointModelFreeFlyer": 14, "JointModelTranslation": 15,
+}
+_AXIS_CODES = {3, 7, 11}
+CUT_CODES = {"revolute": 0, "prismatic": 1, "spherical": 2, "fixed": 3}
+#: PINMECH_CORE=0 in the environment solves everything by the Python path (tests compare
+#: the two; a user can rule the core out when in doubt).
+ENABLED = os.environ.get("PINMECH_CORE", "1") != "0"
+
+
+def placement_rows(placements: list[pin.SE3]) -> np.ndarray:
+    """(n, 12): each placement's rotation row by row, then its translation."""
+    out = np.zeros((len(placements), 12))
+    for i, M in enumerate(placements):
+        out[i, :9] = M.rotation.reshape(9)
+        out[i, 9:] = M.translation
+    return out
+
+
+class CompiledModel:
+    """A `pin.Model`'s joints and some of its frames, rebuilt in the core.
+
+    Attributes:
+        frames: Pinocchio frame id -> its index among the core's frames.
+    """
+
+    def __init__(self, model: pin.Model, frame_ids: list[int]) -> None:
+        self.types, self.parents, placements, axes = [], [], [], np.zeros((model.njoints - 1, 3))
+        for jid in range(1, model.njoints):
+            joint = model.joints[jid]
+            code = JOINT_CODES[joint.shortname()]  # KeyError: not rebuilt (core_for says None)
+            if code in _AXIS_CODES:  # the axis from the motion subspace (not every binding has .axis)
+                jdata = joint.createData()
+                joint.calc(jdata, pin.neutral(model)[joint.idx_q:joint.idx_q + joint.nq])
+                S = np.asarray(jdata.S).reshape(6)
+                axes[jid - 1] = S[:3] if code == 11 else S[3:]
+            self.types.append(code)
+            self.parents.append(int(model.parents[jid]))
+            placements.append(model.jointPlacements[jid])
+        self.placements, self.axes = placement_rows(placements), axes
+        self.frames = {fid: i for i, fid in enumerate(dict.fromkeys(frame_ids))}
+        self.frame_parents = [int(model.frames[fid].parentJoint) for fid in self.frames]
+        self.frame_placements = placement_rows([model.frames[fid].placement for fid in self.frames])
+
+
+def core_for(solver) -> _core.Core | None:
+    """The compiled core of a `LoopSolver` (built once, again when a cut frame moved), or
+    None where the core cannot rebuild the model (then the Python path solves it all)."""
+    if not ENABLED:
+        return None
+    key = _key(solver)
+    cached = solver.__dict__.get("_compiled")
+    if cached is not None and cached[0] == key:
+        return cached[1]
+    core = _build(solver)
+    solver.__dict__["_compiled"] = (key, core)
+    return core
+
+
+def _key(solver) -> tuple:
+    """What the core copies from the model and may be changed by the user: the cut frames'
+    placements, and the tolerance."""
+    model = solver.model
+    frames = [f for c in solver.mechanism.closures for f in (c.parent_frame, c.child_frame)]
+    return (solver.tol, placement_rows([model.frames[f].placement for f in frames]).tobytes())
+
+
+def _build(solver) -> _core.Core | None:
+    model, closures = solver.model, solver.mechanism.closures
+    if not closures or solver.model.nv == 0:
+        return None
+    frames = [f for c in closures for f in (c.parent_frame, c.child_frame)]
+    try:
+        compiled = CompiledModel(model, frames)
+    except KeyError:
+        return None
+    rows6 = [np.ascontiguousarray(c._rows6, dtype=float) for c in closures]
+    full = [np.ascontiguousarray(c.selected * c._scale(), dtype=float) for c in closures]
+    blocks = solver.structure.blocks
+    core = _core.Core(
+        compiled.types, compiled.parents, compiled.placements, compiled.axes,
+        compiled.frame_parents, compiled.frame_placements,
+        [CUT_CODES[c.cut_type] for c in closures],
+        [compiled.frames[c.parent_frame] for c in closures], [compiled.frames[c.child_frame] for c in closures],
+        np.array([c.axis for c in closures], dtype=float), np.array([c.child_axis for c in closures], dtype=float),
+        rows6, full, [int(v) for v in solver._drv_v], [int(v) for v in solver._dep_v],
+        [int(i) for i, _ in solver._drv_q], [int(c) for _, c in solver._drv_q],
+        np.asarray(solver.mechanism.velocity_scale(), dtype=float),
+        [list(map(int, b.rows)) for b in blocks], [list(map(int, b.cols)) for b in blocks], float(solver.tol),
+    )
+    same = (core.nq == model.nq and core.nv == model.nv
+            and core.idx_q == [model.joints[j].idx_q for j in range(1, model.njoints)]
+            and core.idx_v == [model.joints[j].idx_v for j in range(1, model.njoints)])
+    return core if same else None

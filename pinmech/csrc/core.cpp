@@ -1,0 +1,630 @@
+// pinmech's compiled core: a sweep of one driver followed pose by pose, in C++ on Pinocchio.
+//
+// It computes what pinmech/solve_loops.py (closure rows, corrector, rates) and
+// pinmech/continuation.py (predictor, trust region, tangent turn, assembly signature)
+// compute, with the same rules and constants, for the regular steps of a sweep: where a
+// step needs anything more (a signature change, a pivot below PIVOT_BELOW, a singular or
+// overflowing pose, a pose worse conditioned than max_condition) it stops and hands the
+// pose back to the Python path, which names what happened. pinmech/core.py builds it from
+// a LoopSolver; tests/test_core.py checks every number against the Python path and the
+// closed forms.
+//
+// The model is rebuilt here from its joints and frames (types, parents, placements, axes),
+// so only Pinocchio's headers are needed: nothing is linked against the pin wheel's
+// libraries, and the numbers do not depend on which pin version is installed.
+
+#include <nanobind/nanobind.h>
+#include <nanobind/eigen/dense.h>
+#include <nanobind/stl/tuple.h>
+#include <nanobind/stl/vector.h>
+
+#include <pinocchio/multibody.hpp>
+#include <pinocchio/spatial.hpp>
+#include <pinocchio/algorithm/frames.hpp>
+#include <pinocchio/algorithm/jacobian.hpp>
+#include <pinocchio/algorithm/joint-configuration.hpp>
+#include <pinocchio/algorithm/kinematics.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace nb = nanobind;
+namespace pin = pinocchio;
+
+using Eigen::Index;
+using Eigen::Matrix3d;
+using Eigen::MatrixXd;
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6Xd = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+
+namespace {
+
+// The constants of solve_loops.py and continuation.py (tests/test_core.py reads them back).
+constexpr double DEFAULT_TOL = 1e-13;
+constexpr double POLISH = 1e-15;
+constexpr double MAX_NEWTON_STEP = 1.0;  // solve_loops.MAX_STEP
+constexpr double MAX_STEP = 0.25;        // continuation.MAX_STEP
+constexpr double TRUST = 0.25;
+constexpr double MAX_TURN = 30.0 * M_PI / 180.0;
+constexpr double PIVOT_BELOW = 1e-4;
+constexpr int CORRECTOR_ITERATIONS = 8;
+constexpr double SINGULAR_NODE = 1e10;
+constexpr int LINE_SEARCH_HALVINGS = 30;
+
+enum JointType {
+  RX, RY, RZ, R_AXIS, RUBX, RUBY, RUBZ, RUB_AXIS, PX, PY, PZ, P_AXIS, SPHERICAL, PLANAR, FREE, TRANSLATION
+};
+enum CutType { REVOLUTE, PRISMATIC, SPHERICAL_CUT, FIXED };
+
+// Why a sweep stopped before its last pose (the Python path then takes that pose).
+enum Stop { DONE = 0, NEEDS_PIVOT = 1, SIGNATURE_CHANGED = 2, CONDITION = 3, NOT_FINITE = 4 };
+
+pin::SE3 placement_of(const double* row) {  // 12 numbers: R row by row, then p
+  Matrix3d R;
+  R << row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[8];
+  return pin::SE3(R, Vector3d(row[9], row[10], row[11]));
+}
+
+pin::JointModel joint_model(int type, const Vector3d& axis) {
+  switch (type) {
+    case RX: return pin::JointModelRX();
+    case RY: return pin::JointModelRY();
+    case RZ: return pin::JointModelRZ();
+    case R_AXIS: return pin::JointModelRevoluteUnaligned(axis);
+    case RUBX: return pin::JointModelRUBX();
+    case RUBY: return pin::JointModelRUBY();
+    case RUBZ: return pin::JointModelRUBZ();
+    case RUB_AXIS: return pin::JointModelRevoluteUnboundedUnaligned(axis);
+    case PX: return pin::JointModelPX();
+    case PY: return pin::JointModelPY();
+    case PZ: return pin::JointModelPZ();
+    case P_AXIS: return pin::JointModelPrismaticUnaligned(axis);
+    case SPHERICAL: return pin::JointModelSpherical();
+    case PLANAR: return pin::JointModelPlanar();
+    case FREE: return pin::JointModelFreeFlyer();
+    case TRANSLATION: return pin::JointModelTranslation();
+  }
+  throw std::invalid_argument("unknown joint type code " + std::to_string(type));
+}
+
+double max_abs(const Eigen::Ref<const VectorXd>& x) { return x.size() ? x.cwiseAbs().maxCoeff() : 0.0; }
+
+// A x = b for a small square A, as solve_loops._solve_square: closed forms up to 2x2, LU
+// with partial pivoting above; NaN where A is exactly singular.
+VectorXd solve_square(const MatrixXd& A, const VectorXd& b) {
+  const Index n = A.rows();
+  if (n == 1) {
+    return A(0, 0) != 0.0 ? VectorXd::Constant(1, b(0) / A(0, 0)) : VectorXd::Constant(1, NAN);
+  }
+  if (n == 2) {
+    const double det = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
+    if (det == 0.0) return VectorXd::Constant(2, NAN);
+    VectorXd x(2);
+    x << (A(1, 1) * b(0) - A(0, 1) * b(1)) / det, (A(0, 0) * b(1) - A(1, 0) * b(0)) / det;
+    return x;
+  }
+  Eigen::PartialPivLU<MatrixXd> lu(A);
+  VectorXd x = lu.solve(b);
+  if (lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0) x.setConstant(NAN);
+  return x;
+}
+
+// 2-norm condition number and smallest singular value, as solve_loops._condition.
+std::pair<double, double> condition_of(const MatrixXd& A) {
+  const Index n = A.rows();
+  if (n == 0) return {1.0, 1.0};
+  if (n == 1) {
+    const double s = std::abs(A(0, 0));
+    return {s > 0 ? 1.0 : INFINITY, s};
+  }
+  if (n == 2) {
+    const double a = A(0, 0), c = A(0, 1), d = A(1, 0), e = A(1, 1);
+    const double frob2 = a * a + c * c + d * d + e * e, det = std::abs(a * e - c * d);
+    const double s_max2 = 0.5 * (frob2 + std::sqrt(std::max(frob2 * frob2 - 4.0 * det * det, 0.0)));
+    const double s_min = s_max2 > 0 ? det / std::sqrt(s_max2) : 0.0;
+    return {det > 0 ? s_max2 / det : INFINITY, s_min};
+  }
+  Eigen::JacobiSVD<MatrixXd> svd(A);
+  const auto& s = svd.singularValues();
+  const double lo = s(n - 1);
+  return {lo > 0 ? s(0) / lo : INFINITY, lo};
+}
+
+double det_of(const MatrixXd& A) {
+  const Index n = A.rows();
+  if (n == 1) return A(0, 0);
+  if (n == 2) return A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
+  return A.partialPivLu().determinant();
+}
+
+struct Cut {
+  int type;
+  pin::FrameIndex parent, child;
+  Vector3d axis, child_axis;
+  MatrixXd rows6;  // (k, 6): basis @ selection @ diag(scale), as Closure._rows6
+  MatrixXd full;   // (n_sel, 6): selection @ diag(scale), every selected row
+  Index offset;    // first row in the stacked residual
+};
+
+struct Node {
+  double p = 0.0;
+  VectorXd q, d1, d2;
+  std::vector<int> signs;
+  double condition = 1.0, sigma_min = 1.0, velocity_residual = 0.0, acceleration_residual = 0.0, residual = 0.0;
+};
+
+class Core {
+ public:
+  Core(const std::vector<int>& types, const std::vector<int>& parents, const Eigen::Ref<const RowMatrix>& placements,
+       const Eigen::Ref<const RowMatrix>& axes, const std::vector<int>& frame_parents,
+       const Eigen::Ref<const RowMatrix>& frame_placements, const std::vector<int>& cut_types,
+       const std::vector<int>& cut_parent, const std::vector<int>& cut_child,
+       const Eigen::Ref<const RowMatrix>& cut_axes, const Eigen::Ref<const RowMatrix>& cut_child_axes,
+       const std::vector<MatrixXd>& rows6, const std::vector<MatrixXd>& full, const std::vector<int>& drv_v,
+       const std::vector<int>& dep_v, const std::vector<int>& drv_q, const std::vector<int>& drv_continuous,
+       const VectorXd& v_scale, const std::vector<std::vector<int>>& block_rows,
+       const std::vector<std::vector<int>>& block_cols, double tol)
+      : drv_v_(drv_v), dep_v_(dep_v), drv_q_(drv_q), drv_continuous_(drv_continuous), tol_(tol) {
+    const size_t nj = types.size();
+    if (parents.size() != nj || size_t(placements.rows()) != nj || size_t(axes.rows()) != nj)
+      throw std::invalid_argument("joint arrays of different lengths");
+    for (size_t j = 0; j < nj; ++j) {
+      model_.addJoint(pin::JointIndex(parents[j]), joint_model(types[j], axes.row(j).transpose()),
+                      placement_of(placements.row(j).data()), "j" + std::to_string(j + 1));
+    }
+    for (size_t f = 0; f < frame_parents.size(); ++f) {
+      const pin::JointIndex parent = pin::JointIndex(frame_parents[f]);
+      frames_.push_back(model_.addFrame(pin::Frame("f" + std::to_string(f), parent,
+                                                   placement_of(frame_placements.row(f).data()), pin::OP_FRAME)));
+    }
+    Index offset = 0;
+    for (size_t c = 0; c < cut_types.size(); ++c) {
+      Cut cut{cut_types[c], frames_.at(cut_parent[c]), frames_.at(cut_child[c]), cut_axes.row(c).transpose(),
+              cut_child_axes.row(c).transpose(), rows6.at(c), full.at(c), offset};
+      if (cut.rows6.cols() != 6 || cut.full.cols() != 6) throw std::invalid_argument("closure rows must have 6 columns");
+      offset += cut.rows6.rows();
+      cuts_.push_back(cut);
+    }
+    rows_ = offset;
+    data_ = pin::Data(model_);
+    const Index nv = model_.nv;
+    if (v_scale.size() != nv) throw std::invalid_argument("velocity scale of the wrong size");
+    v_scale_inv_ = v_scale.cwiseInverse();
+    dep_scale_.resize(Index(dep_v_.size()));
+    for (size_t i = 0; i < dep_v_.size(); ++i) dep_scale_(Index(i)) = v_scale(dep_v_[i]);
+    if (Index(dep_v_.size()) != rows_) throw std::invalid_argument("the dependent Jacobian must be square");
+    blocks_rows_ = block_rows;
+    blocks_cols_ = block_cols;
+    step_ = VectorXd::Zero(nv);
+    zero_ = VectorXd::Zero(nv);
+    J6_ = Matrix6Xd::Zero(6, nv);
+    JP_ = Matrix6Xd::Zero(6, nv);
+    JC_ = Matrix6Xd::Zero(6, nv);
+  }
+
+  int nq() const { return model_.nq; }
+  int nv() const { return model_.nv; }
+  std::vector<int> idx_q() const { return std::vector<int>(model_.idx_qs.begin() + 1, model_.idx_qs.end()); }
+  std::vector<int> idx_v() const { return std::vector<int>(model_.idx_vs.begin() + 1, model_.idx_vs.end()); }
+
+  // ---------------------------------------------------------------- pieces (also for tests)
+  VectorXd residual(const VectorXd& q) {
+    pin::computeJointJacobians(model_, data_, q);
+    VectorXd r(rows_);
+    for (const Cut& cut : cuts_) {
+      pin::updateFramePlacement(model_, data_, cut.parent);
+      pin::updateFramePlacement(model_, data_, cut.child);
+      r.segment(cut.offset, cut.rows6.rows()) = cut.rows6 * error6(cut);
+    }
+    return r;
+  }
+
+  double full_residual() const {
+    double worst = 0.0;
+    for (const Cut& cut : cuts_) worst = std::max(worst, max_abs(cut.full * error6(cut)));
+    return worst;
+  }
+
+  MatrixXd jacobian(bool newton) {
+    MatrixXd J(rows_, model_.nv);
+    for (const Cut& cut : cuts_) {
+      relative_jacobian(cut, newton);
+      J.middleRows(cut.offset, cut.rows6.rows()) = cut.rows6 * J6_;
+    }
+    return J;
+  }
+
+  VectorXd drift(const VectorXd& q, const VectorXd& v) {
+    pin::forwardKinematics(model_, data_, q, v, zero_);
+    VectorXd out(rows_);
+    for (const Cut& cut : cuts_) {
+      const pin::SE3 &MP = data_.oMf[cut.parent], &MC = data_.oMf[cut.child];
+      const pin::Motion vP = pin::getFrameVelocity(model_, data_, cut.parent, pin::LOCAL_WORLD_ALIGNED);
+      const pin::Motion vC = pin::getFrameVelocity(model_, data_, cut.child, pin::LOCAL_WORLD_ALIGNED);
+      const pin::Motion aP = pin::getFrameClassicalAcceleration(model_, data_, cut.parent, pin::LOCAL_WORLD_ALIGNED);
+      const pin::Motion aC = pin::getFrameClassicalAcceleration(model_, data_, cut.child, pin::LOCAL_WORLD_ALIGNED);
+      const Vector3d wP = vP.angular(), delta = MC.translation() - MP.translation();
+      const Vector3d dv = vC.linear() - vP.linear();
+      const Vector3d d = dv - wP.cross(delta);
+      const Vector3d d_dot = aC.linear() - aP.linear() - aP.angular().cross(delta) - wP.cross(dv);
+      Vector6d e;
+      e.head<3>() = MP.rotation().transpose() * (d_dot - wP.cross(d));
+      e.tail<3>() = MP.rotation().transpose() * (aC.angular() - aP.angular() - wP.cross(vC.angular() - wP));
+      out.segment(cut.offset, cut.rows6.rows()) = cut.rows6 * e;
+    }
+    return out;
+  }
+
+  // ---------------------------------------------------------------- the corrector
+  // LoopSolver.correct(strict=True): full Newton steps, each at least halving the
+  // residual; the polish step of `close`; the full-residual check. False: no root here.
+  bool correct(VectorXd& q, const VectorXd& drivers, int max_iterations, double& residual_left) {
+    set_drivers(q, drivers);
+    VectorXd r = residual(q);
+    double norm = max_abs(r);
+    iterations_ = 0;
+    moved_ = 0.0;
+    for (int it = 0; it < max_iterations; ++it) {
+      if (norm <= tol_) break;
+      const MatrixXd J_dep = dependent(jacobian(true));
+      ++iterations_;
+      const VectorXd step = solve_square(J_dep, -r);
+      if (!step.allFinite()) return false;
+      VectorXd q_new = move(q, step);
+      VectorXd r_new = residual(q_new);
+      const double new_norm = max_abs(r_new);
+      if (new_norm > 0.5 * norm && new_norm > tol_) {
+        residual(q);
+        return false;
+      }
+      q.swap(q_new);
+      r.swap(r_new);
+      norm = new_norm;
+    }
+    if (POLISH < norm && norm <= tol_ && tol_ <= DEFAULT_TOL) {
+      polish(q, r, norm);
+      ++iterations_;
+    }
+    const double full = full_residual();
+    if (norm > tol_ || full > std::max(tol_, 1e-12) * 10) return false;
+    residual_left = std::max(norm, full);
+    return true;
+  }
+
+  // ---------------------------------------------------------------- nodes and steps
+  // Path.node at a closed q whose placements and Jacobians are in data_: the path
+  // derivatives at driver velocity d, the condition number and the signature.
+  bool node_at(Node& node, const VectorXd& d) {
+    const MatrixXd J = jacobian(false);
+    const MatrixXd J_dep = dependent(J);
+    auto [condition, sigma_min] = condition_of(J_dep * dep_scale_.asDiagonal());
+    node.condition = condition;
+    node.sigma_min = sigma_min;
+    node.signs = signs(J_dep);
+    VectorXd v = VectorXd::Zero(model_.nv), a = VectorXd::Zero(model_.nv);
+    for (size_t i = 0; i < drv_v_.size(); ++i) v(drv_v_[i]) = d(Index(i));
+    VectorXd rhs = -(J * v);  // driver columns only: v is zero elsewhere yet
+    const VectorXd v_dep = solve_square(J_dep, rhs);
+    for (size_t i = 0; i < dep_v_.size(); ++i) v(dep_v_[i]) = v_dep(Index(i));
+    const VectorXd dr = drift(node.q, v);
+    const VectorXd a_dep = solve_square(J_dep, -dr);
+    for (size_t i = 0; i < dep_v_.size(); ++i) a(dep_v_[i]) = a_dep(Index(i));
+    node.d1 = v;
+    node.d2 = a;
+    node.velocity_residual = max_abs(J * v);
+    node.acceleration_residual = max_abs(J * a + dr);
+    return true;
+  }
+
+  // Path.step from `from` to p; 0 and `out` filled on success, else why it failed:
+  // 1 corrector, 2 trust region, 3 singular, 4 turn, 5 signature changed (a change point
+  // when `change` is set: the Python path takes it and names it).
+  int step(const Node& from, double p, const VectorXd& x0, const VectorXd& d, double unit, Node& out, bool& change) {
+    change = false;
+    const double h = p - from.p;
+    const VectorXd move_ = from.d1 * h + from.d2 * (0.5 * h * h);
+    VectorXd q = pin::integrate(model_, from.q, move_);
+    double residual_left = 0.0;
+    if (!correct(q, x0 + p * d, CORRECTOR_ITERATIONS, residual_left)) return 1;
+    const double trust = std::min(TRUST, 2.0 * std::abs(h) * unit);
+    if (moved_ > trust * max_abs(move_.cwiseProduct(v_scale_inv_)) + 1e3 * tol_) return 2;
+    out.p = p;
+    out.q = q;
+    out.residual = residual_left;
+    node_at(out, d);
+    for (int s : out.signs)
+      if (s == 0) return 3;
+    if (!(out.condition <= SINGULAR_NODE)) return 3;
+    const double turn = turn_between(from, out, unit);
+    if (turn > MAX_TURN) return 4;
+    if (out.signs != from.signs) {
+      change = std::abs(h) * unit <= 1e-3 && turn < 0.1 * MAX_TURN;
+      return 5;
+    }
+    return 0;
+  }
+
+  // The range mode of solve_cycle._Cycle: from the node (p0, q0, d1, d2) along drivers
+  // x(p) = x0 + p d to each of `targets` in turn (Path.follow: first step at most
+  // MAX_STEP, doubled after a success, halved after a failure down to PIVOT_BELOW).
+  // Returns (poses done, why it stopped, q, d1, d2, accuracy columns).
+  nb::tuple follow(double p0, const VectorXd& q0, const VectorXd& d1, const VectorXd& d2, const std::vector<int>& signs0,
+                   double condition0, const VectorXd& x0, const VectorXd& d, double unit, const VectorXd& targets,
+                   double max_condition) {
+    const Index n = targets.size();
+    RowMatrix Q(n, model_.nq), D1(n, model_.nv), D2(n, model_.nv);
+    RowMatrix acc(n, 6);  // residual, iterations, condition, sigma_min, velocity and acceleration residuals
+    Index done = 0;
+    int stop = DONE;
+    {
+      nb::gil_scoped_release release;
+      Node node, next;
+      node.p = p0;
+      node.q = q0;
+      node.d1 = d1;
+      node.d2 = d2;
+      node.signs = signs0;
+      node.condition = condition0;
+      for (; done < n && stop == DONE; ++done) {
+        const double target = targets(done);
+        double h = std::copysign(std::min(std::abs(target - node.p), MAX_STEP / unit), target - node.p);
+        long iterations = 0;
+        while (node.p != target) {
+          const double remaining = target - node.p;
+          h = std::copysign(std::min(std::abs(h), std::abs(remaining)), remaining);
+          bool change = false;
+          const int why = step(node, std::abs(h) < std::abs(remaining) ? node.p + h : target, x0, d, unit, next, change);
+          if (why == 0) {
+            std::swap(node, next);
+            iterations += iterations_;
+            h *= 2.0;
+            continue;
+          }
+          if (why == 5 && change) {
+            stop = SIGNATURE_CHANGED;
+            break;
+          }
+          if (std::abs(h) * unit > PIVOT_BELOW) {
+            h *= 0.5;
+            continue;
+          }
+          stop = NEEDS_PIVOT;
+          break;
+        }
+        if (stop != DONE) break;
+        if (node.condition > max_condition) {
+          stop = CONDITION;
+          break;
+        }
+        if (!node.d1.allFinite() || !node.d2.allFinite()) {
+          stop = NOT_FINITE;
+          break;
+        }
+        Q.row(done) = node.q.transpose();
+        D1.row(done) = node.d1.transpose();
+        D2.row(done) = node.d2.transpose();
+        acc.row(done) << node.residual, double(iterations), node.condition, node.sigma_min, node.velocity_residual,
+            node.acceleration_residual;
+      }
+    }
+    return nb::make_tuple(done, stop, Q.topRows(done).eval(), D1.topRows(done).eval(), D2.topRows(done).eval(),
+                          acc.topRows(done).eval());
+  }
+
+  // ---------------------------------------------------------------- frames along a sweep
+  // Positions, rotations, velocities and classical accelerations (world axes) of frames
+  // at every pose: (N, F, 3) arrays and (N, F, 9) rotations, row by row.
+  nb::tuple frame_motion(const Eigen::Ref<const RowMatrix>& Q, const Eigen::Ref<const RowMatrix>& V,
+                         const Eigen::Ref<const RowMatrix>& A, const std::vector<int>& frames) {
+    const Index n = Q.rows(), nf = Index(frames.size());
+    if (Q.cols() != model_.nq || V.cols() != model_.nv || A.cols() != model_.nv || V.rows() != n || A.rows() != n)
+      throw std::invalid_argument("q, v and a of the wrong shapes");
+    for (int f : frames)
+      if (f < 0 || size_t(f) >= frames_.size()) throw std::invalid_argument("unknown frame index");
+    RowMatrix P(n, 3 * nf), R(n, 9 * nf), Vel(n, 3 * nf), Omega(n, 3 * nf), Acc(n, 3 * nf), Alpha(n, 3 * nf);
+    {
+      nb::gil_scoped_release release;
+      VectorXd q(model_.nq), v(model_.nv), a(model_.nv);
+      for (Index i = 0; i < n; ++i) {
+        q = Q.row(i).transpose();
+        v = V.row(i).transpose();
+        a = A.row(i).transpose();
+        pin::forwardKinematics(model_, data_, q, v, a);
+        for (Index k = 0; k < nf; ++k) {
+          const pin::FrameIndex f = frames_[size_t(frames[size_t(k)])];
+          const pin::SE3& M = pin::updateFramePlacement(model_, data_, f);
+          const pin::Motion vel = pin::getFrameVelocity(model_, data_, f, pin::LOCAL_WORLD_ALIGNED);
+          const pin::Motion acc = pin::getFrameClassicalAcceleration(model_, data_, f, pin::LOCAL_WORLD_ALIGNED);
+          P.block<1, 3>(i, 3 * k) = M.translation().transpose();
+          for (int r = 0; r < 3; ++r) R.block<1, 3>(i, 9 * k + 3 * r) = M.rotation().row(r);
+          Vel.block<1, 3>(i, 3 * k) = vel.linear().transpose();
+          Omega.block<1, 3>(i, 3 * k) = vel.angular().transpose();
+          Acc.block<1, 3>(i, 3 * k) = acc.linear().transpose();
+          Alpha.block<1, 3>(i, 3 * k) = acc.angular().transpose();
+        }
+      }
+    }
+    return nb::make_tuple(P, R, Vel, Omega, Acc, Alpha);
+  }
+
+  double tol() const { return tol_; }
+  void set_tol(double tol) { tol_ = tol; }
+  int iterations() const { return iterations_; }
+  double moved() const { return moved_; }
+
+  std::vector<int> signs(const MatrixXd& J_dep) const {
+    std::vector<int> out;
+    for (size_t b = 0; b < blocks_rows_.size(); ++b) {
+      const auto &rows = blocks_rows_[b], &cols = blocks_cols_[b];
+      MatrixXd B(Index(rows.size()), Index(cols.size()));
+      for (size_t i = 0; i < rows.size(); ++i)
+        for (size_t j = 0; j < cols.size(); ++j) B(Index(i), Index(j)) = J_dep(rows[i], cols[j]);
+      const double det = det_of(B);
+      out.push_back(det > 0 ? 1 : det < 0 ? -1 : 0);
+    }
+    return out;
+  }
+
+ private:
+  Vector6d error6(const Cut& cut) const {
+    const pin::SE3 &MP = data_.oMf[cut.parent], &MC = data_.oMf[cut.child];
+    Vector6d e;
+    e.head<3>() = MP.rotation().transpose() * (MC.translation() - MP.translation());
+    if (cut.type == SPHERICAL_CUT) {
+      e.tail<3>().setZero();
+    } else {
+      const Matrix3d R_rel = MP.rotation().transpose() * MC.rotation();
+      if (cut.type == REVOLUTE)
+        e.tail<3>() = cut.axis.cross(R_rel * cut.child_axis);
+      else
+        e.tail<3>() = pin::log3(R_rel);
+    }
+    return e;
+  }
+
+  // J6_ = the (6, nv) map from joint velocities to (r_dot, w) of the cut in P; with
+  // `newton`, orientation rows carry the derivative of the error measure instead
+  // (Closure.residual_jacobian).
+  void relative_jacobian(const Cut& cut, bool newton) {
+    JP_.setZero();
+    JC_.setZero();
+    pin::getFrameJacobian(model_, data_, cut.parent, pin::LOCAL_WORLD_ALIGNED, JP_);
+    pin::getFrameJacobian(model_, data_, cut.child, pin::LOCAL_WORLD_ALIGNED, JC_);
+    const pin::SE3 &MP = data_.oMf[cut.parent], &MC = data_.oMf[cut.child];
+    const Matrix3d RT = MP.rotation().transpose();
+    const Vector3d delta = MC.translation() - MP.translation();
+    J6_.topRows<3>() = RT * (JC_.topRows<3>() - JP_.topRows<3>() + pin::skew(delta) * JP_.bottomRows<3>());
+    J6_.bottomRows<3>() = RT * (JC_.bottomRows<3>() - JP_.bottomRows<3>());
+    if (newton && cut.type != SPHERICAL_CUT) {
+      const Matrix3d R_rel = RT * MC.rotation();
+      if (cut.type == REVOLUTE) {
+        const Matrix3d M = -pin::skew(cut.axis) * pin::skew(Vector3d(R_rel * cut.child_axis));
+        J6_.bottomRows<3>() = (M * J6_.bottomRows<3>()).eval();
+      } else {
+        Matrix3d Jlog;
+        pin::Jlog3(R_rel, Jlog);
+        J6_.bottomRows<3>() = (Jlog * R_rel.transpose() * J6_.bottomRows<3>()).eval();
+      }
+    }
+  }
+
+  MatrixXd dependent(const MatrixXd& J) const {
+    MatrixXd out(J.rows(), Index(dep_v_.size()));
+    for (size_t i = 0; i < dep_v_.size(); ++i) out.col(Index(i)) = J.col(dep_v_[i]);
+    return out;
+  }
+
+  void set_drivers(VectorXd& q, const VectorXd& drivers) const {
+    for (size_t i = 0; i < drv_q_.size(); ++i) {
+      const double x = drivers(Index(i));
+      if (drv_continuous_[i]) {
+        q(drv_q_[i]) = std::cos(x);
+        q(drv_q_[i] + 1) = std::sin(x);
+      } else {
+        q(drv_q_[i]) = x;
+      }
+    }
+  }
+
+  // LoopSolver._move: q moved by a step of the dependent joints, at most MAX_NEWTON_STEP.
+  VectorXd move(const VectorXd& q, VectorXd step) {
+    const double size = max_abs(step.cwiseQuotient(dep_scale_));
+    if (size > MAX_NEWTON_STEP) step *= MAX_NEWTON_STEP / size;
+    moved_ += std::min(size, MAX_NEWTON_STEP);
+    step_.setZero();
+    for (size_t i = 0; i < dep_v_.size(); ++i) step_(dep_v_[i]) = step(Index(i));
+    return pin::integrate(model_, q, step_);
+  }
+
+  // LoopSolver._newton_update at the polish: the full step if it lowers the residual,
+  // else the step halved until it does (a square regular J_dep: least squares is Newton).
+  void polish(VectorXd& q, VectorXd& r, double& norm) {
+    const MatrixXd J_dep = dependent(jacobian(true));
+    VectorXd step = solve_square(J_dep, -r);
+    if (!step.allFinite()) return;
+    double alpha = 1.0;
+    for (int k = 0; k <= LINE_SEARCH_HALVINGS; ++k, alpha *= 0.5) {
+      VectorXd trial = move(q, alpha * step);
+      VectorXd r_trial = residual(trial);
+      const double trial_norm = max_abs(r_trial);
+      if (trial_norm < norm) {
+        q.swap(trial);
+        r.swap(r_trial);
+        norm = trial_norm;
+        return;
+      }
+    }
+    residual(q);  // data back at q
+  }
+
+  double turn_between(const Node& a, const Node& b, double unit) const {
+    const VectorXd ta = a.d1.cwiseProduct(v_scale_inv_), tb = b.d1.cwiseProduct(v_scale_inv_);
+    const double na = std::sqrt(ta.squaredNorm() + unit * unit), nb_ = std::sqrt(tb.squaredNorm() + unit * unit);
+    const double c = (ta.dot(tb) + unit * unit) / (na * nb_);
+    return std::acos(std::max(-1.0, std::min(1.0, c)));
+  }
+
+  pin::Model model_;
+  pin::Data data_;
+  std::vector<pin::FrameIndex> frames_;
+  std::vector<Cut> cuts_;
+  Index rows_ = 0;
+  std::vector<int> drv_v_, dep_v_, drv_q_, drv_continuous_;
+  VectorXd dep_scale_, v_scale_inv_, step_, zero_;
+  std::vector<std::vector<int>> blocks_rows_, blocks_cols_;
+  Matrix6Xd J6_, JP_, JC_;
+  double tol_;
+  int iterations_ = 0;
+  double moved_ = 0.0;
+};
+
+}  // namespace
+
+NB_MODULE(_core, m) {
+  m.doc() = "pinmech's compiled core: sweeps of closed-loop mechanisms on Pinocchio (see pinmech/core.py)";
+  m.attr("DEFAULT_TOL") = DEFAULT_TOL;
+  m.attr("POLISH") = POLISH;
+  m.attr("MAX_NEWTON_STEP") = MAX_NEWTON_STEP;
+  m.attr("MAX_STEP") = MAX_STEP;
+  m.attr("TRUST") = TRUST;
+  m.attr("MAX_TURN") = MAX_TURN;
+  m.attr("PIVOT_BELOW") = PIVOT_BELOW;
+  m.attr("CORRECTOR_ITERATIONS") = CORRECTOR_ITERATIONS;
+  m.attr("SINGULAR_NODE") = SINGULAR_NODE;
+  m.attr("PINOCCHIO_VERSION") = PINOCCHIO_VERSION;
+  nb::class_<Core>(m, "Core")
+      .def(nb::init<const std::vector<int>&, const std::vector<int>&, const Eigen::Ref<const RowMatrix>&,
+                    const Eigen::Ref<const RowMatrix>&, const std::vector<int>&, const Eigen::Ref<const RowMatrix>&,
+                    const std::vector<int>&, const std::vector<int>&, const std::vector<int>&,
+                    const Eigen::Ref<const RowMatrix>&, const Eigen::Ref<const RowMatrix>&,
+                    const std::vector<MatrixXd>&, const std::vector<MatrixXd>&, const std::vector<int>&,
+                    const std::vector<int>&, const std::vector<int>&, const std::vector<int>&, const VectorXd&,
+                    const std::vector<std::vector<int>>&, const std::vector<std::vector<int>>&, double>())
+      .def_prop_ro("nq", &Core::nq)
+      .def_prop_ro("nv", &Core::nv)
+      .def_prop_ro("idx_q", &Core::idx_q)
+      .def_prop_ro("idx_v", &Core::idx_v)
+      .def_prop_rw("tol", &Core::tol, &Core::set_tol)
+      .def_prop_ro("iterations", &Core::iterations)
+      .def_prop_ro("moved", &Core::moved)
+      .def("residual", &Core::residual)
+      .def("full_residual", &Core::full_residual)
+      .def("jacobian", &Core::jacobian, nb::arg("newton") = false)
+      .def("drift", &Core::drift)
+      .def("signs", &Core::signs)
+      .def("correct",
+           [](Core& core, VectorXd q, const VectorXd& drivers, int max_iterations) {
+             double residual = NAN;
+             const bool ok = core.correct(q, drivers, max_iterations, residual);
+             return nb::make_tuple(q, ok ? nb::cast(residual) : nb::none());
+           })
+      .def("follow", &Core::follow)
+      .def("frame_motion", &Core::frame_motion);
+}

@@ -1,0 +1,182 @@
+"""The compiled core (pinmech/csrc/core.cpp) against the Python path it stands in for, the
+closed form, and finite differences.
+
+The core rebuilds the model from its joints and frames and computes the closure rows with
+the formulas of closures.py; at every pose the two must agree to rounding. Tolerances:
+- closure rows, Jacobians and drift: 1e-13 of their size (the same formulas, evaluated in
+  another order: a few units in the last place of numbers of order one);
+- sweeps, core against Python path: 1e-12 in q (radians, or loop sizes: the closure
+  tolerance is 1e-13 and both meet it), 1e-10 relative in v and a (rates carry the
+  condition number, up to 1e2 to 1e3 here, times the position difference);
+- against the R-RTR closed form: 1e-13 (issue 13's bar).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import pinmech
+import pinmech.core as core
+from pinmech.continuation import CORRECTOR_ITERATIONS, MAX_STEP, MAX_TURN, PIVOT_BELOW, SINGULAR_NODE, TRUST
+from pinmech.solve_loops import DEFAULT_TOL, POLISH
+from pinmech.solve_loops import MAX_STEP as MAX_NEWTON_STEP
+from pinmech.sweep import Sweep
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
+import closed_form  # noqa: E402
+
+LOOP_SCENES = ["r_rtr.toml", "four_bar.toml", "slider_crank.toml", "four_bar_dynamic.toml",
+               "slider_crank_dynamic.toml", "jansen.toml", "four_bar_drawn.toml", "rsur_drawn.toml",
+               "marghitu_slider_crank.toml", "four_bar_mjcf.toml", "five_bar.toml", "leg_mjcf.toml"]
+
+
+def _sweep(scenes_dir: Path, name: str) -> Sweep:
+    path = scenes_dir / name
+    if not path.is_file():
+        pytest.skip(f"{name} is not bundled")
+    return Sweep.from_scene(pinmech.Scene.load(path))
+
+
+def test_the_core_states_the_python_paths_constants():
+    assert (core._core.DEFAULT_TOL, core._core.POLISH, core._core.MAX_NEWTON_STEP) == (DEFAULT_TOL, POLISH,
+                                                                                       MAX_NEWTON_STEP)
+    assert (core._core.MAX_STEP, core._core.TRUST, core._core.PIVOT_BELOW) == (MAX_STEP, TRUST, PIVOT_BELOW)
+    assert core._core.CORRECTOR_ITERATIONS == CORRECTOR_ITERATIONS
+    assert core._core.SINGULAR_NODE == SINGULAR_NODE
+    assert core._core.MAX_TURN == pytest.approx(MAX_TURN, rel=1e-15)
+
+
+@pytest.mark.parametrize("name", LOOP_SCENES)
+def test_closure_rows_equal_the_python_formulas(scenes_dir, name):
+    """Residual, both Jacobians, drift and the full residual at random configurations,
+    closed or not: the numbers of closures.py to rounding."""
+    sweep = _sweep(scenes_dir, name)
+    solver = sweep.solver
+    compiled = core.core_for(solver)
+    if compiled is None:
+        pytest.skip(f"{name}: a joint the core does not rebuild")
+    model, rng = solver.model, np.random.default_rng(7)
+    for _ in range(5):
+        q = pin.randomConfiguration(model, -np.pi * np.ones(model.nq), np.pi * np.ones(model.nq))
+        v = rng.normal(size=model.nv)
+        r = solver._residual(q)
+        J, Jn = solver._jacobian(), solver._residual_jacobian()
+        full = solver._full_residual()
+        pin.forwardKinematics(model, solver.data, q, v, np.zeros(model.nv))
+        drift = solver._drift()
+        scale = 1.0 + max(np.abs(r).max(), np.abs(J).max(), np.abs(drift).max())
+        np.testing.assert_allclose(compiled.residual(q), r, rtol=0, atol=1e-13 * scale)
+        np.testing.assert_allclose(compiled.jacobian(False), J, rtol=0, atol=1e-13 * scale)
+        np.testing.assert_allclose(compiled.jacobian(True), Jn, rtol=0, atol=1e-13 * scale)
+        assert compiled.full_residual() == pytest.approx(full, rel=1e-13, abs=1e-13)
+        np.testing.assert_allclose(compiled.drift(q, v), drift, rtol=0, atol=1e-13 * scale)
+
+
+def _rows(sweep: Sweep, values: np.ndarray):
+    chunks = list(sweep.chunks(values))
+    q = np.concatenate([c.solution.q for c in chunks])
+    v = np.concatenate([c.solution.v for c in chunks])
+    a = np.concatenate([c.solution.a for c in chunks])
+    errors = sorted(c.start + j for c in chunks for j in c.errors)
+    notes = [(c.start + j, n) for c in chunks for j, n in sorted(c.notes.items())]
+    return q, v, a, errors, notes
+
+
+@pytest.mark.parametrize("name", LOOP_SCENES)
+@pytest.mark.parametrize("spacing", [1.0, 10.0, 45.0])
+def test_sweeps_equal_the_python_path(scenes_dir, name, spacing, monkeypatch):
+    """Every bundled loop scene over a turn: same poses, rates, failures and notes with the
+    core as without it."""
+    sweep = _sweep(scenes_dir, name)
+    if core.core_for(sweep.solver) is None:
+        pytest.skip(f"{name}: a joint the core does not rebuild")
+    angular = sweep.is_angular
+    values = sweep.start + (np.radians(np.arange(0, 361, spacing)) if angular
+                            else np.linspace(0.0, 0.02, int(360 / spacing) + 1))
+    with_core = _rows(sweep, values)
+    monkeypatch.setattr(core, "ENABLED", False)
+    plain = _rows(_sweep(scenes_dir, name), values)
+    assert with_core[3] == plain[3] and with_core[4] == plain[4]
+    ok = np.all(np.isfinite(plain[0]), axis=1)
+    for qa, qb in zip(with_core[0][ok], plain[0][ok]):
+        assert sweep.solver.turn_gap(qa, qb) < 1e-12
+    for got, want in zip(with_core[1:3], plain[1:3]):
+        size = 1.0 + np.abs(want[ok]).max()
+        np.testing.assert_allclose(got[ok], want[ok], rtol=0, atol=1e-10 * size)
+
+
+def test_r_rtr_sweep_meets_the_closed_form(scenes_dir):
+    """P1 of issue 13 through the core: link 3's angle, angular velocity and acceleration,
+    and D's velocity and acceleration, within 1e-13 of each quantity's largest magnitude
+    over the turn, at every degree (Pinocchio's forward kinematics reads them off q, v, a)."""
+    sweep = _sweep(scenes_dir, "r_rtr.toml")
+    assert core.core_for(sweep.solver) is not None
+    phi = np.radians(np.arange(360.0))
+    q, v, a, errors, _ = _rows(sweep, phi)
+    assert not errors
+    model, data = sweep.solver.model, sweep.solver.model.createData()
+    link3, point_d = model.getFrameId("link3"), model.getFrameId("D")
+    got = {k: [] for k in ("phi3", "omega3", "alpha3", "vD", "aD")}
+    for qi, vi, ai in zip(q, v, a):
+        pin.forwardKinematics(model, data, qi, vi, ai)
+        R = pin.updateFramePlacement(model, data, link3).rotation
+        got["phi3"].append(math.atan2(R[1, 0], R[0, 0]))
+        lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+        got["omega3"].append(pin.getFrameVelocity(model, data, link3, lwa).angular[2])
+        got["alpha3"].append(pin.getFrameClassicalAcceleration(model, data, link3, lwa).angular[2])
+        got["vD"].append(pin.getFrameVelocity(model, data, point_d, lwa).linear[:2])
+        got["aD"].append(pin.getFrameClassicalAcceleration(model, data, point_d, lwa).linear[:2])
+    ref = closed_form.r_rtr(phi, float(sweep.drivers.v[0]), float(sweep.drivers.a[0]))
+    d = np.remainder(np.array(got["phi3"]) - ref.phi3 + math.pi, 2 * math.pi) - math.pi
+    assert np.abs(d).max() < 1e-13
+    for name in ("omega3", "alpha3", "vD", "aD"):
+        want = np.asarray(getattr(ref, name))
+        assert np.abs(np.array(got[name]) - want).max() <= 1e-13 * np.abs(want).max(), name
+
+
+def test_path_derivatives_are_finite_differences_of_the_poses(scenes_dir):
+    """q' and q'' of the core's poses against central differences of its own positions
+    (h = 1e-4 rad: truncation h^2 ~ 1e-8, rounding 1e-13 / h^2 ~ 1e-5 for q'')."""
+    sweep = _sweep(scenes_dir, "four_bar.toml")
+    solver = sweep.solver
+    x = sweep.start + np.radians(37.0)
+    h = 1e-4
+    q, v, a, _, _ = _rows(sweep, np.array([x - h, x, x + h]))
+    w = float(sweep.drivers.v[sweep.drivers.names.index(sweep.driver)])
+    dq1 = pin.difference(solver.model, q[0], q[2]) / (2 * h)
+    dq2 = (pin.difference(solver.model, q[1], q[2]) - pin.difference(solver.model, q[0], q[1])) / h**2
+    np.testing.assert_allclose(v[1] / w, dq1, rtol=0, atol=1e-7)
+    alpha = float(sweep.drivers.a[sweep.drivers.names.index(sweep.driver)])
+    np.testing.assert_allclose((a[1] - v[1] / w * alpha) / w**2, dq2, rtol=0, atol=1e-4)
+
+
+def test_a_moved_ground_frame_rebuilds_the_core(scenes_dir):
+    sweep = _sweep(scenes_dir, "four_bar.toml")
+    solver = sweep.solver
+    first = core.core_for(solver)
+    assert core.core_for(solver) is first  # built once
+    closure = solver.mechanism.closures[0]
+    frame = solver.model.frames[closure.parent_frame]
+    placement = frame.placement.copy()
+    placement.translation = placement.translation + np.array([1e-6, 0.0, 0.0])
+    solver.model.frames[closure.parent_frame].placement = placement
+    assert core.core_for(solver) is not first
+
+
+def test_joints_the_core_does_not_rebuild_leave_the_python_path():
+    model = pin.Model()
+    model.addJoint(0, pin.JointModelUniversal(np.array([1.0, 0, 0]), np.array([0, 1.0, 0])), pin.SE3.Identity(), "u")
+    with pytest.raises(KeyError):
+        core.CompiledModel(model, [])
+
+
+def test_the_core_can_be_ruled_out(monkeypatch, scenes_dir):
+    sweep = _sweep(scenes_dir, "four_bar.toml")
+    monkeypatch.setattr(core, "ENABLED", False)
+    assert core.core_for(sweep.solver) is None
