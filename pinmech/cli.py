@@ -248,7 +248,7 @@ def cmd_forces(args: argparse.Namespace) -> int:
 
 def _sweep_forces(args: argparse.Namespace, scene, sweep):
     """The forces of a sweep when asked (flags or the scene's force tables), else None."""
-    from pinmech.forces_scene import wants_forces
+    from pinmech.scene import wants_forces
 
     asked = args.forces or args.static or args.minimum_norm or args.flywheel or args.torque_plot
     if not (asked or wants_forces(scene)):
