@@ -17,11 +17,14 @@ import signal
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from pinmech import __version__
 from pinmech.exceptions import PinmechError
 from pinmech.interrupts import SIGNALS
-from pinmech.outputs import Outputs, check_distinct, plot_path, write_whole
+
+if TYPE_CHECKING:
+    from pinmech.outputs import Outputs
 
 
 def _add_scene_arguments(parser: argparse.ArgumentParser) -> None:
@@ -401,6 +404,7 @@ class _LimitWatch:
 
 
 def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | None, forces=None) -> Outputs:
+    from pinmech.outputs import Outputs, plot_path
     from pinmech.tables import SweepCsv, SweepJsonLines
 
     csv_kind, json_kind, source = SweepCsv, SweepJsonLines, sweep
@@ -445,6 +449,8 @@ class _PathsFigure:
 def _check_outputs(args: argparse.Namespace, scene) -> Path | None:
     """Before computing: the figure's format, one file per output, no output over an input.
     Returns the figure's path (".png" added to a name without suffix)."""
+    from pinmech.outputs import check_distinct, plot_path
+
     figure = plot_path(args.plot_path) if args.plot_path else None
     if getattr(args, "paths_path", None):
         args.paths_path = plot_path(args.paths_path, "--paths")
@@ -488,6 +494,7 @@ def _follow(args: argparse.Namespace, scene) -> int:
     """A task scene followed in time: CSV (JSON lines, a figure) of the joint trajectory."""
     from pinmech.analysis_task import scene_pose, scene_tasks
     from pinmech.limits import limits_at
+    from pinmech.outputs import Outputs
     from pinmech.path import check_timing, follow_path, step_count
     from pinmech.scene_model import limit_mode, load_mechanism
     from pinmech.sweep import sweep_options
@@ -699,10 +706,14 @@ def _write_text(path: str, text: str, what: str) -> None:
 
 def _check_page(args: argparse.Namespace, scene) -> None:
     """Before computing: the page's file can be made and is not an input."""
+    from pinmech.outputs import check_distinct
+
     check_distinct({"-o": args.output}, {"the scene file": scene.path, "the URDF": _urdf_path(scene)})
 
 
 def _write(path: str, html: str) -> None:
+    from pinmech.outputs import write_whole
+
     write_whole(path, html)
     print(f"wrote {path} ({len(html) // 1024} KB, offline: open it in any browser)", file=sys.stderr)
 
