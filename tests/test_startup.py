@@ -120,3 +120,21 @@ def test_a_valid_solve_command_line_builds_the_solve_parser_only(monkeypatch, r_
     with pytest.raises(SystemExit), contextlib.redirect_stderr(io.StringIO()):
         cli.parse_args(["solve", str(r_rtr_scene), "--no-such-option"])
     assert built == ["solve", None]  # the error is the full parser's
+
+
+def test_loops_of_full_rank_on_their_first_closed_pose_are_not_sampled_around(monkeypatch, models_dir):
+    """The mobility check closes one pose; only a rank below the row count (loops that may
+    repeat each other) sends it to close neighbouring poses (tests/test_mobility.py)."""
+    from pinmech import mobility
+    from pinmech.mechanism import Mechanism
+
+    closings = []
+    close = mobility.close_least_squares
+
+    def counting(*args, **kwargs):
+        closings.append(1)
+        return close(*args, **kwargs)
+
+    monkeypatch.setattr(mobility, "close_least_squares", counting)
+    report = mobility.constraint_rank(Mechanism.from_urdf(models_dir / "r_rtr.urdf"))
+    assert (report.rank, report.rows, report.redundant, len(closings)) == (2, 2, (), 1)
