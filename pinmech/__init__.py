@@ -7,12 +7,8 @@ A user's script imports from here only:
     print(pinmech.to_text(analysis))
 """
 
-from pinmech.analysis import Analysis, analyse
-from pinmech.branches import Assembly
-from pinmech.check import compare, load_hand_file
-from pinmech.closures import Closure
-from pinmech.continuation import Route
-from pinmech.draw.report_page import HtmlPage, report_html, snapshot
+from importlib import import_module as _import_module
+
 from pinmech.exceptions import (
     AssemblyError,
     CheckMismatch,
@@ -32,34 +28,56 @@ from pinmech.exceptions import (
     TaskError,
     UnitError,
 )
-from pinmech.flywheel import EnergyFluctuation, energy_fluctuation
-from pinmech.forces import (
-    ForceSolution,
-    ForceSolver,
-    Load,
-    PowerBalance,
-    Reaction,
-    mechanical_advantage,
-)
-from pinmech.forces_scene import ForceSettings, force_settings
-from pinmech.forces_sweep import SweepForces
-from pinmech.linkage import build_urdf, load_linkage
-from pinmech.mechanism import JointInfo, Mechanism
-from pinmech.mjcf import load_mjcf
-from pinmech.motion import CoincidentPoint, Motion, evaluate_motion
-from pinmech.path import PathPoint, follow_path
-from pinmech.polygon import Polygon, acceleration_polygon, velocity_polygon
-from pinmech.report import to_dict, to_json, to_text
-from pinmech.results import Accuracy, LoopSolution, RateSolution
-from pinmech.scene import Scene
-from pinmech.scene_model import Drivers, load_mechanism
-from pinmech.sidecar import load_extended_urdf
-from pinmech.solve_batch import BatchSolution, BatchSolver
-from pinmech.solve_cycle import RangeChunk, solve_range
-from pinmech.solve_loops import LoopSolver, Reference
-from pinmech.solve_rates import RateSolver, Task
-from pinmech.sweep import Sweep, SweepPose
-from pinmech.units import to_si
+
+#: The rest of the public API, by module: imported on first use (`pinmech.Sweep` imports
+#: pinmech.sweep then), so `pinmech solve` or a script that needs one module does not pay
+#: for the others' imports (forces, drawing, linkage files, MJCF, sweeps...).
+_LAZY = {
+    "pinmech.analysis": ("Analysis", "analyse"),
+    "pinmech.branches": ("Assembly",),
+    "pinmech.check": ("compare", "load_hand_file"),
+    "pinmech.closures": ("Closure",),
+    "pinmech.continuation": ("Route",),
+    "pinmech.draw.report_page": ("HtmlPage", "report_html", "snapshot"),
+    "pinmech.flywheel": ("EnergyFluctuation", "energy_fluctuation"),
+    "pinmech.forces": ("ForceSolution", "ForceSolver", "Load", "PowerBalance", "Reaction", "mechanical_advantage"),
+    "pinmech.forces_scene": ("ForceSettings", "force_settings"),
+    "pinmech.forces_sweep": ("SweepForces",),
+    "pinmech.linkage": ("build_urdf", "load_linkage"),
+    "pinmech.mechanism": ("JointInfo", "Mechanism"),
+    "pinmech.mjcf": ("load_mjcf",),
+    "pinmech.motion": ("CoincidentPoint", "Motion", "evaluate_motion"),
+    "pinmech.path": ("PathPoint", "follow_path"),
+    "pinmech.polygon": ("Polygon", "acceleration_polygon", "velocity_polygon"),
+    "pinmech.report": ("to_dict", "to_json", "to_text"),
+    "pinmech.results": ("Accuracy", "LoopSolution", "RateSolution"),
+    "pinmech.scene": ("Scene",),
+    "pinmech.scene_model": ("Drivers", "load_mechanism"),
+    "pinmech.sidecar": ("load_extended_urdf",),
+    "pinmech.solve_batch": ("BatchSolution", "BatchSolver"),
+    "pinmech.solve_cycle": ("RangeChunk", "solve_range"),
+    "pinmech.solve_loops": ("LoopSolver", "Reference"),
+    "pinmech.solve_rates": ("RateSolver", "Task"),
+    "pinmech.sweep": ("Sweep", "SweepPose"),
+    "pinmech.units": ("to_si",),
+}
+_MODULE_OF = {name: module for module, names in _LAZY.items() for name in names}
+
+
+def __getattr__(name: str):
+    """A public name of a module not imported yet (PEP 562): import it, then keep the name
+    here as an eager import would."""
+    module = _MODULE_OF.get(name)
+    if module is None:
+        raise AttributeError(f"module 'pinmech' has no attribute {name!r}")
+    value = getattr(_import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_MODULE_OF))
+
 
 __version__ = "0.1.0"
 

@@ -8,12 +8,10 @@ This is the one function the CLI's `solve` and a user's script share:
 
 from __future__ import annotations
 
-from pinmech.analysis_task import analyse_task
 from pinmech.exceptions import SceneError
-from pinmech.forces_scene import analyse_forces, wants_forces
 from pinmech.motion import evaluate_motion
 from pinmech.results import Analysis
-from pinmech.scene import Scene
+from pinmech.scene import Scene, wants_forces
 from pinmech.scene_model import (
     check_scene_names,
     coincident_points,
@@ -37,6 +35,7 @@ def analyse(scene: Scene, *, forces: bool = False, static: bool = False, minimum
         if forces or static or wants_forces(scene):
             raise SceneError("forces are computed for driven mechanisms ([drivers]), not for [[task]] scenes",
                              path=str(scene.path), key="forces")
+        from pinmech.analysis_task import analyse_task
 
         return analyse_task(scene)
     scene.solver_options()  # settings first: a bad one is named before the model is read
@@ -51,6 +50,8 @@ def analyse(scene: Scene, *, forces: bool = False, static: bool = False, minimum
                              points=points, links=links, coincident=coincident_points(scene))
     if not (forces or static or wants_forces(scene)):
         return Analysis(scene, mechanism, drivers, solution, motion)
+    from pinmech.forces_scene import analyse_forces
+
     force_solution, extra = analyse_forces(scene, mechanism, drivers.names, solution.q, solution.v, solution.a,
                                            static=static, minimum_norm=minimum_norm)
     return Analysis(scene, mechanism, drivers, solution, motion, extra=extra, forces=force_solution)

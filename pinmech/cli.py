@@ -17,11 +17,14 @@ import signal
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from pinmech import __version__
 from pinmech.exceptions import PinmechError
 from pinmech.interrupts import SIGNALS
-from pinmech.outputs import Outputs, check_distinct, plot_path, write_whole
+
+if TYPE_CHECKING:
+    from pinmech.outputs import Outputs
 
 
 def _add_scene_arguments(parser: argparse.ArgumentParser) -> None:
@@ -62,9 +65,11 @@ def _add_limits_argument(parser: argparse.ArgumentParser) -> None:
                         help="a joint beyond its URDF <limit>: a warning (default) or an error (exit 12)")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser, with one sub-parser per subcommand."""
-    parser = argparse.ArgumentParser(
+def build_parser(command: str | None = None, *, parser_class: type[argparse.ArgumentParser] = argparse.ArgumentParser
+                 ) -> argparse.ArgumentParser:
+    """The argument parser, with one sub-parser per subcommand (only `command`'s when given:
+    `main` parses a subcommand's arguments with its parser alone, see `parse_args`)."""
+    parser = parser_class(
         prog="pinmech",
         description="Kinematics of mechanisms and robot arms from URDF, on Pinocchio.",
         epilog="Exit codes: 0 ok, 1 check mismatch, 2 error, 3 URDF, 4 scene, 5 mobility, "
@@ -73,19 +78,29 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"pinmech {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
+    for name, add in _SUBCOMMANDS.items():
+        if command is None or name == command:
+            add(sub)
+    return parser
 
+
+def _solve_parser(sub) -> None:
     solve = sub.add_parser("solve", help="solve a scene and print the report (or JSON)")
     _add_scene_arguments(solve)
     solve.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of text")
     _add_limits_argument(solve)
     solve.set_defaults(func=cmd_solve)
 
+
+def _forces_parser(sub) -> None:
     forces = sub.add_parser("forces", help="driver torques and joint reactions at the scene's pose (inverse dynamics)")
     _add_scene_arguments(forces)
     _add_force_arguments(forces)
     forces.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of text")
     forces.set_defaults(func=cmd_forces)
 
+
+def _sweep_parser(sub) -> None:
     sweep = sub.add_parser("sweep", help="sweep a driver through a cycle (or follow an arm's task in time): "
                            "CSV, JSON lines and a figure")
     _add_scene_arguments(sweep)
@@ -133,6 +148,8 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--torque-plot", dest="torque_plot", help="draw the driver's torque curve here (pinmech[plot])")
     sweep.set_defaults(func=cmd_sweep)
 
+
+def _path_parser(sub) -> None:
     path = sub.add_parser("path", help="integrate an arm's task over time: joint trajectory and drift")
     path.add_argument("scene", help="a task scene, e.g. models/scenes/planar_arm.toml")
     path.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
@@ -142,6 +159,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_output_arguments(path)
     path.set_defaults(func=cmd_path)
 
+
+def _snapshot_parser(sub) -> None:
     snap = sub.add_parser("snapshot", help="save the solved pose as an offline meshcat HTML page (pinmech[viz])")
     _add_scene_arguments(snap)
     snap.add_argument("-o", "--output", required=True, help="the HTML file to write")
@@ -150,6 +169,8 @@ def build_parser() -> argparse.ArgumentParser:
     snap.add_argument("--no-grid", action="store_true", help="hide meshcat's grid and axes")
     snap.set_defaults(func=cmd_snapshot)
 
+
+def _animate_parser(sub) -> None:
     anim = sub.add_parser("animate", help="save a driver cycle as an offline meshcat animation (pinmech[viz])")
     _add_scene_arguments(anim)
     anim.add_argument("-o", "--output", required=True, help="the HTML file to write")
@@ -161,6 +182,8 @@ def build_parser() -> argparse.ArgumentParser:
     anim.add_argument("--no-grid", action="store_true", help="hide meshcat's grid and axes")
     anim.set_defaults(func=cmd_animate)
 
+
+def _polygon_parser(sub) -> None:
     poly = sub.add_parser("polygon", help="draw the velocity (or acceleration) polygon of a planar pose as SVG")
     poly.add_argument("scene", help="scene file (TOML), e.g. models/scenes/r_rtr.toml")
     poly.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
@@ -173,6 +196,8 @@ def build_parser() -> argparse.ArgumentParser:
                       "driver's acceleration comes from the scene or --set")
     poly.set_defaults(func=cmd_polygon)
 
+
+def _report_parser(sub) -> None:
     page = sub.add_parser("report", help="write one offline HTML page: drawing, tables, polygons, sweep figures")
     _add_scene_arguments(page)
     page.add_argument("-o", "--output", required=True, help="the HTML file to write")
@@ -180,15 +205,21 @@ def build_parser() -> argparse.ArgumentParser:
     page.add_argument("--steps", type=int, default=121, help="poses of the sweep drawn (default 121; 0: none)")
     page.set_defaults(func=cmd_report)
 
+
+def _view_parser(sub) -> None:
     live = sub.add_parser("view", help="show the solved pose in a live meshcat server (a browser tab)")
     _add_scene_arguments(live)
     live.set_defaults(func=cmd_view)
 
+
+def _build_parser(sub) -> None:
     build = sub.add_parser("build", help="write the URDF (with <constraint> loop cuts) of a linkage drawn in TOML")
     build.add_argument("linkage", help="linkage file (TOML), e.g. models/linkages/jansen.toml")
     build.add_argument("-o", "--output", required=True, help="the URDF file to write")
     build.set_defaults(func=cmd_build)
 
+
+def _check_parser(sub) -> None:
     check = sub.add_parser("check", help="compare hand-calculated values with pinmech")
     check.add_argument("hand_file", help="hand-value file (TOML), e.g. models/scenes/r_rtr.hand.toml")
     check.add_argument("--slack", type=float, default=None,
@@ -196,7 +227,22 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                        help="override a value of the hand file's scene")
     check.set_defaults(func=cmd_check)
-    return parser
+
+
+#: Each subcommand's parser, in the order `pinmech --help` lists them.
+_SUBCOMMANDS = {
+    "solve": _solve_parser,
+    "forces": _forces_parser,
+    "sweep": _sweep_parser,
+    "path": _path_parser,
+    "snapshot": _snapshot_parser,
+    "animate": _animate_parser,
+    "polygon": _polygon_parser,
+    "report": _report_parser,
+    "view": _view_parser,
+    "build": _build_parser,
+    "check": _check_parser,
+}
 
 
 def _scene(args: argparse.Namespace):
@@ -248,7 +294,7 @@ def cmd_forces(args: argparse.Namespace) -> int:
 
 def _sweep_forces(args: argparse.Namespace, scene, sweep):
     """The forces of a sweep when asked (flags or the scene's force tables), else None."""
-    from pinmech.forces_scene import wants_forces
+    from pinmech.scene import wants_forces
 
     asked = args.forces or args.static or args.minimum_norm or args.flywheel or args.torque_plot
     if not (asked or wants_forces(scene)):
@@ -358,6 +404,7 @@ class _LimitWatch:
 
 
 def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | None, forces=None) -> Outputs:
+    from pinmech.outputs import Outputs, plot_path
     from pinmech.tables import SweepCsv, SweepJsonLines
 
     csv_kind, json_kind, source = SweepCsv, SweepJsonLines, sweep
@@ -402,6 +449,8 @@ class _PathsFigure:
 def _check_outputs(args: argparse.Namespace, scene) -> Path | None:
     """Before computing: the figure's format, one file per output, no output over an input.
     Returns the figure's path (".png" added to a name without suffix)."""
+    from pinmech.outputs import check_distinct, plot_path
+
     figure = plot_path(args.plot_path) if args.plot_path else None
     if getattr(args, "paths_path", None):
         args.paths_path = plot_path(args.paths_path, "--paths")
@@ -445,6 +494,7 @@ def _follow(args: argparse.Namespace, scene) -> int:
     """A task scene followed in time: CSV (JSON lines, a figure) of the joint trajectory."""
     from pinmech.analysis_task import scene_pose, scene_tasks
     from pinmech.limits import limits_at
+    from pinmech.outputs import Outputs
     from pinmech.path import check_timing, follow_path, step_count
     from pinmech.scene_model import limit_mode, load_mechanism
     from pinmech.sweep import sweep_options
@@ -656,10 +706,14 @@ def _write_text(path: str, text: str, what: str) -> None:
 
 def _check_page(args: argparse.Namespace, scene) -> None:
     """Before computing: the page's file can be made and is not an input."""
+    from pinmech.outputs import check_distinct
+
     check_distinct({"-o": args.output}, {"the scene file": scene.path, "the URDF": _urdf_path(scene)})
 
 
 def _write(path: str, html: str) -> None:
+    from pinmech.outputs import write_whole
+
     write_whole(path, html)
     print(f"wrote {path} ({len(html) // 1024} KB, offline: open it in any browser)", file=sys.stderr)
 
@@ -702,10 +756,34 @@ def cmd_check(args: argparse.Namespace) -> int:
     return 1 if any(v.verdict == "MISMATCH" for v in verdicts) else 0
 
 
+class _ParseAgain(Exception):
+    """A command line the one-subcommand parser cannot take."""
+
+
+class _SubcommandOnly(argparse.ArgumentParser):
+    """A parser that stops at an error instead of printing it: `parse_args` then parses
+    again with every subcommand's parser, which says what is wrong as it always has."""
+
+    def error(self, message: str):
+        raise _ParseAgain(message)
+
+
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    """The command line parsed, building only the parser of the subcommand it names
+    (all eleven, with their help texts, take about 10 ms to build). Any error, and
+    `pinmech --help`, go through the full parser: the messages are the same."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv and argv[0] in _SUBCOMMANDS:
+        try:
+            return build_parser(argv[0], parser_class=_SubcommandOnly).parse_args(argv)
+        except _ParseAgain:
+            pass
+    return build_parser().parse_args(argv)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; every pinmech error becomes one line on stderr and its exit code."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parse_args(argv)
     try:
         with SIGNALS.installed():
             return args.func(args)

@@ -59,11 +59,6 @@ class ForceSettings:
     flywheel: float | None
 
 
-def wants_forces(scene: Scene) -> bool:
-    """True when the scene has a `[forces]`, `[gravity]` or `[[load]]` table."""
-    return any(key in scene.raw for key in ("forces", "gravity", "load"))
-
-
 def force_settings(scene: Scene) -> ForceSettings:
     """The scene's force tables, checked (keys, types, units).
 

@@ -44,13 +44,14 @@ class RankReport:
     redundant: tuple[str, ...] = ()
 
 
-def stacked_jacobian(mech, data: pin.Data, q: np.ndarray) -> np.ndarray:
-    """Every closure's rows, stacked, with dimensionless columns (prismatic x size) at q."""
+def stacked_jacobian(mech, data: pin.Data, q: np.ndarray, scale: np.ndarray | None = None) -> np.ndarray:
+    """Every closure's rows, stacked, with dimensionless columns (prismatic x size) at q;
+    `scale`: the mechanism's `velocity_scale()`, when the caller has it already."""
     pin.computeJointJacobians(mech.model, data, q)
     pin.updateFramePlacements(mech.model, data)
     rows = [c.jacobian(mech.model, data) for c in mech.closures]
     J = np.vstack(rows) if rows else np.zeros((0, mech.model.nv))
-    return J * mech.velocity_scale()
+    return J * (mech.velocity_scale() if scale is None else scale)
 
 
 def _residual(mech, data: pin.Data, q: np.ndarray) -> np.ndarray:
@@ -59,14 +60,15 @@ def _residual(mech, data: pin.Data, q: np.ndarray) -> np.ndarray:
     return np.concatenate(parts) if parts else np.zeros(0)
 
 
-def close_least_squares(mech, data: pin.Data, q: np.ndarray, iterations: int = 60) -> np.ndarray | None:
+def close_least_squares(mech, data: pin.Data, q: np.ndarray, iterations: int = 60,
+                        scale: np.ndarray | None = None) -> np.ndarray | None:
     """Gauss-Newton with minimum-norm steps: a closed configuration near q, or None."""
-    scale = mech.velocity_scale()
+    scale = mech.velocity_scale() if scale is None else scale
     for _ in range(iterations):
         r = _residual(mech, data, q)
         if np.max(np.abs(r), initial=0.0) < _CLOSE_TOL:
             return q
-        J = stacked_jacobian(mech, data, q)
+        J = stacked_jacobian(mech, data, q, scale)
         step = np.linalg.lstsq(J, -r, rcond=1e-10)[0]
         size = np.max(np.abs(step), initial=0.0)
         if size > 0.5:
@@ -83,34 +85,38 @@ def _rank(J: np.ndarray) -> int:
 
 
 def constraint_rank(mech) -> RankReport:
-    """The generic rank of the closure rows on the closed poses near the reference."""
+    """The generic rank of the closure rows on the closed poses near the reference (full
+    rank on the first closed pose settles it: no other pose is sampled)."""
     rows = sum(c.rows for c in mech.closures)
     if rows == 0:
         return RankReport(0, 0, mech.neutral())
     data = mech.model.createData()
-    q0 = _closed_start(mech, data)
+    scale = mech.velocity_scale()  # fixed while the rank is sought: computed once
+    q0 = _closed_start(mech, data, scale)
     if q0 is None:
         return RankReport(rows, rows, None)
+    J0 = stacked_jacobian(mech, data, q0, scale)
+    if _rank(J0) == rows:  # no pose has more than full rank: the neighbours below could not raise it
+        return RankReport(rows, rows, q0)
     rng = np.random.default_rng(20261122)
     poses = [q0]
+    null = _null_space(J0)
     for _ in range(_NEIGHBOURS):
-        J = stacked_jacobian(mech, data, q0)
-        null = _null_space(J)
         if null.shape[1] == 0:
             break
         step = null @ rng.normal(size=null.shape[1])
         step *= _STEP / max(np.max(np.abs(step)), 1e-300)
-        q = close_least_squares(mech, data, pin.integrate(mech.model, q0, step * mech.velocity_scale()))
+        q = close_least_squares(mech, data, pin.integrate(mech.model, q0, step * scale), scale=scale)
         if q is not None:
             poses.append(q)
     if len(poses) == 1:  # no neighbour closed: other closed poses, so one singular pose cannot decide
         seeds = np.random.default_rng(11)
         for _ in range(4):
-            start = pin.integrate(mech.model, q0, seeds.normal(size=mech.model.nv) * mech.velocity_scale())
-            q = close_least_squares(mech, data, start)
+            start = pin.integrate(mech.model, q0, seeds.normal(size=mech.model.nv) * scale)
+            q = close_least_squares(mech, data, start, scale=scale)
             if q is not None:
                 poses.append(q)
-    jacobians = [stacked_jacobian(mech, data, q) for q in poses]
+    jacobians = [J0] + [stacked_jacobian(mech, data, q, scale) for q in poses[1:]]
     ranks = [_rank(J) for J in jacobians]
     best = int(np.argmax(ranks))
     rank = ranks[best]
@@ -126,15 +132,15 @@ def constraint_rank(mech) -> RankReport:
     return RankReport(rank, rows, poses[best], redundant)
 
 
-def _closed_start(mech, data: pin.Data) -> np.ndarray | None:
+def _closed_start(mech, data: pin.Data, scale: np.ndarray) -> np.ndarray | None:
     """The reference configuration, closed; else a few seeded starts around it."""
-    q = close_least_squares(mech, data, mech.neutral())
+    q = close_least_squares(mech, data, mech.neutral(), scale=scale)
     rng = np.random.default_rng(7)
     for _ in range(3):
         if q is not None:
             return q
-        start = pin.integrate(mech.model, mech.neutral(), rng.normal(size=mech.model.nv) * mech.velocity_scale())
-        q = close_least_squares(mech, data, start)
+        start = pin.integrate(mech.model, mech.neutral(), rng.normal(size=mech.model.nv) * scale)
+        q = close_least_squares(mech, data, start, scale=scale)
     return q
 
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 from typing import Any
 
@@ -100,6 +99,8 @@ def _pinned(analysis: Analysis) -> bool:
 
 def to_json(analysis: Analysis) -> str:
     """`to_dict` as indented JSON text (non-finite numbers become null)."""
+    import json  # here: a text report does not need it
+
     return json.dumps(_finite(to_dict(analysis)), indent=2)
 
 

@@ -34,6 +34,13 @@ SOLVER_RANGES = {"tol": (1e-16, 1e-3), "max_iterations": (1, 1000), "max_conditi
 #: The keys that name the model file; a scene gives exactly one.
 MODEL_KEYS = ("urdf", "robot", "linkage", "mjcf")
 _DRIVER_KEYS = {"angle": 0, "position": 0, "speed": 1, "velocity": 1, "acceleration": 2}
+#: The tables that turn a scene's force analysis on (forces_scene.py reads them).
+FORCE_KEYS = ("forces", "gravity", "load")
+
+
+def wants_forces(scene: Scene) -> bool:
+    """True when the scene has a `[forces]`, `[gravity]` or `[[load]]` table."""
+    return any(key in scene.raw for key in FORCE_KEYS)
 
 
 @dataclass

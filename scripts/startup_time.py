@@ -21,6 +21,7 @@ Run: python scripts/startup_time.py [--runs 10] [--scene FILE] [--out FILE.md]
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import os
 import re
 import statistics
@@ -139,6 +140,20 @@ def solve_after_import(scene: Path) -> tuple[float, float]:
     return first, second
 
 
+def uncompiled_modules() -> list[str]:
+    """pinmech's source files that every timed run compiles again: they have no bytecode in
+    `__pycache__` (or an older one), and PYTHONDONTWRITEBYTECODE, which the commands inherit,
+    keeps the untimed round from writing it. Empty when the bytecode is, or will be, cached."""
+    if not os.environ.get("PYTHONDONTWRITEBYTECODE"):
+        return []
+    out = []
+    for source in sorted((ROOT / "pinmech").rglob("*.py")):
+        cached = Path(importlib.util.cache_from_source(str(source)))
+        if not cached.is_file() or cached.stat().st_mtime < source.stat().st_mtime:
+            out.append(str(source.relative_to(ROOT)))
+    return out
+
+
 def _short(where: str) -> str:
     """A profiler location with site-packages and the checkout stripped."""
     where = where.replace(str(ROOT) + os.sep, "")
@@ -162,6 +177,12 @@ def report(scene: Path, runs: int, top: int) -> tuple[str, float]:
     verdict = "met" if ratio <= 1.5 else "not met"
     lines += ["", (f"`{names[2]}` takes {ratio:.2f} x `{names[1]}` (medians; issue 13's target: at most "
               f"1.5 x): {verdict}."), ""]
+    uncached = uncompiled_modules()
+    if uncached:
+        lines += [(f"Every `pinmech solve` above compiled pinmech's own modules from source ({len(uncached)} files "
+                   "without cached bytecode, and PYTHONDONTWRITEBYTECODE is set, so no run could cache it), which "
+                   "numpy and Pinocchio, compiled when installed, do not pay: with its bytecode cached (after an "
+                   "installation, or one run without that variable) pinmech starts faster than measured here."), ""]
     by_package, modules, total = import_costs(cmds[names[2]])
     lines += [f"Imports of `pinmech solve` (python -X importtime, one run; {_ms(total)} ms in all, "
               "inflated by the profiling), self time summed by top-level package [ms]: "

@@ -1,0 +1,140 @@
+"""What `pinmech solve` imports and builds (issue 13 item 4: start-up time), guarded without
+timing anything: the modules a plain solve does not need stay unimported, and the CLI
+parses a subcommand with that subcommand's parser alone, saying the same on an error."""
+
+from __future__ import annotations
+
+import ast
+import contextlib
+import io
+import json
+import subprocess
+import sys
+
+import pytest
+
+import pinmech
+from pinmech import cli
+
+#: Modules a plain `pinmech solve` of a URDF scene must not import: each is imported where
+#: it is used (forces, task scenes, sweeps, drawings, linkage files, MJCF, sidecars, hand
+#: checks, output files, JSON), so the command does not pay for it.
+NOT_FOR_A_SOLVE = (
+    "pinmech.analysis_task", "pinmech.solve_rates",  # task scenes ([[task]])
+    "pinmech.forces", "pinmech.forces_scene", "pinmech.forces_report", "pinmech.forces_sweep",
+    "pinmech.flywheel",  # force analyses
+    "pinmech.sweep", "pinmech.solve_cycle", "pinmech.solve_batch", "pinmech.hermite", "pinmech.cut_arrays",
+    "pinmech.tables", "pinmech.outputs", "pinmech.path",  # sweeps, paths, their output files
+    "pinmech.draw", "pinmech.draw.report_page", "pinmech.polygon", "pinmech.plot", "pinmech.link_nodes",
+    "pinmech.check", "pinmech.linkage", "pinmech.linkage_urdf", "pinmech.mjcf", "pinmech.sidecar",
+    "json", "pint", "matplotlib", "meshcat",
+)
+
+_SOLVE_IN_A_FRESH_PROCESS = """
+import contextlib, io, sys
+import pinmech.cli
+with contextlib.redirect_stdout(io.StringIO()) as out:
+    code = pinmech.cli.main(sys.argv[1:])
+print(repr({"code": code, "report": out.getvalue(), "modules": sorted(sys.modules)}))
+"""
+
+
+def _solve_in_a_fresh_process(*args: str) -> dict:
+    """`main(["solve", *args])` in a fresh interpreter: exit code, report, every module
+    imported (read back with `ast.literal_eval`: the harness imports nothing of its own)."""
+    done = subprocess.run([sys.executable, "-c", _SOLVE_IN_A_FRESH_PROCESS, "solve", *args],
+                          capture_output=True, text=True, check=True)
+    return ast.literal_eval(done.stdout)
+
+
+def test_a_plain_solve_imports_none_of_the_modules_it_does_not_use(r_rtr_scene):
+    run = _solve_in_a_fresh_process(str(r_rtr_scene))
+    assert run["code"] == 0 and "Accuracy" in run["report"]
+    imported = set(run["modules"])
+    assert "pinmech.analysis" in imported and "pinocchio" in imported  # the solve did run
+    assert sorted(imported & set(NOT_FOR_A_SOLVE)) == []
+
+
+def test_the_json_report_still_imports_json(r_rtr_scene):
+    run = _solve_in_a_fresh_process(str(r_rtr_scene), "--json")
+    assert run["code"] == 0 and "json" in run["modules"]
+    assert json.loads(run["report"])["accuracy"]["newton_iterations"] >= 0
+
+
+def test_importing_pinmech_imports_its_modules_on_first_use():
+    code = ("import sys, pinmech; before = {m for m in sys.modules if m.startswith('pinmech.')}; "
+            "pinmech.Sweep; print(sorted(before), 'pinmech.sweep' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "['pinmech.exceptions'] True"
+
+
+def test_every_public_name_resolves_to_its_module():
+    for name in pinmech.__all__:
+        value = getattr(pinmech, name)
+        module = getattr(value, "__module__", None)
+        assert name == "__version__" or (module or "").startswith("pinmech."), name
+    assert set(pinmech.__all__) <= set(dir(pinmech))
+    assert pinmech.Sweep is __import__("pinmech.sweep", fromlist=["Sweep"]).Sweep
+    with pytest.raises(AttributeError, match="no attribute 'Nothing'"):
+        pinmech.Nothing  # noqa: B018
+
+
+def _parsed(parse, argv: list[str]):
+    """What a parse gives: the namespace (its function by name), or the exit code, with
+    everything printed."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            args = vars(parse(argv)).copy()
+            args["func"] = args["func"].__name__
+            result = sorted(args.items())
+        except SystemExit as exc:
+            result = exc.code
+    return result, out.getvalue(), err.getvalue()
+
+
+@pytest.mark.parametrize("argv", [
+    ["solve", "s.toml"], ["solve", "s.toml", "--json", "--angle", "45 deg", "--set", "a=1", "--set", "b=2"],
+    ["solve", "s.toml", "--limits", "bad"], ["solve", "s.toml", "extra"], ["solve"], ["solve", "-h"],
+    ["solve", "s.toml", "--version"], ["sweep", "s.toml", "--steps", "x"], ["sweep", "-h"],
+    ["check", "h.toml", "--slack", "3"], ["build", "l.toml"], ["report", "s.toml", "-o", "r.html", "--steps", "0"],
+    [], ["-h"], ["--version"], ["nope", "s.toml"],
+])
+def test_a_subcommand_parsed_alone_reads_and_says_what_the_full_parser_does(argv, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "100")  # both help texts wrapped alike
+    assert _parsed(cli.parse_args, argv) == _parsed(lambda a: cli.build_parser().parse_args(a), argv)
+
+
+def test_a_valid_solve_command_line_builds_the_solve_parser_only(monkeypatch, r_rtr_scene):
+    built = []
+    build = cli.build_parser
+
+    def recording(command=None, **kwargs):
+        built.append(command)
+        return build(command, **kwargs)
+
+    monkeypatch.setattr(cli, "build_parser", recording)
+    cli.parse_args(["solve", str(r_rtr_scene), "--angle", "45 deg"])
+    assert built == ["solve"]
+    built.clear()
+    with pytest.raises(SystemExit), contextlib.redirect_stderr(io.StringIO()):
+        cli.parse_args(["solve", str(r_rtr_scene), "--no-such-option"])
+    assert built == ["solve", None]  # the error is the full parser's
+
+
+def test_loops_of_full_rank_on_their_first_closed_pose_are_not_sampled_around(monkeypatch, models_dir):
+    """The mobility check closes one pose; only a rank below the row count (loops that may
+    repeat each other) sends it to close neighbouring poses (tests/test_mobility.py)."""
+    from pinmech import mobility
+    from pinmech.mechanism import Mechanism
+
+    closings = []
+    close = mobility.close_least_squares
+
+    def counting(*args, **kwargs):
+        closings.append(1)
+        return close(*args, **kwargs)
+
+    monkeypatch.setattr(mobility, "close_least_squares", counting)
+    report = mobility.constraint_rank(Mechanism.from_urdf(models_dir / "r_rtr.urdf"))
+    assert (report.rank, report.rows, report.redundant, len(closings)) == (2, 2, (), 1)
