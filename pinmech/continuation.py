@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from pinmech.core import core_for
 from pinmech.exceptions import AssemblyError, DriverLimitError, PinmechError
 
 #: Largest step, in radians or mechanism sizes of driver motion.
@@ -120,6 +121,15 @@ class Path:
         `at_q` the solver's data already holds q's placements and Jacobians, and
         `residual` is the closure residual measured there."""
         solver = self.solver
+        compiled = core_for(solver)
+        if compiled is not None:  # the same numbers from the compiled core (tests/test_core.py)
+            d1, d2, signs, condition, sigma_min, v_res, a_res, res = compiled.node(q, self.d)
+            if math.isfinite(sum(d1.tolist()) + sum(d2.tolist())):  # else the Python path names the overflow
+                signs = tuple(signs)
+                if not condition <= SINGULAR_NODE or 0 in signs:
+                    raise _Singular
+                return Node(p, q, d1, d2, signs, condition, sigma_min, v_res, a_res,
+                            res if not at_q or residual is None else residual)
         if not at_q or residual is None:
             residual = max(max(map(abs, solver._residual(q).tolist()), default=0.0), solver._full_residual())
         d1, d2, condition, sigma_min, v_res, a_res, signs = solver._rates(q, self.d, self.zero, limit=math.inf)

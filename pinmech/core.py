@@ -26,6 +26,7 @@ JOINT_CODES = {
 }
 _AXIS_CODES = {3, 7, 11}
 CUT_CODES = {"revolute": 0, "prismatic": 1, "spherical": 2, "fixed": 3}
+DEFAULT_TOL = _core.DEFAULT_TOL
 #: PINMECH_CORE=0 in the environment solves everything by the Python path (tests compare
 #: the two; a user can rule the core out when in doubt).
 ENABLED = os.environ.get("PINMECH_CORE", "1") != "0"
@@ -64,6 +65,14 @@ class CompiledModel:
         self.frames = {fid: i for i, fid in enumerate(dict.fromkeys(frame_ids))}
         self.frame_parents = [int(model.frames[fid].parentJoint) for fid in self.frames]
         self.frame_placements = placement_rows([model.frames[fid].placement for fid in self.frames])
+        self.nv = model.nv
+
+    def kinematics(self) -> _core.Core:
+        """A core with these frames and no loops (for `Core.frame_motion`)."""
+        none = np.zeros((0, 3))
+        return _core.Core(self.types, self.parents, self.placements, self.axes, self.frame_parents,
+                          self.frame_placements, [], [], [], none, none, [], [], [], [], [], [], np.ones(self.nv),
+                          [], [], DEFAULT_TOL)
 
 
 def core_for(solver) -> _core.Core | None:
@@ -89,29 +98,39 @@ def _key(solver) -> tuple:
 
 
 def _build(solver) -> _core.Core | None:
-    model, closures = solver.model, solver.mechanism.closures
+    closures = solver.mechanism.closures
     if not closures or solver.model.nv == 0:
         return None
-    frames = [f for c in closures for f in (c.parent_frame, c.child_frame)]
+    built = compile_loops(solver.model, closures, solver.mechanism.velocity_scale(), tol=solver.tol,
+                          drv_v=solver._drv_v, dep_v=solver._dep_v, drv_q=solver._drv_q,
+                          blocks=solver.structure.blocks)
+    return None if built is None else built[0]
+
+
+def compile_loops(model: pin.Model, closures: list, v_scale: np.ndarray, *, extra_frames: list[int] = (),
+                  tol: float = DEFAULT_TOL, drv_v=(), dep_v=(), drv_q=(), blocks=()):
+    """A core of the model with its loop closures (rows as the Closure objects state them)
+    and the frames asked, with the drivers' and dependent joints' indices for sweeps:
+    (core, its CompiledModel), or None where the core cannot rebuild the model."""
+    frames = [f for c in closures for f in (c.parent_frame, c.child_frame)] + list(extra_frames)
     try:
         compiled = CompiledModel(model, frames)
     except KeyError:
         return None
     rows6 = [np.ascontiguousarray(c._rows6, dtype=float) for c in closures]
     full = [np.ascontiguousarray(c.selected * c._scale(), dtype=float) for c in closures]
-    blocks = solver.structure.blocks
+    axes = np.array([c.axis for c in closures], dtype=float).reshape(-1, 3)
+    child_axes = np.array([c.child_axis for c in closures], dtype=float).reshape(-1, 3)
     core = _core.Core(
         compiled.types, compiled.parents, compiled.placements, compiled.axes,
         compiled.frame_parents, compiled.frame_placements,
         [CUT_CODES[c.cut_type] for c in closures],
         [compiled.frames[c.parent_frame] for c in closures], [compiled.frames[c.child_frame] for c in closures],
-        np.array([c.axis for c in closures], dtype=float), np.array([c.child_axis for c in closures], dtype=float),
-        rows6, full, [int(v) for v in solver._drv_v], [int(v) for v in solver._dep_v],
-        [int(i) for i, _ in solver._drv_q], [int(c) for _, c in solver._drv_q],
-        np.asarray(solver.mechanism.velocity_scale(), dtype=float),
-        [list(map(int, b.rows)) for b in blocks], [list(map(int, b.cols)) for b in blocks], float(solver.tol),
+        axes, child_axes, rows6, full, [int(v) for v in drv_v], [int(v) for v in dep_v],
+        [int(i) for i, _ in drv_q], [int(c) for _, c in drv_q], np.asarray(v_scale, dtype=float),
+        [list(map(int, b.rows)) for b in blocks], [list(map(int, b.cols)) for b in blocks], float(tol),
     )
     same = (core.nq == model.nq and core.nv == model.nv
             and core.idx_q == [model.joints[j].idx_q for j in range(1, model.njoints)]
             and core.idx_v == [model.joints[j].idx_v for j in range(1, model.njoints)])
-    return core if same else None
+    return (core, compiled) if same else None

@@ -34,7 +34,7 @@ from itertools import islice
 
 import numpy as np
 
-from pinmech.continuation import Node, Path, Route
+from pinmech.continuation import Node, Path, Route, _Singular
 from pinmech.core import core_for
 from pinmech.exceptions import (
     AssemblyError,
@@ -167,7 +167,9 @@ class _Cycle:
                                "rest (zero speed and acceleration): their motion is not the swept driver's path")
         batch = batch and self.alone
         self.start, self.interpolate = start, int(interpolate)
-        self.batch = BatchSolver(solver) if batch and start == "predictor" and solver._cuts else None
+        # the batched levels serve the Python path only: the compiled core follows every pose
+        self.batch = (BatchSolver(solver) if batch and start == "predictor" and solver._cuts
+                      and core_for(solver) is None else None)
         self.measurer = (self.batch or BatchSolver(solver)) if interpolate > 1 and solver._cuts else None
         self.guess = None if guess is None else np.asarray(guess, dtype=float)
         self.ref: Node | None = None  # the last pose solved: p is the swept value, d1 and d2 its path derivatives
@@ -198,6 +200,9 @@ class _Cycle:
         if self.start != "predictor" or self.mirror != (1.0, 0.0):  # past a fold: pose by pose
             return self._sequential(index, xs)
         if ref is None:  # the first pose, from the user's guess, then the rest
+            fast = self._from_reference(index, xs)
+            if fast is not None:
+                return fast
             head = self._sequential(index, xs[:1])
             if len(xs) == 1:
                 return head
@@ -211,6 +216,27 @@ class _Cycle:
         except _Fallback:  # near trouble: pose by pose, each failure named
             self.ref = ref
             return self._sequential(index, xs)
+
+    def _from_reference(self, index: int, xs: np.ndarray) -> RangeChunk | None:
+        """The first pose and the rest followed from the solver's reference in one call of
+        the compiled core, where the sweep's driver path passes through the reference (the
+        other drivers at its values, the first pose within a turn of it); None otherwise,
+        or where the core hands a pose back (`_first` then takes the first pose)."""
+        solver, ref, k = self.solver, self.solver.reference, self.k
+        compiled = core_for(solver)
+        if compiled is None or ref is None or not ref.keep or self.interpolate > 1:
+            return None
+        if not np.array_equal(np.delete(self.q_drv, k), np.delete(ref.driver_q, k)) \
+                or not abs(float(xs[0]) - float(ref.driver_q[k])) <= 2.0 * math.pi:
+            return None
+        try:
+            self.ref = self.path.node(float(ref.driver_q[k]), ref.q)
+            q, d1, d2, acc = self._compiled(compiled, xs)
+        except (_Fallback, _Singular):
+            self.ref = None
+            return None
+        self.q_drv[k] = self.ref.p
+        return self._actual(index, xs, q, d1, d2, acc, np.zeros(len(xs), dtype=bool))
 
     def _levels(self, xs: np.ndarray) -> tuple[int, ...]:
         """The batched levels this chunk's spacing allows (LEVELS, MAX_SPAN)."""
@@ -463,7 +489,11 @@ class _Cycle:
 
     def _actual(self, index: int, xs: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray,
                 acc: dict[str, np.ndarray], interpolated: np.ndarray) -> RangeChunk:
-        """A chunk in the scene's rates, from path derivatives (as `_scaled`)."""
+        """A chunk in the scene's rates, from path derivatives (as `_scaled`); with other
+        drivers moving too, the rates of every driver's motion at each pose (the path
+        derivatives are the swept driver's share alone)."""
+        if not self.alone:
+            return self._rated(index, xs, q, acc, interpolated)
         w, alpha = float(self.v_drv[self.k]), float(self.a_drv[self.k])
         with np.errstate(over="ignore", invalid="ignore"):
             v, a = d1 * w, d2 * (w * w) + d1 * alpha
@@ -474,6 +504,21 @@ class _Cycle:
             acc["sigma_min"], abs(w) * acc["velocity_residual"],
             w * w * acc["acceleration_residual"] + abs(alpha) * acc["velocity_residual"], self.solver.drivers,
             interpolation=acc["interpolation"] if interpolated.any() else None)
+        return RangeChunk(index, xs, solution, interpolated)
+
+    def _rated(self, index: int, xs: np.ndarray, q: np.ndarray, acc: dict[str, np.ndarray],
+               interpolated: np.ndarray) -> RangeChunk:
+        """A chunk whose rates are solved at each pose with every driver's speed and
+        acceleration (as `_solve` does for the first pose)."""
+        solver, n = self.solver, len(xs)
+        v, a = np.empty((n, solver.model.nv)), np.empty((n, solver.model.nv))
+        numbers = {name: acc[name].copy() for name in _ACCURACY}
+        for j in range(n):
+            v[j], a[j], rated = solver.rates(q[j], self.v_drv, self.a_drv)
+            for name in _ACCURACY[2:]:
+                numbers[name][j] = getattr(rated, name)
+        solution = BatchSolution(q, v, a, *(numbers[name] for name in _ACCURACY), solver.drivers,
+                                 interpolation=acc["interpolation"] if interpolated.any() else None)
         return RangeChunk(index, xs, solution, interpolated)
 
     def _hermite(self, x: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray, solved: np.ndarray,

@@ -84,6 +84,22 @@ STRUCTURAL_RANK_TOL = 1e-9
 _SAMPLES = 3
 
 
+@dataclass(frozen=True)
+class RateBatch:
+    """`RateSolution`s of N poses as arrays: v, a (N, nv); method (N,) as `RateSolution`;
+    condition, sigma_min, closure residuals (N,); achieved task rows (N, rows)."""
+
+    v: np.ndarray
+    a: np.ndarray
+    method: np.ndarray
+    condition: np.ndarray
+    sigma_min: np.ndarray
+    achieved_velocity: np.ndarray
+    achieved_acceleration: np.ndarray
+    closure_velocity_residual: np.ndarray
+    closure_acceleration_residual: np.ndarray
+
+
 class RateSolver:
     """Solves task-space rate problems pose after pose, keeping one `pin.Data`.
 
@@ -167,6 +183,63 @@ class RateSolver:
             closure_velocity_residual=float(np.max(np.abs(achieved_v[:n_c]), initial=0.0)),
             closure_acceleration_residual=float(np.max(np.abs(achieved_a[:n_c]), initial=0.0)),
         )
+
+    @serialized
+    def solve_many(self, q: np.ndarray) -> RateBatch:
+        """`solve` at every row of q (N, nq), with the tasks' own velocities and
+        accelerations, as arrays. The compiled core (core.py) takes the poses of a square
+        task ("exact") conditioned under max_condition; `solve` takes the others, and
+        raises as it does.
+
+        Raises:
+            TaskError, SingularPoseError: as `solve`, at the first pose that has them.
+        """
+        q = np.ascontiguousarray(q, dtype=float)
+        if q.ndim != 2 or q.shape[1] != self.model.nq or not np.all(np.isfinite(q)):
+            raise TaskError(f"q must be an (N, {self.model.nq}) array of finite numbers, got shape {q.shape}")
+        n, m = len(q), self.x_dot.size
+        compiled = self._compiled() if self.method == "exact" else None
+        if compiled is not None:
+            core, frames, rows, local, row_scale = compiled
+            v, a, numbers, achieved_v, achieved_a = core.rates(q, frames, rows, local, self.x_dot, self.x_ddot,
+                                                             row_scale, self.max_condition)
+            condition, sigma_min, closure_v, closure_a, status = numbers.T
+        else:
+            v, a = np.full((n, self.model.nv), np.nan), np.full((n, self.model.nv), np.nan)
+            condition, sigma_min, closure_v, closure_a = (np.full(n, np.nan) for _ in range(4))
+            achieved_v, achieved_a, status = np.full((n, m), np.nan), np.full((n, m), np.nan), np.ones(n)
+        methods = np.full(n, "exact", dtype=object)
+        for i in np.flatnonzero(status != 0):  # the Python path: other methods, singular poses named
+            r = self.solve(q[i])
+            v[i], a[i], condition[i], sigma_min[i] = r.v, r.a, r.condition, r.sigma_min
+            closure_v[i], closure_a[i] = r.closure_velocity_residual, r.closure_acceleration_residual
+            achieved_v[i], achieved_a[i], methods[i] = r.achieved_velocity, r.achieved_acceleration, r.method
+        return RateBatch(v, a, methods, condition, sigma_min, achieved_v, achieved_a, closure_v, closure_a)
+
+    def _compiled(self):
+        """The core with this solver's loops and task frames, and the task rows as it takes
+        them (built once; again when a frame it copied was moved), or None."""
+        from pinmech import core
+
+        if not core.ENABLED:
+            return None
+        frames = [f for c in self.mechanism.closures for f in (c.parent_frame, c.child_frame)] + self.frames
+        key = core.placement_rows([self.model.frames[f].placement for f in frames]).tobytes()
+        cached = self.__dict__.get("_core")
+        if cached is None or cached[0] != key:
+            built = core.compile_loops(self.model, self.mechanism.closures, self.mechanism.velocity_scale(),
+                                       extra_frames=self.frames)
+            value = None
+            if built is not None:
+                compiled, rebuilt = built
+                n_c = sum(c.rows for c in self.mechanism.closures)
+                value = (compiled, [rebuilt.frames[f] for f in self.frames],
+                         [[int(k) for k in t.rows] for t in self.tasks],
+                         [int(t.reference == "local") for t in self.tasks],
+                         np.r_[np.ones(n_c), self._row_scale])
+            cached = (key, value)
+            self.__dict__["_core"] = cached
+        return cached[1]
 
     def _values(self, given: np.ndarray | None, default: np.ndarray, name: str) -> np.ndarray:
         if given is None:

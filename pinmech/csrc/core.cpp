@@ -97,27 +97,31 @@ pin::JointModel joint_model(int type, const Vector3d& axis) {
 double max_abs(const Eigen::Ref<const VectorXd>& x) { return x.size() ? x.cwiseAbs().maxCoeff() : 0.0; }
 
 // A x = b for a small square A, as solve_loops._solve_square: closed forms up to 2x2, LU
-// with partial pivoting above; NaN where A is exactly singular.
-VectorXd solve_square(const MatrixXd& A, const VectorXd& b) {
+// with partial pivoting above (`lu` reused: no allocation per pose); NaN where A is
+// exactly singular.
+void solve_square(const MatrixXd& A, const VectorXd& b, VectorXd& x, Eigen::PartialPivLU<MatrixXd>& lu) {
   const Index n = A.rows();
+  x.resize(n);
   if (n == 1) {
-    return A(0, 0) != 0.0 ? VectorXd::Constant(1, b(0) / A(0, 0)) : VectorXd::Constant(1, NAN);
+    x(0) = A(0, 0) != 0.0 ? b(0) / A(0, 0) : NAN;
+    return;
   }
   if (n == 2) {
     const double det = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
-    if (det == 0.0) return VectorXd::Constant(2, NAN);
-    VectorXd x(2);
+    if (det == 0.0) {
+      x.setConstant(NAN);
+      return;
+    }
     x << (A(1, 1) * b(0) - A(0, 1) * b(1)) / det, (A(0, 0) * b(1) - A(1, 0) * b(0)) / det;
-    return x;
+    return;
   }
-  Eigen::PartialPivLU<MatrixXd> lu(A);
-  VectorXd x = lu.solve(b);
+  lu.compute(A);
+  x = lu.solve(b);
   if (lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0) x.setConstant(NAN);
-  return x;
 }
 
 // 2-norm condition number and smallest singular value, as solve_loops._condition.
-std::pair<double, double> condition_of(const MatrixXd& A) {
+std::pair<double, double> condition_of(const MatrixXd& A, Eigen::JacobiSVD<MatrixXd>& svd) {
   const Index n = A.rows();
   if (n == 0) return {1.0, 1.0};
   if (n == 1) {
@@ -131,7 +135,7 @@ std::pair<double, double> condition_of(const MatrixXd& A) {
     const double s_min = s_max2 > 0 ? det / std::sqrt(s_max2) : 0.0;
     return {det > 0 ? s_max2 / det : INFINITY, s_min};
   }
-  Eigen::JacobiSVD<MatrixXd> svd(A);
+  svd.compute(A);
   const auto& s = svd.singularValues();
   const double lo = s(n - 1);
   return {lo > 0 ? s(0) / lo : INFINITY, lo};
@@ -151,6 +155,7 @@ struct Cut {
   MatrixXd rows6;  // (k, 6): basis @ selection @ diag(scale), as Closure._rows6
   MatrixXd full;   // (n_sel, 6): selection @ diag(scale), every selected row
   Index offset;    // first row in the stacked residual
+  bool ground;     // P is a frame of the ground: no Jacobian, velocity or acceleration
 };
 
 struct Node {
@@ -187,7 +192,8 @@ class Core {
     Index offset = 0;
     for (size_t c = 0; c < cut_types.size(); ++c) {
       Cut cut{cut_types[c], frames_.at(cut_parent[c]), frames_.at(cut_child[c]), cut_axes.row(c).transpose(),
-              cut_child_axes.row(c).transpose(), rows6.at(c), full.at(c), offset};
+              cut_child_axes.row(c).transpose(), rows6.at(c), full.at(c), offset, false};
+      cut.ground = model_.frames[cut.parent].parentJoint == 0;
       if (cut.rows6.cols() != 6 || cut.full.cols() != 6) throw std::invalid_argument("closure rows must have 6 columns");
       offset += cut.rows6.rows();
       cuts_.push_back(cut);
@@ -196,10 +202,10 @@ class Core {
     data_ = pin::Data(model_);
     const Index nv = model_.nv;
     if (v_scale.size() != nv) throw std::invalid_argument("velocity scale of the wrong size");
+    v_scale_ = v_scale;
     v_scale_inv_ = v_scale.cwiseInverse();
     dep_scale_.resize(Index(dep_v_.size()));
     for (size_t i = 0; i < dep_v_.size(); ++i) dep_scale_(Index(i)) = v_scale(dep_v_[i]);
-    if (Index(dep_v_.size()) != rows_) throw std::invalid_argument("the dependent Jacobian must be square");
     blocks_rows_ = block_rows;
     blocks_cols_ = block_cols;
     step_ = VectorXd::Zero(nv);
@@ -207,6 +213,20 @@ class Core {
     J6_ = Matrix6Xd::Zero(6, nv);
     JP_ = Matrix6Xd::Zero(6, nv);
     JC_ = Matrix6Xd::Zero(6, nv);
+    tmp3_ = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, nv);
+    const Index ndep = Index(dep_v_.size());
+    J_ = MatrixXd::Zero(rows_, nv);
+    Jdep_ = MatrixXd::Zero(rows_, ndep);
+    scaled_ = MatrixXd::Zero(rows_, ndep);
+    for (size_t b = 0; b < blocks_rows_.size(); ++b)
+      block_buffers_.push_back(MatrixXd::Zero(Index(blocks_rows_[b].size()), Index(blocks_cols_[b].size())));
+    r_ = VectorXd::Zero(rows_);
+    r_new_ = VectorXd::Zero(rows_);
+    rhs_ = VectorXd::Zero(rows_);
+    drift_ = VectorXd::Zero(rows_);
+    dstep_ = VectorXd::Zero(ndep);
+    q_new_ = VectorXd::Zero(model_.nq);
+    predicted_ = VectorXd::Zero(nv);
   }
 
   int nq() const { return model_.nq; }
@@ -216,14 +236,20 @@ class Core {
 
   // ---------------------------------------------------------------- pieces (also for tests)
   VectorXd residual(const VectorXd& q) {
-    pin::computeJointJacobians(model_, data_, q);
     VectorXd r(rows_);
+    residual_into(q, r);
+    return r;
+  }
+
+  // The independent closure rows at q; leaves joint placements, Jacobians and the cut
+  // frames' placements in data_ (LoopSolver._residual).
+  void residual_into(const VectorXd& q, VectorXd& r) {
+    pin::computeJointJacobians(model_, data_, q);
     for (const Cut& cut : cuts_) {
       pin::updateFramePlacement(model_, data_, cut.parent);
       pin::updateFramePlacement(model_, data_, cut.child);
-      r.segment(cut.offset, cut.rows6.rows()) = cut.rows6 * error6(cut);
+      r.segment(cut.offset, cut.rows6.rows()).noalias() = cut.rows6 * error6(cut);
     }
-    return r;
   }
 
   double full_residual() const {
@@ -233,22 +259,35 @@ class Core {
   }
 
   MatrixXd jacobian(bool newton) {
-    MatrixXd J(rows_, model_.nv);
+    jacobian_into(newton);
+    return J_;
+  }
+
+  // J_ = the stacked rows' Jacobian, Jdep_ its dependent columns (data_ at q).
+  void jacobian_into(bool newton) {
     for (const Cut& cut : cuts_) {
       relative_jacobian(cut, newton);
-      J.middleRows(cut.offset, cut.rows6.rows()) = cut.rows6 * J6_;
+      J_.middleRows(cut.offset, cut.rows6.rows()).noalias() = cut.rows6 * J6_;
     }
-    return J;
+    for (size_t i = 0; i < dep_v_.size(); ++i) Jdep_.col(Index(i)) = J_.col(dep_v_[i]);
   }
 
   VectorXd drift(const VectorXd& q, const VectorXd& v) {
-    pin::forwardKinematics(model_, data_, q, v, zero_);
     VectorXd out(rows_);
+    drift_into(q, v, out);
+    return out;
+  }
+
+  void drift_into(const VectorXd& q, const VectorXd& v, VectorXd& out) {
+    pin::forwardKinematics(model_, data_, q, v, zero_);
     for (const Cut& cut : cuts_) {
       const pin::SE3 &MP = data_.oMf[cut.parent], &MC = data_.oMf[cut.child];
-      const pin::Motion vP = pin::getFrameVelocity(model_, data_, cut.parent, pin::LOCAL_WORLD_ALIGNED);
+      const pin::Motion vP = cut.ground ? pin::Motion::Zero()
+                                        : pin::getFrameVelocity(model_, data_, cut.parent, pin::LOCAL_WORLD_ALIGNED);
       const pin::Motion vC = pin::getFrameVelocity(model_, data_, cut.child, pin::LOCAL_WORLD_ALIGNED);
-      const pin::Motion aP = pin::getFrameClassicalAcceleration(model_, data_, cut.parent, pin::LOCAL_WORLD_ALIGNED);
+      const pin::Motion aP = cut.ground ? pin::Motion::Zero()
+                                        : pin::getFrameClassicalAcceleration(model_, data_, cut.parent,
+                                                                             pin::LOCAL_WORLD_ALIGNED);
       const pin::Motion aC = pin::getFrameClassicalAcceleration(model_, data_, cut.child, pin::LOCAL_WORLD_ALIGNED);
       const Vector3d wP = vP.angular(), delta = MC.translation() - MP.translation();
       const Vector3d dv = vC.linear() - vP.linear();
@@ -257,9 +296,8 @@ class Core {
       Vector6d e;
       e.head<3>() = MP.rotation().transpose() * (d_dot - wP.cross(d));
       e.tail<3>() = MP.rotation().transpose() * (aC.angular() - aP.angular() - wP.cross(vC.angular() - wP));
-      out.segment(cut.offset, cut.rows6.rows()) = cut.rows6 * e;
+      out.segment(cut.offset, cut.rows6.rows()).noalias() = cut.rows6 * e;
     }
-    return out;
   }
 
   // ---------------------------------------------------------------- the corrector
@@ -267,25 +305,27 @@ class Core {
   // residual; the polish step of `close`; the full-residual check. False: no root here.
   bool correct(VectorXd& q, const VectorXd& drivers, int max_iterations, double& residual_left) {
     set_drivers(q, drivers);
-    VectorXd r = residual(q);
+    VectorXd& r = r_;
+    residual_into(q, r);
     double norm = max_abs(r);
     iterations_ = 0;
     moved_ = 0.0;
     for (int it = 0; it < max_iterations; ++it) {
       if (norm <= tol_) break;
-      const MatrixXd J_dep = dependent(jacobian(true));
+      jacobian_into(true);
       ++iterations_;
-      const VectorXd step = solve_square(J_dep, -r);
-      if (!step.allFinite()) return false;
-      VectorXd q_new = move(q, step);
-      VectorXd r_new = residual(q_new);
-      const double new_norm = max_abs(r_new);
+      rhs_ = -r;
+      solve_square(Jdep_, rhs_, dstep_, lu_);
+      if (!dstep_.allFinite()) return false;
+      move_into(q, dstep_, q_new_);
+      residual_into(q_new_, r_new_);
+      const double new_norm = max_abs(r_new_);
       if (new_norm > 0.5 * norm && new_norm > tol_) {
-        residual(q);
+        residual_into(q, r);
         return false;
       }
-      q.swap(q_new);
-      r.swap(r_new);
+      q.swap(q_new_);
+      r.swap(r_new_);
       norm = new_norm;
     }
     if (POLISH < norm && norm <= tol_ && tol_ <= DEFAULT_TOL) {
@@ -301,26 +341,29 @@ class Core {
   // ---------------------------------------------------------------- nodes and steps
   // Path.node at a closed q whose placements and Jacobians are in data_: the path
   // derivatives at driver velocity d, the condition number and the signature.
-  bool node_at(Node& node, const VectorXd& d) {
-    const MatrixXd J = jacobian(false);
-    const MatrixXd J_dep = dependent(J);
-    auto [condition, sigma_min] = condition_of(J_dep * dep_scale_.asDiagonal());
+  void node_at(Node& node, const VectorXd& d) {
+    jacobian_into(false);
+    scaled_ = Jdep_ * dep_scale_.asDiagonal();
+    auto [condition, sigma_min] = condition_of(scaled_, svd_);
     node.condition = condition;
     node.sigma_min = sigma_min;
-    node.signs = signs(J_dep);
-    VectorXd v = VectorXd::Zero(model_.nv), a = VectorXd::Zero(model_.nv);
+    signs_into(Jdep_, node.signs);
+    VectorXd &v = node.d1, &a = node.d2;
+    v.setZero(model_.nv);
+    a.setZero(model_.nv);
     for (size_t i = 0; i < drv_v_.size(); ++i) v(drv_v_[i]) = d(Index(i));
-    VectorXd rhs = -(J * v);  // driver columns only: v is zero elsewhere yet
-    const VectorXd v_dep = solve_square(J_dep, rhs);
-    for (size_t i = 0; i < dep_v_.size(); ++i) v(dep_v_[i]) = v_dep(Index(i));
-    const VectorXd dr = drift(node.q, v);
-    const VectorXd a_dep = solve_square(J_dep, -dr);
-    for (size_t i = 0; i < dep_v_.size(); ++i) a(dep_v_[i]) = a_dep(Index(i));
-    node.d1 = v;
-    node.d2 = a;
-    node.velocity_residual = max_abs(J * v);
-    node.acceleration_residual = max_abs(J * a + dr);
-    return true;
+    rhs_.noalias() = -(J_ * v);  // driver columns only: v is zero elsewhere yet
+    solve_square(Jdep_, rhs_, dstep_, lu_);
+    for (size_t i = 0; i < dep_v_.size(); ++i) v(dep_v_[i]) = dstep_(Index(i));
+    drift_into(node.q, v, drift_);
+    rhs_ = -drift_;
+    solve_square(Jdep_, rhs_, dstep_, lu_);
+    for (size_t i = 0; i < dep_v_.size(); ++i) a(dep_v_[i]) = dstep_(Index(i));
+    rhs_.noalias() = J_ * v;
+    node.velocity_residual = max_abs(rhs_);
+    rhs_.noalias() = J_ * a;
+    rhs_ += drift_;
+    node.acceleration_residual = max_abs(rhs_);
   }
 
   // Path.step from `from` to p; 0 and `out` filled on success, else why it failed:
@@ -329,14 +372,16 @@ class Core {
   int step(const Node& from, double p, const VectorXd& x0, const VectorXd& d, double unit, Node& out, bool& change) {
     change = false;
     const double h = p - from.p;
-    const VectorXd move_ = from.d1 * h + from.d2 * (0.5 * h * h);
-    VectorXd q = pin::integrate(model_, from.q, move_);
+    predicted_ = from.d1 * h + from.d2 * (0.5 * h * h);
+    VectorXd& q = out.q;
+    q.resize(model_.nq);
+    pin::integrate(model_, from.q, predicted_, q);
     double residual_left = 0.0;
-    if (!correct(q, x0 + p * d, CORRECTOR_ITERATIONS, residual_left)) return 1;
+    x_ = x0 + p * d;
+    if (!correct(q, x_, CORRECTOR_ITERATIONS, residual_left)) return 1;
     const double trust = std::min(TRUST, 2.0 * std::abs(h) * unit);
-    if (moved_ > trust * max_abs(move_.cwiseProduct(v_scale_inv_)) + 1e3 * tol_) return 2;
+    if (moved_ > trust * max_abs(predicted_.cwiseProduct(v_scale_inv_)) + 1e3 * tol_) return 2;
     out.p = p;
-    out.q = q;
     out.residual = residual_left;
     node_at(out, d);
     for (int s : out.signs)
@@ -358,9 +403,10 @@ class Core {
   nb::tuple follow(double p0, const VectorXd& q0, const VectorXd& d1, const VectorXd& d2, const std::vector<int>& signs0,
                    double condition0, const VectorXd& x0, const VectorXd& d, double unit, const VectorXd& targets,
                    double max_condition) {
+    if (Index(dep_v_.size()) != rows_) throw std::invalid_argument("the dependent Jacobian must be square");
     const Index n = targets.size();
     RowMatrix Q(n, model_.nq), D1(n, model_.nv), D2(n, model_.nv);
-    RowMatrix acc(n, 6);  // residual, iterations, condition, sigma_min, velocity and acceleration residuals
+    RowMatrix acc(n, 7);  // residual, iterations, condition, sigma_min, velocity and acceleration residuals, steps
     Index done = 0;
     int stop = DONE;
     {
@@ -375,7 +421,7 @@ class Core {
       for (; done < n && stop == DONE; ++done) {
         const double target = targets(done);
         double h = std::copysign(std::min(std::abs(target - node.p), MAX_STEP / unit), target - node.p);
-        long iterations = 0;
+        long iterations = 0, steps = 0;
         while (node.p != target) {
           const double remaining = target - node.p;
           h = std::copysign(std::min(std::abs(h), std::abs(remaining)), remaining);
@@ -384,6 +430,7 @@ class Core {
           if (why == 0) {
             std::swap(node, next);
             iterations += iterations_;
+            ++steps;
             h *= 2.0;
             continue;
           }
@@ -411,11 +458,129 @@ class Core {
         D1.row(done) = node.d1.transpose();
         D2.row(done) = node.d2.transpose();
         acc.row(done) << node.residual, double(iterations), node.condition, node.sigma_min, node.velocity_residual,
-            node.acceleration_residual;
+            node.acceleration_residual, double(steps);
       }
     }
     return nb::make_tuple(done, stop, Q.topRows(done).eval(), D1.topRows(done).eval(), D2.topRows(done).eval(),
                           acc.topRows(done).eval());
+  }
+
+  // Path.node at a closed q: the path derivatives at driver velocity d, the signature,
+  // the condition number and the residuals (closure, velocity, acceleration).
+  nb::tuple node(const VectorXd& q, const VectorXd& d) {
+    if (q.size() != model_.nq || d.size() != Index(drv_v_.size())) throw std::invalid_argument("q or d of the wrong size");
+    Node out;
+    out.q = q;
+    residual_into(q, r_);
+    out.residual = std::max(max_abs(r_), full_residual());
+    node_at(out, d);
+    return nb::make_tuple(out.d1, out.d2, out.signs, out.condition, out.sigma_min, out.velocity_residual,
+                          out.acceleration_residual, out.residual);
+  }
+
+  // ---------------------------------------------------------------- rate problems
+  // RateSolver.solve at every row of Q, for square tasks ("exact"): closure rows stacked
+  // over task rows (frame Jacobian rows in world axes, or the frame's own with `local`),
+  // made dimensionless by `row_scale` and the velocity scale; v and a by LU. A pose whose
+  // stacked Jacobian is not square, or conditioned worse than max_condition, gets status
+  // 1 and no numbers: the Python path names it.
+  nb::tuple rates(const Eigen::Ref<const RowMatrix>& Q, const std::vector<int>& task_frames,
+                  const std::vector<std::vector<int>>& task_rows, const std::vector<int>& task_local,
+                  const VectorXd& x_dot, const VectorXd& x_ddot, const VectorXd& row_scale, double max_condition) {
+    const Index n = Q.rows(), nv = model_.nv;
+    Index m_task = 0;
+    for (const auto& rows : task_rows) m_task += Index(rows.size());
+    const Index m = rows_ + m_task;
+    if (Q.cols() != model_.nq || x_dot.size() != m_task || x_ddot.size() != m_task || row_scale.size() != m ||
+        task_frames.size() != task_rows.size() || task_local.size() != task_rows.size())
+      throw std::invalid_argument("rates: arrays of the wrong sizes");
+    for (int f : task_frames)
+      if (f < 0 || size_t(f) >= frames_.size()) throw std::invalid_argument("unknown frame index");
+    RowMatrix V = RowMatrix::Constant(n, nv, NAN), A = RowMatrix::Constant(n, nv, NAN);
+    RowMatrix numbers = RowMatrix::Constant(n, 5, NAN);  // condition, sigma_min, closure v and a residuals, status
+    RowMatrix achieved_v = RowMatrix::Constant(n, m_task, NAN), achieved_a = RowMatrix::Constant(n, m_task, NAN);
+    {
+      nb::gil_scoped_release release;
+      MatrixXd J(m, nv), Jd(m, nv);
+      VectorXd q(model_.nq), v(nv), a(nv), rhs(m), drift(m), x(nv), achieved(m);
+      Matrix6Xd JT(6, nv);
+      Eigen::PartialPivLU<MatrixXd> lu;
+      Eigen::JacobiSVD<MatrixXd> svd;
+      for (Index i = 0; i < n; ++i) {
+        q = Q.row(i).transpose();
+        if (rows_) {
+          residual_into(q, r_);
+          jacobian_into(false);
+          J.topRows(rows_) = J_;
+        } else {
+          pin::computeJointJacobians(model_, data_, q);
+        }
+        Index row = rows_;
+        for (size_t t = 0; t < task_frames.size(); ++t) {
+          const pin::FrameIndex f = frames_[size_t(task_frames[t])];
+          const pin::SE3& M = pin::updateFramePlacement(model_, data_, f);
+          JT.setZero();
+          pin::getFrameJacobian(model_, data_, f, pin::LOCAL_WORLD_ALIGNED, JT);
+          if (task_local[t]) {
+            tmp3_.noalias() = M.rotation().transpose() * JT.topRows<3>();
+            JT.topRows<3>() = tmp3_;
+            tmp3_.noalias() = M.rotation().transpose() * JT.bottomRows<3>();
+            JT.bottomRows<3>() = tmp3_;
+          }
+          for (int k : task_rows[t]) J.row(row++) = JT.row(k);
+        }
+        Jd = row_scale.asDiagonal() * J * v_scale_.asDiagonal();
+        if (m != nv) {
+          numbers(i, 4) = 1;
+          continue;
+        }
+        svd.compute(Jd);
+        const auto& sv = svd.singularValues();
+        const double smin = sv(m - 1), cond = smin > 0 ? sv(0) / smin : INFINITY;
+        if (!(smin > sv(0) / max_condition) || !(cond <= max_condition)) {
+          numbers(i, 4) = 1;
+          continue;
+        }
+        lu.compute(Jd);
+        rhs.head(rows_).setZero();
+        rhs.tail(m_task) = x_dot;
+        x = lu.solve(row_scale.cwiseProduct(rhs));
+        v = v_scale_.cwiseProduct(x);
+        if (rows_) drift_into(q, v, drift_);
+        else pin::forwardKinematics(model_, data_, q, v, zero_);
+        drift.head(rows_) = drift_;
+        row = rows_;
+        for (size_t t = 0; t < task_frames.size(); ++t) {
+          const pin::FrameIndex f = frames_[size_t(task_frames[t])];
+          const pin::Motion acc = pin::getFrameClassicalAcceleration(model_, data_, f, pin::LOCAL_WORLD_ALIGNED);
+          Vector6d e;
+          e.head<3>() = acc.linear();
+          e.tail<3>() = acc.angular();
+          if (task_local[t]) {
+            const Matrix3d RT = data_.oMf[f].rotation().transpose();
+            e.head<3>() = RT * acc.linear();
+            e.tail<3>() = RT * acc.angular();
+          }
+          for (int k : task_rows[t]) drift(row++) = e(k);
+        }
+        rhs.head(rows_).setZero();
+        rhs.tail(m_task) = x_ddot;
+        rhs -= drift;
+        x = lu.solve(row_scale.cwiseProduct(rhs));
+        a = v_scale_.cwiseProduct(x);
+        V.row(i) = v.transpose();
+        A.row(i) = a.transpose();
+        achieved.noalias() = J * v;
+        achieved_v.row(i) = achieved.tail(m_task).transpose();
+        const double closure_v = rows_ ? max_abs(achieved.head(rows_)) : 0.0;
+        achieved.noalias() = J * a;
+        achieved += drift;
+        achieved_a.row(i) = achieved.tail(m_task).transpose();
+        const double closure_a = rows_ ? max_abs(achieved.head(rows_)) : 0.0;
+        numbers.row(i) << cond, smin, closure_v, closure_a, 0.0;
+      }
+    }
+    return nb::make_tuple(V, A, numbers, achieved_v, achieved_a);
   }
 
   // ---------------------------------------------------------------- frames along a sweep
@@ -459,17 +624,23 @@ class Core {
   int iterations() const { return iterations_; }
   double moved() const { return moved_; }
 
-  std::vector<int> signs(const MatrixXd& J_dep) const {
+  std::vector<int> signs(const MatrixXd& J_dep) {
     std::vector<int> out;
+    signs_into(J_dep, out);
+    return out;
+  }
+
+  // The sign of each block's determinant (branches.AssemblyStructure.signs).
+  void signs_into(const MatrixXd& J_dep, std::vector<int>& out) {
+    out.resize(blocks_rows_.size());
     for (size_t b = 0; b < blocks_rows_.size(); ++b) {
       const auto &rows = blocks_rows_[b], &cols = blocks_cols_[b];
-      MatrixXd B(Index(rows.size()), Index(cols.size()));
+      MatrixXd& B = block_buffers_[b];
       for (size_t i = 0; i < rows.size(); ++i)
         for (size_t j = 0; j < cols.size(); ++j) B(Index(i), Index(j)) = J_dep(rows[i], cols[j]);
       const double det = det_of(B);
-      out.push_back(det > 0 ? 1 : det < 0 ? -1 : 0);
+      out[b] = det > 0 ? 1 : det < 0 ? -1 : 0;
     }
-    return out;
   }
 
  private:
@@ -495,30 +666,30 @@ class Core {
   void relative_jacobian(const Cut& cut, bool newton) {
     JP_.setZero();
     JC_.setZero();
-    pin::getFrameJacobian(model_, data_, cut.parent, pin::LOCAL_WORLD_ALIGNED, JP_);
+    if (!cut.ground) pin::getFrameJacobian(model_, data_, cut.parent, pin::LOCAL_WORLD_ALIGNED, JP_);
     pin::getFrameJacobian(model_, data_, cut.child, pin::LOCAL_WORLD_ALIGNED, JC_);
     const pin::SE3 &MP = data_.oMf[cut.parent], &MC = data_.oMf[cut.child];
     const Matrix3d RT = MP.rotation().transpose();
     const Vector3d delta = MC.translation() - MP.translation();
-    J6_.topRows<3>() = RT * (JC_.topRows<3>() - JP_.topRows<3>() + pin::skew(delta) * JP_.bottomRows<3>());
-    J6_.bottomRows<3>() = RT * (JC_.bottomRows<3>() - JP_.bottomRows<3>());
+    // into fixed-height buffers: no temporaries allocated per pose
+    tmp3_ = JC_.topRows<3>() - JP_.topRows<3>();
+    tmp3_.noalias() += pin::skew(delta) * JP_.bottomRows<3>();
+    J6_.topRows<3>().noalias() = RT * tmp3_;
+    tmp3_ = JC_.bottomRows<3>() - JP_.bottomRows<3>();
+    J6_.bottomRows<3>().noalias() = RT * tmp3_;
     if (newton && cut.type != SPHERICAL_CUT) {
       const Matrix3d R_rel = RT * MC.rotation();
+      Matrix3d M;
       if (cut.type == REVOLUTE) {
-        const Matrix3d M = -pin::skew(cut.axis) * pin::skew(Vector3d(R_rel * cut.child_axis));
-        J6_.bottomRows<3>() = (M * J6_.bottomRows<3>()).eval();
+        M = -pin::skew(cut.axis) * pin::skew(Vector3d(R_rel * cut.child_axis));
       } else {
         Matrix3d Jlog;
         pin::Jlog3(R_rel, Jlog);
-        J6_.bottomRows<3>() = (Jlog * R_rel.transpose() * J6_.bottomRows<3>()).eval();
+        M = Jlog * R_rel.transpose();
       }
+      tmp3_.noalias() = M * J6_.bottomRows<3>();
+      J6_.bottomRows<3>() = tmp3_;
     }
-  }
-
-  MatrixXd dependent(const MatrixXd& J) const {
-    MatrixXd out(J.rows(), Index(dep_v_.size()));
-    for (size_t i = 0; i < dep_v_.size(); ++i) out.col(Index(i)) = J.col(dep_v_[i]);
-    return out;
   }
 
   void set_drivers(VectorXd& q, const VectorXd& drivers) const {
@@ -534,34 +705,36 @@ class Core {
   }
 
   // LoopSolver._move: q moved by a step of the dependent joints, at most MAX_NEWTON_STEP.
-  VectorXd move(const VectorXd& q, VectorXd step) {
+  void move_into(const VectorXd& q, const VectorXd& step, VectorXd& out) {
     const double size = max_abs(step.cwiseQuotient(dep_scale_));
-    if (size > MAX_NEWTON_STEP) step *= MAX_NEWTON_STEP / size;
+    const double shrink = size > MAX_NEWTON_STEP ? MAX_NEWTON_STEP / size : 1.0;
     moved_ += std::min(size, MAX_NEWTON_STEP);
     step_.setZero();
-    for (size_t i = 0; i < dep_v_.size(); ++i) step_(dep_v_[i]) = step(Index(i));
-    return pin::integrate(model_, q, step_);
+    for (size_t i = 0; i < dep_v_.size(); ++i) step_(dep_v_[i]) = shrink * step(Index(i));
+    out.resize(model_.nq);
+    pin::integrate(model_, q, step_, out);
   }
 
   // LoopSolver._newton_update at the polish: the full step if it lowers the residual,
   // else the step halved until it does (a square regular J_dep: least squares is Newton).
   void polish(VectorXd& q, VectorXd& r, double& norm) {
-    const MatrixXd J_dep = dependent(jacobian(true));
-    VectorXd step = solve_square(J_dep, -r);
-    if (!step.allFinite()) return;
+    jacobian_into(true);
+    rhs_ = -r;
+    solve_square(Jdep_, rhs_, dstep_, lu_);
+    if (!dstep_.allFinite()) return;
     double alpha = 1.0;
     for (int k = 0; k <= LINE_SEARCH_HALVINGS; ++k, alpha *= 0.5) {
-      VectorXd trial = move(q, alpha * step);
-      VectorXd r_trial = residual(trial);
-      const double trial_norm = max_abs(r_trial);
+      move_into(q, alpha * dstep_, q_new_);
+      residual_into(q_new_, r_new_);
+      const double trial_norm = max_abs(r_new_);
       if (trial_norm < norm) {
-        q.swap(trial);
-        r.swap(r_trial);
+        q.swap(q_new_);
+        r.swap(r_new_);
         norm = trial_norm;
         return;
       }
     }
-    residual(q);  // data back at q
+    residual_into(q, r);  // data back at q
   }
 
   double turn_between(const Node& a, const Node& b, double unit) const {
@@ -577,9 +750,16 @@ class Core {
   std::vector<Cut> cuts_;
   Index rows_ = 0;
   std::vector<int> drv_v_, dep_v_, drv_q_, drv_continuous_;
-  VectorXd dep_scale_, v_scale_inv_, step_, zero_;
+  VectorXd dep_scale_, v_scale_, v_scale_inv_, step_, zero_;
   std::vector<std::vector<int>> blocks_rows_, blocks_cols_;
   Matrix6Xd J6_, JP_, JC_;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> tmp3_;
+  // work buffers, sized once: a pose allocates nothing
+  MatrixXd J_, Jdep_, scaled_;
+  std::vector<MatrixXd> block_buffers_;
+  VectorXd r_, r_new_, rhs_, dstep_, drift_, q_new_, predicted_, x_;
+  Eigen::PartialPivLU<MatrixXd> lu_;
+  Eigen::JacobiSVD<MatrixXd> svd_;
   double tol_;
   int iterations_ = 0;
   double moved_ = 0.0;
@@ -626,5 +806,7 @@ NB_MODULE(_core, m) {
              return nb::make_tuple(q, ok ? nb::cast(residual) : nb::none());
            })
       .def("follow", &Core::follow)
+      .def("node", &Core::node)
+      .def("rates", &Core::rates)
       .def("frame_motion", &Core::frame_motion);
 }
