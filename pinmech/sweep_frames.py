@@ -8,6 +8,7 @@ for a whole chunk where it rebuilds the model (core.py), Pinocchio pose by pose 
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -64,7 +65,9 @@ def frame_paths(mechanism: Mechanism, names: Sequence[str], q: np.ndarray, v: np
                          f"{q.shape}, {v.shape}, {a.shape}", path=mechanism.source)
     compiled = _core_for(mechanism, fids)
     if compiled is not None:
-        out = compiled.frame_motion(q, v, a, list(range(len(fids))))
+        kinematics, lock = compiled
+        with lock:  # one core per mechanism and frames: threads sharing it take turns
+            out = kinematics.frame_motion(q, v, a, list(range(len(fids))))
         shapes = ((n, len(fids), 3), (n, len(fids), 3, 3)) + ((n, len(fids), 3),) * 4
         return FramePaths(names, *(x.reshape(s) for x, s in zip(out, shapes)))
     return _pose_by_pose(model, names, fids, q, v, a)
@@ -88,8 +91,8 @@ def _pose_by_pose(model: pin.Model, names: tuple[str, ...], fids: list[int], q: 
 
 
 def _core_for(mechanism: Mechanism, fids: list[int]):
-    """A compiled model of the mechanism with these frames (built once per set of frames
-    and their placements), or None where the core does not rebuild its joints."""
+    """A compiled model of the mechanism with these frames and its lock (built once per set
+    of frames and their placements), or None where the core does not rebuild its joints."""
     if not core.ENABLED:
         return None
     model = mechanism.model
@@ -101,5 +104,5 @@ def _core_for(mechanism: Mechanism, fids: list[int]):
         except KeyError:
             cache[key] = None
         else:
-            cache[key] = compiled.kinematics()
+            cache[key] = (compiled.kinematics(), threading.Lock())
     return cache[key]

@@ -180,3 +180,46 @@ def test_the_core_can_be_ruled_out(monkeypatch, scenes_dir):
     sweep = _sweep(scenes_dir, "four_bar.toml")
     monkeypatch.setattr(core, "ENABLED", False)
     assert core.core_for(sweep.solver) is None
+
+
+# ---------------------------------------------------------------------- hypothesis
+from hypothesis import HealthCheck, assume, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from pinmech import LoopSolver, SingularPoseError  # noqa: E402
+from tests.test_assembly import _four_bar, _four_bar_guess, _sweep  # noqa: E402
+
+
+@settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(a=st.floats(0.02, 0.1), b=st.floats(0.05, 0.15), c=st.floats(0.03, 0.12), d=st.floats(0.05, 0.12),
+       start=st.floats(0, 2 * math.pi), step=st.floats(0.5, 50), branch=st.sampled_from([1, -1]))
+def test_random_four_bars_the_core_and_the_python_path_agree(tmp_path_factory, a, b, c, d, start, step, branch):
+    """Random dimensions (Grashof or not: folds, limit angles), starts and spacings: the same
+    poses (1e-10 in radians: rounding times condition numbers up to the accepted 1e4) and
+    the same failures, pose for pose, with the core and without it."""
+    lengths = sorted((a, b, c, d))
+    assume(abs(lengths[0] + lengths[3] - lengths[1] - lengths[2]) > 1e-3 * lengths[3])
+    try:
+        closed_form.four_bar(start, 0, 0, a, b, c, d, branch)
+    except ValueError:
+        return
+    mech = _four_bar(tmp_path_factory.mktemp("fb"), a, b, c, d)
+    values = start + np.radians(np.arange(0, 370, step))
+    runs = []
+    for enabled in (True, False):
+        core.ENABLED = enabled
+        try:
+            solver = LoopSolver(mech, ["O2"])
+            try:
+                solver.set_reference([start], _four_bar_guess(mech, start, a, b, c, d, branch))
+            except (SingularPoseError, pinmech.LoopClosureError):
+                return
+            runs.append(_sweep(solver, values))
+        finally:
+            core.ENABLED = True
+    (q1, e1, n1), (q2, e2, n2) = runs
+    assert {i: type(e) for i, e in e1.items()} == {i: type(e) for i, e in e2.items()}
+    assert n1 == n2
+    for i, (qa, qb) in enumerate(zip(q1, q2)):
+        if i not in e1:
+            assert solver.turn_gap(qa, qb) < 1e-10, i

@@ -50,3 +50,28 @@ def test_bad_names_and_shapes_are_named_errors(r_rtr_rows):
         frame_paths(mechanism, "D", s.q, s.v, s.a)
     with pytest.raises(ModelError, match="arrays"):
         frame_paths(mechanism, ["D"], s.q[:, :2], s.v, s.a)
+
+
+def test_threads_sharing_a_mechanism_get_their_own_answers(scenes_dir):
+    """Two threads reading frames of one mechanism at once (one compiled model, its work
+    buffers shared): each gets what it gets alone."""
+    import threading
+
+    sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(scenes_dir / "r_rtr.toml"))
+    chunk = next(sweep.chunks(np.radians(np.arange(0.0, 360.0, 1.0))))
+    s = chunk.solution
+    alone = [frame_paths(sweep.mechanism, ["D"], s.q[i::2], s.v[i::2], s.a[i::2]).acceleration for i in (0, 1)]
+    got = [[], []]
+
+    def work(i):
+        for _ in range(50):
+            got[i].append(frame_paths(sweep.mechanism, ["D"], s.q[i::2], s.v[i::2], s.a[i::2]).acceleration)
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in (0, 1)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for i in (0, 1):
+        for out in got[i]:
+            np.testing.assert_array_equal(out, alone[i])
