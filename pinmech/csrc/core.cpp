@@ -25,6 +25,9 @@
 #include <pinocchio/algorithm/joint-configuration.hpp>
 #include <pinocchio/algorithm/kinematics.hpp>
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -134,6 +137,23 @@ std::pair<double, double> condition_of(const MatrixXd& A, Eigen::JacobiSVD<Matri
     const double s_max2 = 0.5 * (frob2 + std::sqrt(std::max(frob2 * frob2 - 4.0 * det * det, 0.0)));
     const double s_min = s_max2 > 0 ? det / std::sqrt(s_max2) : 0.0;
     return {det > 0 ? s_max2 / det : INFINITY, s_min};
+  }
+  if (n == 3) {
+    // sigma_max^2 and sigma_min^-2 as the LARGEST eigenvalues of A^T A and A^-1 A^-T (closed
+    // form, Eigen's computeDirect): both to rounding relative to themselves, sigma_min to
+    // about eps times the condition number, as an SVD gives it; a third of the SVD's cost.
+    const Matrix3d M = A;
+    Matrix3d inverse;
+    double det = 0.0;
+    bool invertible = false;
+    M.computeInverseAndDetWithCheck(inverse, det, invertible, 0.0);
+    if (!invertible || !inverse.allFinite()) return {INFINITY, 0.0};
+    Eigen::SelfAdjointEigenSolver<Matrix3d> eig;
+    eig.computeDirect(M.transpose() * M, Eigen::EigenvaluesOnly);
+    const double s_max = std::sqrt(eig.eigenvalues()(2));
+    eig.computeDirect(inverse * inverse.transpose(), Eigen::EigenvaluesOnly);
+    const double s_min = 1.0 / std::sqrt(eig.eigenvalues()(2));
+    return {s_max / s_min, s_min};
   }
   svd.compute(A);
   const auto& s = svd.singularValues();
@@ -534,10 +554,8 @@ class Core {
           numbers(i, 4) = 1;
           continue;
         }
-        svd.compute(Jd);
-        const auto& sv = svd.singularValues();
-        const double smin = sv(m - 1), cond = smin > 0 ? sv(0) / smin : INFINITY;
-        if (!(smin > sv(0) / max_condition) || !(cond <= max_condition)) {
+        const auto [cond, smin] = condition_of(Jd, svd);
+        if (!(cond < max_condition)) {
           numbers(i, 4) = 1;
           continue;
         }
