@@ -78,11 +78,11 @@ def finite_differences(sweep: Sweep, phis: np.ndarray):
 
 
 SETTINGS = [
-    ("default: batched, predictor and Hermite guesses, tol 1e-13", sweep_setting()),
-    ("pose by pose, predictor (--no-batch)", sweep_setting(batch=False)),
+    ("default: compiled core, predictor, tol 1e-13", sweep_setting()),
+    ("--no-batch (the same with the core; batches serve only its absence)", sweep_setting(batch=False)),
     ("pose by pose, warm start (--start warm)", sweep_setting(start="warm")),
     ("pose by pose, cold start (--start cold)", sweep_setting(start="cold")),
-    ("batched, loose tolerance (--tol 1e-6)", sweep_setting(tol=1e-6)),
+    ("loose tolerance (--tol 1e-6)", sweep_setting(tol=1e-6)),
     ("finite differences of positions (Newton pose by pose)", finite_differences),
     ("interpolated, every 8th pose solved (--interpolate 8)", sweep_setting(interpolate=8)),
     ("interpolated, every 32nd pose solved (--interpolate 32)", sweep_setting(interpolate=32)),
@@ -193,7 +193,9 @@ def verdicts(rows: list[dict]) -> str:
              f"{'met' if default['time'] <= 3 * floor_t else 'NOT met'}")
     fast = (f"- fastest setting ({fastest['name']}) is {default['time'] / fastest['time']:.1f} x faster than the "
             f"default (target 5x), error in acceleration {fastest['errors'][2]:.1e}: "
-            f"{'met' if default['time'] >= 5 * fastest['time'] else 'NOT met'}")
+            f"{'met' if default['time'] >= 5 * fastest['time'] else 'NOT met'}"
+            + (" (the default, exact, is as fast as the approximations now: interpolation and its error "
+               "measurement run in Python)" if default['time'] < 5 * fastest['time'] else ""))
     return f"{accuracy}\n{speed}\n{fast}"
 
 
