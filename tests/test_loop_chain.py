@@ -1,0 +1,89 @@
+"""Chains of four-bar loops in series (scripts/benchmark_loops.py, issue 13 item 3): the
+generated URDF, its block-triangular structure, and a sweep against the closed form of
+the four-bar applied loop after loop, with the compiled core and by the Python path.
+
+No timing here (the script measures it). Tolerances:
+- angles 1e-12 rad (issue 13's bar; the closure tolerance is 1e-13 of each loop's size,
+  1e-14 rad is typical);
+- rates and accelerations 1e-11 of the chain's largest: the closure error times the
+  condition number of the dependent Jacobian (up to 14 for four loops), with margin;
+- the script's closed form against scripts/closed_form.py (another derivation of the
+  same four-bar): 1e-13.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+import numpy as np
+import pytest
+
+import closed_form
+import pinmech.core as core
+
+chain = importlib.import_module("benchmark_loops")
+
+K = 4
+THETAS = np.radians(np.arange(360.0))
+
+
+def _solve(k: int, thetas: np.ndarray):
+    mech, solver = chain.chain_solver(k)
+    q, v, a = chain.sweep(solver, thetas)
+    return mech, solver, q, v, a
+
+
+def test_the_closed_form_is_the_four_bar_of_closed_form_py():
+    """One loop: the script's law-of-cosines form and scripts/closed_form.py agree on
+    angles, rates and accelerations (a crank speeding up), for the branch it uses."""
+    a, b, c, d = chain.LENGTHS
+    ours = chain.chain_closed_form(THETAS, 1, omega=2.0, alpha=3.0)
+    ref = closed_form.four_bar(THETAS, 2.0, 3.0, a, b, c, d, branch=-chain.BRANCH)
+    pairs = [(ours.theta3[:, 0], ref.theta3), (ours.phi[:, 1], ref.theta4)]
+    for got, want in pairs:
+        assert np.abs(chain.wrap(got - want)).max() < 1e-13
+    for got, want in [(ours.omega3[:, 0], ref.omega3), (ours.omega[:, 1], ref.omega4),
+                      (ours.alpha3[:, 0], ref.alpha3), (ours.alpha[:, 1], ref.alpha4)]:
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-13)
+
+
+def test_chain_urdf_is_k_loops_in_series(tmp_path):
+    """Mobility one, one cut per loop, and J_dep block lower-triangular: k 2x2 blocks."""
+    mech, solver = chain.chain_solver(K, folder=tmp_path)
+    assert mech.mobility == 1 and len(mech.closures) == K
+    assert mech.model.nv == 2 * K + 1
+    blocks = solver.structure.blocks
+    assert len(blocks) == K and all(len(b.rows) == 2 and len(b.cols) == 2 for b in blocks)
+    with pytest.raises(ValueError):
+        chain.chain_urdf(0)
+
+
+@pytest.mark.parametrize("use_core", [True, False], ids=["core", "python"])
+def test_chain_sweep_meets_the_closed_form(use_core, monkeypatch):
+    """A turn of the crank, 1 degree apart, every loop's coupler and output angle within
+    1e-12 rad of the closed form, rates within 1e-11 of the largest."""
+    monkeypatch.setattr(core, "ENABLED", use_core)
+    mech, solver, q, v, a = _solve(K, THETAS)
+    assert (core.core_for(solver) is not None) == use_core
+    angle, rate, acceleration = chain.chain_errors(mech, q, v, a, chain.chain_closed_form(THETAS, K))
+    assert angle <= 1e-12, angle
+    assert rate <= 1e-11 and acceleration <= 1e-11, (rate, acceleration)
+
+
+def test_the_closed_form_moves_every_loop():
+    """The drag-link proportions carry the motion to the last loop (no loop at rest), and
+    every loop stays far from a toggle (transmission angle at least 29 degrees)."""
+    cf = chain.chain_closed_form(THETAS, 16)
+    assert np.ptp(np.unwrap(cf.phi[:, -1])) > 6.0  # the 16th output turns (nearly) fully
+    transmission = np.abs(np.sin(cf.theta3 - cf.phi[:, 1:]))
+    assert transmission.min() > np.sin(np.radians(29.0))
+
+
+def test_benchmark_loops_runs(tmp_path, capsys):
+    """The script end to end on short sweeps, one round (the timing itself not checked)."""
+    out = tmp_path / "loops.md"
+    rows = chain.main(["--loops", "2", "--poses", "20", "--rounds", "1", "--sample-time", "0", "--out", str(out)])
+    assert out.read_text() == capsys.readouterr().out.rstrip("\n") + "\n"
+    assert {(r.k, r.path) for r in rows} == {(1, "core"), (1, "python"), (2, "core"), (2, "python")}
+    assert all(r.errors[0] <= 1e-12 and len(r.times) == 1 for r in rows)
+    assert "| 2 | core |" in out.read_text()
