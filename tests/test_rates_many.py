@@ -107,3 +107,32 @@ def test_bad_shapes_are_named(models_dir):
     mechanism, solver = _arm(models_dir)
     with pytest.raises(TaskError, match="array"):
         solver.solve_many(np.zeros((3, mechanism.model.nq + 1)))
+
+
+def test_local_axes_and_a_six_dof_arm_equal_solve(scenes_dir):
+    """A task in the frame's own axes on the arm, and a 6-row task on the UR5 (6 joints,
+    SVD above 3x3): `solve_many` equals `solve` pose by pose."""
+    from tests.conftest import MODELS
+
+    mechanism = pinmech.Mechanism.from_urdf(MODELS / "planar_arm.urdf")
+    solver = pinmech.RateSolver(mechanism, [
+        pinmech.Task("D", ("x", "y"), np.array([1.0, 0.0]), np.array([0.5, -0.2]), reference="local"),
+        pinmech.Task("CD", ("wz",), np.array([0.3]), np.zeros(1))])
+    Q = _poses(mechanism, 24)[0]
+    batch = solver.solve_many(Q)
+    for i, q in enumerate(Q):
+        r = solver.solve(q)
+        np.testing.assert_allclose(batch.v[i], r.v, rtol=0, atol=1e-12 * (1 + np.abs(r.v).max()))
+        np.testing.assert_allclose(batch.a[i], r.a, rtol=0, atol=1e-12 * (1 + np.abs(r.a).max()))
+    analysis = pinmech.analyse(pinmech.Scene.load(scenes_dir / "ur5.toml"))
+    mech = analysis.mechanism
+    tasks = [pinmech.Task(analysis.scene.raw["task"][0]["frame"], ("x", "y", "z", "wx", "wy", "wz"),
+                          np.array([0.1, -0.2, 0.05, 0.3, 0.0, -0.1]), np.array([0.0, 0.1, 0.0, 0.0, 0.2, 0.0]))]
+    arm = pinmech.RateSolver(mech, tasks)
+    rng = np.random.default_rng(3)
+    Q = np.array([mech.neutral() + rng.uniform(-1, 1, mech.model.nq) for _ in range(12)])
+    batch = arm.solve_many(Q)  # seeded poses, all regular
+    for i, q in enumerate(Q):
+        r = arm.solve(q)
+        np.testing.assert_allclose(batch.v[i], r.v, rtol=0, atol=1e-10 * (1 + np.abs(r.v).max()))
+        np.testing.assert_allclose(batch.a[i], r.a, rtol=0, atol=1e-10 * (1 + np.abs(r.a).max()))
