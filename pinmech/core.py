@@ -76,25 +76,36 @@ class CompiledModel:
 
 
 def core_for(solver) -> _core.Core | None:
-    """The compiled core of a `LoopSolver` (built once, again when a cut frame moved), or
-    None where the core cannot rebuild the model (then the Python path solves it all)."""
+    """The compiled core of a `LoopSolver` (built once, again when a cut frame moved or the
+    tolerance changed), or None where the core cannot rebuild the model (then the Python
+    path solves it all)."""
     if not ENABLED:
         return None
-    key = _key(solver)
     cached = solver.__dict__.get("_compiled")
-    if cached is not None and cached[0] == key:
+    if cached is not None and _unchanged(solver, cached[0]):
         return cached[1]
+    placements = _placements(solver)
     core = _build(solver)
-    solver.__dict__["_compiled"] = (key, core)
+    solver.__dict__["_compiled"] = ((solver.tol, placements), core)
     return core
 
 
-def _key(solver) -> tuple:
-    """What the core copies from the model and may be changed by the user: the cut frames'
-    placements, and the tolerance."""
+def _placements(solver) -> list[pin.SE3]:
+    """The cut frames' placements on their joints: what the core copies from the model
+    that the user may change."""
     model = solver.model
-    frames = [f for c in solver.mechanism.closures for f in (c.parent_frame, c.child_frame)]
-    return (solver.tol, placement_rows([model.frames[f].placement for f in frames]).tobytes())
+    return [model.frames[f].placement.copy() for c in solver.mechanism.closures
+            for f in (c.parent_frame, c.child_frame)]
+
+
+def _unchanged(solver, key: tuple) -> bool:
+    tol, placements = key
+    if tol != solver.tol:
+        return False
+    frames = solver.model.frames
+    cuts = solver.mechanism.closures
+    return all(frames[f].placement == M for f, M in
+               zip((f for c in cuts for f in (c.parent_frame, c.child_frame)), placements))
 
 
 def _build(solver) -> _core.Core | None:

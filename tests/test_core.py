@@ -256,3 +256,11 @@ def test_four_bars_from_micrometres_to_kilometres_meet_the_closed_form(tmp_path,
         assert np.abs(_rocker_tip(mech, q[i], c, d) - ref.B).max() <= 1e-12 * size, i
         omega4 = chunk.solution.v[i][mech.joint("O4").idx_v]
         assert abs(omega4 - float(ref.omega4)) <= 1e-10 * (1 + abs(float(ref.omega4))), i
+
+
+def test_a_new_tolerance_rebuilds_the_core(scenes_dir):
+    sweep = _sweep(scenes_dir, "four_bar.toml")
+    first = core.core_for(sweep.solver)
+    sweep.solver.tol = 1e-9
+    second = core.core_for(sweep.solver)
+    assert second is not first and second.tol == 1e-9
