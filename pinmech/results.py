@@ -116,7 +116,7 @@ class LoopSolution:
     route: Any = None
 
     def is_closed(self, tol: float = 1e-9) -> bool:
-        """True when every loop closes to `tol` (relative to the mechanism's size)."""
+        """True when every loop closes to `tol` (relative to each loop's size)."""
         return self.accuracy.residual <= tol
 
 
