@@ -128,6 +128,8 @@ def compile_loops(model: pin.Model, closures: list, v_scale: np.ndarray, *, extr
         compiled = CompiledModel(model, frames)
     except KeyError:
         return None
+    for c in closures:  # what the core copies stays as it is (as CutEvaluator does)
+        c.__dict__["_in_use"] = True
     rows6 = [np.ascontiguousarray(c._rows6, dtype=float) for c in closures]
     full = [np.ascontiguousarray(c.selected * c._scale(), dtype=float) for c in closures]
     axes = np.array([c.axis for c in closures], dtype=float).reshape(-1, 3)
