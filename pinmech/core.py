@@ -41,6 +41,22 @@ def placement_rows(placements: list[pin.SE3]) -> np.ndarray:
     return out
 
 
+class ModelCopy:
+    """What a core copied from a `pin.Model` that a user may still change in place: every
+    joint's placement and the placements of the frames it took. A core is rebuilt when
+    they no longer match (the Python path reads them afresh at every pose)."""
+
+    def __init__(self, model: pin.Model, frame_ids) -> None:
+        self.joints = [model.jointPlacements[j].copy() for j in range(1, model.njoints)]
+        self.frame_ids = tuple(int(f) for f in frame_ids)
+        self.frames = [model.frames[f].placement.copy() for f in self.frame_ids]
+
+    def matches(self, model: pin.Model) -> bool:
+        return (model.njoints - 1 == len(self.joints)
+                and all(model.jointPlacements[j + 1] == M for j, M in enumerate(self.joints))
+                and all(model.frames[f].placement == M for f, M in zip(self.frame_ids, self.frames)))
+
+
 class CompiledModel:
     """A `pin.Model`'s joints and some of its frames, rebuilt in the core.
 
@@ -67,45 +83,29 @@ class CompiledModel:
         self.frame_placements = placement_rows([model.frames[fid].placement for fid in self.frames])
         self.nv = model.nv
 
-    def kinematics(self) -> _core.Core:
-        """A core with these frames and no loops (for `Core.frame_motion`)."""
+    def kinematics(self, model: pin.Model) -> _core.Core | None:
+        """A core with these frames and no loops (for `Core.frame_motion`), or None where it
+        disagrees with `model` (`agrees`)."""
         none = np.zeros((0, 3))
-        return _core.Core(self.types, self.parents, self.placements, self.axes, self.frame_parents,
+        core = _core.Core(self.types, self.parents, self.placements, self.axes, self.frame_parents,
                           self.frame_placements, [], [], [], none, none, [], [], [], [], [], [], np.ones(self.nv),
                           [], [], DEFAULT_TOL)
+        return core if agrees(core, self, model, []) else None
 
 
 def core_for(solver) -> _core.Core | None:
-    """The compiled core of a `LoopSolver` (built once, again when a cut frame moved or the
-    tolerance changed), or None where the core cannot rebuild the model (then the Python
-    path solves it all)."""
+    """The compiled core of a `LoopSolver` (built once, again when the model's placements
+    or the tolerance changed), or None where the core cannot rebuild the model, or its
+    rebuilt model disagrees with the Python one (then the Python path solves it all)."""
     if not ENABLED:
         return None
     cached = solver.__dict__.get("_compiled")
-    if cached is not None and _unchanged(solver, cached[0]):
-        return cached[1]
-    placements = _placements(solver)
+    if cached is not None and cached[0] == solver.tol and cached[1].matches(solver.model):
+        return cached[2]
+    copy = ModelCopy(solver.model, [f for c in solver.mechanism.closures for f in (c.parent_frame, c.child_frame)])
     core = _build(solver)
-    solver.__dict__["_compiled"] = ((solver.tol, placements), core)
+    solver.__dict__["_compiled"] = (solver.tol, copy, core)
     return core
-
-
-def _placements(solver) -> list[pin.SE3]:
-    """The cut frames' placements on their joints: what the core copies from the model
-    that the user may change."""
-    model = solver.model
-    return [model.frames[f].placement.copy() for c in solver.mechanism.closures
-            for f in (c.parent_frame, c.child_frame)]
-
-
-def _unchanged(solver, key: tuple) -> bool:
-    tol, placements = key
-    if tol != solver.tol:
-        return False
-    frames = solver.model.frames
-    cuts = solver.mechanism.closures
-    return all(frames[f].placement == M for f, M in
-               zip((f for c in cuts for f in (c.parent_frame, c.child_frame)), placements))
 
 
 def _build(solver) -> _core.Core | None:
@@ -143,7 +143,37 @@ def compile_loops(model: pin.Model, closures: list, v_scale: np.ndarray, *, extr
         [int(i) for i, _ in drv_q], [int(c) for _, c in drv_q], np.asarray(v_scale, dtype=float),
         [list(map(int, b.rows)) for b in blocks], [list(map(int, b.cols)) for b in blocks], float(tol),
     )
+    return (core, compiled) if agrees(core, compiled, model, closures) else None
+
+
+def agrees(core: _core.Core, compiled: CompiledModel, model: pin.Model, closures: list) -> bool:
+    """Whether the rebuilt model is the Python one: the same coordinates, and at a seeded
+    random configuration the same frame placements and closure rows and Jacobians (to
+    1e-12 of their size; the same formulas in another order agree to 1e-15). A rebuild
+    that differs (a joint type read wrongly, an axis) leaves the model to the Python path
+    instead of giving other numbers."""
     same = (core.nq == model.nq and core.nv == model.nv
             and core.idx_q == [model.joints[j].idx_q for j in range(1, model.njoints)]
             and core.idx_v == [model.joints[j].idx_v for j in range(1, model.njoints)])
-    return (core, compiled) if same else None
+    if not same:
+        return False
+    rng = np.random.default_rng(20261122)
+    q = pin.integrate(model, pin.neutral(model), rng.uniform(-1.0, 1.0, model.nv))
+    data = model.createData()
+    pin.computeJointJacobians(model, data, q)
+    pin.updateFramePlacements(model, data)
+    fids = list(compiled.frames)
+    zeros = np.zeros((1, model.nv))
+    P, R = core.frame_motion(q[None], zeros, zeros, list(range(len(fids))))[:2]
+    want_P = np.array([data.oMf[f].translation for f in fids]).reshape(1, -1)
+    want_R = np.array([data.oMf[f].rotation.reshape(9) for f in fids]).reshape(1, -1)
+    size = 1.0 + float(np.abs(want_P).max(initial=0.0))
+    if not (np.abs(P - want_P).max(initial=0.0) <= 1e-12 * size and np.abs(R - want_R).max(initial=0.0) <= 1e-12):
+        return False
+    if not closures:
+        return True
+    r = np.concatenate([c.residual(data) for c in closures])
+    J = np.vstack([c.jacobian(model, data) for c in closures])
+    scale = 1.0 + max(float(np.abs(r).max()), float(np.abs(J).max()))
+    return bool(np.abs(core.residual(q) - r).max() <= 1e-12 * scale
+                and np.abs(core.jacobian(False) - J).max() <= 1e-12 * scale)

@@ -223,10 +223,9 @@ class RateSolver:
 
         if not core.ENABLED:
             return None
-        frames = [f for c in self.mechanism.closures for f in (c.parent_frame, c.child_frame)] + self.frames
-        key = core.placement_rows([self.model.frames[f].placement for f in frames]).tobytes()
         cached = self.__dict__.get("_core")
-        if cached is None or cached[0] != key:
+        if cached is None or not cached[0].matches(self.model):
+            frames = [f for c in self.mechanism.closures for f in (c.parent_frame, c.child_frame)] + self.frames
             built = core.compile_loops(self.model, self.mechanism.closures, self.mechanism.velocity_scale(),
                                        extra_frames=self.frames)
             value = None
@@ -237,7 +236,7 @@ class RateSolver:
                          [[int(k) for k in t.rows] for t in self.tasks],
                          [int(t.reference == "local") for t in self.tasks],
                          np.r_[np.ones(n_c), self._row_scale])
-            cached = (key, value)
+            cached = (core.ModelCopy(self.model, frames), value)
             self.__dict__["_core"] = cached
         return cached[1]
 

@@ -92,17 +92,18 @@ def _pose_by_pose(model: pin.Model, names: tuple[str, ...], fids: list[int], q: 
 
 def _core_for(mechanism: Mechanism, fids: list[int]):
     """A compiled model of the mechanism with these frames and its lock (built once per set
-    of frames and their placements), or None where the core does not rebuild its joints."""
+    of frames, again when the model's placements changed), or None where the core does not
+    rebuild its joints or its rebuild disagrees (`core.agrees`)."""
     if not core.ENABLED:
         return None
     model = mechanism.model
-    key = (tuple(fids), core.placement_rows([model.frames[f].placement for f in fids]).tobytes())
     cache = mechanism.__dict__.setdefault("_frame_cores", {})
-    if key not in cache:
+    cached = cache.get(tuple(fids))
+    if cached is None or not cached[0].matches(model):
         try:
-            compiled = core.CompiledModel(model, fids)
+            built = core.CompiledModel(model, fids).kinematics(model)
         except KeyError:
-            cache[key] = None
-        else:
-            cache[key] = (compiled.kinematics(), threading.Lock())
-    return cache[key]
+            built = None
+        cached = (core.ModelCopy(model, fids), None if built is None else (built, threading.Lock()))
+        cache[tuple(fids)] = cached
+    return cached[1]

@@ -264,3 +264,37 @@ def test_a_new_tolerance_rebuilds_the_core(scenes_dir):
     sweep.solver.tol = 1e-9
     second = core.core_for(sweep.solver)
     assert second is not first and second.tol == 1e-9
+
+
+def test_a_link_lengthened_in_the_model_after_a_sweep_is_seen(scenes_dir, monkeypatch):
+    """A joint placement changed in place once the core is built (a link made longer in
+    code): the next sweep rebuilds the core and equals the Python path on the new model."""
+    def run():
+        sweep = _sweep(scenes_dir, "four_bar.toml")
+        model = sweep.solver.model
+        values = sweep.start + np.radians(np.arange(0.0, 40.0, 5.0))
+        list(sweep.chunks(values))  # the core built on the model as loaded
+        jid = max(range(1, model.njoints), key=lambda j: np.linalg.norm(model.jointPlacements[j].translation))
+        M = model.jointPlacements[jid].copy()
+        M.translation = M.translation * 1.01
+        model.jointPlacements[jid] = M
+        sweep.solver.set_reference(sweep.drivers.q, sweep.solver.reference.q)
+        return _rows(sweep, values)
+
+    with_core = run()
+    monkeypatch.setattr(core, "ENABLED", False)
+    plain = run()
+    np.testing.assert_allclose(with_core[0], plain[0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(with_core[1], plain[1], rtol=0, atol=1e-10)
+
+
+def test_a_rebuild_that_disagrees_is_refused(scenes_dir, monkeypatch):
+    """Whatever the core reads wrongly (here: every z revolute rebuilt about x), its model
+    is checked against Pinocchio's before use and left to the Python path."""
+    sweep = _sweep(scenes_dir, "r_rtr.toml")
+    codes = dict(core.JOINT_CODES)
+    codes["JointModelRZ"] = codes["JointModelRUBZ"] = codes["JointModelRX"]
+    monkeypatch.setattr(core, "JOINT_CODES", codes)
+    assert core.core_for(sweep.solver) is None
+    assert core.CompiledModel(sweep.mechanism.model, [sweep.mechanism.frame_id("D")]).kinematics(
+        sweep.mechanism.model) is None
