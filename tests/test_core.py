@@ -29,6 +29,7 @@ from pinmech.solve_loops import MAX_STEP as MAX_NEWTON_STEP
 from pinmech.sweep import Sweep
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
+import benchmark_loops as chain  # noqa: E402
 import closed_form  # noqa: E402
 
 LOOP_SCENES = ["r_rtr.toml", "four_bar.toml", "slider_crank.toml", "four_bar_dynamic.toml",
@@ -298,3 +299,87 @@ def test_a_rebuild_that_disagrees_is_refused(scenes_dir, monkeypatch):
     assert core.core_for(sweep.solver) is None
     assert core.CompiledModel(sweep.mechanism.model, [sweep.mechanism.frame_id("D")]).kinematics(
         sweep.mechanism.model) is None
+
+
+# ---------------------------------------------------------------------- chains and condition numbers
+def _carried_chain(tmp_path: Path, k: int):
+    """k four-bars in series whose ground pivots sit on a carrier link turning about a
+    tilted axis: every cut frame hangs below the carrier's joint, which moves both sides
+    of each cut together (the core leaves its column of the relative Jacobians out)."""
+    text = chain.chain_urdf(k).replace('<parent link="ground"/><child link="L', '<parent link="base"/><child link="L')
+    carrier = ('<link name="base"/><joint name="carrier" type="continuous"><parent link="ground"/>'
+               '<child link="base"/><origin xyz="0.3 -0.2 0.1" rpy="0.2 0.1 0"/><axis xyz="0.3 0.4 0.866"/></joint>')
+    text = text.replace('<link name="ground"/>', '<link name="ground"/>' + carrier)
+    path = tmp_path / f"carried_chain_{k}.urdf"
+    path.write_text(text, encoding="utf-8")
+    mech = pinmech.Mechanism.from_urdf(path)
+    return pinmech.LoopSolver(mech, ["carrier", "O0"])
+
+
+@pytest.mark.parametrize("carried", [False, True], ids=["ground", "carried"])
+def test_chain_closure_rows_equal_the_python_formulas(tmp_path, carried):
+    """Four loops in series, on the ground or carried by a turning link: the core computes
+    each cut's Jacobian over the joints that move one side of the cut and not the other;
+    the Python path over every column, where the shared ones cancel to rounding."""
+    solver = _carried_chain(tmp_path, 4) if carried else chain.chain_solver(4, folder=tmp_path)[1]
+    compiled = core.core_for(solver)
+    assert compiled is not None
+    model, rng = solver.model, np.random.default_rng(11)
+    for _ in range(5):
+        q = pin.randomConfiguration(model, -np.pi * np.ones(model.nq), np.pi * np.ones(model.nq))
+        v = rng.normal(size=model.nv)
+        r = solver._residual(q)
+        J, Jn = solver._jacobian(), solver._residual_jacobian()
+        pin.forwardKinematics(model, solver.data, q, v, np.zeros(model.nv))
+        drift = solver._drift()
+        scale = 1.0 + max(np.abs(r).max(), np.abs(J).max(), np.abs(drift).max())
+        np.testing.assert_allclose(compiled.residual(q), r, rtol=0, atol=1e-13 * scale)
+        np.testing.assert_allclose(compiled.jacobian(False), J, rtol=0, atol=1e-13 * scale)
+        np.testing.assert_allclose(compiled.jacobian(True), Jn, rtol=0, atol=1e-13 * scale)
+        np.testing.assert_allclose(compiled.drift(q, v), drift, rtol=0, atol=1e-13 * scale)
+    if carried:  # the carrier turns both sides of every cut: its column is exactly zero
+        assert not compiled.jacobian(False)[:, model.joints[model.getJointId("carrier")].idx_v].any()
+
+
+def _with_singular_values(rng, s: np.ndarray) -> np.ndarray:
+    n = len(s)
+    U, _ = np.linalg.qr(rng.normal(size=(n, n)))
+    V, _ = np.linalg.qr(rng.normal(size=(n, n)))
+    return (U * s) @ V.T
+
+
+@settings(max_examples=200, deadline=None)
+@given(n=st.integers(1, 40), log_condition=st.floats(0.0, 12.0), log_size=st.floats(-8.0, 8.0),
+       seed=st.integers(0, 2**32 - 1))
+def test_condition_numbers_are_the_svds(n, log_condition, log_size, seed):
+    """The core's condition number and smallest singular value (largest eigenvalues of
+    A^T A and A^-1 A^-T above 2x2) against numpy's SVD, square matrices 1x1 to 40x40,
+    condition numbers 1 to 1e12, sizes 1e-8 to 1e8. Both are exact to rounding: sigma_max
+    to a few eps relative, sigma_min to about eps x condition (the SVD's own accuracy, and
+    what rounding A itself moves it by), so the bar is 1e-12 + 100 n eps kappa."""
+    rng = np.random.default_rng(seed)
+    s = 10.0**log_size * np.geomspace(1.0, 10.0**-log_condition, n)
+    A = _with_singular_values(rng, s)
+    condition, sigma_min = core._core.condition(A)
+    sigma = np.linalg.svd(A, compute_uv=False)
+    want = sigma[0] / sigma[-1]
+    bar = 1e-12 + 100 * n * np.finfo(float).eps * want
+    assert condition == pytest.approx(want, rel=bar)
+    assert sigma_min == pytest.approx(sigma[-1], rel=bar)
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4, 9, 32])
+def test_singular_matrices_have_infinite_condition(n):
+    """A zero row or a repeated column is singular at every size: condition inf, sigma_min
+    0 where the factorization meets an exact zero, else beyond 1e15 (rounding's floor)."""
+    rng = np.random.default_rng(n)
+    A = rng.normal(size=(n, n))
+    A[-1] = 0.0
+    assert core._core.condition(A) == (math.inf, 0.0)
+    if n >= 2:
+        B = rng.normal(size=(n, n))
+        B[:, -1] = B[:, 0]
+        condition, sigma_min = core._core.condition(B)
+        assert condition > 1e15 and sigma_min < 1e-14 * np.abs(B).max()
+    with pytest.raises(ValueError, match="square"):
+        core._core.condition(np.zeros((n, n + 1)))

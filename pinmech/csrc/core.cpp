@@ -15,6 +15,7 @@
 
 #include <nanobind/nanobind.h>
 #include <nanobind/eigen/dense.h>
+#include <nanobind/stl/pair.h>
 #include <nanobind/stl/tuple.h>
 #include <nanobind/stl/vector.h>
 
@@ -26,7 +27,6 @@
 #include <pinocchio/algorithm/kinematics.hpp>
 
 #include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
 
 #include <algorithm>
 #include <cmath>
@@ -100,31 +100,56 @@ pin::JointModel joint_model(int type, const Vector3d& axis) {
 double max_abs(const Eigen::Ref<const VectorXd>& x) { return x.size() ? x.cwiseAbs().maxCoeff() : 0.0; }
 
 // A x = b for a small square A, as solve_loops._solve_square: closed forms up to 2x2, LU
-// with partial pivoting above (`lu` reused: no allocation per pose); NaN where A is
-// exactly singular.
-void solve_square(const MatrixXd& A, const VectorXd& b, VectorXd& x, Eigen::PartialPivLU<MatrixXd>& lu) {
-  const Index n = A.rows();
-  x.resize(n);
-  if (n == 1) {
-    x(0) = A(0, 0) != 0.0 ? b(0) / A(0, 0) : NAN;
-    return;
-  }
-  if (n == 2) {
-    const double det = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
-    if (det == 0.0) {
-      x.setConstant(NAN);
-      return;
+// with partial pivoting above; NaN where A is exactly singular. Factored once for several
+// right-hand sides; the LU's buffers are reused, so a pose allocates nothing.
+class SquareSolve {
+ public:
+  void factor(const MatrixXd& A) {
+    A_ = &A;
+    if (A.rows() >= 3) {
+      lu_.compute(A);
+      singular_ = lu_.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0;
     }
-    x << (A(1, 1) * b(0) - A(0, 1) * b(1)) / det, (A(0, 0) * b(1) - A(1, 0) * b(0)) / det;
-    return;
   }
-  lu.compute(A);
-  x = lu.solve(b);
-  if (lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0) x.setConstant(NAN);
-}
+
+  void solve(const VectorXd& b, VectorXd& x) const {
+    const MatrixXd& A = *A_;
+    const Index n = A.rows();
+    x.resize(n);
+    if (n == 1) {
+      x(0) = A(0, 0) != 0.0 ? b(0) / A(0, 0) : NAN;
+    } else if (n == 2) {
+      const double det = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
+      if (det == 0.0) x.setConstant(NAN);
+      else x << (A(1, 1) * b(0) - A(0, 1) * b(1)) / det, (A(0, 0) * b(1) - A(1, 0) * b(0)) / det;
+    } else if (n > 2) {
+      x = lu_.solve(b);
+      if (singular_) x.setConstant(NAN);
+    }
+  }
+
+ private:
+  const MatrixXd* A_ = nullptr;
+  Eigen::PartialPivLU<MatrixXd> lu_;
+  bool singular_ = false;
+};
+
+// Work buffers of condition_of for matrices above 3x3 (sized on first use).
+struct ConditionWork {
+  Eigen::PartialPivLU<MatrixXd> lu;
+  MatrixXd inverse, gram;
+  Eigen::SelfAdjointEigenSolver<MatrixXd> eig;
+};
 
 // 2-norm condition number and smallest singular value, as solve_loops._condition.
-std::pair<double, double> condition_of(const MatrixXd& A, Eigen::JacobiSVD<MatrixXd>& svd) {
+// Above 2x2: sigma_max^2 and sigma_min^-2 as the LARGEST eigenvalues of A^T A and
+// A^-1 A^-T (closed form at 3x3, Eigen's computeDirect; a symmetric eigensolver above).
+// A largest eigenvalue of a symmetric positive matrix is found to rounding relative to
+// itself, so sigma_max is exact to rounding and sigma_min good to about eps times the
+// condition number, as an SVD gives it (tests/test_core.py checks both against numpy's
+// SVD up to 40x40 and condition 1e12). Cost (callgrind): at 3x3 a third of the SVD's, at
+// 32x32 (a chain of 16 four-bars) 0.93M instructions against JacobiSVD's 3.3M.
+std::pair<double, double> condition_of(const MatrixXd& A, ConditionWork& work) {
   const Index n = A.rows();
   if (n == 0) return {1.0, 1.0};
   if (n == 1) {
@@ -139,15 +164,14 @@ std::pair<double, double> condition_of(const MatrixXd& A, Eigen::JacobiSVD<Matri
     return {det > 0 ? s_max2 / det : INFINITY, s_min};
   }
   if (n == 3) {
-    // sigma_max^2 and sigma_min^-2 as the LARGEST eigenvalues of A^T A and A^-1 A^-T (closed
-    // form, Eigen's computeDirect): both to rounding relative to themselves, sigma_min to
-    // about eps times the condition number, as an SVD gives it; a third of the SVD's cost.
+    // The inverse by LU with partial pivoting: the cofactor formula of
+    // computeInverseAndDetWithCheck lost 2e-3 of the condition number at 1e10, where
+    // rounding allows 2e-6 (tests/test_core.py found it).
     const Matrix3d M = A;
-    Matrix3d inverse;
-    double det = 0.0;
-    bool invertible = false;
-    M.computeInverseAndDetWithCheck(inverse, det, invertible, 0.0);
-    if (!invertible || !inverse.allFinite()) return {INFINITY, 0.0};
+    const Eigen::PartialPivLU<Matrix3d> lu(M);
+    if (lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0) return {INFINITY, 0.0};
+    const Matrix3d inverse = lu.inverse();
+    if (!inverse.allFinite()) return {INFINITY, 0.0};
     Eigen::SelfAdjointEigenSolver<Matrix3d> eig;
     eig.computeDirect(M.transpose() * M, Eigen::EigenvaluesOnly);
     const double s_max = std::sqrt(eig.eigenvalues()(2));
@@ -155,10 +179,18 @@ std::pair<double, double> condition_of(const MatrixXd& A, Eigen::JacobiSVD<Matri
     const double s_min = 1.0 / std::sqrt(eig.eigenvalues()(2));
     return {s_max / s_min, s_min};
   }
-  svd.compute(A);
-  const auto& s = svd.singularValues();
-  const double lo = s(n - 1);
-  return {lo > 0 ? s(0) / lo : INFINITY, lo};
+  work.lu.compute(A);
+  if (work.lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0) return {INFINITY, 0.0};
+  work.inverse = work.lu.inverse();
+  if (!work.inverse.allFinite()) return {INFINITY, 0.0};
+  work.gram.noalias() = A.transpose() * A;
+  work.eig.compute(work.gram, Eigen::EigenvaluesOnly);
+  const double s_max = std::sqrt(work.eig.eigenvalues()(n - 1));
+  work.gram.noalias() = work.inverse * work.inverse.transpose();
+  work.eig.compute(work.gram, Eigen::EigenvaluesOnly);
+  const double s_min = 1.0 / std::sqrt(work.eig.eigenvalues()(n - 1));
+  if (!(s_min > 0.0)) return {INFINITY, 0.0};
+  return {s_max / s_min, s_min};
 }
 
 double det_of(const MatrixXd& A) {
@@ -176,6 +208,11 @@ struct Cut {
   MatrixXd full;   // (n_sel, 6): selection @ diag(scale), every selected row
   Index offset;    // first row in the stacked residual
   bool ground;     // P is a frame of the ground: no Jacobian, velocity or acceleration
+  // The velocity columns that move C relative to P: joints supporting C and not P, and
+  // joints supporting P and not C. A joint supporting both moves P and C together, so its
+  // column of the relative Jacobian is zero (exactly, where the full difference would
+  // leave rounding): a cut costs the joints of its own loop, not the depth of the tree.
+  std::vector<Index> child_cols, parent_cols;
 };
 
 struct Node {
@@ -214,6 +251,7 @@ class Core {
       Cut cut{cut_types[c], frames_.at(cut_parent[c]), frames_.at(cut_child[c]), cut_axes.row(c).transpose(),
               cut_child_axes.row(c).transpose(), rows6.at(c), full.at(c), offset, false};
       cut.ground = model_.frames[cut.parent].parentJoint == 0;
+      relative_columns(cut);
       if (cut.rows6.cols() != 6 || cut.full.cols() != 6) throw std::invalid_argument("closure rows must have 6 columns");
       offset += cut.rows6.rows();
       cuts_.push_back(cut);
@@ -230,9 +268,6 @@ class Core {
     blocks_cols_ = block_cols;
     step_ = VectorXd::Zero(nv);
     zero_ = VectorXd::Zero(nv);
-    J6_ = Matrix6Xd::Zero(6, nv);
-    JP_ = Matrix6Xd::Zero(6, nv);
-    JC_ = Matrix6Xd::Zero(6, nv);
     tmp3_ = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, nv);
     const Index ndep = Index(dep_v_.size());
     J_ = MatrixXd::Zero(rows_, nv);
@@ -285,10 +320,7 @@ class Core {
 
   // J_ = the stacked rows' Jacobian, Jdep_ its dependent columns (data_ at q).
   void jacobian_into(bool newton) {
-    for (const Cut& cut : cuts_) {
-      relative_jacobian(cut, newton);
-      J_.middleRows(cut.offset, cut.rows6.rows()).noalias() = cut.rows6 * J6_;
-    }
+    for (const Cut& cut : cuts_) relative_jacobian(cut, newton);
     for (size_t i = 0; i < dep_v_.size(); ++i) Jdep_.col(Index(i)) = J_.col(dep_v_[i]);
   }
 
@@ -335,7 +367,8 @@ class Core {
       jacobian_into(true);
       ++iterations_;
       rhs_ = -r;
-      solve_square(Jdep_, rhs_, dstep_, lu_);
+      square_.factor(Jdep_);
+      square_.solve(rhs_, dstep_);
       if (!dstep_.allFinite()) return false;
       move_into(q, dstep_, q_new_);
       residual_into(q_new_, r_new_);
@@ -364,7 +397,7 @@ class Core {
   void node_at(Node& node, const VectorXd& d) {
     jacobian_into(false);
     scaled_ = Jdep_ * dep_scale_.asDiagonal();
-    auto [condition, sigma_min] = condition_of(scaled_, svd_);
+    auto [condition, sigma_min] = condition_of(scaled_, condition_work_);
     node.condition = condition;
     node.sigma_min = sigma_min;
     signs_into(Jdep_, node.signs);
@@ -373,11 +406,12 @@ class Core {
     a.setZero(model_.nv);
     for (size_t i = 0; i < drv_v_.size(); ++i) v(drv_v_[i]) = d(Index(i));
     rhs_.noalias() = -(J_ * v);  // driver columns only: v is zero elsewhere yet
-    solve_square(Jdep_, rhs_, dstep_, lu_);
+    square_.factor(Jdep_);
+    square_.solve(rhs_, dstep_);
     for (size_t i = 0; i < dep_v_.size(); ++i) v(dep_v_[i]) = dstep_(Index(i));
     drift_into(node.q, v, drift_);
     rhs_ = -drift_;
-    solve_square(Jdep_, rhs_, dstep_, lu_);
+    square_.solve(rhs_, dstep_);  // J_dep unchanged by the drift: factored once
     for (size_t i = 0; i < dep_v_.size(); ++i) a(dep_v_[i]) = dstep_(Index(i));
     rhs_.noalias() = J_ * v;
     node.velocity_residual = max_abs(rhs_);
@@ -525,7 +559,7 @@ class Core {
       VectorXd q(model_.nq), v(nv), a(nv), rhs(m), drift(m), x(nv), achieved(m);
       Matrix6Xd JT(6, nv);
       Eigen::PartialPivLU<MatrixXd> lu;
-      Eigen::JacobiSVD<MatrixXd> svd;
+      ConditionWork condition_work;
       for (Index i = 0; i < n; ++i) {
         q = Q.row(i).transpose();
         if (rows_) {
@@ -554,7 +588,7 @@ class Core {
           numbers(i, 4) = 1;
           continue;
         }
-        const auto [cond, smin] = condition_of(Jd, svd);
+        const auto [cond, smin] = condition_of(Jd, condition_work);
         if (!(cond < max_condition)) {
           numbers(i, 4) = 1;
           continue;
@@ -678,26 +712,34 @@ class Core {
     return e;
   }
 
-  // J6_ = the (6, nv) map from joint velocities to (r_dot, w) of the cut in P; with
-  // `newton`, orientation rows carry the derivative of the error measure instead
-  // (Closure.residual_jacobian).
+  // The columns of the cut's relative Jacobian that can be nonzero (Cut::child_cols).
+  void relative_columns(Cut& cut) const {
+    const auto& P = model_.supports[model_.frames[cut.parent].parentJoint];
+    const auto& C = model_.supports[model_.frames[cut.child].parentJoint];
+    auto add = [this](std::vector<Index>& cols, const std::vector<pin::JointIndex>& from,
+                      const std::vector<pin::JointIndex>& other) {
+      for (pin::JointIndex j : from) {
+        if (j == 0 || std::find(other.begin(), other.end(), j) != other.end()) continue;
+        for (int k = 0; k < model_.nvs[j]; ++k) cols.push_back(Index(model_.idx_vs[j] + k));
+      }
+    };
+    add(cut.child_cols, C, P);
+    add(cut.parent_cols, P, C);
+  }
+
+  // Rows offset .. offset + k of J_ = the cut's rows6 times its (6, nv) map from joint
+  // velocities to (r_dot, w) of C in P; with `newton`, orientation rows carry the
+  // derivative of the error measure instead (Closure.residual_jacobian). Columns come
+  // from data_.J (world axes, at the origin: pin::getFrameJacobian's source), only those
+  // of Cut::child_cols and parent_cols; J_'s other columns of these rows stay zero.
   void relative_jacobian(const Cut& cut, bool newton) {
-    JP_.setZero();
-    JC_.setZero();
-    if (!cut.ground) pin::getFrameJacobian(model_, data_, cut.parent, pin::LOCAL_WORLD_ALIGNED, JP_);
-    pin::getFrameJacobian(model_, data_, cut.child, pin::LOCAL_WORLD_ALIGNED, JC_);
     const pin::SE3 &MP = data_.oMf[cut.parent], &MC = data_.oMf[cut.child];
     const Matrix3d RT = MP.rotation().transpose();
-    const Vector3d delta = MC.translation() - MP.translation();
-    // into fixed-height buffers: no temporaries allocated per pose
-    tmp3_ = JC_.topRows<3>() - JP_.topRows<3>();
-    tmp3_.noalias() += pin::skew(delta) * JP_.bottomRows<3>();
-    J6_.topRows<3>().noalias() = RT * tmp3_;
-    tmp3_ = JC_.bottomRows<3>() - JP_.bottomRows<3>();
-    J6_.bottomRows<3>().noalias() = RT * tmp3_;
+    const Vector3d &pP = MP.translation(), &pC = MC.translation();
+    const Vector3d delta = pC - pP;
+    Matrix3d M = Matrix3d::Identity();
     if (newton && cut.type != SPHERICAL_CUT) {
       const Matrix3d R_rel = RT * MC.rotation();
-      Matrix3d M;
       if (cut.type == REVOLUTE) {
         M = -pin::skew(cut.axis) * pin::skew(Vector3d(R_rel * cut.child_axis));
       } else {
@@ -705,8 +747,22 @@ class Core {
         pin::Jlog3(R_rel, Jlog);
         M = Jlog * R_rel.transpose();
       }
-      tmp3_.noalias() = M * J6_.bottomRows<3>();
-      J6_.bottomRows<3>() = tmp3_;
+    }
+    const Matrix3d MRT = M * RT;
+    const Index k = cut.rows6.rows();
+    Vector6d e;
+    for (Index c : cut.child_cols) {  // C's frame velocity at C, in P's axes
+      const Vector3d w = data_.J.col(c).tail<3>();
+      e.head<3>().noalias() = RT * (data_.J.col(c).head<3>() + w.cross(pC));
+      e.tail<3>().noalias() = MRT * w;
+      J_.block(cut.offset, c, k, 1).noalias() = cut.rows6 * e;
+    }
+    for (Index c : cut.parent_cols) {  // minus P's frame velocity at P, and P turning delta
+      const Vector3d w = data_.J.col(c).tail<3>();
+      const Vector3d v = data_.J.col(c).head<3>() + w.cross(pP);
+      e.head<3>().noalias() = RT * (delta.cross(w) - v);
+      e.tail<3>().noalias() = -(MRT * w);
+      J_.block(cut.offset, c, k, 1).noalias() = cut.rows6 * e;
     }
   }
 
@@ -738,7 +794,8 @@ class Core {
   void polish(VectorXd& q, VectorXd& r, double& norm) {
     jacobian_into(true);
     rhs_ = -r;
-    solve_square(Jdep_, rhs_, dstep_, lu_);
+    square_.factor(Jdep_);
+    square_.solve(rhs_, dstep_);
     if (!dstep_.allFinite()) return;
     double alpha = 1.0;
     for (int k = 0; k <= LINE_SEARCH_HALVINGS; ++k, alpha *= 0.5) {
@@ -770,14 +827,13 @@ class Core {
   std::vector<int> drv_v_, dep_v_, drv_q_, drv_continuous_;
   VectorXd dep_scale_, v_scale_, v_scale_inv_, step_, zero_;
   std::vector<std::vector<int>> blocks_rows_, blocks_cols_;
-  Matrix6Xd J6_, JP_, JC_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> tmp3_;
   // work buffers, sized once: a pose allocates nothing
   MatrixXd J_, Jdep_, scaled_;
   std::vector<MatrixXd> block_buffers_;
   VectorXd r_, r_new_, rhs_, dstep_, drift_, q_new_, predicted_, x_;
-  Eigen::PartialPivLU<MatrixXd> lu_;
-  Eigen::JacobiSVD<MatrixXd> svd_;
+  SquareSolve square_;
+  ConditionWork condition_work_;
   double tol_;
   int iterations_ = 0;
   double moved_ = 0.0;
@@ -797,6 +853,14 @@ NB_MODULE(_core, m) {
   m.attr("CORRECTOR_ITERATIONS") = CORRECTOR_ITERATIONS;
   m.attr("SINGULAR_NODE") = SINGULAR_NODE;
   m.attr("PINOCCHIO_VERSION") = PINOCCHIO_VERSION;
+  m.def(
+      "condition",
+      [](const MatrixXd& A) {
+        if (A.rows() != A.cols()) throw std::invalid_argument("condition: A must be square");
+        ConditionWork work;
+        return condition_of(A, work);
+      },
+      "2-norm condition number and smallest singular value of a square A, as the core computes them");
   nb::class_<Core>(m, "Core")
       .def(nb::init<const std::vector<int>&, const std::vector<int>&, const Eigen::Ref<const RowMatrix>&,
                     const Eigen::Ref<const RowMatrix>&, const std::vector<int>&, const Eigen::Ref<const RowMatrix>&,
