@@ -15,7 +15,12 @@ import os
 import numpy as np
 import pinocchio as pin
 
-from pinmech import _core
+try:
+    from pinmech import _core
+except ImportError as error:  # e.g. `python -m pinmech` in a checkout installed with `pip install .`
+    raise ImportError(f"pinmech's compiled core is missing from {os.path.dirname(__file__)}, a source tree "
+                      "without its build: run pinmech from outside the checkout, or install the checkout "
+                      f"with `pip install -e .` ({error})") from error
 
 #: Pinocchio joint types the core rebuilds, by shortname -> its code in core.cpp.
 JOINT_CODES = {
