@@ -27,11 +27,15 @@ import re
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from collections import defaultdict
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+#: Every child runs here, outside the checkout, so `python -c` imports the pinmech the
+#: console script imports (a regular install's copy, not the source tree beside it).
+NEUTRAL = Path(tempfile.gettempdir())
 SCENE = ROOT / "models" / "scenes" / "r_rtr.toml"
 IMPORT_LINE = re.compile(r"import time:\s+(\d+)\s+\|\s+(\d+)\s+\|( *)(\S+)")
 
@@ -42,8 +46,10 @@ times = []
 for _ in range(2):
     with contextlib.redirect_stdout(io.StringIO()):
         t0 = time.perf_counter()
-        pinmech.cli.main(["solve", sys.argv[1]])
+        code = pinmech.cli.main(["solve", sys.argv[1]])
         times.append(time.perf_counter() - t0)
+    if code:
+        sys.exit(f"pinmech solve exited with {code}")
 print(*times)
 """
 
@@ -52,7 +58,9 @@ import cProfile, contextlib, io, pstats, sys
 import pinmech.cli
 profile = cProfile.Profile()
 with contextlib.redirect_stdout(io.StringIO()):
-    profile.runcall(pinmech.cli.main, ["solve", sys.argv[1]])
+    code = profile.runcall(pinmech.cli.main, ["solve", sys.argv[1]])
+if code:
+    sys.exit(f"pinmech solve exited with {code}")
 stats = pstats.Stats(profile)
 rows = sorted(stats.stats.items(), key=lambda kv: -kv[1][3])
 print(f"total {stats.total_tt:.6f}")
@@ -81,7 +89,7 @@ def wall_time(command: list[str], env: dict[str, str] | None = None) -> float:
     """Wall time [s] of one run; a failing command stops the script with its message."""
     t0 = time.perf_counter()
     done = subprocess.run(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                          check=False, env=env)
+                          check=False, env=env, cwd=NEUTRAL)
     elapsed = time.perf_counter() - t0
     if done.returncode != 0:
         sys.exit(f"{' '.join(command)} failed (exit {done.returncode}): {done.stderr.strip()[-500:]}")
@@ -105,7 +113,7 @@ def import_costs(command: list[str]) -> tuple[dict[str, float], list[tuple[float
     module's self time, and the cumulative time of all top-level imports [s]."""
     env = dict(os.environ, PYTHONPROFILEIMPORTTIME="1")
     done = subprocess.run(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                          check=False, env=env)
+                          check=False, env=env, cwd=NEUTRAL)
     by_package: dict[str, float] = defaultdict(float)
     modules, total = [], 0.0
     for match in IMPORT_LINE.finditer(done.stderr):
@@ -121,7 +129,7 @@ def profile_after_import(scene: Path, top: int) -> tuple[float, list[tuple[float
     """cProfile of the solve command once pinmech.cli is imported: total [s] and the
     functions with the largest cumulative time [s]."""
     done = subprocess.run([sys.executable, "-c", PROFILE, str(scene), str(top)], capture_output=True,
-                          text=True, check=False)
+                          text=True, check=False, cwd=NEUTRAL)
     if done.returncode != 0:
         sys.exit(f"profiling pinmech solve failed: {done.stderr.strip()[-500:]}")
     lines = done.stdout.split("\n")
@@ -133,24 +141,36 @@ def solve_after_import(scene: Path) -> tuple[float, float]:
     """Wall time [s] of `main(["solve", SCENE])` once pinmech.cli is imported, and of the
     same call again in that process (what stays once every one-off cost is paid)."""
     done = subprocess.run([sys.executable, "-c", TIMED, str(scene)], capture_output=True, text=True,
-                          check=False)
+                          check=False, cwd=NEUTRAL)
     if done.returncode != 0:
         sys.exit(f"timing pinmech solve failed: {done.stderr.strip()[-500:]}")
     first, second = (float(x) for x in done.stdout.split())
     return first, second
 
 
-def uncompiled_modules() -> list[str]:
+def measured_package() -> Path:
+    """The pinmech package the commands import: a regular install's copy in site-packages,
+    or the checkout itself for an editable install."""
+    done = subprocess.run([sys.executable, "-c", "import pinmech; print(pinmech.__file__)"], capture_output=True,
+                          text=True, check=False, cwd=NEUTRAL)
+    if done.returncode != 0:
+        sys.exit(f"import pinmech failed: {done.stderr.strip()[-500:]}")
+    return Path(done.stdout.strip()).parent
+
+
+def uncompiled_modules(package: Path) -> list[str]:
     """pinmech's source files that every timed run compiles again: they have no bytecode in
     `__pycache__` (or an older one), and PYTHONDONTWRITEBYTECODE, which the commands inherit,
-    keeps the untimed round from writing it. Empty when the bytecode is, or will be, cached."""
+    keeps the untimed round from writing it. Empty when the bytecode is, or will be, cached
+    (pip compiles a regular install's bytecode; an editable install runs the checkout's
+    source)."""
     if not os.environ.get("PYTHONDONTWRITEBYTECODE"):
         return []
     out = []
-    for source in sorted((ROOT / "pinmech").rglob("*.py")):
+    for source in sorted(package.rglob("*.py")):
         cached = Path(importlib.util.cache_from_source(str(source)))
         if not cached.is_file() or cached.stat().st_mtime < source.stat().st_mtime:
-            out.append(str(source.relative_to(ROOT)))
+            out.append(str(source.relative_to(package.parent)))
     return out
 
 
@@ -177,7 +197,11 @@ def report(scene: Path, runs: int, top: int) -> tuple[str, float]:
     verdict = "met" if ratio <= 1.5 else "not met"
     lines += ["", (f"`{names[2]}` takes {ratio:.2f} x `{names[1]}` (medians; issue 13's target: at most "
               f"1.5 x): {verdict}."), ""]
-    uncached = uncompiled_modules()
+    package = measured_package()
+    editable = package.resolve() == ROOT / "pinmech"
+    where = "the checkout's source (an editable install)" if editable else "a regular install (in site-packages)"
+    lines += [f"pinmech measured: {where}.", ""]
+    uncached = uncompiled_modules(package)
     if uncached:
         lines += [(f"Every `pinmech solve` above compiled pinmech's own modules from source ({len(uncached)} files "
                    "without cached bytecode, and PYTHONDONTWRITEBYTECODE is set, so no run could cache it), which "
