@@ -164,16 +164,18 @@ class RateSolver:
         x_ddot = self._values(acceleration, self.x_ddot, "acceleration")
         J, n_c = self._jacobian(self.data, q)
         m, n = J.shape
-        sigma = np.linalg.svd(self._dimensionless(J, n_c), compute_uv=False)
+        rows, columns = self._scales(n_c)
+        Jd = rows[:, None] * J * columns
+        sigma = np.linalg.svd(Jd, compute_uv=False)
         rank = min(m, n)
         if rank and not sigma[rank - 1] > sigma[0] / self.max_condition:
             rank = min(rank, self._structural_rank()[0])  # only poses that look singular pay
         sigma_min = float(sigma[rank - 1]) if rank else 0.0
         condition = float(sigma[0] / sigma_min) if sigma_min > 0 else float("inf")
         method = self._method(m, n, rank, condition, sigma_min, q)
-        v = self._apply(J, np.r_[np.zeros(n_c), x_dot], method, rank)
+        v = columns * self._apply(Jd, rows * np.concatenate((np.zeros(n_c), x_dot)), method, rank)
         drift = self._drift(q, v, n_c)
-        a = self._apply(J, np.r_[np.zeros(n_c), x_ddot] - drift, method, rank)
+        a = columns * self._apply(Jd, rows * (np.concatenate((np.zeros(n_c), x_ddot)) - drift), method, rank)
         achieved_v, achieved_a = J @ v, J @ a + drift
         return RateSolution(
             v=v, a=a, method=method, condition=condition, sigma_min=sigma_min,
@@ -235,7 +237,7 @@ class RateSolver:
                 value = (compiled, [rebuilt.frames[f] for f in self.frames],
                          [[int(k) for k in t.rows] for t in self.tasks],
                          [int(t.reference == "local") for t in self.tasks],
-                         np.r_[np.ones(n_c), self._row_scale])
+                         self._scales(n_c)[0])
             cached = (core.ModelCopy(self.model, frames), value)
             self.__dict__["_core"] = cached
         return cached[1]
@@ -276,14 +278,19 @@ class RateSolver:
             if task.reference == "local":
                 R_T = self.data.oMf[fid].rotation.T
                 linear, angular = R_T @ linear, R_T @ angular
-            parts.append(np.r_[linear, angular][task.rows])
+            parts.append(np.concatenate((linear, angular))[task.rows])
         return np.concatenate(parts) if parts else np.zeros(n_c)
 
     def _dimensionless(self, J: np.ndarray, n_closure: int) -> np.ndarray:
         """J with linear task rows divided by the mechanism's size and prismatic columns
         multiplied by it, so its condition number does not depend on units or size."""
-        rows = np.r_[np.ones(n_closure), self._row_scale]
-        return rows[:, None] * J * self.mechanism.velocity_scale()
+        rows, columns = self._scales(n_closure)
+        return rows[:, None] * J * columns
+
+    def _scales(self, n_closure: int) -> tuple[np.ndarray, np.ndarray]:
+        """The row and column factors of `_dimensionless` (read from the mechanism afresh:
+        a model changed in place changes its size)."""
+        return np.concatenate((np.ones(n_closure), self._row_scale)), self.mechanism.velocity_scale()
 
     def _structural_rank(self) -> tuple[int, np.ndarray, list[int]]:
         """Rank of the stacked Jacobian at random poses (the highest found), its task rows
@@ -353,23 +360,18 @@ class RateSolver:
         return describe_joint_values(self.mechanism, names, [self.mechanism.coordinate(q, n) for n in names])
 
     def _apply(self, J: np.ndarray, rhs: np.ndarray, method: str, rank: int) -> np.ndarray:
-        """Solve J x = rhs by `method`, in dimensionless rows and columns (see `_dimensionless`),
-        so that the minimum norm, the least squares and the damping weigh a turn of one radian
-        like a slide of one mechanism size: the same answer at any size, in any unit."""
-        n_c = J.shape[0] - self._row_scale.size
-        columns = self.mechanism.velocity_scale()
-        rows = np.r_[np.ones(n_c), self._row_scale]
-        J, rhs = self._dimensionless(J, n_c), rows * rhs
+        """Solve J x = rhs by `method`, J and rhs dimensionless (see `_dimensionless`: the
+        caller scales rows in and columns out), so that the minimum norm, the least squares
+        and the damping weigh a turn of one radian like a slide of one mechanism size: the
+        same answer at any size, in any unit."""
         if method == "exact":
-            x = np.linalg.solve(J, rhs)
-        elif method == "damped":
-            x = J.T @ np.linalg.solve(J @ J.T + self.damping**2 * np.eye(J.shape[0]), rhs)
-        elif rank == min(J.shape):
-            x = np.linalg.lstsq(J, rhs, rcond=None)[0]  # minimum-norm or least-squares
-        else:
-            U, s, Vt = np.linalg.svd(J, full_matrices=False)  # rank-deficient: truncated pseudo-inverse
-            x = Vt[:rank].T @ ((U[:, :rank].T @ rhs) / s[:rank])
-        return columns * x
+            return np.linalg.solve(J, rhs)
+        if method == "damped":
+            return J.T @ np.linalg.solve(J @ J.T + self.damping**2 * np.eye(J.shape[0]), rhs)
+        if rank == min(J.shape):
+            return np.linalg.lstsq(J, rhs, rcond=None)[0]  # minimum-norm or least-squares
+        U, s, Vt = np.linalg.svd(J, full_matrices=False)  # rank-deficient: truncated pseudo-inverse
+        return Vt[:rank].T @ ((U[:, :rank].T @ rhs) / s[:rank])
 
 
 def _rank(J: np.ndarray) -> int:
