@@ -1,8 +1,9 @@
 """The speed/accuracy trade of sweeps, measured in one run on this machine.
 
 R-RTR cycle (Problem Chapter I.9, crank at -50 rpm, 3600 poses): for each accuracy choice,
-the median time per pose (median of `--repeats` runs of the whole cycle, divided by the
-number of poses) of solving every pose, i.e. q, v, a of every joint with its accuracy
+the median time per pose (median of `--repeats` rounds of the whole cycle, divided by the
+number of poses; the rounds interleaved, every setting once a round, with the fastest and
+slowest round as the spread) of solving every pose, i.e. q, v, a of every joint with its accuracy
 (closure residual, condition number), and the largest relative error of D's position,
 velocity and acceleration over the cycle against the independent closed form
 (scripts/closed_form.py):
@@ -140,6 +141,21 @@ def timed(fn, repeats: int):
     return statistics.median(times), result
 
 
+def interleaved(fns: list, repeats: int) -> tuple[list[list[float]], list]:
+    """Wall times of `repeats` rounds, every fn called once a round in turn (so the
+    machine's load falls on all of them alike), and each fn's last result. One untimed
+    call of each first: set-up that a first call pays (the compiled core's build) is not
+    in the time."""
+    results = [fn() for fn in fns]
+    times: list[list[float]] = [[] for _ in fns]
+    for _ in range(repeats):
+        for i, fn in enumerate(fns):
+            start = time.perf_counter()
+            results[i] = fn()
+            times[i].append(time.perf_counter() - start)
+    return times, results
+
+
 # ------------------------------------------------------------------ tables
 def cycle_rows(poses: int, repeats: int) -> list[dict]:
     scene = pinmech.Scene.load(SCENE)
@@ -148,19 +164,19 @@ def cycle_rows(poses: int, repeats: int) -> list[dict]:
     t_cf, cf = timed(lambda: closed_form.r_rtr(phis, omega, 0.0), repeats)
     reference = [cf.D, cf.vD, cf.aD]
     rows = [{"name": "closed form, vectorized numpy (lower bound)", "time": t_cf / poses, "errors": [0.0] * 3}]
-    results = []
-    for name, run in SETTINGS:
-        sweep = Sweep.from_scene(scene)  # loading the model is not timed
-        t, (Q, V, A, iterations) = timed(lambda run=run, sweep=sweep: run(sweep, phis), repeats)
-        results.append((name, t, Q, V, A, iterations, sweep))
-    Q0, V0 = results[0][2], results[0][3]
-    sweep = results[0][6]
-    for keep, label in ((False, "results thrown away"), (True, "results kept in arrays: the floor")):
-        t, _ = timed(lambda keep=keep: floor(sweep, Q0, V0, keep), repeats)
-        rows.append({"name": f"bare Pinocchio calls of one pose, {label}", "time": t / poses, "errors": None,
-                     "floor": keep})
-    for name, t, Q, V, A, iterations, sweep in results:
-        rows.append({"name": name, "time": t / poses, "errors": relative_errors(read_d(sweep, Q, V, A), reference),
+    sweeps = [Sweep.from_scene(scene) for _ in SETTINGS]  # loading the model is not timed
+    first = sweeps[0]
+    Q0, V0, _, _ = SETTINGS[0][1](first, phis)
+    floors = ((False, "results thrown away"), (True, "results kept in arrays: the floor"))
+    fns = [lambda run=run, sweep=sweep: run(sweep, phis) for (_, run), sweep in zip(SETTINGS, sweeps)]
+    fns += [lambda keep=keep: floor(first, Q0, V0, keep) for keep, _ in floors]
+    times, results = interleaved(fns, repeats)
+    timing = [{"time": statistics.median(t) / poses, "fastest": min(t) / poses, "slowest": max(t) / poses}
+              for t in times]
+    for (keep, label), t in zip(floors, timing[len(SETTINGS):]):
+        rows.append({"name": f"bare Pinocchio calls of one pose, {label}", **t, "errors": None, "floor": keep})
+    for (name, _), sweep, (Q, V, A, iterations), t in zip(SETTINGS, sweeps, results, timing):
+        rows.append({"name": name, **t, "errors": relative_errors(read_d(sweep, Q, V, A), reference),
                      "iterations": None if iterations is None else float(np.mean(iterations))})
     return rows
 
@@ -168,13 +184,14 @@ def cycle_rows(poses: int, repeats: int) -> list[dict]:
 def cycle_table(rows: list[dict]) -> str:
     floor_t = next(r["time"] for r in rows if r.get("floor"))
     default_t = next(r["time"] for r in rows if r["name"].startswith("default"))
-    header = ("| setting | time per pose [us] | vs floor | vs default | Newton iterations per pose "
-              "| rel. error position | velocity | acceleration |")
-    lines = [header, "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    header = ("| setting | time per pose [us] (median) | spread (fastest - slowest round) | vs floor | vs default "
+              "| Newton iterations per pose | rel. error position | velocity | acceleration |")
+    lines = [header, "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in rows:
         errors = " | ".join(f"{e:.1e}" for e in r["errors"]) if r["errors"] is not None else "- | - | -"
         iterations = f"{r['iterations']:.2f}" if r.get("iterations") is not None else "-"
-        lines.append(f"| {r['name']} | {1e6 * r['time']:.2f} | {r['time'] / floor_t:.2f} | "
+        spread = f"{1e6 * r['fastest']:.2f} - {1e6 * r['slowest']:.2f}" if "fastest" in r else "-"
+        lines.append(f"| {r['name']} | {1e6 * r['time']:.2f} | {spread} | {r['time'] / floor_t:.2f} | "
                      f"{r['time'] / default_t:.2f} | {iterations} | {errors} |")
     return "\n".join(lines)
 
@@ -290,7 +307,7 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     cycle = cycle_rows(args.poses, args.repeats)
     paths = path_rows(max(1, min(args.repeats, 3)))
-    head = (f"{args.poses} poses, median of {args.repeats} runs, pin {pin.__version__}, numpy {np.__version__}, "
+    head = (f"{args.poses} poses, median of {args.repeats} interleaved rounds, pin {pin.__version__}, numpy {np.__version__}, "
             f"Python {sys.version.split()[0]}")
     text = "\n\n".join([head, cycle_table(cycle), verdicts(cycle),
                         "Arm path (text 17.110, D at 1 m/s along x, CD vertical, 0.08 s):", path_table(paths)])
