@@ -138,3 +138,27 @@ def test_loops_of_full_rank_on_their_first_closed_pose_are_not_sampled_around(mo
     monkeypatch.setattr(mobility, "close_least_squares", counting)
     report = mobility.constraint_rank(Mechanism.from_urdf(models_dir / "r_rtr.urdf"))
     assert (report.rank, report.rows, report.redundant, len(closings)) == (2, 2, (), 1)
+
+
+def test_a_source_tree_without_its_compiled_core_says_so_in_one_line(tmp_path, scenes_dir):
+    """`python -m pinmech` run inside a checkout that was installed with `pip install .` imports
+    the checkout's source, which has no compiled core beside it: the command says so in one
+    line (exit 2) and names the way out, instead of a traceback. (Here the source is copied
+    without its core, and the editable install's import hook, which would find the real
+    package first, is left out.)"""
+    import shutil
+    from pathlib import Path
+
+    source = Path(pinmech.__file__).parent
+    shutil.copytree(source, tmp_path / "pinmech", ignore=shutil.ignore_patterns("*.so", "*.pyd", "__pycache__", "csrc"))
+    run = ("import runpy, sys\n"
+           "sys.meta_path[:] = [f for f in sys.meta_path if 'editable' not in getattr(f, '__module__', '')]\n"
+           "sys.path.insert(0, sys.argv[1])\n"
+           "sys.argv = ['pinmech', 'solve', sys.argv[2]]\n"
+           "runpy.run_module('pinmech', run_name='__main__')\n")
+    done = subprocess.run([sys.executable, "-c", run, str(tmp_path), str(scenes_dir / "r_rtr.toml")],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2, done.stdout[-300:] + done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("pinmech: error: pinmech's compiled core is missing from")
+    assert str(tmp_path / "pinmech") in lines[0] and "pip install -e ." in lines[0]
