@@ -46,7 +46,6 @@ Run: python scripts/benchmark_loops.py [--loops 1 2 4 8 16] [--poses 360] [--rou
 from __future__ import annotations
 
 import argparse
-import gc
 import math
 import os
 import platform
@@ -61,6 +60,8 @@ from importlib import metadata
 from pathlib import Path
 
 import numpy as np
+
+from interleave import time_rounds
 
 LOOPS = (1, 2, 4, 8, 16)
 #: Drag link: input a, coupler b, output c, ground d [m] (Grashof, ground shortest).
@@ -289,21 +290,6 @@ def warm_up(row: Row, sample_time: float) -> None:
     row.run()
     second = time.perf_counter() - t0
     row.calls = max(1, math.ceil(sample_time / max(second, 1e-9)))
-
-
-def time_rounds(rows: list[Row], rounds: int) -> None:
-    """Interleaved rounds: each round times every row once, the order rotated."""
-    for r in range(rounds):
-        for row in rows[r % len(rows):] + rows[: r % len(rows)]:
-            gc.collect()
-            gc.disable()
-            try:
-                t0 = time.perf_counter()
-                for _ in range(row.calls):
-                    row.run()
-                row.times.append((time.perf_counter() - t0) / (row.calls * row.poses))
-            finally:
-                gc.enable()
 
 
 def measure(loops=LOOPS, poses: int = 360, rounds: int = 7, sample_time: float = 0.2,

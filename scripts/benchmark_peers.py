@@ -50,7 +50,6 @@ from __future__ import annotations
 import argparse
 import atexit
 import functools
-import gc
 import importlib
 import math
 import os
@@ -66,6 +65,8 @@ from importlib import metadata
 from pathlib import Path
 
 import numpy as np
+
+from interleave import time_rounds
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import closed_form
@@ -674,22 +675,6 @@ def warm_up(row: Row, ref: np.ndarray, sample_time: float) -> None:
     row.calls = max(1, math.ceil(sample_time / max(second, 1e-9)))
     if first > 2 * second + 0.01:  # compiling (numba), loading caches, first imports
         row.one_off += f"; first call {_seconds(first)} (then {_seconds(second)})"
-
-
-def time_rounds(rows: list[Row], rounds: int) -> None:
-    """Interleaved rounds: each round times every row once, the order rotated."""
-    live = [r for r in rows if r.run is not None]
-    for k in range(rounds if live else 0):
-        for row in live[k % len(live):] + live[: k % len(live)]:
-            gc.collect()
-            gc.disable()
-            try:
-                t0 = time.perf_counter()
-                for _ in range(row.calls):
-                    row.run()
-                row.times.append((time.perf_counter() - t0) / (row.calls * row.poses))
-            finally:
-                gc.enable()
 
 
 def measure(poses: int = 360, rounds: int = 7, sample_time: float = 0.05) -> list[Row]:

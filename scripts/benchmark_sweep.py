@@ -39,6 +39,7 @@ import pinocchio as pin
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import closed_form
+from interleave import Timed, time_rounds
 
 import pinmech
 import pinmech.scene_model
@@ -141,21 +142,6 @@ def timed(fn, repeats: int):
     return statistics.median(times), result
 
 
-def interleaved(fns: list, repeats: int) -> tuple[list[list[float]], list]:
-    """Wall times of `repeats` rounds, every fn called once a round in turn (so the
-    machine's load falls on all of them alike), and each fn's last result. One untimed
-    call of each first: set-up that a first call pays (the compiled core's build) is not
-    in the time."""
-    results = [fn() for fn in fns]
-    times: list[list[float]] = [[] for _ in fns]
-    for _ in range(repeats):
-        for i, fn in enumerate(fns):
-            start = time.perf_counter()
-            results[i] = fn()
-            times[i].append(time.perf_counter() - start)
-    return times, results
-
-
 # ------------------------------------------------------------------ tables
 def cycle_rows(poses: int, repeats: int) -> list[dict]:
     scene = pinmech.Scene.load(SCENE)
@@ -170,9 +156,11 @@ def cycle_rows(poses: int, repeats: int) -> list[dict]:
     floors = ((False, "results thrown away"), (True, "results kept in arrays: the floor"))
     fns = [lambda run=run, sweep=sweep: run(sweep, phis) for (_, run), sweep in zip(SETTINGS, sweeps)]
     fns += [lambda keep=keep: floor(first, Q0, V0, keep) for keep, _ in floors]
-    times, results = interleaved(fns, repeats)
-    timing = [{"time": statistics.median(t) / poses, "fastest": min(t) / poses, "slowest": max(t) / poses}
-              for t in times]
+    results = [fn() for fn in fns]  # untimed: a first call's set-up (the core's build) stays out
+    timed_rows = [Timed(fn, poses) for fn in fns]
+    time_rounds(timed_rows, repeats)
+    timing = [{"time": statistics.median(r.times), "fastest": min(r.times), "slowest": max(r.times)}
+              for r in timed_rows]
     for (keep, label), t in zip(floors, timing[len(SETTINGS):]):
         rows.append({"name": f"bare Pinocchio calls of one pose, {label}", **t, "errors": None, "floor": keep})
     for (name, _), sweep, (Q, V, A, iterations), t in zip(SETTINGS, sweeps, results, timing):
