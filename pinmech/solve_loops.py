@@ -130,7 +130,8 @@ def _solve_square(A: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _condition(A: np.ndarray) -> tuple[float, float]:
     """2-norm condition number and smallest singular value of a square A: closed forms up
-    to 2x2 (sigma_max^2 + sigma_min^2 = |A|_F^2, sigma_max sigma_min = |det A|), SVD above."""
+    to 2x2 (sigma_max = |(a+e, c-d)|/2 + |(a-e, c+d)|/2, a sum without cancellation, and
+    sigma_max sigma_min = |det A|), SVD above."""
     n = A.shape[0]
     if n == 0:
         return 1.0, 1.0
@@ -139,10 +140,10 @@ def _condition(A: np.ndarray) -> tuple[float, float]:
         return (1.0 if s > 0 else math.inf), s
     if n == 2:
         (a, c), (d, e) = A.tolist()
-        frob2, det = a * a + c * c + d * d + e * e, abs(a * e - c * d)
-        s_max2 = 0.5 * (frob2 + math.sqrt(max(frob2 * frob2 - 4.0 * det * det, 0.0)))
-        s_min = det / math.sqrt(s_max2) if s_max2 > 0 else 0.0
-        return (s_max2 / det if det > 0 else math.inf), s_min
+        s_max = 0.5 * (math.hypot(a + e, c - d) + math.hypot(a - e, c + d))
+        det = abs(a * e - c * d)
+        s_min = det / s_max if s_max > 0 else 0.0
+        return (s_max * s_max / det if det > 0 else math.inf), s_min
     sigma = np.linalg.svd(A, compute_uv=False)
     return (float(sigma[0] / sigma[-1]) if sigma[-1] > 0 else math.inf), float(sigma[-1])
 

@@ -24,7 +24,7 @@ import pytest
 import pinmech
 import pinmech.core as core
 from pinmech.continuation import CORRECTOR_ITERATIONS, MAX_STEP, MAX_TURN, PIVOT_BELOW, SINGULAR_NODE, TRUST
-from pinmech.solve_loops import DEFAULT_TOL, POLISH
+from pinmech.solve_loops import DEFAULT_TOL, POLISH, _condition
 from pinmech.solve_loops import MAX_STEP as MAX_NEWTON_STEP
 from pinmech.sweep import Sweep
 
@@ -62,7 +62,13 @@ def test_closure_rows_equal_the_python_formulas(scenes_dir, name):
     compiled = core.core_for(solver)
     if compiled is None:
         pytest.skip(f"{name}: a joint the core does not rebuild")
-    model, rng = solver.model, np.random.default_rng(7)
+    _check_against_solver(compiled, solver, seed=7)
+
+
+def _check_against_solver(compiled, solver, seed: int) -> None:
+    """The core's residual, both Jacobians, full residual and drift against the solver's
+    (closures.py) at five random configurations, closed or not."""
+    model, rng = solver.model, np.random.default_rng(seed)
     for _ in range(5):
         q = pin.randomConfiguration(model, -np.pi * np.ones(model.nq), np.pi * np.ones(model.nq))
         v = rng.normal(size=model.nv)
@@ -71,11 +77,18 @@ def test_closure_rows_equal_the_python_formulas(scenes_dir, name):
         full = solver._full_residual()
         pin.forwardKinematics(model, solver.data, q, v, np.zeros(model.nv))
         drift = solver._drift()
-        scale = 1.0 + max(np.abs(r).max(), np.abs(J).max(), np.abs(drift).max())
-        np.testing.assert_allclose(compiled.residual(q), r, rtol=0, atol=1e-13 * scale)
-        np.testing.assert_allclose(compiled.jacobian(False), J, rtol=0, atol=1e-13 * scale)
-        np.testing.assert_allclose(compiled.jacobian(True), Jn, rtol=0, atol=1e-13 * scale)
+        _assert_same_rows(compiled, q, r, J, Jn, v, drift)
         assert compiled.full_residual() == pytest.approx(full, rel=1e-13, abs=1e-13)
+
+
+def _assert_same_rows(compiled, q, r, J, Jn, v=None, drift=None) -> None:
+    """Equal to rounding: 1e-13 of the largest number (see the module docstring)."""
+    extra = () if drift is None else (np.abs(drift).max(),)
+    scale = 1.0 + max(np.abs(r).max(), np.abs(J).max(), *extra)
+    np.testing.assert_allclose(compiled.residual(q), r, rtol=0, atol=1e-13 * scale)
+    np.testing.assert_allclose(compiled.jacobian(False), J, rtol=0, atol=1e-13 * scale)
+    np.testing.assert_allclose(compiled.jacobian(True), Jn, rtol=0, atol=1e-13 * scale)
+    if drift is not None:
         np.testing.assert_allclose(compiled.drift(q, v), drift, rtol=0, atol=1e-13 * scale)
 
 
@@ -324,19 +337,8 @@ def test_chain_closure_rows_equal_the_python_formulas(tmp_path, carried):
     solver = _carried_chain(tmp_path, 4) if carried else chain.chain_solver(4, folder=tmp_path)[1]
     compiled = core.core_for(solver)
     assert compiled is not None
-    model, rng = solver.model, np.random.default_rng(11)
-    for _ in range(5):
-        q = pin.randomConfiguration(model, -np.pi * np.ones(model.nq), np.pi * np.ones(model.nq))
-        v = rng.normal(size=model.nv)
-        r = solver._residual(q)
-        J, Jn = solver._jacobian(), solver._residual_jacobian()
-        pin.forwardKinematics(model, solver.data, q, v, np.zeros(model.nv))
-        drift = solver._drift()
-        scale = 1.0 + max(np.abs(r).max(), np.abs(J).max(), np.abs(drift).max())
-        np.testing.assert_allclose(compiled.residual(q), r, rtol=0, atol=1e-13 * scale)
-        np.testing.assert_allclose(compiled.jacobian(False), J, rtol=0, atol=1e-13 * scale)
-        np.testing.assert_allclose(compiled.jacobian(True), Jn, rtol=0, atol=1e-13 * scale)
-        np.testing.assert_allclose(compiled.drift(q, v), drift, rtol=0, atol=1e-13 * scale)
+    _check_against_solver(compiled, solver, seed=11)
+    model = solver.model
     if carried:  # the carrier turns both sides of every cut: its column is exactly zero
         assert not compiled.jacobian(False)[:, model.joints[model.getJointId("carrier")].idx_v].any()
 
@@ -360,10 +362,7 @@ def test_closure_rows_on_a_floating_base_equal_the_python_formulas(tmp_path):
         r = np.concatenate([c.residual(data) for c in mech.closures])
         J = np.vstack([c.jacobian(model, data) for c in mech.closures])
         Jn = np.vstack([c.residual_jacobian(model, data) for c in mech.closures])
-        scale = 1.0 + max(np.abs(r).max(), np.abs(J).max())
-        np.testing.assert_allclose(compiled.residual(q), r, rtol=0, atol=1e-13 * scale)
-        np.testing.assert_allclose(compiled.jacobian(False), J, rtol=0, atol=1e-13 * scale)
-        np.testing.assert_allclose(compiled.jacobian(True), Jn, rtol=0, atol=1e-13 * scale)
+        _assert_same_rows(compiled, q, r, J, Jn)
         assert not compiled.jacobian(False)[:, base.idx_v:base.idx_v + 6].any()
 
 
@@ -379,19 +378,22 @@ def _with_singular_values(rng, s: np.ndarray) -> np.ndarray:
        seed=st.integers(0, 2**32 - 1))
 def test_condition_numbers_are_the_svds(n, log_condition, log_size, seed):
     """The core's condition number and smallest singular value (largest eigenvalues of
-    A^T A and A^-1 A^-T above 2x2) against numpy's SVD, square matrices 1x1 to 40x40,
-    condition numbers 1 to 1e12, sizes 1e-8 to 1e8. Both are exact to rounding: sigma_max
+    A^T A and A^-1 A^-T above 2x2) and the Python path's (solve_loops._condition: closed
+    forms to 2x2, SVD above) against numpy's SVD, square matrices 1x1 to 40x40,
+    condition numbers 1 to 1e12, sizes 1e-8 to 1e8. All are exact to rounding: sigma_max
     to a few eps relative, sigma_min to about eps x condition (the SVD's own accuracy, and
-    what rounding A itself moves it by), so the bar is 1e-12 + 100 n eps kappa."""
+    what rounding A itself moves it by), so the bar is 1e-12 + 100 n eps kappa. (It found
+    the 2x2 closed form losing 1.4e-12 at condition 1.00007, and the 3x3 cofactor inverse
+    losing 2e-3 at 1e10.)"""
     rng = np.random.default_rng(seed)
     s = 10.0**log_size * np.geomspace(1.0, 10.0**-log_condition, n)
     A = _with_singular_values(rng, s)
-    condition, sigma_min = core._core.condition(A)
     sigma = np.linalg.svd(A, compute_uv=False)
     want = sigma[0] / sigma[-1]
     bar = 1e-12 + 100 * n * np.finfo(float).eps * want
-    assert condition == pytest.approx(want, rel=bar)
-    assert sigma_min == pytest.approx(sigma[-1], rel=bar)
+    for condition, sigma_min in (core._core.condition(A), _condition(A)):
+        assert condition == pytest.approx(want, rel=bar)
+        assert sigma_min == pytest.approx(sigma[-1], rel=bar)
 
 
 @pytest.mark.parametrize("n", [1, 2, 3, 4, 9, 32])

@@ -128,6 +128,9 @@ class SquareSolve {
     }
   }
 
+  // The LU of the matrix last factored (above 2x2).
+  const Eigen::PartialPivLU<MatrixXd>& lu() const { return lu_; }
+
  private:
   const MatrixXd* A_ = nullptr;
   Eigen::PartialPivLU<MatrixXd> lu_;
@@ -136,7 +139,6 @@ class SquareSolve {
 
 // Work buffers of condition_of for matrices above 3x3 (sized on first use).
 struct ConditionWork {
-  Eigen::PartialPivLU<MatrixXd> lu;
   MatrixXd inverse, gram;
   Eigen::SelfAdjointEigenSolver<MatrixXd> eig;
 };
@@ -148,8 +150,10 @@ struct ConditionWork {
 // itself, so sigma_max is exact to rounding and sigma_min good to about eps times the
 // condition number, as an SVD gives it (tests/test_core.py checks both against numpy's
 // SVD up to 40x40 and condition 1e12). Cost (callgrind): at 3x3 a third of the SVD's, at
-// 32x32 (a chain of 16 four-bars) 0.93M instructions against JacobiSVD's 3.3M.
-std::pair<double, double> condition_of(const MatrixXd& A, ConditionWork& work) {
+// 32x32 (a chain of 16 four-bars) about 0.9M instructions against JacobiSVD's 3.3M.
+// `lu` is A's factorization, which the caller also solves with (used above 3x3 only).
+std::pair<double, double> condition_of(const MatrixXd& A, const Eigen::PartialPivLU<MatrixXd>& lu,
+                                       ConditionWork& work) {
   const Index n = A.rows();
   if (n == 0) return {1.0, 1.0};
   if (n == 1) {
@@ -157,11 +161,14 @@ std::pair<double, double> condition_of(const MatrixXd& A, ConditionWork& work) {
     return {s > 0 ? 1.0 : INFINITY, s};
   }
   if (n == 2) {
+    // sigma_max = |(a+e, c-d)|/2 + |(a-e, c+d)|/2, a sum of two non-negative terms (no
+    // cancellation, where sqrt(frob^4 - 4 det^2) lost 1e-12 near condition 1); then
+    // sigma_min = |det| / sigma_max.
     const double a = A(0, 0), c = A(0, 1), d = A(1, 0), e = A(1, 1);
-    const double frob2 = a * a + c * c + d * d + e * e, det = std::abs(a * e - c * d);
-    const double s_max2 = 0.5 * (frob2 + std::sqrt(std::max(frob2 * frob2 - 4.0 * det * det, 0.0)));
-    const double s_min = s_max2 > 0 ? det / std::sqrt(s_max2) : 0.0;
-    return {det > 0 ? s_max2 / det : INFINITY, s_min};
+    const double s_max = 0.5 * (std::hypot(a + e, c - d) + std::hypot(a - e, c + d));
+    const double det = std::abs(a * e - c * d);
+    const double s_min = s_max > 0 ? det / s_max : 0.0;
+    return {det > 0 ? s_max * s_max / det : INFINITY, s_min};
   }
   if (n == 3) {
     // The inverse by LU with partial pivoting: the cofactor formula of
@@ -179,9 +186,8 @@ std::pair<double, double> condition_of(const MatrixXd& A, ConditionWork& work) {
     const double s_min = 1.0 / std::sqrt(eig.eigenvalues()(2));
     return {s_max / s_min, s_min};
   }
-  work.lu.compute(A);
-  if (work.lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0) return {INFINITY, 0.0};
-  work.inverse = work.lu.inverse();
+  if (lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0) return {INFINITY, 0.0};
+  work.inverse = lu.inverse();
   if (!work.inverse.allFinite()) return {INFINITY, 0.0};
   work.gram.noalias() = A.transpose() * A;
   work.eig.compute(work.gram, Eigen::EigenvaluesOnly);
@@ -395,9 +401,12 @@ class Core {
   // Path.node at a closed q whose placements and Jacobians are in data_: the path
   // derivatives at driver velocity d, the condition number and the signature.
   void node_at(Node& node, const VectorXd& d) {
+    // One factorization of the dimensionless J_dep (columns times dep_scale_) serves the
+    // condition number and both solves; a dependent rate is dep_scale_ times its unknown.
     jacobian_into(false);
     scaled_ = Jdep_ * dep_scale_.asDiagonal();
-    auto [condition, sigma_min] = condition_of(scaled_, condition_work_);
+    square_.factor(scaled_);
+    auto [condition, sigma_min] = condition_of(scaled_, square_.lu(), condition_work_);
     node.condition = condition;
     node.sigma_min = sigma_min;
     signs_into(Jdep_, node.signs);
@@ -406,13 +415,12 @@ class Core {
     a.setZero(model_.nv);
     for (size_t i = 0; i < drv_v_.size(); ++i) v(drv_v_[i]) = d(Index(i));
     rhs_.noalias() = -(J_ * v);  // driver columns only: v is zero elsewhere yet
-    square_.factor(Jdep_);
     square_.solve(rhs_, dstep_);
-    for (size_t i = 0; i < dep_v_.size(); ++i) v(dep_v_[i]) = dstep_(Index(i));
+    for (size_t i = 0; i < dep_v_.size(); ++i) v(dep_v_[i]) = dep_scale_(Index(i)) * dstep_(Index(i));
     drift_into(node.q, v, drift_);
     rhs_ = -drift_;
-    square_.solve(rhs_, dstep_);  // J_dep unchanged by the drift: factored once
-    for (size_t i = 0; i < dep_v_.size(); ++i) a(dep_v_[i]) = dstep_(Index(i));
+    square_.solve(rhs_, dstep_);
+    for (size_t i = 0; i < dep_v_.size(); ++i) a(dep_v_[i]) = dep_scale_(Index(i)) * dstep_(Index(i));
     rhs_.noalias() = J_ * v;
     node.velocity_residual = max_abs(rhs_);
     rhs_.noalias() = J_ * a;
@@ -588,12 +596,12 @@ class Core {
           numbers(i, 4) = 1;
           continue;
         }
-        const auto [cond, smin] = condition_of(Jd, condition_work);
+        lu.compute(Jd);
+        const auto [cond, smin] = condition_of(Jd, lu, condition_work);
         if (!(cond < max_condition)) {
           numbers(i, 4) = 1;
           continue;
         }
-        lu.compute(Jd);
         rhs.head(rows_).setZero();
         rhs.tail(m_task) = x_dot;
         x = lu.solve(row_scale.cwiseProduct(rhs));
@@ -858,7 +866,7 @@ NB_MODULE(_core, m) {
       [](const MatrixXd& A) {
         if (A.rows() != A.cols()) throw std::invalid_argument("condition: A must be square");
         ConditionWork work;
-        return condition_of(A, work);
+        return condition_of(A, Eigen::PartialPivLU<MatrixXd>(A), work);
       },
       "2-norm condition number and smallest singular value of a square A, as the core computes them");
   nb::class_<Core>(m, "Core")
