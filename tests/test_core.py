@@ -377,9 +377,10 @@ def _with_singular_values(rng, s: np.ndarray) -> np.ndarray:
 @given(n=st.integers(1, 40), log_condition=st.floats(0.0, 12.0), log_size=st.floats(-8.0, 8.0),
        seed=st.integers(0, 2**32 - 1))
 def test_condition_numbers_are_the_svds(n, log_condition, log_size, seed):
-    """The core's condition number and smallest singular value (largest eigenvalues of
-    A^T A and A^-1 A^-T above 2x2) and the Python path's (solve_loops._condition: closed
-    forms to 2x2, SVD above) against numpy's SVD, square matrices 1x1 to 40x40,
+    """The core's condition number and smallest singular value (above 2x2: a Householder
+    bidiagonalization, then Laguerre's method on its Golub-Kahan matrix, certified by
+    Sturm counts) and the Python path's (solve_loops._condition: closed forms to 2x2, SVD
+    above) against numpy's SVD, square matrices 1x1 to 40x40,
     condition numbers 1 to 1e12, sizes 1e-8 to 1e8. All are exact to rounding: sigma_max
     to a few eps relative, sigma_min to about eps x condition (the SVD's own accuracy, and
     what rounding A itself moves it by), so the bar is 1e-12 + 100 n eps kappa. (It found
@@ -392,6 +393,30 @@ def test_condition_numbers_are_the_svds(n, log_condition, log_size, seed):
     want = sigma[0] / sigma[-1]
     bar = 1e-12 + 100 * n * np.finfo(float).eps * want
     for condition, sigma_min in (core._core.condition(A), _condition(A)):
+        assert condition == pytest.approx(want, rel=bar)
+        assert sigma_min == pytest.approx(sigma[-1], rel=bar)
+
+
+@pytest.mark.parametrize("n", [3, 4, 9, 32, 40])
+@pytest.mark.parametrize("spectrum", ["top cluster", "bottom cluster", "repeated", "graded"])
+def test_condition_numbers_of_clustered_singular_values(n, spectrum):
+    """Singular values in a cluster act on Laguerre's method like a multiple root: it
+    converges slowly there, and the core falls back to bisection on its Sturm counts. Every
+    spectrum here gives the SVD's numbers to the same bar as above: all but the smallest
+    within 1e-9 of 1 ("top cluster"), all but the largest within 1e-10 of 1e-7 ("bottom
+    cluster"), exactly repeated values, and a spectrum spread evenly over 12 decades."""
+    rng = np.random.default_rng(n)
+    i = np.arange(n)
+    s = {"top cluster": np.where(i < n - 1, 1.0 + 1e-9 * i, 1e-6),
+         "bottom cluster": np.where(i == 0, 1.0, 1e-7 * (1.0 + 1e-10 * i)),
+         "repeated": np.where(i < n // 2, 3.0, 0.5),
+         "graded": np.geomspace(1.0, 1e-12, n)}[spectrum]
+    for _ in range(5):
+        A = _with_singular_values(rng, s)
+        sigma = np.linalg.svd(A, compute_uv=False)
+        want = sigma[0] / sigma[-1]
+        bar = 1e-12 + 100 * n * np.finfo(float).eps * want
+        condition, sigma_min = core._core.condition(A)
         assert condition == pytest.approx(want, rel=bar)
         assert sigma_min == pytest.approx(sigma[-1], rel=bar)
 
