@@ -26,6 +26,7 @@
 #include <pinocchio/algorithm/joint-configuration.hpp>
 #include <pinocchio/algorithm/kinematics.hpp>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Householder>
 #include <Eigen/LU>
 
@@ -139,7 +140,7 @@ class SquareSolve {
 };
 
 // ---------------------------------------------------------------- condition numbers
-// Above 2x2 the singular values come from a Householder bidiagonalization B = U^T A V
+// Above 3x3 the singular values come from a Householder bidiagonalization B = U^T A V
 // (backward stable: B's singular values are those of A + E, |E| <= c n eps |A|, so
 // sigma_max exact to rounding and sigma_min to about eps x condition, as an SVD gives
 // them), then the extreme singular values of B as eigenvalues of its Golub-Kahan matrix:
@@ -242,8 +243,9 @@ double golub_kahan_eigenvalue(const VectorXd& beta, int index, double x, bool ri
 }
 
 // 2-norm condition number and smallest singular value, as solve_loops._condition: closed
-// forms up to 2x2, bidiagonalization above. `lu` is A's factorization, which the caller
-// also solves with (above 2x2): an exact zero pivot is a singular A.
+// forms up to 2x2, eigenvalues of fixed-size 3x3 products at 3x3, bidiagonalization above.
+// `lu` is A's factorization, which the caller also solves with (above 3x3): an exact zero
+// pivot is a singular A.
 std::pair<double, double> condition_of(const MatrixXd& A, const Eigen::PartialPivLU<MatrixXd>& lu,
                                        ConditionWork& work) {
   const Index n = A.rows();
@@ -261,6 +263,26 @@ std::pair<double, double> condition_of(const MatrixXd& A, const Eigen::PartialPi
     const double det = std::abs(a * e - c * d);
     const double s_min = s_max > 0 ? det / s_max : 0.0;
     return {det > 0 ? s_max * s_max / det : INFINITY, s_min};
+  }
+  if (n == 3) {
+    // Fixed-size: the largest eigenvalues of A^T A and A^-1 A^-T (closed form, Eigen's
+    // computeDirect), a largest eigenvalue being exact to rounding relative to itself; the
+    // inverse by LU with partial pivoting (the cofactor formula of
+    // computeInverseAndDetWithCheck lost 2e-3 of the condition number at 1e10, where
+    // rounding allows 2e-6; tests/test_core.py found it). A third of the time of the
+    // bidiagonalization below at this size (RateSolver.solve_many on P2: 1.8 against 2.2 us
+    // a pose).
+    const Matrix3d M = A;
+    const Eigen::PartialPivLU<Matrix3d> lu3(M);
+    if (lu3.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0) return {INFINITY, 0.0};
+    const Matrix3d inverse = lu3.inverse();
+    if (!inverse.allFinite()) return {INFINITY, 0.0};
+    Eigen::SelfAdjointEigenSolver<Matrix3d> eig;
+    eig.computeDirect(M.transpose() * M, Eigen::EigenvaluesOnly);
+    const double s_max = std::sqrt(eig.eigenvalues()(2));
+    eig.computeDirect(inverse * inverse.transpose(), Eigen::EigenvaluesOnly);
+    const double s_min = 1.0 / std::sqrt(eig.eigenvalues()(2));
+    return {s_max / s_min, s_min};
   }
   if (lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0) return {INFINITY, 0.0};
   const double scale = A.cwiseAbs().maxCoeff();  // B of largest entry 1: no over- or underflow
