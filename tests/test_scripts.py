@@ -18,6 +18,7 @@ import pytest
         ("benchmark_sweep", ["--poses", "40", "--repeats", "1"]),
         ("sweep_memory", ["--poses", "200"]),
         ("singular_accuracy", []),
+        ("condition_time", ["--sizes", "1", "5", "--rounds", "1"]),
     ],
 )
 def test_script_runs(name, argv, capsys):
@@ -110,3 +111,15 @@ def test_startup_time_runs(capsys):
     assert out.count("| `") == 3 and "pinmech solve models/scenes/r_rtr.toml" in out
     assert "pinocchio" in out.split("self time summed by top-level package")[1]
     assert len([ln for ln in out.splitlines() if ln.startswith("- ")]) == 6
+
+
+def test_condition_time_errors_are_rounding(capsys):
+    """scripts/condition_time.py's last column: the core's condition numbers agree with
+    numpy's SVD to rounding (1e-13 relative at these sizes and condition numbers below
+    1e3), on the Laguerre path (random) and the bisection path (half repeated) alike."""
+    importlib.import_module("condition_time").main(["--sizes", "4", "12", "--rounds", "1"])
+    rows = [line for line in capsys.readouterr().out.splitlines() if line.startswith("| 4 ") or line.startswith("| 12 ")]
+    assert len(rows) == 4
+    for row in rows:
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        assert float(cells[2]) < 1e3 and float(cells[-1]) < 1e-13
