@@ -337,6 +337,7 @@ def test_chain_closure_rows_equal_the_python_formulas(tmp_path, carried):
     solver = _carried_chain(tmp_path, 4) if carried else chain.chain_solver(4, folder=tmp_path)[1]
     compiled = core.core_for(solver)
     assert compiled is not None
+    assert compiled.solve_blocks == 4  # forward substitution over the four loops' blocks
     _check_against_solver(compiled, solver, seed=11)
     model = solver.model
     if carried:  # the carrier turns both sides of every cut: its column is exactly zero

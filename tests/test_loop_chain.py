@@ -14,12 +14,15 @@ No timing here (the script measures it). Tolerances:
 from __future__ import annotations
 
 import importlib
+import re
 
 import numpy as np
 import pytest
 
 import closed_form
+import pinmech
 import pinmech.core as core
+from pinmech import solve_cycle
 
 chain = importlib.import_module("benchmark_loops")
 
@@ -61,10 +64,55 @@ def test_chain_urdf_is_k_loops_in_series(tmp_path):
 @pytest.mark.parametrize("use_core", [True, False], ids=["core", "python"])
 def test_chain_sweep_meets_the_closed_form(use_core, monkeypatch):
     """A turn of the crank, 1 degree apart, every loop's coupler and output angle within
-    1e-12 rad of the closed form, rates within 1e-11 of the largest."""
+    1e-12 rad of the closed form, rates within 1e-11 of the largest. The core solves for
+    the dependent joints by forward substitution over the K diagonal blocks."""
     monkeypatch.setattr(core, "ENABLED", use_core)
     mech, solver, q, v, a = _solve(K, THETAS)
     assert (core.core_for(solver) is not None) == use_core
+    if use_core:
+        assert core.core_for(solver).solve_blocks == K
+    angle, rate, acceleration = chain.chain_errors(mech, q, v, a, chain.chain_closed_form(THETAS, K))
+    assert angle <= 1e-12, angle
+    assert rate <= 1e-11 and acceleration <= 1e-11, (rate, acceleration)
+
+
+class _FollowSpy:
+    """A compiled core whose `follow` records why each run stopped (0: every pose done)."""
+
+    def __init__(self, compiled, stops: list):
+        self.compiled, self.stops = compiled, stops
+
+    def follow(self, *args):
+        out = self.compiled.follow(*args)
+        self.stops.append(out[1])
+        return out
+
+
+def test_a_chain_listed_last_loop_first_is_solved_in_dependency_order(tmp_path, monkeypatch):
+    """The cuts listed last loop first: J_dep's blocks then come last loop first, the
+    reverse of what forward substitution needs (each loop's rows touch the previous
+    loop's output column). The core orders the blocks itself, and the sweep meets the
+    closed form to the same bars as above (a block solved before the one it leans on
+    would read unsolved columns: the corrector would fail and hand every pose to the
+    Python path, and the rates would be wrong)."""
+    text = chain.chain_urdf(K)
+    cuts = re.findall(r"<constraint .*?</constraint>", text, flags=re.S)
+    for cut in cuts:
+        text = text.replace(cut, "")
+    text = text.replace("</robot>", "  " + "\n  ".join(reversed(cuts)) + "\n</robot>")
+    path = tmp_path / "chain_backwards.urdf"
+    path.write_text(text, encoding="utf-8")
+    mech = pinmech.Mechanism.from_urdf(path)
+    solver = pinmech.LoopSolver(mech, ["O0"])
+    solver.set_reference([0.0], chain.chain_guess(mech, chain.chain_closed_form(0.0, K), 0))
+    assert [b.name for b in solver.structure.blocks] == [f"B{i}" for i in reversed(range(K))]
+    assert core.core_for(solver).solve_blocks == K
+    stops: list[int] = []
+    compiled_path = solve_cycle._Cycle._compiled
+    monkeypatch.setattr(solve_cycle._Cycle, "_compiled",
+                        lambda cycle, compiled, xs: compiled_path(cycle, _FollowSpy(compiled, stops), xs))
+    q, v, a = chain.sweep(solver, THETAS)
+    assert stops and set(stops) == {0}  # the core took every pose: none handed to the Python path
     angle, rate, acceleration = chain.chain_errors(mech, q, v, a, chain.chain_closed_form(THETAS, K))
     assert angle <= 1e-12, angle
     assert rate <= 1e-11 and acceleration <= 1e-11, (rate, acceleration)

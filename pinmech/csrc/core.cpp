@@ -104,38 +104,113 @@ double max_abs(const Eigen::Ref<const VectorXd>& x) { return x.size() ? x.cwiseA
 // A x = b for a small square A, as solve_loops._solve_square: closed forms up to 2x2, LU
 // with partial pivoting above; NaN where A is exactly singular. Factored once for several
 // right-hand sides; the LU's buffers are reused, so a pose allocates nothing.
-class SquareSolve {
+class DenseSolve {
  public:
-  void factor(const MatrixXd& A) {
+  void factor(const MatrixXd& A) {  // A must stay as it is until the last solve
     A_ = &A;
-    if (A.rows() >= 3) {
+    const Index n = A.rows();
+    if (n == 1) {
+      singular_ = A(0, 0) == 0.0;
+    } else if (n == 2) {
+      singular_ = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0) == 0.0;
+    } else if (n >= 3) {
       lu_.compute(A);
       singular_ = lu_.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0;
+    } else {
+      singular_ = false;
     }
   }
+
+  // Factored with an exact zero pivot (a zero determinant up to 2x2).
+  bool singular() const { return singular_; }
 
   void solve(const VectorXd& b, VectorXd& x) const {
     const MatrixXd& A = *A_;
     const Index n = A.rows();
     x.resize(n);
-    if (n == 1) {
-      x(0) = A(0, 0) != 0.0 ? b(0) / A(0, 0) : NAN;
+    if (singular_) {
+      x.setConstant(NAN);
+    } else if (n == 1) {
+      x(0) = b(0) / A(0, 0);
     } else if (n == 2) {
       const double det = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
-      if (det == 0.0) x.setConstant(NAN);
-      else x << (A(1, 1) * b(0) - A(0, 1) * b(1)) / det, (A(0, 0) * b(1) - A(1, 0) * b(0)) / det;
+      x << (A(1, 1) * b(0) - A(0, 1) * b(1)) / det, (A(0, 0) * b(1) - A(1, 0) * b(0)) / det;
     } else if (n > 2) {
       x = lu_.solve(b);
-      if (singular_) x.setConstant(NAN);
     }
   }
-
-  // The LU of the matrix last factored (above 2x2).
-  const Eigen::PartialPivLU<MatrixXd>& lu() const { return lu_; }
 
  private:
   const MatrixXd* A_ = nullptr;
   Eigen::PartialPivLU<MatrixXd> lu_;
+  bool singular_ = false;
+};
+
+// One diagonal block of the dependent Jacobian's block-triangular form: its rows and
+// columns, the columns of earlier blocks its rows touch, and buffers.
+struct DiagonalBlock {
+  std::vector<Index> rows, cols, coupling;
+  MatrixXd M;
+  DenseSolve dense;
+  VectorXd rhs, x;
+};
+
+// A x = b for the square dependent Jacobian: by forward substitution over the diagonal
+// blocks of its block-triangular form where it has several (Core::ordered_blocks: each
+// block's rows touch only its own and earlier blocks' columns), each block solved as
+// DenseSolve, so a chain of k loops costs k small factorizations, not one of size 2k;
+// whole where it is one block. A block-triangular A is singular exactly where one of its
+// diagonal blocks is: then NaN everywhere, as DenseSolve gives for a singular A.
+class SquareSolve {
+ public:
+  void set_blocks(std::vector<DiagonalBlock> blocks) { blocks_ = std::move(blocks); }
+  size_t blocks() const { return blocks_.size(); }
+
+  void factor(const MatrixXd& A) {  // A must stay as it is until the last solve
+    A_ = &A;
+    if (blocks_.empty()) {
+      whole_.factor(A);
+      singular_ = whole_.singular();
+      return;
+    }
+    singular_ = false;
+    for (DiagonalBlock& b : blocks_) {
+      for (size_t i = 0; i < b.rows.size(); ++i)
+        for (size_t j = 0; j < b.cols.size(); ++j) b.M(Index(i), Index(j)) = A(b.rows[i], b.cols[j]);
+      b.dense.factor(b.M);
+      singular_ = singular_ || b.dense.singular();
+    }
+  }
+
+  // Factored with an exact zero pivot in A (or in a diagonal block of it).
+  bool singular() const { return singular_; }
+
+  void solve(const VectorXd& rhs, VectorXd& x) {
+    if (blocks_.empty()) {
+      whole_.solve(rhs, x);
+      return;
+    }
+    const MatrixXd& A = *A_;
+    x.resize(A.cols());
+    if (singular_) {
+      x.setConstant(NAN);
+      return;
+    }
+    for (DiagonalBlock& b : blocks_) {
+      for (size_t i = 0; i < b.rows.size(); ++i) {
+        double s = rhs(b.rows[i]);
+        for (Index c : b.coupling) s -= A(b.rows[i], c) * x(c);
+        b.rhs(Index(i)) = s;
+      }
+      b.dense.solve(b.rhs, b.x);
+      for (size_t j = 0; j < b.cols.size(); ++j) x(b.cols[j]) = b.x(Index(j));
+    }
+  }
+
+ private:
+  const MatrixXd* A_ = nullptr;
+  std::vector<DiagonalBlock> blocks_;
+  DenseSolve whole_;
   bool singular_ = false;
 };
 
@@ -245,10 +320,9 @@ double golub_kahan_eigenvalue(const VectorXd& beta, int index, double x, bool ri
 
 // 2-norm condition number and smallest singular value, as solve_loops._condition: closed
 // forms up to 2x2, eigenvalues of fixed-size 3x3 products at 3x3, bidiagonalization above.
-// `lu` is A's factorization, which the caller also solves with (above 3x3): an exact zero
-// pivot is a singular A.
-std::pair<double, double> condition_of(const MatrixXd& A, const Eigen::PartialPivLU<MatrixXd>& lu,
-                                       ConditionWork& work) {
+// `singular`: the caller's factorization of A (which it also solves with) met an exact zero
+// pivot (used above 3x3).
+std::pair<double, double> condition_of(const MatrixXd& A, bool singular, ConditionWork& work) {
   const Index n = A.rows();
   if (n == 0) return {1.0, 1.0};
   if (n == 1) {
@@ -285,7 +359,7 @@ std::pair<double, double> condition_of(const MatrixXd& A, const Eigen::PartialPi
     const double s_min = 1.0 / std::sqrt(eig.eigenvalues()(2));
     return {s_max / s_min, s_min};
   }
-  if (lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0) return {INFINITY, 0.0};
+  if (singular) return {INFINITY, 0.0};
   const double scale = A.cwiseAbs().maxCoeff();  // B of largest entry 1: no over- or underflow
   if (!std::isfinite(scale)) return {INFINITY, 0.0};
   work.B = A / scale;
@@ -409,6 +483,7 @@ class Core {
     dstep_ = VectorXd::Zero(ndep);
     q_new_ = VectorXd::Zero(model_.nq);
     predicted_ = VectorXd::Zero(nv);
+    square_.set_blocks(ordered_blocks());
   }
 
   int nq() const { return model_.nq; }
@@ -527,7 +602,7 @@ class Core {
     jacobian_into(false);
     scaled_ = Jdep_ * dep_scale_.asDiagonal();
     square_.factor(scaled_);
-    auto [condition, sigma_min] = condition_of(scaled_, square_.lu(), condition_work_);
+    auto [condition, sigma_min] = condition_of(scaled_, square_.singular(), condition_work_);
     node.condition = condition;
     node.sigma_min = sigma_min;
     signs_into(Jdep_, node.signs);
@@ -718,7 +793,8 @@ class Core {
           continue;
         }
         lu.compute(Jd);
-        const auto [cond, smin] = condition_of(Jd, lu, condition_work);
+        const auto [cond, smin] =
+            condition_of(Jd, lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0, condition_work);
         if (!(cond < max_condition)) {
           numbers(i, 4) = 1;
           continue;
@@ -803,6 +879,8 @@ class Core {
   double tol() const { return tol_; }
   void set_tol(double tol) { tol_ = tol; }
   int iterations() const { return iterations_; }
+  // Diagonal blocks the dependent solves go through (0: the whole matrix at once).
+  int solve_blocks() const { return int(square_.blocks()); }
   double moved() const { return moved_; }
 
   std::vector<int> signs(const MatrixXd& J_dep) {
@@ -893,6 +971,71 @@ class Core {
       e.tail<3>().noalias() = -(MRT * w);
       J_.block(cut.offset, c, k, 1).noalias() = cut.rows6 * e;
     }
+  }
+
+  // The assembly blocks (branches.AssemblyStructure: the irreducible diagonal blocks of
+  // J_dep's block-triangular form) in an order for forward substitution, each with the
+  // columns of earlier blocks its rows touch (its cut's support columns: J_dep is exactly
+  // zero elsewhere). None (the whole matrix at once) where there is one block, where the
+  // blocks do not partition a square J_dep into square blocks, or where no order has every
+  // block touch only earlier ones.
+  std::vector<DiagonalBlock> ordered_blocks() const {
+    const Index n = Index(dep_v_.size());
+    const size_t count = blocks_rows_.size();
+    if (count < 2 || rows_ != n || blocks_cols_.size() != count) return {};
+    std::vector<int> row_block(size_t(n), -1), col_block(size_t(n), -1);
+    for (size_t b = 0; b < count; ++b) {
+      if (blocks_rows_[b].size() != blocks_cols_[b].size() || blocks_rows_[b].empty()) return {};
+      for (int r : blocks_rows_[b]) {
+        if (r < 0 || r >= n || row_block[size_t(r)] != -1) return {};
+        row_block[size_t(r)] = int(b);
+      }
+      for (int c : blocks_cols_[b]) {
+        if (c < 0 || c >= n || col_block[size_t(c)] != -1) return {};
+        col_block[size_t(c)] = int(b);
+      }
+    }
+    std::vector<Index> dep_col(size_t(model_.nv), -1);
+    for (size_t i = 0; i < dep_v_.size(); ++i) dep_col[size_t(dep_v_[i])] = Index(i);
+    std::vector<std::vector<Index>> coupling(count);
+    std::vector<std::vector<char>> needs(count, std::vector<char>(count, 0));
+    for (const Cut& cut : cuts_) {
+      for (Index r = cut.offset; r < cut.offset + cut.rows6.rows(); ++r) {
+        const int b = row_block[size_t(r)];
+        for (const auto* cols : {&cut.child_cols, &cut.parent_cols})
+          for (Index v : *cols) {
+            const Index c = dep_col[size_t(v)];
+            if (c < 0 || col_block[size_t(c)] == b) continue;
+            needs[size_t(b)][size_t(col_block[size_t(c)])] = 1;
+            if (std::find(coupling[size_t(b)].begin(), coupling[size_t(b)].end(), c) == coupling[size_t(b)].end())
+              coupling[size_t(b)].push_back(c);
+          }
+      }
+    }
+    std::vector<DiagonalBlock> out;
+    std::vector<char> placed(count, 0);
+    while (out.size() < count) {  // a block whose needs are all placed, first by index
+      size_t next = count;
+      for (size_t b = 0; b < count && next == count; ++b) {
+        if (placed[b]) continue;
+        bool ready = true;
+        for (size_t c = 0; c < count; ++c) ready = ready && (!needs[b][c] || placed[c]);
+        if (ready) next = b;
+      }
+      if (next == count) return {};  // a cycle: not block-triangular in these blocks
+      placed[next] = 1;
+      DiagonalBlock block;
+      block.rows.assign(blocks_rows_[next].begin(), blocks_rows_[next].end());
+      block.cols.assign(blocks_cols_[next].begin(), blocks_cols_[next].end());
+      block.coupling = coupling[next];
+      std::sort(block.coupling.begin(), block.coupling.end());
+      const Index m = Index(block.rows.size());
+      block.M = MatrixXd::Zero(m, m);
+      block.rhs = VectorXd::Zero(m);
+      block.x = VectorXd::Zero(m);
+      out.push_back(std::move(block));
+    }
+    return out;
   }
 
   void set_drivers(VectorXd& q, const VectorXd& drivers) const {
@@ -987,7 +1130,8 @@ NB_MODULE(_core, m) {
       [](const MatrixXd& A) {
         if (A.rows() != A.cols()) throw std::invalid_argument("condition: A must be square");
         ConditionWork work;
-        return condition_of(A, Eigen::PartialPivLU<MatrixXd>(A), work);
+        const Eigen::PartialPivLU<MatrixXd> lu(A);
+        return condition_of(A, A.rows() > 0 && lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0, work);
       },
       "2-norm condition number and smallest singular value of a square A, as the core computes them");
   nb::class_<Core>(m, "Core")
@@ -1004,6 +1148,7 @@ NB_MODULE(_core, m) {
       .def_prop_ro("idx_v", &Core::idx_v)
       .def_prop_rw("tol", &Core::tol, &Core::set_tol)
       .def_prop_ro("iterations", &Core::iterations)
+      .def_prop_ro("solve_blocks", &Core::solve_blocks)
       .def_prop_ro("moved", &Core::moved)
       .def("residual", &Core::residual)
       .def("full_residual", &Core::full_residual)
