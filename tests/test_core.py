@@ -206,7 +206,7 @@ def test_the_core_can_be_ruled_out(monkeypatch, scenes_dir):
 
 
 # ---------------------------------------------------------------------- hypothesis
-from hypothesis import HealthCheck, assume, given, settings  # noqa: E402
+from hypothesis import HealthCheck, assume, example, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 from pinmech import LoopSolver, SingularPoseError  # noqa: E402
@@ -378,10 +378,11 @@ def _with_singular_values(rng, s: np.ndarray) -> np.ndarray:
 @given(n=st.integers(1, 40), log_condition=st.floats(0.0, 12.0), log_size=st.floats(-8.0, 8.0),
        seed=st.integers(0, 2**32 - 1))
 def test_condition_numbers_are_the_svds(n, log_condition, log_size, seed):
-    """The core's condition number and smallest singular value (above 2x2: a Householder
-    bidiagonalization, then Laguerre's method on its Golub-Kahan matrix, certified by
-    Sturm counts) and the Python path's (solve_loops._condition: closed forms to 2x2, SVD
-    above) against numpy's SVD, square matrices 1x1 to 40x40,
+    """The core's condition number and smallest singular value (closed form at 2x2,
+    eigenvalues of fixed-size products at 3x3; above, a bidiagonalization, then Laguerre's
+    method on its Golub-Kahan matrix, certified by Sturm counts) and the Python path's
+    (solve_loops._condition: closed forms to 2x2, SVD above) against numpy's SVD, square
+    matrices 1x1 to 40x40 (dense: the Householder bidiagonalization),
     condition numbers 1 to 1e12, sizes 1e-8 to 1e8. All are exact to rounding: sigma_max
     to a few eps relative, sigma_min to about eps x condition (the SVD's own accuracy, and
     what rounding A itself moves it by), so the bar is 1e-12 + 100 n eps kappa. (It found
@@ -396,6 +397,29 @@ def test_condition_numbers_are_the_svds(n, log_condition, log_size, seed):
     for condition, sigma_min in (core._core.condition(A), _condition(A)):
         assert condition == pytest.approx(want, rel=bar)
         assert sigma_min == pytest.approx(sigma[-1], rel=bar)
+
+
+@settings(max_examples=200, deadline=None)
+@given(n=st.integers(4, 40), kl=st.integers(0, 5), ku=st.integers(0, 5), log_grade=st.floats(0.0, 8.0),
+       seed=st.integers(0, 2**32 - 1))
+@example(n=32, kl=2, ku=1, log_grade=0.0, seed=1)  # a chain of 16 four-bars
+@example(n=40, kl=2, ku=1, log_grade=6.0, seed=2)
+def test_condition_numbers_of_band_matrices_are_the_svds(n, kl, ku, log_grade, seed):
+    """Band matrices, kl nonzeros below the diagonal and ku above (the dependent Jacobian
+    of a chain of loops has 2 and 1), rows graded over up to 8 decades. Where the band is
+    narrow (5.5 (kl + ku) <= n + 8) the core bidiagonalizes by plane rotations that keep
+    the band, else by reflections: both give the SVD's numbers, to the bar above."""
+    rng = np.random.default_rng(seed)
+    i, j = np.indices((n, n))
+    A = np.where((i - j <= kl) & (j - i <= ku), rng.normal(size=(n, n)), 0.0)
+    A *= np.geomspace(1.0, 10.0**-log_grade, n)[:, None]
+    sigma = np.linalg.svd(A, compute_uv=False)
+    assume(sigma[-1] > 0 and sigma[0] / sigma[-1] < 1e12)
+    want = sigma[0] / sigma[-1]
+    bar = 1e-12 + 100 * n * np.finfo(float).eps * want
+    condition, sigma_min = core._core.condition(A)
+    assert condition == pytest.approx(want, rel=bar)
+    assert sigma_min == pytest.approx(sigma[-1], rel=bar)
 
 
 @pytest.mark.parametrize("n", [3, 4, 9, 32, 40])
