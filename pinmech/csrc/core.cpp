@@ -345,60 +345,126 @@ void band_bidiagonalize(ConditionWork& w, Index kl, Index ku) {
   }
 }
 
-// Eigenvalues of the Golub-Kahan matrix (squared off-diagonals beta) below x.
-int count_below(const VectorXd& beta, double x) {
-  double t = -x;
-  if (std::abs(t) <= PIVMIN) t = -PIVMIN;
-  int count = t < 0;
-  for (Index j = 0; j < beta.size(); ++j) {
-    t = -x - beta(j) / t;
-    if (std::abs(t) <= PIVMIN) t = -PIVMIN;
-    count += t < 0;
+// Eigenvalues of the Golub-Kahan matrix (squared off-diagonals beta) below each of K
+// values x: K independent recurrences in one loop, so their divisions overlap.
+template <int K>
+void counts_below(const VectorXd& beta, const double* x, int* count) {
+  double t[K];
+  for (int k = 0; k < K; ++k) {
+    t[k] = std::abs(x[k]) <= PIVMIN ? -PIVMIN : -x[k];
+    count[k] = t[k] < 0;
   }
+  for (Index j = 0; j < beta.size(); ++j) {
+    const double b = beta(j);
+    for (int k = 0; k < K; ++k) {
+      double u = -x[k] - b / t[k];
+      if (std::abs(u) <= PIVMIN) u = -PIVMIN;
+      t[k] = u;
+      count[k] += u < 0;
+    }
+  }
+}
+
+int count_below(const VectorXd& beta, double x) {
+  int count;
+  counts_below<1>(beta, &x, &count);
   return count;
 }
 
 // One Laguerre step for det(T - x I) = prod t_j (the pivots of the Sturm count, with their
 // first and second derivatives in x): G = p'/p, H = -(ln p)''. `right`: the step towards
-// the next root above x, else the one below.
-double laguerre_step(const VectorXd& beta, double x, bool right) {
-  double t = -x, t1 = -1.0, t2 = 0.0;
-  if (std::abs(t) <= PIVMIN) t = -PIVMIN;
-  double r = 1.0 / t, G = t1 * r, H = G * G;
+// the next root above x, else the one below. K steps at once, as counts_below.
+template <int K>
+void laguerre_steps(const VectorXd& beta, const double* x, const bool* right, double* next) {
+  double t[K], t1[K], t2[K], r[K], G[K], H[K];
+  for (int k = 0; k < K; ++k) {
+    t[k] = std::abs(x[k]) <= PIVMIN ? -PIVMIN : -x[k];
+    t1[k] = -1.0;
+    t2[k] = 0.0;
+    r[k] = 1.0 / t[k];
+    G[k] = t1[k] * r[k];
+    H[k] = G[k] * G[k];
+  }
   for (Index j = 0; j < beta.size(); ++j) {
-    const double b = beta(j), rr = r * r;
-    t2 = b * rr * (t2 - 2.0 * r * t1 * t1);
-    t1 = -1.0 + b * rr * t1;
-    t = -x - b * r;
-    if (std::abs(t) <= PIVMIN) t = -PIVMIN;
-    r = 1.0 / t;
-    const double u = t1 * r;
-    G += u;
-    H += u * u - t2 * r;
+    const double b = beta(j);
+    for (int k = 0; k < K; ++k) {
+      const double rr = r[k] * r[k];
+      t2[k] = b * rr * (t2[k] - 2.0 * r[k] * t1[k] * t1[k]);
+      t1[k] = -1.0 + b * rr * t1[k];
+      double u = -x[k] - b * r[k];
+      if (std::abs(u) <= PIVMIN) u = -PIVMIN;
+      t[k] = u;
+      r[k] = 1.0 / u;
+      const double v = t1[k] * r[k];
+      G[k] += v;
+      H[k] += v * v - t2[k] * r[k];
+    }
   }
   const double m = double(beta.size() + 1);
-  const double disc = std::sqrt(std::max(0.0, (m - 1.0) * (m * H - G * G)));
-  return x - m / (right ? G - disc : G + disc);
+  for (int k = 0; k < K; ++k) {
+    const double disc = std::sqrt(std::max(0.0, (m - 1.0) * (m * H[k] - G[k] * G[k])));
+    next[k] = x[k] - m / (right[k] ? G[k] - disc : G[k] + disc);
+  }
 }
 
-// The eigenvalue with `index` eigenvalues below it, starting at x from below (`right`) or
-// above, within the bracket lo < it <= hi (bisection's start where Laguerre fails).
-double golub_kahan_eigenvalue(const VectorXd& beta, int index, double x, bool right, double lo, double hi) {
+// A search for the eigenvalue with `index` eigenvalues below it, from x below it (`right`)
+// or above, within the bracket lo < it <= hi (bisection's start where Laguerre fails).
+struct EigenvalueSearch {
+  int index;
+  double x;
+  bool right;
+  double lo, hi;
+  bool moving = true, converged = false;
+};
+
+// Both searches at once (sigma_max and sigma_min): Laguerre passes while either moves, two
+// counts on either side of each result to certify it to 4 (2n) eps relative, and
+// bisection on the counts for a search Laguerre did not bring there (it left the bracket,
+// or a cluster of eigenvalues slowed it down).
+void find_eigenvalues(const VectorXd& beta, EigenvalueSearch (&searches)[2], double (&found)[2]) {
   const double delta = 4.0 * double(beta.size() + 1) * EPS;
-  bool converged = false;
-  for (int pass = 0; pass < LAGUERRE_PASSES && !converged; ++pass) {
-    const double next = laguerre_step(beta, x, right);
-    if (!(next > lo && next <= hi)) break;  // left the bracket (or NaN): bisect
-    converged = std::abs(next - x) <= 2.0 * EPS * next;
-    x = next;
+  for (int pass = 0; pass < LAGUERRE_PASSES; ++pass) {
+    EigenvalueSearch* live[2];
+    int count = 0;
+    for (EigenvalueSearch& s : searches)
+      if (s.moving) live[count++] = &s;
+    if (count == 0) break;
+    double x[2], next[2];
+    bool right[2];
+    for (int k = 0; k < count; ++k) {
+      x[k] = live[k]->x;
+      right[k] = live[k]->right;
+    }
+    if (count == 2) laguerre_steps<2>(beta, x, right, next);
+    else laguerre_steps<1>(beta, x, right, next);
+    for (int k = 0; k < count; ++k) {
+      EigenvalueSearch& s = *live[k];
+      if (!(next[k] > s.lo && next[k] <= s.hi)) {  // left the bracket (or NaN): bisect
+        s.moving = false;
+        continue;
+      }
+      s.converged = std::abs(next[k] - s.x) <= 2.0 * EPS * next[k];
+      s.moving = !s.converged;
+      s.x = next[k];
+    }
   }
-  if (converged && count_below(beta, x * (1.0 - delta)) == index && count_below(beta, x * (1.0 + delta)) > index)
-    return x;
-  while (hi - lo > 2.0 * EPS * hi && hi > PIVMIN) {
-    const double mid = lo > 0.0 && hi > 4.0 * lo ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
-    (count_below(beta, mid) > index ? hi : lo) = mid;
+  const double sides[4] = {searches[0].x * (1.0 - delta), searches[0].x * (1.0 + delta),
+                           searches[1].x * (1.0 - delta), searches[1].x * (1.0 + delta)};
+  int counts[4];
+  counts_below<4>(beta, sides, counts);
+  for (int i = 0; i < 2; ++i) {
+    EigenvalueSearch& s = searches[i];
+    if (s.converged && counts[2 * i] == s.index && counts[2 * i + 1] > s.index) {
+      found[i] = s.x;
+      continue;
+    }
+    double lo = s.lo, hi = s.hi;
+    while (hi - lo > 2.0 * EPS * hi && hi > PIVMIN) {
+      const double mid = lo > 0.0 && hi > 4.0 * lo ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
+      (count_below(beta, mid) > s.index ? hi : lo) = mid;
+    }
+    found[i] = 0.5 * (lo + hi);
   }
-  return 0.5 * (lo + hi);
 }
 
 // 2-norm condition number and smallest singular value, as solve_loops._condition: closed
@@ -484,11 +550,14 @@ std::pair<double, double> condition_of(const MatrixXd& A, bool singular, Conditi
   // chain of alike loops). sigma_min in [1/|B^-1|_F, min(|d_0|, |d_(n-1)|)] (a row and a
   // column of B): from below, or from above if rounding put the lower bound past it.
   const double hi_max = std::min(frobenius, gershgorin) * (1.0 + 4.0 * EPS);
-  const double s_max = golub_kahan_eigenvalue(beta, int(2 * n - 1), hi_max, false, largest * (1.0 - 4.0 * EPS), hi_max);
   const double lo_min = (1.0 - 4.0 * EPS) / std::sqrt(inverse_frobenius);
   const double hi_min = std::min(std::abs(d(0)), std::abs(d(n - 1))) * (1.0 + 4.0 * EPS);
   const bool below = count_below(beta, lo_min) == n;
-  const double s_min = golub_kahan_eigenvalue(beta, int(n), below ? lo_min : hi_min, below, below ? lo_min : 0.0, hi_min);
+  EigenvalueSearch searches[2] = {{int(2 * n - 1), hi_max, false, largest * (1.0 - 4.0 * EPS), hi_max},
+                                  {int(n), below ? lo_min : hi_min, below, below ? lo_min : 0.0, hi_min}};
+  double found[2];
+  find_eigenvalues(beta, searches, found);
+  const double s_max = found[0], s_min = found[1];
   if (!(s_min > 0.0)) return {INFINITY, 0.0};
   return {s_max / s_min, std::ldexp(s_min, exponent)};
 }
