@@ -48,6 +48,9 @@ using Eigen::VectorXd;
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Matrix6Xd = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+// At most six rows of six columns (a cut's closure rows), sized at run time: products with
+// a 6-vector are unrolled, where a dynamic matrix would go through Eigen's general kernel.
+using Rows6 = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor, 6, 6>;
 
 namespace {
 
@@ -573,8 +576,8 @@ struct Cut {
   int type;
   pin::FrameIndex parent, child;
   Vector3d axis, child_axis;
-  MatrixXd rows6;  // (k, 6): basis @ selection @ diag(scale), as Closure._rows6
-  MatrixXd full;   // (n_sel, 6): selection @ diag(scale), every selected row
+  Rows6 rows6;  // (k, 6): basis @ selection @ diag(scale), as Closure._rows6
+  Rows6 full;   // (n_sel, 6): selection @ diag(scale), every selected row
   Index offset;    // first row in the stacked residual
   bool ground;     // P is a frame of the ground: no Jacobian, velocity or acceleration
   // The velocity columns that move C relative to P: joints supporting C and not P, and
@@ -617,11 +620,12 @@ class Core {
     }
     Index offset = 0;
     for (size_t c = 0; c < cut_types.size(); ++c) {
+      if (rows6.at(c).cols() != 6 || full.at(c).cols() != 6 || rows6.at(c).rows() > 6 || full.at(c).rows() > 6)
+        throw std::invalid_argument("closure rows must be at most 6 rows of 6 columns");
       Cut cut{cut_types[c], frames_.at(cut_parent[c]), frames_.at(cut_child[c]), cut_axes.row(c).transpose(),
               cut_child_axes.row(c).transpose(), rows6.at(c), full.at(c), offset, false};
       cut.ground = model_.frames[cut.parent].parentJoint == 0;
       relative_columns(cut);
-      if (cut.rows6.cols() != 6 || cut.full.cols() != 6) throw std::invalid_argument("closure rows must have 6 columns");
       offset += cut.rows6.rows();
       cuts_.push_back(cut);
     }
