@@ -6,7 +6,10 @@ The core computes 2x2 in closed form, 3x3 from fixed-size eigenvalue problems, a
 that from a Householder bidiagonalization and Laguerre's method on its Golub-Kahan matrix,
 with bisection on Sturm counts where Laguerre does not converge (a repeated or clustered
 singular value). Two spectra at each size: a random Gaussian matrix, and one with half its
-singular values equal (3) and the other half equal (0.5), which takes the bisection.
+singular values equal (3) and the other half equal (0.5), which takes the bisection; from
+4x4 up, a band matrix too, 2 nonzeros below the diagonal and 1 above (the dependent
+Jacobian of a chain of loops in block order), which the core bidiagonalizes by plane
+rotations.
 
 Times are microseconds a call from Python (the call's overhead included: see the 1x1 row),
 median of the rounds and spread (fastest - slowest round). The core's call also factors
@@ -54,6 +57,9 @@ def main(argv: list[str] | None = None) -> int:
         spectra = {"random": rng.normal(size=(n, n))}
         if n >= 2:
             spectra["half repeated"] = with_singular_values(rng, np.where(np.arange(n) < n // 2, 3.0, 0.5))
+        if n >= 4:
+            i, j = np.indices((n, n))
+            spectra["band (2 below, 1 above)"] = np.where((i - j <= 2) & (j - i <= 1), rng.normal(size=(n, n)), 0.0)
         for name, A in spectra.items():
             sigma = np.linalg.svd(A, compute_uv=False)
             want = sigma[0] / sigma[-1]
