@@ -230,20 +230,20 @@ class SquareSolve {
 };
 
 // ---------------------------------------------------------------- condition numbers
-// Above 3x3 the singular values come from a Householder bidiagonalization B = U^T A V
-// (backward stable: B's singular values are those of A + E, |E| <= c n eps |A|, so
-// sigma_max exact to rounding and sigma_min to about eps x condition, as an SVD gives
-// them), then the extreme singular values of B as eigenvalues of its Golub-Kahan matrix:
-// the 2n x 2n symmetric tridiagonal with zero diagonal and off-diagonals d0, e0, d1, e1,
-// ..., d(n-1), whose eigenvalues are +-sigma_i. Counting its eigenvalues below x (Sturm
-// count; exact for a matrix within a few eps relative of it) brackets a singular value;
-// Laguerre's method on det(T - x I) finds it in a few passes (cubic convergence, monotone
-// for a polynomial with real roots), and two counts certify the result to 4 (2n) eps
-// relative. Where Laguerre has not converged (a cluster of singular values acts as a
-// multiple root), plain bisection on the counts finds it. Cost at 32x32 (README): 38 us
-// where the eigenvalue route this replaced (largest eigenvalues of A^T A and A^-1 A^-T)
-// took about 3 times as long, and numpy's SVD 67; tests/test_core.py checks against
-// numpy's SVD.
+// Above 3x3 the singular values come from a bidiagonalization B = U^T A V: plane
+// rotations that keep the band for a band matrix (band_bidiagonalize), Householder
+// reflections otherwise (bidiagonalize). Both are backward stable (B's singular values are
+// those of A + E, |E| <= c n eps |A|: sigma_max exact to rounding, sigma_min to about eps
+// x condition, as an SVD gives them). The extreme singular values of B are then
+// eigenvalues of its Golub-Kahan matrix: the 2n x 2n symmetric tridiagonal with zero
+// diagonal and off-diagonals d0, e0, d1, e1, ..., d(n-1), whose eigenvalues are +-sigma_i.
+// Counting its eigenvalues below x (Sturm count; exact for a matrix within a few eps
+// relative of it) brackets a singular value; Laguerre's method on det(T - x I) finds it in
+// a few passes (cubic convergence, monotone for a polynomial with real roots), and two
+// counts certify the result to 4 (2n) eps relative. Where Laguerre has not converged (a
+// cluster of singular values acts as a multiple root), plain bisection on the counts finds
+// it. Cost and accuracy against numpy's SVD: scripts/condition_time.py (README);
+// tests/test_core.py checks against numpy's SVD.
 
 constexpr double EPS = std::numeric_limits<double>::epsilon();
 constexpr double PIVMIN = std::numeric_limits<double>::min();
