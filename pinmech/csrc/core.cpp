@@ -496,7 +496,7 @@ std::pair<double, double> condition_of(const MatrixXd& A, bool singular, Conditi
     // computeDirect), a largest eigenvalue being exact to rounding relative to itself; the
     // inverse by LU with partial pivoting (the cofactor formula of
     // computeInverseAndDetWithCheck lost 2e-3 of the condition number at 1e10, where
-    // rounding allows 2e-6; tests/test_core.py found it). A third of the time of the
+    // rounding allows 2e-6; tests/test_core.py found it). Quicker than the
     // bidiagonalization below at this size (RateSolver.solve_many on P2: 1.8 against 2.2 us
     // a pose).
     const Matrix3d M = A;
