@@ -118,6 +118,33 @@ def test_a_chain_listed_last_loop_first_is_solved_in_dependency_order(tmp_path, 
     assert rate <= 1e-11 and acceleration <= 1e-11, (rate, acceleration)
 
 
+def _conditions(solver, thetas: np.ndarray) -> np.ndarray:
+    """The condition number of J_dep the sweep reports at each pose."""
+    chunks = list(solve_cycle.solve_range(solver, "O0", thetas, driver_q=np.zeros(1), driver_v=np.array([chain.OMEGA]),
+                                          driver_a=np.array([chain.ALPHA])))
+    assert not any(c.errors for c in chunks)
+    return np.concatenate([c.solution.condition for c in chunks])
+
+
+@pytest.mark.parametrize("k", [2, 5, 16])
+def test_chain_condition_numbers_are_the_python_paths(k, monkeypatch):
+    """The condition numbers a chain's sweep reports, pose by pose: the core's (J_dep
+    permuted into block order, a band, bidiagonalized by plane rotations from 5 loops on)
+    against the Python path's (numpy's SVD of its own J_dep). A wrong permutation or band
+    would be off by order one. The bar is tests/test_core.py's against the SVD, 1e-12 +
+    100 n eps kappa with n = 2k (at most 3e-11 here, condition numbers below 40); the two
+    paths' poses differ by rounding only (seen: 5e-15)."""
+    thetas = np.radians(np.arange(0.0, 360.0, 7.0))
+    got = {}
+    for use_core in (True, False):
+        monkeypatch.setattr(core, "ENABLED", use_core)
+        _, solver = chain.chain_solver(k)
+        got[use_core] = _conditions(solver, thetas)
+    assert np.all(got[False] < 40.0)
+    bar = 1e-12 + 100 * 2 * k * np.finfo(float).eps * got[False]
+    assert np.all(np.abs(got[True] / got[False] - 1.0) <= bar)
+
+
 def test_the_closed_form_moves_every_loop():
     """The drag-link proportions carry the motion to the last loop (no loop at rest), and
     every loop stays far from a toggle (transmission angle at least 29 degrees)."""

@@ -115,7 +115,8 @@ class DenseSolve {
     if (n == 1) {
       singular_ = A(0, 0) == 0.0;
     } else if (n == 2) {
-      singular_ = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0) == 0.0;
+      det_ = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
+      singular_ = det_ == 0.0;
     } else if (n >= 3) {
       lu_.compute(A);
       singular_ = lu_.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0;
@@ -136,8 +137,7 @@ class DenseSolve {
     } else if (n == 1) {
       x(0) = b(0) / A(0, 0);
     } else if (n == 2) {
-      const double det = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
-      x << (A(1, 1) * b(0) - A(0, 1) * b(1)) / det, (A(0, 0) * b(1) - A(1, 0) * b(0)) / det;
+      x << (A(1, 1) * b(0) - A(0, 1) * b(1)) / det_, (A(0, 0) * b(1) - A(1, 0) * b(0)) / det_;
     } else if (n > 2) {
       x = lu_.solve(b);
     }
@@ -146,6 +146,7 @@ class DenseSolve {
  private:
   const MatrixXd* A_ = nullptr;
   Eigen::PartialPivLU<MatrixXd> lu_;
+  double det_ = 0.0;  // 2x2
   bool singular_ = false;
 };
 
@@ -313,7 +314,8 @@ void rotate_columns(MatrixXd& R, Index p, Index q, Index from, Index to, Rotatio
 // superdiagonal are cleared from the outside in by a column rotation, and the bulge this
 // leaves below the diagonal is chased down the band, w rows a step, by alternating row and
 // column rotations (as LAPACK's dgbbrd). About n^2 w rotations against the dense
-// reflections' 8 n^3 / 3 flops: a chain of 16 loops (32 x 32, w = 3) in half the time.
+// reflections' 8 n^3 / 3 flops; condition_of takes them where the band is narrow enough
+// for that to pay (scripts/condition_time.py times both).
 void band_bidiagonalize(ConditionWork& w, Index kl, Index ku) {
   MatrixXd& R = w.B;
   const Index n = R.rows(), width = kl + ku;
