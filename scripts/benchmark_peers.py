@@ -36,6 +36,12 @@ row saying "not installed", never a crash):
   classical frame accelerations;
 - pinmech's compiled core: its `follow` alone (the C++ loop, from the sweep's first pose),
   and `Sweep.chunks` with the core ruled out (the Python path it stands in for);
+- Pinocchio's passes alone, in C++ (`Core.pinocchio_passes`, on the solved poses): the
+  fewest Pinocchio calls any certified answer needs at a pose, with nothing else. P1: the
+  joint Jacobians twice (the Newton step at the predicted q; the certifying residual and
+  the velocity Jacobian at the corrected q) and the kinematics at (q, v, 0) once (the
+  acceleration drift); P2: the joint Jacobians and the kinematics once each. A cost, not
+  an answer (no error): the verdicts say how much of the fastest peer's time it leaves;
 - pinmech: `Sweep.chunks` with `frame_paths` of link 3 and D on each chunk (every output,
   in the timing);
 - pinmech: `Sweep.chunks` of the bundled scene (q, v, a of every joint) alone and with
@@ -90,6 +96,8 @@ P1_OUTPUTS = "phi3, omega3, alpha3, s', s'', vD, aD"
 #: the compiled core's loop alone (the C++ floor of the first).
 ANSWERS = ("pinmech Sweep.chunks + frame_paths (every output)", "pinmech RateSolver.solve_many")
 FLOOR = "pinmech compiled core's follow alone (C++ floor)"
+#: Pinocchio's own passes alone, in C++ (Core.pinocchio_passes): a cost, not an answer.
+PASSES = "Pinocchio's passes alone, C++"
 P2_OUTPUTS = "omega_AB, omega_BC, alpha_AB, alpha_BC"
 BENCH_EXTRA = 'pip install "pinmech[bench]"'
 
@@ -156,6 +164,8 @@ class Row:
     one_off: str = ""
     status: str = ""
     is_pinmech: bool = False
+    #: Pinocchio's share of any answer (PASSES), timed like the methods but no answer itself.
+    is_bound: bool = False
 
     @property
     def median_us(self) -> float:
@@ -574,6 +584,23 @@ def pinmech_p1_core_follow(phi: np.ndarray):
     return run, read, "from the sweep's first pose (solved in set-up)"
 
 
+def pinocchio_passes_p1(phi: np.ndarray):
+    """Pinocchio's passes alone at every P1 pose (its solved q and v), through the compiled
+    core: joint Jacobians twice (the Newton step at the predicted q, then the certifying
+    residual and the velocity Jacobian at the corrected q) and the kinematics at (q, v, 0)
+    once (the acceleration drift). No certified closed-loop answer calls Pinocchio less."""
+    from pinmech.core import core_for
+
+    pinmech, sweep = _pinmech_p1_sweep()
+    compiled = core_for(sweep.solver)
+    if compiled is None:
+        raise RuntimeError("the compiled core does not take this model")
+    chunks = list(sweep.chunks(phi))
+    Q = np.concatenate([c.solution.q for c in chunks])
+    V = np.concatenate([c.solution.v for c in chunks])
+    return (lambda: compiled.pinocchio_passes(Q, V, 2)), None, "q and v solved in set-up"
+
+
 def pinmech_p1_motion(phi: np.ndarray):
     """`Sweep.chunks` and `evaluate_motion(points=[D], links=[link3])` at every pose."""
     pinmech, sweep = _pinmech_p1_sweep()
@@ -622,6 +649,20 @@ def pinmech_p2(th1: np.ndarray, th2: np.ndarray, many: bool = False):
     return (run_many if many else run), None, ""
 
 
+def pinocchio_passes_p2(th1: np.ndarray, th2: np.ndarray):
+    """Pinocchio's passes alone at every P2 pose, through the compiled core: the joint
+    Jacobians once (the rate problem's matrix) and the kinematics at (q, v, 0) once (the
+    acceleration drift). No answer to the rate problem calls Pinocchio less."""
+    run_many, _, _ = pinmech_p2(th1, th2, many=True)
+    cells = {type(c.cell_contents).__name__: c.cell_contents for c in run_many.__closure__}
+    solver, Q = cells["RateSolver"], cells["ndarray"]
+    compiled = solver._compiled()
+    if compiled is None:
+        raise RuntimeError("the compiled core does not take this model")
+    V = solver.solve_many(Q).v
+    return (lambda: compiled[0].pinocchio_passes(Q, V, 1)), None, "v solved in set-up"
+
+
 # ------------------------------------------------------------------ measuring
 def rows_for(poses: int) -> tuple[list[Row], dict]:
     """Every method on P1 and P2, built (not yet timed), and the closed forms."""
@@ -640,6 +681,8 @@ def rows_for(poses: int) -> tuple[list[Row], dict]:
         ("P1", "pinmech Sweep.chunks, Python path (PINMECH_CORE=0)", poses, None,
          lambda: pinmech_p1_python_path(phi)),
         ("P1", "pinmech compiled core's follow alone (C++ floor)", poses, None, lambda: pinmech_p1_core_follow(phi)),
+        ("P1", f"{PASSES} (2 joint Jacobians + 1 kinematics a pose)", poses, None,
+         lambda: pinocchio_passes_p1(phi)),
         ("P1", "pinmech Sweep.chunks (q, v, a)", 10 * poses, None, lambda: pinmech_p1_chunks(fine)),
         ("P1", "pinmech Sweep.chunks + evaluate_motion", 10 * poses, None, lambda: pinmech_p1_motion(fine)),
         ("P2", "closed form, vectorized numpy (lower bound)", poses, None,
@@ -650,8 +693,10 @@ def rows_for(poses: int) -> tuple[list[Row], dict]:
         ("P2", "Pinocchio from a Python script", poses, None, lambda: pinocchio_p2(th1, th2)),
         ("P2", "pinmech RateSolver.solve_many", poses, None, lambda: pinmech_p2(th1, th2, many=True)),
         ("P2", "pinmech RateSolver.solve", poses, None, lambda: pinmech_p2(th1, th2)),
+        ("P2", f"{PASSES} (1 joint Jacobian + 1 kinematics a pose)", poses, None,
+         lambda: pinocchio_passes_p2(th1, th2)),
     ]
-    rows = [build(Row(p, m, n, is_pinmech=m.startswith("pinmech")), package, make)
+    rows = [build(Row(p, m, n, is_pinmech=m.startswith("pinmech"), is_bound=m.startswith(PASSES)), package, make)
             for p, m, n, package, make in plan]
     rows.insert(2, Row("P2", "pylinkage", poses, status="no inverse-rate API (forward-driven points only)"))
     rows.sort(key=lambda r: r.problem)
@@ -668,7 +713,8 @@ def warm_up(row: Row, ref: np.ndarray, sample_time: float) -> None:
         t0 = time.perf_counter()
         raw = row.run()
         second = time.perf_counter() - t0
-        row.error = largest_error(row.read(raw), ref, angle_columns=(0,) if row.problem == "P1" else ())
+        if not row.is_bound:  # a bound gives no answer to compare
+            row.error = largest_error(row.read(raw), ref, angle_columns=(0,) if row.problem == "P1" else ())
     except Exception as exc:  # noqa: BLE001 (a peer that fails is a row that says so)
         row.run, row.status = None, f"failed: {type(exc).__name__}: {exc}"
         return
@@ -725,7 +771,7 @@ def verdicts(rows: list[Row], poses: int) -> list[str]:
     out = []
     for problem in ("P1", "P2"):
         timed = [r for r in rows if r.problem == problem and r.poses == poses and r.times]
-        peers = [r for r in timed if not r.is_pinmech and not r.method.startswith("closed form")]
+        peers = [r for r in timed if not (r.is_pinmech or r.is_bound or r.method.startswith("closed form"))]
         ours = [r for r in timed if r.method in ANSWERS]  # the full answer, as the peers give it
         if not peers or not ours:
             out.append(f"- {problem}: no peer or no pinmech time to compare")
@@ -737,6 +783,14 @@ def verdicts(rows: list[Row], poses: int) -> list[str]:
                    f"{ours.error:.1e}; fastest peer {best.method} {best.median_us:.3g} us at {best.error:.1e}: "
                    f"pinmech is {ours.median_us / best.median_us:.3g} x its time. Target (faster than every "
                    f"peer at <= 1e-13): {'met' if met else 'not met'}")
+        bound = [r for r in timed if r.is_bound]
+        if bound:
+            share = bound[0].median_us
+            room = (f"pinmech's own work above Pinocchio's would have to fit in {best.median_us - share:.3g} us"
+                    if share < best.median_us else "no pinmech answer can be faster: Pinocchio's share alone "
+                    "is slower than the peer's whole answer")
+            out.append(f"  Pinocchio's passes alone take {share:.3g} us per pose, {share / best.median_us:.3g} x "
+                       f"the fastest peer's whole answer: {room}.")
     floor = [r for r in rows if r.poses == poses and r.times and r.method == FLOOR]
     answer = [r for r in rows if r.poses == poses and r.times and r.method == ANSWERS[0]]
     if floor and answer:

@@ -461,3 +461,35 @@ def test_singular_matrices_have_infinite_condition(n):
         assert condition > 1e15 and sigma_min < 1e-14 * np.abs(B).max()
     with pytest.raises(ValueError, match="square"):
         core._core.condition(np.zeros((n, n + 1)))
+
+
+@pytest.mark.parametrize("name", ["r_rtr.toml", "jansen.toml"])
+def test_pinocchio_passes_compute_pinocchios_kinematics(scenes_dir, name):
+    """Core.pinocchio_passes (the benchmark's measure of Pinocchio's share of a pose) runs
+    Pinocchio's own kinematics: the last joint's world position and the linear part of
+    its spatial acceleration at a = 0, rotated to world axes, are pin's from Python at
+    random q and v, whatever the number of Jacobian passes before. Tolerance 1e-13 of
+    the mechanism's size (m) and of |v|^2 times it: the same Pinocchio calls on the
+    rebuilt model, rounding apart."""
+    sweep = _sweep(scenes_dir, name)
+    compiled = core.core_for(sweep.solver)
+    model = sweep.mechanism.model
+    data = model.createData()
+    rng = np.random.default_rng(3)
+    Q = np.array([pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq)) for _ in range(5)])
+    V = rng.normal(size=(5, model.nv))
+    last = model.njoints - 1
+    want = []
+    for q, v in zip(Q, V):
+        pin.forwardKinematics(model, data, q, v, np.zeros(model.nv))
+        R = data.oMi[last].rotation
+        want.append(np.r_[data.oMi[last].translation, R @ data.a[last].linear])
+    size = max(1.0, np.max(np.abs(np.array(want)[:, :3])))
+    for jacobians in (0, 1, 2):
+        got = compiled.pinocchio_passes(Q, V, jacobians)
+        assert got.shape == (5, 6)
+        np.testing.assert_allclose(got[:, :3], np.array(want)[:, :3], rtol=0, atol=1e-13 * size)
+        np.testing.assert_allclose(got[:, 3:], np.array(want)[:, 3:], rtol=0,
+                                   atol=1e-13 * size * (1 + np.max(np.abs(V))) ** 2)
+    with pytest.raises(ValueError, match="wrong shapes"):
+        compiled.pinocchio_passes(Q[:, :-1], V, 1)

@@ -1058,6 +1058,37 @@ class Core {
     return nb::make_tuple(P, R, Vel, Omega, Acc, Alpha);
   }
 
+  // ---------------------------------------------------------------- Pinocchio's share
+  // The Pinocchio passes alone that any certified answer at a pose needs, with nothing
+  // else: `jacobians` times computeJointJacobians(q) (a closed loop's Newton step at the
+  // predicted q, then the residual and the velocity Jacobian at the corrected q: two; an
+  // open chain's rates: one), then forwardKinematics(q, v, 0) (the acceleration drift).
+  // scripts/benchmark_peers.py times it as the cost no pinmech answer can go below.
+  // Returns the last joint's world position and its spatial acceleration's linear part
+  // (world axes, the drift at a = 0) at every pose, (N, 6), so that a test can check the
+  // passes ran.
+  RowMatrix pinocchio_passes(const Eigen::Ref<const RowMatrix>& Q, const Eigen::Ref<const RowMatrix>& V,
+                             int jacobians) {
+    const Index n = Q.rows();
+    if (Q.cols() != model_.nq || V.cols() != model_.nv || V.rows() != n || jacobians < 0)
+      throw std::invalid_argument("pinocchio_passes: q and v of the wrong shapes, or jacobians < 0");
+    RowMatrix out(n, 6);
+    {
+      nb::gil_scoped_release release;
+      VectorXd q(model_.nq), v(model_.nv);
+      const pin::JointIndex last = pin::JointIndex(model_.njoints - 1);
+      for (Index i = 0; i < n; ++i) {
+        q = Q.row(i).transpose();
+        v = V.row(i).transpose();
+        for (int k = 0; k < jacobians; ++k) pin::computeJointJacobians(model_, data_, q);
+        pin::forwardKinematics(model_, data_, q, v, zero_);
+        out.block<1, 3>(i, 0) = data_.oMi[last].translation().transpose();
+        out.block<1, 3>(i, 3) = (data_.oMi[last].rotation() * data_.a[last].linear()).transpose();
+      }
+    }
+    return out;
+  }
+
   double tol() const { return tol_; }
   void set_tol(double tol) { tol_ = tol; }
   int iterations() const { return iterations_; }
@@ -1354,5 +1385,6 @@ NB_MODULE(_core, m) {
       .def("follow", &Core::follow)
       .def("node", &Core::node)
       .def("rates", &Core::rates)
-      .def("frame_motion", &Core::frame_motion);
+      .def("frame_motion", &Core::frame_motion)
+      .def("pinocchio_passes", &Core::pinocchio_passes);
 }
