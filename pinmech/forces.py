@@ -233,8 +233,13 @@ class ForceSolver:
         self._check_masses(set(massless))
 
     def _check_masses(self, massless: set[str]) -> None:
-        """Every moving body has a mass, unless all its links are declared massless."""
+        """The file's masses are the model's (no `force_caveats`), and every moving body
+        has a mass, unless all its links are declared massless."""
         model, mech = self.model, self.mechanism
+        if mech.force_caveats:
+            more = len(mech.force_caveats) - 1
+            raise ModelError(f"forces: {mech.force_caveats[0]}" + (f" (and {more} more)" if more else ""),
+                             path=mech.source)
         missing = []
         for jid in range(1, model.njoints):
             if model.inertias[jid].mass > 0:
@@ -418,6 +423,7 @@ class ForceSolver:
             gravity_power += float(twists[i].dot(inertia * pin.Motion(g_local, np.zeros(3))))
             inertial = inertia * data.a[i] + data.v[i].cross(inertia * data.v[i])
             kinetic += float(twists[i].dot(inertial))
+        kinetic += float(virtual @ (model.armature * a))  # rotor inertias (MJCF armature), as rnea has them
         pin.updateFramePlacements(model, data)
         return gravity_power, load_power, kinetic
 

@@ -88,6 +88,9 @@ class Mechanism:
         mimics: joints following another one (URDF `<mimic>`) and still moving.
         limits: name -> position limits of the URDF's `<limit>` [rad or m],
             for the revolute and prismatic joints that give them (locked ones included).
+        force_caveats: why the file's forces are not this model's (masses its parser
+            does not compute as the file's own tool, passive joint forces): kinematics do
+            not need them, `ForceSolver` refuses to run on them.
     """
 
     model: pin.Model
@@ -105,6 +108,7 @@ class Mechanism:
     _rank: object = field(default=None, repr=False, compare=False)
     mimics: dict[str, MimicJoint] = field(default_factory=dict)
     limits: dict[str, JointLimit] = field(default_factory=dict)
+    force_caveats: tuple[str, ...] = ()
 
     # ---------------------------------------------------------------- construction
     @classmethod

@@ -15,7 +15,19 @@ fixed cut). Its known traps, each handled here or refused in one line:
 * an `axisangle` axis that is not of unit length is used as is (MuJoCo normalises it): pinmech
   normalises every one before parsing;
 * equality types pinmech cannot close (`joint`, `tendon`, `flex`), inactive equalities, and
-  `weld` with `relpose` are refused, never dropped.
+  `weld` with `relpose` are refused, never dropped;
+* default classes (`<default>`, `class`, `childclass`) are applied only in part (a joint's or
+  a site's `pos`, a site's orientation, a geom's `mass`, `pos` and `euler` are dropped, and
+  `class="main"` crashes the parser): pinmech writes every default onto its element, as
+  MuJoCo resolves them, and hands Pinocchio a file without defaults;
+* `euler` under an `eulerseq` with upper-case (extrinsic) axes is misread (4 degrees off for
+  euler="0.1 0.2 0.3" rad): pinmech turns every `euler` into the quaternion MuJoCo computes;
+* a site given by `fromto` keeps its body's axes (MuJoCo turns its z axis along fromto):
+  pinmech writes it as `pos` and `quat`;
+* masses the parser does not compute as MuJoCo (a mesh geom's inertia is 1 kg m², compiler
+  options such as `settotalmass`) and joint damping, stiffness and friction loss (passive
+  forces MuJoCo adds) become the mechanism's `force_caveats`: kinematics do not need them,
+  forces refuse to run on them (`ForceSolver`).
 
 Ball joints (nq 4, nv 3) work in loops: pinmech moves along the tangent space.
 """
@@ -40,17 +52,237 @@ WRAPPER = "pinmech_world"
 
 
 def _parse(path: Path) -> ET.Element:
+    """The file's XML with its defaults written out, its `euler` angles as quaternions
+    and its `fromto` sites as `pos` and `quat`: what MuJoCo's compiler reads, in the
+    forms Pinocchio's parser reads right."""
     root = read_xml(path, "mujoco", "MJCF")
     if root.find("include") is not None or root.find(".//include") is not None:
         raise ModelError("<include> is not supported: give pinmech the whole model in one file", path=str(path))
+    _apply_defaults(root, str(path))
+    _eulers_as_quaternions(root, str(path))
+    _fromto_sites(root, str(path))
     return root
 
 
 def mjcf_joint_types(path: str | Path) -> dict[str, str]:
-    """Joint name -> "revolute", "prismatic", "ball" or "free", read from the XML."""
+    """Joint name -> "revolute", "prismatic", "ball" or "free", read from the XML (default
+    classes applied)."""
     root = _parse(Path(path))
     return {j.get("name"): _TYPES.get(j.get("type", "hinge"), "other") for j in root.iter("joint")
             if j.get("name") and j.get("type", "hinge") in _TYPES}
+
+
+# ---------------------------------------------------------------- default classes
+_ORIENTATION = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
+#: elements of a body that take a default class, and the default element each reads
+_BODY_ELEMENTS = ("joint", "geom", "site", "camera", "light")
+_ASSET_ELEMENTS = ("mesh", "material", "texture", "hfield")
+
+
+def _merged(base: dict[str, str], own: dict[str, str]) -> dict[str, str]:
+    """Attributes `own` over `base`, MuJoCo's way: one orientation given replaces any other
+    form of it, and a `fromto` replaces `pos` and the orientation."""
+    out = dict(base)
+    if any(k in own for k in _ORIENTATION) or "fromto" in own:
+        for key in _ORIENTATION:
+            out.pop(key, None)
+    if "fromto" in own:
+        out.pop("pos", None)
+    out.update(own)
+    return out
+
+
+def _default_classes(root: ET.Element, source: str) -> dict[str, dict[str, dict[str, str]]]:
+    """Class name -> element tag -> attributes, each class holding its ancestors' too."""
+    classes: dict[str, dict[str, dict[str, str]]] = {}
+
+    def walk(node: ET.Element, inherited: dict[str, dict[str, str]], name: str) -> None:
+        if name in classes:
+            raise ModelError(f"two default classes are called \"{name}\"", path=source,
+                             element=f"<default class=\"{name}\">")
+        own = {tag: dict(attrs) for tag, attrs in inherited.items()}
+        for child in node:
+            if child.tag != "default":
+                own[child.tag] = _merged(own.get(child.tag, {}), {k: v for k, v in child.attrib.items()
+                                                                  if k != "class"})
+        classes[name] = own
+        for child in node.findall("default"):
+            if not child.get("class"):
+                raise ModelError("a <default> inside another needs a class name", path=source,
+                                 element=f"<default class=\"{name}\"> <default>")
+            walk(child, own, child.get("class"))
+
+    tops = root.findall("default")
+    if len(tops) > 1:
+        raise ModelError(f"{len(tops)} top-level <default> elements: MuJoCo takes one (class \"main\")",
+                         path=source, element="<default>")
+    if tops:
+        if tops[0].get("class", "main") != "main":
+            raise ModelError(f"the top-level <default> is class \"main\", not \"{tops[0].get('class')}\"",
+                             path=source, element="<default>")
+        walk(tops[0], {}, "main")
+    else:
+        classes["main"] = {}
+    return classes
+
+
+def _apply_defaults(root: ET.Element, source: str) -> None:
+    """Every attribute an element takes from its default class written on it (its `class`,
+    else the nearest `childclass` of the bodies around it, else "main"), then the
+    `<default>` elements and the class attributes removed: Pinocchio's parser then reads
+    only what is written on each element."""
+    classes = _default_classes(root, source)
+
+    def resolve(el: ET.Element, name: str, tag: str) -> None:
+        if name not in classes:
+            raise ModelError(f"no default class \"{name}\"", path=source,
+                             element=f"<{el.tag} name=\"{el.get('name', '')}\">")
+        attrs = _merged(classes[name].get(tag, {}), {k: v for k, v in el.attrib.items() if k != "class"})
+        el.attrib.clear()
+        el.attrib.update(attrs)
+
+    def in_body(body: ET.Element, childclass: str) -> None:
+        for child in body:
+            if child.tag in ("body", "frame"):
+                in_body(child, child.get("childclass", childclass))
+            elif child.tag in _BODY_ELEMENTS:
+                resolve(child, child.get("class", childclass), child.tag)
+
+    for world in root.findall("worldbody"):
+        in_body(world, "main")
+    for equality in root.findall("equality"):
+        for el in equality:
+            resolve(el, el.get("class", "main"), "equality")
+    for asset in root.findall("asset"):
+        for el in asset:
+            if el.tag in _ASSET_ELEMENTS:
+                resolve(el, el.get("class", "main"), el.tag)
+    for top in root.findall("default"):
+        root.remove(top)
+    for el in root.iter():
+        el.attrib.pop("class", None)
+        el.attrib.pop("childclass", None)
+
+
+# ---------------------------------------------------------------- orientations
+def _numbers(el: ET.Element, key: str, count: int, source: str) -> list[float]:
+    text = el.get(key, "")
+    try:
+        values = [float(v) for v in text.split()]
+    except ValueError:
+        values = []
+    if len(values) != count or not all(np.isfinite(values)):
+        raise ModelError(f"{key}=\"{text}\" is not {count} finite numbers", path=source,
+                         element=f"<{el.tag} name=\"{el.get('name', '')}\">")
+    return values
+
+
+def _quaternion_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a b, quaternions w x y z."""
+    return np.array([a[0] * b[0] - a[1:] @ b[1:], *(a[0] * b[1:] + b[0] * a[1:] + np.cross(a[1:], b[1:]))])
+
+
+def _eulers_as_quaternions(root: ET.Element, source: str) -> None:
+    """Every `euler` written as the `quat` MuJoCo's compiler makes of it: for each axis of
+    `eulerseq` in turn, the rotation about it multiplied on the right (a lower-case,
+    moving axis) or on the left (an upper-case, fixed axis); angles in the compiler's unit."""
+    sequence, degrees = "xyz", True
+    for compiler in root.findall("compiler"):
+        sequence = compiler.get("eulerseq", sequence)
+        degrees = compiler.get("angle", "degree" if degrees else "radian") == "degree"
+    if len(sequence) != 3 or any(c not in "xyzXYZ" for c in sequence):
+        raise ModelError(f"eulerseq=\"{sequence}\" is not three of x, y, z, X, Y, Z", path=source,
+                         element="<compiler>")
+    axes = {"x": np.array([1.0, 0, 0]), "y": np.array([0, 1.0, 0]), "z": np.array([0, 0, 1.0])}
+    for el in root.iter():
+        if el.get("euler") is None or el.tag == "compiler":
+            continue
+        angles = np.array(_numbers(el, "euler", 3, source))
+        if degrees:
+            angles = np.radians(angles)
+        q = np.array([1.0, 0, 0, 0])
+        for letter, angle in zip(sequence, angles):
+            turn = np.array([np.cos(angle / 2), *(np.sin(angle / 2) * axes[letter.lower()])])
+            q = _quaternion_product(q, turn) if letter.islower() else _quaternion_product(turn, q)
+        del el.attrib["euler"]
+        el.set("quat", " ".join(repr(float(x)) for x in q))
+
+
+def _z_to(vector: np.ndarray) -> np.ndarray:
+    """The quaternion (w x y z) turning z onto `vector` by the shortest way, as MuJoCo's
+    mju_quatZ2Vec (a half turn about x for -z)."""
+    length = np.linalg.norm(vector)
+    if not length > 0:
+        return np.array([1.0, 0, 0, 0])
+    v = vector / length
+    axis = np.cross([0.0, 0.0, 1.0], v)
+    sine = np.linalg.norm(axis)
+    if sine < 1e-15:
+        return np.array([1.0, 0, 0, 0]) if v[2] > 0 else np.array([0.0, 1.0, 0, 0])
+    angle = np.arctan2(sine, v[2])
+    return np.array([np.cos(angle / 2), *(np.sin(angle / 2) * axis / sine)])
+
+
+def _fromto_sites(root: ET.Element, source: str) -> None:
+    """A site given by `fromto` sits at its middle with its z axis from its second end to
+    its first (MuJoCo's compiler): written as `pos` and `quat`, which Pinocchio's parser
+    reads."""
+    for world in root.findall("worldbody"):
+        for site in world.iter("site"):
+            if site.get("fromto") is None:
+                continue
+            ends = np.array(_numbers(site, "fromto", 6, source))
+            del site.attrib["fromto"]
+            for key in _ORIENTATION:
+                site.attrib.pop(key, None)
+            site.set("pos", " ".join(repr(float(x)) for x in (ends[:3] + ends[3:]) / 2))
+            site.set("quat", " ".join(repr(float(x)) for x in _z_to(ends[:3] - ends[3:])))
+
+
+# ---------------------------------------------------------------- what forces need
+_MASS_OPTIONS = ("inertiafromgeom", "settotalmass", "boundmass", "boundinertia", "balanceinertia",
+                 "inertiagrouprange", "exactmeshinertia")
+_PASSIVE = ("damping", "stiffness", "frictionloss")
+
+
+def _force_caveats(root: ET.Element) -> tuple[str, ...]:
+    """Why the forces of this file are not those of Pinocchio's model of it: masses the
+    parser does not compute as MuJoCo, and passive joint forces MuJoCo adds."""
+    out = []
+    for compiler in root.findall("compiler"):
+        for key in _MASS_OPTIONS:
+            value = compiler.get(key)
+            if value is not None and not (key == "inertiafromgeom" and value == "auto"):
+                out.append(f"<compiler {key}=\"{value}\"> sets masses in MuJoCo that Pinocchio's parser "
+                           "computes otherwise: remove it and give the bodies <inertial> elements")
+    for world in root.findall("worldbody"):
+        for body in world.iter("body"):
+            if body.find("inertial") is not None:
+                continue
+            for geom in body.findall("geom"):
+                kind = geom.get("type", "mesh" if geom.get("mesh") else "sphere")
+                if geom.get("mass") in ("0", "0.0") or geom.get("density") in ("0", "0.0"):
+                    continue
+                if kind in ("mesh", "hfield", "sdf"):
+                    out.append(f"<body name=\"{body.get('name', '')}\"> has no <inertial> and a {kind} geom: "
+                               "Pinocchio's parser gives it 1 kg m^2 about each axis, not MuJoCo's inertia; "
+                               "give the body an <inertial> element")
+                elif not 0 <= int(float(geom.get("group", "0"))) <= 5:
+                    out.append(f"<body name=\"{body.get('name', '')}\"> has no <inertial> and a geom of group "
+                               f"{geom.get('group')}, which MuJoCo leaves out of its mass; give the body an "
+                               "<inertial> element")
+        for joint in world.iter("joint"):
+            for key in _PASSIVE:
+                text = joint.get(key, "0")
+                try:
+                    nonzero = any(float(v) != 0 for v in text.split())
+                except ValueError:
+                    nonzero = True
+                if nonzero:
+                    out.append(f"<joint name=\"{joint.get('name', '')}\"> has {key}=\"{text}\": MuJoCo adds "
+                               "that passive force, pinmech's forces are those of ideal joints; remove it to "
+                               "compute forces")
+    return tuple(out)
 
 
 def _equalities(root: ET.Element, source: str) -> tuple[list[str], list[str], list[ET.Element]]:
@@ -172,6 +404,7 @@ def load_mjcf(path: str | Path, *, locked: dict[str, float] | None = None) -> Me
     if locked:  # checked as drawn; then the joints the scene holds are locked out
         mech = Mechanism.from_model(model, points + frames, names=connects + welds, source=source,
                                     reference=qpos0, urdf_path=str(wrapped), locked=locked)
+    mech.force_caveats = _force_caveats(root)
     return mech
 
 
@@ -186,9 +419,8 @@ def _check_everything_read(root: ET.Element, model: pin.Model, source: str) -> N
         if name and name not in bodies:
             raise ModelError("Pinocchio's parser left this body out of the model", path=source,
                              element=f"<body name=\"{name}\">")
-    typed_defaults = any(j.get("type") for d in root.findall("default") for j in d.iter("joint"))
     freedoms = sum(_DOFS.get(j.get("type", "hinge"), 0) for j in root.find("worldbody").iter("joint"))
-    if not typed_defaults and freedoms != model.nv:  # (a default class may set a joint's type)
+    if freedoms != model.nv:  # (default classes are written out: every type is on its joint)
         raise ModelError(f"the file's joints have {freedoms} freedoms, Pinocchio's model {model.nv}", path=source,
                          element="<joint>")
 

@@ -300,3 +300,159 @@ def test_lock_in_an_mjcf_scene(tmp_path):
                                atol=1e-12)
     with pytest.raises(ModelError, match="rod_ball.*3 freedoms"):
         load_mjcf(MJCF / "leg_ball.xml", locked={"rod_ball": 0.0})
+
+
+# ---------------------------------------------------------------- default classes, euler sequences, fromto sites
+CHAIN = """<mujoco>{compiler}{defaults}<worldbody>
+  <body name="a" pos="0.1 0.2 0.3" {turn}{childclass}><joint name="ja" {joint}/>
+    <geom {geom}/><site name="s" {site}/>
+    <body name="b" pos="0.2 0 0.05" {turn}><joint name="jb" axis="0 1 0.5" {joint_b}/>
+      <geom type="box" size="0.05 0.02 0.01" mass="0.3"/><site name="t" {site_b}/></body>
+  </body></worldbody></mujoco>"""
+CHAIN_PLAIN = dict(compiler="", defaults="", turn="", childclass="", joint='axis="0 0 1"', geom='type="sphere" '
+                   'size="0.02" pos="0.1 0 0" mass="0.5"', site='pos="0.05 0.1 0"', joint_b="",
+                   site_b='pos="0.05 0.02 0"')
+CHAIN_CASES = {
+    "joint pos from <default>": dict(defaults='<default><joint pos="0 0.1 0"/></default>'),
+    "site pos from <default>": dict(defaults='<default><site pos="0.1 0.2 0.3"/></default>', site=""),
+    "site quat from a class": dict(defaults='<default><default class="k"><site quat="0.9 0.1 0.3 0.2"/></default>'
+                                   '</default>', site='class="k" pos="0.05 0.1 0"'),
+    "nested classes, euler over an inherited quat": dict(
+        defaults='<default><site quat="0.9 0.1 0.3 0.2"/><default class="k"><site euler="10 20 30"/>'
+                 '<joint pos="0.01 0.02 0"/></default></default>', childclass=' childclass="k"'),
+    "class main named": dict(defaults='<default><joint pos="0 0.05 0"/></default>', joint='class="main" axis="0 0 1"'),
+    "joint type slide from a childclass": dict(defaults='<default><default class="k"><joint type="slide"/></default>'
+                                               '</default>', childclass=' childclass="k"'),
+    "eulerseq XYZ (fixed axes), degrees": dict(compiler='<compiler eulerseq="XYZ"/>', turn='euler="10 20 30"'),
+    "eulerseq ZYX, radians": dict(compiler='<compiler angle="radian" eulerseq="ZYX"/>', turn='euler="0.1 0.2 0.3"'),
+    "eulerseq xYz, mixed": dict(compiler='<compiler eulerseq="xYz"/>', turn='euler="10 -20 30"'),
+    "site along fromto": dict(site='type="capsule" size="0.01" fromto="0 0 0 0.3 0.2 0.1"'),
+    "site along +z fromto": dict(site='type="capsule" size="0.01" fromto="0 0 0 0 0 0.2"',
+                                 site_b='type="capsule" size="0.01" fromto="0 0 0.2 0 0 0"'),
+}
+
+
+def _chain(tmp_path, **changes) -> Path:
+    path = tmp_path / "chain.xml"
+    path.write_text(CHAIN.format(**(CHAIN_PLAIN | changes)))
+    return path
+
+
+@pytest.mark.parametrize("case", sorted(CHAIN_CASES))
+def test_defaults_euler_sequences_and_fromto_sites_as_mujoco_compiles_them(tmp_path, case):
+    """Every body and site where MuJoCo puts it, axes included, at qpos0 and at a moved
+    pose: Pinocchio's parser alone drops a default joint's or site's pos (85 mm off at 50
+    degrees), a class's site orientation (45 degrees), reads upper-case eulerseq as
+    another rotation (4 degrees) and leaves a fromto site with its body's axes (180
+    degrees). Same arithmetic on the same numbers: 1e-12."""
+    path = _chain(tmp_path, **CHAIN_CASES[case])
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    mech = load_mjcf(path)
+    data = mech.model.createData()
+    for q in (np.zeros(2), np.array([0.87, -0.4])):
+        d.qpos[:] = q
+        mujoco.mj_forward(m, d)
+        pin.framesForwardKinematics(mech.model, data, q)
+        for i in range(1, m.nbody):
+            frame = data.oMf[mech.links[m.body(i).name]]
+            np.testing.assert_allclose(frame.translation, d.xpos[i], atol=1e-12, err_msg=m.body(i).name)
+            np.testing.assert_allclose(frame.rotation, d.xmat[i].reshape(3, 3), atol=1e-12, err_msg=m.body(i).name)
+        for i in range(m.nsite):
+            frame = data.oMf[mech.points[m.site(i).name]]
+            np.testing.assert_allclose(frame.translation, d.site_xpos[i], atol=1e-12, err_msg=m.site(i).name)
+            np.testing.assert_allclose(frame.rotation, d.site_xmat[i].reshape(3, 3), atol=1e-12, err_msg=m.site(i).name)
+
+
+def test_a_joint_type_from_a_default_class_is_read(tmp_path):
+    """The scene reads driver kinds from the file: a slide set by a class is prismatic."""
+    from pinmech.mjcf import mjcf_joint_types
+
+    path = _chain(tmp_path, **CHAIN_CASES["joint type slide from a childclass"])
+    assert mjcf_joint_types(path) == {"ja": "prismatic", "jb": "prismatic"}
+    assert load_mjcf(path).joints["ja"].kind == "prismatic"
+
+
+@pytest.mark.parametrize("geom", [
+    '',  # the mass of <default>
+    'pos="0.1 0.05 0"',  # the place of the class
+    'type="box" size="0.05 0.02 0.01" euler="0 0 40"',  # the turn of the box's inertia
+])
+def test_masses_from_default_classes_are_mujocos(tmp_path, geom):
+    """Each body's mass, centre of mass and inertia as MuJoCo compiles them (Pinocchio's
+    parser alone took the default density for a default mass: 0.034 kg for 0.5). Same
+    arithmetic: 1e-12 relative."""
+    defaults = '<default><geom type="sphere" size="0.02" mass="0.5"/><default class="g"><geom pos="0.2 0 0.1"/>' \
+               '</default></default>'
+    path = _chain(tmp_path, defaults=defaults, geom=f'class="g" {geom}')
+    m = mujoco.MjModel.from_xml_path(str(path))
+    mech = load_mjcf(path)
+    for i in range(1, m.nbody):
+        inertia = mech.model.inertias[mech.model.frames[mech.links[m.body(i).name]].parentJoint]
+        R = np.zeros(9)
+        mujoco.mju_quat2Mat(R, m.body_iquat[i])
+        R = R.reshape(3, 3)
+        assert inertia.mass == pytest.approx(m.body_mass[i], rel=1e-12)
+        np.testing.assert_allclose(inertia.lever, m.body_ipos[i], atol=1e-12)
+        np.testing.assert_allclose(inertia.inertia, R @ np.diag(m.body_inertia[i]) @ R.T, atol=1e-12 * m.body_mass[i])
+
+
+PENDULUM = """<mujoco><compiler angle="radian"/>{compiler}<asset>{asset}</asset><worldbody>
+  <body name="arm" pos="0 0 1"><joint name="hinge" type="hinge" axis="0 1 0" {joint}/>{geom}
+  <site name="tip" pos="0.3 0 0"/></body></worldbody></mujoco>"""
+BALL = '<geom type="sphere" size="0.02" pos="0.3 0 0" mass="0.5"/>'
+
+
+def _pendulum(tmp_path, compiler="", asset="", joint="", geom=BALL) -> Path:
+    path = tmp_path / "pendulum.xml"
+    path.write_text(PENDULUM.format(compiler=compiler, asset=asset, joint=joint, geom=geom))
+    return path
+
+
+@pytest.mark.parametrize("change, words", [
+    (dict(asset='<mesh name="m" vertex="0 0 0 1 0 0 0 1 0 0 0 1"/>', geom='<geom type="mesh" mesh="m" mass="0.5"/>'),
+     ['<body name="arm">', "mesh geom", "<inertial>"]),
+    (dict(compiler='<compiler settotalmass="3"/>'), ['settotalmass="3"']),
+    (dict(joint='damping="3"'), ['<joint name="hinge">', 'damping="3"', "ideal joints"]),
+    (dict(joint='stiffness="10"'), ['stiffness="10"']),
+])
+def test_forces_refuse_what_pinocchio_does_not_model_as_mujoco(tmp_path, capsys, change, words):
+    """A mesh's inertia (Pinocchio's parser: 1 kg m^2, 24 times MuJoCo's torque here), a
+    compiler mass option, passive joint forces: forces refuse, in one line naming the file
+    and the element; kinematics still run."""
+    from pinmech.forces import ForceSolver
+
+    path = _pendulum(tmp_path, **change)
+    mech = load_mjcf(path)
+    LoopSolver(mech, ["hinge"]).solve([0.3], [1.0], [0.0])  # kinematics do not need masses
+    with pytest.raises(ModelError) as err:
+        ForceSolver(mech, ["hinge"])
+    message = str(err.value)
+    assert str(path) in message and "\n" not in message
+    for word in words:
+        assert word in message, message
+    scene = tmp_path / "pendulum.toml"
+    scene.write_text(f'mjcf = "{path}"\n[drivers.hinge]\nangle = "0 deg"\n')
+    assert main(["forces", str(scene)]) == 3
+    err_text = capsys.readouterr().err
+    assert len(err_text.strip().splitlines()) == 1 and words[0] in err_text
+
+
+def test_armature_is_in_the_torque_and_the_power_balance(tmp_path):
+    """Rotor inertia (armature 0.2 kg m^2) at 2 rad/s and 10 rad/s^2, no gravity: the
+    driver torque is MuJoCo's inverse dynamics (rigid body 0.4508 + armature 2 N m), and
+    the power balance holds (it left the armature out: residual 0.82). 1e-12: the same
+    arithmetic."""
+    from pinmech.forces import ForceSolver
+
+    path = _pendulum(tmp_path, joint='armature="0.2"')
+    mech = load_mjcf(path)
+    sol = LoopSolver(mech, ["hinge"]).solve([0.4], [2.0], [10.0])
+    forces = ForceSolver(mech, ["hinge"]).solve(sol.q, sol.v, sol.a)
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    m.opt.gravity[:] = 0
+    d.qpos[0], d.qvel[0], d.qacc[0] = 0.4, 2.0, 10.0
+    mujoco.mj_inverse(m, d)
+    assert forces.effort[0] == pytest.approx(d.qfrc_inverse[0], rel=1e-12)
+    assert forces.power.residual < 1e-12
