@@ -207,6 +207,25 @@ class RateOverflowError(PinmechError):
     exit_code = 2
 
 
+class BalanceError(PinmechError):
+    """Forces that fail their own checks beyond rounding: the virtual power of the driver,
+    gravity and loads differs from the kinetic rate, or the joint equations are not met
+    (a term the model computes one way and the check another). Never printed as an answer.
+
+    Attributes:
+        power_residual, equation_residual: the two relative residuals.
+        bound: what rounding allows at this condition number.
+    """
+
+    exit_code = 13
+
+    def __init__(self, message: str, *, power_residual: float, equation_residual: float, bound: float):
+        super().__init__(message)
+        self.power_residual = power_residual
+        self.equation_residual = equation_residual
+        self.bound = bound
+
+
 class Interrupted(KeyboardInterrupt):
     """The run was stopped by a signal: Ctrl-C (SIGINT), SIGTERM or SIGHUP (the terminal
     closed). A KeyboardInterrupt, so code that stops on Ctrl-C stops on all three.

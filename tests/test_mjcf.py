@@ -456,3 +456,30 @@ def test_armature_is_in_the_torque_and_the_power_balance(tmp_path):
     mujoco.mj_inverse(m, d)
     assert forces.effort[0] == pytest.approx(d.qfrc_inverse[0], rel=1e-12)
     assert forces.power.residual < 1e-12
+
+
+def test_forces_that_fail_their_power_balance_are_an_error(tmp_path, monkeypatch, capsys):
+    """The guard behind the armature mend: a power balance that leaves a term out (here
+    the armature again, patched back out of it) is a BalanceError naming the pose, exit
+    13 in one line, never a printed answer."""
+    from pinmech.exceptions import BalanceError
+    from pinmech.forces import ForceSolver
+
+    original = ForceSolver._power_terms
+
+    def without_armature(self, q, v, a, virtual):
+        gravity, loads, kinetic = original(self, q, v, a, virtual)
+        return gravity, loads, kinetic - float(virtual @ (self.model.armature * a))
+
+    monkeypatch.setattr(ForceSolver, "_power_terms", without_armature)
+    path = _pendulum(tmp_path, joint='armature="0.2"')
+    mech = load_mjcf(path)
+    sol = LoopSolver(mech, ["hinge"]).solve([0.4], [2.0], [10.0])
+    with pytest.raises(BalanceError, match=r"hinge = 22\.9\d* deg.*power balance off by 0\.8"):
+        ForceSolver(mech, ["hinge"]).solve(sol.q, sol.v, sol.a)
+    scene = tmp_path / "pendulum.toml"
+    scene.write_text(f'mjcf = "{path}"\n[drivers.hinge]\nangle = "0.4 rad"\nspeed = "2 rad/s"\n'
+                     'acceleration = "10 rad/s^2"\n')
+    assert main(["forces", str(scene)]) == 13
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "fail their own check" in err
