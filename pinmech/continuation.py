@@ -222,6 +222,7 @@ class Path:
         curve = _Curve(self, node)
         sense = 1.0 if p_target > node.p else -1.0
         state = curve.start(sense)
+        folded = False
         for _ in range(MAX_PIVOT_STEPS):
             nxt = curve.advance(state)
             if nxt is None:
@@ -229,7 +230,7 @@ class Path:
             if nxt.dp * state.dp <= 0:  # the driver turned back: a fold in between
                 fold = curve.locate_fold(state, nxt)
                 if (fold.p - p_target) * sense >= 0:  # the target comes before the fold
-                    return self._land(curve, state, fold, p_target), p_target
+                    return self._kept(node, self._land(curve, state, fold, p_target), folded), p_target
                 x_fold = self.drivers(fold.p)
                 if not self.through_folds:
                     raise DriverLimitError(
@@ -242,10 +243,22 @@ class Path:
                 route.fold_p.append(fold.p)
                 p_target = 2.0 * fold.p - p_target
                 sense = -sense
+                folded = True
             elif (nxt.p - p_target) * sense >= 0:  # passed the target: close there
-                return self._land(curve, state, nxt, p_target), p_target
+                return self._kept(node, self._land(curve, state, nxt, p_target), folded), p_target
             state = curve.repivot(nxt)
         raise self._stuck(node, why)
+
+    def _kept(self, start: Node, landed: Node, folded: bool) -> Node:
+        """`landed`, where the pivot-parametrized curve kept `start`'s assembly: with no
+        fold crossed (through_folds turns onto the mirrored branch there), the signature
+        must be start's. The curve can cross from one branch to another where the two
+        come within rounding of each other (a linkage a nanometre from a parallelogram):
+        that is a named error, never the other branch's answer."""
+        if folded or landed.signs == start.signs:
+            return landed
+        raise self._stuck(start, f"the path comes within rounding of another assembly here and would land on it "
+                                 f"({_signs(start.signs)} -> {_signs(landed.signs)}): the two cannot be told apart")
 
     def _land(self, curve: _Curve, a: _CurvePoint, b: _CurvePoint, p_target: float) -> Node:
         """The pose at p_target between two curve points that bracket it (p monotonic
@@ -329,6 +342,16 @@ class _Curve:
         self.d_hat = path.d / path.unit  # drivers' motion per radian or size along the path
         self._ds = 1e-3
 
+    def _cos(self, a: np.ndarray, b: np.ndarray) -> float:
+        """Cosine of the angle between two tangents, each made dimensionless (joint rates
+        over their velocity scales, the last entry in radians or sizes already): the
+        angle a mechanism scaled in size keeps. (As stored, a prismatic joint's entry is
+        in metres: the raw dot product of two tangents was 0.73 for equal ones at a 0.1 m
+        size, and any turn passed at 100 m.)"""
+        scale = np.append(self.solver._v_scale_inv, 1.0)
+        ua, ub = a * scale, b * scale
+        return float(ua @ ub) / float(np.linalg.norm(ua) * np.linalg.norm(ub))
+
     def _pivot(self, tangent: np.ndarray) -> int:
         scaled = np.abs(tangent[:-1] * self.solver._v_scale_inv)
         return max(self.scalar, key=lambda v: scaled[v])
@@ -354,7 +377,7 @@ class _Curve:
         n = self.node
         t = self._tangent(n.q)
         along = np.append(n.d1 / self.path.unit, 1.0) * sense
-        if t @ along < 0:
+        if self._cos(t, along) < 0:
             t = -t
         return _CurvePoint(n.p, n.q, 0.0, t, self._pivot(t))
 
@@ -411,9 +434,10 @@ class _Curve:
         if solver.scaled_norm(pin.difference(model, guess, q)) > TRUST * solver.scaled_norm(move) + 1e3 * solver.tol:
             return None
         t = self._tangent(q)
-        if t @ a.tangent < 0:
-            t = -t
-        if t @ a.tangent < math.cos(MAX_TURN):
+        cos = self._cos(t, a.tangent)
+        if cos < 0:
+            t, cos = -t, -cos
+        if cos < math.cos(MAX_TURN):
             return None
         return _CurvePoint(p, q, s, t, a.pivot)
 

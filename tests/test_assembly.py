@@ -433,3 +433,70 @@ def test_a_driver_value_with_its_unit_is_a_named_error_in_the_api(models_dir):
     solver = LoopSolver(Mechanism.from_urdf(models_dir / "r_rtr.urdf"), ["A"])
     with pytest.raises(pinmech.UnitError, match="to_si"):
         solver.solve(["30 deg"])
+
+
+# ---------------------------------------------------------------------- near change points, folds at any size
+@pytest.mark.parametrize("eps", [1e-4, 1e-6, 1e-8, 1e-10])
+@pytest.mark.parametrize("step", [30.0, -45.0, 90.0])
+@pytest.mark.parametrize("branch", [+1, -1])
+def test_four_bars_a_hair_from_a_parallelogram_keep_their_branch_or_say_so(tmp_path, eps, step, branch):
+    """Crank 40, coupler 100, ground 100 mm, rocker 40 (1 + eps) mm: Grashof, so each
+    branch is regular all the way round and its closed form holds, but near O2 = 180 deg
+    the two branches pass within about eps of the size of each other. Swept over two
+    turns at coarse spacing, every row is on the reference's branch (1e-9 of the size),
+    or a named error: the pivot-parametrized continuation used to cross onto the other
+    branch there in silence (53 mm off at eps = 1e-8)."""
+    a, b, c, d = 0.04, 0.10, 0.04 * (1 + eps), 0.10
+    mech = _four_bar(tmp_path, a, b, c, d)
+    solver = LoopSolver(mech, ["O2"])
+    start = math.radians(60.0)
+    solver.set_reference([start], _four_bar_guess(mech, start, a, b, c, d, branch))
+    values = start + np.radians(step * np.arange(1, int(720 / abs(step)) + 1))
+    qs, errors, _ = _sweep(solver, values)
+    for i, (theta, qi) in enumerate(zip(values, qs)):
+        if i in errors:
+            assert isinstance(errors[i], (AssemblyError, SingularPoseError)), errors[i]
+            continue
+        expected = closed_form.four_bar(theta, 0, 0, a, b, c, d, branch)
+        assert np.allclose(_rocker_tip(mech, qi, c, d), expected.B, rtol=0, atol=1e-9 * d), (i, math.degrees(theta))
+
+
+TRAMMEL = """title = "elliptic trammel"
+ground = ["O"]
+[joints]
+O = ["0 mm", "0 mm"]
+P1 = ["{x0} mm", "0 mm"]
+P2 = ["0 mm", "{y0} mm"]
+Q1 = ["{x0} mm", "0 mm"]
+[links]
+b1 = ["P1", "Q1"]
+b2 = ["P2"]
+bar = ["P1", "P2"]
+[sliders]
+S1 = {{ block = "b1", on = "ground", at = "P1", along = "0 deg" }}
+S2 = {{ block = "b2", on = "ground", at = "P2", along = "90 deg" }}
+"""
+
+
+@pytest.mark.parametrize("size", [1e-4, 0.1, 100.0])
+def test_a_trammel_reaches_its_fold_at_any_size(tmp_path, size):
+    """An elliptic trammel (bar L between a block on x, drawn at x0 = 0.3 L, and one on y),
+    driven by the x block: the fold is at x = L, S1 = 0.7 L. Just before it the y block
+    is at sqrt(L^2 - x^2) (1e-9 of L: the pose is 0.1% of L from the fold, condition ~1e2);
+    past it the drivers stop there, named (DriverLimitError, located to 1e-9 of L). The
+    continuation's turn check read prismatic joints' tangents in metres, so below about
+    1 m every step was refused and reachable poses were AssemblyErrors."""
+    L = size
+    x0 = 0.3 * L
+    path = tmp_path / "trammel.toml"
+    path.write_text(TRAMMEL.format(x0=repr(x0 * 1e3), y0=repr(math.sqrt(L * L - x0 * x0) * 1e3)))
+    mech = pinmech.load_linkage(path)
+    solver = LoopSolver(mech, ["S1"])
+    solver.set_reference([0.0], mech.reference)
+    x = 0.999 * L
+    sol = solver.solve([x - x0])
+    y0 = math.sqrt(L * L - x0 * x0)
+    assert y0 + mech.coordinate(sol.q, "S2") == pytest.approx(math.sqrt(L * L - x * x), abs=1e-9 * L)
+    with pytest.raises(DriverLimitError) as err:
+        solver.solve([0.75 * L])
+    assert err.value.limit[0] == pytest.approx(0.7 * L, abs=1e-9 * L)
