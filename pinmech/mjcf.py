@@ -35,6 +35,7 @@ Ball joints (nq 4, nv 3) work in loops: pinmech moves along the tangent space.
 from __future__ import annotations
 
 import hashlib
+import math
 import os
 import tempfile
 import xml.etree.ElementTree as ET
@@ -59,6 +60,7 @@ def _parse(path: Path) -> ET.Element:
     if root.find("include") is not None or root.find(".//include") is not None:
         raise ModelError("<include> is not supported: give pinmech the whole model in one file", path=str(path))
     _apply_defaults(root, str(path))
+    _check_numbers(root, str(path))
     _eulers_as_quaternions(root, str(path))
     _fromto_sites(root, str(path))
     return root
@@ -162,6 +164,33 @@ def _apply_defaults(root: ET.Element, source: str) -> None:
     for el in root.iter():
         el.attrib.pop("class", None)
         el.attrib.pop("childclass", None)
+
+
+# ---------------------------------------------------------------- numbers
+#: attributes of placements, axes and masses -> how many numbers each holds
+_COUNTS = {"pos": (3,), "quat": (4,), "axisangle": (4,), "euler": (3,), "xyaxes": (6,), "zaxis": (3,),
+           "axis": (3,), "fromto": (6,), "anchor": (3,), "mass": (1,), "density": (1,), "diaginertia": (3,),
+           "fullinertia": (6,), "ref": (1,), "size": (1, 2, 3)}
+
+
+def _check_numbers(root: ET.Element, source: str) -> None:
+    """Every placement, axis and mass attribute of the bodies and equalities holds as many
+    finite numbers as MuJoCo reads: Pinocchio's parser reads pos="0.16, 0.05, 0" (a
+    comma) or "0.16 0.05" as garbage (z = -2e243 was seen) and "0 0 nan" as given."""
+    for section in root.findall("worldbody") + root.findall("equality"):
+        for el in section.iter():
+            for key, counts in _COUNTS.items():
+                text = el.get(key)
+                if text is None:
+                    continue
+                try:
+                    values = [float(v) for v in text.split()]
+                except ValueError:
+                    values = []
+                if len(values) not in counts or not all(math.isfinite(v) for v in values):
+                    want = " or ".join(str(c) for c in counts)
+                    raise ModelError(f"{key}=\"{text}\" is not {want} finite numbers (separated by spaces)",
+                                     path=source, element=f"<{el.tag} name=\"{el.get('name', '')}\">")
 
 
 # ---------------------------------------------------------------- orientations

@@ -176,6 +176,11 @@ def _variant(tmp_path, old: str, new: str, name: str = "four_bar") -> Path:
      ["relpose"]),
     ("</mujoco>", "", ["malformed XML"]),
     ('body2="rocker"', 'body2="rockr"', ["Pinocchio cannot build", "rockr"]),
+    # the parser read these as garbage (z = -2e243) or as given: MuJoCo refuses them
+    ('<body name="coupler" pos="0.04 0 0"', '<body name="coupler" pos="0.04, 0, 0"', ['<body name="coupler">', "pos="]),
+    ('<body name="coupler" pos="0.04 0 0"', '<body name="coupler" pos="0.04 0"', ["not 3 finite numbers"]),
+    ('<site name="P" pos="0.06 0.03 0"/>', '<site name="P" pos="0.06 0.03 nan"/>', ['<site name="P">', "nan"]),
+    ('anchor="0.12 0 0"/>', 'anchor="0.12 0 0 1"/>', ["anchor=", "not 3 finite numbers"]),
 ])
 def test_refusals_are_one_line_naming_file_and_element(tmp_path, capsys, old, new, words):
     path = _variant(tmp_path, old, new)
