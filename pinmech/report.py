@@ -228,8 +228,10 @@ def _assembly_lines(t: _Text, analysis: Analysis) -> None:
             at = ", ".join(f"{n} = {_angle_or_length(analysis, n, v)}" for n, v in zip(analysis.drivers.names, x))
             t.lines.append(f"  passed a change point near {at}, on the branch of continuous tangent")
     if not _pinned(analysis):
-        t.lines.append(f"  the scene has no [guess]: this assembly was found from the neutral configuration; "
-                       f"pin it with [guess] or {sol.assembly.pin_hint()}")
+        found = ("is the one the model is drawn in (its reference pose)" if analysis.mechanism.reference is not None
+                 else "was found from the neutral configuration")
+        t.lines.append(f"  the scene has no [guess]: this assembly {found}; pin it with [guess] or "
+                       f"{sol.assembly.pin_hint()}")
 
 
 def _angle_or_length(analysis: Analysis, name: str, q: float) -> str:

@@ -345,7 +345,10 @@ def test_a_scene_without_guess_says_which_assembly_and_how_to_pin_it(tmp_path, m
     scene.write_text(f'urdf = "{models_dir / "four_bar.urdf"}"\n{body}')
     assert main(["solve", str(scene)]) == 0
     out = capsys.readouterr().out
-    assert "no [guess]" in out and 'assembly = { "B" = ' in out
+    assert "no [guess]" in out and 'assembly = { "B" = ' in out and "neutral configuration" in out
+    assert main(["solve", str(models_dir / "scenes" / "four_bar_drawn.toml")]) == 0  # a drawing is its own guess
+    drawn = capsys.readouterr().out
+    assert "the one the model is drawn in" in drawn and "neutral" not in drawn
     wrong = "+" if '"B" = "-"' in out else "-"
     top = f'urdf = "{models_dir / "four_bar.urdf"}"\n'
     scene.write_text(top + f'assembly = {{ B = "{wrong}" }}\n' + body)
