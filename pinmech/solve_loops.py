@@ -676,10 +676,12 @@ class LoopSolver:
         ref = self.reference
         if ref is not None and ref.keep and signs != ref.signs and not (route and (route.folds or route.change_points)):
             expected, found = self.structure.assembly(ref.signs), self.structure.assembly(signs, self.data)
+            how = ("followed from the reference: the path passes within rounding of the other assembly; set "
+                   "assembly = \"any\" to take the pose anyway" if route is not None else
+                   "from its guess: solve without a guess to follow the reference, or set assembly = \"any\"")
             raise AssemblyError(
                 f"{self.mechanism.source}: at {self.describe_drivers(self._driver_values(q))} the pose is on "
-                f"assembly {found.describe()}, not the reference's {expected.describe()} (from its guess: solve "
-                f"without a guess to follow the reference, or set assembly = \"any\")",
+                f"assembly {found.describe()}, not the reference's {expected.describe()} ({how})",
                 expected=ref.signs, found=signs, drivers=self.drivers, value=tuple(self._driver_values(q)))
         assembly = self.structure.assembly(signs, self.data) if signs else None
         return LoopSolution(q=q, v=v, a=a, accuracy=Accuracy(residual, iterations, *numbers), drivers=self.drivers,
