@@ -462,8 +462,19 @@ def _check_outputs(args: argparse.Namespace, scene) -> Path | None:
     check_distinct({"--csv": args.csv_path, "--json": args.json_path, "--plot": figure,
                     "--paths": getattr(args, "paths_path", None),
                     "--torque-plot": plot_path(torque, "--torque-plot") if torque else None},
-                   {"the scene file": scene.path, "the URDF": _urdf_path(scene)})
+                   _inputs(scene))
     return figure
+
+
+def _inputs(scene, hand: str | None = None) -> dict[str, Path]:
+    """What a run reads, which no output may overwrite: the scene, its model file, a
+    sidecar (robot.yaml) and a hand file."""
+    out = {"the scene file": scene.path, "the URDF": _urdf_path(scene)}
+    if "sidecar" in scene.raw:
+        out["the sidecar"] = scene.model_file("sidecar")
+    if hand:
+        out["the hand file"] = Path(hand)
+    return out
 
 
 def _urdf_path(scene) -> Path:
@@ -632,7 +643,9 @@ def cmd_polygon(args: argparse.Namespace) -> int:
     from pinmech.polygon import acceleration_polygon, velocity_polygon
 
     args.acceleration = None  # the flag names the polygon here, not the driver's acceleration
-    analysis = analyse(_scene(args))
+    scene = _scene(args)
+    _check_page(args, scene)
+    analysis = analyse(scene)
     polygon = (acceleration_polygon if args.acceleration_polygon else velocity_polygon)(analysis)
     _write_text(args.output, polygon_svg(polygon), "SVG drawing")
     return 0
@@ -646,7 +659,9 @@ def cmd_report(args: argparse.Namespace) -> int:
     if args.steps < 0 or args.steps == 1:
         raise PinmechError(f"--steps must be 0 (no sweep) or at least 2, got {args.steps}")
     hand_text = None
-    analysis = analyse(_scene(args))
+    scene = _scene(args)
+    _check_page(args, scene, hand=args.hand)
+    analysis = analyse(scene)
     if args.hand:
         from pinmech.check import DEFAULT_SLACK, compare, format_verdicts, load_hand_file
         from pinmech.report import to_dict
@@ -664,7 +679,9 @@ def cmd_build(args: argparse.Namespace) -> int:
     """`pinmech build LINKAGE -o FILE.urdf`: the URDF of a drawn linkage, written whole or not at all."""
     from pinmech.linkage import build_urdf
     from pinmech.linkage_urdf import spanning_tree
+    from pinmech.outputs import check_distinct
 
+    check_distinct({"-o": args.output}, {"the linkage file": args.linkage})
     try:
         linkage = build_urdf(args.linkage, args.output)
     except OSError as exc:
@@ -708,11 +725,11 @@ def _write_text(path: str, text: str, what: str) -> None:
     print(f"wrote {path} ({what}, {max(1, len(text) // 1024)} KB)", file=sys.stderr)
 
 
-def _check_page(args: argparse.Namespace, scene) -> None:
-    """Before computing: the page's file can be made and is not an input."""
+def _check_page(args: argparse.Namespace, scene, hand: str | None = None) -> None:
+    """Before computing: the output file can be made and is not an input."""
     from pinmech.outputs import check_distinct
 
-    check_distinct({"-o": args.output}, {"the scene file": scene.path, "the URDF": _urdf_path(scene)})
+    check_distinct({"-o": args.output}, _inputs(scene, hand))
 
 
 def _write(path: str, html: str) -> None:

@@ -215,3 +215,30 @@ def test_rows_sent_to_standard_output_end_with_a_mark_when_the_run_stops(singula
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == 1 + 4 + 1  # header, the 4 poses before 0 deg, the mark
     assert lines[-1].startswith("INCOMPLETE: pinmech stopped before the last row (sweep stopped at A = 0 deg")
+
+
+def test_polygon_report_and_build_never_write_over_what_they_read(tmp_path, models_dir, capsys):
+    """`polygon -o`, `report -o` and `build -o` named their own scene, URDF, hand file or
+    linkage and replaced it (exit 0): now refused before anything is computed, the file
+    untouched. Copies in tmp_path, so a regression destroys nothing bundled."""
+    import shutil
+
+    urdf = tmp_path / "r_rtr.urdf"
+    shutil.copy(models_dir / "r_rtr.urdf", urdf)
+    scene = tmp_path / "s.toml"
+    scene.write_text('urdf = "r_rtr.urdf"\n[drivers.A]\nangle = "30 deg"\n[guess]\nB = "20 deg"\nB_slider = "-60 mm"\n')
+    hand = tmp_path / "s.hand.toml"
+    hand.write_text('scene = "s.toml"\n[[value]]\nlabel = "x"\npath = "joints.A.q"\nvalue = "30 deg"\n')
+    linkage = tmp_path / "four_bar.toml"
+    shutil.copy(models_dir / "linkages" / "four_bar.toml", linkage)
+    before = {p: p.read_bytes() for p in (urdf, scene, hand, linkage)}
+    runs = [(["polygon", str(scene), "-o", str(scene)], "the scene file"),
+            (["polygon", str(scene), "-o", str(urdf)], "the URDF"),
+            (["report", str(scene), "-o", str(scene), "--steps", "0"], "the scene file"),
+            (["report", str(scene), "--hand", str(hand), "-o", str(hand), "--steps", "0"], "the hand file"),
+            (["build", str(linkage), "-o", str(linkage)], "the linkage file")]
+    for argv, what in runs:
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert f"would overwrite {what}" in err and len(err.strip().splitlines()) == 1, err
+    assert {p: p.read_bytes() for p in before} == before
