@@ -493,6 +493,7 @@ class _Cut:
 def _parse_constraint(el: ET.Element, model: pin.Model, links: list[str], source: str) -> _Cut:
     name = el.get("name") or "<unnamed>"
     where = f"<constraint name=\"{name}\">"
+    _check_known(el, where, source)
     cut_type = el.get("type")
     if cut_type not in CUT_TYPES:
         raise ModelError(f"type=\"{cut_type}\" is not one of {', '.join(CUT_TYPES)}", path=source, element=where)
@@ -517,6 +518,35 @@ def _parse_constraint(el: ET.Element, model: pin.Model, links: list[str], source
         sides[side] = (link, pin.SE3(pin.rpy.rpyToMatrix(rpy), xyz), axis / norm)
     return _Cut(name, cut_type, sides["parent"][0], sides["child"][0], sides["parent"][1], sides["child"][1],
                 sides["parent"][2], sides["child"][2], source)
+
+
+#: what a <constraint> holds: its attributes, and each child element with its attributes
+_CONSTRAINT_ATTRIBUTES = {"name", "type"}
+_CONSTRAINT_CHILDREN = {"parent": {"link"}, "child": {"link"}, "parent_origin": {"xyz", "rpy"},
+                        "child_origin": {"xyz", "rpy"}, "parent_axis": {"xyz"}, "child_axis": {"xyz"}}
+
+
+def _check_known(el: ET.Element, where: str, source: str) -> None:
+    """Every attribute and child of a <constraint> is one pinmech reads: a misspelled
+    <parent_orgin> was skipped, its origin taken as 0 0 0, and another mechanism solved."""
+    for key in el.attrib:
+        if key not in _CONSTRAINT_ATTRIBUTES:
+            raise ModelError(f"unknown attribute {key}=\"{el.get(key)}\" (a <constraint> has "
+                             f"{', '.join(sorted(_CONSTRAINT_ATTRIBUTES))})", path=source, element=where)
+    seen = set()
+    for child in el:
+        if not isinstance(child.tag, str):  # a comment
+            continue
+        if child.tag not in _CONSTRAINT_CHILDREN:
+            raise ModelError(f"unknown element <{child.tag}> (a <constraint> holds "
+                             f"{', '.join(f'<{t}>' for t in _CONSTRAINT_CHILDREN)})", path=source, element=where)
+        if child.tag in seen:
+            raise ModelError(f"<{child.tag}> is given twice", path=source, element=where)
+        seen.add(child.tag)
+        for key in child.attrib:
+            if key not in _CONSTRAINT_CHILDREN[child.tag]:
+                raise ModelError(f"unknown attribute {key}=\"{child.get(key)}\" of <{child.tag}> (it has "
+                                 f"{', '.join(sorted(_CONSTRAINT_CHILDREN[child.tag]))})", path=source, element=where)
 
 
 # -------------------------------------------------------------------- model building

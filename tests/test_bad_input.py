@@ -177,10 +177,15 @@ LAUGHS = ('<!DOCTYPE robot [<!ENTITY a "aaaaaaaaaa">' + "".join(
         ('<robot name="r_rtr">', '<!DOCTYPE robot [<!ENTITY x SYSTEM "file:///etc/passwd">]><robot name="&x;">', 3,
          "external entity"),
         ('<robot name="r_rtr">', LAUGHS, 3, "malformed XML"),  # a billion laughs: refused, not expanded
+        # a misspelling inside <constraint> was skipped: origin 0 0 0, link 3 pinned at A, D 50 mm off
+        ('<parent_origin xyz="0.05 0 0"', '<parent_orgin xyz="0.05 0 0"', 3, "unknown element <parent_orgin>"),
+        ('<parent_origin xyz="0.05 0 0"', '<parent_origin xzy="0.05 0 0"', 3, 'unknown attribute xzy="0.05 0 0"'),
+        (R_RTR_CUT, R_RTR_CUT.replace('type=', 'kind="pin" type='), 3, 'unknown attribute kind="pin"'),
     ],
     ids=["nan origin", "inf origin", "1e300 origin", "nan cut origin", "zero axis", "negative length",
          "unknown link", "cut to itself", "unknown cut type", "over-constrained", "out of plane",
-         "joint cycle", "duplicate cut", "unused external entity", "external entity", "billion laughs"],
+         "joint cycle", "duplicate cut", "unused external entity", "external entity", "billion laughs",
+         "misspelled element", "misspelled attribute", "unknown constraint attribute"],
 )
 def test_urdf_mistakes(copies, capsys, old, new, code, message):
     got, err = _run(capsys, "solve", _r_rtr(copies, old, new))
