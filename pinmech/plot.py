@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pinmech.exceptions import PinmechError
+from pinmech.exceptions import FrameNotFound, PinmechError
 from pinmech.plot_paths import PathRecorder
 
 if TYPE_CHECKING:
@@ -44,6 +44,13 @@ def _pyplot():
     except ImportError as exc:
         raise ImportError('plots need matplotlib: pip install "pinmech[plot]"') from exc
     return plt
+
+
+def _check_names(sweep: Sweep, what: str, names: list[str] | None, known, where: str) -> None:
+    """Before the sweep runs: every name asked for the figure is a link (point) of the model."""
+    for name in names or ():
+        if name not in known:
+            raise FrameNotFound(f"{what} (in {where})", name, list(known), path=str(sweep.scene.path))
 
 
 class SweepPlot:
@@ -71,6 +78,8 @@ class SweepPlot:
         self.paths = PathRecorder(sweep.mechanism, plane)
         self.mark_q = None  # configuration of the pose nearest the scene's (drawn under the paths)
         self.links, self.points = links or chosen.get("links"), points or chosen.get("points")
+        _check_names(sweep, "link", self.links, sweep.mechanism.links, "--links" if links else "[sweep] links")
+        _check_names(sweep, "point", self.points, sweep.mechanism.points, "--points" if points else "[sweep] points")
         self.every = max(1, math.ceil(total / max_points)) if total else 1
         self.normal = sweep.mechanism.plane_normal
         self.x = array("d")

@@ -456,3 +456,20 @@ def test_an_unknown_kind_of_quantity_is_a_unit_error():
 
     with pytest.raises(UnitError, match="unknown kind of quantity 'lengthh'"):
         to_si("1 m", "lengthh")
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--links", "nope", "--plot", "f.png"], "unknown link (in --links) 'nope'"),
+    (["--points", "nope", "--plot", "f.png"], "unknown point (in --points) 'nope'"),
+    (["--paths", "p.png", "--points", "nope"], "unknown point (in --points) 'nope'"),
+])
+def test_a_figure_asked_of_unknown_links_or_points_is_refused_before_the_sweep(tmp_path, models_dir, capsys,
+                                                                               extra, words):
+    """A name the figure cannot draw was a KeyError traceback (exit 1) after the sweep ran."""
+    pytest.importorskip("matplotlib")
+    argv = ["sweep", str(models_dir / "scenes" / "r_rtr.toml"), "--steps", "5"]
+    argv += [str(tmp_path / x) if x.endswith(".png") else x for x in extra]
+    assert main(argv) == 4
+    err = capsys.readouterr().err
+    assert words in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert not list(tmp_path.iterdir())
