@@ -102,6 +102,16 @@ pin::JointModel joint_model(int type, const Vector3d& axis) {
   throw std::invalid_argument("unknown joint type code " + std::to_string(type));
 }
 
+// Steps between two looks at Python's signal handlers in a long loop run without the GIL.
+constexpr long SIGNAL_EVERY = 4096;
+
+// Run Python's signal handlers (Ctrl-C, SIGTERM: pinmech's raise Interrupted) from a loop
+// that released the GIL, and leave the loop with the exception they raised.
+void check_signals() {
+  nb::gil_scoped_acquire acquire;
+  if (PyErr_CheckSignals() != 0) throw nb::python_error();
+}
+
 double max_abs(const Eigen::Ref<const VectorXd>& x) { return x.size() ? x.cwiseAbs().maxCoeff() : 0.0; }
 
 // A x = b for a small square A, as solve_loops._solve_square: closed forms up to 2x2, LU
@@ -849,6 +859,7 @@ class Core {
     RowMatrix acc(n, 7);  // residual, iterations, condition, sigma_min, velocity and acceleration residuals, steps
     Index done = 0;
     int stop = DONE;
+    long attempts = 0;
     {
       nb::gil_scoped_release release;
       Node node, next;
@@ -863,6 +874,7 @@ class Core {
         double h = std::copysign(std::min(std::abs(target - node.p), MAX_STEP / unit), target - node.p);
         long iterations = 0, steps = 0;
         while (node.p != target) {
+          if (++attempts % SIGNAL_EVERY == 0) check_signals();  // a span of many turns takes long
           const double remaining = target - node.p;
           h = std::copysign(std::min(std::abs(h), std::abs(remaining)), remaining);
           bool change = false;
