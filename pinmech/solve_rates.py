@@ -39,6 +39,12 @@ from pinmech.solve_loops import DEFAULT_MAX_CONDITION, checked_option, describe_
 
 COMPONENTS = ("x", "y", "z", "wx", "wy", "wz")
 METHODS = ("exact", "least_squares", "damped")
+#: Accepted damping lambda (dimensionless). Below 1e-5, lambda^2 drowns in the rounding of
+#: J J^T (the damped answer is off by about eps / lambda^2: 4e-7 at 1e-5, 8e-5 at 1e-6, and
+#: at 1e-9 the damped matrix is singular in float64); above 1e50, the bound on every
+#: quantity pinmech takes (README "Scale and speed"), lambda^2 overflows by 1e155 and the
+#: rates underflow to denormals before that.
+DAMPING_RANGE = (1e-5, 1e50)
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
@@ -111,12 +117,13 @@ class RateSolver:
             inconsistent tasks: the least-squares motion, asked vs achieved reported),
             or "damped" (damped least squares with `damping`, also at singular poses).
         damping: lambda of the damped least squares, dimensionless: rows and columns are
-            scaled as for the condition number (lengths in mechanism sizes).
+            scaled as for the condition number (lengths in mechanism sizes); in
+            DAMPING_RANGE (1e-5 to 1e50).
         max_condition: above this condition number (dimensionless) the pose is singular
             (SingularPoseError) unless the method is "damped".
 
     Raises:
-        TaskError: unknown method, or no task.
+        TaskError: unknown method, no task, or a damping out of DAMPING_RANGE.
         FrameNotFound: a task names a frame the model lacks.
     """
 
@@ -126,8 +133,11 @@ class RateSolver:
             raise TaskError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
         if not tasks:
             raise TaskError("no task given: add a [[task]] with frame, components, velocity, acceleration")
-        if not (np.isfinite(damping) and damping > 0):
-            raise TaskError(f"damping must be a positive number, got {damping!r}")
+        low, high = DAMPING_RANGE
+        number = damping if isinstance(damping, (int, float, np.number)) and not isinstance(damping, bool) else None
+        if number is None or not low <= number <= high:  # NaN is in no range
+            raise TaskError(f"damping must be a positive number in [{low:g}, {high:g}] (dimensionless: below, "
+                            f"its square drowns in rounding; above, it overflows), got {damping!r}")
         self.mechanism = mechanism
         self.model = mechanism.model
         self.lock = threading.RLock()  # one Data: threads sharing the solver take turns

@@ -21,6 +21,7 @@ from pinmech import (
     Task,
     TaskError,
 )
+from pinmech.solve_rates import DAMPING_RANGE
 from tests.conftest import MODELS
 
 DEG = np.pi / 180
@@ -230,12 +231,24 @@ def test_malformed_tasks(kwargs, message):
         Task("D", **kwargs)
 
 
+@pytest.mark.parametrize("damping", [DAMPING_RANGE[0], 1.0, DAMPING_RANGE[1]])
+def test_damping_at_its_bounds_gives_normal_numbers(arm, damping):
+    """At 1e50 the rates are about 1e-100 of the motion asked: small, not denormal (before,
+    1e154 gave 1e-309 and 1e155 an OverflowError)."""
+    sol = RateSolver(arm, arm_tasks(), method="damped", damping=damping).solve(arm_q(arm, (0, 0, -90)))
+    assert np.all(np.isfinite(sol.v)) and np.abs(sol.v).max() > 1e-120
+
+
 @pytest.mark.parametrize(
     "options, message",
     [
         ({"method": "pinv"}, "method must be one of exact, least_squares, damped"),
         ({"method": "damped", "damping": -1.0}, "damping must be a positive number"),
         ({"method": "damped", "damping": float("nan")}, "damping must be a positive number"),
+        ({"method": "damped", "damping": 1e155}, r"damping must be a positive number in \[1e-05, 1e\+50\].*got 1e\+155"),
+        ({"method": "damped", "damping": float("inf")}, r"in \[1e-05, 1e\+50\].*got inf"),
+        ({"method": "damped", "damping": 1e-9}, r"in \[1e-05, 1e\+50\].*drowns in rounding.*got 1e-09"),
+        ({"method": "damped", "damping": "0.1"}, r"got '0.1'"),
     ],
 )
 def test_bad_solver_options(arm, options, message):
