@@ -161,15 +161,19 @@ class RateSolver:
         """Joint rates and accelerations at configuration q (loops already closed).
 
         Args:
-            q: configuration of the model.
+            q: configuration of the model (nq finite numbers; quaternions and (cos, sin)
+                pairs of unit norm).
             velocity, acceleration: the task rows' values for this call, in task order
                 (default: the tasks' own) [m/s, rad/s; m/s^2, rad/s^2].
 
         Raises:
+            ModelError: q is not a configuration of the model (shape, NaN, a quaternion
+                whose norm is not 1).
             TaskError: an over-determined task, or rows that cannot hold together at any
                 pose (a zero row, a row repeated), unless method is "least_squares".
             SingularPoseError: the stacked Jacobian is singular at q, unless "damped".
         """
+        q = self.mechanism.checked_q(q)
         x_dot = self._values(velocity, self.x_dot, "velocity")
         x_ddot = self._values(acceleration, self.x_ddot, "acceleration")
         J, n_c = self._jacobian(self.data, q)
@@ -204,11 +208,10 @@ class RateSolver:
         raises as it does.
 
         Raises:
+            ModelError: q is not an (N, nq) array of configurations (as `solve`).
             TaskError, SingularPoseError: as `solve`, at the first pose that has them.
         """
-        q = np.ascontiguousarray(q, dtype=float)
-        if q.ndim != 2 or q.shape[1] != self.model.nq or not np.all(np.isfinite(q)):
-            raise TaskError(f"q must be an (N, {self.model.nq}) array of finite numbers, got shape {q.shape}")
+        q = np.ascontiguousarray(self.mechanism.checked_q(q, many=True))
         n, m = len(q), self.x_dot.size
         compiled = self._compiled() if self.method == "exact" else None
         if compiled is not None:

@@ -16,6 +16,7 @@ from pinmech import (
     FrameNotFound,
     LoopSolver,
     Mechanism,
+    ModelError,
     RateSolver,
     SingularPoseError,
     Task,
@@ -229,6 +230,49 @@ def test_task_on_the_r_rtr_loop_against_its_closed_form(models_dir):
 def test_malformed_tasks(kwargs, message):
     with pytest.raises(TaskError, match=message):
         Task("D", **kwargs)
+
+
+@pytest.mark.parametrize(
+    "bad, message",
+    [
+        (lambda q: q[:2], r"q must be 3 finite numbers \(SI\), got shape \(2,\)"),
+        (lambda q: np.r_[q[:2], np.nan], r"q must be 3 finite numbers \(SI\), got shape \(3,\) with a non-finite"),
+        (lambda q: q[None], r"q must be 3 finite numbers \(SI\), got shape \(1, 3\)"),
+        (lambda q: ["a", "b", "c"], "q must be 3 numbers"),
+    ],
+)
+def test_a_q_that_is_no_configuration_is_a_model_error_naming_q(arm, bad, message):
+    """Before: raw Pinocchio or numpy errors (README: a ModelError naming the argument)."""
+    with pytest.raises(ModelError, match=message):
+        RateSolver(arm, arm_tasks()).solve(bad(arm_q(arm, (50, -65, -75))))
+
+
+def test_a_q_given_as_a_list_is_the_array():
+    q = arm_q(Mechanism.from_urdf(MODELS / "planar_arm.urdf"), (50, -65, -75))
+    solver = RateSolver(Mechanism.from_urdf(MODELS / "planar_arm.urdf"), arm_tasks())
+    np.testing.assert_array_equal(solver.solve(list(q)).v, solver.solve(q).v)
+
+
+def test_a_quaternion_or_cos_sin_pair_whose_norm_is_not_one_is_refused_with_its_norm():
+    """Pinocchio reads a quaternion of norm n as a rotation scaled by n^2: before, a floating
+    base's (or a ball joint's) rates came out different, silently. A norm within 1e-12 of 1
+    (Pinocchio's isNormalized) is taken as it is."""
+    floating = Mechanism.from_urdf(MODELS / "planar_arm.urdf", root_joint="free_flyer")
+    solver = RateSolver(floating, arm_tasks())
+    q = floating.neutral()
+    q[3:7] = [0.2, 0.1, 0.0, 2.0]  # norm 2.0125
+    with pytest.raises(ModelError, match=r"joint 'root_joint' has a quaternion of norm 2.01246117974981\d*, not 1"):
+        solver.solve(q)
+    with pytest.raises(ModelError, match=r"q \(row 1\): joint 'root_joint' has a quaternion of norm 2.0124"):
+        solver.solve_many(np.array([floating.neutral(), q]))
+    q[3:7] /= np.linalg.norm(q[3:7])
+    solver.solve(q)
+    mech = Mechanism.from_urdf(MODELS / "four_bar.urdf")
+    q = mech.neutral()
+    j = mech.joint("O2").idx_q  # a continuous joint: (cos, sin)
+    q[j : j + 2] *= 1.5
+    with pytest.raises(ModelError, match=r"joint 'O2' has a \(cos, sin\) pair of norm 1.5, not 1"):
+        RateSolver(mech, [Task("P", ("x",), np.array([0.1]), np.zeros(1))]).solve(q)
 
 
 @pytest.mark.parametrize("damping", [DAMPING_RANGE[0], 1.0, DAMPING_RANGE[1]])
