@@ -32,7 +32,7 @@ from pinmech.scene_model import (
     report_lists,
     scene_guess,
 )
-from pinmech.solve_loops import SOLVER_RANGES, LoopSolver
+from pinmech.solve_loops import DEFAULT_TOL, SOLVER_RANGES, LoopSolver
 from pinmech.solve_rates import COMPONENTS, DAMPING_RANGE, RateSolver, Task
 
 _ORDER_KINDS = {True: ("angular_velocity", "angular_acceleration"), False: ("velocity", "acceleration")}
@@ -142,7 +142,8 @@ def analyse_task(scene: Scene) -> Analysis:
     tasks = scene_tasks(scene)
     _check_frames(scene, mechanism, tasks)
     check_scene_names(scene, mechanism)
-    rates = RateSolver(mechanism, tasks, **_rate_options(scene))
+    rates = RateSolver(mechanism, tasks, **_rate_options(scene),
+                       tol=scene.solver_options().get("tol", DEFAULT_TOL))  # the q closed above, to this tol
     rs = rates.solve(q)
     accuracy = Accuracy(residual, iterations, rs.condition, rs.sigma_min,
                         max(rs.closure_velocity_residual, rs.velocity_error),
