@@ -283,15 +283,18 @@ class RateSolver:
         independent, full = np.zeros(n), np.zeros(n)
         for k, c in enumerate(self.mechanism.closures):
             R_P, R_C = R[:, 2 * k], R[:, 2 * k + 1]
-            linear = np.einsum("nji,nj->ni", R_P, P[:, 2 * k + 1] - P[:, 2 * k])
-            R_rel = np.einsum("nji,njk->nik", R_P, R_C)
-            if c.cut_type == "revolute":
-                angular = np.cross(c.axis, R_rel @ c.child_axis)
+            r6 = np.empty((n, 6))
+            r6[:, :3] = _in_parent(R_P, P[:, 2 * k + 1] - P[:, 2 * k])
+            if c.cut_type == "revolute":  # axis x (R_P^T R_C child_axis)
+                u = _in_parent(R_P, R_C @ c.child_axis)
+                a = c.axis
+                r6[:, 3] = a[1] * u[:, 2] - a[2] * u[:, 1]
+                r6[:, 4] = a[2] * u[:, 0] - a[0] * u[:, 2]
+                r6[:, 5] = a[0] * u[:, 1] - a[1] * u[:, 0]
             elif c.cut_type == "spherical":
-                angular = np.zeros((n, 3))
+                r6[:, 3:] = 0.0
             else:
-                angular = _log3(R_rel)
-            r6 = np.concatenate((linear, angular), axis=1)
+                r6[:, 3:] = _log3(np.matmul(R_P.transpose(0, 2, 1), R_C))
             independent = np.maximum(independent, np.max(np.abs(r6 @ c._rows6.T), axis=1, initial=0.0))
             full = np.maximum(full, np.max(np.abs((r6 * c._scale()) @ c.selected.T), axis=1, initial=0.0))
         return independent, full
@@ -451,6 +454,11 @@ class RateSolver:
             return np.linalg.lstsq(J, rhs, rcond=None)[0]  # minimum-norm or least-squares
         U, s, Vt = np.linalg.svd(J, full_matrices=False)  # rank-deficient: truncated pseudo-inverse
         return Vt[:rank].T @ ((U[:, :rank].T @ rhs) / s[:rank])
+
+
+def _in_parent(R: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """R_i^T x_i for (N, 3, 3) rotations and (N, 3) vectors."""
+    return np.einsum("nji,nj->ni", R, x)
 
 
 def _log3(R: np.ndarray) -> np.ndarray:
