@@ -32,8 +32,8 @@ from pinmech.scene_model import (
     report_lists,
     scene_guess,
 )
-from pinmech.solve_loops import LoopSolver
-from pinmech.solve_rates import COMPONENTS, RateSolver, Task
+from pinmech.solve_loops import DEFAULT_TOL, SOLVER_RANGES, LoopSolver
+from pinmech.solve_rates import COMPONENTS, DAMPING_RANGE, RateSolver, Task
 
 _ORDER_KINDS = {True: ("angular_velocity", "angular_acceleration"), False: ("velocity", "acceleration")}
 
@@ -118,11 +118,15 @@ def _rate_options(scene: Scene) -> dict[str, Any]:
     if unknown:
         raise SceneError(f"unknown key(s) {sorted(unknown)}; known: method, damping, max_condition",
                          path=str(scene.path), key="rates")
+    ranges = {"damping": DAMPING_RANGE, "max_condition": SOLVER_RANGES["max_condition"]}
     for key, value in options.items():
         number = key != "method"
         if (number and (isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0)) or (
                 not number and not isinstance(value, str)):
             raise SceneError(f"must be {'a positive number' if number else 'a string'}, got {value!r}",
+                             path=str(scene.path), key=f"rates.{key}")
+        if number and not ranges[key][0] <= value <= ranges[key][1]:
+            raise SceneError(f"rates.{key} = {value!r} is outside [{ranges[key][0]:g}, {ranges[key][1]:g}]",
                              path=str(scene.path), key=f"rates.{key}")
     return dict(options)
 
@@ -138,7 +142,8 @@ def analyse_task(scene: Scene) -> Analysis:
     tasks = scene_tasks(scene)
     _check_frames(scene, mechanism, tasks)
     check_scene_names(scene, mechanism)
-    rates = RateSolver(mechanism, tasks, **_rate_options(scene))
+    rates = RateSolver(mechanism, tasks, **_rate_options(scene),
+                       tol=scene.solver_options().get("tol", DEFAULT_TOL))  # the q closed above, to this tol
     rs = rates.solve(q)
     accuracy = Accuracy(residual, iterations, rs.condition, rs.sigma_min,
                         max(rs.closure_velocity_residual, rs.velocity_error),

@@ -34,6 +34,20 @@ from pinmech.urdf_joints import JointLimit, MimicJoint, joint_limits, mimic_join
 #: Singular values below this fraction of the largest mark a row as structurally zero.
 STRUCTURAL_RANK_TOL = 1e-9
 _SAMPLES = 4
+#: A configuration's quaternions and (cos, sin) pairs must have a norm within this of 1
+#: (Pinocchio's own `isNormalized` precision): Pinocchio reads a quaternion of norm n as a
+#: rotation scaled by n^2, so a ball joint's rates came out wrong by that factor, silently.
+#: Within it the rotation is off by at most 2e-12 (relative); pinmech never normalises.
+UNIT_NORM_TOL = 1e-12
+#: Joint types whose coordinates hold a unit quaternion or (cos, sin) pair: its slice of
+#: the joint's coordinates and what it is called in an error.
+_UNIT_PARTS = {
+    "JointModelSpherical": (0, 4, "quaternion"),
+    "JointModelFreeFlyer": (3, 7, "quaternion"),
+    "JointModelPlanar": (2, 4, "(cos, sin) pair"),
+    **{f"JointModelRUB{axis}": (0, 2, "(cos, sin) pair") for axis in "XYZ"},
+    "JointModelRevoluteUnboundedUnaligned": (0, 2, "(cos, sin) pair"),
+}
 
 
 @dataclass(frozen=True)
@@ -402,6 +416,37 @@ class Mechanism:
         else:
             raise ModelError(f"joint '{name}' has {j.nq} coordinates; give it a full configuration", path=self.source)
 
+    def checked_q(self, q: Any, name: str = "q", *, many: bool = False) -> np.ndarray:
+        """q as a configuration of the model (`many`: an (N, nq) array of them), checked
+        once where it enters: finite numbers of the right shape, and every quaternion or
+        (cos, sin) pair of unit norm (to UNIT_NORM_TOL).
+
+        Raises:
+            ModelError: naming the argument and what it got (a non-unit quaternion: the
+                joint and its norm).
+        """
+        nq = self.model.nq
+        out = checked_numbers(q, (None, nq) if many else (nq,), name, self.source)
+        rows = out if many else out[None]
+        parts = self.__dict__.get("_unit_parts")
+        if parts is None:  # the joints' types are fixed: found once
+            parts = []
+            for jid in range(1, self.model.njoints):
+                joint = self.model.joints[jid]
+                part = _UNIT_PARTS.get(joint.shortname())
+                if part is not None:
+                    parts.append((self.model.names[jid], joint.idx_q + part[0], joint.idx_q + part[1], part[2]))
+            self.__dict__["_unit_parts"] = parts
+        for joint, start, stop, what in parts:
+            norms = np.sqrt(np.sum(rows[:, start:stop] ** 2, axis=1))
+            bad = np.flatnonzero(~(np.abs(norms - 1.0) <= UNIT_NORM_TOL))
+            if bad.size:
+                at = f" (row {bad[0]})" if many else ""
+                raise ModelError(f"{name}{at}: joint '{joint}' has a {what} of norm {norms[bad[0]]:.17g}, not 1 "
+                                 f"(within {UNIT_NORM_TOL:g}): normalise it (pinocchio.normalize(model, q)); "
+                                 "pinmech does not guess which rotation was meant", path=self.source)
+        return out
+
     def coordinate(self, q: np.ndarray, name: str) -> float:
         """A one-dof joint's coordinate (angle in (-pi, pi] for a continuous joint)."""
         if name in self.mimics:
@@ -411,6 +456,27 @@ class Mechanism:
         if j.kind == "continuous":
             return float(np.arctan2(q[j.idx_q + 1], q[j.idx_q]))
         return float(q[j.idx_q])
+
+
+def checked_numbers(x: Any, shape: tuple[int | None, ...], name: str, source: str) -> np.ndarray:
+    """x as a float array of `shape` (None: any length) of finite numbers, else a
+    ModelError naming the argument and what it got. The one check of a vector argument
+    (q, v, a) of the Python API."""
+    try:
+        out = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"{name} must be {_shape_words(shape)} numbers (SI), got {x!r:.80}", path=source) from None
+    right = out.ndim == len(shape) and all(n is None or n == k for n, k in zip(shape, out.shape))
+    if not right or not np.all(np.isfinite(out)):
+        raise ModelError(f"{name} must be {_shape_words(shape)} finite numbers (SI), got shape {out.shape}"
+                         + ("" if not right else " with a non-finite number"), path=source)
+    return out
+
+
+def _shape_words(shape: tuple[int | None, ...]) -> str:
+    if len(shape) == 1 and shape[0] is not None:
+        return str(shape[0])
+    return "an (" + ", ".join("N" if n is None else str(n) for n in shape) + ") array of"
 
 
 # -------------------------------------------------------------------- XML reading

@@ -19,7 +19,7 @@ import pinocchio as pin
 
 from pinmech.closures import _cross
 from pinmech.exceptions import FrameNotFound, ModelError
-from pinmech.mechanism import Mechanism
+from pinmech.mechanism import Mechanism, checked_numbers
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -124,8 +124,8 @@ def evaluate_motion(
     for name, names in (("points", points), ("links", links)):
         if isinstance(names, (str, bytes)):
             raise ModelError(f"{name} must be a list of names, got the string {names!r}", path=mechanism.source)
-    q, v, a = (_vector(x, n, name, mechanism) for x, n, name in ((q, model.nq, "q"), (v, model.nv, "v"),
-                                                                 (a, model.nv, "a")))
+    q = mechanism.checked_q(q)
+    v, a = (_vector(x, model.nv, name, mechanism) for x, name in ((v, "v"), (a, "a")))
     if not isinstance(data, pin.Data) or len(data.oMi) != model.njoints or len(data.oMf) != model.nframes:
         raise ModelError("data must be a pin.Data of the mechanism's model (mechanism.model.createData())",
                          path=mechanism.source)
@@ -152,14 +152,7 @@ def evaluate_motion(
 
 def _vector(x: Any, size: int, name: str, mechanism: Mechanism) -> np.ndarray:
     """x as `size` finite floats, else a ModelError naming the argument and what it got."""
-    try:
-        out = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise ModelError(f"{name} must be {size} numbers (SI), got {x!r:.80}", path=mechanism.source) from None
-    if out.shape != (size,) or not np.all(np.isfinite(out)):
-        raise ModelError(f"{name} must be {size} finite numbers (SI), got shape {out.shape}"
-                         + ("" if out.shape != (size,) else " with a non-finite number"), path=mechanism.source)
-    return out
+    return checked_numbers(x, (size,), name, mechanism.source)
 
 
 def _joint_motions(mechanism: Mechanism, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict[str, JointMotion]:

@@ -146,6 +146,9 @@ class RateSolution:
             (J a + Jdot v) [m/s^2 or rad/s^2].
         closure_velocity_residual, closure_acceleration_residual: largest |row| of the
             loop-closure equations at the solution (0 on an open chain).
+        closure_residual: the closure residual of the q solved at, dimensionless as
+            `Accuracy.residual` (0 on an open chain; a q open beyond the solver's tol is
+            refused, never solved).
     """
 
     v: np.ndarray
@@ -161,6 +164,7 @@ class RateSolution:
     closure_velocity_residual: float = 0.0
     closure_acceleration_residual: float = 0.0
     rank: int = -1
+    closure_residual: float = 0.0
 
     @property
     def velocity_error(self) -> float:

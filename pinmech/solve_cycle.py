@@ -514,7 +514,7 @@ class _Cycle:
         v, a = np.empty((n, solver.model.nv)), np.empty((n, solver.model.nv))
         numbers = {name: acc[name].copy() for name in _ACCURACY}
         for j in range(n):
-            v[j], a[j], rated = solver.rates(q[j], self.v_drv, self.a_drv)
+            v[j], a[j], rated = solver.rates(q[j], self.v_drv, self.a_drv, closed=not interpolated[j])
             for name in _ACCURACY[2:]:
                 numbers[name][j] = getattr(rated, name)
         solution = BatchSolution(q, v, a, *(numbers[name] for name in _ACCURACY), solver.drivers,

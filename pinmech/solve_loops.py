@@ -101,6 +101,38 @@ def describe_joint_values(mechanism: Mechanism, names: Sequence[str], values: Se
     return ", ".join(out)
 
 
+def is_closed(independent: float, full: float, tol: float) -> bool:
+    """Whether a pose's loops are closed: its independent closure rows within `tol`, and
+    every selected row (the ones reduced away as out of the plane too) within ten times
+    max(tol, 1e-12), as `LoopSolver.close` accepts them (all dimensionless: lengths in
+    loop sizes, angles in rad)."""
+    return independent <= tol and full <= max(tol, 1e-12) * 10
+
+
+def open_loops_error(mechanism: Mechanism, data: pin.Data, q: np.ndarray, residual: float, tol: float,
+                     where: str) -> LoopClosureError:
+    """The error for rates asked at a pose whose loops are open: each open loop's gap
+    between its cut frames [m] and the misalignment of its axes [deg], the residual
+    relative to the loop's size, and the tolerance. `data` holds q's joint placements."""
+    pin.updateFramePlacements(mechanism.model, data)
+    said = []
+    for c in mechanism.closures:
+        if is_closed(float(np.max(np.abs(c.residual(data)), initial=0.0)),
+                     float(np.max(np.abs(c.full_residual(data)), initial=0.0)), tol):
+            continue
+        r6, rows = c.residual6(data), c.selected
+        gap = float(np.linalg.norm(rows[:, :3] @ r6[:3]))  # the distance its rows constrain [m]
+        turn = float(np.linalg.norm(rows[:, 3:] @ r6[3:]))  # rad, or the sine of the axes' angle
+        angle = math.degrees(math.asin(min(turn, 1.0)) if c.cut_type == "revolute" else turn)
+        said.append(f"loop {c.name}'s cut frames are {gap:.3g} m apart ({gap / c.length_scale:.3g} of its size, "
+                    f"{c.length_scale:.3g} m)" + (f", axes {angle:.3g} deg apart" if rows[:, 3:].any() else ""))
+    return LoopClosureError(
+        f"{mechanism.source}: {where}: the loops are open: {'; '.join(said)} (largest closure row "
+        f"{residual:.3g}, tolerance {tol:g}, both of the loop's size); rates hold only where the loops "
+        "are closed: close them first (LoopSolver.solve or close) and pass that q",
+        residual=float(residual), iterations=0, partial=q)
+
+
 def _max_abs(x: np.ndarray) -> float:
     """Largest |x_i| (0 when empty); plain Python below 9 entries, where numpy's call costs more."""
     if x.size < 9:
@@ -366,7 +398,7 @@ class LoopSolver:
             q, r, norm, _ = self._newton_update(q, J_dep, r, norm)  # kept only if it helps
             iterations += 1
         full = self._full_residual()
-        if norm > self._tol or full > max(self._tol, 1e-12) * 10:
+        if not is_closed(norm, full, self._tol):
             self._raise_not_closed(q, max(norm, full), iterations, driver_q)
         return q, iterations, max(norm, full)
 
@@ -407,7 +439,7 @@ class LoopSolver:
             q, r, norm, _ = self._newton_update(q, J_dep, r, norm)
             self.iterations += 1
         full = self._full_residual()
-        if norm > self._tol or full > max(self._tol, 1e-12) * 10:
+        if not is_closed(norm, full, self._tol):
             return q, None
         return q, max(norm, full)
 
@@ -483,20 +515,33 @@ class LoopSolver:
 
     @serialized
     def rates(self, q: np.ndarray, driver_v: Sequence[float], driver_a: Sequence[float], *,
-              at_q: bool = False) -> tuple[np.ndarray, np.ndarray, Accuracy]:
-        """Velocities and accelerations at a closed configuration q.
+              at_q: bool = False, closed: bool = True) -> tuple[np.ndarray, np.ndarray, Accuracy]:
+        """Velocities and accelerations at a closed configuration q; the accuracy carries
+        q's closure residual (dimensionless, as `Accuracy.residual`).
 
         Args:
             at_q: the solver's data already holds q's placements and Jacobians (as `close`
                 leaves them), so they are not computed again.
+            closed: refuse a q whose loops are open beyond `tol` (False: an interpolated
+                pose, whose error the caller states; the residual is still measured).
 
         Raises:
+            LoopClosureError: q's loops are not closed (beyond `tol`, scaled as `close`
+                scales it), with how far apart each cut is [m, deg].
             SingularPoseError: the dependent-joint constraint Jacobian is singular.
         """
-        if not at_q:
-            self._residual(q)
+        if at_q:
+            for cut in self._cuts:
+                cut.place(self.data)
+            rows = np.concatenate([c.residual() for c in self._cuts]) if self._cuts else np.zeros(0)
+        else:
+            rows = self._residual(q)
+        independent, full = _max_abs(rows), self._full_residual()
+        if closed and not is_closed(independent, full, self._tol):
+            raise open_loops_error(self.mechanism, self.data, q, max(independent, full), self._tol,
+                                   f"rates at {self.describe_drivers(self._driver_values(q))}")
         v, a, *numbers, _ = self._rates(q, driver_v, driver_a)
-        return v, a, Accuracy(0.0, 0, *numbers)
+        return v, a, Accuracy(max(independent, full), 0, *numbers)
 
     def _rates(self, q: np.ndarray, driver_v, driver_a, limit: float | None = None) -> tuple:
         """v, a, condition, sigma_min, velocity and acceleration residuals, and the assembly

@@ -25,6 +25,7 @@ rows cannot all hold is a TaskError and a singular pose a SingularPoseError.
 
 from __future__ import annotations
 
+import math
 import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -35,10 +36,24 @@ import pinocchio as pin
 from pinmech.exceptions import SingularPoseError, TaskError
 from pinmech.mechanism import Mechanism
 from pinmech.results import RateSolution
-from pinmech.solve_loops import DEFAULT_MAX_CONDITION, checked_option, describe_joint_values, serialized
+from pinmech.solve_loops import (
+    DEFAULT_MAX_CONDITION,
+    DEFAULT_TOL,
+    checked_option,
+    describe_joint_values,
+    is_closed,
+    open_loops_error,
+    serialized,
+)
 
 COMPONENTS = ("x", "y", "z", "wx", "wy", "wz")
 METHODS = ("exact", "least_squares", "damped")
+#: Accepted damping lambda (dimensionless). Below 1e-5, lambda^2 drowns in the rounding of
+#: J J^T (the damped answer is off by about eps / lambda^2: 4e-7 at 1e-5, 8e-5 at 1e-6, and
+#: at 1e-9 the damped matrix is singular in float64); above 1e50, the bound on every
+#: quantity pinmech takes (README "Scale and speed"), lambda^2 overflows by 1e155 and the
+#: rates underflow to denormals before that.
+DAMPING_RANGE = (1e-5, 1e50)
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
@@ -87,7 +102,8 @@ _SAMPLES = 3
 @dataclass(frozen=True)
 class RateBatch:
     """`RateSolution`s of N poses as arrays: v, a (N, nv); method (N,) as `RateSolution`;
-    condition, sigma_min, closure residuals (N,); achieved task rows (N, rows)."""
+    condition, sigma_min, closure residuals (velocity, acceleration, position) (N,);
+    achieved task rows (N, rows)."""
 
     v: np.ndarray
     a: np.ndarray
@@ -98,6 +114,7 @@ class RateBatch:
     achieved_acceleration: np.ndarray
     closure_velocity_residual: np.ndarray
     closure_acceleration_residual: np.ndarray
+    closure_residual: np.ndarray
 
 
 class RateSolver:
@@ -111,23 +128,31 @@ class RateSolver:
             inconsistent tasks: the least-squares motion, asked vs achieved reported),
             or "damped" (damped least squares with `damping`, also at singular poses).
         damping: lambda of the damped least squares, dimensionless: rows and columns are
-            scaled as for the condition number (lengths in mechanism sizes).
+            scaled as for the condition number (lengths in mechanism sizes); in
+            DAMPING_RANGE (1e-5 to 1e50).
         max_condition: above this condition number (dimensionless) the pose is singular
             (SingularPoseError) unless the method is "damped".
+        tol: how closed the loops of a q must be (dimensionless, as `LoopSolver`'s tol,
+            which closed it): a q whose loops are open beyond it is a LoopClosureError.
 
     Raises:
-        TaskError: unknown method, or no task.
+        TaskError: unknown method, no task, or a damping out of DAMPING_RANGE.
+        OptionError: max_condition or tol out of SOLVER_RANGES.
         FrameNotFound: a task names a frame the model lacks.
     """
 
     def __init__(self, mechanism: Mechanism, tasks: Sequence[Task], *, method: str = "exact",
-                 damping: float = 1e-3, max_condition: float = DEFAULT_MAX_CONDITION) -> None:
+                 damping: float = 1e-3, max_condition: float = DEFAULT_MAX_CONDITION,
+                 tol: float = DEFAULT_TOL) -> None:
         if method not in METHODS:
             raise TaskError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
         if not tasks:
             raise TaskError("no task given: add a [[task]] with frame, components, velocity, acceleration")
-        if not (np.isfinite(damping) and damping > 0):
-            raise TaskError(f"damping must be a positive number, got {damping!r}")
+        low, high = DAMPING_RANGE
+        number = damping if isinstance(damping, (int, float, np.number)) and not isinstance(damping, bool) else None
+        if number is None or not low <= number <= high:  # NaN is in no range
+            raise TaskError(f"damping must be a positive number in [{low:g}, {high:g}] (dimensionless: below, "
+                            f"its square drowns in rounding; above, it overflows), got {damping!r}")
         self.mechanism = mechanism
         self.model = mechanism.model
         self.lock = threading.RLock()  # one Data: threads sharing the solver take turns
@@ -137,6 +162,7 @@ class RateSolver:
         self.method = method
         self.damping = float(damping)
         self.max_condition = checked_option("max_condition", max_condition)  # NaN would turn the check off
+        self.tol = checked_option("tol", tol)
         self.x_dot = np.concatenate([t.velocity for t in self.tasks])
         self.x_ddot = np.concatenate([t.acceleration for t in self.tasks])
         self.row_names = [f"{t.frame}.{c}" for t in self.tasks for c in t.components]
@@ -151,18 +177,24 @@ class RateSolver:
         """Joint rates and accelerations at configuration q (loops already closed).
 
         Args:
-            q: configuration of the model.
+            q: configuration of the model (nq finite numbers; quaternions and (cos, sin)
+                pairs of unit norm).
             velocity, acceleration: the task rows' values for this call, in task order
                 (default: the tasks' own) [m/s, rad/s; m/s^2, rad/s^2].
 
         Raises:
+            ModelError: q is not a configuration of the model (shape, NaN, a quaternion
+                whose norm is not 1).
+            LoopClosureError: q's loops are open beyond `tol` (how far, in m and deg).
             TaskError: an over-determined task, or rows that cannot hold together at any
                 pose (a zero row, a row repeated), unless method is "least_squares".
             SingularPoseError: the stacked Jacobian is singular at q, unless "damped".
         """
+        q = self.mechanism.checked_q(q)
         x_dot = self._values(velocity, self.x_dot, "velocity")
         x_ddot = self._values(acceleration, self.x_ddot, "acceleration")
         J, n_c = self._jacobian(self.data, q)
+        closure = self._closure_residual(q)
         m, n = J.shape
         rows, columns = self._scales(n_c)
         Jd = rows[:, None] * J * columns
@@ -184,6 +216,7 @@ class RateSolver:
             requested_acceleration=x_ddot.copy(), achieved_acceleration=achieved_a[n_c:],
             closure_velocity_residual=float(np.max(np.abs(achieved_v[:n_c]), initial=0.0)),
             closure_acceleration_residual=float(np.max(np.abs(achieved_a[:n_c]), initial=0.0)),
+            closure_residual=closure,
         )
 
     @serialized
@@ -194,29 +227,77 @@ class RateSolver:
         raises as it does.
 
         Raises:
-            TaskError, SingularPoseError: as `solve`, at the first pose that has them.
+            ModelError: q is not an (N, nq) array of configurations (as `solve`).
+            LoopClosureError, TaskError, SingularPoseError: as `solve`, at the first pose
+                that has them.
         """
-        q = np.ascontiguousarray(q, dtype=float)
-        if q.ndim != 2 or q.shape[1] != self.model.nq or not np.all(np.isfinite(q)):
-            raise TaskError(f"q must be an (N, {self.model.nq}) array of finite numbers, got shape {q.shape}")
+        q = np.ascontiguousarray(self.mechanism.checked_q(q, many=True))
         n, m = len(q), self.x_dot.size
         compiled = self._compiled() if self.method == "exact" else None
         if compiled is not None:
-            core, frames, rows, local, row_scale = compiled
+            core, frames, rows, local, row_scale, cut_frames = compiled
             v, a, numbers, achieved_v, achieved_a = core.rates(q, frames, rows, local, self.x_dot, self.x_ddot,
                                                              row_scale, self.max_condition)
             condition, sigma_min, closure_v, closure_a, status = numbers.T
+            closure = np.zeros(n)
+            if cut_frames:  # the core measures no position residual: open poses go to `solve`, named there
+                independent, full = self._closure_residuals(core, cut_frames, q)
+                closure = np.maximum(independent, full)
+                closed = (independent <= self.tol) & (full <= max(self.tol, 1e-12) * 10)  # is_closed, per pose
+                status[~closed] = 1
         else:
             v, a = np.full((n, self.model.nv), np.nan), np.full((n, self.model.nv), np.nan)
-            condition, sigma_min, closure_v, closure_a = (np.full(n, np.nan) for _ in range(4))
+            condition, sigma_min, closure_v, closure_a, closure = (np.full(n, np.nan) for _ in range(5))
             achieved_v, achieved_a, status = np.full((n, m), np.nan), np.full((n, m), np.nan), np.ones(n)
         methods = np.full(n, "exact", dtype=object)
-        for i in np.flatnonzero(status != 0):  # the Python path: other methods, singular poses named
+        for i in np.flatnonzero(status != 0):  # the Python path: other methods, singular and open poses named
             r = self.solve(q[i])
             v[i], a[i], condition[i], sigma_min[i] = r.v, r.a, r.condition, r.sigma_min
             closure_v[i], closure_a[i] = r.closure_velocity_residual, r.closure_acceleration_residual
             achieved_v[i], achieved_a[i], methods[i] = r.achieved_velocity, r.achieved_acceleration, r.method
-        return RateBatch(v, a, methods, condition, sigma_min, achieved_v, achieved_a, closure_v, closure_a)
+            closure[i] = r.closure_residual
+        return RateBatch(v, a, methods, condition, sigma_min, achieved_v, achieved_a, closure_v, closure_a, closure)
+
+    def _closure_residual(self, q: np.ndarray) -> float:
+        """q's closure residual (dimensionless, as `LoopSolver`'s; data at q, frames placed).
+
+        Raises:
+            LoopClosureError: the loops are open beyond `tol` (`is_closed`)."""
+        closures = self.mechanism.closures
+        if not closures:
+            return 0.0
+        independent = max(float(np.max(np.abs(c.residual(self.data)), initial=0.0)) for c in closures)
+        full = max(float(np.max(np.abs(c.full_residual(self.data)), initial=0.0)) for c in closures)
+        if not is_closed(independent, full, self.tol):
+            raise open_loops_error(self.mechanism, self.data, q, max(independent, full), self.tol,
+                                   f"the task's rates at {self._pose(q)}")
+        return max(independent, full)
+
+    def _closure_residuals(self, core, cut_frames: list[int], q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """`Closure.residual` and `full_residual`'s largest |row| at every pose (N,), from
+        the cut frames' placements the core computes for all poses in one call."""
+        n = len(q)
+        zeros = np.zeros((n, self.model.nv))
+        P, R = core.frame_motion(q, zeros, zeros, cut_frames)[:2]
+        P, R = P.reshape(n, -1, 3), R.reshape(n, -1, 3, 3)
+        independent, full = np.zeros(n), np.zeros(n)
+        for k, c in enumerate(self.mechanism.closures):
+            R_P, R_C = R[:, 2 * k], R[:, 2 * k + 1]
+            r6 = np.empty((n, 6))
+            r6[:, :3] = _in_parent(R_P, P[:, 2 * k + 1] - P[:, 2 * k])
+            if c.cut_type == "revolute":  # axis x (R_P^T R_C child_axis)
+                u = _in_parent(R_P, R_C @ c.child_axis)
+                a = c.axis
+                r6[:, 3] = a[1] * u[:, 2] - a[2] * u[:, 1]
+                r6[:, 4] = a[2] * u[:, 0] - a[0] * u[:, 2]
+                r6[:, 5] = a[0] * u[:, 1] - a[1] * u[:, 0]
+            elif c.cut_type == "spherical":
+                r6[:, 3:] = 0.0
+            else:
+                r6[:, 3:] = _log3(np.matmul(R_P.transpose(0, 2, 1), R_C))
+            independent = np.maximum(independent, np.max(np.abs(r6 @ c._rows6.T), axis=1, initial=0.0))
+            full = np.maximum(full, np.max(np.abs((r6 * c._scale()) @ c.selected.T), axis=1, initial=0.0))
+        return independent, full
 
     def _compiled(self):
         """The core with this solver's loops and task frames, and the task rows as it takes
@@ -237,7 +318,8 @@ class RateSolver:
                 value = (compiled, [rebuilt.frames[f] for f in self.frames],
                          [[int(k) for k in t.rows] for t in self.tasks],
                          [int(t.reference == "local") for t in self.tasks],
-                         self._scales(n_c)[0])
+                         self._scales(n_c)[0],
+                         [rebuilt.frames[f] for f in frames[: 2 * len(self.mechanism.closures)]])
             cached = (core.ModelCopy(self.model, frames), value)
             self.__dict__["_core"] = cached
         return cached[1]
@@ -372,6 +454,23 @@ class RateSolver:
             return np.linalg.lstsq(J, rhs, rcond=None)[0]  # minimum-norm or least-squares
         U, s, Vt = np.linalg.svd(J, full_matrices=False)  # rank-deficient: truncated pseudo-inverse
         return Vt[:rank].T @ ((U[:, :rank].T @ rhs) / s[:rank])
+
+
+def _in_parent(R: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """R_i^T x_i for (N, 3, 3) rotations and (N, 3) vectors."""
+    return np.einsum("nji,nj->ni", R, x)
+
+
+def _log3(R: np.ndarray) -> np.ndarray:
+    """`pin.log3` of every rotation of an (N, 3, 3) array (N, 3): the angle from atan2 of
+    the skew part's norm and the trace, so it holds from 0 to a half turn."""
+    cos = np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    vee = 0.5 * np.stack((R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]), axis=1)
+    sin = np.linalg.norm(vee, axis=1)
+    theta = np.arctan2(sin, cos)
+    out = vee * (theta / np.where(sin > 0, sin, 1.0))[:, None]
+    out[(sin == 0) & (cos < 0)] = math.pi  # exactly a half turn: no axis from the skew part, open by pi
+    return out
 
 
 def _rank(J: np.ndarray) -> int:

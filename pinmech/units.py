@@ -168,7 +168,7 @@ def _split(text: str, kind: str, where: str) -> tuple[float, str]:
                         f"'1.5 {_example(kind)}'", key=where)
     unit = match.group(2).strip().translate(_TYPOGRAPHY)
     unit = re.sub(r"\s*(\*\*|[/*^])\s*", r"\1", unit)
-    if re.search(r"\d", _EXPONENT.sub("", unit)):
+    if re.search(r"\b\d", _EXPONENT.sub("", unit)):  # a digit that starts a word; "g0" is a unit's name
         angles = " (an angle may be written 30° 20' 15\")" if kind.startswith(("angle", "angular")) else ""
         raise UnitError(f"{text!r} holds more than one number: write one number and one unit, e.g. "
                         f"'1.5 {_example(kind)}'{angles}", key=where)

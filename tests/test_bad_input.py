@@ -262,6 +262,12 @@ def test_a_tolerance_tighter_than_rounding_says_so(scenes_dir, capsys):
         ('rates.damping=[]', "rates.damping: must be a positive number"),
         ('rates.damping="-0"', "rates.damping: must be a positive number"),
         ('rates.max_condition={}', "rates.max_condition: must be a positive number"),
+        # out of range: named by file and key like NaN is (before: the API's words, no file, no key;
+        # 1e155 an OverflowError traceback, 1e154 denormal rates)
+        ('rates.max_condition=0.5', "rates.max_condition: rates.max_condition = 0.5 is outside [1, inf]"),
+        ('rates.damping=inf', "rates.damping: rates.damping = inf is outside [1e-05, 1e+50]"),
+        ('rates.damping=1e155', "rates.damping: rates.damping = 1e+155 is outside [1e-05, 1e+50]"),
+        ('rates.damping=1e-9', "rates.damping: rates.damping = 1e-09 is outside [1e-05, 1e+50]"),
         ('rates.method=1', "rates.method: must be a string"),
         ('move=[]', "move = [] leaves no joint to move"),
         ('task=[]', "task must be an array of tables"),

@@ -19,7 +19,7 @@ import pytest
 
 import pinmech
 import pinmech.core as core
-from pinmech.exceptions import SingularPoseError, TaskError
+from pinmech.exceptions import ModelError, SingularPoseError
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
 import closed_form  # noqa: E402
@@ -104,9 +104,13 @@ def test_a_singular_pose_is_named_as_by_solve(models_dir):
 
 
 def test_bad_shapes_are_named(models_dir):
+    """A q that is no (N, nq) array of configurations is a ModelError naming q, as for
+    `solve` and `evaluate_motion` (README, "Python API")."""
     mechanism, solver = _arm(models_dir)
-    with pytest.raises(TaskError, match="array"):
+    with pytest.raises(ModelError, match=r"q must be an \(N, 3\) array of finite numbers \(SI\), got shape \(3, 4\)"):
         solver.solve_many(np.zeros((3, mechanism.model.nq + 1)))
+    with pytest.raises(ModelError, match=r"got shape \(3,\)"):
+        solver.solve_many(np.zeros(3))
 
 
 def test_local_axes_and_a_six_dof_arm_equal_solve(scenes_dir):

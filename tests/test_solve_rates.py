@@ -14,13 +14,18 @@ import pytest
 
 from pinmech import (
     FrameNotFound,
+    LoopClosureError,
     LoopSolver,
     Mechanism,
+    ModelError,
+    OptionError,
     RateSolver,
     SingularPoseError,
     Task,
     TaskError,
+    core,
 )
+from pinmech.solve_rates import DAMPING_RANGE
 from tests.conftest import MODELS
 
 DEG = np.pi / 180
@@ -210,6 +215,116 @@ def test_task_on_the_r_rtr_loop_against_its_closed_form(models_dir):
     assert sol.closure_velocity_residual < 1e-13 and sol.closure_acceleration_residual < 1e-12
 
 
+# --------------------------------------------------------------------- open loops
+def four_bar_open() -> tuple[Mechanism, np.ndarray, np.ndarray]:
+    """The four-bar, its loop closed at O2 = 0.7 rad, and a q with the same joint angles as
+    the probe's (O2 0.7, A 0.4, O4 1.9 rad) whose cut is 58.0 mm apart: 0.32 of the loop's
+    0.18 m (the distance checked against Pinocchio's placements of the two cut frames)."""
+    mech = Mechanism.from_urdf(MODELS / "four_bar.urdf")
+    open_q = mech.neutral()
+    for name, x in (("O2", 0.7), ("A", 0.4), ("O4", 1.9)):
+        mech.set_coordinate(open_q, name, x)
+    closed_q, _, _ = LoopSolver(mech, ["O2"]).close(mech.neutral(), [0.7])
+    return mech, closed_q, open_q
+
+
+def cut_gap(mech, q) -> float:
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, q)
+    c = mech.closures[0]
+    return float(np.linalg.norm(data.oMf[c.child_frame].translation - data.oMf[c.parent_frame].translation))
+
+
+def test_rates_at_an_open_loop_are_a_named_error_saying_how_far_open():
+    """Before: method 'exact' and rates of another mechanism, with no residual stated."""
+    mech, _, open_q = four_bar_open()
+    assert cut_gap(mech, open_q) == pytest.approx(0.0580, abs=5e-5)
+    with pytest.raises(LoopClosureError, match=r"O2 = 40.1\d* deg.*loop B's cut frames are 0.058 m apart "
+                                               r"\(0.322 of its size, 0.18 m\).*tolerance 1e-13") as info:
+        RateSolver(mech, [Task("P", ("x",), np.array([0.1]), np.zeros(1))]).solve(open_q)
+    assert info.value.residual == pytest.approx(0.31, abs=5e-3) and "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("enabled", [True, False], ids=["core", "python"])
+def test_solve_many_refuses_an_open_pose_among_closed_ones(enabled, monkeypatch):
+    """The compiled core measures no position residual: the poses it solved are checked in
+    numpy, and an open one is named by `solve`, as one by one."""
+    monkeypatch.setattr(core, "ENABLED", enabled)
+    mech, closed_q, open_q = four_bar_open()
+    solver = RateSolver(mech, [Task("P", ("x",), np.array([0.1]), np.zeros(1))])
+    batch = solver.solve_many(np.array([closed_q, closed_q]))
+    np.testing.assert_array_equal(batch.closure_residual, [solver.solve(closed_q).closure_residual] * 2)
+    assert np.all(batch.closure_residual <= 1e-13)
+    with pytest.raises(LoopClosureError, match="0.058 m apart"):
+        solver.solve_many(np.array([closed_q, open_q, closed_q]))
+
+
+def test_a_loop_closed_within_a_looser_tol_states_its_residual():
+    """A q closed to 1e-9 of the loop's size: refused at the default tol (1e-13), solved
+    with tol = 1e-6, and the residual carried is the one Pinocchio's placements give (not
+    0, as LoopSolver.rates wrote before)."""
+    mech, closed_q, _ = four_bar_open()
+    q = closed_q.copy()
+    mech.set_coordinate(q, "O4", mech.coordinate(q, "O4") + 1e-9)
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, q)
+    expected = max(np.abs(c.full_residual(data)).max() for c in mech.closures)
+    assert 1e-11 < expected < 1e-8
+    task = [Task("P", ("x",), np.array([0.1]), np.zeros(1))]
+    with pytest.raises(LoopClosureError, match="tolerance 1e-13"):
+        RateSolver(mech, task).solve(q)
+    with pytest.raises(OptionError, match=r"tol = nan must be a number in \[1e-16, 0.001\]"):
+        RateSolver(mech, task, tol=float("nan"))  # as LoopSolver's: NaN would close every loop
+    sol = RateSolver(mech, task, tol=1e-6).solve(q)
+    assert sol.closure_residual == pytest.approx(expected, rel=1e-6)  # the same rows, to rounding of 1e-15
+    assert RateSolver(mech, task, tol=1e-6).solve_many(q[None]).closure_residual[0] == pytest.approx(expected,
+                                                                                                     rel=1e-6)
+    loop = LoopSolver(mech, ["O2"])
+    with pytest.raises(LoopClosureError, match="rates at O2 = 40.1"):
+        loop.rates(q, [1.0], [0.0])
+    loop.tol = 1e-6
+    assert loop.rates(q, [1.0], [0.0])[2].residual == pytest.approx(expected, rel=1e-6)
+    assert loop.rates(closed_q, [1.0], [0.0])[2].residual <= 1e-13
+
+
+@pytest.mark.parametrize("build", ["prismatic", "spherical", "fixed", "revolute"])
+def test_solve_many_measures_each_cut_type_as_the_closures_do(build, tmp_path):
+    """solve_many's residuals (numpy, from the core's frame placements, its own log3) equal
+    Closure.residual and full_residual at 20 random poses, all open, of a prismatic cut, a
+    spherical one (the RSUR), a weld (MJCF ball_loop, its ball's quaternion in q) and the
+    four-bar's revolute cut: to 1e-10 of 1 + the residual. The same formulas in another
+    order agree to 1e-15, except the weld's rotation near a half turn, where log3 from the
+    skew part loses digits like 1 / sin(angle) (8e-12 at 2.95 rad); the decision open or
+    closed is taken at residuals near 1e-13, where the angle is tiny."""
+    from pinmech.mjcf import load_mjcf
+    from tests import _mechanisms
+
+    if build == "fixed":
+        mech = load_mjcf(MODELS / "mjcf" / "ball_loop.xml")
+    elif build == "revolute":
+        mech = Mechanism.from_urdf(MODELS / "four_bar.urdf")
+    else:
+        text = (_mechanisms.slider_crank_prismatic_cut_urdf() if build == "prismatic"
+                else _mechanisms.spatial_rsur_urdf())
+        mech = Mechanism.from_urdf(_mechanisms.write(tmp_path, f"{build}.urdf", text))
+    assert {c.cut_type for c in mech.closures} == {build}
+    solver = RateSolver(mech, [Task(next(iter(mech.links)), ("x",), np.array([0.1]), np.zeros(1))])
+    compiled = solver._compiled()
+    if compiled is None:
+        pytest.skip("the compiled core is not built here")
+    rng = np.random.default_rng(7)
+    Q = np.array([pin.integrate(mech.model, mech.neutral(), rng.normal(size=mech.model.nv)) for _ in range(20)])
+    independent, full = solver._closure_residuals(compiled[0], compiled[5], Q)
+    data = mech.model.createData()
+    for i, q in enumerate(Q):
+        pin.framesForwardKinematics(mech.model, data, q)
+        want_i = max(np.abs(c.residual(data)).max() for c in mech.closures)
+        want_f = max(np.abs(c.full_residual(data)).max() for c in mech.closures)
+        assert want_f > 1e-3  # open: a random pose
+        assert independent[i] == pytest.approx(want_i, abs=1e-10 * (1 + want_i))
+        assert full[i] == pytest.approx(want_f, abs=1e-10 * (1 + want_f))
+
+
 # --------------------------------------------------------------------- malformed input
 @pytest.mark.parametrize(
     "kwargs, message",
@@ -231,11 +346,66 @@ def test_malformed_tasks(kwargs, message):
 
 
 @pytest.mark.parametrize(
+    "bad, message",
+    [
+        (lambda q: q[:2], r"q must be 3 finite numbers \(SI\), got shape \(2,\)"),
+        (lambda q: np.r_[q[:2], np.nan], r"q must be 3 finite numbers \(SI\), got shape \(3,\) with a non-finite"),
+        (lambda q: q[None], r"q must be 3 finite numbers \(SI\), got shape \(1, 3\)"),
+        (lambda q: ["a", "b", "c"], "q must be 3 numbers"),
+    ],
+)
+def test_a_q_that_is_no_configuration_is_a_model_error_naming_q(arm, bad, message):
+    """Before: raw Pinocchio or numpy errors (README: a ModelError naming the argument)."""
+    with pytest.raises(ModelError, match=message):
+        RateSolver(arm, arm_tasks()).solve(bad(arm_q(arm, (50, -65, -75))))
+
+
+def test_a_q_given_as_a_list_is_the_array():
+    q = arm_q(Mechanism.from_urdf(MODELS / "planar_arm.urdf"), (50, -65, -75))
+    solver = RateSolver(Mechanism.from_urdf(MODELS / "planar_arm.urdf"), arm_tasks())
+    np.testing.assert_array_equal(solver.solve(list(q)).v, solver.solve(q).v)
+
+
+def test_a_quaternion_or_cos_sin_pair_whose_norm_is_not_one_is_refused_with_its_norm():
+    """Pinocchio reads a quaternion of norm n as a rotation scaled by n^2: before, a floating
+    base's (or a ball joint's) rates came out different, silently. A norm within 1e-12 of 1
+    (Pinocchio's isNormalized) is taken as it is."""
+    floating = Mechanism.from_urdf(MODELS / "planar_arm.urdf", root_joint="free_flyer")
+    solver = RateSolver(floating, arm_tasks())
+    q = floating.neutral()
+    q[3:7] = [0.2, 0.1, 0.0, 2.0]  # norm 2.0125
+    with pytest.raises(ModelError, match=r"joint 'root_joint' has a quaternion of norm 2.01246117974981\d*, not 1"):
+        solver.solve(q)
+    with pytest.raises(ModelError, match=r"q \(row 1\): joint 'root_joint' has a quaternion of norm 2.0124"):
+        solver.solve_many(np.array([floating.neutral(), q]))
+    q[3:7] /= np.linalg.norm(q[3:7])
+    solver.solve(q)
+    mech = Mechanism.from_urdf(MODELS / "four_bar.urdf")
+    q = mech.neutral()
+    j = mech.joint("O2").idx_q  # a continuous joint: (cos, sin)
+    q[j : j + 2] *= 1.5
+    with pytest.raises(ModelError, match=r"joint 'O2' has a \(cos, sin\) pair of norm 1.5, not 1"):
+        RateSolver(mech, [Task("P", ("x",), np.array([0.1]), np.zeros(1))]).solve(q)
+
+
+@pytest.mark.parametrize("damping", [DAMPING_RANGE[0], 1.0, DAMPING_RANGE[1]])
+def test_damping_at_its_bounds_gives_normal_numbers(arm, damping):
+    """At 1e50 the rates are about 1e-100 of the motion asked: small, not denormal (before,
+    1e154 gave 1e-309 and 1e155 an OverflowError)."""
+    sol = RateSolver(arm, arm_tasks(), method="damped", damping=damping).solve(arm_q(arm, (0, 0, -90)))
+    assert np.all(np.isfinite(sol.v)) and np.abs(sol.v).max() > 1e-120
+
+
+@pytest.mark.parametrize(
     "options, message",
     [
         ({"method": "pinv"}, "method must be one of exact, least_squares, damped"),
         ({"method": "damped", "damping": -1.0}, "damping must be a positive number"),
         ({"method": "damped", "damping": float("nan")}, "damping must be a positive number"),
+        ({"method": "damped", "damping": 1e155}, r"damping must be a positive number in \[1e-05, 1e\+50\].*got 1e\+155"),
+        ({"method": "damped", "damping": float("inf")}, r"in \[1e-05, 1e\+50\].*got inf"),
+        ({"method": "damped", "damping": 1e-9}, r"in \[1e-05, 1e\+50\].*drowns in rounding.*got 1e-09"),
+        ({"method": "damped", "damping": "0.1"}, r"got '0.1'"),
     ],
 )
 def test_bad_solver_options(arm, options, message):

@@ -91,6 +91,7 @@ def test_an_angle_in_degrees_minutes_and_seconds_is_their_sum(text, degrees):
         ("30 deg 20 arcmin", "angular_velocity", "more than one number"),
         ("1/2 deg", "angle", "more than one number"),
         ("2 3 mm", "length", "more than one number"),
+        ("1 mm2", "length", "cannot read quantity '1 mm2': UndefinedUnitError"),  # a name, not two numbers
         ("10 deg deg", "angle", r"not an angle \(its unit is radian\^2\)"),
         ("1 deg**2", "angle", "not an angle"),
         ("1 sr", "angle", "not an angle"),  # a solid angle is rad^2
@@ -120,6 +121,9 @@ def test_quantities_of_the_wrong_exact_dimension_or_shape_are_refused(text, kind
         ("36 km/h", "velocity", 10.0),  # not in the common table: pint reads it
         ("1 arcmin", "angle", math.radians(1 / 60)),
         ("1 deg*percent", "angle", math.radians(0.01)),
+        # a digit inside a unit's name is no second number (before: "holds more than one number")
+        ("1 g0", "acceleration", 9.80665),  # pint's standard gravity, as "1 g_n"
+        ("2 g0", "acceleration", 2 * 9.80665),
     ],
 )
 def test_other_spellings_of_one_number_and_one_unit(text, kind, si):
