@@ -89,6 +89,10 @@ _COMMON_UNITS: dict[str, tuple[float, str]] = {
 #: Largest magnitude of a quantity in SI units. Kinematics multiplies speeds and lengths
 #: (a = omega^2 r) and squares the results (norms), which must stay below 1.8e308.
 MAX_MAGNITUDE = 1e50
+#: Angles written in another unit than the radian (degrees, turns) convert exactly up to
+#: this [rad]: the product's rounding (2.3e-16 of it) stays below 1e-9 rad. Beyond, the
+#: pose of "1e15 deg" would be -80.05 deg, not -80: refused, naming the same pose.
+MAX_CONVERTED_ANGLE = 4e6
 
 _NUMBER = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?(?:infinity|inf|nan)\b)\s*(.*)",
                      re.IGNORECASE | re.DOTALL)
@@ -149,6 +153,15 @@ def to_si(value: Any, kind: str, *, where: str = "") -> float:
     if abs(result) > MAX_MAGNITUDE:
         raise UnitError(f"{value!r} is {result:.3g} {format_si(result, kind)}, beyond the {MAX_MAGNITUDE:g} (SI) "
                         "pinmech computes with: its squares would overflow", key=where)
+    factor = result / number if number else 1.0
+    if kind == "angle" and factor != 1.0 and abs(result) > MAX_CONVERTED_ANGLE:
+        turn = 2 * math.pi / factor  # one turn in the unit written (360 for degrees, 1 for turns)
+        off = abs(result) * 2.3e-16
+        lost = f"is off by up to {off:.1g} rad" if off < 1 else "is lost"
+        raise UnitError(f"{value!r} is {result:.4g} rad: converted to radians in float64 its pose {lost}; write "
+                        f"the angle within {MAX_CONVERTED_ANGLE / (2 * math.pi):.0f}"
+                        f" turns (the same pose: '{math.remainder(number, turn):.17g} {unit}'), or in radians",
+                        key=where)
     return result
 
 
@@ -172,7 +185,11 @@ def _split(text: str, kind: str, where: str) -> tuple[float, str]:
         angles = " (an angle may be written 30° 20' 15\")" if kind.startswith(("angle", "angular")) else ""
         raise UnitError(f"{text!r} holds more than one number: write one number and one unit, e.g. "
                         f"'1.5 {_example(kind)}'{angles}", key=where)
-    return float(match.group(1)), unit
+    return float(match.group(1)), _ARC_MARKS.get(unit, unit)
+
+
+#: minutes and seconds of arc written with their marks alone ("1.5 '"): pint knows no mark
+_ARC_MARKS = {"'": "arcmin", "\u2032": "arcmin", '"': "arcsec", "''": "arcsec", "\u2033": "arcsec"}
 
 
 def _degrees(text: str, dms: re.Match, where: str) -> float:

@@ -172,3 +172,23 @@ def test_forces_torques_and_inertias_in_si_with_kilograms(text, kind, si):
 def test_forces_torques_and_inertias_of_the_wrong_dimension_are_refused(text, kind):
     with pytest.raises(UnitError, match="is not a"):
         to_si(text, kind)
+
+
+@pytest.mark.parametrize("text, same", [("1e15 deg", "-80 deg"), ("1e9 turn", "0 turn"), ("-5e8 deg", "40 deg"),
+                                        ("-1e40 deg", "-112 deg")])
+def test_angles_in_degrees_or_turns_beyond_float64s_pose_are_refused_naming_the_same_pose(text, same):
+    """1e15 deg times pi/180 in float64 is -80.05 deg modulo a turn, not -80: beyond 4e6 rad
+    (the product's rounding above 1e-9 rad) such an angle is refused, and the message names
+    the same pose, reduced exactly in the unit written; radians are the number itself."""
+    with pytest.raises(UnitError, match=f"the same pose: '{same}'"):
+        to_si(text, "angle")
+    assert to_si("1e6 deg", "angle") == pytest.approx(1e6 * math.pi / 180, rel=1e-15)
+    assert to_si("1e15 rad", "angle") == 1e15
+
+
+@pytest.mark.parametrize("text, arcmin", [("1.5 '", 1.5), ("2 \u2032", 2.0), ('30 "', 0.5), ("30 ''", 0.5),
+                                          ("45 \u2033", 0.75)])
+def test_minutes_and_seconds_of_arc_by_their_marks_alone(text, arcmin):
+    """The marks ' and " (and the primes) with no degrees before them: an internal pint
+    AssertionError before; now the arc minute (pi/10800 rad) and second (1/60 of it)."""
+    assert to_si(text, "angle") == pytest.approx(arcmin * math.pi / 10800, rel=1e-15)
