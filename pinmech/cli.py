@@ -249,11 +249,23 @@ _SUBCOMMANDS = {
 }
 
 
+def _given(value: str | None, option: str) -> str | None:
+    """An option's text, None where it was not given; an empty one (an unset shell
+    variable) is an error, never the scene's own value in silence."""
+    if value is not None and not value.strip():
+        from pinmech.exceptions import UnitError
+
+        raise UnitError(f"{option} is empty: give a quantity such as '30 deg' (or leave the option out)")
+    return value
+
+
 def _scene(args: argparse.Namespace):
     from pinmech.scene import Scene
 
     overrides = list(args.overrides)
     shortcuts = {"angle": args.angle, "speed": args.speed, "acceleration": args.acceleration}
+    for key, value in shortcuts.items():
+        _given(value, f"--{key}")
     if any(shortcuts.values()):
         scene = Scene.load(args.scene)
         drivers = list(scene.section("drivers"))
@@ -328,8 +340,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         raise PinmechError(f"--steps must be at least 2, got {steps}")
     sweep = Sweep.from_scene(scene, args.driver)
     kind = "angle" if sweep.is_angular else "length"
-    first = args.first or options.get("from")
-    last = args.last or options.get("to")
+    first = _given(args.first, "--from") or options.get("from")
+    last = _given(args.last, "--to") or options.get("to")
     start = scene.quantity(first, kind, "--from") if first else sweep.start
     stop = scene.quantity(last, kind, "--to") if last else start + (sweep.default_values(2)[1] - sweep.start)
     if args.tol is not None:
@@ -619,8 +631,9 @@ def cmd_animate(args: argparse.Namespace) -> int:
     _check_page(args, scene)
     sweep = Sweep.from_scene(scene)
     kind = "angle" if sweep.is_angular else "length"
-    start = scene.quantity(args.start, kind, "--from") if args.start else sweep.start
-    stop = scene.quantity(args.stop, kind, "--to") if args.stop else start + (sweep.default_values(2)[1] - sweep.start)
+    start = scene.quantity(args.start, kind, "--from") if _given(args.start, "--from") else sweep.start
+    stop = (scene.quantity(args.stop, kind, "--to") if _given(args.stop, "--to")
+            else start + (sweep.default_values(2)[1] - sweep.start))
     if not 2 <= args.steps <= _MAX_FRAMES:
         raise PinmechError(f"--steps must be between 2 and {_MAX_FRAMES} frames (each is kept in the page), "
                            f"got {args.steps}")

@@ -221,5 +221,8 @@ class Scene:
             if not low <= value <= high:
                 raise SceneError(f"solver.{key} = {value!r} is outside [{low:g}, {high:g}]",
                                  path=str(self.path), key=f"solver.{key}")
+            if allowed[key] is int and value != int(value):  # 2.7 was cut to 2 in silence
+                raise SceneError(f"solver.{key} = {value!r} must be a whole number of iterations",
+                                 path=str(self.path), key=f"solver.{key}")
             out[key] = allowed[key](value)
         return out

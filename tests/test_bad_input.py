@@ -235,6 +235,7 @@ def test_urdf_with_nothing_to_move(copies, capsys, text, message):
         ('title=3', 4, "title: must be a string"),
         ('solver.max_iterations=0', 4, "positive number"),
         ('solver.max_iterations=1000000000', 4, "outside [1, 1000]"),
+        ('solver.max_iterations=2.7', 4, "must be a whole number"),  # was cut to 2 in silence
         ('solver.tol=inf', 4, "solver.tol = inf is outside [1e-16, 0.001]"),
         ('solver.tol=0.5', 4, "outside [1e-16, 0.001]"),
         ('solver.max_condition=0.5', 4, "outside [1, inf]"),
@@ -479,3 +480,13 @@ def test_a_figure_asked_of_unknown_links_or_points_is_refused_before_the_sweep(t
     err = capsys.readouterr().err
     assert words in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("argv", [["solve", "--angle", ""], ["solve", "--speed", " "], ["sweep", "--from", ""],
+                                  ["sweep", "--to", "", "--steps", "3"]])
+def test_an_empty_option_is_an_error_not_the_scenes_value(r_rtr_scene, capsys, argv):
+    """--angle "" (an unset shell variable) solved the scene's own pose in silence."""
+    command, *rest = argv
+    got, err = _run(capsys, command, r_rtr_scene, *rest)
+    assert got == 4 and "is empty" in err
+    _one_line_error(got, err, "")
