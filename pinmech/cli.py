@@ -725,16 +725,9 @@ def cmd_view(args: argparse.Namespace) -> int:
 
 def _write_text(path: str, text: str, what: str) -> None:
     """Write a whole file at once (a failed write leaves no half file behind) and say so."""
-    import os
-    import tempfile
+    from pinmech.outputs import write_whole
 
-    folder = os.path.dirname(os.path.abspath(path))
-    with tempfile.NamedTemporaryFile("w", encoding="utf-8", dir=folder, delete=False, suffix=".part") as stream:
-        stream.write(text)
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(stream.name, 0o666 & ~umask)  # as open() would make it, not the temporary file's 0600
-    os.replace(stream.name, path)
+    write_whole(path, text)
     print(f"wrote {path} ({what}, {max(1, len(text) // 1024)} KB)", file=sys.stderr)
 
 

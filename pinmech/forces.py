@@ -242,7 +242,11 @@ class ForceSolver:
                              path=mech.source)
         missing = []
         for jid in range(1, model.njoints):
-            if model.inertias[jid].mass > 0:
+            mass = model.inertias[jid].mass
+            if mass < 0 or not np.isfinite(mass):
+                raise ModelError(f"forces: the body moved by joint {model.names[jid]} has a mass of {mass:g} kg: a "
+                                 "mass must be a positive number", path=mech.source)
+            if mass > 0:
                 continue
             names = [n for n, fid in mech.links.items() if model.frames[fid].parentJoint == jid]
             if not set(names) <= massless:

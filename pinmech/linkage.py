@@ -392,15 +392,11 @@ def build_urdf(path: str | Path, output: str | Path) -> Linkage:
 
 
 def _write_whole(path: Path, text: str) -> None:
-    """Write to a temporary file beside `path`, then rename: never a half-written URDF."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent if str(path.parent) else ".")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as stream:
-            stream.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    """Through a temporary file beside `path`, renamed when whole (outputs.write_whole:
+    never a half-written URDF; the mode an ordinary write gives, or the old file's)."""
+    from pinmech.outputs import write_whole
+
+    write_whole(path, text)
 
 
 def _cached_urdf(text: str) -> Path:

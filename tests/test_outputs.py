@@ -263,3 +263,23 @@ def test_a_signal_stops_the_compiled_core_inside_a_span_of_a_million_turns(model
     assert process.returncode == 128 + signum, err
     [line] = err.strip().splitlines()
     assert line.startswith(f"pinmech: interrupted by {signal.Signals(signum).name}: stopped")
+
+
+def test_build_writes_files_as_every_other_output_does(tmp_path, models_dir):
+    """`pinmech build` left its URDF at mkstemp's 0600 (and turned an existing 0640 file to
+    0600): now the mode an ordinary write gives under the umask, or the old file's."""
+    import os
+    import stat
+
+    umask = os.umask(0o022)
+    try:
+        fresh, kept = tmp_path / "a.urdf", tmp_path / "b.urdf"
+        kept.write_text("x")
+        kept.chmod(0o640)
+        for target in (fresh, kept):
+            assert main(["build", str(models_dir / "linkages" / "four_bar.toml"), "-o", str(target)]) == 0
+    finally:
+        os.umask(umask)
+    assert stat.S_IMODE(fresh.stat().st_mode) == 0o644
+    assert stat.S_IMODE(kept.stat().st_mode) == 0o640
+    assert "<robot" in kept.read_text()
