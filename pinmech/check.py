@@ -19,6 +19,7 @@ A printed value is an interval: "0.386" means [0.3855, 0.3865]. Verdicts:
 
 from __future__ import annotations
 
+import difflib
 import math
 import re
 import sys
@@ -39,6 +40,9 @@ else:  # pragma: no cover
 #: and the most a user may allow (more would call any value rounding).
 DEFAULT_SLACK = 2.0
 MAX_SLACK = 100.0
+#: The keys a hand file and each of its [[value]] tables may hold: any other is a typo.
+_FILE_KEYS = ("scene", "source", "value")
+_ENTRY_KEYS = ("label", "quantity", "hand", "unit", "kind")
 _COMPONENTS: dict[str, int | str] = {"x": 0, "y": 1, "z": 2, "norm": "norm"}
 _KINDS = {
     "position": "length",
@@ -97,7 +101,8 @@ def load_hand_file(path: str | Path) -> HandFile:
     """Read a hand-value file; its scene path is relative to the file's folder.
 
     Raises:
-        SceneError: malformed TOML, a value that is not a printed number, an unknown unit.
+        SceneError: malformed TOML, an unknown key, no value to check, a value that is not
+            a printed number, an unknown unit.
     """
     path = Path(path)
     if not path.is_file():
@@ -108,13 +113,29 @@ def load_hand_file(path: str | Path) -> HandFile:
         raise SceneError(f"malformed TOML: {exc}", path=str(path)) from exc
     if not isinstance(raw.get("scene"), str):
         raise SceneError("missing scene = \"scene.toml\"", path=str(path), key="scene")
+    _refuse_unknown_keys(raw, _FILE_KEYS, str(path), "")
     entries = raw.get("value", [])
     if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
         raise SceneError("values must be tables: [[value]] with quantity, hand and unit", path=str(path), key="value")
+    if not entries:
+        raise SceneError("no [[value]] to check: a hand file lists at least one (quantity, hand, unit); "
+                         "an empty check would pass", path=str(path), key="value")
     values = []
     for i, entry in enumerate(entries):
+        _refuse_unknown_keys(entry, _ENTRY_KEYS, str(path), f"value[{i}]")
         values.extend(_hand_values(entry, f"value[{i}]", str(path)))
     return HandFile(path, (path.parent / raw["scene"]).resolve(), str(raw.get("source", "")), values)
+
+
+def _refuse_unknown_keys(table: dict[str, Any], known: tuple[str, ...], path: str, where: str) -> None:
+    """SceneError on a key that is not in `known` (a typo would otherwise check nothing),
+    suggesting the closest known key."""
+    for key in table:
+        if key not in known:
+            close = [f"[[{k}]]" if k == "value" else repr(k) for k in difflib.get_close_matches(key, known, n=1)]
+            hint = f" (did you mean {close[0]}?)" if close else ""
+            holds = "a [[value]] holds " + ", ".join(known) if where else "a hand file holds scene, source and [[value]]"
+            raise SceneError(f"unknown key {key!r}{hint}: {holds}", path=path, key=f"{where}.{key}" if where else key)
 
 
 def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue]:

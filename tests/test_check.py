@@ -137,3 +137,35 @@ def test_a_slack_that_is_not_a_small_number_of_digits_is_refused(slack, capsys):
     assert "--slack must be a number from 0 to 100" in capsys.readouterr().err
     with pytest.raises(SceneError, match="slack must be"):
         compare({}, [], float(slack))
+
+
+# ------------------------------------------------------------- a hand file checks what it says
+def _hand_file(tmp_path, body: str, scene: str = "r_rtr.toml"):
+    from tests.conftest import SCENES
+
+    path = tmp_path / "h.hand.toml"
+    path.write_text(f'scene = "{SCENES / scene}"\n{body}')
+    return path
+
+
+def _entry(quantity: str, hand: str, unit: str, extra: str = "") -> str:
+    return f'[[value]]\nquantity = "{quantity}"\nhand = {hand}\nunit = "{unit}"\n{extra}'
+
+
+def test_a_misspelled_values_table_is_refused_not_checked_as_nothing(tmp_path):
+    path = _hand_file(tmp_path, _entry("points.D.velocity", '["0.386", "-0.282"]', "m/s").replace("[[value]]", "[[values]]"))
+    with pytest.raises(SceneError, match=r"h\.hand\.toml, values: unknown key 'values' \(did you mean \[\[value\]\]\?\)"):
+        load_hand_file(path)
+
+
+def test_a_misspelled_key_of_a_value_is_refused(tmp_path):
+    path = _hand_file(tmp_path, _entry("links.link3.angle", '["53.794"]', "deg", 'knd = "angle"\n'))
+    with pytest.raises(SceneError, match=r"h\.hand\.toml, value\[0\]\.knd: unknown key 'knd' \(did you mean 'kind'\?\)"):
+        load_hand_file(path)
+
+
+@pytest.mark.parametrize("body", ["", "value = []\n", 'source = "p. 12"\n'])
+def test_a_hand_file_with_nothing_to_check_is_an_error_not_a_pass(tmp_path, body):
+    with pytest.raises(SceneError, match=r"h\.hand\.toml, value: no \[\[value\]\] to check"):
+        load_hand_file(_hand_file(tmp_path, body))
+
