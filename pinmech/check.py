@@ -147,6 +147,11 @@ def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue
     if not 1 <= len(hand) <= 3:
         raise SceneError(f"hand = {hand!r}: give one to three printed values", path=path, key=where)
     base, component = _split_component(quantity)
+    if component == "norm" and len(hand) > 1:
+        raise SceneError(f"{quantity!r} is a magnitude: give one printed value", path=path, key=where)
+    if component is not None and len(hand) > 1:
+        raise SceneError(f"{quantity!r} is one component: give one printed value, or list x, y (, z) on {base!r}",
+                         path=path, key=where)
     kind = _kind_of(base, str(entry.get("kind", "")), path, where)
     label = str(entry.get("label", quantity))
     out = []
@@ -160,8 +165,6 @@ def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue
             raise SceneError(f"hand value {printed!r} is not a number", path=path, key=where) from None
         if not finite:
             raise SceneError(f"hand value {printed!r} is not a finite number as printed", path=path, key=where)
-        if component == "norm" and len(hand) > 1:
-            raise SceneError(f"{quantity!r} is a magnitude: give one printed value", path=path, key=where)
         comp = component if component is not None else (i if len(hand) > 1 else None)
         suffix = "" if len(hand) == 1 else f" {'xyz'[i]}"
         out.append(HandValue(label + suffix, base, comp, printed.strip(), str(entry["unit"]), kind))
@@ -210,7 +213,12 @@ def lookup(result: dict[str, Any], quantity: str, component: int | None, *, wher
         if component is None:
             raise SceneError(f"{quantity!r} is a vector: add .x, .y, .z or .norm, or give a list of hand values",
                              key=where)
-        node = node[component] if component < len(node) else None
+        if component >= len(node):
+            raise SceneError(f"{quantity!r} has {len(node)} components, no {'xyz'[component]}", key=where)
+        node = node[component]
+    elif component is not None and isinstance(node, (int, float)) and not isinstance(node, bool):
+        raise SceneError(f"{quantity!r} is a number, not a vector: give one hand value, without .x, .y or .z",
+                         key=where)
     if isinstance(node, bool) or not isinstance(node, (int, float)):
         raise SceneError(f"{quantity!r} is not a number of the result", key=where)
     return float(node)

@@ -169,3 +169,23 @@ def test_a_hand_file_with_nothing_to_check_is_an_error_not_a_pass(tmp_path, body
     with pytest.raises(SceneError, match=r"h\.hand\.toml, value: no \[\[value\]\] to check"):
         load_hand_file(_hand_file(tmp_path, body))
 
+
+def test_a_component_path_takes_one_printed_value(tmp_path):
+    # v_D = (0.935792, -0.685048) m/s: a second "0.936" is not v_D,y and must not be labelled so.
+    path = _hand_file(tmp_path, _entry("points.D.velocity.x", '["0.936", "0.936"]', "m/s"))
+    with pytest.raises(SceneError, match=r"value\[0\]: 'points.D.velocity.x' is one component: give one printed "
+                                         r"value, or list x, y \(, z\) on 'points.D.velocity'"):
+        load_hand_file(path)
+
+
+def test_a_list_of_values_on_a_number_of_the_result_is_refused():
+    angle = {"links": {"L": {"angle": 0.938882}}}
+    for component in (0, 1):
+        with pytest.raises(SceneError, match=r"'links.L.angle' is a number, not a vector"):
+            compare(angle, [HandValue(f"phi {component}", "links.L.angle", component, "53.79", "deg", "angle")])
+
+
+def test_a_vector_has_no_fourth_component():
+    with pytest.raises(SceneError, match=r"'points.B.position' has 2 components, no z"):
+        compare({"points": {"B": {"position": [0.1, 0.2]}}}, [HandValue("z", "points.B.position", 2, "0", "m", "length")])
+
