@@ -28,8 +28,8 @@ from decimal import Decimal, InvalidOperation
 from pathlib import Path
 from typing import Any
 
-from pinmech.exceptions import SceneError
-from pinmech.units import SI_UNITS, to_si
+from pinmech.exceptions import SceneError, UnitError
+from pinmech.units import SI_UNITS, format_si, to_si
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -67,6 +67,13 @@ class HandValue:
     printed: str
     unit: str
     kind: str
+    file: str = ""  # the hand file, for error messages ("" when built in Python)
+    entry: str = ""  # its [[value]] table: "value[3]"
+
+    @property
+    def where(self) -> str:
+        """The entry and its label, for error messages: "value[3] (text: omega_3)"."""
+        return f"{self.entry} ({self.label})" if self.entry else self.label
 
     @property
     def value(self) -> float:
@@ -124,7 +131,10 @@ def load_hand_file(path: str | Path) -> HandFile:
     for i, entry in enumerate(entries):
         _refuse_unknown_keys(entry, _ENTRY_KEYS, str(path), f"value[{i}]")
         values.extend(_hand_values(entry, f"value[{i}]", str(path)))
-    return HandFile(path, (path.parent / raw["scene"]).resolve(), str(raw.get("source", "")), values)
+    scene = (path.parent / raw["scene"]).resolve()
+    if not scene.is_file():
+        raise SceneError(f"scene = {raw['scene']!r}: no such scene file ({scene})", path=str(path), key="scene")
+    return HandFile(path, scene, str(raw.get("source", "")), values)
 
 
 def _refuse_unknown_keys(table: dict[str, Any], known: tuple[str, ...], path: str, where: str) -> None:
@@ -167,14 +177,65 @@ def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue
             raise SceneError(f"hand value {printed!r} is not a finite number as printed", path=path, key=where)
         comp = component if component is not None else (i if len(hand) > 1 else None)
         suffix = "" if len(hand) == 1 else f" {'xyz'[i]}"
-        out.append(HandValue(label + suffix, base, comp, printed.strip(), str(entry["unit"]), kind))
+        out.append(HandValue(label + suffix, base, comp, printed.strip(), str(entry["unit"]), kind, path, where))
     unit = out[0].unit
     if not unit.strip() or re.search(r"^\s*[-+.\d]|,", unit):
         raise SceneError(f"unit = {unit!r} is not a unit (e.g. \"m/s\", \"deg\")", path=path, key=f"{where}.unit")
-    factor = to_si(f"1 {unit}", kind, where=f"{where}.unit")  # unknown or wrong unit fails here
+    factor = _unit_factor(out[0], where)  # unknown or wrong unit fails here
     if not factor > 0:
         raise SceneError(f"unit = {out[0].unit!r} is not a unit", path=path, key=f"{where}.unit")
     return out
+
+
+def _unit_factor(hv: HandValue, where: str) -> float:
+    """SI value of one `hv.unit` (m/s for "mm/s": 0.001); `where` names the entry in errors.
+
+    Raises:
+        UnitError: naming the hand file, the entry and the unit as written: a unit of
+            another kind than the quantity's, or one pinmech cannot read.
+    """
+    try:
+        return to_si(f"1 {hv.unit}", hv.kind)
+    except UnitError as exc:
+        if _unit_kind(hv.unit) is not None:
+            raise _misfit(hv, hv.kind, where) from None
+        said = str(exc).replace(repr(f"1 {hv.unit}"), repr(hv.unit))  # the unit as the file writes it
+        raise UnitError(said, path=hv.file or None, key=f"{where}.unit") from None
+
+
+def _unit_kind(unit: str) -> str | None:
+    """The kind of quantity `unit` measures ("rpm": angular_velocity), None if none."""
+    for kind in SI_UNITS:
+        try:
+            to_si(f"1 {unit}", kind)
+        except UnitError:
+            continue
+        return kind
+    return None
+
+
+def _a(kind: str) -> str:
+    """"an angular velocity", "a length"."""
+    name = kind.replace("_", " ")
+    return f"an {name}" if name[0] in "aeiou" else f"a {name}"
+
+
+def _misfit(hv: HandValue, expected: str, where: str, declared: str = "", why: str = "") -> UnitError:
+    """The error for a unit (or a declared kind) that does not fit the quantity, which is
+    `expected` (`why`: how pinmech knows, e.g. " (joint B is prismatic)")."""
+    measures = _unit_kind(hv.unit)
+    if declared and declared != expected:
+        wrong = declared
+        said = f"kind = {declared!r} and unit = {hv.unit!r} say" if measures == declared else f"kind = {declared!r} says"
+    else:
+        wrong, said = measures or "something else", f"unit = {hv.unit!r} says"
+    if measures == expected:
+        advice = f"make it kind = {expected!r}, or leave kind out"
+    else:
+        advice = f"give it in {format_si(1.0, expected)} (or another {expected.replace('_', ' ')} unit)"
+        advice += f" with kind = {expected!r}" if declared else ""
+    return UnitError(f"{hv.quantity!r} is {_a(expected)}{why}, not {_a(wrong)} as {said}: {advice}",
+                     path=hv.file or None, key=where)
 
 
 def _split_component(quantity: str) -> tuple[str, int | str | None]:
@@ -196,31 +257,34 @@ def _kind_of(path: str, declared: str, file: str, where: str) -> str:
                      path=file, key=where)
 
 
-def lookup(result: dict[str, Any], quantity: str, component: int | None, *, where: str = "") -> float:
-    """A number of a `pinmech solve --json` result, by dotted path and component."""
+def lookup(result: dict[str, Any], quantity: str, component: int | str | None, *, where: str = "",
+           path: str | None = None) -> float:
+    """A number of a `pinmech solve --json` result, by dotted path and component
+    (`where`, `path`: the entry and hand file, for errors)."""
     node: Any = result
     for part in quantity.split("."):
         if not isinstance(node, dict) or part not in node:
             known = ", ".join(node) if isinstance(node, dict) else "nothing"
-            raise SceneError(f"{quantity!r}: no '{part}' in the result (has {known})", key=where)
+            raise SceneError(f"{quantity!r}: no '{part}' in the result (has {known})", path=path, key=where)
         node = node[part]
     if component == "norm":
         numbers = node if isinstance(node, list) else [node]
         if not numbers or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in numbers):
-            raise SceneError(f"{quantity!r} has no magnitude: it is not a number or a vector of the result", key=where)
+            raise SceneError(f"{quantity!r} has no magnitude: it is not a number or a vector of the result",
+                             path=path, key=where)
         return math.hypot(*numbers)
     if isinstance(node, list):
         if component is None:
             raise SceneError(f"{quantity!r} is a vector: add .x, .y, .z or .norm, or give a list of hand values",
-                             key=where)
+                             path=path, key=where)
         if component >= len(node):
-            raise SceneError(f"{quantity!r} has {len(node)} components, no {'xyz'[component]}", key=where)
+            raise SceneError(f"{quantity!r} has {len(node)} components, no {'xyz'[component]}", path=path, key=where)
         node = node[component]
     elif component is not None and isinstance(node, (int, float)) and not isinstance(node, bool):
         raise SceneError(f"{quantity!r} is a number, not a vector: give one hand value, without .x, .y or .z",
-                         key=where)
+                         path=path, key=where)
     if isinstance(node, bool) or not isinstance(node, (int, float)):
-        raise SceneError(f"{quantity!r} is not a number of the result", key=where)
+        raise SceneError(f"{quantity!r} is not a number of the result", path=path, key=where)
     return float(node)
 
 
@@ -234,8 +298,8 @@ def compare(result: dict[str, Any], values: list[HandValue], slack: float = DEFA
     check_slack(slack)
     out = []
     for hv in values:
-        factor = to_si(f"1 {hv.unit}", hv.kind)
-        computed = lookup(result, hv.quantity, hv.component, where=hv.label) / factor
+        factor = _unit_factor(hv, hv.where)
+        computed = lookup(result, hv.quantity, hv.component, where=hv.where, path=hv.file or None) / factor
         if hv.kind == "angle" and hv.component != "norm":
             turn = 2 * math.pi / factor  # a full turn in the hand unit
             computed += turn * round((hv.value - computed) / turn)

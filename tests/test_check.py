@@ -14,6 +14,7 @@ import pytest
 
 from pinmech import SceneError, analyse, compare, load_hand_file, to_dict
 from pinmech.check import HandValue, format_verdicts
+from pinmech.exceptions import UnitError
 from pinmech.scene import Scene
 
 
@@ -189,3 +190,25 @@ def test_a_vector_has_no_fourth_component():
     with pytest.raises(SceneError, match=r"'points.B.position' has 2 components, no z"):
         compare({"points": {"B": {"position": [0.1, 0.2]}}}, [HandValue("z", "points.B.position", 2, "0", "m", "length")])
 
+
+
+def test_hand_file_errors_name_the_hand_file_and_the_unit_as_written(tmp_path):
+    path = _hand_file(tmp_path, _entry("points.D.velocity", '["0.9", "0.1"]', "rpm"))
+    with pytest.raises(UnitError, match=r"^\S*h\.hand\.toml, value\[0\]: .*unit = 'rpm' says") as raised:
+        load_hand_file(path)
+    assert "'1 rpm'" not in str(raised.value)
+    path = _hand_file(tmp_path, _entry("points.DD.velocity", '["0.9", "0.1"]', "m/s"))
+    hand = load_hand_file(path)
+    with pytest.raises(SceneError, match=r"^\S*h\.hand\.toml, value\[0\] \(points.DD.velocity x\): 'points.DD.velocity': "
+                                         r"no 'DD' in the result \(has A, B\)"):
+        compare({"points": {"A": {}, "B": {}}}, hand.values)
+    path = _hand_file(tmp_path, _entry("points.D.velocity", '["0.9", "0.1"]', "blorps/s"))
+    with pytest.raises(UnitError, match=r"^\S*h\.hand\.toml, value\[0\]\.unit: cannot read quantity 'blorps/s'"):
+        load_hand_file(path)
+
+
+def test_a_missing_scene_is_named_with_the_hand_file(tmp_path):
+    path = tmp_path / "h.hand.toml"
+    path.write_text('scene = "nope.toml"\n' + _entry("points.D.velocity", '["0.9", "0.1"]', "m/s"))
+    with pytest.raises(SceneError, match=r"h\.hand\.toml, scene: scene = 'nope.toml': no such scene file \(.*nope\.toml\)"):
+        load_hand_file(path)
