@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from pinmech.exceptions import SceneError, UnitError
-from pinmech.units import SI_UNITS, format_si, to_si
+from pinmech.units import JOINT_KINDS, SI_UNITS, format_si, to_si
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -55,6 +55,11 @@ _KINDS = {
     "angular_velocity": "angular_velocity",
     "angular_acceleration": "angular_acceleration",
 }
+#: The kind of each number of a joint reaction (forces.reactions.B.force ...).
+_REACTION_KINDS = {"force": "force", "normal_force": "force", "axial_force": "force", "magnitude": "force",
+                   "moment": "torque", "axial_moment": "torque", "point": "length", "angle": "angle"}
+#: A joint type of the result, as a key of JOINT_KINDS.
+_JOINT_FAMILIES = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
 
 
 @dataclass(frozen=True)
@@ -157,12 +162,19 @@ def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue
     if not 1 <= len(hand) <= 3:
         raise SceneError(f"hand = {hand!r}: give one to three printed values", path=path, key=where)
     base, component = _split_component(quantity)
+    declared = str(entry.get("kind", ""))
+    if declared and declared not in SI_UNITS:
+        raise SceneError(f"kind = {declared!r} is not one of {', '.join(SI_UNITS)}", path=path, key=where)
     if component == "norm" and len(hand) > 1:
         raise SceneError(f"{quantity!r} is a magnitude: give one printed value", path=path, key=where)
     if component is not None and len(hand) > 1:
         raise SceneError(f"{quantity!r} is one component: give one printed value, or list x, y (, z) on {base!r}",
                          path=path, key=where)
-    kind = _kind_of(base, str(entry.get("kind", "")), path, where)
+    known, _ = _path_kind(base)
+    kind = known or declared
+    if not kind:
+        raise SceneError(f"cannot tell the kind of {base!r}: add kind = \"angle\" (or length, velocity, ...)",
+                         path=path, key=where)
     label = str(entry.get("label", quantity))
     out = []
     for i, printed in enumerate(hand):
@@ -181,6 +193,8 @@ def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue
     unit = out[0].unit
     if not unit.strip() or re.search(r"^\s*[-+.\d]|,", unit):
         raise SceneError(f"unit = {unit!r} is not a unit (e.g. \"m/s\", \"deg\")", path=path, key=f"{where}.unit")
+    if known and declared and declared != known:  # a declared kind never overrides the quantity's own
+        raise _misfit(out[0], known, where, declared)
     factor = _unit_factor(out[0], where)  # unknown or wrong unit fails here
     if not factor > 0:
         raise SceneError(f"unit = {out[0].unit!r} is not a unit", path=path, key=f"{where}.unit")
@@ -233,7 +247,7 @@ def _misfit(hv: HandValue, expected: str, where: str, declared: str = "", why: s
         advice = f"make it kind = {expected!r}, or leave kind out"
     else:
         advice = f"give it in {format_si(1.0, expected)} (or another {expected.replace('_', ' ')} unit)"
-        advice += f" with kind = {expected!r}" if declared else ""
+        advice += f" with kind = {expected!r}" if why else " and leave kind out" if declared else ""
     return UnitError(f"{hv.quantity!r} is {_a(expected)}{why}, not {_a(wrong)} as {said}: {advice}",
                      path=hv.file or None, key=where)
 
@@ -245,16 +259,28 @@ def _split_component(quantity: str) -> tuple[str, int | str | None]:
     return quantity, None
 
 
-def _kind_of(path: str, declared: str, file: str, where: str) -> str:
-    if declared:
-        if declared not in SI_UNITS:
-            raise SceneError(f"kind = {declared!r} is not one of {', '.join(SI_UNITS)}", path=file, key=where)
-        return declared
-    last = path.removesuffix(".norm").rsplit(".", 1)[-1]
-    if last in _KINDS:
-        return _KINDS[last]
-    raise SceneError(f"cannot tell the kind of {path!r}: add kind = \"angle\" (or length, velocity, ...)",
-                     path=file, key=where)
+def _path_kind(quantity: str, result: dict[str, Any] | None = None) -> tuple[str | None, str]:
+    """The kind of the number at a result path, and how it is known (" (joint B is
+    prismatic)"), or None. A joint's coordinate (joints.B.q, drivers.B.v) and a driver's
+    effort (forces.drivers.B.effort) are known from the joint's type in `result` only."""
+    parts = quantity.split(".")
+    if len(parts) == 3 and parts[0] in ("joints", "drivers") and parts[2] in ("q", "v", "a"):
+        joint, index = parts[1], "qva".index(parts[2])
+    elif len(parts) == 4 and parts[:2] == ["forces", "drivers"] and parts[3] == "effort":
+        joint, index = parts[2], None
+    elif len(parts) == 4 and parts[:2] == ["forces", "reactions"]:
+        return _REACTION_KINDS.get(parts[3]), ""
+    elif quantity == "forces.gravity":
+        return "acceleration", ""
+    else:
+        return _KINDS.get(parts[-1]), ""
+    about = (result or {}).get("joints", {}).get(joint) if isinstance((result or {}).get("joints"), dict) else None
+    joint_type = str(about.get("type")) if isinstance(about, dict) else ""
+    family = _JOINT_FAMILIES.get(joint_type)
+    if family is None:
+        return None, ""
+    kind = JOINT_KINDS[family][index] if index is not None else "torque" if family == "revolute" else "force"
+    return kind, f" (joint {joint} is {joint_type})"
 
 
 def lookup(result: dict[str, Any], quantity: str, component: int | str | None, *, where: str = "",
@@ -293,9 +319,16 @@ def compare(result: dict[str, Any], values: list[HandValue], slack: float = DEFA
     compared with the equivalent of pinmech's nearest it (413.794 deg is 53.794 deg).
 
     Raises:
-        SceneError: a slack that is not a number from 0 to `MAX_SLACK`.
+        SceneError: a slack that is not a number from 0 to `MAX_SLACK`; a path not in the
+            result.
+        UnitError: a value whose kind (and unit) is not the quantity's: a prismatic
+            joint's q in degrees.
     """
     check_slack(slack)
+    for hv in values:  # the kinds first: no verdict on a value read in the wrong unit
+        expected, why = _path_kind(hv.quantity, result)
+        if expected is not None and expected != hv.kind:
+            raise _misfit(hv, expected, hv.where, hv.kind, why)
     out = []
     for hv in values:
         factor = _unit_factor(hv, hv.where)

@@ -191,6 +191,44 @@ def test_a_vector_has_no_fourth_component():
         compare({"points": {"B": {"position": [0.1, 0.2]}}}, [HandValue("z", "points.B.position", 2, "0", "m", "length")])
 
 
+@pytest.mark.parametrize(
+    "quantity, hand, unit, kind, message",
+    [
+        # m/s read as deg/s, rad/s as mm/s: each was "ok"
+        ("points.D.velocity.x", '["53.62"]', "deg/s", "angular_velocity",
+         (r"'points.D.velocity' is a velocity, not an angular velocity as kind = 'angular_velocity' and "
+          r"unit = 'deg/s' say: give it in m/s \(or another velocity unit\)")),
+        ("links.link3.angular_velocity.z", '["-7732"]', "mm/s", "velocity",
+         (r"'links.link3.angular_velocity' is an angular velocity, not a velocity as kind = 'velocity' and "
+          r"unit = 'mm/s' say: give it in rad/s")),
+        ("points.D.position.x", '["0.1386"]', "m", "angle", r"'points.D.position' is a length, not an angle"),
+        ("points.D.velocity", '["0.9", "0.1"]', "rpm", None,
+         r"'points.D.velocity' is a velocity, not an angular velocity as unit = 'rpm' says"),
+    ],
+)
+def test_a_unit_must_have_the_dimension_of_the_quantity(tmp_path, quantity, hand, unit, kind, message):
+    extra = f'kind = "{kind}"\n' if kind else ""
+    path = _hand_file(tmp_path, _entry(quantity, hand, unit, extra))
+    with pytest.raises(UnitError, match=r"h\.hand\.toml, value\[0\]: " + message):
+        load_hand_file(path)
+
+
+def test_a_joint_coordinate_is_checked_in_the_joint_s_own_kind():
+    # B_slider is prismatic: its q is a length, however kind and unit are declared.
+    result = {"joints": {"B_slider": {"q": -0.061966, "v": 0.2112, "type": "prismatic"},
+                         "A": {"q": 0.5236, "type": "continuous"}}}
+    slider_in_degrees = HandValue("q", "joints.B_slider.q", None, "-3.4", "deg", "angle", file="h.toml", entry="value[1]")
+    with pytest.raises(UnitError, match=r"h\.toml, value\[1\] \(q\): 'joints.B_slider.q' is a length \(joint B_slider is "
+                                        r"prismatic\), not an angle as kind = 'angle' and unit = 'deg' say"):
+        compare(result, [slider_in_degrees])
+    crank_in_mm = HandValue("q", "joints.A.q", None, "523.6", "mm", "length")
+    with pytest.raises(UnitError, match=r"'joints.A.q' is an angle \(joint A is continuous\)"):
+        compare(result, [crank_in_mm])
+    right = [HandValue("q", "joints.B_slider.q", None, "-61.97", "mm", "length"),
+             HandValue("v", "joints.B_slider.v", None, "0.2112", "m/s", "velocity"),
+             HandValue("q", "joints.A.q", None, "30.00", "deg", "angle")]
+    assert [v.verdict for v in compare(result, right)] == ["ok", "ok", "ok"]
+
 
 def test_hand_file_errors_name_the_hand_file_and_the_unit_as_written(tmp_path):
     path = _hand_file(tmp_path, _entry("points.D.velocity", '["0.9", "0.1"]', "rpm"))
