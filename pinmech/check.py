@@ -242,7 +242,7 @@ def _misfit(hv: HandValue, expected: str, where: str, declared: str = "", why: s
         wrong = declared
         said = f"kind = {declared!r} and unit = {hv.unit!r} say" if measures == declared else f"kind = {declared!r} says"
     else:
-        wrong, said = measures or "something else", f"unit = {hv.unit!r} says"
+        wrong, said = measures or hv.kind, f"unit = {hv.unit!r} says"
     if measures == expected:
         advice = f"make it kind = {expected!r}, or leave kind out"
     else:
@@ -274,7 +274,8 @@ def _path_kind(quantity: str, result: dict[str, Any] | None = None) -> tuple[str
         return "acceleration", ""
     else:
         return _KINDS.get(parts[-1]), ""
-    about = (result or {}).get("joints", {}).get(joint) if isinstance((result or {}).get("joints"), dict) else None
+    joints = result.get("joints") if isinstance(result, dict) else None
+    about = joints.get(joint) if isinstance(joints, dict) else None
     joint_type = str(about.get("type")) if isinstance(about, dict) else ""
     family = _JOINT_FAMILIES.get(joint_type)
     if family is None:
