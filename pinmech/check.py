@@ -10,6 +10,10 @@ precision is kept:
     hand = ["0.386", "-0.282"]         # x, y as printed
     unit = "m/s"
 
+A list of values goes with a vector path; a component (.x, .y, .z, .norm) takes one. The
+unit must measure the quantity's own kind (a declared `kind`, needed for a joint's q, v
+and a, must agree with it), and any key but these is refused as a typo.
+
 A printed value is an interval: "0.386" means [0.3855, 0.3865]. Verdicts:
     ok        within half a unit of the last printed digit: correctly rounded;
     rounding  within `slack` units: truncated, or carried rounding of the hand work's
