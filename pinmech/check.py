@@ -10,6 +10,10 @@ precision is kept:
     hand = ["0.386", "-0.282"]         # x, y as printed
     unit = "m/s"
 
+A list of values goes with a vector path; a component (.x, .y, .z, .norm) takes one. The
+unit must measure the quantity's own kind (a declared `kind`, needed for a joint's q, v
+and a, must agree with it), and any key but these is refused as a typo.
+
 A printed value is an interval: "0.386" means [0.3855, 0.3865]. Verdicts:
     ok        within half a unit of the last printed digit: correctly rounded;
     rounding  within `slack` units: truncated, or carried rounding of the hand work's
@@ -19,6 +23,7 @@ A printed value is an interval: "0.386" means [0.3855, 0.3865]. Verdicts:
 
 from __future__ import annotations
 
+import difflib
 import math
 import re
 import sys
@@ -27,8 +32,8 @@ from decimal import Decimal, InvalidOperation
 from pathlib import Path
 from typing import Any
 
-from pinmech.exceptions import SceneError
-from pinmech.units import SI_UNITS, to_si
+from pinmech.exceptions import SceneError, UnitError
+from pinmech.units import JOINT_KINDS, SI_UNITS, format_si, to_si
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -39,6 +44,9 @@ else:  # pragma: no cover
 #: and the most a user may allow (more would call any value rounding).
 DEFAULT_SLACK = 2.0
 MAX_SLACK = 100.0
+#: The keys a hand file and each of its [[value]] tables may hold: any other is a typo.
+_FILE_KEYS = ("scene", "source", "value")
+_ENTRY_KEYS = ("label", "quantity", "hand", "unit", "kind")
 _COMPONENTS: dict[str, int | str] = {"x": 0, "y": 1, "z": 2, "norm": "norm"}
 _KINDS = {
     "position": "length",
@@ -51,6 +59,11 @@ _KINDS = {
     "angular_velocity": "angular_velocity",
     "angular_acceleration": "angular_acceleration",
 }
+#: The kind of each number of a joint reaction (forces.reactions.B.force ...).
+_REACTION_KINDS = {"force": "force", "normal_force": "force", "axial_force": "force", "magnitude": "force",
+                   "moment": "torque", "axial_moment": "torque", "point": "length", "angle": "angle"}
+#: A joint type of the result, as a key of JOINT_KINDS.
+_JOINT_FAMILIES = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
 
 
 @dataclass(frozen=True)
@@ -63,6 +76,13 @@ class HandValue:
     printed: str
     unit: str
     kind: str
+    file: str = ""  # the hand file, for error messages ("" when built in Python)
+    entry: str = ""  # its [[value]] table: "value[3]"
+
+    @property
+    def where(self) -> str:
+        """The entry and its label, for error messages: "value[3] (text: omega_3)"."""
+        return f"{self.entry} ({self.label})" if self.entry else self.label
 
     @property
     def value(self) -> float:
@@ -97,7 +117,8 @@ def load_hand_file(path: str | Path) -> HandFile:
     """Read a hand-value file; its scene path is relative to the file's folder.
 
     Raises:
-        SceneError: malformed TOML, a value that is not a printed number, an unknown unit.
+        SceneError: malformed TOML, an unknown key, no value to check, a value that is not
+            a printed number, an unknown unit.
     """
     path = Path(path)
     if not path.is_file():
@@ -108,13 +129,32 @@ def load_hand_file(path: str | Path) -> HandFile:
         raise SceneError(f"malformed TOML: {exc}", path=str(path)) from exc
     if not isinstance(raw.get("scene"), str):
         raise SceneError("missing scene = \"scene.toml\"", path=str(path), key="scene")
+    _refuse_unknown_keys(raw, _FILE_KEYS, str(path), "")
     entries = raw.get("value", [])
     if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
         raise SceneError("values must be tables: [[value]] with quantity, hand and unit", path=str(path), key="value")
+    if not entries:
+        raise SceneError("no [[value]] to check: a hand file lists at least one (quantity, hand, unit); "
+                         "an empty check would pass", path=str(path), key="value")
     values = []
     for i, entry in enumerate(entries):
+        _refuse_unknown_keys(entry, _ENTRY_KEYS, str(path), f"value[{i}]")
         values.extend(_hand_values(entry, f"value[{i}]", str(path)))
-    return HandFile(path, (path.parent / raw["scene"]).resolve(), str(raw.get("source", "")), values)
+    scene = (path.parent / raw["scene"]).resolve()
+    if not scene.is_file():
+        raise SceneError(f"scene = {raw['scene']!r}: no such scene file ({scene})", path=str(path), key="scene")
+    return HandFile(path, scene, str(raw.get("source", "")), values)
+
+
+def _refuse_unknown_keys(table: dict[str, Any], known: tuple[str, ...], path: str, where: str) -> None:
+    """SceneError on a key that is not in `known` (a typo would otherwise check nothing),
+    suggesting the closest known key."""
+    for key in table:
+        if key not in known:
+            close = [f"[[{k}]]" if k == "value" else repr(k) for k in difflib.get_close_matches(key, known, n=1)]
+            hint = f" (did you mean {close[0]}?)" if close else ""
+            holds = "a [[value]] holds " + ", ".join(known) if where else "a hand file holds scene, source and [[value]]"
+            raise SceneError(f"unknown key {key!r}{hint}: {holds}", path=path, key=f"{where}.{key}" if where else key)
 
 
 def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue]:
@@ -126,7 +166,19 @@ def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue
     if not 1 <= len(hand) <= 3:
         raise SceneError(f"hand = {hand!r}: give one to three printed values", path=path, key=where)
     base, component = _split_component(quantity)
-    kind = _kind_of(base, str(entry.get("kind", "")), path, where)
+    declared = str(entry.get("kind", ""))
+    if declared and declared not in SI_UNITS:
+        raise SceneError(f"kind = {declared!r} is not one of {', '.join(SI_UNITS)}", path=path, key=where)
+    if component == "norm" and len(hand) > 1:
+        raise SceneError(f"{quantity!r} is a magnitude: give one printed value", path=path, key=where)
+    if component is not None and len(hand) > 1:
+        raise SceneError(f"{quantity!r} is one component: give one printed value, or list x, y (, z) on {base!r}",
+                         path=path, key=where)
+    known, _ = _path_kind(base)
+    kind = known or declared
+    if not kind:
+        raise SceneError(f"cannot tell the kind of {base!r}: add kind = \"angle\" (or length, velocity, ...)",
+                         path=path, key=where)
     label = str(entry.get("label", quantity))
     out = []
     for i, printed in enumerate(hand):
@@ -139,18 +191,69 @@ def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue
             raise SceneError(f"hand value {printed!r} is not a number", path=path, key=where) from None
         if not finite:
             raise SceneError(f"hand value {printed!r} is not a finite number as printed", path=path, key=where)
-        if component == "norm" and len(hand) > 1:
-            raise SceneError(f"{quantity!r} is a magnitude: give one printed value", path=path, key=where)
         comp = component if component is not None else (i if len(hand) > 1 else None)
         suffix = "" if len(hand) == 1 else f" {'xyz'[i]}"
-        out.append(HandValue(label + suffix, base, comp, printed.strip(), str(entry["unit"]), kind))
+        out.append(HandValue(label + suffix, base, comp, printed.strip(), str(entry["unit"]), kind, path, where))
     unit = out[0].unit
     if not unit.strip() or re.search(r"^\s*[-+.\d]|,", unit):
         raise SceneError(f"unit = {unit!r} is not a unit (e.g. \"m/s\", \"deg\")", path=path, key=f"{where}.unit")
-    factor = to_si(f"1 {unit}", kind, where=f"{where}.unit")  # unknown or wrong unit fails here
+    if known and declared and declared != known:  # a declared kind never overrides the quantity's own
+        raise _misfit(out[0], known, where, declared)
+    factor = _unit_factor(out[0], where)  # unknown or wrong unit fails here
     if not factor > 0:
         raise SceneError(f"unit = {out[0].unit!r} is not a unit", path=path, key=f"{where}.unit")
     return out
+
+
+def _unit_factor(hv: HandValue, where: str) -> float:
+    """SI value of one `hv.unit` (m/s for "mm/s": 0.001); `where` names the entry in errors.
+
+    Raises:
+        UnitError: naming the hand file, the entry and the unit as written: a unit of
+            another kind than the quantity's, or one pinmech cannot read.
+    """
+    try:
+        return to_si(f"1 {hv.unit}", hv.kind)
+    except UnitError as exc:
+        if _unit_kind(hv.unit) is not None:
+            raise _misfit(hv, hv.kind, where) from None
+        said = str(exc).replace(repr(f"1 {hv.unit}"), repr(hv.unit))  # the unit as the file writes it
+        raise UnitError(said, path=hv.file or None, key=f"{where}.unit") from None
+
+
+def _unit_kind(unit: str) -> str | None:
+    """The kind of quantity `unit` measures ("rpm": angular_velocity), None if none."""
+    for kind in SI_UNITS:
+        try:
+            to_si(f"1 {unit}", kind)
+        except UnitError:
+            continue
+        return kind
+    return None
+
+
+def _a(kind: str) -> str:
+    """"an angular velocity", "a length"."""
+    name = kind.replace("_", " ")
+    return f"an {name}" if name[0] in "aeiou" else f"a {name}"
+
+
+def _misfit(hv: HandValue, expected: str, where: str, declared: str = "", why: str = "") -> UnitError:
+    """The error for a unit (or a declared kind) that does not fit the quantity, which is
+    `expected` (`why`: how pinmech knows, e.g. " (joint B is prismatic)")."""
+    measures = _unit_kind(hv.unit)
+    if declared and declared != expected:
+        wrong = declared
+        said = f"kind = {declared!r} and unit = {hv.unit!r} say" if measures == declared else f"kind = {declared!r} says"
+    else:
+        wrong, said = measures or hv.kind, f"unit = {hv.unit!r} says"
+    if measures == expected:
+        advice = f"make it kind = {expected!r}, or leave kind out"
+    else:
+        advice = f"give it in {format_si(1.0, expected)} (or another {expected.replace('_', ' ')} unit)"
+        advice += f" with kind = {expected!r}" if why else " and leave kind out" if declared else ""
+    return UnitError(f"{hv.quantity!r} is {_a(expected)}{why}, not {_a(wrong)} as {said}: {advice}",
+                     path=hv.file or None, key=where)
 
 
 def _split_component(quantity: str) -> tuple[str, int | str | None]:
@@ -160,38 +263,59 @@ def _split_component(quantity: str) -> tuple[str, int | str | None]:
     return quantity, None
 
 
-def _kind_of(path: str, declared: str, file: str, where: str) -> str:
-    if declared:
-        if declared not in SI_UNITS:
-            raise SceneError(f"kind = {declared!r} is not one of {', '.join(SI_UNITS)}", path=file, key=where)
-        return declared
-    last = path.removesuffix(".norm").rsplit(".", 1)[-1]
-    if last in _KINDS:
-        return _KINDS[last]
-    raise SceneError(f"cannot tell the kind of {path!r}: add kind = \"angle\" (or length, velocity, ...)",
-                     path=file, key=where)
+def _path_kind(quantity: str, result: dict[str, Any] | None = None) -> tuple[str | None, str]:
+    """The kind of the number at a result path, and how it is known (" (joint B is
+    prismatic)"), or None. A joint's coordinate (joints.B.q, drivers.B.v) and a driver's
+    effort (forces.drivers.B.effort) are known from the joint's type in `result` only."""
+    parts = quantity.split(".")
+    if len(parts) == 3 and parts[0] in ("joints", "drivers") and parts[2] in ("q", "v", "a"):
+        joint, index = parts[1], "qva".index(parts[2])
+    elif len(parts) == 4 and parts[:2] == ["forces", "drivers"] and parts[3] == "effort":
+        joint, index = parts[2], None
+    elif len(parts) == 4 and parts[:2] == ["forces", "reactions"]:
+        return _REACTION_KINDS.get(parts[3]), ""
+    elif quantity == "forces.gravity":
+        return "acceleration", ""
+    else:
+        return _KINDS.get(parts[-1]), ""
+    joints = result.get("joints") if isinstance(result, dict) else None
+    about = joints.get(joint) if isinstance(joints, dict) else None
+    joint_type = str(about.get("type")) if isinstance(about, dict) else ""
+    family = _JOINT_FAMILIES.get(joint_type)
+    if family is None:
+        return None, ""
+    kind = JOINT_KINDS[family][index] if index is not None else "torque" if family == "revolute" else "force"
+    return kind, f" (joint {joint} is {joint_type})"
 
 
-def lookup(result: dict[str, Any], quantity: str, component: int | None, *, where: str = "") -> float:
-    """A number of a `pinmech solve --json` result, by dotted path and component."""
+def lookup(result: dict[str, Any], quantity: str, component: int | str | None, *, where: str = "",
+           path: str | None = None) -> float:
+    """A number of a `pinmech solve --json` result, by dotted path and component
+    (`where`, `path`: the entry and hand file, for errors)."""
     node: Any = result
     for part in quantity.split("."):
         if not isinstance(node, dict) or part not in node:
             known = ", ".join(node) if isinstance(node, dict) else "nothing"
-            raise SceneError(f"{quantity!r}: no '{part}' in the result (has {known})", key=where)
+            raise SceneError(f"{quantity!r}: no '{part}' in the result (has {known})", path=path, key=where)
         node = node[part]
     if component == "norm":
         numbers = node if isinstance(node, list) else [node]
         if not numbers or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in numbers):
-            raise SceneError(f"{quantity!r} has no magnitude: it is not a number or a vector of the result", key=where)
+            raise SceneError(f"{quantity!r} has no magnitude: it is not a number or a vector of the result",
+                             path=path, key=where)
         return math.hypot(*numbers)
     if isinstance(node, list):
         if component is None:
             raise SceneError(f"{quantity!r} is a vector: add .x, .y, .z or .norm, or give a list of hand values",
-                             key=where)
-        node = node[component] if component < len(node) else None
+                             path=path, key=where)
+        if component >= len(node):
+            raise SceneError(f"{quantity!r} has {len(node)} components, no {'xyz'[component]}", path=path, key=where)
+        node = node[component]
+    elif component is not None and isinstance(node, (int, float)) and not isinstance(node, bool):
+        raise SceneError(f"{quantity!r} is a number, not a vector: give one hand value, without .x, .y or .z",
+                         path=path, key=where)
     if isinstance(node, bool) or not isinstance(node, (int, float)):
-        raise SceneError(f"{quantity!r} is not a number of the result", key=where)
+        raise SceneError(f"{quantity!r} is not a number of the result", path=path, key=where)
     return float(node)
 
 
@@ -200,13 +324,20 @@ def compare(result: dict[str, Any], values: list[HandValue], slack: float = DEFA
     compared with the equivalent of pinmech's nearest it (413.794 deg is 53.794 deg).
 
     Raises:
-        SceneError: a slack that is not a number from 0 to `MAX_SLACK`.
+        SceneError: a slack that is not a number from 0 to `MAX_SLACK`; a path not in the
+            result.
+        UnitError: a value whose kind (and unit) is not the quantity's: a prismatic
+            joint's q in degrees.
     """
     check_slack(slack)
+    for hv in values:  # the kinds first: no verdict on a value read in the wrong unit
+        expected, why = _path_kind(hv.quantity, result)
+        if expected is not None and expected != hv.kind:
+            raise _misfit(hv, expected, hv.where, hv.kind, why)
     out = []
     for hv in values:
-        factor = to_si(f"1 {hv.unit}", hv.kind)
-        computed = lookup(result, hv.quantity, hv.component, where=hv.label) / factor
+        factor = _unit_factor(hv, hv.where)
+        computed = lookup(result, hv.quantity, hv.component, where=hv.where, path=hv.file or None) / factor
         if hv.kind == "angle" and hv.component != "norm":
             turn = 2 * math.pi / factor  # a full turn in the hand unit
             computed += turn * round((hv.value - computed) / turn)

@@ -314,6 +314,14 @@ def test_sweep_tolerance_range(r_rtr_scene, capsys, tol):
         ('quantity = "joints.A.q"\nhand = ["1"]\nunit = "deg"\nkind = "temperature"', "kind = 'temperature' is not one of"),
         ('quantity = "points.D"\nhand = ["1"]\nunit = "m"\nkind = "length"', "is not a number of the result"),
         ('quantity = "points.Z.position"\nhand = ["1", "0"]\nunit = "m"', "no 'Z' in the result"),
+        ('quantity = "links.link3.angle"\nhand = ["53.794"]\nunit = "deg"\nknd = "angle"',
+         "unknown key 'knd' (did you mean 'kind'?)"),
+        ('quantity = "points.D.velocity.x"\nhand = ["0.936", "0.936"]\nunit = "m/s"', "is one component"),
+        ('quantity = "points.D.velocity.x"\nhand = ["53.62"]\nunit = "deg/s"\nkind = "angular_velocity"',
+         "'points.D.velocity' is a velocity, not an angular velocity"),
+        ('quantity = "joints.B_slider.q"\nhand = ["-3.4"]\nunit = "deg"\nkind = "angle"',
+         "'joints.B_slider.q' is a length (joint B_slider is prismatic), not an angle"),
+        ('quantity = "points.D.velocity"\nhand = ["0.9", "0.1"]\nunit = "rpm"', "unit = 'rpm' says"),
     ],
 )
 def test_hand_file_mistakes(copies, capsys, entry, message):
@@ -321,7 +329,23 @@ def test_hand_file_mistakes(copies, capsys, entry, message):
     hand.write_text(f'scene = "r_rtr.toml"\n[[value]]\n{entry}\n')
     code, err = _run(capsys, "check", hand)
     assert code == 4 and message in err, err
-    _one_line_error(code, err)
+    _one_line_error(code, err, "h.toml")
+
+
+@pytest.mark.parametrize(
+    "values, message",
+    [
+        ("", "no [[value]] to check"),
+        ('[[values]]\nquantity = "points.D.velocity"\nhand = ["0.9", "0.1"]\nunit = "m/s"\n',
+         "unknown key 'values' (did you mean [[value]]?)"),
+    ],
+)
+def test_a_hand_file_that_checks_nothing_does_not_pass(copies, capsys, values, message):
+    hand = copies / "h.toml"
+    hand.write_text(f'scene = "r_rtr.toml"\n{values}')
+    code, err = _run(capsys, "check", hand)
+    assert code == 4 and message in err, err
+    _one_line_error(code, err, "h.toml")
 
 
 def test_hand_file_values_must_be_tables(copies, capsys):

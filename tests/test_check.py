@@ -14,6 +14,7 @@ import pytest
 
 from pinmech import SceneError, analyse, compare, load_hand_file, to_dict
 from pinmech.check import HandValue, format_verdicts
+from pinmech.exceptions import UnitError
 from pinmech.scene import Scene
 
 
@@ -137,3 +138,115 @@ def test_a_slack_that_is_not_a_small_number_of_digits_is_refused(slack, capsys):
     assert "--slack must be a number from 0 to 100" in capsys.readouterr().err
     with pytest.raises(SceneError, match="slack must be"):
         compare({}, [], float(slack))
+
+
+# ------------------------------------------------------------- a hand file checks what it says
+def _hand_file(tmp_path, body: str, scene: str = "r_rtr.toml"):
+    from tests.conftest import SCENES
+
+    path = tmp_path / "h.hand.toml"
+    path.write_text(f'scene = "{SCENES / scene}"\n{body}')
+    return path
+
+
+def _entry(quantity: str, hand: str, unit: str, extra: str = "") -> str:
+    return f'[[value]]\nquantity = "{quantity}"\nhand = {hand}\nunit = "{unit}"\n{extra}'
+
+
+def test_a_misspelled_values_table_is_refused_not_checked_as_nothing(tmp_path):
+    path = _hand_file(tmp_path, _entry("points.D.velocity", '["0.386", "-0.282"]', "m/s").replace("[[value]]", "[[values]]"))
+    with pytest.raises(SceneError, match=r"h\.hand\.toml, values: unknown key 'values' \(did you mean \[\[value\]\]\?\)"):
+        load_hand_file(path)
+
+
+def test_a_misspelled_key_of_a_value_is_refused(tmp_path):
+    path = _hand_file(tmp_path, _entry("links.link3.angle", '["53.794"]', "deg", 'knd = "angle"\n'))
+    with pytest.raises(SceneError, match=r"h\.hand\.toml, value\[0\]\.knd: unknown key 'knd' \(did you mean 'kind'\?\)"):
+        load_hand_file(path)
+
+
+@pytest.mark.parametrize("body", ["", "value = []\n", 'source = "p. 12"\n'])
+def test_a_hand_file_with_nothing_to_check_is_an_error_not_a_pass(tmp_path, body):
+    with pytest.raises(SceneError, match=r"h\.hand\.toml, value: no \[\[value\]\] to check"):
+        load_hand_file(_hand_file(tmp_path, body))
+
+
+def test_a_component_path_takes_one_printed_value(tmp_path):
+    # v_D = (0.935792, -0.685048) m/s: a second "0.936" is not v_D,y and must not be labelled so.
+    path = _hand_file(tmp_path, _entry("points.D.velocity.x", '["0.936", "0.936"]', "m/s"))
+    with pytest.raises(SceneError, match=r"value\[0\]: 'points.D.velocity.x' is one component: give one printed "
+                                         r"value, or list x, y \(, z\) on 'points.D.velocity'"):
+        load_hand_file(path)
+
+
+def test_a_list_of_values_on_a_number_of_the_result_is_refused():
+    angle = {"links": {"L": {"angle": 0.938882}}}
+    for component in (0, 1):
+        with pytest.raises(SceneError, match=r"'links.L.angle' is a number, not a vector"):
+            compare(angle, [HandValue(f"phi {component}", "links.L.angle", component, "53.79", "deg", "angle")])
+
+
+def test_a_vector_has_no_fourth_component():
+    with pytest.raises(SceneError, match=r"'points.B.position' has 2 components, no z"):
+        compare({"points": {"B": {"position": [0.1, 0.2]}}}, [HandValue("z", "points.B.position", 2, "0", "m", "length")])
+
+
+@pytest.mark.parametrize(
+    "quantity, hand, unit, kind, message",
+    [
+        # m/s read as deg/s, rad/s as mm/s: each was "ok"
+        ("points.D.velocity.x", '["53.62"]', "deg/s", "angular_velocity",
+         (r"'points.D.velocity' is a velocity, not an angular velocity as kind = 'angular_velocity' and "
+          r"unit = 'deg/s' say: give it in m/s \(or another velocity unit\)")),
+        ("links.link3.angular_velocity.z", '["-7732"]', "mm/s", "velocity",
+         (r"'links.link3.angular_velocity' is an angular velocity, not a velocity as kind = 'velocity' and "
+          r"unit = 'mm/s' say: give it in rad/s")),
+        ("points.D.position.x", '["0.1386"]', "m", "angle", r"'points.D.position' is a length, not an angle"),
+        ("points.D.velocity", '["0.9", "0.1"]', "rpm", None,
+         r"'points.D.velocity' is a velocity, not an angular velocity as unit = 'rpm' says"),
+    ],
+)
+def test_a_unit_must_have_the_dimension_of_the_quantity(tmp_path, quantity, hand, unit, kind, message):
+    extra = f'kind = "{kind}"\n' if kind else ""
+    path = _hand_file(tmp_path, _entry(quantity, hand, unit, extra))
+    with pytest.raises(UnitError, match=r"h\.hand\.toml, value\[0\]: " + message):
+        load_hand_file(path)
+
+
+def test_a_joint_coordinate_is_checked_in_the_joint_s_own_kind():
+    # B_slider is prismatic: its q is a length, however kind and unit are declared.
+    result = {"joints": {"B_slider": {"q": -0.061966, "v": 0.2112, "type": "prismatic"},
+                         "A": {"q": 0.5236, "type": "continuous"}}}
+    slider_in_degrees = HandValue("q", "joints.B_slider.q", None, "-3.4", "deg", "angle", file="h.toml", entry="value[1]")
+    with pytest.raises(UnitError, match=r"h\.toml, value\[1\] \(q\): 'joints.B_slider.q' is a length \(joint B_slider is "
+                                        r"prismatic\), not an angle as kind = 'angle' and unit = 'deg' say"):
+        compare(result, [slider_in_degrees])
+    crank_in_mm = HandValue("q", "joints.A.q", None, "523.6", "mm", "length")
+    with pytest.raises(UnitError, match=r"'joints.A.q' is an angle \(joint A is continuous\)"):
+        compare(result, [crank_in_mm])
+    right = [HandValue("q", "joints.B_slider.q", None, "-61.97", "mm", "length"),
+             HandValue("v", "joints.B_slider.v", None, "0.2112", "m/s", "velocity"),
+             HandValue("q", "joints.A.q", None, "30.00", "deg", "angle")]
+    assert [v.verdict for v in compare(result, right)] == ["ok", "ok", "ok"]
+
+
+def test_hand_file_errors_name_the_hand_file_and_the_unit_as_written(tmp_path):
+    path = _hand_file(tmp_path, _entry("points.D.velocity", '["0.9", "0.1"]', "rpm"))
+    with pytest.raises(UnitError, match=r"^\S*h\.hand\.toml, value\[0\]: .*unit = 'rpm' says") as raised:
+        load_hand_file(path)
+    assert "'1 rpm'" not in str(raised.value)
+    path = _hand_file(tmp_path, _entry("points.DD.velocity", '["0.9", "0.1"]', "m/s"))
+    hand = load_hand_file(path)
+    with pytest.raises(SceneError, match=r"^\S*h\.hand\.toml, value\[0\] \(points.DD.velocity x\): 'points.DD.velocity': "
+                                         r"no 'DD' in the result \(has A, B\)"):
+        compare({"points": {"A": {}, "B": {}}}, hand.values)
+    path = _hand_file(tmp_path, _entry("points.D.velocity", '["0.9", "0.1"]', "blorps/s"))
+    with pytest.raises(UnitError, match=r"^\S*h\.hand\.toml, value\[0\]\.unit: cannot read quantity 'blorps/s'"):
+        load_hand_file(path)
+
+
+def test_a_missing_scene_is_named_with_the_hand_file(tmp_path):
+    path = tmp_path / "h.hand.toml"
+    path.write_text('scene = "nope.toml"\n' + _entry("points.D.velocity", '["0.9", "0.1"]', "m/s"))
+    with pytest.raises(SceneError, match=r"h\.hand\.toml, scene: scene = 'nope.toml': no such scene file \(.*nope\.toml\)"):
+        load_hand_file(path)
