@@ -387,3 +387,12 @@ def test_the_speed_fluctuation_of_a_heavy_flywheel_is_that_of_the_energy_equatio
     speed = np.sqrt(2 * (energy - potential) / (flywheel + inertia))
     exact = (speed.max() - speed.min()) / (0.5 * (speed.max() + speed.min()))
     assert predicted == pytest.approx(exact, rel=2e-3)
+
+
+def test_a_negative_mass_is_named_as_such(tmp_path, models_dir):
+    """link3 at -0.15 kg was reported as having no <inertial> mass."""
+    text = (models_dir / "r_rtr.urdf").read_text().replace('<mass value="0.15"/>', '<mass value="-0.15"/>')
+    path = tmp_path / "r_rtr.urdf"
+    path.write_text(text)
+    with pytest.raises(ModelError, match=r"mass of -0\.15 kg: a mass must be a positive number"):
+        ForceSolver(pinmech.Mechanism.from_urdf(path), ["A"])
