@@ -182,7 +182,7 @@ class Mechanism:
         mech = cls(
             model=model,
             closures=[],
-            joints=_joint_infos(model, joint_links),
+            joints=_joint_infos(model, joint_links, source),
             links={n: _body_frame(model, n) for n in links_xml if n not in point_names and model.existBodyName(n)},
             points={n: _body_frame(model, n) for n in point_names if model.existBodyName(n)},
             length_scale=1.0,
@@ -257,7 +257,7 @@ class Mechanism:
             joint_links[model.names[jid]] = (parent, child)
         if points is None:
             points = [f.name for f in model.frames if f.type == pin.FrameType.OP_FRAME]
-        mech = cls(model=model, closures=[], joints=_joint_infos(model, joint_links),
+        mech = cls(model=model, closures=[], joints=_joint_infos(model, joint_links, source),
                    links={n: _body_frame(model, n) for n in bodies},
                    points={n: model.getFrameId(n) for n in points}, length_scale=1.0, plane_normal=None,
                    source=source, urdf_path=urdf_path, locked=dict(locked or {}))
@@ -737,8 +737,12 @@ def _joint_kind(joint: pin.JointModel) -> str:
     return "other"
 
 
-def _joint_axis(joint: pin.JointModel) -> np.ndarray:
-    """Unit axis of a one-dof joint in its own frame (motion subspace)."""
+def _joint_axis(joint: pin.JointModel, name: str, source: str) -> np.ndarray:
+    """Unit axis of a one-dof joint in its own frame (motion subspace).
+
+    Raises:
+        ModelError: an axis of zero length (or not finite): the joint would move nothing.
+    """
     if joint.nv != 1:
         return np.zeros(3)
     data = joint.createData()
@@ -748,16 +752,20 @@ def _joint_axis(joint: pin.JointModel) -> np.ndarray:
     joint.calc(data, q)
     S = np.array(data.S).reshape(6, 1)[:, 0]
     part = S[3:] if np.linalg.norm(S[3:]) > 0 else S[:3]
-    return part / np.linalg.norm(part)
+    norm = float(np.linalg.norm(part))
+    if not (norm > 0 and np.isfinite(norm)):
+        raise ModelError(f"the axis of joint {name} is {np.round(part, 6).tolist()}: not a direction, the joint "
+                         "would move nothing", path=source, element=f"<joint name=\"{name}\"> <axis>")
+    return part / norm
 
 
-def _joint_infos(model: pin.Model, joint_links: dict[str, tuple[str, str]]) -> dict[str, JointInfo]:
+def _joint_infos(model: pin.Model, joint_links: dict[str, tuple[str, str]], source: str) -> dict[str, JointInfo]:
     infos = {}
     for jid in range(1, model.njoints):
         joint, name = model.joints[jid], model.names[jid]
         parent, child = joint_links.get(name, (model.names[model.parents[jid]], name))
         infos[name] = JointInfo(name, jid, _joint_kind(joint), joint.idx_q, joint.idx_v, joint.nq, joint.nv,
-                                parent, child, _joint_axis(joint))
+                                parent, child, _joint_axis(joint, name, source))
     return infos
 
 

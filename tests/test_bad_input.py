@@ -181,11 +181,13 @@ LAUGHS = ('<!DOCTYPE robot [<!ENTITY a "aaaaaaaaaa">' + "".join(
         ('<parent_origin xyz="0.05 0 0"', '<parent_orgin xyz="0.05 0 0"', 3, "unknown element <parent_orgin>"),
         ('<parent_origin xyz="0.05 0 0"', '<parent_origin xzy="0.05 0 0"', 3, 'unknown attribute xzy="0.05 0 0"'),
         (R_RTR_CUT, R_RTR_CUT.replace('type=', 'kind="pin" type='), 3, 'unknown attribute kind="pin"'),
+        # a joint's zero axis: a numpy warning, then "out of reach for these dimensions" (exit 6)
+        ('<axis xyz="1 0 0"/>', '<axis xyz="0 0 0"/>', 3, "the axis of joint B_slider is [0.0, 0.0, 0.0]"),
     ],
     ids=["nan origin", "inf origin", "1e300 origin", "nan cut origin", "zero axis", "negative length",
          "unknown link", "cut to itself", "unknown cut type", "over-constrained", "out of plane",
          "joint cycle", "duplicate cut", "unused external entity", "external entity", "billion laughs",
-         "misspelled element", "misspelled attribute", "unknown constraint attribute"],
+         "misspelled element", "misspelled attribute", "unknown constraint attribute", "zero joint axis"],
 )
 def test_urdf_mistakes(copies, capsys, old, new, code, message):
     got, err = _run(capsys, "solve", _r_rtr(copies, old, new))
