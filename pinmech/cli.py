@@ -658,6 +658,8 @@ def cmd_polygon(args: argparse.Namespace) -> int:
     args.acceleration = None  # the flag names the polygon here, not the driver's acceleration
     scene = _scene(args)
     _check_page(args, scene)
+    if Path(args.output).suffix.lower() != ".svg":  # SVG text under p.png was written and called done
+        raise PinmechError(f"-o {args.output}: the polygon is an SVG drawing; name the file *.svg")
     analysis = analyse(scene)
     polygon = (acceleration_polygon if args.acceleration_polygon else velocity_polygon)(analysis)
     _write_text(args.output, polygon_svg(polygon), "SVG drawing")

@@ -196,3 +196,10 @@ def test_the_svg_file_is_made_as_any_file_is(tmp_path):
     os.umask(umask)
     assert out.stat().st_mode & 0o777 == 0o666 & ~umask
     assert [p.name for p in tmp_path.iterdir()] == ["v.svg"]  # no temporary file left
+
+
+def test_a_polygon_is_written_only_under_an_svg_name(tmp_path, capsys):
+    """`-o p.png` wrote SVG text under a PNG name and said it was done."""
+    out = tmp_path / "p.png"
+    assert main(["polygon", str(SCENES / "r_rtr.toml"), "-o", str(out)]) == 2
+    assert "name the file *.svg" in capsys.readouterr().err and not out.exists()
