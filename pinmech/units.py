@@ -231,7 +231,17 @@ def _wrong_kind(text: str, kind: str, has_angle: bool, powers: dict[str, Any] | 
 
 
 def _no_unit(value: Any, kind: str) -> str:
+    number = value if isinstance(value, (int, float)) else _leading_number(value)
+    if number is not None and not math.isfinite(number):  # "nan rpm" is refused too: say what is wrong
+        return f"{value!r} is not a finite number ({kind.replace('_', ' ')})"
     return f"{value!r} has no unit: write it as '{value} {_example(kind)}' ({kind.replace('_', ' ')})"
+
+
+def _leading_number(text: str) -> float | None:
+    try:
+        return float(str(text).split()[0])
+    except (ValueError, IndexError):
+        return None
 
 
 def _article(kind: str) -> str:

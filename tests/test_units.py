@@ -192,3 +192,10 @@ def test_minutes_and_seconds_of_arc_by_their_marks_alone(text, arcmin):
     """The marks ' and " (and the primes) with no degrees before them: an internal pint
     AssertionError before; now the arc minute (pi/10800 rad) and second (1/60 of it)."""
     assert to_si(text, "angle") == pytest.approx(arcmin * math.pi / 10800, rel=1e-15)
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), "nan", "-inf"])
+def test_a_bare_non_finite_number_is_called_so_not_told_to_take_a_unit(value):
+    """'nan' was told to be written 'nan rpm', which is refused in turn."""
+    with pytest.raises(UnitError, match="is not a finite number"):
+        to_si(value, "angular_velocity")
