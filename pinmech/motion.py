@@ -145,9 +145,39 @@ def evaluate_motion(
         joints=_joint_motions(mechanism, q, v, a),
         links=link_motion,
         points=point_motion,
-        sliders={n: _slider(mechanism, data, n, float(v[j.idx_v]), float(a[j.idx_v]))
-                 for n, j in mechanism.joints.items() if j.kind == "prismatic"},
+        sliders=_sliders(mechanism, data, v, a),
     )
+
+
+def _sliders(mechanism: Mechanism, data: pin.Data, v: np.ndarray, a: np.ndarray) -> dict[str, SliderMotion]:
+    """Every prismatic joint of the tree, and every prismatic loop cut (a drawn pin-in-slot
+    is cut at its slide), by name."""
+    out = {n: _slider(mechanism, data, n, float(v[j.idx_v]), float(a[j.idx_v]))
+           for n, j in mechanism.joints.items() if j.kind == "prismatic"}
+    for closure in mechanism.closures:
+        if closure.cut_type == "prismatic" and closure.name not in out:
+            out[closure.name] = _cut_slider(mechanism, data, closure)
+    return out
+
+
+def _cut_slider(mechanism: Mechanism, data: pin.Data, closure) -> SliderMotion:
+    """The child cut frame's origin relative to the parent link (the slot), by the
+    relative-motion formulas: v_rel = v_C - (v_P + w x r), a_rel = a_C - (a_P + alpha x r
+    + w x (w x r)) - 2 w x v_rel, with r from the parent cut frame's origin to C's."""
+    model = mechanism.model
+    parent, child = closure.parent_frame, closure.child_frame
+    r = data.oMf[child].translation - data.oMf[parent].translation
+    vel_p = pin.getFrameVelocity(model, data, parent, _LWA)
+    acc_p = pin.getFrameClassicalAcceleration(model, data, parent, _LWA)
+    alpha = pin.getFrameAcceleration(model, data, parent, _LWA).angular
+    w = vel_p.angular
+    v_c = pin.getFrameVelocity(model, data, child, _LWA).linear
+    a_c = pin.getFrameClassicalAcceleration(model, data, child, _LWA).linear
+    v_rel = v_c - (vel_p.linear + _cross(w, r))
+    coriolis = 2.0 * _cross(w, v_rel)
+    a_rel = a_c - (acc_p.linear + _cross(alpha, r) + _cross(w, _cross(w, r))) - coriolis
+    return SliderMotion(parent=closure.parent_link, child=closure.child_link, relative_velocity=v_rel,
+                        relative_acceleration=a_rel, coriolis_acceleration=coriolis)
 
 
 def _vector(x: Any, size: int, name: str, mechanism: Mechanism) -> np.ndarray:

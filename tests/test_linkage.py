@@ -154,6 +154,14 @@ def test_inverted_slider_crank_matches_r_rtr_closed_form_and_hand_urdf(models_di
     theirs = follow(hand, "A", values, omega=3.0, alpha=-1.0, start=guess, points=["D"])
     np.testing.assert_allclose([m.points["D"].acceleration for m in motions],
                                [m.points["D"].acceleration for m in theirs], atol=REL_TOL * np.max(np.abs(ref.aD)))
+    # the slot is the drawn model's loop cut: its slide is reported as the hand URDF's tree slider, from the
+    # other side (the block on the guide, not link 3 on the block): every vector the opposite of the URDF's
+    for ours, hands in zip(motions, theirs):
+        slot, slider = ours.sliders["B_slide"], hands.sliders["B_slider"]
+        for name in ("relative_velocity", "relative_acceleration", "coriolis_acceleration"):
+            want = -getattr(slider, name)
+            np.testing.assert_allclose(getattr(slot, name), want, atol=REL_TOL * max(1.0, np.max(np.abs(want))))
+        assert (slot.parent, slot.child) == ("guide", "B_block")
 
 
 def test_drawn_slider_crank_moves_as_the_bundled_hand_urdf(models_dir, tmp_path):
