@@ -259,7 +259,7 @@ class LoopSolver:
         self._step = np.zeros(self.model.nv)
         self._dep_scale = mechanism.velocity_scale()[self._dep_v]  # dimensionless columns
         self._v_scale_inv = 1.0 / mechanism.velocity_scale()
-        self.dep_is_scalar = [self._joint_nv(int(v)) == 1 for v in self._dep_v]
+        self.dep_is_scalar = [self._one_coordinate(int(v)) for v in self._dep_v]
         self._zero_a = np.zeros(self.model.nv)
         self.structure = AssemblyStructure(self.model, mechanism.closures, self._dep_v, mechanism.plane_normal)
         self.reference: Reference | None = None
@@ -304,6 +304,23 @@ class LoopSolver:
             q, _, _ = self.close(ref.q, ref.driver_q)
             signs = self._rates(q, np.zeros(len(self.drivers)), np.zeros(len(self.drivers)))[-1]
             self.reference = Reference(ref.driver_q, q, signs, ref.keep)
+
+    def _one_coordinate(self, v: int) -> bool:
+        """Velocity index v moves one coordinate alone: a one-freedom joint, or a one-freedom
+        joint inside a composite (MJCF's several hinges in one body), which the
+        continuation can hold fixed as its curve's parameter."""
+        for joint in self.model.joints[1:]:
+            if joint.idx_v <= v < joint.idx_v + joint.nv:
+                if joint.nv == 1:
+                    return True
+                if joint.shortname() != "JointModelComposite":
+                    return False
+                offset = joint.idx_v
+                for part in joint.extract().joints:
+                    if offset <= v < offset + part.nv:
+                        return part.nv == 1
+                    offset += part.nv
+        return False
 
     def _joint_nv(self, v: int) -> int:
         for joint in self.model.joints[1:]:

@@ -488,3 +488,43 @@ def test_forces_that_fail_their_power_balance_are_an_error(tmp_path, monkeypatch
     assert main(["forces", str(scene)]) == 13
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and "fail their own check" in err
+
+
+RUSR = """<mujoco model="rusr"><compiler angle="radian"/>
+  <default><geom type="sphere" size="0.01" mass="0.5"/></default>
+  <worldbody>
+    <body name="crank"><joint name="crank" type="hinge" axis="0 0 1"/><geom/>
+      <body name="coupler" pos="0.1 0 0">
+        <joint name="u1" type="hinge" axis="0 0 1"/><joint name="u2" type="hinge" axis="0.3 -0.2 0.9"/>
+        <geom pos="0.1 0.05 0.03"/><site name="E" pos="0.25 0.12 0.08"/></body></body>
+    <body name="rocker" pos="0.3 0.25 -0.05"><joint name="rock" type="hinge" axis="1 0.2 0.1"/>
+      <geom pos="0.05 -0.05 0.02"/></body>
+  </worldbody>
+  <equality><connect name="S" body1="coupler" body2="rocker" anchor="0.25 0.12 0.08"/></equality>
+</mujoco>"""
+
+
+def test_a_fold_followed_through_a_composite_joint_is_a_driver_limit(tmp_path):
+    """A spatial RUSR whose universal joint is two hinges in one body (one composite joint
+    in Pinocchio). Its crank's limit near -14.44 deg was an AssemblyError naming -14.32 deg:
+    near the fold only the composite's hinges move fast enough to follow the curve by, and
+    they were not allowed as its parameter. Now the limit is named (DriverLimitError), between
+    the crank values where MuJoCo's own equality closes (-14.43 deg) and cannot (-14.44 deg);
+    0.006 deg inside it pinmech's pose closes MuJoCo's equality to 1e-12 m."""
+    from pinmech.exceptions import DriverLimitError
+
+    path = tmp_path / "rusr.xml"
+    path.write_text(RUSR)
+    mech = load_mjcf(path)
+    solver = LoopSolver(mech, ["crank"])
+    solver.set_reference([0.0], mech.neutral())
+    with pytest.raises(DriverLimitError) as err:
+        solver.solve([np.radians(-20.0)])
+    limit = err.value.limit[0]
+    assert np.radians(-14.44) < limit < np.radians(-14.43)
+    q = solver.solve([limit + 1e-4]).q  # 0.006 deg inside: condition number about 2e3
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    set_qpos(mech, q, m, d)
+    eq = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+    np.testing.assert_allclose(d.efc_pos[eq], 0.0, atol=1e-12)
