@@ -386,11 +386,9 @@ class _Cycle:
                 raise fail from None
             raise
         solver = self.solver
-        self.ref = node
-        self.q_drv[self.k] = node.p
         accuracy = Accuracy(0.0, 0, node.condition, node.sigma_min, node.velocity_residual,
                             node.acceleration_residual)
-        if node.condition > solver.max_condition:
+        if node.condition > solver.max_condition:  # not a pose to go on from: the reference stays
             try:
                 solver._residual(node.q)
                 solver._rates(node.q, self.zero, self.zero)  # raises SingularPoseError, named
@@ -398,6 +396,8 @@ class _Cycle:
                 if fail is not None:
                     raise fail from None
                 raise
+        self.ref = node  # the next pose goes on from this one (a singular one, e.g. a
+        self.q_drv[self.k] = node.p  # parallelogram's change point, has no one tangent)
         residual = node.residual
         accuracy = Accuracy(residual, self._iterations, *(getattr(accuracy, f) for f in _ACCURACY[2:]))
         sol = LoopSolution(node.q, node.d1, node.d2, accuracy, solver.drivers)

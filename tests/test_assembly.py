@@ -277,6 +277,35 @@ def test_a_parallelogram_keeps_its_branch_through_the_change_points(tmp_path):
     assert sum("change point" in n for n in notes) == 2
 
 
+@pytest.mark.parametrize("core", [True, False])
+def test_a_parallelogram_swept_onto_its_change_points_keeps_its_branch_after_each(tmp_path, monkeypatch, core):
+    """60 deg apart from 60 deg backwards, poses land exactly on the change points (0, -180,
+    -360, -540 deg): those fail by name (singular), and every other row is the
+    parallelogram (rocker parallel to the crank) after a note. A failed singular pose used
+    to become the sweep's reference, and the next pose, followed from a point where both
+    branches meet, came out on the antiparallelogram in silence (from -600 deg on)."""
+    import pinmech.core
+
+    monkeypatch.setattr(pinmech.core, "ENABLED", core)
+    a, b = 0.04, 0.10
+    mech = _four_bar(tmp_path, a, b, a, b)
+    solver = LoopSolver(mech, ["O2"])
+    q = mech.neutral()
+    mech.set_coordinate(q, "O2", math.radians(60))
+    mech.set_coordinate(q, "A", -math.radians(60))
+    mech.set_coordinate(q, "O4", math.radians(60))
+    solver.set_reference([math.radians(60)], q)
+    values = np.radians(60 - 60.0 * np.arange(1, 14))
+    qs, errors, notes = _sweep(solver, values)
+    for i, (theta, qi) in enumerate(zip(values, qs)):
+        if i in errors:
+            assert isinstance(errors[i], (SingularPoseError, AssemblyError)), errors[i]
+            assert abs(math.remainder(theta, math.pi)) < 1e-9  # only at the change points
+            continue
+        assert abs(math.remainder(mech.coordinate(qi, "O4") - theta, 2 * math.pi)) < 1e-12, math.degrees(theta)
+    assert sum("change point" in n for n in notes) >= 3
+
+
 # ---------------------------------------------------------------------- hypothesis
 @settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(a=st.floats(0.02, 0.1), b=st.floats(0.05, 0.15), c=st.floats(0.03, 0.12), d=st.floats(0.05, 0.12),
