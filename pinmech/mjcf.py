@@ -60,6 +60,7 @@ def _parse(path: Path) -> ET.Element:
     if root.find("include") is not None or root.find(".//include") is not None:
         raise ModelError("<include> is not supported: give pinmech the whole model in one file", path=str(path))
     _apply_defaults(root, str(path))
+    _check_spelling(root, str(path))
     _check_numbers(root, str(path))
     _eulers_as_quaternions(root, str(path))
     _fromto_sites(root, str(path))
@@ -164,6 +165,44 @@ def _apply_defaults(root: ET.Element, source: str) -> None:
     for el in root.iter():
         el.attrib.pop("class", None)
         el.attrib.pop("childclass", None)
+
+
+# ---------------------------------------------------------------- spelling
+#: attributes the kinematics and masses are read from: a near miss of one of these is a typo
+_READ = ("pos", "quat", "axisangle", "euler", "xyaxes", "zaxis", "axis", "ref", "type", "anchor", "body1",
+         "body2", "site1", "site2", "mass", "density", "diaginertia", "fullinertia", "fromto", "size", "name",
+         "class", "childclass", "active", "relpose", "mesh")
+#: other attributes of MuJoCo's body, joint, geom, site, inertial, connect and weld
+_OTHER = frozenset((
+    "group", "springdamper", "limited", "actuatorfrclimited", "solreflimit", "solimplimit", "solreffriction",
+    "solimpfriction", "stiffness", "range", "actuatorfrcrange", "actuatorgravcomp", "margin", "springref",
+    "armature", "damping", "frictionloss", "user", "contype", "conaffinity", "condim", "priority", "material",
+    "friction", "shellinertia", "solmix", "solref", "solimp", "gap", "hfield", "fitscale", "rgba", "fluidshape",
+    "fluidcoef", "gravcomp", "mocap", "torquescale", "polycoef", "joint1", "joint2", "align"))
+_SPELLED = ("body", "joint", "geom", "site", "inertial", "connect", "weld")
+
+
+def _check_spelling(root: ET.Element, source: str) -> None:
+    """An attribute of a body, joint, geom, site, inertial, connect or weld that is not
+    MuJoCo's but a near miss of one the kinematics or masses are read from (`anchr`,
+    `eular`, `mas`) is refused: Pinocchio's parser skips it, and a connect's anchor
+    then sits at the body's origin (another linkage), a mass comes from the density.
+    MuJoCo itself refuses any unknown attribute; attributes far from these are left to
+    it, as a newer MuJoCo may know them."""
+    import difflib
+
+    for section in root.findall("worldbody") + root.findall("equality"):
+        for el in section.iter():
+            if el.tag not in _SPELLED:
+                continue
+            for key in el.attrib:
+                if key in _READ or key in _OTHER:
+                    continue
+                near = difflib.get_close_matches(key, _READ, n=1, cutoff=0.7)
+                if near:
+                    raise ModelError(f"unknown attribute {key}=\"{el.get(key)}\": did you mean {near[0]}? "
+                                     "(Pinocchio's parser would skip it)", path=source,
+                                     element=f"<{el.tag} name=\"{el.get('name', '')}\">")
 
 
 # ---------------------------------------------------------------- numbers

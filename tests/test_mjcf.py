@@ -181,6 +181,9 @@ def _variant(tmp_path, old: str, new: str, name: str = "four_bar") -> Path:
     ('<body name="coupler" pos="0.04 0 0"', '<body name="coupler" pos="0.04 0"', ["not 3 finite numbers"]),
     ('<site name="P" pos="0.06 0.03 0"/>', '<site name="P" pos="0.06 0.03 nan"/>', ['<site name="P">', "nan"]),
     ('anchor="0.12 0 0"/>', 'anchor="0.12 0 0 1"/>', ["anchor=", "not 3 finite numbers"]),
+    # a misspelled attribute the kinematics read was skipped: the anchor at the body's origin, another linkage
+    ('anchor="0.12 0 0"/>', 'anchr="0.12 0 0"/>', ["<connect name=\"B\">", "anchr=", "did you mean anchor"]),
+    ('<site name="P" pos="0.06 0.03 0"/>', '<site name="P" poss="0.06 0.03 0"/>', ["did you mean pos"]),
 ])
 def test_refusals_are_one_line_naming_file_and_element(tmp_path, capsys, old, new, words):
     path = _variant(tmp_path, old, new)
