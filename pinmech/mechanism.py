@@ -157,6 +157,7 @@ class Mechanism:
         path = Path(path)
         source = str(path)
         root = _parse_xml(path)
+        _check_urdf_spelling(root, source)
         _check_locked(locked or {}, source)
         mimics = mimic_joints(root, source)
         full = _build_model(source, root_joint, mimic=bool(mimics))
@@ -584,6 +585,49 @@ def _parse_constraint(el: ET.Element, model: pin.Model, links: list[str], source
         sides[side] = (link, pin.SE3(pin.rpy.rpyToMatrix(rpy), xyz), axis / norm)
     return _Cut(name, cut_type, sides["parent"][0], sides["child"][0], sides["parent"][1], sides["child"][1],
                 sides["parent"][2], sides["child"][2], source)
+
+
+#: URDF elements whose children and attributes pinmech's kinematics and masses depend on,
+#: with what they hold (urdfdom skips anything else: a misspelled <orign> leaves the joint
+#: at the identity, another mechanism)
+_URDF_CHILDREN = {"joint": ("origin", "parent", "child", "axis", "calibration", "dynamics", "limit", "mimic",
+                            "safety_controller"),
+                  "inertial": ("origin", "mass", "inertia")}
+_URDF_ATTRIBUTES = {"origin": ("xyz", "rpy"), "axis": ("xyz",), "mass": ("value",),
+                    "inertia": ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), "parent": ("link",), "child": ("link",),
+                    "joint": ("name", "type")}
+
+
+def _check_urdf_spelling(root: ET.Element, source: str) -> None:
+    """A child of a <joint> or <inertial>, or an attribute of the elements the kinematics
+    and masses are read from, that is a near miss of a URDF name (<orgin>, xzy=) is
+    refused with the likely spelling; urdfdom would skip it in silence. Names far from
+    these are left alone (URDF files carry extensions)."""
+    import difflib
+
+    def near(name: str, known: tuple[str, ...]) -> str | None:
+        if name in known:
+            return None
+        swapped = [k for k in known if sorted(k) == sorted(name)]  # xzy for xyz
+        match = swapped or difflib.get_close_matches(name, known, n=1, cutoff=0.7)
+        return match[0] if match else None
+
+    elements = [(j, "joint", f"<joint name=\"{j.get('name', '')}\">") for j in root.iter("joint")]
+    elements += [(i, "inertial", f"<link name=\"{link.get('name', '')}\"> <inertial>")
+                 for link in root.iter("link") for i in link.findall("inertial")]
+    for el, parent_tag, where in elements:
+        for child in el:
+            if not isinstance(child.tag, str):  # a comment
+                continue
+            guess = near(child.tag, _URDF_CHILDREN[parent_tag])
+            if guess:
+                raise ModelError(f"unknown element <{child.tag}>: did you mean <{guess}>? (the URDF parser would "
+                                 "skip it)", path=source, element=where)
+            for key in child.attrib:
+                guess = near(key, _URDF_ATTRIBUTES.get(child.tag, ()))
+                if guess:
+                    raise ModelError(f"unknown attribute {key}=\"{child.get(key)}\" of <{child.tag}>: did you "
+                                     f"mean {guess}?", path=source, element=where)
 
 
 #: what a <constraint> holds: its attributes, and each child element with its attributes

@@ -183,11 +183,17 @@ LAUGHS = ('<!DOCTYPE robot [<!ENTITY a "aaaaaaaaaa">' + "".join(
         (R_RTR_CUT, R_RTR_CUT.replace('type=', 'kind="pin" type='), 3, 'unknown attribute kind="pin"'),
         # a joint's zero axis: a numpy warning, then "out of reach for these dimensions" (exit 6)
         ('<axis xyz="1 0 0"/>', '<axis xyz="0 0 0"/>', 3, "the axis of joint B_slider is [0.0, 0.0, 0.0]"),
+        # urdfdom skips a misspelled element or attribute: the joint at the identity, the mass at zero
+        ('<origin xyz="0.10 0 0" rpy="0 0 0"/>', '<orgin xyz="0.10 0 0" rpy="0 0 0"/>', 3,
+         "unknown element <orgin>: did you mean <origin>?"),
+        ('<origin xyz="0.10 0 0" rpy="0 0 0"/>', '<origin xzy="0.10 0 0" rpy="0 0 0"/>', 3, "did you mean xyz?"),
+        ('<mass value="0.15"/>', '<mass vaule="0.15"/>', 3, '<link name="link3"> <inertial>'),
     ],
     ids=["nan origin", "inf origin", "1e300 origin", "nan cut origin", "zero axis", "negative length",
          "unknown link", "cut to itself", "unknown cut type", "over-constrained", "out of plane",
          "joint cycle", "duplicate cut", "unused external entity", "external entity", "billion laughs",
-         "misspelled element", "misspelled attribute", "unknown constraint attribute", "zero joint axis"],
+         "misspelled element", "misspelled attribute", "unknown constraint attribute", "zero joint axis", "misspelled origin", "swapped xyz",
+         "misspelled mass value"],
 )
 def test_urdf_mistakes(copies, capsys, old, new, code, message):
     got, err = _run(capsys, "solve", _r_rtr(copies, old, new))
