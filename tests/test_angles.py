@@ -68,6 +68,25 @@ def test_crank_angles_at_the_wrap_and_after_many_turns(r_rtr, angle):
     assert r_rtr.coordinate(sol.q, "A") == pytest.approx(_wrapped(angle), abs=1e-15) or abs(angle) == np.pi
 
 
+@pytest.mark.parametrize("angle", [1e6, -1e6, 1e12, 1e15 + 0.25, -1e15])
+def test_far_crank_angles_reached_from_the_reference_close_the_loop(r_rtr, angle):
+    """The same angles reached by continuation from a reference at 30 deg (as --angle and
+    every solve without a guess do): the turns repeat, so the rest of the way is followed.
+    It was x1 - x0 less its turns, and x1 - x0 rounded to the spacing of 1e15 (0.125 rad)
+    left the loop open by 0.03 of its size with exit 0; now the pose is the closed form's
+    (1e-13 m) and the loop closed to the solver's tolerance."""
+    guess = r_rtr.neutral()
+    r_rtr.set_coordinate(guess, "B_slider", -0.06)
+    solver = LoopSolver(r_rtr, ["A"])
+    solver.set_reference([np.radians(30)], guess)
+    sol = solver.solve([angle], [1.0], [0.5])
+    assert sol.accuracy.residual <= solver.tol
+    m = evaluate_motion(r_rtr, solver.data, sol.q, sol.v, sol.a, points=["D"])
+    cf = closed_form.r_rtr(_wrapped(angle), 1.0, 0.5)
+    np.testing.assert_allclose(m.points["D"].position[:2], cf.D, atol=1e-13)
+    np.testing.assert_allclose(m.points["D"].velocity[:2], cf.vD, atol=1e-13)
+
+
 @pytest.mark.parametrize("turns", [0, 1, -3, 1000, 10**6])
 def test_a_revolute_arm_joint_after_whole_turns(models_dir, turns):
     """A revolute joint (not continuous) keeps its angle as written; its pose and rates after
