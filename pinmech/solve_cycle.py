@@ -320,6 +320,10 @@ class _Cycle:
                 q[j:j + done], d1[j:j + done], d2[j:j + done] = Q, D1, D2
                 for col, name in enumerate(_ACCURACY):
                     acc[name][j:j + done] = numbers[:, col]
+                for i in np.flatnonzero(numbers[:, 6] == 0):  # no step: the start pose, whose
+                    for name in _ACCURACY[2:]:  # numbers the core was not given
+                        acc[name][j + i] = getattr(ref, name)
+                    acc["residual"][j + i] = ref.residual
                 last = numbers[-1]
                 self.ref = Node(float(xs[j + done - 1]), Q[-1].copy(), D1[-1].copy(), D2[-1].copy(), ref.signs,
                                 float(last[2]), float(last[3]), float(last[4]), float(last[5]), float(last[0]))

@@ -129,3 +129,20 @@ def test_options_that_cannot_hold_are_errors(sweep):
         list(sweep.chunks(values, interpolate=0))
     with pytest.raises(PinmechError, match="predictor start"):
         list(sweep.chunks(values, start="cold", interpolate=4))
+
+
+def test_a_sweeps_first_row_at_the_scenes_pose_states_that_poses_own_accuracy(scenes_dir):
+    """The first row, at the scene's pose, came from the compiled core with placeholder
+    numbers (residual 0, sigma_min 1): with tol = 1e-3 its stated position bound was 2e-15
+    where the pose is 2e-5 rad off. Now its residual, condition and sigma_min are those
+    of the pose, as `analyse` gives them (the same arithmetic: equal to 1e-12)."""
+    import pinmech
+
+    scene = pinmech.Scene.load(scenes_dir / "four_bar.toml", ["solver.tol=1e-3"])
+    sweep = pinmech.Sweep.from_scene(scene)
+    first = next(iter(sweep.chunks([sweep.start, sweep.start + 0.5])))
+    accuracy = first.solution.solution(0).accuracy
+    alone = pinmech.analyse(scene).solution.accuracy
+    assert accuracy.residual == pytest.approx(alone.residual, rel=1e-12) and accuracy.residual > 1e-7
+    assert accuracy.sigma_min == pytest.approx(alone.sigma_min, rel=1e-12)
+    assert accuracy.condition == pytest.approx(alone.condition, rel=1e-12)
