@@ -85,8 +85,8 @@ class SweepForces:
         planar = self._planar_z()
         cols = [f"{n}.{'torque [N*m]' if self._angular(n) else 'force [N]'}" for n in first.drivers]
         for name, r in first.reactions.items():
-            if r.kind == "prismatic":
-                cols += [f"{name}.normal [N]", f"{name}.moment [N*m]"]
+            if r.kind == "prismatic":  # the normal force as a vector: its side of the guide is its sign
+                cols += [f"{name}.N{c} [N]" for c in ("xy" if planar else "xyz")] + [f"{name}.moment [N*m]"]
             else:
                 cols += [f"{name}.F{c} [N]" for c in ("xy" if planar else "xyz")] + [f"{name}.|F| [N]"]
         if self._advantage(first) is not None:
@@ -107,7 +107,7 @@ class SweepForces:
         for r in f.reactions.values():
             if r.kind == "prismatic":
                 moment = float(normal @ r.moment) if normal is not None else float(np.linalg.norm(r.moment))
-                out += [float(np.linalg.norm(r.normal_force)), moment]
+                out += [float(x) for x in (r.normal_force[:2] if planar else r.normal_force)] + [moment]
             else:
                 out += [float(x) for x in (r.force[:2] if planar else r.force)] + [r.magnitude]
         advantage = self._advantage(f)

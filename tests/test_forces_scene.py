@@ -134,7 +134,8 @@ def test_sweep_adds_torque_and_reaction_columns_and_the_cycle_summary(capsys):
         h = hand(deg)
         assert float(row["O.torque [N*m]"]) == pytest.approx(h.T, abs=1e-9 * np.abs(h.F12).max())
         assert float(row["B.Fx [N]"]) == pytest.approx(h.F34[0], abs=1e-9 * np.abs(h.F12).max())
-        assert float(row["slide.normal [N]"]) == pytest.approx(abs(h.N14), abs=1e-9 * np.abs(h.F12).max())
+        assert float(row["slide.Ny [N]"]) == pytest.approx(h.N14, abs=1e-9 * np.abs(h.F12).max())  # signed
+        assert abs(float(row["slide.Nx [N]"])) < 1e-9 * np.abs(h.F12).max()  # across a horizontal guide
         assert float(row["power_residual [1]"]) < 1e-12
     summary = captured.err
     mean = float(summary.split("mean torque ")[1].split(" N m")[0])
@@ -255,3 +256,23 @@ def test_failed_poses_leave_blank_force_cells(tmp_path, capsys):
     assert failed and solved
     assert all(r["O4.torque [N*m]"] == "" for r in failed)
     assert all(float(r["power_residual [1]"]) < 1e-12 for r in solved)
+
+
+def test_a_sweeps_slider_normal_force_keeps_its_side(scenes_dir, tmp_path):
+    """The CSV held |N| of the guide's normal force, its side lost (+700.756 N where the
+    ground pushes the piston down, -700.756 N in y): now its components, the JSON's
+    normal_force, to the printed digits."""
+    import csv
+    import json
+
+    from pinmech.cli import main
+
+    out, lines = tmp_path / "f.csv", tmp_path / "f.jsonl"
+    assert main(["sweep", str(scenes_dir / "slider_crank_dynamic.toml"), "--steps", "5", "--csv", str(out),
+                 "--json", str(lines)]) == 0
+    rows = list(csv.DictReader(out.open()))
+    for row, line in zip(rows, lines.read_text().splitlines()):
+        want = json.loads(line)["forces"]["reactions"]["slide"]["normal_force"]
+        got = [float(row["slide.Nx [N]"]), float(row["slide.Ny [N]"])]
+        assert got == pytest.approx(want[:2], rel=1e-9, abs=1e-9)
+    assert any(float(r["slide.Ny [N]"]) < 0 for r in rows)
