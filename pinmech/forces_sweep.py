@@ -124,10 +124,27 @@ class SweepForces:
 
     # ------------------------------------------------------------------ cycle
     def energy(self) -> EnergyFluctuation | None:
-        """Energy fluctuation of the swept driver's torque curve (None for a slider or < 2 poses)."""
-        if not self.sweep.is_angular or len(self.values) < 2 or self.values[0] == self.values[-1]:
+        """Energy fluctuation of the swept driver's torque curve (None for a slider, < 2
+        poses, or a driver that turned back at a fold: its net travel is no cycle)."""
+        if not self.sweep.is_angular or len(self.values) < 2 or self.values[0] == self.values[-1] \
+                or not self._monotonic():
             return None
         return energy_fluctuation(np.array(self.values), np.array(self.efforts))
+
+    def _monotonic(self) -> bool:
+        steps = np.diff(np.array(self.values))
+        return bool(np.all(steps > 0) or np.all(steps < 0))
+
+    def _energy_coarse(self) -> EnergyFluctuation | None:
+        """The energy fluctuation from every other pose (None below five poses): how much it
+        moves is how far the trapezoids between the poses may be off. (The rule's error
+        falls as the step squared, so the full set's is about a third of that change where
+        the poses resolve the curve; it was half of it at 361 poses of the slider-crank.)"""
+        n = len(self.values)
+        if n < 5:
+            return None
+        keep = list(range(0, n, 2)) + ([n - 1] if (n - 1) % 2 else [])
+        return energy_fluctuation(np.array(self.values)[keep], np.array(self.efforts)[keep])
 
     def summary(self) -> list[str]:
         """Lines for the end of a sweep: the cycle's torque, energy, zero crossings, residual."""
@@ -143,11 +160,25 @@ class SweepForces:
                 lines.append(f"{name}: the driver effort changes sign (zero: toggle or load reversal) near "
                              + ", ".join(crossings))
         energy = None if self.static else self.energy()
+        if not self.static and angular and len(self.values) > 2 and not self._monotonic():
+            lines.append(f"{name}: no mean torque or energy fluctuation: the driver turned back at a fold, so "
+                         "the curve is not one run of the driver")
         if energy is not None:
-            lines.append(f"{name}: mean torque {_shown(energy.mean_torque, self.efforts):.6g} N m over {math.degrees(energy.span):.6g} deg; "
-                         f"energy fluctuation {energy.energy_fluctuation:.6g} J (slowest at "
-                         f"{math.degrees(energy.slowest_angle):.4g} deg, fastest at "
-                         f"{math.degrees(energy.fastest_angle):.4g} deg)")
+            coarse = self._energy_coarse()
+            change = None if coarse is None else abs(coarse.energy_fluctuation - energy.energy_fluctuation)
+            if change is not None and change > 0.05 * energy.energy_fluctuation:
+                lines.append(f"{name}: mean torque {_shown(energy.mean_torque, self.efforts):.6g} N m over "
+                             f"{math.degrees(energy.span):.6g} deg; energy fluctuation not resolved by "
+                             f"{len(self.values)} poses ({energy.energy_fluctuation:.4g} J from them, "
+                             f"{coarse.energy_fluctuation:.4g} J from every other one): sweep with more --steps")
+                energy = None  # no flywheel sized from it
+            else:
+                about = "" if change is None else f" (within about {change:.2g} J: the trapezoids between the poses)"
+                lines.append(f"{name}: mean torque {_shown(energy.mean_torque, self.efforts):.6g} N m over "
+                             f"{math.degrees(energy.span):.6g} deg; energy fluctuation {energy.energy_fluctuation:.6g} J"
+                             f"{about}, slowest at {math.degrees(energy.slowest_angle):.4g} deg, fastest at "
+                             f"{math.degrees(energy.fastest_angle):.4g} deg")
+        if energy is not None:
             speed = abs(float(self.sweep.drivers.v[self.driver_index]))
             if self.flywheel and speed > 0:
                 lines.append(f"{name}: coefficient of speed fluctuation {energy.speed_fluctuation(self.flywheel, speed):.4g}"

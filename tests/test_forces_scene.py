@@ -276,3 +276,44 @@ def test_a_sweeps_slider_normal_force_keeps_its_side(scenes_dir, tmp_path):
         got = [float(row["slide.Nx [N]"]), float(row["slide.Ny [N]"])]
         assert got == pytest.approx(want[:2], rel=1e-9, abs=1e-9)
     assert any(float(r["slide.Ny [N]"]) < 0 for r in rows)
+
+
+@pytest.mark.parametrize("steps, resolved", [(5, False), (25, False), (73, True), (361, True)])
+def test_the_energy_fluctuation_states_its_accuracy_or_is_not_given(scenes_dir, capsys, steps, resolved):
+    """Against the fine sweep's value (1441 poses, whose own bound is 0.002 J): a stated
+    'within about X J' holds, and poses too coarse for the curve give no number (5 poses
+    gave 28.9 J where the curve holds 125.8, with nothing to say so)."""
+    from pinmech.cli import main
+
+    def summary(n: int) -> str:
+        assert main(["sweep", str(scenes_dir / "slider_crank_dynamic.toml"), "--steps", str(n), "--csv",
+                     "/dev/null"]) == 0
+        return [line for line in capsys.readouterr().err.splitlines() if "energy fluctuation" in line][0]
+
+    fine = float(summary(1441).split("energy fluctuation ")[1].split(" J")[0])
+    line = summary(steps)
+    if not resolved:
+        assert f"not resolved by {steps} poses" in line and "more --steps" in line
+        return
+    value = float(line.split("energy fluctuation ")[1].split(" J")[0])
+    bound = float(line.split("within about ")[1].split(" J")[0])
+    assert abs(value - fine) <= bound
+
+
+def test_a_sweep_through_a_fold_gives_no_mean_torque(scenes_dir, tmp_path, capsys):
+    """The bundled dynamic four-bar driven at its rocker, past the rocker's extreme and back
+    (--through-folds): the work over a net travel of nearly nothing made a mean torque of
+    -3.5e8 N m and a speed fluctuation of 4e10. Now the summary says why there is none."""
+    from pinmech.cli import main
+
+    text = (scenes_dir / "four_bar_dynamic.toml").read_text()
+    scene = tmp_path / "rocker.toml"
+    model = (scenes_dir.parent / "four_bar_dynamic.urdf").as_posix()
+    scene.write_text(f'title = "rocker-driven"\nurdf = "{model}"\n[drivers.O4]\nangle = "100 deg"\n'
+                     'speed = "10 rpm"\n[guess]\nO2 = "127 deg"\nA = "-100 deg"\n'
+                     + text[text.index("[gravity]"):])
+    assert main(["sweep", str(scene), "--from", "120 deg", "--to", "137.3 deg", "--steps", "10", "--through-folds",
+                 "--flywheel", "0.001 kg*m^2", "--csv", str(tmp_path / "f.csv")]) == 0
+    err = capsys.readouterr().err
+    assert "turned back at a fold" in err and "mean torque" not in err.replace("no mean torque", "")
+    assert "coefficient of speed fluctuation" not in err
