@@ -577,20 +577,13 @@ _ARROW_UNITS = {"velocity": "m/s", "acceleration": "m/s^2"}
 def _visuals(mechanism):
     """The mechanism's visual geometry, built only when drawing: meshes of the model's own
     package only (the others named on stderr), links without visuals sketched."""
-    from pinmech.draw import package_visuals
-    from pinmech.draw.sketch import sketch_visuals
+    from pinmech.draw.pages import mechanism_visuals
 
-    path = mechanism.urdf_path or mechanism.source
-    if str(path).endswith(".xml"):
-        from pinmech.mjcf import mjcf_visuals
-
-        visuals = mjcf_visuals(path, mechanism.model)
-    else:
-        visuals, skipped = package_visuals(path, mechanism.model)
-        for mesh in skipped:
-            print(f"pinmech: warning: mesh {mesh} left out of the drawing: it is outside the model's package",
-                  file=sys.stderr)
-    return sketch_visuals(mechanism, visuals)
+    visuals, skipped = mechanism_visuals(mechanism)
+    for mesh in skipped:
+        print(f"pinmech: warning: mesh {mesh} left out of the drawing: it is outside the model's package",
+              file=sys.stderr)
+    return visuals
 
 
 def cmd_snapshot(args: argparse.Namespace) -> int:

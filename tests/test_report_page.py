@@ -101,6 +101,17 @@ def test_the_report_page_of_a_bare_model(tmp_path):
     assert "paths" in page and "Velocity polygon" in page and not re.search(OFF_PAGE, html.unescape(page))
 
 
+@pytest.mark.parametrize("name", ["four_bar_drawn.toml", "jansen.toml", "leg_mjcf.toml"])
+def test_the_report_page_of_a_drawn_linkage_or_an_mjcf_scene(tmp_path, name):
+    """The page took its visuals from the scene's model file as a URDF: every drawn linkage
+    and MJCF scene ended in 'cannot build its visual geometry' (exit 9), while snapshot
+    drew them. Now the page draws what snapshot draws, offline."""
+    out = tmp_path / "page.html"
+    assert main(["report", str(SCENES / name), "-o", str(out), "--steps", "0"]) == 0
+    page = out.read_text(encoding="utf-8")
+    assert "<iframe" in page and not re.search(OFF_PAGE, html.unescape(page))
+
+
 def test_notebooks_show_tables_and_the_drawing():
     analysis = analyse(Scene.load(SCENES / "r_rtr.toml"))
     table = analysis._repr_html_()

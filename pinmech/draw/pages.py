@@ -62,6 +62,23 @@ def package_visuals(
     return visuals, drop_outside(visuals, model, package_roots(path, dirs))
 
 
+def mechanism_visuals(mechanism) -> tuple[pin.GeometryModel, list[str]]:
+    """The visual geometry of a mechanism from the file its model was built from (the
+    URDF, a drawn linkage's generated URDF, an MJCF file), links without visuals
+    sketched, and the meshes left out (outside the model's package)."""
+    from pinmech.draw.sketch import sketch_visuals
+
+    path = mechanism.urdf_path or mechanism.source
+    skipped: list[str] = []
+    if str(path).endswith(".xml"):
+        from pinmech.mjcf import mjcf_visuals
+
+        visuals = mjcf_visuals(path, mechanism.model)
+    else:
+        visuals, skipped = package_visuals(path, mechanism.model)
+    return sketch_visuals(mechanism, visuals), skipped
+
+
 def snapshot_html(
     model: pin.Model,
     visual_model: pin.GeometryModel,

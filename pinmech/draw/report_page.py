@@ -160,10 +160,10 @@ class HtmlPage:
 def snapshot(analysis: Analysis) -> HtmlPage:
     """The solved pose drawn (meshcat, offline), its points named: shows inline in Jupyter."""
     mech = analysis.mechanism
-    from pinmech.draw import load_visuals, snapshot_html
-    from pinmech.draw.sketch import sketch_visuals
+    from pinmech.draw import snapshot_html
+    from pinmech.draw.pages import mechanism_visuals
 
-    visuals = sketch_visuals(mech, load_visuals(mech.source, mech.model))
+    visuals = mechanism_visuals(mech)[0]  # the model's own file: a URDF, a drawn linkage's, an MJCF file
     points = {n: p.position for n, p in analysis.motion.points.items()}
     return HtmlPage(snapshot_html(mech.model, visuals, analysis.solution.q, points=points,
                                   plane_normal=mech.plane_normal, title=analysis.scene.title))
