@@ -58,7 +58,8 @@ def _add_force_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--static", action="store_true",
                         help="statics: forces with zero speeds and accelerations ([forces] static = true)")
     parser.add_argument("--minimum-norm", dest="minimum_norm", action="store_true",
-                        help="redundant loops: give the minimum-norm reactions instead of an error")
+                        help="forces not determined: the minimum-norm reactions instead of an error "
+                             "(a scene's redundant loops are refused before; see README, Forces)")
 
 
 def _add_limits_argument(parser: argparse.ArgumentParser) -> None:
