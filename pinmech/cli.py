@@ -363,6 +363,10 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                         start=mode or "predictor", batch=not args.no_batch and options.get("batch", True),
                         interpolate=interpolate, through_folds=args.through_folds)
     forces = _sweep_forces(args, scene, sweep)
+    if forces is not None and interpolate and interpolate > 1:  # before any pose is computed
+        raise PinmechError(f"forces need solved poses: --interpolate {interpolate} gives interpolated ones, whose "
+                           "rates miss the loops' equations by the interpolation error (the power balance fails); "
+                           "sweep without --interpolate for forces")
     limits = _LimitWatch(limit_mode(scene, args.limits), "poses")
     sinks = _sweep_sinks(args, sweep, steps, figure, forces)
     with sinks:

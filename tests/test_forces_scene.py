@@ -317,3 +317,17 @@ def test_a_sweep_through_a_fold_gives_no_mean_torque(scenes_dir, tmp_path, capsy
     err = capsys.readouterr().err
     assert "turned back at a fold" in err and "mean torque" not in err.replace("no mean torque", "")
     assert "coefficient of speed fluctuation" not in err
+
+
+def test_forces_are_not_computed_on_interpolated_poses(scenes_dir, tmp_path, capsys):
+    """--interpolate 4 with forces ended, pose after pose, in a BalanceError blaming 'a term
+    the model holds': interpolated rates miss the loops' equations. Now refused before any
+    pose is computed, saying why, and no file is written."""
+    from pinmech.cli import main
+
+    out = tmp_path / "f.csv"
+    assert main(["sweep", str(scenes_dir / "slider_crank_dynamic.toml"), "--interpolate", "4", "--csv",
+                 str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "forces need solved poses" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
