@@ -380,7 +380,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     for line in forces.summary() if forces else []:
         print(line, file=sys.stderr)
     limits.summary(steps)
-    _say_return(sweep, stop - start)
+    if not args.through_folds:  # past a fold the driver turns back: no whole turns to speak of
+        _say_return(sweep, stop - start)
     return 0
 
 
@@ -392,9 +393,9 @@ def _say_return(sweep, span: float) -> None:
     if not sweep.is_angular or abs(turns) < 0.5 or abs(turns - round(turns)) > 1e-12:
         return
     gap = sweep.return_gap()
-    if math.isnan(gap):
+    if math.isnan(gap):  # the first or the last pose failed
         return
-    if gap <= 1e-9:
+    if gap <= max(1e-9, 10 * sweep.solver.tol):  # each end closed to tol
         print(f"pinmech: after {round(abs(turns))} turn(s) the mechanism is back where it began "
               f"(largest joint gap {gap:.1e})", file=sys.stderr)
     else:

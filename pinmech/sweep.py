@@ -138,8 +138,8 @@ class Sweep:
     driver: str
     start: float
     drivers: Drivers
-    last_q: np.ndarray | None = None  # configuration of the last pose solved (for drawing)
-    first_q: np.ndarray | None = None  # configuration of the first pose solved
+    last_q: np.ndarray | None = None  # configuration of the last pose, None if it failed (drawings, return_gap)
+    first_q: np.ndarray | None = None  # configuration of the first pose, None if it failed
 
     @classmethod
     def from_scene(cls, scene: Scene, driver: str | None = None) -> Sweep:
@@ -221,6 +221,9 @@ class Sweep:
                 index = chunk.start + j
                 if j in chunk.errors:
                     exc = chunk.errors[j]
+                    self.last_q = None  # the sweep did not end on a solved pose (return_gap: NaN)
+                    if index == 0:
+                        self.first_q = None
                     if not skip_failures:
                         raise SweepError(f"sweep stopped at {self.driver} = {self._format(value)}: {exc}",
                                          driver=self.driver, value=value, cause=exc) from exc
@@ -228,7 +231,7 @@ class Sweep:
                     continue
                 sol = chunk.solution
                 self.last_q = sol.q[j]
-                if self.first_q is None:
+                if index == 0:
                     self.first_q = sol.q[j]
                 with self.solver.lock:  # the solver's Data, which another thread may be using
                     motion = evaluate_motion(self.mechanism, self.solver.data, sol.q[j], sol.v[j], sol.a[j],
@@ -237,9 +240,10 @@ class Sweep:
                                 note=chunk.notes.get(j, ""))
 
     def return_gap(self) -> float:
-        """How far the last pose solved is from the first: the largest joint difference,
-        angles modulo a turn [rad], slides in mechanism sizes. After a sweep of whole turns
-        of the driver, a mechanism back on its start has a gap at rounding level."""
+        """How far the sweep's last pose is from its first: the largest joint difference,
+        angles modulo a turn [rad], slides in mechanism sizes (NaN where either failed).
+        After a sweep of whole turns of the driver, a mechanism back on its start has a gap
+        at the closure tolerance."""
         if self.first_q is None or self.last_q is None:
             return math.nan
         return self.solver.turn_gap(self.first_q, self.last_q)

@@ -532,3 +532,26 @@ def test_a_trammel_reaches_its_fold_at_any_size(tmp_path, size):
     with pytest.raises(DriverLimitError) as err:
         solver.solve([0.75 * L])
     assert err.value.limit[0] == pytest.approx(0.7 * L, abs=1e-9 * L)
+
+
+def test_the_return_message_speaks_only_of_whole_turns_it_saw(tmp_path, capsys):
+    """'after 1 turn(s) the mechanism is NOT back where it began' was said of a non-Grashof
+    crank whose rows past its limit failed (--skip-failures: the last solved row is not the
+    turn's end), of a sweep through folds (the driver never turns) and of a Grashof four-bar
+    closed to a loose tol (its gap is that tol). Now: nothing, nothing, and back."""
+    from pinmech.cli import main
+
+    a, b, c, d = 0.08, 0.05, 0.06, 0.10  # non-Grashof: the crank is limited to +-74.41 deg
+    write(tmp_path, "ng.urdf", four_bar_urdf(a, b, c, d))
+    scene = tmp_path / "ng.toml"
+    ref = closed_form.four_bar(0.0, 0, 0, a, b, c, d, 1)
+    scene.write_text(f'urdf = "ng.urdf"\n[drivers.O2]\nangle = "0 deg"\n[guess]\n'
+                     f'A = "{math.degrees(float(ref.theta3)):.6f} deg"\nO4 = "{math.degrees(float(ref.theta4)):.6f} deg"\n')
+    for extra in (["--skip-failures"], ["--through-folds"]):
+        assert main(["sweep", str(scene), "--from", "0 deg", "--to", "360 deg", "--steps", "9", "--csv",
+                     str(tmp_path / "s.csv"), *extra]) == 0
+        assert "back where it began" not in capsys.readouterr().err, extra
+    write(tmp_path, "g.urdf", four_bar_urdf(0.04, 0.12, 0.08, 0.10))
+    scene.write_text('urdf = "g.urdf"\n[drivers.O2]\nangle = "60 deg"\n[solver]\ntol = 1e-3\n')
+    assert main(["sweep", str(scene), "--steps", "9", "--csv", str(tmp_path / "s.csv")]) == 0
+    assert "the mechanism is back where it began" in capsys.readouterr().err
