@@ -103,11 +103,12 @@ def load_extended_urdf(urdf: str | Path, sidecar: str | Path, *,
     points = [n for n in _point_links(root) if model.existFrame(n)]
     mech = Mechanism.from_model(model, constraints, names=names, points=points, source=str(urdf),
                                 urdf_path=str(urdf), locked=locked)
+    held = set(mech.locked)
     for motor in content["name_mot"]:
-        if motor not in mech.joints:
+        if motor not in mech.joints and motor not in held:
             raise ModelError(f"motor '{motor}' is not a joint of {urdf.name} (joints: {', '.join(mech.joints)})",
                              path=str(sidecar), element="name_mot")
-    mech.motors = list(content["name_mot"])
+    mech.motors = [m for m in content["name_mot"] if m not in held]  # a locked motor drives nothing
     return mech
 
 

@@ -172,3 +172,14 @@ def test_locking_the_joint_that_carries_a_cut_moves_the_cut_onto_its_parent():
     for point in ("closedloop1_A", "closedloop1_B"):
         np.testing.assert_allclose(d_locked.oMf[locked.points[point]].translation,
                                    d_free.oMf[free.points[point]].translation, atol=1e-12)
+
+
+def test_a_locked_motor_is_neither_a_missing_joint_nor_a_default_driver():
+    """Locking mot2 of the five-bar (its other motor driven) was refused as "motor 'mot2' is
+    not a joint of robot.urdf": the lock had taken it out of the model. Now the five-bar
+    with mot2 held is a four-bar driven by mot1, and mot2 is no motor of it."""
+    folder = MODELS / "five_bar"
+    mech = load_extended_urdf(folder / "robot.urdf", folder / "robot.yaml", locked={"mot2": math.radians(15)})
+    assert "mot2" not in mech.joints and mech.motors == ["mot1"] and mech.mobility == 1
+    held = load_extended_urdf(folder / "robot.urdf", folder / "robot.yaml")
+    assert held.motors == ["mot1", "mot2"]
