@@ -425,13 +425,18 @@ def load_linkage(path: str | Path, *, locked: dict[str, float] | None = None):
     linkage = parse_linkage(path)
     text, reference = linkage_urdf(linkage)
     urdf = _cached_urdf(text)
-    try:
-        mech = Mechanism.from_urdf(urdf, locked=locked, reference=reference)
-    except ModelError as exc:  # name the user's file, not the generated one
-        raise ModelError(str(exc).replace(str(urdf), str(path)), path=None) from exc
-    mech.source, mech.urdf_path = str(path), str(urdf)
-    _check_closed(mech)
-    return mech
+
+    def built(held: dict[str, float] | None):
+        try:
+            mech = Mechanism.from_urdf(urdf, locked=held, reference=reference)
+        except ModelError as exc:  # name the user's file, not the generated one
+            raise ModelError(str(exc).replace(str(urdf), str(path)), path=None) from exc
+        mech.source, mech.urdf_path = str(path), str(urdf)
+        return mech
+
+    mech = built(None)
+    _check_closed(mech)  # as drawn; a joint held at another value than drawn opens the drawn pose,
+    return built(locked) if locked else mech  # which the solver closes from there
 
 
 def joint_kinds(path: str | Path) -> dict[str, str]:

@@ -542,3 +542,22 @@ def test_a_planar_linkage_written_in_3d_moves_as_the_planar_one(tmp_path):
 def test_bundled_scenes_of_other_formats_solve(scenes_dir, scene, capsys):
     assert main(["solve", str(scenes_dir / f"{scene}.toml"), "--json"]) == 0
     assert capsys.readouterr().out.lstrip().startswith("{")
+
+
+def test_a_drawn_linkage_locked_away_from_its_drawing(models_dir):
+    """[lock] at another value than drawn was refused ('loop cut B is open ... at the drawn
+    pose'): the drawing is checked as drawn, then the held joint opens the drawn pose and
+    the solver closes it. The four-bar with its crank held 17 deg past the drawing is the
+    free four-bar driven there (every coupler point to 1e-12 m)."""
+    free = load_linkage(LINKAGES / "four_bar.toml")
+    held_at = free.coordinate(free.reference, "O2") + math.radians(17)
+    locked = load_linkage(LINKAGES / "four_bar.toml", locked={"O2": held_at})
+    assert locked.mobility == 0 and "O2" not in locked.joints
+    q = LoopSolver(locked, []).solve([], guess=locked.reference).q
+    q_free = LoopSolver(free, ["O2"]).solve([held_at], guess=free.reference).q
+    data, data_free = locked.model.createData(), free.model.createData()
+    pin.framesForwardKinematics(locked.model, data, q)
+    pin.framesForwardKinematics(free.model, data_free, q_free)
+    for point in free.points:
+        np.testing.assert_allclose(data.oMf[locked.points[point]].translation,
+                                   data_free.oMf[free.points[point]].translation, atol=1e-12)
