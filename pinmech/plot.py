@@ -81,6 +81,7 @@ class SweepPlot:
         _check_names(sweep, "link", self.links, sweep.mechanism.links, "--links" if links else "[sweep] links")
         _check_names(sweep, "point", self.points, sweep.mechanism.points, "--points" if points else "[sweep] points")
         self.every = max(1, math.ceil(total / max_points)) if total else 1
+        self.last = total - 1 if total else None  # drawn whatever every is: a turn ends where it ends
         self.normal = sweep.mechanism.plane_normal
         self.x = array("d")
         self.series: dict[str, dict[str, array]] = {}
@@ -103,7 +104,7 @@ class SweepPlot:
         if not self.series:
             self._choose(pose)
         nearer = self.mark is None or abs(pose.value - self.sweep.start) < abs(self.mark[0] - self.sweep.start)
-        kept = pose.index % self.every == 0
+        kept = pose.index % self.every == 0 or pose.index == self.last
         if not (nearer or kept):
             return
         values = self._values(pose)
@@ -360,13 +361,14 @@ class PathPlot:
         self.mechanism, self.title, self.note = mechanism, title, note
         self.joints = [j for j in mechanism.joints.values() if j.nv == 1]
         self.every = max(1, math.ceil(total / max_points)) if total else 1
+        self.total = total
         self.t: list[float] = []
         self.rows: list[list[float]] = []
         self.count = 0
 
     def add(self, point: PathPoint) -> None:
         self.count += 1
-        if (self.count - 1) % self.every:
+        if (self.count - 1) % self.every and self.count != self.total:  # the last point is always drawn
             return
         q = [self.mechanism.coordinate(point.q, j.name) for j in self.joints]
         q = [math.degrees(x) if j.is_angular else x for x, j in zip(q, self.joints)]

@@ -156,3 +156,20 @@ def test_the_jansen_legs_foot_path_is_the_closed_forms(figures, tmp_path):
     (line,) = [x for x in figures[0].axes[0].get_lines() if x.get_label() == "path of G"]
     theta = np.radians(np.linspace(90, 450, 73))
     np.testing.assert_allclose(np.asarray(line.get_xydata(), dtype=float), 1000 * jansen_leg(theta)["G"], atol=1e-6)
+
+
+def test_a_decimated_sweep_figure_keeps_its_last_pose(scenes_dir):
+    """Above MAX_POINTS poses the figure keeps every n-th: 20,002 poses over a turn were drawn
+    30 to 390 deg less the end (the last pose was not an n-th). The last pose is always kept."""
+    import math
+
+    import pinmech
+    from pinmech.plot import MAX_POINTS, SweepPlot
+
+    sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(scenes_dir / "r_rtr.toml"))
+    total = MAX_POINTS + 2
+    values = sweep.start + np.linspace(0.0, 2 * math.pi, total)
+    plot = SweepPlot(sweep, total=total)
+    for pose in sweep.poses(values):
+        plot.add(pose)
+    assert plot.every > 1 and plot.x[-1] == pytest.approx(math.degrees(values[-1]), abs=1e-9)
