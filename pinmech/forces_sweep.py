@@ -224,6 +224,8 @@ class ForceJsonLines(SweepJsonLines):
         f = self.forces.solve(pose)
         if f is not None:
             entry["forces"] = forces_dict(f, self.sweep.mechanism, static=self.forces.static)
+            if self.forces.static:  # as `pinmech forces --static --json` and the CSV column
+                entry["forces"]["mechanical_advantage"] = self.forces._advantage(f)
         return entry
 
 

@@ -331,3 +331,18 @@ def test_forces_are_not_computed_on_interpolated_poses(scenes_dir, tmp_path, cap
     err = capsys.readouterr().err
     assert "forces need solved poses" in err and len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_a_static_sweeps_json_lines_carry_the_mechanical_advantage(scenes_dir, tmp_path):
+    """The CSV had the column, the JSON lines of the same sweep did not: now both, equal."""
+    import csv
+    import json
+
+    from pinmech.cli import main
+
+    out, lines = tmp_path / "s.csv", tmp_path / "s.jsonl"
+    assert main(["sweep", str(scenes_dir / "four_bar_dynamic.toml"), "--static", "--steps", "5", "--csv", str(out),
+                 "--json", str(lines)]) == 0
+    column = [float(r["mechanical_advantage [1]"]) for r in csv.DictReader(out.open())]
+    json_values = [json.loads(line)["forces"]["mechanical_advantage"] for line in lines.read_text().splitlines()]
+    assert json_values == pytest.approx(column, rel=1e-9)
