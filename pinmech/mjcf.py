@@ -100,7 +100,7 @@ def _default_classes(root: ET.Element, source: str) -> dict[str, dict[str, dict[
     classes: dict[str, dict[str, dict[str, str]]] = {}
 
     def walk(node: ET.Element, inherited: dict[str, dict[str, str]], name: str) -> None:
-        if name in classes:
+        if name in classes and name != "main":
             raise ModelError(f"two default classes are called \"{name}\"", path=source,
                              element=f"<default class=\"{name}\">")
         own = {tag: dict(attrs) for tag, attrs in inherited.items()}
@@ -115,17 +115,12 @@ def _default_classes(root: ET.Element, source: str) -> dict[str, dict[str, dict[
                                  element=f"<default class=\"{name}\"> <default>")
             walk(child, own, child.get("class"))
 
-    tops = root.findall("default")
-    if len(tops) > 1:
-        raise ModelError(f"{len(tops)} top-level <default> elements: MuJoCo takes one (class \"main\")",
-                         path=source, element="<default>")
-    if tops:
-        if tops[0].get("class", "main") != "main":
-            raise ModelError(f"the top-level <default> is class \"main\", not \"{tops[0].get('class')}\"",
+    classes["main"] = {}
+    for top in root.findall("default"):  # several top-level ones all add to "main", as MuJoCo reads them
+        if top.get("class", "main") != "main":
+            raise ModelError(f"the top-level <default> is class \"main\", not \"{top.get('class')}\"",
                              path=source, element="<default>")
-        walk(tops[0], {}, "main")
-    else:
-        classes["main"] = {}
+        walk(top, classes["main"], "main")
     return classes
 
 

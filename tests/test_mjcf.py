@@ -531,3 +531,21 @@ def test_a_fold_followed_through_a_composite_joint_is_a_driver_limit(tmp_path):
     set_qpos(mech, q, m, d)
     eq = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
     np.testing.assert_allclose(d.efc_pos[eq], 0.0, atol=1e-12)
+
+
+def test_two_top_level_defaults_both_apply(tmp_path):
+    """MuJoCo reads several top-level <default> elements as one class "main": a joint pos
+    from the first and a site pos from the second both count (positions at a moved pose
+    as MuJoCo's, 1e-12 m)."""
+    path = _chain(tmp_path, defaults='<default><joint pos="0 0.1 0"/></default><default><site pos="0.1 0.2 0.3"/>'
+                                     '</default>', site="")
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    mech = load_mjcf(path)
+    data = mech.model.createData()
+    q = np.array([0.87, -0.4])
+    d.qpos[:] = q
+    mujoco.mj_forward(m, d)
+    pin.framesForwardKinematics(mech.model, data, q)
+    for i in range(m.nsite):
+        np.testing.assert_allclose(data.oMf[mech.points[m.site(i).name]].translation, d.site_xpos[i], atol=1e-12)
