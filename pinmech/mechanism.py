@@ -15,6 +15,7 @@ rows). Named points are massless leaf links hung on fixed joints.
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 import tempfile
@@ -438,6 +439,10 @@ class Mechanism:
                 if part is not None:
                     parts.append((self.model.names[jid], joint.idx_q + part[0], joint.idx_q + part[1], part[2]))
             self.__dict__["_unit_parts"] = parts
+        if not many:  # one pose (evaluate_motion, solve): plain floats, a microsecond, not numpy's 30
+            values = out.tolist()
+            if all(abs(math.hypot(*values[start:stop]) - 1.0) <= UNIT_NORM_TOL for _, start, stop, _ in parts):
+                return out
         for joint, start, stop, what in parts:
             norms = np.sqrt(np.sum(rows[:, start:stop] ** 2, axis=1))
             bad = np.flatnonzero(~(np.abs(norms - 1.0) <= UNIT_NORM_TOL))
