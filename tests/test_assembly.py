@@ -255,11 +255,8 @@ def test_the_rsur_near_its_rocker_limit_keeps_its_root_or_names_the_other(tmp_pa
 
 
 # ---------------------------------------------------------------------- bifurcation
-def test_a_parallelogram_keeps_its_branch_through_the_change_points(tmp_path):
-    """a = c, b = d: at 0 and 180 deg the parallelogram and the antiparallelogram meet. A
-    sweep through both keeps the coupler parallel to the ground (tangent continuous) and
-    says it passed the change points."""
-    a, b = 0.05, 0.12
+def _parallelogram(tmp_path, a: float, b: float) -> tuple[Mechanism, LoopSolver]:
+    """A four-bar with a = c, b = d, its reference the parallelogram at O2 = 60 deg."""
     mech = _four_bar(tmp_path, a, b, a, b)
     solver = LoopSolver(mech, ["O2"])
     q = mech.neutral()
@@ -267,6 +264,14 @@ def test_a_parallelogram_keeps_its_branch_through_the_change_points(tmp_path):
     mech.set_coordinate(q, "A", -math.radians(60))
     mech.set_coordinate(q, "O4", math.radians(60))
     solver.set_reference([math.radians(60)], q)
+    return mech, solver
+
+
+def test_a_parallelogram_keeps_its_branch_through_the_change_points(tmp_path):
+    """a = c, b = d: at 0 and 180 deg the parallelogram and the antiparallelogram meet. A
+    sweep through both keeps the coupler parallel to the ground (tangent continuous) and
+    says it passed the change points."""
+    mech, solver = _parallelogram(tmp_path, 0.05, 0.12)
     values = np.radians(np.arange(60.5, 60.5 + 360, 1.0))
     qs, errors, notes = _sweep(solver, values)
     assert not errors
@@ -287,14 +292,7 @@ def test_a_parallelogram_swept_onto_its_change_points_keeps_its_branch_after_eac
     import pinmech.core
 
     monkeypatch.setattr(pinmech.core, "ENABLED", core)
-    a, b = 0.04, 0.10
-    mech = _four_bar(tmp_path, a, b, a, b)
-    solver = LoopSolver(mech, ["O2"])
-    q = mech.neutral()
-    mech.set_coordinate(q, "O2", math.radians(60))
-    mech.set_coordinate(q, "A", -math.radians(60))
-    mech.set_coordinate(q, "O4", math.radians(60))
-    solver.set_reference([math.radians(60)], q)
+    mech, solver = _parallelogram(tmp_path, 0.04, 0.10)
     values = np.radians(60 - 60.0 * np.arange(1, 14))
     qs, errors, notes = _sweep(solver, values)
     for i, (theta, qi) in enumerate(zip(values, qs)):
