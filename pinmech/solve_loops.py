@@ -113,12 +113,12 @@ def describe_joint_values(mechanism: Mechanism, names: Sequence[str], values: Se
     return ", ".join(out)
 
 
-def is_closed(independent: float, full: float, tol: float) -> bool:
+def is_closed(independent, full, tol: float):
     """Whether a pose's loops are closed: its independent closure rows within `tol`, and
     every selected row (the ones reduced away as out of the plane too) within ten times
     max(tol, 1e-12), as `LoopSolver.close` accepts them (all dimensionless: lengths in
-    loop sizes, angles in rad)."""
-    return independent <= tol and full <= max(tol, 1e-12) * 10
+    loop sizes, angles in rad). Floats give a bool, arrays of poses an array of them."""
+    return (independent <= tol) & (full <= max(tol, 1e-12) * 10)
 
 
 def open_loops_error(mechanism: Mechanism, data: pin.Data, q: np.ndarray, residual: float, tol: float,

@@ -235,16 +235,12 @@ class RateSolver:
         n, m = len(q), self.x_dot.size
         compiled = self._compiled() if self.method == "exact" else None
         if compiled is not None:
-            core, frames, rows, local, row_scale, cut_frames = compiled
+            core, frames, rows, local, row_scale = compiled
             v, a, numbers, achieved_v, achieved_a = core.rates(q, frames, rows, local, self.x_dot, self.x_ddot,
                                                              row_scale, self.max_condition)
-            condition, sigma_min, closure_v, closure_a, status = numbers.T
-            closure = np.zeros(n)
-            if cut_frames:  # the core measures no position residual: open poses go to `solve`, named there
-                independent, full = self._closure_residuals(core, cut_frames, q)
-                closure = np.maximum(independent, full)
-                closed = (independent <= self.tol) & (full <= max(self.tol, 1e-12) * 10)  # is_closed, per pose
-                status[~closed] = 1
+            condition, sigma_min, closure_v, closure_a, status, independent, full = numbers.T
+            closure = np.maximum(independent, full)  # q's own closure residual, measured by the core
+            status[~is_closed(independent, full, self.tol)] = 1  # open poses go to `solve`, named there
         else:
             v, a = np.full((n, self.model.nv), np.nan), np.full((n, self.model.nv), np.nan)
             condition, sigma_min, closure_v, closure_a, closure = (np.full(n, np.nan) for _ in range(5))
@@ -273,32 +269,6 @@ class RateSolver:
                                    f"the task's rates at {self._pose(q)}")
         return max(independent, full)
 
-    def _closure_residuals(self, core, cut_frames: list[int], q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """`Closure.residual` and `full_residual`'s largest |row| at every pose (N,), from
-        the cut frames' placements the core computes for all poses in one call."""
-        n = len(q)
-        zeros = np.zeros((n, self.model.nv))
-        P, R = core.frame_motion(q, zeros, zeros, cut_frames)[:2]
-        P, R = P.reshape(n, -1, 3), R.reshape(n, -1, 3, 3)
-        independent, full = np.zeros(n), np.zeros(n)
-        for k, c in enumerate(self.mechanism.closures):
-            R_P, R_C = R[:, 2 * k], R[:, 2 * k + 1]
-            r6 = np.empty((n, 6))
-            r6[:, :3] = _in_parent(R_P, P[:, 2 * k + 1] - P[:, 2 * k])
-            if c.cut_type == "revolute":  # axis x (R_P^T R_C child_axis)
-                u = _in_parent(R_P, R_C @ c.child_axis)
-                a = c.axis
-                r6[:, 3] = a[1] * u[:, 2] - a[2] * u[:, 1]
-                r6[:, 4] = a[2] * u[:, 0] - a[0] * u[:, 2]
-                r6[:, 5] = a[0] * u[:, 1] - a[1] * u[:, 0]
-            elif c.cut_type == "spherical":
-                r6[:, 3:] = 0.0
-            else:
-                r6[:, 3:] = _log3(np.matmul(R_P.transpose(0, 2, 1), R_C))
-            independent = np.maximum(independent, np.max(np.abs(r6 @ c._rows6.T), axis=1, initial=0.0))
-            full = np.maximum(full, np.max(np.abs((r6 * c._scale()) @ c.selected.T), axis=1, initial=0.0))
-        return independent, full
-
     def _compiled(self):
         """The core with this solver's loops and task frames, and the task rows as it takes
         them (built once; again when a frame it copied was moved), or None."""
@@ -318,8 +288,7 @@ class RateSolver:
                 value = (compiled, [rebuilt.frames[f] for f in self.frames],
                          [[int(k) for k in t.rows] for t in self.tasks],
                          [int(t.reference == "local") for t in self.tasks],
-                         self._scales(n_c)[0],
-                         [rebuilt.frames[f] for f in frames[: 2 * len(self.mechanism.closures)]])
+                         self._scales(n_c)[0])
             cached = (core.ModelCopy(self.model, frames), value)
             self.__dict__["_core"] = cached
         return cached[1]
@@ -454,23 +423,6 @@ class RateSolver:
             return np.linalg.lstsq(J, rhs, rcond=None)[0]  # minimum-norm or least-squares
         U, s, Vt = np.linalg.svd(J, full_matrices=False)  # rank-deficient: truncated pseudo-inverse
         return Vt[:rank].T @ ((U[:, :rank].T @ rhs) / s[:rank])
-
-
-def _in_parent(R: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """R_i^T x_i for (N, 3, 3) rotations and (N, 3) vectors."""
-    return np.einsum("nji,nj->ni", R, x)
-
-
-def _log3(R: np.ndarray) -> np.ndarray:
-    """`pin.log3` of every rotation of an (N, 3, 3) array (N, 3): the angle from atan2 of
-    the skew part's norm and the trace, so it holds from 0 to a half turn."""
-    cos = np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
-    vee = 0.5 * np.stack((R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]), axis=1)
-    sin = np.linalg.norm(vee, axis=1)
-    theta = np.arctan2(sin, cos)
-    out = vee * (theta / np.where(sin > 0, sin, 1.0))[:, None]
-    out[(sin == 0) & (cos < 0)] = math.pi  # exactly a half turn: no axis from the skew part, open by pi
-    return out
 
 
 def _rank(J: np.ndarray) -> int:

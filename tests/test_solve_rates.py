@@ -289,13 +289,12 @@ def test_a_loop_closed_within_a_looser_tol_states_its_residual():
 
 @pytest.mark.parametrize("build", ["prismatic", "spherical", "fixed", "revolute"])
 def test_solve_many_measures_each_cut_type_as_the_closures_do(build, tmp_path):
-    """solve_many's residuals (numpy, from the core's frame placements, its own log3) equal
-    Closure.residual and full_residual at 20 random poses, all open, of a prismatic cut, a
-    spherical one (the RSUR), a weld (MJCF ball_loop, its ball's quaternion in q) and the
-    four-bar's revolute cut: to 1e-10 of 1 + the residual. The same formulas in another
-    order agree to 1e-15, except the weld's rotation near a half turn, where log3 from the
-    skew part loses digits like 1 / sin(angle) (8e-12 at 2.95 rad); the decision open or
-    closed is taken at residuals near 1e-13, where the angle is tiny."""
+    """The closure residuals solve_many reads from the compiled core (the rows its rate
+    solve already evaluates at each pose) equal Closure.residual and full_residual at 20
+    random poses, all open, of a prismatic cut, a spherical one (the RSUR), a weld (MJCF
+    ball_loop, its ball's quaternion in q) and the four-bar's revolute cut: to 1e-12 of
+    1 + the residual (the same formulas in C++, rounding apart; tests/test_core.py holds
+    the rows to 1e-13 of their size)."""
     from pinmech.mjcf import load_mjcf
     from tests import _mechanisms
 
@@ -314,15 +313,17 @@ def test_solve_many_measures_each_cut_type_as_the_closures_do(build, tmp_path):
         pytest.skip("the compiled core is not built here")
     rng = np.random.default_rng(7)
     Q = np.array([pin.integrate(mech.model, mech.neutral(), rng.normal(size=mech.model.nv)) for _ in range(20)])
-    independent, full = solver._closure_residuals(compiled[0], compiled[5], Q)
+    core, frames, rows, local, row_scale = compiled
+    numbers = core.rates(Q, frames, rows, local, solver.x_dot, solver.x_ddot, row_scale, solver.max_condition)[2]
+    independent, full = numbers[:, 5], numbers[:, 6]
     data = mech.model.createData()
     for i, q in enumerate(Q):
         pin.framesForwardKinematics(mech.model, data, q)
         want_i = max(np.abs(c.residual(data)).max() for c in mech.closures)
         want_f = max(np.abs(c.full_residual(data)).max() for c in mech.closures)
         assert want_f > 1e-3  # open: a random pose
-        assert independent[i] == pytest.approx(want_i, abs=1e-10 * (1 + want_i))
-        assert full[i] == pytest.approx(want_f, abs=1e-10 * (1 + want_f))
+        assert independent[i] == pytest.approx(want_i, abs=1e-12 * (1 + want_i))
+        assert full[i] == pytest.approx(want_f, abs=1e-12 * (1 + want_f))
 
 
 # --------------------------------------------------------------------- malformed input

@@ -949,7 +949,9 @@ class Core {
     for (int f : task_frames)
       if (f < 0 || size_t(f) >= frames_.size()) throw std::invalid_argument("unknown frame index");
     RowMatrix V = RowMatrix::Constant(n, nv, NAN), A = RowMatrix::Constant(n, nv, NAN);
-    RowMatrix numbers = RowMatrix::Constant(n, 5, NAN);  // condition, sigma_min, closure v and a residuals, status
+    // condition, sigma_min, closure v and a residuals, status, then q's closure residuals
+    // (independent rows, full rows: LoopSolver's is_closed reads both)
+    RowMatrix numbers = RowMatrix::Constant(n, 7, NAN);
     RowMatrix achieved_v = RowMatrix::Constant(n, m_task, NAN), achieved_a = RowMatrix::Constant(n, m_task, NAN);
     {
       nb::gil_scoped_release release;
@@ -962,9 +964,12 @@ class Core {
         q = Q.row(i).transpose();
         if (rows_) {
           residual_into(q, r_);
+          numbers(i, 5) = max_abs(r_);
+          numbers(i, 6) = full_residual();
           jacobian_into(false);
           J.topRows(rows_) = J_;
         } else {
+          numbers(i, 5) = numbers(i, 6) = 0.0;
           pin::computeJointJacobians(model_, data_, q);
         }
         Index row = rows_;
@@ -1028,7 +1033,7 @@ class Core {
         achieved += drift;
         achieved_a.row(i) = achieved.tail(m_task).transpose();
         const double closure_a = rows_ ? max_abs(achieved.head(rows_)) : 0.0;
-        numbers.row(i) << cond, smin, closure_v, closure_a, 0.0;
+        numbers.block<1, 5>(i, 0) << cond, smin, closure_v, closure_a, 0.0;
       }
     }
     return nb::make_tuple(V, A, numbers, achieved_v, achieved_a);
