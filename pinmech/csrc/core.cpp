@@ -483,7 +483,9 @@ void find_eigenvalues(const VectorXd& beta, EigenvalueSearch (&searches)[2], dou
 }
 
 // 2-norm condition number and smallest singular value, as solve_loops._condition: closed
-// forms up to 2x2, eigenvalues of fixed-size 3x3 products at 3x3, bidiagonalization above.
+// forms up to 2x2, bidiagonalization from 3x3 up (Eigen's closed-form 3x3 eigenvalues of
+// A^T A lost 1e-9 of the condition number at a repeated singular value, where rounding
+// allows 1e-14: tests/test_core.py found it).
 // `singular`: the caller's factorization of A (which it also solves with) met an exact zero
 // pivot (used above 3x3).
 std::pair<double, double> condition_of(const MatrixXd& A, bool singular, ConditionWork& work) {
@@ -502,26 +504,6 @@ std::pair<double, double> condition_of(const MatrixXd& A, bool singular, Conditi
     const double det = std::abs(a * e - c * d);
     const double s_min = s_max > 0 ? det / s_max : 0.0;
     return {det > 0 ? s_max * s_max / det : INFINITY, s_min};
-  }
-  if (n == 3) {
-    // Fixed-size: the largest eigenvalues of A^T A and A^-1 A^-T (closed form, Eigen's
-    // computeDirect), a largest eigenvalue being exact to rounding relative to itself; the
-    // inverse by LU with partial pivoting (the cofactor formula of
-    // computeInverseAndDetWithCheck lost 2e-3 of the condition number at 1e10, where
-    // rounding allows 2e-6; tests/test_core.py found it). Quicker than the
-    // bidiagonalization below at this size (RateSolver.solve_many on P2: 1.8 against 2.2 us
-    // a pose).
-    const Matrix3d M = A;
-    const Eigen::PartialPivLU<Matrix3d> lu3(M);
-    if (lu3.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0) return {INFINITY, 0.0};
-    const Matrix3d inverse = lu3.inverse();
-    if (!inverse.allFinite()) return {INFINITY, 0.0};
-    Eigen::SelfAdjointEigenSolver<Matrix3d> eig;
-    eig.computeDirect(M.transpose() * M, Eigen::EigenvaluesOnly);
-    const double s_max = std::sqrt(eig.eigenvalues()(2));
-    eig.computeDirect(inverse * inverse.transpose(), Eigen::EigenvaluesOnly);
-    const double s_min = 1.0 / std::sqrt(eig.eigenvalues()(2));
-    return {s_max / s_min, s_min};
   }
   if (singular) return {INFINITY, 0.0};
   const double largest_entry = A.cwiseAbs().maxCoeff();
