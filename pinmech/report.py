@@ -73,7 +73,16 @@ def to_dict(analysis: Analysis) -> dict[str, Any]:
     out["accuracy"] = analysis.solution.accuracy.as_dict()
     if analysis.extra:
         out.update({k: v for k, v in analysis.extra.items() if not k.startswith("_")})
+    if _has_design(analysis):
+        from pinmech.design import analysis_design, design_dict
+
+        out["design"] = design_dict(analysis_design(analysis))
     return out
+
+
+def _has_design(analysis: Analysis) -> bool:
+    """Design diagnostics belong to driven mechanisms, not to [[task]] scenes."""
+    return not (analysis.extra and "task" in analysis.extra)
 
 
 def assembly_dict(analysis: Analysis) -> dict[str, Any]:
@@ -205,6 +214,10 @@ def to_text(analysis: Analysis) -> str:
     )
     for line in (analysis.extra or {}).get("_text", []):
         t.lines.append(line)
+    if _has_design(analysis):
+        from pinmech.design import analysis_design, design_lines
+
+        t.lines += design_lines(analysis_design(analysis))
     return "\n".join(t.lines) + "\n"
 
 

@@ -59,6 +59,31 @@ class Dyad:
 
 
 @dataclass(frozen=True)
+class Output:
+    """A moving link with one pair to the ground and no driver: a rocker (or crank) on a
+    ground pivot, or a block on a ground slide. Its limit positions are where it stops.
+
+    Attributes:
+        kind: "pin" or "slide"; output: the link; ground: its pair with the ground.
+    """
+
+    kind: str
+    output: int
+    ground: Pair
+
+
+def find_outputs(linkage: PlanarLinkage, drivers: list[str]) -> list[Output]:
+    """Every link, other than the inputs, with exactly one pair, a pin or a slide, to the ground."""
+    inputs = input_links(linkage, drivers)
+    out = []
+    for link in sorted(linkage.names):
+        grounds = [p for other, p in linkage.neighbours(link) if other == 0]
+        if link != 0 and link not in inputs and len(grounds) == 1:
+            out.append(Output(grounds[0].kind, link, grounds[0]))
+    return out
+
+
+@dataclass(frozen=True)
 class DyadAngles:
     """The angles of a dyad at one pose [deg].
 
@@ -155,25 +180,26 @@ def dyad_angles(linkage: PlanarLinkage, dyad: Dyad) -> DyadAngles:
     return DyadAngles(90.0 - phi, 90.0 - phi, phi)
 
 
-def output_rate(linkage: PlanarLinkage, dyad: Dyad) -> float:
+def output_rate(linkage: PlanarLinkage, output: Output | Dyad) -> float:
     """The output's rate [rad/s, or m/s along the slide's axis] at the placed velocities."""
-    if dyad.kind == "pin":
-        return linkage.omega(dyad.output)
-    slide = dyad.ground
+    if output.kind == "pin":
+        return linkage.omega(output.output)
+    slide = output.ground
     u = linkage.direction(slide.links[0], slide.axis)
-    B = linkage.point(dyad.output, _end(slide, dyad.output))
-    sign = 1.0 if slide.links[1] == dyad.output else -1.0  # the block's motion on the ground
-    return float(sign * (u @ linkage.velocity(dyad.output, B)))
+    B = linkage.point(output.output, _end(slide, output.output))
+    sign = 1.0 if slide.links[1] == output.output else -1.0  # the block's motion on the ground
+    return float(sign * (u @ linkage.velocity(output.output, B)))
 
 
-def output_position(linkage: PlanarLinkage, dyad: Dyad) -> float:
-    """The output's angle (of OB from the plane's e1) [rad] or its place along the slide [m]."""
-    B = linkage.point(dyad.coupler, _end(dyad.joint, dyad.coupler))
-    if dyad.kind == "pin":
-        d = B - linkage.point(0, _end(dyad.ground, 0))
+def output_position(linkage: PlanarLinkage, output: Output | Dyad) -> float:
+    """The output's angle (of its frame's x axis from the plane's e1, as a report's phi)
+    [rad], or its place along the slide [m] (the slide's point on the block)."""
+    if output.kind == "pin":
+        d = linkage.direction(output.output, np.array([1.0, 0.0, 0.0]))
         return math.atan2(d[1], d[0])
-    u = linkage.direction(dyad.ground.links[0], dyad.ground.axis)
-    return float(u @ B)
+    slide = output.ground
+    u = linkage.direction(slide.links[0], slide.axis)
+    return float(u @ linkage.point(output.output, _end(slide, output.output)))
 
 
 def toggle(linkage: PlanarLinkage, dyad: Dyad, tol: float = 1e-6) -> str:
