@@ -379,10 +379,23 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             sinks.add(pose)
     for line in forces.summary() if forces else []:
         print(line, file=sys.stderr)
+    for line in _design_summary(sweep, stop - start, args.through_folds):
+        print(line, file=sys.stderr)
     limits.summary(steps)
     if not args.through_folds:  # past a fold the driver turns back: no whole turns to speak of
         _say_return(sweep, stop - start)
     return 0
+
+
+def _design_summary(sweep, span: float, through_folds: bool) -> list[str]:
+    """The sweep's design diagnostics (README: Design diagnostics); the time ratio when the
+    driver made exactly one turn."""
+    import math
+
+    from pinmech.design_sweep import design_of
+
+    turn = sweep.is_angular and not through_folds and abs(abs(span) - 2 * math.pi) <= 1e-9
+    return design_of(sweep).summary(2 * math.pi if turn else None)
 
 
 def _say_return(sweep, span: float) -> None:
@@ -431,6 +444,9 @@ def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | Non
 
     csv_kind, json_kind, source = SweepCsv, SweepJsonLines, sweep
     sinks = Outputs()
+    from pinmech.design_sweep import design_of
+
+    sinks.plot(design_of(sweep), None)  # every pose, for the design summary, whatever is written
     if forces is not None:
         from pinmech.forces_sweep import ForceCsv, ForceJsonLines, TorquePlot
 

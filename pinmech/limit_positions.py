@@ -124,11 +124,11 @@ class LimitFinder:
             r0, r1 = rates[i], rates[i + 1]
             if r0 is None or r1 is None or not (r0 * r1 < 0 or (r0 == 0 and i > 0)):
                 continue
-            x, q = self._bisect(output, qs[i], float(values[i]), float(values[i + 1]), r0)
-            out.append(self._limit(output, q, x, "max" if r0 > 0 else "min"))
+            x, q = self.bisect(output, qs[i], float(values[i]), float(values[i + 1]), r0)
+            out.append(self.limit(output, q, x, "max" if r0 > 0 else "min"))
         return out
 
-    def _bisect(self, output: Output, q0: np.ndarray, a: float, b: float, ra: float) -> tuple[float, np.ndarray]:
+    def bisect(self, output: Output, q0: np.ndarray, a: float, b: float, ra: float) -> tuple[float, np.ndarray]:
         """The driver value in [a, b] where the output's rate changes sign (ra at a), and q there."""
         x0 = a
         while abs(b - a) > BISECTION_TOL:
@@ -145,7 +145,7 @@ class LimitFinder:
         x = 0.5 * (a + b)
         return x, self.pose(q0, x0, x)
 
-    def _limit(self, output: Output, q: np.ndarray, x: float, label: str) -> LimitPosition:
+    def limit(self, output: Output, q: np.ndarray, x: float, label: str) -> LimitPosition:
         self.linkage.place(q)
         name = self.linkage.names[output.output]
         kind = "rocker extreme" if output.kind == "pin" else "dead centre"
