@@ -106,7 +106,7 @@ class DesignSweep:
             pressure.add(phi, pose.value)
         for i, (stat, value) in enumerate(zip(self.advantages, out["advantage"])):
             if math.isfinite(value):
-                stat.add(value, pose.value)
+                stat.add(abs(value), pose.value)
             before = self.previous[i]
             if before is not None and not pose.note and not pose.interpolated and before[2] * rates[i] < 0:
                 self.brackets[i].append((before[0], before[1], before[2], pose.value))
@@ -194,8 +194,9 @@ class DesignSweep:
             name = self.linkage.names[output.output]
             lines += self._travel_lines(name, found, span)
             if math.isfinite(stat.low):
-                lines.append(f"design: {name}: mechanical advantage from {stat.low:.6g} to {stat.high:.6g} "
-                             f"[{self._unit(output)}] over the poses (infinite at its limit positions)")
+                lines.append(f"design: {name}: mechanical advantage |driver rate / {name}'s rate| least "
+                             f"{stat.low:.6g} [{self._unit(output)}] at {self._driver(stat.low_at)} over the poses "
+                             "(infinite at its limit positions)")
         return lines
 
     def _travel_lines(self, name: str, found: list[LimitPosition], span: float | None) -> list[str]:
