@@ -79,17 +79,12 @@ def design_at(mechanism, drivers: list[str], q: np.ndarray, v: np.ndarray, unit_
     return design
 
 
-def analysis_design(analysis) -> Design:
-    """The diagnostics of a solved scene (`pinmech.analyse`)."""
-    from pinmech.solve_loops import LoopSolver
-
+def analysis_design(analysis, unit_rates: np.ndarray | None = None) -> Design:
+    """The diagnostics of a solved scene (`pinmech.analyse`); `unit_rates`: its joint
+    rates per unit driver rate, for the mechanical advantage (`unit_rates_of`)."""
     mech, names = analysis.mechanism, list(analysis.drivers.names)
-    unit = None
-    if analysis.mechanism.plane_normal is not None and len(names) == 1:
-        solver = LoopSolver(mech, names, **analysis.scene.solver_options())
-        unit, _, _ = solver.rates(analysis.solution.q, [1.0], [0.0])
     angular = mech.joint(names[0]).is_angular if names else True
-    return design_at(mech, names, analysis.solution.q, analysis.solution.v, unit, angular)
+    return design_at(mech, names, analysis.solution.q, analysis.solution.v, unit_rates, angular)
 
 
 # ---------------------------------------------------------------------- reports

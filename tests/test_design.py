@@ -15,7 +15,6 @@ from closed_form import four_bar, slider_crank
 
 import pinmech
 from pinmech.cli import main
-from pinmech.design import analysis_design
 from pinmech.design_sweep import design_of
 from pinmech.exceptions import DiagnosticError
 from pinmech.grashof import loop_classes
@@ -57,6 +56,13 @@ rocker = ["O4", "B"]
 
 def _solve(scene, angle_deg: float):
     return pinmech.analyse(pinmech.Scene.load(scene, [f'drivers.O2.angle="{angle_deg} deg"']))
+
+
+def analysis_design(analysis):
+    """The design section `pinmech solve` reports (with the mechanical advantage)."""
+    from pinmech.report import scene_design
+
+    return scene_design(analysis)
 
 
 # Norton §2.12: s + l vs p + q, and which link is the shortest. (d, a, b, c) [mm], the
@@ -271,3 +277,23 @@ def test_cli_solve_json_and_sweep_columns_carry_the_diagnostics(tmp_path, capsys
     first = json.loads(lines.read_text().splitlines()[0])
     mu = math.radians(float(rows[0]["B.transmission_angle [deg]"]))
     np.testing.assert_allclose(first["design"]["dyads"]["B"]["transmission_angle"], mu, rtol=1e-11)
+
+
+def test_fixed_centrode_of_the_coupler_is_the_meeting_point_of_crank_and_rocker_lines():
+    """The fixed centrode of the coupler traces I13 (lines O2A and O4B meet), the moving
+    centrode is that point in the coupler's frame: mapped back, it is the same point."""
+    from pinmech.instant_centres import centrodes
+
+    sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(SCENES / "four_bar.toml"))
+    thetas = np.radians([60.0, 100.0, 200.0])
+    qs = [design_of(sweep)._q(p.motion) for p in sweep.poses(thetas)]
+    linkage = planar_linkage(sweep.mechanism)
+    coupler = next(i for i, n in linkage.names.items() if n == "coupler")
+    fixed, moving = centrodes(linkage, coupler, np.array(qs))
+    for theta, q, f, m in zip(thetas, qs, fixed, moving):
+        fb = four_bar(theta, 1.0, 0.0, 0.04, 0.12, 0.08, 0.10)
+        A, B, O4 = np.asarray(fb.A), np.asarray(fb.B), np.array([0.10, 0.0])
+        t = np.linalg.solve(np.column_stack([A, -(B - O4)]), O4)
+        np.testing.assert_allclose(f, t[0] * A, rtol=1e-9)  # closed form vs Kennedy: rounding x 1e6
+        linkage.place(q)
+        np.testing.assert_allclose(linkage.point(coupler, m), f, rtol=0, atol=1e-12)
