@@ -49,6 +49,8 @@ class DesignSweep:
         from pinmech.solve_loops import LoopSolver
 
         self.sweep, self.reason = sweep, ""
+        self._cache: tuple[int, dict] = (-1, {})
+        self.count = 0
         try:
             self.linkage = planar_linkage(sweep.mechanism)
         except DiagnosticError as exc:
@@ -66,8 +68,6 @@ class DesignSweep:
         self.advantages = [_Extreme() for _ in self.outputs]
         self.previous: list[tuple | None] = [None] * len(self.outputs)
         self.brackets: list[list[tuple]] = [[] for _ in self.outputs]
-        self._cache: tuple[int, dict] = (-1, {})
-        self.count = 0
 
     @property
     def applicable(self) -> bool:

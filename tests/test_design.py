@@ -260,6 +260,9 @@ def test_spatial_mechanism_is_refused_by_name_and_said_in_the_report(capsys):
         planar_linkage(pinmech.load_linkage(MODELS / "linkages" / "rsur.toml"))
     assert main(["solve", str(SCENES / "rsur_drawn.toml")]) == 0
     assert "planar diagnostics: not applicable" in capsys.readouterr().out
+    assert main(["sweep", str(SCENES / "rsur_drawn.toml"), "--steps", "5", "--skip-failures"]) == 0
+    out, err = capsys.readouterr()
+    assert "design: planar diagnostics: not applicable" in err and "transmission_angle" not in out
 
 
 def test_cli_solve_json_and_sweep_columns_carry_the_diagnostics(tmp_path, capsys):
