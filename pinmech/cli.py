@@ -5,7 +5,7 @@ Exit codes: 0 success; 1 hand values mismatch (`check`); 2 usage or other pinmec
 the mobility; 6 a loop cannot close; 7 singular pose, or forces not determined; 8 inconsistent
 task; 9 a drawing input out of range; 10 another assembly than the scene's (or none reachable
 on it); 11 the drivers cannot go further (a fold: limit angle, extreme, stroke); 12 a joint
-beyond its URDF <limit> (with --limits error); 13 forces that fail their own power balance.
+beyond its URDF <limit> (with --limits error); 13 forces that fail their own power balance; 14 a planar design diagnostic asked of a spatial mechanism.
 An output file that cannot be written is 2.
 Stopped by a signal: 128 + its number (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP), outputs kept
 as NAME.partial.
@@ -76,7 +76,7 @@ def build_parser(command: str | None = None, *, parser_class: type[argparse.Argu
         description="Kinematics of mechanisms and robot arms from URDF, on Pinocchio.",
         epilog="Exit codes: 0 ok, 1 check mismatch, 2 error, 3 URDF, 4 scene, 5 mobility, "
         "6 loop cannot close, 7 singular pose (or undetermined forces), 8 task, 9 drawing, 10 assembly, "
-        "11 driver limit, 12 joint limit (--limits error), 13 forces off their balance, "
+        "11 driver limit, 12 joint limit (--limits error), 13 forces off their balance, 14 design diagnostic (spatial), "
         "130 Ctrl-C (128 + signal).",
     )
     parser.add_argument("--version", action="version", version=f"pinmech {__version__}")
@@ -379,10 +379,23 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             sinks.add(pose)
     for line in forces.summary() if forces else []:
         print(line, file=sys.stderr)
+    for line in _design_summary(sweep, stop - start, args.through_folds):
+        print(line, file=sys.stderr)
     limits.summary(steps)
     if not args.through_folds:  # past a fold the driver turns back: no whole turns to speak of
         _say_return(sweep, stop - start)
     return 0
+
+
+def _design_summary(sweep, span: float, through_folds: bool) -> list[str]:
+    """The sweep's design diagnostics (README: Design diagnostics); the time ratio when the
+    driver made exactly one turn."""
+    import math
+
+    from pinmech.design_sweep import design_of
+
+    turn = sweep.is_angular and not through_folds and abs(abs(span) - 2 * math.pi) <= 1e-9
+    return design_of(sweep).summary(2 * math.pi if turn else None)
 
 
 def _say_return(sweep, span: float) -> None:
@@ -431,6 +444,9 @@ def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | Non
 
     csv_kind, json_kind, source = SweepCsv, SweepJsonLines, sweep
     sinks = Outputs()
+    from pinmech.design_sweep import design_of
+
+    sinks.plot(design_of(sweep), None)  # every pose, for the design summary, whatever is written
     if forces is not None:
         from pinmech.forces_sweep import ForceCsv, ForceJsonLines, TorquePlot
 

@@ -256,3 +256,19 @@ class LimitError(PinmechError):
     def __init__(self, message: str, *, violations: list[Any]):
         super().__init__(message)
         self.violations = violations
+
+
+class DiagnosticError(PinmechError):
+    """A design diagnostic (transmission angle, Grashof class, limit positions, instant
+    centres) asked of a mechanism it does not apply to (a spatial one, a joint that is
+    not a pin or a slide), or one that cannot be stated to its bound at this pose.
+
+    Attributes:
+        path: the model file.
+    """
+
+    exit_code = 14
+
+    def __init__(self, message: str, *, path: str | None = None):
+        super().__init__(f"{path}: {message}" if path else message)
+        self.path = path

@@ -73,7 +73,30 @@ def to_dict(analysis: Analysis) -> dict[str, Any]:
     out["accuracy"] = analysis.solution.accuracy.as_dict()
     if analysis.extra:
         out.update({k: v for k, v in analysis.extra.items() if not k.startswith("_")})
+    if _has_design(analysis):
+        from pinmech.design import design_dict
+
+        out["design"] = design_dict(scene_design(analysis))
     return out
+
+
+def scene_design(analysis: Analysis):
+    """The scene's design diagnostics (design.py), with the rates per unit driver rate of a
+    one-driver planar mechanism for its mechanical advantage."""
+    from pinmech.design import analysis_design
+    from pinmech.solve_loops import LoopSolver
+
+    names = list(analysis.drivers.names)
+    unit = None
+    if analysis.mechanism.plane_normal is not None and len(names) == 1:
+        solver = LoopSolver(analysis.mechanism, names, **analysis.scene.solver_options())
+        unit, _, _ = solver.rates(analysis.solution.q, [1.0], [0.0])
+    return analysis_design(analysis, unit)
+
+
+def _has_design(analysis: Analysis) -> bool:
+    """Design diagnostics belong to driven mechanisms, not to [[task]] scenes."""
+    return not (analysis.extra and "task" in analysis.extra)
 
 
 def assembly_dict(analysis: Analysis) -> dict[str, Any]:
@@ -205,6 +228,10 @@ def to_text(analysis: Analysis) -> str:
     )
     for line in (analysis.extra or {}).get("_text", []):
         t.lines.append(line)
+    if _has_design(analysis):
+        from pinmech.design import design_lines
+
+        t.lines += design_lines(scene_design(analysis))
     return "\n".join(t.lines) + "\n"
 
 

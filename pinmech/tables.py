@@ -15,6 +15,7 @@ from typing import IO, TYPE_CHECKING
 
 import numpy as np
 
+from pinmech.design_sweep import design_of
 from pinmech.limits import limit_violations
 from pinmech.motion import Motion
 from pinmech.report import motion_dict
@@ -42,6 +43,7 @@ def columns(sweep: Sweep, first: Motion) -> list[str]:
         cols += [f"{name}.a{c} [m/s^2]" for c in "xyz"] + [f"{name}.|a| [m/s^2]"]
     for name in first.sliders:
         cols += [f"{name}.s [m]", f"{name}.v_rel [m/s]", f"{name}.a_rel [m/s^2]", f"{name}.|a_cor| [m/s^2]"]
+    cols += design_of(sweep).columns()  # transmission and pressure angles, mechanical advantage
     return cols + ["closure_residual [1]", "condition_number [1]", "newton_iterations [1]", "beyond_limits", "pose",
                    "error"]
 
@@ -64,6 +66,7 @@ def row(sweep: Sweep, pose: SweepPose, width: int) -> list[object]:
         out += p.position.tolist() + v + [math.hypot(*v)] + a + [math.hypot(*a)]
     for name, s in m.sliders.items():
         out += [m.joints[name].q, m.joints[name].v, m.joints[name].a, _norm(s.coriolis_acceleration)]
+    out += design_of(sweep).cells(pose)
     acc = pose.accuracy
     beyond = " ".join(v.joint for v in limit_violations(sweep.mechanism, m))
     return out + [acc.residual, acc.condition, acc.iterations, beyond, "interpolated" if pose.interpolated else "solved",
@@ -143,6 +146,9 @@ class SweepJsonLines:
             entry.update(motion_dict(pose.motion))
             entry["limit_violations"] = [v.as_dict() for v in limit_violations(self.sweep.mechanism, pose.motion)]
             entry["accuracy"] = pose.accuracy.as_dict()
+            design = design_of(self.sweep).entry(pose)
+            if design is not None:
+                entry["design"] = design
         return entry
 
     def close(self) -> None:
