@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from pinmech.exceptions import ModelError, UnitError
+from pinmech.linkage_expr import check_param_name, length
 from pinmech.units import to_si
 
 if sys.version_info >= (3, 11):
@@ -157,30 +158,21 @@ class _Reader:
 
     def __init__(self, source: str, params: dict[str, Any]):
         self.source = source
-        self.params = {name: self._quantity(value, "length", f"params.{name}") for name, value in params.items()}
+        self.params: dict[str, float] = {}
+        for name, value in params.items():  # in the order written: a parameter may use earlier ones
+            check_param_name(name, source)
+            self.params[name] = self.length(value, f"[params] {name}")
+
+    def length(self, value: Any, where: str) -> float:
+        """A length [m]: "15 mm", a parameter name "crank", or an expression "-a", "2*a + b"
+        (see `pinmech.linkage_expr`)."""
+        return length(value, self.params, self.source, where)
 
     def _quantity(self, value: Any, kind: str, where: str) -> float:
         try:
             return to_si(value, kind, where=where)
         except UnitError as exc:
             raise ModelError(str(exc), path=self.source) from exc
-
-    def length(self, value: Any, where: str) -> float:
-        """A length [m]: "15 mm", a parameter name "crank", or "-crank"."""
-        if isinstance(value, str):
-            text = value.strip()
-            sign = -1.0 if text.startswith("-") else 1.0
-            name = text.lstrip("+-").strip()
-            if name in self.params:
-                return sign * self.params[name]
-            if name.isidentifier() and not any(c.isdigit() for c in text):
-                try:
-                    return self._quantity(value, "length", where)
-                except ModelError:
-                    known = ", ".join(self.params) or "none"
-                    raise ModelError(f"'{name}' is neither a length with units nor a parameter "
-                                     f"(params: {known})", path=self.source, element=where) from None
-        return self._quantity(value, "length", where)
 
     def angle(self, value: Any, where: str) -> float:
         return self._quantity(value, "angle", where)
