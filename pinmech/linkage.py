@@ -210,7 +210,8 @@ class _Reader:
                 raise ModelError("a polar construction has exactly from, length, angle", path=self.source,
                                  element=where)
             r, phi = self.length(spec["length"], f"{where} length"), self.angle(spec["angle"], f"{where} angle")
-            return known[bases[0]][:2] + r * np.array([math.cos(phi), math.sin(phi)])
+            base = known[bases[0]]  # in 3-D: in the plane z = the base's z (the angle from x, seen from +z)
+            return base + r * np.array([math.cos(phi), math.sin(phi), 0.0][: base.size])
         if len(bases) != 2 or set(spec) != {"from", "lengths", "side"}:
             raise ModelError("a compass construction has exactly from = [\"A\", \"B\"], lengths = [|A..|, |B..|], "
                              "side = \"left\" or \"right\" (of the line A -> B)", path=self.source, element=where)
@@ -221,8 +222,26 @@ class _Reader:
             raise ModelError(f"side must be \"left\" or \"right\", got {spec['side']!r}", path=self.source,
                              element=where)
         r1, r2 = (self.length(v, f"{where} lengths") for v in lengths)
-        return _compass(known[bases[0]][:2], known[bases[1]][:2], r1, r2, spec["side"] == "left",
-                        f"{self.source}, {where}")
+        a, b = _level(known[bases[0]], known[bases[1]], bases, self.source, where)
+        point = _compass(a[:2], b[:2], r1, r2, spec["side"] == "left", f"{self.source}, {where}")
+        return np.append(point, a[2]) if a.size == 3 else point
+
+
+def _level(a: np.ndarray, b: np.ndarray, names: list[str], source: str, where: str) -> tuple[np.ndarray, np.ndarray]:
+    """The two bases of a compass construction, both 2-D or both 3-D at one z [m]: left and
+    right of A -> B are seen from +z, so the circles are drawn in the plane z = z_A.
+
+    Raises:
+        ModelError: bases at different heights (the circles' plane would be a guess).
+    """
+    if a.size == b.size == 2:
+        return a, b
+    a, b = (np.append(p, 0.0) if p.size == 2 else p for p in (a, b))
+    if abs(a[2] - b[2]) > 1e-12 * max(float(np.linalg.norm(b - a)), float(np.max(np.abs(a))), 1e-300):
+        raise ModelError(f"a compass construction draws in a plane z = constant, but {names[0]} is at z = "
+                         f"{a[2]:.6g} m and {names[1]} at z = {b[2]:.6g} m: give this joint's [x, y, z]",
+                         path=source, element=where)
+    return a, b
 
 
 def _compass(a: np.ndarray, b: np.ndarray, r1: float, r2: float, left: bool, where: str) -> np.ndarray:
