@@ -382,6 +382,9 @@ def _check_names(linkage: Linkage) -> None:
     for kind, names in (("link", linkage.links), ("point", linkage.point_links),
                         ("joint", [e.name for e in linkage.edges])):
         for name in names:
+            if not name.strip() or not name.isprintable():
+                raise ModelError(f"the {kind} name {name!r} is empty or holds a control character: names go "
+                                 "into the generated URDF and the reports", path=linkage.source)
             if name in seen and not (kind == "point" and seen[name] == "link"):
                 raise ModelError(f"'{name}' names both a {seen[name]} and a {kind}: rename one",
                                  path=linkage.source)
