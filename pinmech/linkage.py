@@ -18,11 +18,8 @@ Conventions of the generated URDF (all in the plane z = 0, axes along z):
 
 from __future__ import annotations
 
-import hashlib
 import math
-import os
 import sys
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -414,13 +411,11 @@ def _write_whole(path: Path, text: str) -> None:
 
 
 def _cached_urdf(text: str) -> Path:
-    """The generated URDF in a per-user cache folder, named by its content (for drawings)."""
-    folder = Path(tempfile.gettempdir()) / f"pinmech-{os.getuid() if hasattr(os, 'getuid') else 'user'}"
-    folder.mkdir(mode=0o700, exist_ok=True)
-    path = folder / f"linkage-{hashlib.sha256(text.encode()).hexdigest()[:20]}.urdf"
-    if not path.is_file() or path.read_text(encoding="utf-8") != text:
-        _write_whole(path, text)
-    return path
+    """The generated URDF in this user's private cache folder, named by its content (for
+    drawings); see `pinmech.user_cache`."""
+    from pinmech.user_cache import cached_text
+
+    return cached_text("linkage", ".urdf", text)
 
 
 def load_linkage(path: str | Path, *, locked: dict[str, float] | None = None):
