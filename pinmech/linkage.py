@@ -28,6 +28,7 @@ import numpy as np
 
 from pinmech.exceptions import ModelError, UnitError
 from pinmech.linkage_expr import check_param_name, length
+from pinmech.linkage_masses import LinkMass, parse_masses
 from pinmech.units import to_si
 
 if sys.version_info >= (3, 11):
@@ -36,7 +37,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 GROUND = "ground"
-_KEYS = {"title", "ground", "params", "joints", "links", "sliders", "slots", "colors", "axes", "balls"}
+_KEYS = {"title", "ground", "params", "joints", "links", "sliders", "slots", "colors", "axes", "balls", "masses"}
 
 @dataclass(frozen=True)
 class Edge:
@@ -72,6 +73,8 @@ class Linkage:
         hidden: links added for pin-in-slot joints (no visual of their own).
         spatial: points are 3-D (x, y, z) and pins have their own axes (`[axes]`), balls
             (`balls = [...]`) are spherical joints; else planar, in z = 0, axes along z.
+        masses: link -> its mass, as `[masses]` states it (`pinmech.linkage_masses`); a
+            link not there has none.
     """
 
     source: str
@@ -85,6 +88,7 @@ class Linkage:
     spatial: bool = False
     axes: dict[str, np.ndarray] = field(default_factory=dict)
     balls: set[str] = field(default_factory=set)
+    masses: dict[str, LinkMass] = field(default_factory=dict)
 
 
 # ------------------------------------------------------------------------- reading
@@ -131,7 +135,20 @@ def parse_linkage(path: str | Path) -> Linkage:
     for name, spec in _table(raw, "slots", source).items():
         _slot(linkage, reader, name, spec)
     _check_names(linkage)
+    _masses(linkage, reader, raw.get("masses", {}))
     return linkage
+
+
+def _masses(linkage: Linkage, reader: _Reader, table: Any) -> None:
+    """`[masses]`: the links' masses as stated (`pinmech.linkage_masses`), none invented."""
+    links = {n: v for n, v in linkage.links.items() if n not in linkage.hidden}
+    linkage.masses = parse_masses(table, links, linkage.points, linkage.spatial, reader.length, linkage.source)
+    for link, stated in linkage.masses.items():
+        if stated.centre.size == 3 and not linkage.spatial:
+            raise ModelError("a planar linkage's centre of mass is [x, y]", path=linkage.source,
+                             element=f"[masses] {link}")
+        if linkage.spatial and stated.centre.size == 2:
+            linkage.masses[link] = LinkMass(stated.mass, np.append(stated.centre, 0.0), stated.inertia)
 
 
 def _table(raw: dict[str, Any], key: str, source: str) -> dict[str, Any]:
@@ -441,6 +458,8 @@ def load_linkage(path: str | Path, *, locked: dict[str, float] | None = None):
         except ModelError as exc:  # name the user's file, not the generated one
             raise ModelError(str(exc).replace(str(urdf), str(path)), path=None) from exc
         mech.source, mech.urdf_path = str(path), str(urdf)
+        mech.mass_source = "mass under the linkage's [masses]"
+        mech.massless_links = tuple(n for n in mech.links if n not in linkage.links or n in linkage.hidden)
         return mech
 
     mech = built(None)

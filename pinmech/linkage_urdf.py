@@ -247,14 +247,22 @@ def _link_xml(linkage: Linkage, link: str, frame: _Frame, size: float, index: in
         for p in local:
             shapes.append((p, 0.0, f'<cylinder radius="{_num(0.6 * width)}" length="{_num(1.2 * width)}"/>'))
     out = [f"  <link name={quoteattr(link)}>"]
-    if link != GROUND:
-        out.append('    <inertial><mass value="1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" '
-                   'iyz="0"/></inertial>')
+    if link in linkage.masses:
+        stated = linkage.masses[link]  # izz and ixx = iyy = izz/2 are the same in the link's frame
+        out.append(_inertial_xml(stated.mass, _xyz(frame.local(stated.centre)), stated.inertia))
     for p, phi, geometry in shapes:
         out.append(f'    <visual><origin xyz="{_xyz(p, z)}" rpy="0 0 {_num(phi)}"/><geometry>{geometry}</geometry>'
                    f'<material name="{material}"/></visual>')
     out.append("  </link>")
     return out
+
+
+def _inertial_xml(mass: float, origin: str, inertia: np.ndarray) -> str:
+    """A stated mass [kg] at its centre (`origin`, link frame [m]), inertia about it [kg m^2]."""
+    (xx, xy, xz), (_, yy, yz), (_, _, zz) = inertia
+    values = " ".join(f'{k}="{_num(v)}"' for k, v in (("ixx", xx), ("iyy", yy), ("izz", zz), ("ixy", xy),
+                                                        ("ixz", xz), ("iyz", yz)))
+    return f'    <inertial><origin xyz="{origin}"/><mass value="{_num(mass)}"/><inertia {values}/></inertial>'
 
 
 # ------------------------------------------------------------------------- spatial
@@ -348,9 +356,9 @@ def _spatial_link_xml(linkage: Linkage, link: str, origin: np.ndarray, size: flo
     material = "ground" if link == GROUND else f"c{(index - 1) % len(_COLOURS)}"
     local = [linkage.points[n] - origin for n in linkage.links[link]]
     out = [f"  <link name={quoteattr(link)}>"]
-    if link != GROUND:
-        out.append('    <inertial><mass value="1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" '
-                   'iyz="0"/></inertial>')
+    if link in linkage.masses:  # the link's axes are the world's at the drawn pose
+        stated = linkage.masses[link]
+        out.append(_inertial_xml(stated.mass, _xyz3(stated.centre - origin), stated.inertia))
     ring = [] if link == GROUND else local + local[:1] if len(local) > 2 else local[:2]  # outline, or a bar
     pairs = [(ring[i], ring[i + 1]) for i in range(len(ring) - 1)]
     for p, q in pairs:
