@@ -460,6 +460,7 @@ def load_linkage(path: str | Path, *, locked: dict[str, float] | None = None):
         mech.source, mech.urdf_path = str(path), str(urdf)
         mech.mass_source = "mass under the linkage's [masses]"
         mech.massless_links = tuple(n for n in mech.links if n not in linkage.links or n in linkage.hidden)
+        mech.limits = {}  # a drawing states no limits: the URDF's slide <limit> is a formality
         return mech
 
     mech = built(None)

@@ -599,3 +599,9 @@ def test_a_compass_between_two_heights_is_refused(tmp_path):
     with pytest.raises(ModelError, match=r"tilted\.toml, \[joints\] B: a compass .* A is at z = 0\.05 m and O4 at "
                                          r"z = 0 m"):
         parse_linkage(path)
+
+
+def test_a_drawn_slider_has_no_invented_limits():
+    """URDF needs a <limit> on a prismatic joint; the one written for a drawn slider (1000
+    times the mechanism's size) is no fact of the drawing and is no limit of the model."""
+    assert load_linkage(LINKAGES / "slider_crank.toml").limits == {}
