@@ -463,9 +463,16 @@ def load_linkage(path: str | Path, *, locked: dict[str, float] | None = None):
         mech.limits = {}  # a drawing states no limits: the URDF's slide <limit> is a formality
         return mech
 
+    from pinmech.linkage_pins import add_pin_frames, pin_places
+
     mech = built(None)
     _check_closed(mech)  # as drawn; a joint held at another value than drawn opens the drawn pose,
-    return built(locked) if locked else mech  # which the solver closes from there
+    pins = {n: p for n, p in linkage.points.items()
+            if n not in linkage.point_links and any(n in names for names in linkage.links.values())}
+    places = pin_places(mech, pins, linkage.links)  # (which the solver closes from there)
+    mech = built(locked) if locked else mech
+    add_pin_frames(mech, places)
+    return mech
 
 
 def joint_kinds(path: str | Path) -> dict[str, str]:
