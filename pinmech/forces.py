@@ -246,14 +246,18 @@ class ForceSolver:
             if mass < 0 or not np.isfinite(mass):
                 raise ModelError(f"forces: the body moved by joint {model.names[jid]} has a mass of {mass:g} kg: a "
                                  "mass must be a positive number", path=mech.source)
-            if mass > 0:
-                continue
             names = [n for n, fid in mech.links.items() if model.frames[fid].parentJoint == jid]
-            if not set(names) <= massless:
+            if mass > 0:
+                if names and set(names) <= massless:  # the mass would be used all the same
+                    raise ModelError(f"forces: {', '.join(names)} listed in [forces] massless, but the file gives "
+                                     f"{'it' if len(names) == 1 else 'them'} {mass:g} kg: drop the mass or the "
+                                     "listing", path=mech.source)
+                continue
+            if not set(names) <= massless | set(mech.massless_links):
                 missing += [n for n in names if n not in massless] or [model.names[jid]]
         if missing:
             raise ModelError(f"forces need the masses of the moving links; {', '.join(missing)} "
-                             "have no <inertial> mass (give one, or list the links meant to be "
+                             f"have no {mech.mass_source} (give one, or list the links meant to be "
                              "massless: [forces] massless = [...])", path=mech.source)
 
     # ------------------------------------------------------------------ solve

@@ -18,11 +18,8 @@ Conventions of the generated URDF (all in the plane z = 0, axes along z):
 
 from __future__ import annotations
 
-import hashlib
 import math
-import os
 import sys
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -30,6 +27,8 @@ from typing import Any
 import numpy as np
 
 from pinmech.exceptions import ModelError, UnitError
+from pinmech.linkage_expr import check_param_name, length
+from pinmech.linkage_masses import LinkMass, parse_masses
 from pinmech.units import to_si
 
 if sys.version_info >= (3, 11):
@@ -38,7 +37,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 GROUND = "ground"
-_KEYS = {"title", "ground", "params", "joints", "links", "sliders", "slots", "colors", "axes", "balls"}
+_KEYS = {"title", "ground", "params", "joints", "links", "sliders", "slots", "colors", "axes", "balls", "masses"}
 
 @dataclass(frozen=True)
 class Edge:
@@ -74,6 +73,8 @@ class Linkage:
         hidden: links added for pin-in-slot joints (no visual of their own).
         spatial: points are 3-D (x, y, z) and pins have their own axes (`[axes]`), balls
             (`balls = [...]`) are spherical joints; else planar, in z = 0, axes along z.
+        masses: link -> its mass, as `[masses]` states it (`pinmech.linkage_masses`); a
+            link not there has none.
     """
 
     source: str
@@ -87,6 +88,7 @@ class Linkage:
     spatial: bool = False
     axes: dict[str, np.ndarray] = field(default_factory=dict)
     balls: set[str] = field(default_factory=set)
+    masses: dict[str, LinkMass] = field(default_factory=dict)
 
 
 # ------------------------------------------------------------------------- reading
@@ -133,7 +135,20 @@ def parse_linkage(path: str | Path) -> Linkage:
     for name, spec in _table(raw, "slots", source).items():
         _slot(linkage, reader, name, spec)
     _check_names(linkage)
+    _masses(linkage, reader, raw.get("masses", {}))
     return linkage
+
+
+def _masses(linkage: Linkage, reader: _Reader, table: Any) -> None:
+    """`[masses]`: the links' masses as stated (`pinmech.linkage_masses`), none invented."""
+    links = {n: v for n, v in linkage.links.items() if n not in linkage.hidden}
+    linkage.masses = parse_masses(table, links, linkage.points, linkage.spatial, reader.length, linkage.source)
+    for link, stated in linkage.masses.items():
+        if stated.centre.size == 3 and not linkage.spatial:
+            raise ModelError("a planar linkage's centre of mass is [x, y]", path=linkage.source,
+                             element=f"[masses] {link}")
+        if linkage.spatial and stated.centre.size == 2:
+            linkage.masses[link] = LinkMass(stated.mass, np.append(stated.centre, 0.0), stated.inertia)
 
 
 def _table(raw: dict[str, Any], key: str, source: str) -> dict[str, Any]:
@@ -157,30 +172,21 @@ class _Reader:
 
     def __init__(self, source: str, params: dict[str, Any]):
         self.source = source
-        self.params = {name: self._quantity(value, "length", f"params.{name}") for name, value in params.items()}
+        self.params: dict[str, float] = {}
+        for name, value in params.items():  # in the order written: a parameter may use earlier ones
+            check_param_name(name, source)
+            self.params[name] = self.length(value, f"[params] {name}")
+
+    def length(self, value: Any, where: str) -> float:
+        """A length [m]: "15 mm", a parameter name "crank", or an expression "-a", "2*a + b"
+        (see `pinmech.linkage_expr`)."""
+        return length(value, self.params, self.source, where)
 
     def _quantity(self, value: Any, kind: str, where: str) -> float:
         try:
             return to_si(value, kind, where=where)
         except UnitError as exc:
             raise ModelError(str(exc), path=self.source) from exc
-
-    def length(self, value: Any, where: str) -> float:
-        """A length [m]: "15 mm", a parameter name "crank", or "-crank"."""
-        if isinstance(value, str):
-            text = value.strip()
-            sign = -1.0 if text.startswith("-") else 1.0
-            name = text.lstrip("+-").strip()
-            if name in self.params:
-                return sign * self.params[name]
-            if name.isidentifier() and not any(c.isdigit() for c in text):
-                try:
-                    return self._quantity(value, "length", where)
-                except ModelError:
-                    known = ", ".join(self.params) or "none"
-                    raise ModelError(f"'{name}' is neither a length with units nor a parameter "
-                                     f"(params: {known})", path=self.source, element=where) from None
-        return self._quantity(value, "length", where)
 
     def angle(self, value: Any, where: str) -> float:
         return self._quantity(value, "angle", where)
@@ -218,7 +224,8 @@ class _Reader:
                 raise ModelError("a polar construction has exactly from, length, angle", path=self.source,
                                  element=where)
             r, phi = self.length(spec["length"], f"{where} length"), self.angle(spec["angle"], f"{where} angle")
-            return known[bases[0]][:2] + r * np.array([math.cos(phi), math.sin(phi)])
+            base = known[bases[0]]  # in 3-D: in the plane z = the base's z (the angle from x, seen from +z)
+            return base + r * np.array([math.cos(phi), math.sin(phi), 0.0][: base.size])
         if len(bases) != 2 or set(spec) != {"from", "lengths", "side"}:
             raise ModelError("a compass construction has exactly from = [\"A\", \"B\"], lengths = [|A..|, |B..|], "
                              "side = \"left\" or \"right\" (of the line A -> B)", path=self.source, element=where)
@@ -229,8 +236,26 @@ class _Reader:
             raise ModelError(f"side must be \"left\" or \"right\", got {spec['side']!r}", path=self.source,
                              element=where)
         r1, r2 = (self.length(v, f"{where} lengths") for v in lengths)
-        return _compass(known[bases[0]][:2], known[bases[1]][:2], r1, r2, spec["side"] == "left",
-                        f"{self.source}, {where}")
+        a, b = _level(known[bases[0]], known[bases[1]], bases, self.source, where)
+        point = _compass(a[:2], b[:2], r1, r2, spec["side"] == "left", f"{self.source}, {where}")
+        return np.append(point, a[2]) if a.size == 3 else point
+
+
+def _level(a: np.ndarray, b: np.ndarray, names: list[str], source: str, where: str) -> tuple[np.ndarray, np.ndarray]:
+    """The two bases of a compass construction, both 2-D or both 3-D at one z [m]: left and
+    right of A -> B are seen from +z, so the circles are drawn in the plane z = z_A.
+
+    Raises:
+        ModelError: bases at different heights (the circles' plane would be a guess).
+    """
+    if a.size == b.size == 2:
+        return a, b
+    a, b = (np.append(p, 0.0) if p.size == 2 else p for p in (a, b))
+    if abs(a[2] - b[2]) > 1e-12 * max(float(np.linalg.norm(b - a)), float(np.max(np.abs(a))), 1e-300):
+        raise ModelError(f"a compass construction draws in a plane z = constant, but {names[0]} is at z = "
+                         f"{a[2]:.6g} m and {names[1]} at z = {b[2]:.6g} m: give this joint's [x, y, z]",
+                         path=source, element=where)
+    return a, b
 
 
 def _compass(a: np.ndarray, b: np.ndarray, r1: float, r2: float, left: bool, where: str) -> np.ndarray:
@@ -371,6 +396,9 @@ def _check_names(linkage: Linkage) -> None:
     for kind, names in (("link", linkage.links), ("point", linkage.point_links),
                         ("joint", [e.name for e in linkage.edges])):
         for name in names:
+            if not name.strip() or not name.isprintable():
+                raise ModelError(f"the {kind} name {name!r} is empty or holds a control character: names go "
+                                 "into the generated URDF and the reports", path=linkage.source)
             if name in seen and not (kind == "point" and seen[name] == "link"):
                 raise ModelError(f"'{name}' names both a {seen[name]} and a {kind}: rename one",
                                  path=linkage.source)
@@ -400,13 +428,11 @@ def _write_whole(path: Path, text: str) -> None:
 
 
 def _cached_urdf(text: str) -> Path:
-    """The generated URDF in a per-user cache folder, named by its content (for drawings)."""
-    folder = Path(tempfile.gettempdir()) / f"pinmech-{os.getuid() if hasattr(os, 'getuid') else 'user'}"
-    folder.mkdir(mode=0o700, exist_ok=True)
-    path = folder / f"linkage-{hashlib.sha256(text.encode()).hexdigest()[:20]}.urdf"
-    if not path.is_file() or path.read_text(encoding="utf-8") != text:
-        _write_whole(path, text)
-    return path
+    """The generated URDF in this user's private cache folder, named by its content (for
+    drawings); see `pinmech.user_cache`."""
+    from pinmech.user_cache import cached_text
+
+    return cached_text("linkage", ".urdf", text)
 
 
 def load_linkage(path: str | Path, *, locked: dict[str, float] | None = None):
@@ -432,11 +458,21 @@ def load_linkage(path: str | Path, *, locked: dict[str, float] | None = None):
         except ModelError as exc:  # name the user's file, not the generated one
             raise ModelError(str(exc).replace(str(urdf), str(path)), path=None) from exc
         mech.source, mech.urdf_path = str(path), str(urdf)
+        mech.mass_source = "mass under the linkage's [masses]"
+        mech.massless_links = tuple(n for n in mech.links if n not in linkage.links or n in linkage.hidden)
+        mech.limits = {}  # a drawing states no limits: the URDF's slide <limit> is a formality
         return mech
+
+    from pinmech.linkage_pins import add_pin_frames, pin_places
 
     mech = built(None)
     _check_closed(mech)  # as drawn; a joint held at another value than drawn opens the drawn pose,
-    return built(locked) if locked else mech  # which the solver closes from there
+    pins = {n: p for n, p in linkage.points.items()
+            if n not in linkage.point_links and any(n in names for names in linkage.links.values())}
+    places = pin_places(mech, pins, linkage.links)  # (which the solver closes from there)
+    mech = built(locked) if locked else mech
+    add_pin_frames(mech, places)
+    return mech
 
 
 def joint_kinds(path: str | Path) -> dict[str, str]:

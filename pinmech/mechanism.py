@@ -106,6 +106,9 @@ class Mechanism:
         force_caveats: why the file's forces are not this model's (masses its parser
             does not compute as the file's own tool, passive joint forces): kinematics do
             not need them, `ForceSolver` refuses to run on them.
+        massless_links: links without mass by construction (a drawn slot's hidden block, a
+            ball's gimbal links): no mass is missing there.
+        mass_source: where a file gives a link's mass, for the message naming links without.
     """
 
     model: pin.Model
@@ -124,6 +127,8 @@ class Mechanism:
     mimics: dict[str, MimicJoint] = field(default_factory=dict)
     limits: dict[str, JointLimit] = field(default_factory=dict)
     force_caveats: tuple[str, ...] = ()
+    massless_links: tuple[str, ...] = ()
+    mass_source: str = "<inertial> mass"
 
     # ---------------------------------------------------------------- construction
     @classmethod

@@ -34,10 +34,8 @@ Ball joints (nq 4, nv 3) work in loops: pinmech moves along the tangent space.
 
 from __future__ import annotations
 
-import hashlib
 import math
 import os
-import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -46,6 +44,7 @@ import pinocchio as pin
 
 from pinmech.exceptions import ModelError
 from pinmech.mechanism import Mechanism, pinocchio_build, read_xml
+from pinmech.user_cache import cached_text
 
 _CLOSE_TOL = 1e-9  # [m] gap of a connect at qpos0 read as open (parsers print 6-9 digits)
 _TYPES = {"hinge": "revolute", "slide": "prismatic", "ball": "ball", "free": "free"}
@@ -401,15 +400,7 @@ def _wrapped(root: ET.Element, source: str) -> Path:
                 for key in ("body1", "body2"):
                     if el.get(key) in (None, "world"):
                         el.set(key, WRAPPER)
-    text = ET.tostring(root, encoding="unicode")
-    folder = Path(tempfile.gettempdir()) / f"pinmech-{os.getuid() if hasattr(os, 'getuid') else 'user'}"
-    folder.mkdir(mode=0o700, exist_ok=True)
-    out = folder / f"mjcf-{hashlib.sha256((source + text).encode()).hexdigest()[:20]}.xml"
-    if not out.is_file():
-        tmp = out.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, out)
-    return out
+    return cached_text("mjcf", ".xml", ET.tostring(root, encoding="unicode"))  # read back only if it is ours
 
 
 def _normalise_axisangles(root: ET.Element, source: str) -> None:

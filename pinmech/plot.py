@@ -79,7 +79,9 @@ class SweepPlot:
         self.mark_q = None  # configuration of the pose nearest the scene's (drawn under the paths)
         self.links, self.points = links or chosen.get("links"), points or chosen.get("points")
         _check_names(sweep, "link", self.links, sweep.mechanism.links, "--links" if links else "[sweep] links")
-        _check_names(sweep, "point", self.points, sweep.mechanism.points, "--points" if points else "[sweep] points")
+        named = [n for n in self.points or () if sweep.mechanism.model.existFrame(n)]  # a drawn linkage's pins
+        _check_names(sweep, "point", self.points, [*sweep.mechanism.points, *named],
+                     "--points" if points else "[sweep] points")
         self.every = max(1, math.ceil(total / max_points)) if total else 1
         self.last = total - 1 if total else None  # drawn whatever every is: a turn ends where it ends
         self.normal = sweep.mechanism.plane_normal

@@ -197,6 +197,8 @@ class Analysis:
 
     def _repr_html_(self) -> str:
         """Jupyter shows the points' and links' motion as tables."""
+        import html
+
         from pinmech.draw.report_page import motion_table_html
 
-        return f"<h4>{self.scene.title}</h4>" + motion_table_html(self)
+        return f"<h4>{html.escape(self.scene.title)}</h4>" + motion_table_html(self)

@@ -30,6 +30,7 @@ SI_UNITS: dict[str, str] = {
     "force": "newton",
     "torque": "newton * meter",
     "moment_of_inertia": "kilogram * meter ** 2",
+    "mass": "kilogram",
 }
 
 #: For a joint coordinate: the kind of q, v and a for a revolute and a prismatic joint.
@@ -50,6 +51,7 @@ _DIMENSIONS: dict[str, dict[str, int]] = {
     "force": {"gram": 1, "meter": 1, "second": -2},  # pint's root unit of mass is the gram
     "torque": {"gram": 1, "meter": 2, "second": -2},
     "moment_of_inertia": {"gram": 1, "meter": 2},
+    "mass": {"gram": 1},
 }
 
 _DEG = math.pi / 180
@@ -84,6 +86,8 @@ _COMMON_UNITS: dict[str, tuple[float, str]] = {
     "kN": (1e3, "force"),
     "N*m": (1.0, "torque"),
     **{u: (1.0, "moment_of_inertia") for u in ("kg*m^2", "kg*m**2")},
+    "kg": (1.0, "mass"),
+    "g": (1e-3, "mass"),
 }
 
 #: Largest magnitude of a quantity in SI units. Kinematics multiplies speeds and lengths
@@ -260,6 +264,7 @@ def _example(kind: str) -> str:
         "force": "N",
         "torque": "N*m",
         "moment_of_inertia": "kg*m^2",
+        "mass": "kg",
     }[kind]
 
 
@@ -276,4 +281,5 @@ def format_si(value: float, kind: str) -> str:
         "force": "N",
         "torque": "N m",
         "moment_of_inertia": "kg m^2",
+        "mass": "kg",
     }[kind]

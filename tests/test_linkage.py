@@ -561,3 +561,47 @@ def test_a_drawn_linkage_locked_away_from_its_drawing(models_dir):
     for point in free.points:
         np.testing.assert_allclose(data.oMf[locked.points[point]].translation,
                                    data_free.oMf[free.points[point]].translation, atol=1e-12)
+
+
+# ------------------------------------------------------------------- spatial constructions
+SPATIAL_LIFTED = """ground = ["O2", "O4"]
+[joints]
+O2 = ["0 mm", "0 mm", "50 mm"]
+O4 = ["100 mm", "0 mm", "50 mm"]
+A = { from = "O2", length = "40 mm", angle = "30 deg" }
+B = { from = ["A", "O4"], lengths = ["120 mm", "80 mm"], side = "left" }
+[links]
+crank = ["O2", "A"]
+coupler = ["A", "B"]
+rocker = ["O4", "B"]
+"""
+
+
+def test_spatial_constructions_keep_their_bases_height(tmp_path):
+    """A four-bar drawn in the plane z = 50 mm (was: the constructions dropped z, so the bars
+    written 120 and 80 mm came out 130 and 94.3 mm). Each bar is its written length, by the
+    distance formula on the drawn points, and the constructed points stay at z = 50 mm;
+    A is the polar point (40 cos 30 deg, 40 sin 30 deg, 50) mm by hand."""
+    path = tmp_path / "lifted.toml"
+    path.write_text(SPATIAL_LIFTED)
+    p = parse_linkage(path).points
+    np.testing.assert_allclose(p["A"], [0.04 * math.cos(math.pi / 6), 0.02, 0.05], rtol=0, atol=1e-15)
+    bars = [np.linalg.norm(p[x] - p[y]) for x, y in (("O2", "A"), ("A", "B"), ("O4", "B"))]
+    np.testing.assert_allclose(bars, [0.040, 0.120, 0.080], rtol=0, atol=1e-15)  # rounding of mm -> m only
+    assert p["B"][2] == pytest.approx(0.05, abs=1e-15) and p["B"][1] > 0  # left of A -> O4, seen from +z
+    assert load_linkage(path).mobility == 1  # and the drawing closes as built
+
+
+def test_a_compass_between_two_heights_is_refused(tmp_path):
+    """Bases at z = 50 and 0 mm: the plane of the two circles is not given, so no guess."""
+    path = tmp_path / "tilted.toml"
+    path.write_text(SPATIAL_LIFTED.replace('O4 = ["100 mm", "0 mm", "50 mm"]', 'O4 = ["100 mm", "0 mm", "0 mm"]'))
+    with pytest.raises(ModelError, match=r"tilted\.toml, \[joints\] B: a compass .* A is at z = 0\.05 m and O4 at "
+                                         r"z = 0 m"):
+        parse_linkage(path)
+
+
+def test_a_drawn_slider_has_no_invented_limits():
+    """URDF needs a <limit> on a prismatic joint; the one written for a drawn slider (1000
+    times the mechanism's size) is no fact of the drawing and is no limit of the model."""
+    assert load_linkage(LINKAGES / "slider_crank.toml").limits == {}

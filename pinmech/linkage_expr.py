@@ -1,0 +1,160 @@
+"""Lengths of a drawn linkage written with its parameters: `"crank"`, `"-a"`, `"2*a + b/2"`.
+
+A length in a linkage file is either one quantity with its unit (`"15 mm"`, read by
+`pinmech.units.to_si`) or an arithmetic expression over the file's `[params]` and plain
+numbers. The expression is read by Python's `ast` and only this grammar is evaluated:
+
+    expr   := term (("+" | "-") term)*          both sides lengths
+    term   := factor (("*" | "/") factor)*      at most one length in a product; divide by numbers only
+    factor := ["+" | "-"] atom                  one sign, never two ("--a", "+-a", "a - -b")
+    atom   := PARAM | NUMBER | "(" expr ")"
+
+Everything else is refused with a `ModelError` naming the file, the key and the text:
+`**`, implicit multiplication (`"2 a"` would be 2 years to pint: written with a parameter's
+name as its unit it is ambiguous), unknown names, division by zero, a result that is not a
+length or not finite, or a magnitude beyond `units.MAX_MAGNITUDE`.
+"""
+
+from __future__ import annotations
+
+import ast
+import keyword
+import math
+import re
+from typing import Any
+
+from pinmech.exceptions import ModelError, UnitError
+from pinmech.units import MAX_MAGNITUDE, to_si
+
+#: Longer texts are not read as expressions (a guard on the parser's work and depth).
+MAX_TEXT = 200
+_BINARY = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/"}
+
+
+class _Refused(Exception):
+    """Why an expression is not read (turned into a ModelError by `length`)."""
+
+
+def check_param_name(name: str, source: str) -> None:
+    """A parameter is named as an identifier that is not a Python keyword (`in` is an inch).
+
+    Raises:
+        ModelError: naming the file and the parameter.
+    """
+    if not name.isidentifier() or keyword.iskeyword(name):
+        raise ModelError(f"parameter name {name!r} must be letters, digits and _ (not starting with a digit, "
+                         "not a word such as 'in' or 'and'), so that expressions can use it",
+                         path=source, element=f"[params] {name}")
+
+
+def length(value: Any, params: dict[str, float], source: str, where: str) -> float:
+    """A length [m]: a quantity with its unit, or an expression over `params` [m].
+
+    Raises:
+        ModelError: anything but one quantity or one expression of the grammar above.
+    """
+    if not isinstance(value, str):
+        return _quantity(value, source, where)
+    text = value.strip().replace("\u2212", "-")  # a typographic minus sign is a minus sign
+    tree = _parse(text)
+    if tree is None or not any(isinstance(n, ast.Name) for n in ast.walk(tree)):
+        _refuse_unit_named_as_param(text, params, source, where)
+        try:
+            return _quantity(value, source, where)
+        except ModelError:
+            used = sorted(set(re.findall(r"[A-Za-z_]\w*", text)) & set(params))
+            if not used:
+                raise
+            raise ModelError(f"{value!r} mixes the parameter(s) {', '.join(used)} with quantities: an expression "
+                             "holds parameters, plain numbers, + - * / and parentheses (put '1 mm' in [params])",
+                             path=source, element=where) from None
+    try:
+        result, is_length = _evaluate(tree.body, params)
+    except _Refused as exc:
+        raise ModelError(f"{value!r}: {exc}", path=source, element=where) from None
+    if not is_length:
+        raise ModelError(f"{value!r} is a plain number, not a length: use a parameter or a unit", path=source,
+                         element=where)
+    if not math.isfinite(result) or abs(result) > MAX_MAGNITUDE:
+        raise ModelError(f"{value!r} is {result:.3g} m, beyond the {MAX_MAGNITUDE:g} m pinmech computes with",
+                         path=source, element=where)
+    return result
+
+
+def _parse(text: str) -> ast.Expression | None:
+    """The expression's tree, or None when the text is no expression (a quantity "15 mm")."""
+    if len(text) > MAX_TEXT:
+        return None
+    try:
+        return ast.parse(text, mode="eval")
+    except (SyntaxError, ValueError, RecursionError, MemoryError):
+        return None
+
+
+def _quantity(value: Any, source: str, where: str) -> float:
+    try:
+        return to_si(value, "length", where=where)
+    except UnitError as exc:
+        raise ModelError(str(exc), path=source) from exc
+
+
+def _refuse_unit_named_as_param(text: str, params: dict[str, float], source: str, where: str) -> None:
+    """`"2 a"` with a parameter `a`: 2 years to pint, 2*a to a reader; neither is guessed."""
+    words = text.split()
+    if len(words) == 2 and words[1] in params:
+        raise ModelError(f"{text!r} is ambiguous: '{words[1]}' is a parameter and a unit; write "
+                         f"'{words[0]}*{words[1]}' for the parameter times {words[0]}, or the quantity with "
+                         "another spelling of its unit", path=source, element=where)
+
+
+def _evaluate(node: ast.AST, params: dict[str, float]) -> tuple[float, bool]:
+    """The value of a node and whether it is a length [m] (else a plain number)."""
+    if isinstance(node, ast.Name):
+        if node.id not in params:
+            known = ", ".join(params) or "none"
+            raise _Refused(f"'{node.id}' is not a parameter (params: {known})")
+        return params[node.id], True
+    if isinstance(node, ast.Constant):
+        if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
+            raise _Refused(f"{node.value!r} is not a number")
+        try:
+            number = float(node.value)
+        except OverflowError:
+            raise _Refused("a number too large for a float") from None
+        if not math.isfinite(number):
+            raise _Refused(f"{number!r} is not a finite number")
+        return number, False
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.UAdd, ast.USub)):
+        if isinstance(node.operand, ast.UnaryOp):
+            raise _Refused("two signs in a row: write one sign")
+        value, is_length = _evaluate(node.operand, params)
+        return (-value if isinstance(node.op, ast.USub) else value), is_length
+    if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
+        return _binary(node, params)
+    if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow):
+        raise _Refused("'**' (a power) is not a length: write products out")
+    raise _Refused("only parameters, numbers, + - * / and parentheses are read")
+
+
+def _binary(node: ast.BinOp, params: dict[str, float]) -> tuple[float, bool]:
+    symbol = _BINARY[type(node.op)]
+    if symbol in "+-" and isinstance(node.right, ast.UnaryOp):
+        raise _Refused(f"a sign right after '{symbol}': write one sign")
+    (a, a_len), (b, b_len) = _evaluate(node.left, params), _evaluate(node.right, params)
+    if symbol in "+-":
+        if a_len != b_len:
+            raise _Refused(f"'{symbol}' between a length and a plain number: give both a unit or a parameter")
+        result, is_length = (a + b if symbol == "+" else a - b), a_len
+    elif symbol == "*":
+        if a_len and b_len:
+            raise _Refused("a length times a length is an area, not a length")
+        result, is_length = a * b, a_len or b_len
+    else:
+        if b_len:
+            raise _Refused("dividing by a length gives no length: divide by plain numbers")
+        if b == 0:
+            raise _Refused("division by zero")
+        result, is_length = a / b, a_len
+    if not math.isfinite(result) or abs(result) > MAX_MAGNITUDE:
+        raise _Refused(f"{result:.3g} is beyond the {MAX_MAGNITUDE:g} pinmech computes with")
+    return result, is_length

@@ -1,0 +1,105 @@
+"""Generated model files (a drawn linkage's URDF, a rewritten MJCF) in a folder only this user can touch.
+
+Pinocchio's parsers read files, so a model pinmech generates is written to disk first. The
+shared temporary folder is open to every local user, so a file there is used only when:
+
+  * its folder `$TMPDIR/pinmech-<uid>` is a real folder (not a symbolic link), owned by this
+    user, with no permission for anyone else (mode 0700); otherwise this process makes a
+    fresh private folder (`tempfile.mkdtemp`, 0700, removed at exit) and uses that;
+  * the file is named by the SHA-256 of its text, is a regular file owned by this user, and
+    holds exactly that text when read back; otherwise it is written anew;
+  * it is written through `tempfile.mkstemp` (an unpredictable name, created exclusively)
+    and renamed into place whole.
+"""
+
+from __future__ import annotations
+
+import atexit
+import hashlib
+import os
+import shutil
+import stat
+import tempfile
+from pathlib import Path
+
+_fallback: Path | None = None
+
+
+def cached_text(kind: str, suffix: str, text: str) -> Path:
+    """A file holding exactly `text` in this user's private cache folder.
+
+    Args:
+        kind: the file name's prefix ("linkage", "mjcf").
+        suffix: its extension (".urdf", ".xml").
+        text: the content (UTF-8).
+    """
+    data = text.encode("utf-8", errors="surrogateescape")
+    folder = private_folder()
+    path = folder / f"{kind}-{hashlib.sha256(data).hexdigest()}{suffix}"
+    if not _holds(path, data):
+        _write(folder, path, data)
+    return path
+
+
+def private_folder() -> Path:
+    """`$TMPDIR/pinmech-<uid>` if it is this user's alone (made so if absent), else a fresh
+    folder of this process's own."""
+    folder = Path(tempfile.gettempdir()) / f"pinmech-{_uid() if _uid() is not None else 'user'}"
+    try:
+        os.mkdir(folder, 0o700)
+    except FileExistsError:
+        pass
+    except OSError:
+        return _own_folder()
+    return folder if is_private(folder) else _own_folder()
+
+
+def is_private(folder: Path) -> bool:
+    """A real folder (not a link) owned by this user, with no access for group or others."""
+    try:
+        info = os.lstat(folder)
+    except OSError:
+        return False
+    if not stat.S_ISDIR(info.st_mode):
+        return False
+    if _uid() is None:  # no owners to compare (Windows): the folder of the user's own temp
+        return True
+    return info.st_uid == _uid() and stat.S_IMODE(info.st_mode) & 0o077 == 0
+
+
+def _holds(path: Path, data: bytes) -> bool:
+    """The file is a regular file of this user's holding exactly `data` (read without following links)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+    except OSError:
+        return False
+    with os.fdopen(fd, "rb") as handle:
+        info = os.fstat(handle.fileno())
+        if not stat.S_ISREG(info.st_mode) or (_uid() is not None and info.st_uid != _uid()):
+            return False
+        return handle.read(len(data) + 1) == data
+
+
+def _write(folder: Path, path: Path, data: bytes) -> None:
+    """Through a new file of an unpredictable name, renamed over `path` when whole."""
+    handle, name = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+        os.replace(name, path)
+    except BaseException:
+        Path(name).unlink(missing_ok=True)
+        raise
+
+
+def _own_folder() -> Path:
+    """A private folder for this process (0700, unpredictable name), removed at exit."""
+    global _fallback
+    if _fallback is None or not is_private(_fallback):
+        _fallback = Path(tempfile.mkdtemp(prefix="pinmech-"))
+        atexit.register(shutil.rmtree, _fallback, ignore_errors=True)
+    return _fallback
+
+
+def _uid() -> int | None:
+    return os.getuid() if hasattr(os, "getuid") else None
