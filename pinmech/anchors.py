@@ -17,6 +17,7 @@ import pinocchio as pin
 
 from pinmech.closures import Closure
 from pinmech.exceptions import ModelError
+from pinmech.frame_names import reduced_model
 
 
 @dataclass(frozen=True)
@@ -90,7 +91,7 @@ def lock_anchored(model: pin.Model, cuts: list[AnchorCut], locked: dict[str, flo
         ids.append(jid)
     data = model.createData()
     pin.forwardKinematics(model, data, q_full)
-    reduced = pin.buildReducedModel(model, ids, q_full)
+    reduced = reduced_model(model, ids, q_full)
 
     def moved(joint: int, placement: pin.SE3) -> tuple[int, pin.SE3]:
         keep = joint

@@ -45,6 +45,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import ModelError
+from pinmech.frame_names import frame_named
 from pinmech.mechanism import Mechanism, pinocchio_build, read_xml
 
 _CLOSE_TOL = 1e-9  # [m] gap of a connect at qpos0 read as open (parsers print 6-9 digits)
@@ -504,7 +505,7 @@ def _check_sites(mech: Mechanism, elements: list[ET.Element], source: str) -> No
         site1, site2 = el.get("site1"), el.get("site2")
         if el.tag != "connect" or not (site1 and site2):
             continue
-        ids = [mech.model.getFrameId(s) if mech.model.existFrame(s) else None for s in (site1, site2)]
+        ids = [frame_named(mech.model, s, (pin.FrameType.OP_FRAME,), source) for s in (site1, site2)]
         if None in ids:
             raise ModelError(f"site1/site2 {site1}, {site2} are not both sites Pinocchio read", path=source,
                              element=f"<connect name=\"{el.get('name', '')}\">")

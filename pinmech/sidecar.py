@@ -21,6 +21,7 @@ from typing import Any
 import pinocchio as pin
 
 from pinmech.exceptions import ModelError
+from pinmech.frame_names import frame_named, reduced_model
 from pinmech.mechanism import Mechanism, _build_model, _parse_xml, _point_links
 
 _KEYS = {"closed_loop", "type", "name_mot", "joint_name", "joint_type"}
@@ -92,15 +93,16 @@ def load_extended_urdf(urdf: str | Path, sidecar: str | Path, *,
     model = _changed_joints(model, content["joint_name"], content["joint_type"], str(sidecar))
     constraints, names = [], []
     for (a, b), kind in zip(content["closed_loop"], content["type"]):
-        for name in (a, b):
-            if not model.existFrame(name):
+        ids = [frame_named(model, name, source=str(sidecar)) for name in (a, b)]
+        for name, fid in zip((a, b), ids):
+            if fid is None:
                 raise ModelError(f"frame '{name}' is not in {urdf.name}", path=str(sidecar), element="closed_loop")
-        fa, fb = model.frames[model.getFrameId(a)], model.frames[model.getFrameId(b)]
+        fa, fb = model.frames[ids[0]], model.frames[ids[1]]
         contact = pin.ContactType.CONTACT_3D if kind == "3d" else pin.ContactType.CONTACT_6D
         constraints.append(pin.RigidConstraintModel(contact, model, fa.parentJoint, fa.placement, fb.parentJoint,
                                                     fb.placement, pin.ReferenceFrame.LOCAL))
         names.append(f"{a}C{b}")
-    points = [n for n in _point_links(root) if model.existFrame(n)]
+    points = [n for n in _point_links(root) if frame_named(model, n, source=str(urdf)) is not None]
     mech = Mechanism.from_model(model, constraints, names=names, points=points, source=str(urdf),
                                 urdf_path=str(urdf), locked=locked)
     held = set(mech.locked)
@@ -137,13 +139,14 @@ def _changed_joints(model: pin.Model, names: list[str], types: list[str], source
             name = f"{name}_Y"
         new_id = new.addJoint(parent, joint, placement, name)
         new.appendBodyToJoint(new_id, model.inertias[jid], pin.SE3.Identity())
-    for frame in list(model.frames)[1:]:
+    new_frame = {0: 0}  # old frame id -> new (frames of several kinds may share a name)
+    for fid, frame in enumerate(list(model.frames)[1:], start=1):
         owner = model.names[frame.parentJoint]
         joint = new.getJointId(renamed.get(owner, owner))
-        parent_frame = new.getFrameId(model.frames[frame.parentFrame].name) if frame.parentFrame else 0
-        new.addFrame(pin.Frame(frame.name, joint, parent_frame, frame.placement, frame.type), False)
+        new_frame[fid] = new.addFrame(pin.Frame(frame.name, joint, new_frame[frame.parentFrame], frame.placement,
+                                                frame.type), False)
     fixed = [new.getJointId(n) for n, t in change.items() if t == "FIXED"]
     if fixed:
-        new = pin.buildReducedModel(new, fixed, pin.neutral(new))
+        new = reduced_model(new, fixed, pin.neutral(new))
     return new
 

@@ -183,3 +183,42 @@ def test_a_locked_motor_is_neither_a_missing_joint_nor_a_default_driver():
     assert "mot2" not in mech.joints and mech.motors == ["mot1"] and mech.mobility == 1
     held = load_extended_urdf(folder / "robot.urdf", folder / "robot.yaml")
     assert held.motors == ["mot1", "mot2"]
+
+
+def _five_bar_named_after_links(tmp_path, yaml_extra: str = "") -> tuple[Path, Path]:
+    """The five-bar with every joint named after its child link (as MuJoCo Menagerie names them)."""
+    text = FIVE[0].read_text()
+    for joint, link in (("mot1", "proximal1"), ("elbow1", "distal1"), ("mot2", "proximal2"), ("elbow2", "distal2"),
+                        ("to_closedloop1_A", "closedloop1_A"), ("to_closedloop1_B", "closedloop1_B")):
+        text = text.replace(f'joint name="{joint}"', f'joint name="{link}"')
+    urdf, sidecar = tmp_path / "robot.urdf", tmp_path / "robot.yaml"
+    urdf.write_text(text)
+    sidecar.write_text("closed_loop: [['closedloop1_A', 'closedloop1_B']]\ntype: ['3d']\n"
+                       "name_mot: ['proximal1', 'proximal2']\n" + yaml_extra)
+    return urdf, sidecar
+
+
+@pytest.mark.parametrize("how", ["[lock]", "joint_type FIXED"])
+def test_joints_named_after_links_lock_and_close(tmp_path, how):
+    """Elbow 2 held at its drawn angle e = 1.6185 rad: proximal 2 and distal 2 are one rigid
+    link, so the end P is L2 from the elbow B1 = L1 u(t1) and |L1 + L2 u(e)| from the second
+    motor O2 (law of cosines)."""
+    if how == "[lock]":
+        urdf, sidecar = _five_bar_named_after_links(tmp_path)
+        mech = load_extended_urdf(urdf, sidecar, locked={"distal2": 0.0})
+    else:
+        urdf, sidecar = _five_bar_named_after_links(tmp_path, "joint_name: ['distal2']\njoint_type: ['FIXED']\n")
+        mech = load_extended_urdf(urdf, sidecar)
+    assert mech.mobility == 1
+    solver = LoopSolver(mech, ["proximal1"])
+    e, O2 = 1.6185128527327788, np.array([D, 0.0])
+    rigid = math.sqrt(L1**2 + L2**2 + 2 * L1 * L2 * math.cos(e))
+    q = mech.neutral()
+    for q1 in (0.0, 0.1, 0.2):
+        q = solver.solve([q1], [0.0], [0.0], guess=q).q
+        pin.framesForwardKinematics(mech.model, solver.data, q)
+        P = solver.data.oMf[mech.points["closedloop1_A"]].translation[:2]
+        t1 = 2 * math.pi / 3 + q1
+        B1 = L1 * np.array([math.cos(t1), math.sin(t1)])
+        # lengths of 0.1 m solved to 1e-13 of the size: 1e-12 m allowed
+        np.testing.assert_allclose([np.linalg.norm(P - B1), np.linalg.norm(P - O2)], [L2, rigid], atol=1e-12)
