@@ -23,6 +23,7 @@ import pinocchio as pin
 from pinmech.exceptions import ModelError
 from pinmech.frame_names import frame_named, reduced_model
 from pinmech.mechanism import Mechanism, _build_model, _parse_xml, _point_links
+from pinmech.urdf_joints import joint_limits, mimic_joints, with_followers
 
 _KEYS = {"closed_loop", "type", "name_mot", "joint_name", "joint_type"}
 _JOINT_TYPES = ("SPHERICAL", "CARDAN", "FIXED")
@@ -89,8 +90,14 @@ def load_extended_urdf(urdf: str | Path, sidecar: str | Path, *,
     urdf, sidecar = Path(urdf), Path(sidecar)
     content = read_sidecar(sidecar)
     root = _parse_xml(urdf)
-    model = _build_model(str(urdf))
+    mimics = mimic_joints(root, str(urdf))
+    model = _build_model(str(urdf), mimic=bool(mimics))
+    if mimics and content["joint_name"]:
+        raise ModelError(f"joint_name/joint_type change joints of a URDF with <mimic> joints "
+                         f"({', '.join(mimics)}): pinmech cannot rebuild those; change the URDF itself",
+                         path=str(sidecar), element="joint_name")
     model = _changed_joints(model, content["joint_name"], content["joint_type"], str(sidecar))
+    locked = with_followers(dict(locked or {}), mimics, str(urdf))
     constraints, names = [], []
     for (a, b), kind in zip(content["closed_loop"], content["type"]):
         ids = [frame_named(model, name, source=str(sidecar)) for name in (a, b)]
@@ -105,6 +112,8 @@ def load_extended_urdf(urdf: str | Path, sidecar: str | Path, *,
     points = [n for n in _point_links(root) if frame_named(model, n, source=str(urdf)) is not None]
     mech = Mechanism.from_model(model, constraints, names=names, points=points, source=str(urdf),
                                 urdf_path=str(urdf), locked=locked)
+    mech.mimics = {n: m for n, m in mimics.items() if n not in mech.locked}
+    mech.limits = {n: lu for n, lu in joint_limits(root, str(urdf)).items() if n in mech.joints or n in mech.locked}
     held = set(mech.locked)
     for motor in content["name_mot"]:
         if motor not in mech.joints and motor not in held:

@@ -222,3 +222,34 @@ def test_joints_named_after_links_lock_and_close(tmp_path, how):
         B1 = L1 * np.array([math.cos(t1), math.sin(t1)])
         # lengths of 0.1 m solved to 1e-13 of the size: 1e-12 m allowed
         np.testing.assert_allclose([np.linalg.norm(P - B1), np.linalg.norm(P - O2)], [L2, rigid], atol=1e-12)
+
+
+def test_a_mimic_through_the_sidecar_couples_the_motors(tmp_path):
+    """mot2 follows mot1 (<mimic multiplier="-1">): one driver moves both, and the end is the
+    circle intersection at t1 = 2 pi/3 + q1, t2 = pi/3 - q1 (as the URDF alone would say)."""
+    text = FIVE[0].read_text()
+    for motor in ("mot1", "mot2"):
+        text = text.replace(f'<joint name="{motor}" type="continuous">', f'<joint name="{motor}" type="revolute">')
+    text = text.replace('<origin xyz="0.1 0 0" rpy="0 0 1.0471975511965976"/><axis xyz="0 0 1"/></joint>',
+                        '<origin xyz="0.1 0 0" rpy="0 0 1.0471975511965976"/><axis xyz="0 0 1"/>'
+                        '<limit lower="-3" upper="3" effort="1" velocity="1"/><mimic joint="mot1" multiplier="-1"/>'
+                        '</joint>')
+    text = text.replace('<origin xyz="0 0 0" rpy="0 0 2.0943951023931953"/><axis xyz="0 0 1"/></joint>',
+                        '<origin xyz="0 0 0" rpy="0 0 2.0943951023931953"/><axis xyz="0 0 1"/>'
+                        '<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>')
+    urdf, sidecar = tmp_path / "robot.urdf", tmp_path / "robot.yaml"
+    urdf.write_text(text)
+    sidecar.write_text(FIVE[1].read_text().replace("name_mot: ['mot1', 'mot2']", "name_mot: ['mot1']"))
+    mech = load_extended_urdf(urdf, sidecar)
+    assert mech.mobility == 1 and "mot2" in mech.mimics
+    solver = LoopSolver(mech, ["mot1"])
+    q = mech.neutral()
+    for q1 in (0.05, 0.1, 0.2):
+        q = solver.solve([q1], [0.0], [0.0], guess=q).q
+        pin.framesForwardKinematics(mech.model, solver.data, q)
+        P = solver.data.oMf[mech.points["closedloop1_A"]].translation[:2]
+        # positions solved to 1e-13 of the 0.1 m size: 1e-12 m allowed
+        np.testing.assert_allclose(P, five_bar_end(2 * math.pi / 3 + q1, math.pi / 3 - q1), atol=1e-12)
+        assert mech.coordinate(q, "mot2") == pytest.approx(-q1, abs=1e-15)
+    locked = load_extended_urdf(urdf, sidecar, locked={"mot1": 0.1})  # locking the leader holds its follower
+    assert locked.locked == {"mot1": 0.1, "mot2": -0.1} and locked.mobility == 0
