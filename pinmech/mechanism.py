@@ -31,6 +31,7 @@ import pinocchio as pin
 from pinmech.closures import CUT_TYPES, Closure
 from pinmech.exceptions import FrameNotFound, ModelError
 from pinmech.frame_names import frame_named, frames_of_kind, reduced_model
+from pinmech.inertia_check import model_inertia_caveats, urdf_inertia_caveats
 from pinmech.urdf_joints import JointLimit, MimicJoint, joint_limits, mimic_joints, with_followers
 
 #: Singular values below this fraction of the largest mark a row as structurally zero.
@@ -193,6 +194,7 @@ class Mechanism:
             source=source,
             locked=dict(locked or {}),
             mimics={n: m for n, m in mimics.items() if n not in (locked or {})},
+            force_caveats=tuple(urdf_inertia_caveats(root, source)),
         )
         mech.limits = {n: lu for n, lu in joint_limits(root, source).items() if n in mech.joints or n in mech.locked}
         mech.closures = [_make_closure(model, c) for c in cuts]
@@ -260,7 +262,8 @@ class Mechanism:
             joint_links[model.names[jid]] = (parent, child)
         mech = cls(model=model, closures=[], joints=_joint_infos(model, joint_links, source), links=bodies,
                    points=_named_points(model, points, source), length_scale=1.0, plane_normal=None,
-                   source=source, urdf_path=urdf_path, locked=dict(locked or {}))
+                   source=source, urdf_path=urdf_path, locked=dict(locked or {}),
+                   force_caveats=tuple(model_inertia_caveats(model)))
         mech.closures = [anchor_closure(model, cut, 1.0) for cut in cuts]  # each loop's size: below
         mech.length_scale = _length_scale(model, mech.closures, source)
         _reduce_rows(mech)

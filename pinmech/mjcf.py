@@ -47,6 +47,7 @@ import pinocchio as pin
 
 from pinmech.exceptions import ModelError
 from pinmech.frame_names import frame_named
+from pinmech.inertia_check import check_mjcf_inertias
 from pinmech.mjcf_limits import mjcf_limits
 from pinmech.mjcf_frames import angles_in_radians, fromto_sites, hoist_to_moving_bodies, orientations_as_quaternions
 from pinmech.mechanism import Mechanism, pinocchio_build, read_xml
@@ -68,6 +69,7 @@ def _parse(path: Path) -> ET.Element:
     _check_spelling(root, str(path))
     _check_keywords(root, str(path))
     _check_numbers(root, str(path))
+    check_mjcf_inertias(root, str(path))
     orientations_as_quaternions(root, str(path))
     angles_in_radians(root, str(path))
     fromto_sites(root, str(path))
@@ -416,7 +418,7 @@ def load_mjcf(path: str | Path, *, locked: dict[str, float] | None = None) -> Me
     if locked:  # checked as drawn; then the joints the scene holds are locked out
         mech = Mechanism.from_model(model, points + frames, names=connects + welds, source=source,
                                     reference=qpos0, urdf_path=str(wrapped), locked=locked)
-    mech.force_caveats = _force_caveats(root)
+    mech.force_caveats = mech.force_caveats + _force_caveats(root)
     mech.limits = {n: lu for n, lu in mjcf_limits(root, source).items() if n in mech.joints or n in mech.locked}
     return mech
 

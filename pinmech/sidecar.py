@@ -22,6 +22,7 @@ import pinocchio as pin
 
 from pinmech.exceptions import ModelError
 from pinmech.frame_names import frame_named, reduced_model
+from pinmech.inertia_check import urdf_inertia_caveats
 from pinmech.mechanism import Mechanism, _build_model, _parse_xml, _point_links
 from pinmech.urdf_joints import joint_limits, mimic_joints, with_followers
 
@@ -113,6 +114,7 @@ def load_extended_urdf(urdf: str | Path, sidecar: str | Path, *,
     mech = Mechanism.from_model(model, constraints, names=names, points=points, source=str(urdf),
                                 urdf_path=str(urdf), locked=locked)
     mech.mimics = {n: m for n, m in mimics.items() if n not in mech.locked}
+    mech.force_caveats = tuple(urdf_inertia_caveats(root, str(urdf))) + mech.force_caveats
     mech.limits = {n: lu for n, lu in joint_limits(root, str(urdf)).items() if n in mech.joints or n in mech.locked}
     held = set(mech.locked)
     for motor in content["name_mot"]:
