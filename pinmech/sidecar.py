@@ -53,16 +53,27 @@ def read_sidecar(path: str | Path) -> dict[str, Any]:
         raise ModelError("expected keys closed_loop, type, name_mot", path=source)
     unknown = set(content) - _KEYS
     if unknown:
-        raise ModelError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_KEYS))}",
+        raise ModelError(f"unknown key(s) {', '.join(sorted(map(str, unknown)))}; known: {', '.join(sorted(_KEYS))}",
                          path=source)
     out = {key: content.get(key) or [] for key in _KEYS}
     for key in _KEYS:
         if not isinstance(out[key], list):
-            raise ModelError(f"must be a list, got {out[key]!r}", path=source, element=key)
+            raise ModelError(f"must be a list, got {out[key]!r:.80}", path=source, element=key)
+    for key in ("type", "name_mot", "joint_name", "joint_type"):
+        for i, entry in enumerate(out[key]):
+            if not isinstance(entry, str):
+                raise ModelError(f"entry {i + 1} must be a name (text), got {entry!r:.80}", path=source, element=key)
+    for key in ("name_mot", "joint_name"):
+        twice = sorted({n for n in out[key] if out[key].count(n) > 1})
+        if twice:
+            raise ModelError(f"{', '.join(twice)} listed twice", path=source, element=key)
     for i, pair in enumerate(out["closed_loop"]):
         if not (isinstance(pair, list) and len(pair) == 2 and all(isinstance(n, str) for n in pair)):
-            raise ModelError(f"entry {i + 1} must be two frame names, got {pair!r}", path=source,
+            raise ModelError(f"entry {i + 1} must be two frame names, got {pair!r:.80}", path=source,
                              element="closed_loop")
+        if pair[0] == pair[1]:
+            raise ModelError(f"entry {i + 1} joins frame '{pair[0]}' to itself: a loop needs two frames",
+                             path=source, element="closed_loop")
     types = [str(t).lower() for t in out["type"]]
     for t in types:
         if t not in ("3d", "6d"):

@@ -122,6 +122,15 @@ def test_five_bar_scene_and_snapshot(scenes_dir, tmp_path):
     ("closed_loop: [[\n", ["malformed YAML"]),
     ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\njoint_name: ['elbow9']\njoint_type: ['CARDAN']\n",
      ["joint_name", "elbow9"]),
+    # entries that are not names: a number, a list, null, a boolean (were a TypeError or Boost.Python.ArgumentError)
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\nname_mot: [[mot1], mot2]\n", ["name_mot", "entry 1", "['mot1']"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\njoint_name: [3]\njoint_type: [FIXED]\n",
+     ["joint_name", "entry 1", "got 3"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\nname_mot: [null, true]\n", ["name_mot", "got None"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\ntype: [[3d]]\n", ["type", "entry 1"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_A']]\n", ["closed_loop", "to itself"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\n1: [x]\nfoo: 2\n", ["unknown key", "1, foo"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\nname_mot: [mot1, mot1]\n", ["name_mot", "listed twice"]),
 ])
 def test_sidecar_errors_name_the_file_and_key(tmp_path, yaml_text, words):
     sidecar = tmp_path / "robot.yaml"
