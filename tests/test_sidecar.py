@@ -262,3 +262,30 @@ def test_a_mimic_through_the_sidecar_couples_the_motors(tmp_path):
         assert mech.coordinate(q, "mot2") == pytest.approx(-q1, abs=1e-15)
     locked = load_extended_urdf(urdf, sidecar, locked={"mot1": 0.1})  # locking the leader holds its follower
     assert locked.locked == {"mot1": 0.1, "mot2": -0.1} and locked.mobility == 0
+
+
+def test_gepettos_five_bar_with_pins_at_its_6d_closure_says_which_lock_it_needs(tmp_path, capsys):
+    """Gepetto's published five-bar closes a 6d loop between two frames that each turn on a
+    revolute joint about the same axis (closedloop1_A, closedloop1_B): the welded pair spins
+    idly, mobility 3 for 2 motors. The error gives the [lock] line; with it, the end is the
+    circle intersection."""
+    text = FIVE[0].read_text()
+    for side, link in (("A", "sphere"), ("B", "sphere_2")):
+        text = text.replace(f'<link name="closedloop1_{side}"/>', f'<link name="{link}"/>')
+        text = text.replace(f'<joint name="to_closedloop1_{side}" type="fixed">',
+                            f'<joint name="closedloop1_{side}" type="continuous"><axis xyz="0 0 1"/>')
+        text = text.replace(f'<child link="closedloop1_{side}"/>', f'<child link="{link}"/>')
+    (tmp_path / "robot.urdf").write_text(text)
+    (tmp_path / "robot.yaml").write_text("closed_loop: [['closedloop1_A', 'closedloop1_B']]\ntype: ['6d']\n"
+                                         "name_mot: ['mot1', 'mot2']\n")
+    scene = tmp_path / "five.toml"
+    scene.write_text('urdf = "robot.urdf"\nsidecar = "robot.yaml"\n')
+    assert main(["solve", str(scene)]) == 5
+    assert '[lock] closedloop1_A = "0 deg"' in capsys.readouterr().err
+    mech = load_extended_urdf(tmp_path / "robot.urdf", tmp_path / "robot.yaml", locked={"closedloop1_A": 0.0})
+    solver = LoopSolver(mech, ["mot1", "mot2"])
+    q = solver.solve([-0.2, 0.3], [0.0, 0.0], [0.0, 0.0], guess=mech.neutral()).q
+    pin.framesForwardKinematics(mech.model, solver.data, q)
+    P = solver.data.oMf[mech.frame_id("sphere")].translation[:2]
+    # as the five-bar above: 1e-12 m on a 0.1 m mechanism
+    np.testing.assert_allclose(P, five_bar_end(2 * math.pi / 3 - 0.2, math.pi / 3 + 0.3), atol=1e-12)
