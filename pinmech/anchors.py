@@ -17,6 +17,7 @@ import pinocchio as pin
 
 from pinmech.closures import Closure
 from pinmech.exceptions import ModelError
+from pinmech.frame_names import reduced_model
 
 
 @dataclass(frozen=True)
@@ -84,13 +85,16 @@ def lock_anchored(model: pin.Model, cuts: list[AnchorCut], locked: dict[str, flo
             raise FrameNotFound("joint to lock", name, list(model.names[1:]), path=source)
         jid = model.getJointId(name)
         joint = model.joints[jid]
+        if joint.nq == 0 and "Mimic" in joint.shortname():
+            ids.append(jid)  # a follower: its leader, locked with it, sets where it is held
+            continue
         if joint.nv != 1:
             raise ModelError(f"joint '{name}' has {joint.nv} freedoms and cannot be locked by one value", path=source)
         q_full[joint.idx_q: joint.idx_q + joint.nq] = (np.cos(value), np.sin(value)) if joint.nq == 2 else value
         ids.append(jid)
     data = model.createData()
     pin.forwardKinematics(model, data, q_full)
-    reduced = pin.buildReducedModel(model, ids, q_full)
+    reduced = reduced_model(model, ids, q_full)
 
     def moved(joint: int, placement: pin.SE3) -> tuple[int, pin.SE3]:
         keep = joint

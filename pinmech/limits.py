@@ -1,4 +1,4 @@
-"""Joint limits (URDF `<limit lower upper>`): which joints a solved pose puts beyond them.
+"""Joint limits (URDF `<limit lower upper>`, MJCF `range`): which joints a solved pose puts beyond them.
 
 pinmech solves the kinematics the drivers ask for; a pose that puts a joint beyond the
 range its URDF gives is reported (text: a "Joint limits" section, JSON: "limit_violations"),
@@ -44,6 +44,7 @@ def limit_violations(mechanism: Mechanism, motion: Motion) -> list[LimitViolatio
     """The joints of a solved pose beyond their URDF limits, locked ones included (a margin
     of 1e-9, relative to the bound or absolute below 1, for the rounding of a closed loop)."""
     values = {n: j.q for n, j in motion.joints.items() if isinstance(j.q, float)}
+    values |= {n: ball_angle(j.q) for n, j in motion.joints.items() if n in mechanism.limits and np.size(j.q) == 4}
     return _beyond(mechanism, values)
 
 
@@ -51,7 +52,18 @@ def limits_at(mechanism: Mechanism, q: np.ndarray) -> list[LimitViolation]:
     """The joints beyond their URDF limits at configuration q (an arm path's point)."""
     values = {n: mechanism.coordinate(q, n) for n in mechanism.limits
               if n in mechanism.mimics or (n in mechanism.joints and mechanism.joints[n].nv == 1)}
+    for name in mechanism.limits:
+        joint = mechanism.joints.get(name)
+        if joint is not None and joint.nq == 4 and joint.nv == 3:
+            values[name] = ball_angle(q[joint.idx_q: joint.idx_q + 4])
     return _beyond(mechanism, values)
+
+
+def ball_angle(quaternion: np.ndarray) -> float:
+    """The angle a ball joint has turned from its reference [rad, in 0..pi]: MuJoCo's
+    limited ball joint keeps it below its range's upper bound. Pinocchio's order x y z w."""
+    quaternion = np.asarray(quaternion, dtype=float)
+    return float(2 * np.arctan2(np.linalg.norm(quaternion[:3]), abs(quaternion[3])))
 
 
 def _beyond(mechanism: Mechanism, values: dict[str, float]) -> list[LimitViolation]:

@@ -30,6 +30,8 @@ import pinocchio as pin
 
 from pinmech.closures import CUT_TYPES, Closure
 from pinmech.exceptions import FrameNotFound, ModelError
+from pinmech.frame_names import frame_named, frames_of_kind, reduced_model
+from pinmech.inertia_check import model_inertia_caveats, urdf_inertia_caveats
 from pinmech.urdf_joints import JointLimit, MimicJoint, joint_limits, mimic_joints, with_followers
 
 #: Singular values below this fraction of the largest mark a row as structurally zero.
@@ -197,6 +199,7 @@ class Mechanism:
             source=source,
             locked=dict(locked or {}),
             mimics={n: m for n, m in mimics.items() if n not in (locked or {})},
+            force_caveats=tuple(urdf_inertia_caveats(root, source)),
         )
         mech.limits = {n: lu for n, lu in joint_limits(root, source).items() if n in mech.joints or n in mech.locked}
         mech.closures = [_make_closure(model, c) for c in cuts]
@@ -254,7 +257,7 @@ class Mechanism:
         for name in listed:
             if listed.count(name) > 1:
                 raise ModelError(f"two constraints share the name '{name}'", path=source)
-        bodies = [f.name for f in model.frames if f.type == pin.FrameType.BODY]
+        bodies = frames_of_kind(model, pin.FrameType.BODY, source)
         joint_links = {}
         for jid in range(1, model.njoints):
             child = next((f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == jid),
@@ -262,12 +265,10 @@ class Mechanism:
             parent = next((f.name for f in model.frames if f.type == pin.FrameType.BODY
                            and f.parentJoint == model.parents[jid]), "universe")
             joint_links[model.names[jid]] = (parent, child)
-        if points is None:
-            points = [f.name for f in model.frames if f.type == pin.FrameType.OP_FRAME]
-        mech = cls(model=model, closures=[], joints=_joint_infos(model, joint_links, source),
-                   links={n: _body_frame(model, n) for n in bodies},
-                   points={n: model.getFrameId(n) for n in points}, length_scale=1.0, plane_normal=None,
-                   source=source, urdf_path=urdf_path, locked=dict(locked or {}))
+        mech = cls(model=model, closures=[], joints=_joint_infos(model, joint_links, source), links=bodies,
+                   points=_named_points(model, points, source), length_scale=1.0, plane_normal=None,
+                   source=source, urdf_path=urdf_path, locked=dict(locked or {}),
+                   force_caveats=tuple(model_inertia_caveats(model)))
         mech.closures = [anchor_closure(model, cut, 1.0) for cut in cuts]  # each loop's size: below
         mech.length_scale = _length_scale(model, mech.closures, source)
         _reduce_rows(mech)
@@ -332,8 +333,9 @@ class Mechanism:
             return self.points[name]
         if name in self.links:
             return self.links[name]
-        if self.model.existFrame(name):
-            return self.model.getFrameId(name)
+        fid = frame_named(self.model, name, source=self.source)
+        if fid is not None:
+            return fid
         known = list(self.points) + list(self.links)
         raise FrameNotFound("point or frame", name, known, path=self.source)
 
@@ -734,27 +736,7 @@ def _lock_joints(model: pin.Model, locked: dict[str, float], source: str) -> pin
         else:
             raise ModelError(f"joint '{name}' has {joint.nq} coordinates and cannot be locked by one value", path=source)
         ids.append(jid)
-    return _reduced(model, ids, q_ref)
-
-
-def _reduced(model: pin.Model, ids: list[int], q_ref: np.ndarray) -> pin.Model:
-    """pin.buildReducedModel, also when a locked joint has the name of a link (Pinocchio
-    then finds "several frames" by that name): such a joint is renamed while the model
-    is reduced, and its fixed frame named back."""
-    model = pin.Model(model)
-    renamed = {}
-    for jid in ids:
-        name = model.names[jid]
-        if sum(f.name == name for f in model.frames) > 1:
-            renamed[f"{name}__pinmech_locked"] = name
-            model.names[jid] = f"{name}__pinmech_locked"
-            for frame in model.frames:
-                if frame.name == name and frame.type == pin.FrameType.JOINT:
-                    frame.name = f"{name}__pinmech_locked"
-    reduced = pin.buildReducedModel(model, ids, q_ref)
-    for frame in reduced.frames:
-        frame.name = renamed.get(frame.name, frame.name)
-    return reduced
+    return reduced_model(model, ids, q_ref)
 
 
 #: Most degrees of freedom a model may keep. Pinocchio's `Data` allocates, whatever it is
@@ -823,8 +805,26 @@ def _joint_infos(model: pin.Model, joint_links: dict[str, tuple[str, str]], sour
     return infos
 
 
+def _named_points(model: pin.Model, names: Sequence[str] | None, source: str) -> dict[str, int]:
+    """Name -> frame id of the named points: the frames called so (a site before a body or
+    a joint of the same name), by default every OP_FRAME (MJCF sites).
+
+    Raises:
+        FrameNotFound: a name no frame has.
+    """
+    if names is None:
+        return frames_of_kind(model, pin.FrameType.OP_FRAME, source)
+    out = {}
+    for name in names:
+        fid = frame_named(model, name, source=source)
+        if fid is None:
+            raise FrameNotFound("point", name, sorted({f.name for f in model.frames}), path=source)
+        out[name] = fid
+    return out
+
+
 def _body_frame(model: pin.Model, link: str) -> int:
-    return model.getFrameId(link, pin.FrameType.BODY)
+    return frame_named(model, link, (pin.FrameType.BODY,))
 
 
 #: Mechanism sizes pinmech accepts [m]: squares of lengths and speeds must stay finite.

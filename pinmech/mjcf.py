@@ -12,18 +12,19 @@ fixed cut). Its known traps, each handled here or refused in one line:
   seen (sites given to `connect` that do not meet at qpos0) and otherwise documented;
 * a floating base (a `<freejoint>` on a top-level body, as Cassie's pelvis) is held at its
   qpos0 pose: pinmech computes the mechanism's motion relative to its base;
-* an `axisangle` axis that is not of unit length is used as is (MuJoCo normalises it): pinmech
-  normalises every one before parsing;
+* orientations, angle units, and sites or anchors on jointless bodies are misread in ways
+  mjcf_frames.py lists: every orientation is written as MuJoCo's unit quaternion, every
+  angle in radians, and sites and anchors moved onto the nearest body that moves;
 * equality types pinmech cannot close (`joint`, `tendon`, `flex`), inactive equalities, and
   `weld` with `relpose` are refused, never dropped;
 * default classes (`<default>`, `class`, `childclass`) are applied only in part (a joint's or
   a site's `pos`, a site's orientation, a geom's `mass`, `pos` and `euler` are dropped, and
   `class="main"` crashes the parser): pinmech writes every default onto its element, as
   MuJoCo resolves them, and hands Pinocchio a file without defaults;
-* `euler` under an `eulerseq` with upper-case (extrinsic) axes is misread (4 degrees off for
-  euler="0.1 0.2 0.3" rad): pinmech turns every `euler` into the quaternion MuJoCo computes;
-* a site given by `fromto` keeps its body's axes (MuJoCo turns its z axis along fromto):
-  pinmech writes it as `pos` and `quat`;
+* keywords MuJoCo refuses (active="0", angle="DEGREE", type="Hinge") and nesting deeper than
+  MuJoCo reads are refused, not read another way;
+* joint limits (`range`, `limited`, `autolimits`) are read as MuJoCo reads them (mjcf_limits.py)
+  and checked as a URDF's `<limit>` are;
 * masses the parser does not compute as MuJoCo (a mesh geom's inertia is 1 kg m², compiler
   options such as `settotalmass`) and joint damping, stiffness and friction loss (passive
   forces MuJoCo adds) become the mechanism's `force_caveats`: kinematics do not need them,
@@ -43,6 +44,10 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import ModelError
+from pinmech.frame_names import frame_named
+from pinmech.inertia_check import check_mjcf_inertias
+from pinmech.mjcf_limits import mjcf_limits
+from pinmech.mjcf_frames import angles_in_radians, fromto_sites, hoist_to_moving_bodies, orientations_as_quaternions
 from pinmech.mechanism import Mechanism, pinocchio_build, read_xml
 from pinmech.user_cache import cached_text
 
@@ -58,11 +63,15 @@ def _parse(path: Path) -> ET.Element:
     root = read_xml(path, "mujoco", "MJCF")
     if root.find("include") is not None or root.find(".//include") is not None:
         raise ModelError("<include> is not supported: give pinmech the whole model in one file", path=str(path))
+    _check_depth(root, str(path))
     _apply_defaults(root, str(path))
     _check_spelling(root, str(path))
+    _check_keywords(root, str(path))
     _check_numbers(root, str(path))
-    _eulers_as_quaternions(root, str(path))
-    _fromto_sites(root, str(path))
+    check_mjcf_inertias(root, str(path))
+    orientations_as_quaternions(root, str(path))
+    angles_in_radians(root, str(path))
+    fromto_sites(root, str(path))
     return root
 
 
@@ -72,6 +81,22 @@ def mjcf_joint_types(path: str | Path) -> dict[str, str]:
     root = _parse(Path(path))
     return {j.get("name"): _TYPES.get(j.get("type", "hinge"), "other") for j in root.iter("joint")
             if j.get("name") and j.get("type", "hinge") in _TYPES}
+
+
+#: Deepest element MuJoCo's XML reader (tinyxml2) takes, the root counting 1: 496 nested bodies
+MAX_DEPTH = 499
+
+
+def _check_depth(root: ET.Element, source: str) -> None:
+    """Elements nested no deeper than MuJoCo reads them (it refuses 'Element nesting is too
+    deep'); checked without recursion, before anything recurses over the tree."""
+    stack = [(root, 1)]
+    while stack:
+        el, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            raise ModelError(f"elements are nested more than {MAX_DEPTH} deep (MuJoCo refuses 'Element nesting is "
+                             "too deep')", path=source, element=f"<{el.tag} name=\"{el.get('name', '')}\">")
+        stack.extend((child, depth + 1) for child in el)
 
 
 # ---------------------------------------------------------------- default classes
@@ -199,6 +224,29 @@ def _check_spelling(root: ET.Element, source: str) -> None:
                                      element=f"<{el.tag} name=\"{el.get('name', '')}\">")
 
 
+# ---------------------------------------------------------------- keywords
+#: (element, attribute) -> the keywords MuJoCo takes there (case-sensitive); anything else it refuses
+_KEYWORDS = {
+    ("compiler", "autolimits"): ("true", "false"), ("compiler", "inertiafromgeom"): ("false", "true", "auto"),
+    ("compiler", "coordinate"): ("local",), ("joint", "type"): ("hinge", "slide", "ball", "free"),
+    ("joint", "limited"): ("true", "false", "auto"), ("connect", "active"): ("true", "false"),
+    ("weld", "active"): ("true", "false"),
+    ("geom", "type"): ("plane", "hfield", "sphere", "capsule", "ellipsoid", "cylinder", "box", "mesh", "sdf"),
+}
+
+
+def _check_keywords(root: ET.Element, source: str) -> None:
+    """Every keyword attribute pinmech or Pinocchio's parser reads is one MuJoCo takes
+    (active="0" was read as active, coordinate="global" as local): refused otherwise."""
+    for el in root.iter():
+        for key, value in el.attrib.items():
+            allowed = _KEYWORDS.get((el.tag, key))
+            if allowed is not None and value not in allowed:
+                raise ModelError(f"{key}=\"{value}\" is not one of {', '.join(allowed)} (MuJoCo refuses it; "
+                                 "keywords are lower case)", path=source,
+                                 element=f"<{el.tag} name=\"{el.get('name', '')}\">")
+
+
 # ---------------------------------------------------------------- numbers
 #: attributes of placements, axes and masses -> how many numbers each holds
 _COUNTS = {"pos": (3,), "quat": (4,), "axisangle": (4,), "euler": (3,), "xyaxes": (6,), "zaxis": (3,),
@@ -224,81 +272,6 @@ def _check_numbers(root: ET.Element, source: str) -> None:
                     want = " or ".join(str(c) for c in counts)
                     raise ModelError(f"{key}=\"{text}\" is not {want} finite numbers (separated by spaces)",
                                      path=source, element=f"<{el.tag} name=\"{el.get('name', '')}\">")
-
-
-# ---------------------------------------------------------------- orientations
-def _numbers(el: ET.Element, key: str, count: int, source: str) -> list[float]:
-    text = el.get(key, "")
-    try:
-        values = [float(v) for v in text.split()]
-    except ValueError:
-        values = []
-    if len(values) != count or not all(np.isfinite(values)):
-        raise ModelError(f"{key}=\"{text}\" is not {count} finite numbers", path=source,
-                         element=f"<{el.tag} name=\"{el.get('name', '')}\">")
-    return values
-
-
-def _quaternion_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a b, quaternions w x y z."""
-    return np.array([a[0] * b[0] - a[1:] @ b[1:], *(a[0] * b[1:] + b[0] * a[1:] + np.cross(a[1:], b[1:]))])
-
-
-def _eulers_as_quaternions(root: ET.Element, source: str) -> None:
-    """Every `euler` written as the `quat` MuJoCo's compiler makes of it: for each axis of
-    `eulerseq` in turn, the rotation about it multiplied on the right (a lower-case,
-    moving axis) or on the left (an upper-case, fixed axis); angles in the compiler's unit."""
-    sequence, degrees = "xyz", True
-    for compiler in root.findall("compiler"):
-        sequence = compiler.get("eulerseq", sequence)
-        degrees = compiler.get("angle", "degree" if degrees else "radian") == "degree"
-    if len(sequence) != 3 or any(c not in "xyzXYZ" for c in sequence):
-        raise ModelError(f"eulerseq=\"{sequence}\" is not three of x, y, z, X, Y, Z", path=source,
-                         element="<compiler>")
-    axes = {"x": np.array([1.0, 0, 0]), "y": np.array([0, 1.0, 0]), "z": np.array([0, 0, 1.0])}
-    for el in root.iter():
-        if el.get("euler") is None or el.tag == "compiler":
-            continue
-        angles = np.array(_numbers(el, "euler", 3, source))
-        if degrees:
-            angles = np.radians(angles)
-        q = np.array([1.0, 0, 0, 0])
-        for letter, angle in zip(sequence, angles):
-            turn = np.array([np.cos(angle / 2), *(np.sin(angle / 2) * axes[letter.lower()])])
-            q = _quaternion_product(q, turn) if letter.islower() else _quaternion_product(turn, q)
-        del el.attrib["euler"]
-        el.set("quat", " ".join(repr(float(x)) for x in q))
-
-
-def _z_to(vector: np.ndarray) -> np.ndarray:
-    """The quaternion (w x y z) turning z onto `vector` by the shortest way, as MuJoCo's
-    mju_quatZ2Vec (a half turn about x for -z)."""
-    length = np.linalg.norm(vector)
-    if not length > 0:
-        return np.array([1.0, 0, 0, 0])
-    v = vector / length
-    axis = np.cross([0.0, 0.0, 1.0], v)
-    sine = np.linalg.norm(axis)
-    if sine < 1e-15:
-        return np.array([1.0, 0, 0, 0]) if v[2] > 0 else np.array([0.0, 1.0, 0, 0])
-    angle = np.arctan2(sine, v[2])
-    return np.array([np.cos(angle / 2), *(np.sin(angle / 2) * axis / sine)])
-
-
-def _fromto_sites(root: ET.Element, source: str) -> None:
-    """A site given by `fromto` sits at its middle with its z axis from its second end to
-    its first (MuJoCo's compiler): written as `pos` and `quat`, which Pinocchio's parser
-    reads."""
-    for world in root.findall("worldbody"):
-        for site in world.iter("site"):
-            if site.get("fromto") is None:
-                continue
-            ends = np.array(_numbers(site, "fromto", 6, source))
-            del site.attrib["fromto"]
-            for key in _ORIENTATION:
-                site.attrib.pop(key, None)
-            site.set("pos", " ".join(repr(float(x)) for x in (ends[:3] + ends[3:]) / 2))
-            site.set("quat", " ".join(repr(float(x)) for x in _z_to(ends[:3] - ends[3:])))
 
 
 # ---------------------------------------------------------------- what forces need
@@ -378,11 +351,7 @@ def _wrapped(root: ET.Element, source: str) -> Path:
         raise ModelError("<worldbody> has no <body>: nothing moves", path=source)
     if any(b.get("name") == WRAPPER for b in root.iter("body")):
         raise ModelError(f"a body is called {WRAPPER}, the name pinmech gives its wrapper", path=source)
-    _normalise_axisangles(root, source)
-    compiler = root.find("compiler")
-    if compiler is None:
-        compiler = ET.Element("compiler")
-        root.insert(0, compiler)
+    compiler = root.find("compiler")  # (angles_in_radians made one)
     folder_of = Path(source).resolve().parent
     for key in ("meshdir", "texturedir", "assetdir"):  # the copy lives elsewhere: absolute folders
         compiler.set(key, str(folder_of / compiler.get(key, "")) + os.sep)
@@ -400,26 +369,8 @@ def _wrapped(root: ET.Element, source: str) -> Path:
                 for key in ("body1", "body2"):
                     if el.get(key) in (None, "world"):
                         el.set(key, WRAPPER)
+    hoist_to_moving_bodies(root, wrapper, source)
     return cached_text("mjcf", ".xml", ET.tostring(root, encoding="unicode"))  # read back only if it is ours
-
-
-def _normalise_axisangles(root: ET.Element, source: str) -> None:
-    """Unit axes in every `axisangle`: MuJoCo normalises them, Pinocchio's parser does not
-    (axisangle="0.3 0.5 0.8 40" turns a body by a wrong rotation there, 0.15 rad off)."""
-    for el in root.iter():
-        text = el.get("axisangle")
-        if text is None:
-            continue
-        try:
-            x, y, z, angle = (float(v) for v in text.split())
-        except ValueError:
-            raise ModelError(f"axisangle=\"{text}\" is not four numbers", path=source,
-                             element=f"<{el.tag} name=\"{el.get('name', '')}\">") from None
-        norm = (x * x + y * y + z * z) ** 0.5
-        if not norm > 0:
-            raise ModelError(f"axisangle=\"{text}\" has no axis", path=source,
-                             element=f"<{el.tag} name=\"{el.get('name', '')}\">")
-        el.set("axisangle", f"{x / norm!r} {y / norm!r} {z / norm!r} {angle!r}")
 
 
 def _build(path: Path, source: str) -> tuple[pin.Model, list, list]:
@@ -458,7 +409,8 @@ def load_mjcf(path: str | Path, *, locked: dict[str, float] | None = None) -> Me
     if locked:  # checked as drawn; then the joints the scene holds are locked out
         mech = Mechanism.from_model(model, points + frames, names=connects + welds, source=source,
                                     reference=qpos0, urdf_path=str(wrapped), locked=locked)
-    mech.force_caveats = _force_caveats(root)
+    mech.force_caveats = mech.force_caveats + _force_caveats(root)
+    mech.limits = {n: lu for n, lu in mjcf_limits(root, source).items() if n in mech.joints or n in mech.locked}
     return mech
 
 
@@ -495,7 +447,7 @@ def _check_sites(mech: Mechanism, elements: list[ET.Element], source: str) -> No
         site1, site2 = el.get("site1"), el.get("site2")
         if el.tag != "connect" or not (site1 and site2):
             continue
-        ids = [mech.model.getFrameId(s) if mech.model.existFrame(s) else None for s in (site1, site2)]
+        ids = [frame_named(mech.model, s, (pin.FrameType.OP_FRAME,), source) for s in (site1, site2)]
         if None in ids:
             raise ModelError(f"site1/site2 {site1}, {site2} are not both sites Pinocchio read", path=source,
                              element=f"<connect name=\"{el.get('name', '')}\">")

@@ -146,7 +146,8 @@ def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
             free = mechanism.idle_joints(names)
             if free:
                 single = [n for n in free if n in mechanism.joints and mechanism.joints[n].nv == 1]
-                advice = ("lock it under [lock] or drive it" if len(single) == len(free) else
+                advice = (f"lock it where it stands ({_lock_lines(mechanism, single)}) or drive it"
+                          if len(single) == len(free) else
                           "a ball joint cannot be locked by one value: give it two hinges across the rod instead "
                           "(a universal joint), or lock or drive a one-freedom joint")
                 idle = (f"; with those held, {', '.join(free)} can still move (a joint spinning freely, as a rod "
@@ -157,6 +158,17 @@ def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
                             f"{idle}", mobility=mechanism.mobility, drivers=len(names))
     arr = np.array(values, dtype=float).reshape(-1, 3)
     return Drivers(tuple(names), arr[:, 0].copy(), arr[:, 1].copy(), arr[:, 2].copy())
+
+
+def _lock_lines(mechanism: Mechanism, names: list[str]) -> str:
+    """The `[lock]` lines holding `names` at their reference values, in deg or mm."""
+    reference = mechanism.neutral()
+    lines = []
+    for name in names:
+        value = mechanism.coordinate(reference, name)
+        said = f"{np.degrees(value):.6g} deg" if mechanism.joints[name].is_angular else f"{value * 1e3:.6g} mm"
+        lines.append(f'[lock] {name} = "{said}"')
+    return "; ".join(lines)
 
 
 def scene_guess(scene: Scene, mechanism: Mechanism) -> np.ndarray:

@@ -21,7 +21,10 @@ from typing import Any
 import pinocchio as pin
 
 from pinmech.exceptions import ModelError
+from pinmech.frame_names import frame_named, reduced_model
+from pinmech.inertia_check import urdf_inertia_caveats
 from pinmech.mechanism import Mechanism, _build_model, _parse_xml, _point_links
+from pinmech.urdf_joints import joint_limits, mimic_joints, with_followers
 
 _KEYS = {"closed_loop", "type", "name_mot", "joint_name", "joint_type"}
 _JOINT_TYPES = ("SPHERICAL", "CARDAN", "FIXED")
@@ -50,16 +53,27 @@ def read_sidecar(path: str | Path) -> dict[str, Any]:
         raise ModelError("expected keys closed_loop, type, name_mot", path=source)
     unknown = set(content) - _KEYS
     if unknown:
-        raise ModelError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_KEYS))}",
+        raise ModelError(f"unknown key(s) {', '.join(sorted(map(str, unknown)))}; known: {', '.join(sorted(_KEYS))}",
                          path=source)
     out = {key: content.get(key) or [] for key in _KEYS}
     for key in _KEYS:
         if not isinstance(out[key], list):
-            raise ModelError(f"must be a list, got {out[key]!r}", path=source, element=key)
+            raise ModelError(f"must be a list, got {out[key]!r:.80}", path=source, element=key)
+    for key in ("type", "name_mot", "joint_name", "joint_type"):
+        for i, entry in enumerate(out[key]):
+            if not isinstance(entry, str):
+                raise ModelError(f"entry {i + 1} must be a name (text), got {entry!r:.80}", path=source, element=key)
+    for key in ("name_mot", "joint_name"):
+        twice = sorted({n for n in out[key] if out[key].count(n) > 1})
+        if twice:
+            raise ModelError(f"{', '.join(twice)} listed twice", path=source, element=key)
     for i, pair in enumerate(out["closed_loop"]):
         if not (isinstance(pair, list) and len(pair) == 2 and all(isinstance(n, str) for n in pair)):
-            raise ModelError(f"entry {i + 1} must be two frame names, got {pair!r}", path=source,
+            raise ModelError(f"entry {i + 1} must be two frame names, got {pair!r:.80}", path=source,
                              element="closed_loop")
+        if pair[0] == pair[1]:
+            raise ModelError(f"entry {i + 1} joins frame '{pair[0]}' to itself: a loop needs two frames",
+                             path=source, element="closed_loop")
     types = [str(t).lower() for t in out["type"]]
     for t in types:
         if t not in ("3d", "6d"):
@@ -88,21 +102,31 @@ def load_extended_urdf(urdf: str | Path, sidecar: str | Path, *,
     urdf, sidecar = Path(urdf), Path(sidecar)
     content = read_sidecar(sidecar)
     root = _parse_xml(urdf)
-    model = _build_model(str(urdf))
+    mimics = mimic_joints(root, str(urdf))
+    model = _build_model(str(urdf), mimic=bool(mimics))
+    if mimics and content["joint_name"]:
+        raise ModelError(f"joint_name/joint_type change joints of a URDF with <mimic> joints "
+                         f"({', '.join(mimics)}): pinmech cannot rebuild those; change the URDF itself",
+                         path=str(sidecar), element="joint_name")
     model = _changed_joints(model, content["joint_name"], content["joint_type"], str(sidecar))
+    locked = with_followers(dict(locked or {}), mimics, str(urdf))
     constraints, names = [], []
     for (a, b), kind in zip(content["closed_loop"], content["type"]):
-        for name in (a, b):
-            if not model.existFrame(name):
+        ids = [frame_named(model, name, source=str(sidecar)) for name in (a, b)]
+        for name, fid in zip((a, b), ids):
+            if fid is None:
                 raise ModelError(f"frame '{name}' is not in {urdf.name}", path=str(sidecar), element="closed_loop")
-        fa, fb = model.frames[model.getFrameId(a)], model.frames[model.getFrameId(b)]
+        fa, fb = model.frames[ids[0]], model.frames[ids[1]]
         contact = pin.ContactType.CONTACT_3D if kind == "3d" else pin.ContactType.CONTACT_6D
         constraints.append(pin.RigidConstraintModel(contact, model, fa.parentJoint, fa.placement, fb.parentJoint,
                                                     fb.placement, pin.ReferenceFrame.LOCAL))
         names.append(f"{a}C{b}")
-    points = [n for n in _point_links(root) if model.existFrame(n)]
+    points = [n for n in _point_links(root) if frame_named(model, n, source=str(urdf)) is not None]
     mech = Mechanism.from_model(model, constraints, names=names, points=points, source=str(urdf),
                                 urdf_path=str(urdf), locked=locked)
+    mech.mimics = {n: m for n, m in mimics.items() if n not in mech.locked}
+    mech.force_caveats = tuple(urdf_inertia_caveats(root, str(urdf))) + mech.force_caveats
+    mech.limits = {n: lu for n, lu in joint_limits(root, str(urdf)).items() if n in mech.joints or n in mech.locked}
     held = set(mech.locked)
     for motor in content["name_mot"]:
         if motor not in mech.joints and motor not in held:
@@ -137,13 +161,14 @@ def _changed_joints(model: pin.Model, names: list[str], types: list[str], source
             name = f"{name}_Y"
         new_id = new.addJoint(parent, joint, placement, name)
         new.appendBodyToJoint(new_id, model.inertias[jid], pin.SE3.Identity())
-    for frame in list(model.frames)[1:]:
+    new_frame = {0: 0}  # old frame id -> new (frames of several kinds may share a name)
+    for fid, frame in enumerate(list(model.frames)[1:], start=1):
         owner = model.names[frame.parentJoint]
         joint = new.getJointId(renamed.get(owner, owner))
-        parent_frame = new.getFrameId(model.frames[frame.parentFrame].name) if frame.parentFrame else 0
-        new.addFrame(pin.Frame(frame.name, joint, parent_frame, frame.placement, frame.type), False)
+        new_frame[fid] = new.addFrame(pin.Frame(frame.name, joint, new_frame[frame.parentFrame], frame.placement,
+                                                frame.type), False)
     fixed = [new.getJointId(n) for n, t in change.items() if t == "FIXED"]
     if fixed:
-        new = pin.buildReducedModel(new, fixed, pin.neutral(new))
+        new = reduced_model(new, fixed, pin.neutral(new))
     return new
 

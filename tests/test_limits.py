@@ -106,3 +106,76 @@ def test_an_arm_path_beyond_a_limit_is_a_warning_or_stops(tmp_path, capsys):
     assert "path points put joints beyond their URDF <limit> (first at t = " in err and ": B = " in err
     assert main(["path", str(scene), "--duration", "0.02 s", "--csv", str(tmp_path / "p.csv"), "--limits", "error"]) == 12
     assert "stopped at t = " in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------- every route reads its file's limits
+ARM_MJCF = """<mujoco><worldbody><body name="upper"><joint name="shoulder" axis="0 0 1" range="-30 60"/>
+  <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.01"/>
+  <body name="fore" pos="0.3 0 0"><joint name="slide" type="slide" axis="1 0 0" range="-0.05 0.05"/>
+    <geom size="0.01"/><site name="tip"/></body></body></worldbody></mujoco>"""
+
+
+def test_mjcf_ranges_are_mujocos_limits_and_are_checked(tmp_path, capsys):
+    """`range` in the compiler's default unit (degrees) for a hinge, metres for a slide, read as
+    MuJoCo reads them (its jnt_range, in radians); driving the shoulder to 90 deg is beyond 60 deg."""
+    mujoco = pytest.importorskip("mujoco")
+    from pinmech.mjcf import load_mjcf
+
+    (tmp_path / "arm.xml").write_text(ARM_MJCF)
+    m = mujoco.MjModel.from_xml_string(ARM_MJCF)
+    mech = load_mjcf(tmp_path / "arm.xml")
+    for j in range(m.njnt):
+        limit = mech.limits[m.joint(j).name]
+        assert m.jnt_limited[j]
+        assert (limit.lower, limit.upper) == pytest.approx(tuple(m.jnt_range[j]), abs=1e-15)
+    scene = tmp_path / "arm.toml"
+    scene.write_text('mjcf = "arm.xml"\n[drivers.shoulder]\nangle = "90 deg"\n[drivers.slide]\nposition = "0 mm"\n'
+                     '[report]\nlimits = "error"\n')
+    assert main(["solve", str(scene)]) == 12
+    assert "shoulder = 90 deg is above its upper limit 60 deg" in capsys.readouterr().err
+    scene.write_text(scene.read_text().replace('"90 deg"', '"45 deg"'))
+    assert main(["solve", str(scene)]) == 0
+
+
+def test_a_limited_ball_joint_is_checked_where_mujoco_finds_it_beyond(tmp_path):
+    """A ball joint's range "0 30" (degrees) bounds the angle it turns. Turned 40 deg about
+    (1, 2, 2)/3, MuJoCo's compiler puts a joint-limit row with a negative distance (beyond it);
+    pinmech reports 40 deg against 30."""
+    mujoco = pytest.importorskip("mujoco")
+    import numpy as np
+
+    from pinmech.limits import limits_at
+    from pinmech.mjcf import load_mjcf
+
+    text = ('<mujoco><worldbody><body name="rod"><joint name="ball" type="ball" range="0 30"/><geom size="0.01"/>'
+            '</body></worldbody></mujoco>')
+    (tmp_path / "ball.xml").write_text(text)
+    axis, angle = np.array([1.0, 2.0, 2.0]) / 3, math.radians(40)
+    m = mujoco.MjModel.from_xml_string(text)
+    d = mujoco.MjData(m)
+    d.qpos[:] = [math.cos(angle / 2), *(math.sin(angle / 2) * axis)]
+    mujoco.mj_forward(m, d)
+    rows = d.efc_type == mujoco.mjtConstraint.mjCNSTR_LIMIT_JOINT
+    assert rows.sum() == 1 and d.efc_pos[rows][0] == pytest.approx(math.radians(30 - 40), abs=1e-12)
+    mech = load_mjcf(tmp_path / "ball.xml")
+    q = np.array([*(math.sin(angle / 2) * axis), math.cos(angle / 2)])  # Pinocchio: x y z w
+    [violation] = limits_at(mech, q)
+    assert violation.joint == "ball" and violation.value == pytest.approx(angle, abs=1e-12)
+    assert violation.upper == pytest.approx(math.radians(30), abs=1e-15)
+
+
+def test_urdf_limits_through_a_sidecar_are_checked(tmp_path, capsys):
+    """The five-bar's first motor made revolute with <limit lower="-0.1" upper="0.1">: driven
+    to 0.3 rad it is beyond, as the same URDF alone says."""
+    text = (MODELS / "five_bar" / "robot.urdf").read_text()
+    text = text.replace('<joint name="mot1" type="continuous">', '<joint name="mot1" type="revolute">')
+    text = text.replace('<origin xyz="0 0 0" rpy="0 0 2.0943951023931953"/><axis xyz="0 0 1"/></joint>',
+                        '<origin xyz="0 0 0" rpy="0 0 2.0943951023931953"/><axis xyz="0 0 1"/>'
+                        '<limit lower="-0.1" upper="0.1" effort="1" velocity="1"/></joint>', 1)
+    (tmp_path / "robot.urdf").write_text(text)
+    (tmp_path / "robot.yaml").write_text((MODELS / "five_bar" / "robot.yaml").read_text())
+    scene = tmp_path / "five.toml"
+    scene.write_text('urdf = "robot.urdf"\nsidecar = "robot.yaml"\n[drivers.mot1]\nangle = "0.3 rad"\n'
+                     '[drivers.mot2]\nangle = "0.2 rad"\n[report]\nlimits = "error"\n')
+    assert main(["solve", str(scene)]) == 12
+    assert "mot1 = 17.1887 deg is above its upper limit 5.72958 deg" in capsys.readouterr().err

@@ -122,6 +122,15 @@ def test_five_bar_scene_and_snapshot(scenes_dir, tmp_path):
     ("closed_loop: [[\n", ["malformed YAML"]),
     ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\njoint_name: ['elbow9']\njoint_type: ['CARDAN']\n",
      ["joint_name", "elbow9"]),
+    # entries that are not names: a number, a list, null, a boolean (were a TypeError or Boost.Python.ArgumentError)
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\nname_mot: [[mot1], mot2]\n", ["name_mot", "entry 1", "['mot1']"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\njoint_name: [3]\njoint_type: [FIXED]\n",
+     ["joint_name", "entry 1", "got 3"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\nname_mot: [null, true]\n", ["name_mot", "got None"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\ntype: [[3d]]\n", ["type", "entry 1"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_A']]\n", ["closed_loop", "to itself"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\n1: [x]\nfoo: 2\n", ["unknown key", "1, foo"]),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\nname_mot: [mot1, mot1]\n", ["name_mot", "listed twice"]),
 ])
 def test_sidecar_errors_name_the_file_and_key(tmp_path, yaml_text, words):
     sidecar = tmp_path / "robot.yaml"
@@ -183,3 +192,100 @@ def test_a_locked_motor_is_neither_a_missing_joint_nor_a_default_driver():
     assert "mot2" not in mech.joints and mech.motors == ["mot1"] and mech.mobility == 1
     held = load_extended_urdf(folder / "robot.urdf", folder / "robot.yaml")
     assert held.motors == ["mot1", "mot2"]
+
+
+def _five_bar_named_after_links(tmp_path, yaml_extra: str = "") -> tuple[Path, Path]:
+    """The five-bar with every joint named after its child link (as MuJoCo Menagerie names them)."""
+    text = FIVE[0].read_text()
+    for joint, link in (("mot1", "proximal1"), ("elbow1", "distal1"), ("mot2", "proximal2"), ("elbow2", "distal2"),
+                        ("to_closedloop1_A", "closedloop1_A"), ("to_closedloop1_B", "closedloop1_B")):
+        text = text.replace(f'joint name="{joint}"', f'joint name="{link}"')
+    urdf, sidecar = tmp_path / "robot.urdf", tmp_path / "robot.yaml"
+    urdf.write_text(text)
+    sidecar.write_text("closed_loop: [['closedloop1_A', 'closedloop1_B']]\ntype: ['3d']\n"
+                       "name_mot: ['proximal1', 'proximal2']\n" + yaml_extra)
+    return urdf, sidecar
+
+
+@pytest.mark.parametrize("how", ["[lock]", "joint_type FIXED"])
+def test_joints_named_after_links_lock_and_close(tmp_path, how):
+    """Elbow 2 held at its drawn angle e = 1.6185 rad: proximal 2 and distal 2 are one rigid
+    link, so the end P is L2 from the elbow B1 = L1 u(t1) and |L1 + L2 u(e)| from the second
+    motor O2 (law of cosines)."""
+    if how == "[lock]":
+        urdf, sidecar = _five_bar_named_after_links(tmp_path)
+        mech = load_extended_urdf(urdf, sidecar, locked={"distal2": 0.0})
+    else:
+        urdf, sidecar = _five_bar_named_after_links(tmp_path, "joint_name: ['distal2']\njoint_type: ['FIXED']\n")
+        mech = load_extended_urdf(urdf, sidecar)
+    assert mech.mobility == 1
+    solver = LoopSolver(mech, ["proximal1"])
+    e, O2 = 1.6185128527327788, np.array([D, 0.0])
+    rigid = math.sqrt(L1**2 + L2**2 + 2 * L1 * L2 * math.cos(e))
+    q = mech.neutral()
+    for q1 in (0.0, 0.1, 0.2):
+        q = solver.solve([q1], [0.0], [0.0], guess=q).q
+        pin.framesForwardKinematics(mech.model, solver.data, q)
+        P = solver.data.oMf[mech.points["closedloop1_A"]].translation[:2]
+        t1 = 2 * math.pi / 3 + q1
+        B1 = L1 * np.array([math.cos(t1), math.sin(t1)])
+        # lengths of 0.1 m solved to 1e-13 of the size: 1e-12 m allowed
+        np.testing.assert_allclose([np.linalg.norm(P - B1), np.linalg.norm(P - O2)], [L2, rigid], atol=1e-12)
+
+
+def test_a_mimic_through_the_sidecar_couples_the_motors(tmp_path):
+    """mot2 follows mot1 (<mimic multiplier="-1">): one driver moves both, and the end is the
+    circle intersection at t1 = 2 pi/3 + q1, t2 = pi/3 - q1 (as the URDF alone would say)."""
+    text = FIVE[0].read_text()
+    for motor in ("mot1", "mot2"):
+        text = text.replace(f'<joint name="{motor}" type="continuous">', f'<joint name="{motor}" type="revolute">')
+    text = text.replace('<origin xyz="0.1 0 0" rpy="0 0 1.0471975511965976"/><axis xyz="0 0 1"/></joint>',
+                        '<origin xyz="0.1 0 0" rpy="0 0 1.0471975511965976"/><axis xyz="0 0 1"/>'
+                        '<limit lower="-3" upper="3" effort="1" velocity="1"/><mimic joint="mot1" multiplier="-1"/>'
+                        '</joint>')
+    text = text.replace('<origin xyz="0 0 0" rpy="0 0 2.0943951023931953"/><axis xyz="0 0 1"/></joint>',
+                        '<origin xyz="0 0 0" rpy="0 0 2.0943951023931953"/><axis xyz="0 0 1"/>'
+                        '<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>')
+    urdf, sidecar = tmp_path / "robot.urdf", tmp_path / "robot.yaml"
+    urdf.write_text(text)
+    sidecar.write_text(FIVE[1].read_text().replace("name_mot: ['mot1', 'mot2']", "name_mot: ['mot1']"))
+    mech = load_extended_urdf(urdf, sidecar)
+    assert mech.mobility == 1 and "mot2" in mech.mimics
+    solver = LoopSolver(mech, ["mot1"])
+    q = mech.neutral()
+    for q1 in (0.05, 0.1, 0.2):
+        q = solver.solve([q1], [0.0], [0.0], guess=q).q
+        pin.framesForwardKinematics(mech.model, solver.data, q)
+        P = solver.data.oMf[mech.points["closedloop1_A"]].translation[:2]
+        # positions solved to 1e-13 of the 0.1 m size: 1e-12 m allowed
+        np.testing.assert_allclose(P, five_bar_end(2 * math.pi / 3 + q1, math.pi / 3 - q1), atol=1e-12)
+        assert mech.coordinate(q, "mot2") == pytest.approx(-q1, abs=1e-15)
+    locked = load_extended_urdf(urdf, sidecar, locked={"mot1": 0.1})  # locking the leader holds its follower
+    assert locked.locked == {"mot1": 0.1, "mot2": -0.1} and locked.mobility == 0
+
+
+def test_gepettos_five_bar_with_pins_at_its_6d_closure_says_which_lock_it_needs(tmp_path, capsys):
+    """Gepetto's published five-bar closes a 6d loop between two frames that each turn on a
+    revolute joint about the same axis (closedloop1_A, closedloop1_B): the welded pair spins
+    idly, mobility 3 for 2 motors. The error gives the [lock] line; with it, the end is the
+    circle intersection."""
+    text = FIVE[0].read_text()
+    for side, link in (("A", "sphere"), ("B", "sphere_2")):
+        text = text.replace(f'<link name="closedloop1_{side}"/>', f'<link name="{link}"/>')
+        text = text.replace(f'<joint name="to_closedloop1_{side}" type="fixed">',
+                            f'<joint name="closedloop1_{side}" type="continuous"><axis xyz="0 0 1"/>')
+        text = text.replace(f'<child link="closedloop1_{side}"/>', f'<child link="{link}"/>')
+    (tmp_path / "robot.urdf").write_text(text)
+    (tmp_path / "robot.yaml").write_text("closed_loop: [['closedloop1_A', 'closedloop1_B']]\ntype: ['6d']\n"
+                                         "name_mot: ['mot1', 'mot2']\n")
+    scene = tmp_path / "five.toml"
+    scene.write_text('urdf = "robot.urdf"\nsidecar = "robot.yaml"\n')
+    assert main(["solve", str(scene)]) == 5
+    assert '[lock] closedloop1_A = "0 deg"' in capsys.readouterr().err
+    mech = load_extended_urdf(tmp_path / "robot.urdf", tmp_path / "robot.yaml", locked={"closedloop1_A": 0.0})
+    solver = LoopSolver(mech, ["mot1", "mot2"])
+    q = solver.solve([-0.2, 0.3], [0.0, 0.0], [0.0, 0.0], guess=mech.neutral()).q
+    pin.framesForwardKinematics(mech.model, solver.data, q)
+    P = solver.data.oMf[mech.frame_id("sphere")].translation[:2]
+    # as the five-bar above: 1e-12 m on a 0.1 m mechanism
+    np.testing.assert_allclose(P, five_bar_end(2 * math.pi / 3 - 0.2, math.pi / 3 + 0.3), atol=1e-12)
