@@ -12,7 +12,7 @@ route as the browser tests (tests/browser.py).
   `<visual>` taken out (a user's model), and `docs/images/jansen_leg.png`, a model written
   without any: their links sketched from their joints and points.
 - `docs/images/sweep_r_rtr.png`, `docs/images/paths_four_bar.png`, `paths_jansen_leg.png`:
-  `pinmech sweep --plot` and `--paths`; `docs/images/polygon_v_r_rtr.png`,
+  `pinmech sweep --plot` and `--paths`; `docs/images/torque_slider_crank.png`: `--torque-plot`; `docs/images/polygon_v_r_rtr.png`,
   `polygon_a_r_rtr.png`: `pinmech polygon`.
 
 Poses and rates of the first two come from the independent closed forms in
@@ -128,6 +128,8 @@ def cli_pictures(chromium: str, tmp: Path) -> None:
     pinmech(["sweep", str(scenes / "r_rtr.toml"), "--plot", str(IMAGES / "sweep_r_rtr.png"), "--csv", str(tmp / "s.csv")])
     for name in ("four_bar", "jansen_leg"):
         pinmech(["sweep", str(scenes / f"{name}.toml"), "--paths", str(IMAGES / f"paths_{name}.png")])
+    pinmech(["sweep", str(scenes / "slider_crank_dynamic.toml"), "--torque-plot",
+             str(IMAGES / "torque_slider_crank.png"), "--csv", str(tmp / "t.csv")])
     for kind in ("v", "a"):
         svg = tmp / f"polygon_{kind}.svg"
         pinmech(["polygon", str(scenes / "r_rtr.toml"), "-o", str(svg)] + (["--acceleration"] if kind == "a" else []))
