@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from pinmech.flywheel import energy_curve
+from pinmech.plot_curves import draw_markers
 
 
 @dataclass(frozen=True)
@@ -96,18 +97,6 @@ def _turn(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         order = np.concatenate(([order[-1]], order, [order[0]]))
         wrapped = np.concatenate(([wrapped[-1] - 360.0], wrapped, [wrapped[0] + 360.0]))
     return wrapped, order
-
-
-def draw_markers(axes, markers: list[tuple[float, str]]) -> None:
-    """Vertical lines at driver values (limit, toggle, fold positions) in every panel, each
-    labelled once, at the top of the first panel."""
-    for k, ax in enumerate(axes):
-        for x, label in markers:
-            ax.axvline(x, color="0.3", linestyle=(0, (4, 2, 1, 2)), linewidth=0.9, zorder=1)
-            if k == 0:
-                ax.annotate(label, (x, 1.0), xycoords=("data", "axes fraction"), xytext=(2, -2),
-                            textcoords="offset points", ha="left", va="top", fontsize=7.5, color="0.25",
-                            rotation=90)
 
 
 def torque_figure(curve: TorqueCurve, title: str):
