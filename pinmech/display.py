@@ -44,11 +44,13 @@ def display_name(name: str, taken: set[str] | frozenset[str] = frozenset()) -> s
 
 
 def display_names(mechanism: Mechanism) -> dict[str, str]:
-    """Every point, link and joint name of the mechanism -> the name printed for it."""
-    points = set(mechanism.points)
-    taken = points | set(mechanism.links)  # a joint's name is free: the pin A_pin is at is joint A
-    out = {n: n for n in [*mechanism.links, *mechanism.joints]}
-    out.update({n: display_name(n, taken - {n}) for n in mechanism.points})
+    """Every point, link, joint and loop cut name of the mechanism -> the name printed for it
+    (a joint or cut `E_pin` is printed `E`, as is a point `E_pin` unless another point is `E`)."""
+    points, links = set(mechanism.points), set(mechanism.links)
+    pins = [*mechanism.joints, *(c.name for c in mechanism.closures)]  # joints and loop cuts
+    out = {n: n for n in links}
+    out.update({n: display_name(n, links) for n in pins})  # the joint E_pin is the textbook's E
+    out.update({n: display_name(n, (points | links) - {n}) for n in points})  # a joint may share it
     return out
 
 
