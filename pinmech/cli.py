@@ -610,7 +610,9 @@ def cmd_snapshot(args: argparse.Namespace) -> int:
     scene = _scene(args)
     _check_page(args, scene)
     analysis = analyse(scene)
-    points = {n: p.position for n, p in analysis.motion.points.items()}
+    from pinmech.display import labelled_places
+
+    points = labelled_places(analysis.mechanism, analysis.solution.q)  # joints and points, as the textbook names them
     arrows = []
     for spec in args.arrows:
         name, _, quantity = spec.rpartition(".")

@@ -73,3 +73,22 @@ def colour_of(mechanism: Mechanism, name: str) -> tuple[float, float, float]:
 def hex_colour(rgb: tuple[float, float, float]) -> str:
     """`#rrggbb` for an RGB colour in [0, 1]."""
     return "#" + "".join(f"{round(255 * min(max(c, 0.0), 1.0)):02x}" for c in rgb[:3])
+
+
+def labelled_places(mechanism: Mechanism, q) -> dict[str, "np.ndarray"]:
+    """Every joint, loop cut and named point at configuration q, by its printed name ->
+    its world position [m], one name a place (a pin's name wins over a point's there)."""
+    import numpy as np
+    import pinocchio as pin
+
+    from pinmech.link_nodes import sketch_links, world_nodes
+
+    data = mechanism.model.createData()
+    pin.forwardKinematics(mechanism.model, data, np.asarray(q, float))
+    names, out = display_names(mechanism), {}
+    tol = 1e-9 * mechanism.length_scale
+    for link in sketch_links(mechanism).values():
+        for node, p in zip(link.nodes, world_nodes(link, data)):
+            if node.kind != "other" and not any(np.linalg.norm(p - x) <= tol for x in out.values()):
+                out.setdefault(names.get(node.name, node.name), p)
+    return out

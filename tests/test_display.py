@@ -145,3 +145,23 @@ def test_a_sweep_through_folds_marks_them_clips_their_spikes_and_styles_each_ass
     assert peak > 10 * max(abs(low), abs(high))  # clipped: the spike does not set the scale
     styles = {x.get_linestyle() for x in alpha.get_lines() if str(x.get_label()).startswith("coupler, assembly")}
     assert styles == {"-", "--"}
+
+
+def test_the_snapshot_names_every_joint_and_point_where_the_four_bar_puts_them():
+    """The four-bar at O2 = 60 deg (crank a = 40, coupler b = 120, rocker c = 80, ground
+    g = 100 mm): O2 at the origin, O4 at (g, 0), A = a (cos 60°, sin 60°), and B where
+    |AB| = b and |O4 B| = c (the loop's own equations). Each place named once, by the
+    textbook's letter (A, not A_pin). Tolerance 1e-12 m: loops closed to 1e-13 of 0.1 m."""
+    from pinmech.analysis import analyse
+    from pinmech.display import labelled_places
+    from pinmech.scene import Scene
+
+    analysis = analyse(Scene.load(SCENES / "four_bar.toml"))
+    places = labelled_places(analysis.mechanism, analysis.solution.q)
+    assert set(places) == {"O2", "A", "B", "O4", "P"}
+    np.testing.assert_allclose(places["O2"], [0.0, 0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(places["O4"], [0.1, 0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(places["A"], [0.04 * math.cos(math.pi / 3), 0.04 * math.sin(math.pi / 3), 0.0],
+                               atol=1e-12)
+    assert np.linalg.norm(places["B"] - places["A"]) == pytest.approx(0.12, abs=1e-12)
+    assert np.linalg.norm(places["B"] - places["O4"]) == pytest.approx(0.08, abs=1e-12)
