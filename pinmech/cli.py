@@ -321,7 +321,14 @@ def _sweep_forces(args: argparse.Namespace, scene, sweep):
     flywheel = scene.quantity(args.flywheel, "moment_of_inertia", "--flywheel") if args.flywheel else None
     if flywheel is not None and not flywheel > 0:
         raise PinmechError(f"--flywheel must be positive, got {args.flywheel}")
-    return SweepForces(sweep, static=args.static, minimum_norm=args.minimum_norm, flywheel=flywheel)
+    forces = SweepForces(sweep, static=args.static, minimum_norm=args.minimum_norm, flywheel=flywheel)
+    if forces.static and flywheel is not None:  # the scene's [forces] static = true
+        from pinmech.exceptions import OptionRefused
+
+        raise OptionRefused("--flywheel: a flywheel is sized from the energy a moving cycle stores, and the "
+                            "scene's [forces] static = true has no motion", options=["--flywheel"],
+                            scene=str(scene.path))
+    return forces
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
@@ -331,7 +338,10 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from pinmech.scene_model import limit_mode
     from pinmech.sweep import DriverValues, Sweep, sweep_options
 
+    from pinmech.unused_options import refuse_sweep_options
+
     scene = _scene(args)
+    refuse_sweep_options(args, str(scene.path), task="task" in scene.raw)
     if "task" in scene.raw:
         return _follow(args, scene)
     figure = _check_outputs(args, scene)
@@ -616,7 +626,9 @@ def cmd_snapshot(args: argparse.Namespace) -> int:
     scene = _scene(args)
     _check_page(args, scene)
     analysis = analyse(scene)
-    points = {n: p.position for n, p in analysis.motion.points.items()}
+    from pinmech.display import labelled_places
+
+    points = labelled_places(analysis.mechanism, analysis.solution.q)  # joints and points, as the textbook names them
     arrows = []
     for spec in args.arrows:
         name, _, quantity = spec.rpartition(".")

@@ -272,3 +272,21 @@ class DiagnosticError(PinmechError):
     def __init__(self, message: str, *, path: str | None = None):
         super().__init__(f"{path}: {message}" if path else message)
         self.path = path
+
+
+class OptionRefused(PinmechError):
+    """A command was given an option it cannot honour for this scene (a figure of a swept
+    mechanism asked of a task scene, a figure setting without its figure): refused before
+    anything runs, never ignored in silence.
+
+    Attributes:
+        options: the command-line options refused ("--paths", ...).
+        scene: the scene file.
+    """
+
+    exit_code = 2
+
+    def __init__(self, message: str, *, options: list[str], scene: str | None = None):
+        super().__init__(f"{scene}: {message}" if scene else message)
+        self.options = options
+        self.scene = scene

@@ -42,8 +42,9 @@ class EnergyFluctuation:
         return self.energy_fluctuation / (coefficient * speed**2)
 
 
-def energy_fluctuation(angles: np.ndarray, torques: np.ndarray) -> EnergyFluctuation:
-    """Trapezoidal integral of a torque curve [N m] over crank angles [rad] (increasing or not).
+def energy_curve(angles: np.ndarray, torques: np.ndarray) -> tuple[float, np.ndarray]:
+    """The mean torque T_m [N m] and E(theta) = integral from the first angle of (T - T_m) dtheta [J]
+    at each angle (trapezoids; 0 at both ends of the range): the energy the flywheel gives up.
 
     Raises:
         ValueError: fewer than two samples, or a zero span.
@@ -51,10 +52,19 @@ def energy_fluctuation(angles: np.ndarray, torques: np.ndarray) -> EnergyFluctua
     angles, torques = np.asarray(angles, float), np.asarray(torques, float)
     if angles.size < 2 or angles[-1] == angles[0]:
         raise ValueError("the energy fluctuation needs a torque curve over a range of angles")
-    steps = np.diff(angles)
-    work = np.concatenate(([0.0], np.cumsum(0.5 * (torques[1:] + torques[:-1]) * steps)))
+    work = np.concatenate(([0.0], np.cumsum(0.5 * (torques[1:] + torques[:-1]) * np.diff(angles))))
+    mean = float(work[-1] / (angles[-1] - angles[0]))
+    return mean, work - mean * (angles - angles[0])
+
+
+def energy_fluctuation(angles: np.ndarray, torques: np.ndarray) -> EnergyFluctuation:
+    """Trapezoidal integral of a torque curve [N m] over crank angles [rad] (increasing or not).
+
+    Raises:
+        ValueError: fewer than two samples, or a zero span.
+    """
+    angles = np.asarray(angles, float)
+    mean, energy = energy_curve(angles, torques)
     span = float(angles[-1] - angles[0])
-    mean = float(work[-1] / span)
-    energy = work - mean * (angles - angles[0])
     return EnergyFluctuation(mean, float(energy.max() - energy.min()), float(angles[int(np.argmax(energy))]),
                              float(angles[int(np.argmin(energy))]), span)

@@ -10,6 +10,7 @@ torque zero crossings) is printed once the sweep ends.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import IO, Any
 
@@ -230,37 +231,34 @@ class ForceJsonLines(SweepJsonLines):
 
 
 class TorquePlot:
-    """The driver's torque (or force) curve with its mean and the energy between them."""
+    """The driver's torque (or force) curve: with its mean and the flywheel's energy E(θ) in
+    dynamics, with the mechanical advantage in statics (`pinmech.plot_torque`)."""
 
     def __init__(self, forces: SweepForces) -> None:
         self.forces = forces
+        self.advantage: list[float] = []
 
     def add(self, pose: SweepPose) -> None:
-        self.forces.solve(pose)
+        f = self.forces.solve(pose)
+        if f is not None and self.forces.static and self.forces.solver.loads:
+            self.advantage.append(self.forces._advantage(f))
 
     def save(self, path: str | Path) -> Path:
-        from pinmech.plot import _pyplot, _save
+        from pinmech.plot_torque import save_torque_figure, torque_curve
 
-        plt = _pyplot()
         f = self.forces
-        angular = f.sweep.is_angular
-        x = np.degrees(f.values) if angular else np.array(f.values)
-        y = np.array(f.efforts)
-        fig, ax = plt.subplots(figsize=(8, 4.5))
-        ax.plot(x, y, lw=1.5, label=f"{f.sweep.driver} driver {'torque' if angular else 'force'}")
-        energy = f.energy()
-        if energy is not None:
-            mean = _shown(energy.mean_torque, f.efforts)
-            ax.axhline(mean, color="k", lw=0.8, ls="--", label=f"mean {mean:.4g} N m")
-            ax.fill_between(x, y, energy.mean_torque, alpha=0.2,
-                            label=f"energy fluctuation {energy.energy_fluctuation:.4g} J")
-        ax.set_xlabel(f"{f.sweep.driver} [{'deg' if angular else 'm'}]")
-        ax.set_ylabel("N m" if angular else "N")
-        ax.set_title(f"{f.sweep.scene.title}: driver effort over the sweep")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        return _save(plt, fig, path)
+        if not f.values:
+            raise SceneError(f"no pose of the sweep could be solved: no torque curve to draw in {path}",
+                             path=str(f.sweep.scene.path))
+        cycle = not f.static and f.energy() is not None
+        unit = advantage_unit(f.sweep.is_angular, f.solver.loads[0]) if self.advantage else "1"
+        curve = torque_curve(f.sweep.driver, np.array(f.values), np.array(f.efforts), angular=f.sweep.is_angular,
+                             cycle=cycle, advantage=np.array(self.advantage) if self.advantage else None,
+                             advantage_unit=unit)
+        if cycle:  # the mean as the summary prints it (rounding noise shown as 0)
+            curve = replace(curve, mean=_shown(curve.mean, f.efforts))
+        kind = "statics" if f.static else "dynamics"
+        return save_torque_figure(curve, f"{f.sweep.scene.title}: driver {f.sweep.driver} over the sweep ({kind})", path)
 
 
 def _shown(mean: float, efforts: list[float]) -> float:

@@ -19,27 +19,6 @@ from pinmech.mechanism import Mechanism
 
 _SAME = 1e-9  # nodes closer than this share of the mechanism's size are one node
 
-#: One colour a link (RGB in [0, 1]), in the order of `sketch_links`, in 3-D and in figures alike.
-PALETTE = (
-    (0.85, 0.15, 0.15),
-    (0.15, 0.35, 0.85),
-    (0.15, 0.65, 0.25),
-    (0.9, 0.55, 0.05),
-    (0.55, 0.25, 0.75),
-    (0.1, 0.65, 0.7),
-    (0.6, 0.4, 0.2),
-    (0.9, 0.4, 0.7),
-    (0.45, 0.5, 0.1),
-    (0.2, 0.2, 0.5),
-)
-GROUND_GREY = (0.45, 0.45, 0.45)
-
-
-def link_colour(index: int, link: LinkSketch) -> tuple[float, float, float]:
-    """The colour of the `index`-th link of `sketch_links` (the ground grey)."""
-    return GROUND_GREY if link.is_ground else PALETTE[index % len(PALETTE)]
-
-
 @dataclass(frozen=True)
 class Node:
     """A place on a link, in the frame of the joint the link hangs on.

@@ -23,6 +23,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from pinmech.exceptions import FrameNotFound, PinmechError
+from pinmech.display import colour_of, display_names, hex_colour, joint_colours
+from pinmech.plot_curves import BRANCH_STYLES, angles as _angles, branch_pieces, driver_axis as _driver_axis
+from pinmech.plot_curves import draw_markers, nearest as _nearest, spike_limits
 from pinmech.plot_paths import PathRecorder
 
 if TYPE_CHECKING:
@@ -32,7 +35,6 @@ if TYPE_CHECKING:
 
 MAX_POINTS = 20_000
 ANGLE_STYLES = ("continuous", "wrapped")
-_STYLES = ("-", "--", "-.", ":")  # one a curve: a curve under another still shows
 
 
 def _pyplot():
@@ -86,6 +88,11 @@ class SweepPlot:
         self.last = total - 1 if total else None  # drawn whatever every is: a turn ends where it ends
         self.normal = sweep.mechanism.plane_normal
         self.x = array("d")
+        self.branch = array("i")  # the branch of the assembly each kept pose is on (a fold starts one)
+        self._branch, self._folded = 0, False
+        #: (driver value as drawn, label): vertical lines in every panel (folds; limit positions)
+        self.markers: list[tuple[float, str]] = []
+        self.names = display_names(sweep.mechanism)
         self.series: dict[str, dict[str, array]] = {}
         self.failed: list[float] = []
         self.mark: tuple[float, dict[str, dict[str, float]]] | None = None  # nearest pose to the scene's
@@ -94,10 +101,15 @@ class SweepPlot:
         return math.degrees(value) if self.sweep.is_angular else value
 
     def add(self, pose: SweepPose) -> None:
+        if "fold" in pose.note:  # the engine crossed a limit position: the driver turns back there,
+            self._branch = 1 - self._branch  # and the assembly changes (two of them, in turn)
+            self._folded = True
+            self.markers.append((self._x(pose.value), f"fold ({self.sweep.driver} limit)"))
         if pose.motion is None:
             self.failed.append(self._x(pose.value))
             if self.series:
                 self.x.append(self._x(pose.value))  # a gap in every curve
+                self.branch.append(self._branch)
                 self.paths.add({p: np.full(3, math.nan) for p in self.points})
                 for panel in self.series.values():
                     for values in panel.values():
@@ -117,6 +129,7 @@ class SweepPlot:
             return
         self.paths.add({p: pose.motion.points[p].position for p in self.points})
         self.x.append(self._x(pose.value))
+        self.branch.append(self._branch)
         for title, panel in values.items():
             for name, value in panel.items():
                 self.series[title][name].append(value)
@@ -131,6 +144,9 @@ class SweepPlot:
             self.points = [n for n, p in motion.points.items()
                            if p.link in mech.links and model.frames[mech.links[p.link]].parentJoint != 0]
         self.sliders = list(motion.sliders)
+        by_joint = joint_colours(mech)
+        self.colours = {n: hex_colour(colour_of(mech, n)) for n in [*self.links, *self.points]}
+        self.colours.update({n: hex_colour(by_joint[mech.joint(n).id]) for n in self.sliders})
         # raw doubles, not lists of floats: the kept values would pin memory pools freed by the rest
         self.series = {title: {name: array("d") for name in names} for title, names in self._panels().items()}
 
@@ -196,17 +212,19 @@ class SweepPlot:
             ax.set_xlim(lo, hi)
             if turn:
                 ax.set_xticks(np.arange(0, 361, 60))
-            ax.set_xlabel(f"{sweep.driver} [{unit}]", fontsize=9)
+            ax.set_xlabel(self._driver_label(), fontsize=9)
             if self.failed:
                 failed = np.mod(self.failed, 360.0) if turn else self.failed
                 ax.plot(failed, np.zeros(len(failed)), "x", color="red", markersize=6,
                         transform=ax.get_xaxis_transform(), clip_on=False)
+        markers = [(m % 360.0 if turn else m, label) for m, label in self.markers]
+        draw_markers(list(axes.flat[:len(panels)]), markers)
         if drawn_paths:
             ax = axes.flat[len(panels)]
             if self.paths.is_3d:  # a 3-D panel in the same place
                 ax.remove()
                 ax = fig.add_subplot(rows, cols, len(panels) + 1, projection="3d")
-            self.paths.draw(ax, self.mark_q, self._travel())
+            self.paths.draw(ax, self.mark_q, self._travel(), backwards=self._backwards())
         spare = list(axes.flat[len(panels) + drawn_paths:])
         for ax in spare:
             ax.set_visible(False)
@@ -218,6 +236,22 @@ class SweepPlot:
         fig.suptitle(self._title(marked, mark_x, unit), fontsize=11)
         fig.tight_layout()
         return _save(plt, fig, path)
+
+    def _driver_label(self) -> str:
+        """The driver axis' label, with the sense its angle is counted in (planar mechanisms)."""
+        sweep, mech = self.sweep, self.sweep.mechanism
+        if not sweep.is_angular:
+            return f"driver {sweep.driver}: s [m] along its guide"
+        if self.normal is None:
+            return f"driver {sweep.driver}: θ [deg]"
+        import pinocchio as pin
+
+        joint = mech.joint(sweep.driver)
+        data = mech.model.createData()
+        pin.forwardKinematics(mech.model, data, mech.neutral())
+        axis = data.oMi[joint.id].rotation @ np.asarray(joint.axis, float)
+        sense = "counter-clockwise" if float(axis @ self.normal) > 0 else "clockwise"
+        return f"driver {sweep.driver}: θ [deg], {sense} (joint coordinate)"
 
     def _comes_back(self) -> bool:
         """Whether every drawn quantity ends where it began (angles modulo 360 deg): only
@@ -242,50 +276,77 @@ class SweepPlot:
         plt = _pyplot()
         fig = plt.figure(figsize=(8, 6.5))
         ax = fig.add_subplot(projection="3d" if self.paths.is_3d else None)
-        self.paths.draw(ax, self.mark_q, self._travel())
+        self.paths.draw(ax, self.mark_q, self._travel(), backwards=self._backwards())
         fig.suptitle(f"{self.sweep.scene.title}: paths over the sweep", fontsize=11)
         fig.tight_layout()
         return _save(plt, fig, path)
 
+    def _speed(self) -> float:
+        """The swept driver's speed in the scene [rad/s or m/s]."""
+        drivers = self.sweep.drivers
+        return float(drivers.v[drivers.names.index(self.sweep.driver)])
+
+    def _increasing(self) -> bool:
+        x = np.array(self.x)
+        return bool(np.nanmean(np.diff(x)) > 0) if len(x) > 1 else True
+
+    def _backwards(self) -> bool:
+        """The points move against the order of the poses: the driver's speed and the sweep's
+        direction have opposite signs (a crank at -50 rpm swept from 30 to 390 deg)."""
+        return self._speed() != 0 and (self._speed() > 0) != self._increasing()
+
     def _travel(self) -> str:
         unit = "deg" if self.sweep.is_angular else "m"
-        x = np.array(self.x)
-        increasing = np.nanmean(np.diff(x)) > 0 if len(x) > 1 else True
-        return f"arrows: travel as {self.sweep.driver} {'grows' if increasing else 'falls'} [{unit}]"
+        if self._speed() == 0:
+            return f"arrows: travel as {self.sweep.driver} {'grows' if self._increasing() else 'falls'} [{unit}]"
+        spec = self.sweep.scene.section("drivers").get(self.sweep.driver, {})
+        speed = spec.get("speed", spec.get("velocity", f"{self._speed():.4g}"))
+        return f"arrows: the motion, {self.sweep.driver} at {speed}"
 
     def _panel(self, ax, title: str, series: dict[str, array], x: np.ndarray, order: np.ndarray,
                mark_x: float | None) -> None:
-        """One quantity against the driver: a curve per name, constant ones said in words."""
+        """One quantity against the driver: a curve per name in its link's colour (one line
+        style a branch), constant ones said in the legend, a fold's spike clipped."""
         quantity, label = title.split(", ")
         symbol, dim = label.split(" [")
         angle = title.startswith("angle")
-        constants = []
         curves = {name: _angles(np.array(v)[order], self.angles) if angle else np.array(v)[order]
                   for name, v in series.items()}
         largest = max((float(np.nanmax(np.abs(y))) for y in curves.values() if np.any(np.isfinite(y))), default=0.0)
         flat = max(1e-9 * largest, 1e-12)  # changes below this are rounding (1e-12: noise about an exact 0)
-        for k, (name, y) in enumerate(curves.items()):
+        constants, drawn, branch = [], [], np.array(self.branch)[order]
+        for name, y in curves.items():
             finite = y[np.isfinite(y)]
             if finite.size and np.ptp(finite) <= flat:
-                constants.append(f"{name}: {symbol} = {finite[0]:.6g} {dim.rstrip(']')} (constant, not drawn)")
+                constants.append(f"{self.names.get(name, name)}: {symbol} = {finite[0]:.6g} {dim.rstrip(']')} "
+                                 "(constant, not drawn)")
                 continue
-            (line,) = ax.plot(x, y, linewidth=1.6, color=f"C{k % 10}", linestyle=_STYLES[k % len(_STYLES)],
-                              label=name)  # a name keeps its colour and dash from panel to panel
+            drawn.append(y)
+            self._curve(ax, name, x, y, branch)
             if mark_x is not None:
                 at = _nearest(x, y, mark_x, self.mark[1][title][name])
-                ax.plot([mark_x], [at], "o", color=line.get_color(), markersize=5)
+                ax.plot([mark_x], [at], "o", color=self.colours.get(name, "k"), markersize=5)
+        for text in constants:  # in the legend, not in a box over the curves
+            ax.plot([], [], " ", label=text)
+        clipped = spike_limits(drawn)
+        if clipped is not None:
+            ax.set_ylim(clipped[0], clipped[1])
+            quantity += f" (clipped: reaches {clipped[2]:.3g} at a fold)"
         if mark_x is not None:
             ax.axvline(mark_x, color="0.35", linestyle="--", linewidth=1)
-        if constants:
-            ax.text(0.02, 0.04, "\n".join(constants), transform=ax.transAxes, fontsize=8, color="0.25", zorder=6,
-                    bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "0.8", "boxstyle": "round"})
-        drawn = len(series) - len(constants)
-        name = next(iter(series))
+        name = self.names.get(next(iter(series)), next(iter(series)))
         ax.set_title(f"{name}: {quantity}" if len(series) == 1 else quantity, fontsize=10)
         ax.set_ylabel(label + (f", {self.angles}" if angle else ""))
         ax.grid(True, alpha=0.35)
-        if drawn > 1:
-            ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+
+    def _curve(self, ax, name: str, x: np.ndarray, y: np.ndarray, branch: np.ndarray) -> None:
+        """One name's curve, in its link's colour, one line style for each branch."""
+        colour = self.colours.get(name, "k")
+        for b, mask in branch_pieces(branch):
+            label = self.names.get(name, name) + (f", assembly {b + 1}" if self._folded else "")
+            ax.plot(x, np.where(mask, y, np.nan), linewidth=1.6, color=colour,
+                    linestyle=BRANCH_STYLES[b % len(BRANCH_STYLES)], label=label)
 
     def _title(self, marked: bool, mark_x: float, unit: str) -> str:
         sweep = self.sweep
@@ -305,43 +366,6 @@ class SweepPlot:
             for name, value in values.items():
                 lines.append(f"  {name + ' ' + symbol:<18} {value: .5g} {dim.rstrip(']')}")
         return "\n".join(lines)
-
-
-def _driver_axis(x: np.ndarray, angular: bool) -> tuple[np.ndarray, np.ndarray, bool]:
-    """The driver values as drawn, the order of the poses along them, and whether they
-    make one whole turn (then drawn from 0 to 360 deg, whatever angle the sweep began at;
-    `angular` False: as swept)."""
-    finite = x[np.isfinite(x)]
-    turn = angular and finite.size > 1 and abs(np.ptp(finite) - 360.0) <= 1e-9 * 360.0
-    if not turn:
-        return x, np.arange(len(x)), False
-    wrapped = np.mod(x, 360.0)
-    order = np.argsort(wrapped, kind="stable")
-    wrapped = wrapped[order]
-    at_zero = np.nonzero(np.isclose(wrapped, 0.0, atol=1e-9))[0]
-    if at_zero.size:  # the pose at 0 deg closes the turn at 360 deg too
-        order = np.append(order, order[at_zero[0]])
-        wrapped = np.append(wrapped, 360.0)
-    return wrapped, order, True
-
-
-def _angles(y: np.ndarray, style: str) -> np.ndarray:
-    """Angles [deg] along the driver: continuous (no jump at +-180, starting in (-180, 180]),
-    or wrapped to (-180, 180] with a gap where they jump."""
-    y = y.copy()
-    ok = np.isfinite(y)
-    if style == "continuous":
-        y[ok] = np.degrees(np.unwrap(np.radians(y[ok])))
-        y[ok] -= 360.0 * math.ceil((y[ok][0] - 180.0) / 360.0) if y[ok].size else 0.0
-        return y
-    y[ok] = 180.0 - np.mod(180.0 - y[ok], 360.0)
-    y[np.nonzero(np.abs(np.diff(y)) > 180.0)[0]] = math.nan  # no vertical line where it wraps
-    return y
-
-
-def _nearest(x: np.ndarray, y: np.ndarray, at_x: float, fallback: float) -> float:
-    i = int(np.argmin(np.abs(x - at_x)))
-    return float(y[i]) if np.isfinite(y[i]) else fallback
 
 
 def plot_sweep(sweep: Sweep, poses: Iterable[SweepPose], path: str | Path, *,

@@ -15,14 +15,14 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import PinmechError
-from pinmech.link_nodes import link_colour, sketch_links, world_nodes
+from pinmech.display import colour_of, display_names, hex_colour, joint_colours
+from pinmech.link_nodes import sketch_links, world_nodes
 from pinmech.motion import _plane_reference
 
 if TYPE_CHECKING:
     from pinmech.mechanism import Mechanism
 
 PLANES = {"xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
-_PATH_COLOURS = ("#111111", "#7b2d8b", "#0b6e6e", "#9c2f2f")  # dark: the paths over the light sketch
 
 
 class PathRecorder:
@@ -49,6 +49,7 @@ class PathRecorder:
             self.axes, self.names = np.eye(3)[[i, j]], ("xyz"[i], "xyz"[j])
             self.projection = ", 3-D view" if self.is_3d else f", projected on the world {plane or 'xy'} plane"
         self.xyz: dict[str, tuple[array, array, array]] = {}
+        self.labels = display_names(mechanism)
         self.count = 0
 
     def add(self, positions: dict[str, np.ndarray]) -> None:
@@ -63,34 +64,44 @@ class PathRecorder:
         """The paths in the drawing plane's coordinates [m]."""
         return {name: tuple(self.axes @ np.array(xyz)) for name, xyz in self.xyz.items()}
 
-    def draw(self, ax, q: np.ndarray | None, travel: str) -> None:
+    def draw(self, ax, q: np.ndarray | None, travel: str, *, backwards: bool = False) -> None:
         """Paths, the mechanism at q (if given) and arrows of travel, on matplotlib axes
-        (3-D axes when the recorder is 3-D)."""
+        (3-D axes when the recorder is 3-D); `backwards`: the points move against the order
+        they were recorded in (a driver turning at a negative speed), and the arrows say so."""
         if self.is_3d:
-            return self._draw_3d(ax, q, travel)
+            return self._draw_3d(ax, q, travel, backwards)
         scale, unit = (1000.0, "mm") if self._size() < 1.0 else (1.0, "m")
         if q is not None:
             draw_linkage(ax, self.mechanism, q, self.axes, scale)
         for k, (name, (u, v)) in enumerate(self.uv.items()):
             u, v = np.array(u) * scale, np.array(v) * scale
-            (line,) = ax.plot(u, v, linewidth=1.6, color=_PATH_COLOURS[k % len(_PATH_COLOURS)],
-                              linestyle=("-", "--", "-.", ":")[k % 4], label=f"path of {name}", zorder=4)
-            _arrows(ax, u, v, line.get_color())
+            (line,) = ax.plot(u, v, linewidth=1.6, color=self._colour(name), linestyle=("-", "--", "-.", ":")[k % 4],
+                              label=f"path of {self.labels.get(name, name)}", zorder=4)
+            _arrows(ax, u[::-1], v[::-1], line.get_color()) if backwards else _arrows(ax, u, v, line.get_color())
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_xlabel(f"{self.names[0]} [{unit}]", fontsize=9)
         ax.set_ylabel(f"{self.names[1]} [{unit}]", fontsize=9)
         self._finish(ax, travel)
         return None
 
-    def _draw_3d(self, ax, q: np.ndarray | None, travel: str) -> None:
+    def _colour(self, name: str) -> str:
+        """A point's path in its link's colour (pinmech.display); black for a point not on a link."""
+        try:
+            return hex_colour(colour_of(self.mechanism, name))
+        except KeyError:
+            return "#111111"
+
+    def _draw_3d(self, ax, q: np.ndarray | None, travel: str, backwards: bool = False) -> None:
         scale, unit = (1000.0, "mm") if self._size() < 1.0 else (1.0, "m")
         if q is not None:
             draw_linkage_3d(ax, self.mechanism, q, scale)
         for k, (name, xyz) in enumerate(self.xyz.items()):
             x, y, z = (np.array(c) * scale for c in xyz)
-            colour = _PATH_COLOURS[k % len(_PATH_COLOURS)]
+            colour = self._colour(name)
             ax.plot(x, y, z, linewidth=1.6, color=colour, linestyle=("-", "--", "-.", ":")[k % 4],
-                    label=f"path of {name}")
+                    label=f"path of {self.labels.get(name, name)}")
+            if backwards:
+                x, y, z = x[::-1], y[::-1], z[::-1]
             ok = np.nonzero(np.isfinite(x) & np.isfinite(y) & np.isfinite(z))[0]
             arrow = 0.08 * self._size() * scale
             for i in ok[len(ok) // 5 :: max(1, len(ok) // 5)][:4]:  # arrows of travel
@@ -141,9 +152,11 @@ def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scal
     sketches = sketch_links(mechanism)
     spans = [np.linalg.norm(a.position - b.position) for s in sketches.values() for a in s.nodes for b in s.nodes]
     size = scale * max(spans, default=mechanism.length_scale)
-    for k, link in enumerate(sketches.values()):
+    colours = joint_colours(mechanism)  # as in every figure (pinmech.display)
+    _labels(ax, mechanism, sketches, data, axes, scale, size)
+    for link in sketches.values():
         uv = (world_nodes(link, data) @ axes.T) * scale
-        colour = link_colour(k, link)  # as in the 3-D drawings
+        colour = colours[link.joint]
         if link.is_ground:
             _ground(ax, link, uv, size, axes, scale)
             continue
@@ -159,6 +172,26 @@ def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scal
         for node, p in zip(link.nodes, uv):
             if node.kind == "revolute":
                 ax.plot(*p, "o", markersize=5, markerfacecolor="white", markeredgecolor="0.15", zorder=3)
+
+
+def _labels(ax, mechanism: Mechanism, sketches: dict, data: pin.Data, axes: np.ndarray, scale: float,
+            size: float) -> None:
+    """Every joint, cut and named point written beside its place (once a place), as the
+    textbook letters them (pinmech.display), away from the mechanism's centre."""
+    names = display_names(mechanism)
+    places: list[tuple[np.ndarray, str]] = []
+    for link in sketches.values():
+        for node, p in zip(link.nodes, (world_nodes(link, data) @ axes.T) * scale):
+            if node.kind != "other" and not any(np.linalg.norm(p - q) <= 1e-6 * size for q, _ in places):
+                places.append((p, names.get(node.name, node.name)))
+    if not places:
+        return
+    centre = np.mean([p for p, _ in places], axis=0)
+    for p, name in places:
+        away = p - centre
+        away = away / np.linalg.norm(away) if np.linalg.norm(away) > 1e-9 * size else np.array([0.0, 1.0])
+        ax.annotate(name, p, xytext=tuple(13 * away), textcoords="offset points", ha="center", va="center",
+                    fontsize=9, fontweight="bold", color="0.1", zorder=6)
 
 
 def _farthest(uv: np.ndarray) -> tuple[int, int]:
@@ -194,9 +227,10 @@ def draw_linkage_3d(ax, mechanism: Mechanism, q: np.ndarray, scale: float = 1.0)
     """The mechanism at q on 3-D matplotlib axes: each link's nodes joined by lines [m x scale]."""
     data = mechanism.model.createData()
     pin.forwardKinematics(mechanism.model, data, q)
-    for k, link in enumerate(sketch_links(mechanism).values()):
+    colours = joint_colours(mechanism)  # as in every figure (pinmech.display)
+    for link in sketch_links(mechanism).values():
         xyz = world_nodes(link, data) * scale
-        colour = link_colour(k, link)  # as in the 3-D drawings
+        colour = colours[link.joint]
         pins = xyz[[n.kind == "revolute" for n in link.nodes]]
         if len(pins):
             ax.scatter(*pins.T, s=18, facecolors="white", edgecolors="0.15", depthshade=False)

@@ -12,7 +12,7 @@ route as the browser tests (tests/browser.py).
   `<visual>` taken out (a user's model), and `docs/images/jansen_leg.png`, a model written
   without any: their links sketched from their joints and points.
 - `docs/images/sweep_r_rtr.png`, `docs/images/paths_four_bar.png`, `paths_jansen_leg.png`:
-  `pinmech sweep --plot` and `--paths`; `docs/images/polygon_v_r_rtr.png`,
+  `pinmech sweep --plot` and `--paths`; `docs/images/path_planar_arm.png`: `pinmech path --plot`; `docs/images/torque_slider_crank.png`: `--torque-plot`; `docs/images/polygon_v_r_rtr.png`,
   `polygon_a_r_rtr.png`: `pinmech polygon`.
 
 Poses and rates of the first two come from the independent closed forms in
@@ -109,7 +109,7 @@ def page(name: str, arrow_labels: list[str]) -> str:
 
 
 def cli_pictures(chromium: str, tmp: Path) -> None:
-    """The pictures pinmech's own commands make: snapshots, a bare model, figures, polygons."""
+    """The pictures pinmech's own commands make in a browser: snapshots, a bare model, polygons."""
     import re
 
     from pinmech.cli import main as pinmech
@@ -125,13 +125,25 @@ def cli_pictures(chromium: str, tmp: Path) -> None:
         html = tmp / f"{name}.html"
         pinmech(["snapshot", str(scene_file), "-o", str(html), "--no-grid"])
         photograph(chromium, html, IMAGES / f"{name}.png")
-    pinmech(["sweep", str(scenes / "r_rtr.toml"), "--plot", str(IMAGES / "sweep_r_rtr.png"), "--csv", str(tmp / "s.csv")])
-    for name in ("four_bar", "jansen_leg"):
-        pinmech(["sweep", str(scenes / f"{name}.toml"), "--paths", str(IMAGES / f"paths_{name}.png")])
     for kind in ("v", "a"):
         svg = tmp / f"polygon_{kind}.svg"
         pinmech(["polygon", str(scenes / "r_rtr.toml"), "-o", str(svg)] + (["--acceleration"] if kind == "a" else []))
         photograph(chromium, svg, IMAGES / f"polygon_{kind}_r_rtr.png", window=_svg_pixels(svg))
+
+
+def figure_pictures(tmp: Path) -> None:
+    """The matplotlib figures of the README (no browser needed): a sweep, two paths figures,
+    the torque and flywheel-energy figure, an arm's path in time."""
+    from pinmech.cli import main as pinmech
+
+    scenes = MODELS / "scenes"
+    pinmech(["sweep", str(scenes / "r_rtr.toml"), "--plot", str(IMAGES / "sweep_r_rtr.png"), "--csv", str(tmp / "s.csv")])
+    for name in ("four_bar", "jansen_leg"):
+        pinmech(["sweep", str(scenes / f"{name}.toml"), "--paths", str(IMAGES / f"paths_{name}.png")])
+    pinmech(["sweep", str(scenes / "slider_crank_dynamic.toml"), "--torque-plot",
+             str(IMAGES / "torque_slider_crank.png"), "--csv", str(tmp / "t.csv")])
+    pinmech(["path", str(scenes / "planar_arm.toml"), "--csv", str(tmp / "arm.csv"),
+             "--plot", str(IMAGES / "path_planar_arm.png")])
 
 
 def _svg_pixels(svg: Path) -> tuple[int, int]:
@@ -143,21 +155,27 @@ def _svg_pixels(svg: Path) -> tuple[int, int]:
 
 
 def main() -> None:
-    """Write docs/images/NAME.png for every picture in SCENES."""
+    """Write every picture of the README under docs/images (the browser's only with chromium)."""
     from pinmech.draw.browser import find_chromium, photograph
 
-    chromium = find_chromium()
-    if chromium is None:
-        print("this script needs Debian's chromium: apt-get install chromium")
-        return
-    try:
-        import meshcat  # noqa: F401
-    except ImportError:
-        print('this script needs meshcat: pip install "pinmech[viz]"')
-        return
     sys.path.insert(0, str(Path(__file__).resolve().parent))  # closed_form.py, beside this file
     IMAGES.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            print('the figures need matplotlib: pip install "pinmech[plot]"')
+        else:
+            figure_pictures(Path(tmp))
+        chromium = find_chromium()
+        if chromium is None:
+            print("the snapshots and polygons: this script needs Debian's chromium: apt-get install chromium")
+            return
+        try:
+            import meshcat  # noqa: F401
+        except ImportError:
+            print('the snapshots need meshcat: pip install "pinmech[viz]"')
+            return
         for name, arrow_labels in SCENES.items():
             html = Path(tmp) / f"{name}.html"
             html.write_text(page(name, arrow_labels), encoding="utf-8")

@@ -33,6 +33,7 @@ def test_render_snapshots_script_runs(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(module, "IMAGES", tmp_path)
     monkeypatch.setattr(module, "SCENES", {"r_rtr": []})
     monkeypatch.setattr(module, "cli_pictures", lambda chromium, tmp: None)  # pinmech's commands: tested apart
+    monkeypatch.setattr(module, "figure_pictures", lambda tmp: None)
     module.main()
     out = capsys.readouterr().out
     assert "needs Debian's chromium" in out or (tmp_path / "r_rtr.png").stat().st_size > 1000

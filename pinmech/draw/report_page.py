@@ -164,6 +164,8 @@ def snapshot(analysis: Analysis) -> HtmlPage:
     from pinmech.draw.pages import mechanism_visuals
 
     visuals = mechanism_visuals(mech)[0]  # the model's own file: a URDF, a drawn linkage's, an MJCF file
-    points = {n: p.position for n, p in analysis.motion.points.items()}
+    from pinmech.display import labelled_places
+
+    points = labelled_places(mech, analysis.solution.q)  # joints and points, as the textbook names them
     return HtmlPage(snapshot_html(mech.model, visuals, analysis.solution.q, points=points,
                                   plane_normal=mech.plane_normal, title=analysis.scene.title))

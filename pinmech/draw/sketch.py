@@ -14,7 +14,8 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.draw.geometry import _screen_up
-from pinmech.link_nodes import LinkSketch, link_colour, sketch_links
+from pinmech.display import joint_colours
+from pinmech.link_nodes import LinkSketch, sketch_links
 from pinmech.mechanism import Mechanism
 
 _BAR = 0.05  # bar width, as a share of the longest link
@@ -41,10 +42,11 @@ def sketch_visuals(mechanism: Mechanism, visual_model: pin.GeometryModel | None 
     normal = mechanism.plane_normal
     data = mechanism.model.createData()  # link frames at the neutral pose: their plane normal
     pin.forwardKinematics(mechanism.model, data, mechanism.neutral())
-    for i, link in enumerate(sketches.values()):
+    colours = joint_colours(mechanism)  # as in every figure (pinmech.display)
+    for link in sketches.values():
         if link.joint in drawn:
             continue
-        colour = np.array([*link_colour(i, link), 1.0])
+        colour = np.array([*colours[link.joint], 1.0])
         local_normal = None if normal is None else data.oMi[link.joint].rotation.T @ normal
         shapes = _ground_shapes(link, scale, normal) if link.is_ground else []
         shapes += _link_shapes(link, scale, local_normal, coal)
