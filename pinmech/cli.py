@@ -5,7 +5,7 @@ Exit codes: 0 success; 1 hand values mismatch (`check`); 2 usage or other pinmec
 the mobility; 6 a loop cannot close; 7 singular pose, or forces not determined; 8 inconsistent
 task; 9 a drawing input out of range; 10 another assembly than the scene's (or none reachable
 on it); 11 the drivers cannot go further (a fold: limit angle, extreme, stroke); 12 a joint
-beyond its URDF <limit> (with --limits error); 13 forces that fail their own power balance; 14 a planar design diagnostic asked of a spatial mechanism.
+beyond its limits (URDF <limit>, MJCF range; with --limits error); 13 forces that fail their own power balance; 14 a planar design diagnostic asked of a spatial mechanism.
 An output file that cannot be written is 2.
 Stopped by a signal: 128 + its number (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP), outputs kept
 as NAME.partial.
@@ -64,7 +64,7 @@ def _add_force_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _add_limits_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--limits", choices=("warn", "error"),
-                        help="a joint beyond its URDF <limit>: a warning (default) or an error (exit 12)")
+                        help="a joint beyond its limits (URDF <limit>, MJCF range): a warning (default) or an error (exit 12)")
 
 
 def build_parser(command: str | None = None, *, parser_class: type[argparse.ArgumentParser] = argparse.ArgumentParser
@@ -295,7 +295,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     enforce(violations, mode, str(scene.path))
     print(to_json(analysis) if args.json else to_text(analysis), end="" if not args.json else "\n")
     for v in violations:
-        print(f"pinmech: warning: {v.describe()} (URDF <limit>)", file=sys.stderr)
+        print(f"pinmech: warning: {v.describe()}", file=sys.stderr)
     return 0
 
 
@@ -427,7 +427,7 @@ def _say_return(sweep, span: float) -> None:
 
 
 class _LimitWatch:
-    """Poses (or path points) that put a joint beyond its URDF <limit>: counted and summed
+    """Poses (or path points) that put a joint beyond its limits: counted and summed
     up in a warning, or the run stopped at the first (LimitError) in mode "error"."""
 
     def __init__(self, mode: str, what: str, column: str = "; see the beyond_limits column") -> None:
@@ -444,7 +444,7 @@ class _LimitWatch:
 
     def summary(self, total: int) -> None:
         if self.count:
-            print(f"pinmech: warning: {self.count} of {total} {self.what} put joints beyond their URDF <limit> "
+            print(f"pinmech: warning: {self.count} of {total} {self.what} put joints beyond their limits "
                   f"(first {self.first}){self.column}", file=sys.stderr)
 
 

@@ -30,11 +30,14 @@ class LimitViolation:
     lower: float
     upper: float
     angular: bool
+    element: str = "URDF <limit>"
 
     def describe(self) -> str:
-        """One phrase in the user's units: "B_slider = 0.183 m is above its upper limit 0.1 m"."""
+        """One phrase in the user's units, naming the element that states the limit:
+        "B_slider = 0.183 m is above its upper limit 0.1 m (URDF <limit>)"."""
         side, bound = ("above its upper", self.upper) if self.value > self.upper else ("below its lower", self.lower)
-        return f"{self.joint} = {_format(self.value, self.angular)} is {side} limit {_format(bound, self.angular)}"
+        return (f"{self.joint} = {_format(self.value, self.angular)} is {side} limit "
+                f"{_format(bound, self.angular)} ({self.element})")
 
     def as_dict(self) -> dict[str, float | str]:
         return {"joint": self.joint, "value": self.value, "lower": self.lower, "upper": self.upper}
@@ -78,7 +81,7 @@ def _beyond(mechanism: Mechanism, values: dict[str, float]) -> list[LimitViolati
             continue
         margin = 1e-9 * max(1.0, abs(limit.lower), abs(limit.upper))
         if value < limit.lower - margin or value > limit.upper + margin:
-            out.append(LimitViolation(name, value, limit.lower, limit.upper, limit.angular))
+            out.append(LimitViolation(name, value, limit.lower, limit.upper, limit.angular, limit.element))
     return out
 
 
@@ -88,7 +91,7 @@ def enforce(violations: list[LimitViolation], mode: str, where: str = "") -> Non
         raise LimitError(f"limits must be one of {', '.join(LIMIT_MODES)}, got {mode!r}", violations=[])
     if violations and mode == "error":
         said = "; ".join(v.describe() for v in violations)
-        raise LimitError(f"{where}{': ' if where else ''}{said} (URDF <limit>)", violations=violations)
+        raise LimitError(f"{where}{': ' if where else ''}{said}", violations=violations)
 
 
 def _format(x: float, angular: bool) -> str:

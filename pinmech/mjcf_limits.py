@@ -53,5 +53,5 @@ def mjcf_limits(root: ET.Element, source: str) -> dict[str, JointLimit]:
             if not lower < upper:
                 raise ModelError(f"range=\"{joint.get('range')}\": the lower bound is not below the upper one",
                                  path=source, element=where(joint))
-            out[joint.get("name", "")] = JointLimit(float(lower), float(upper), kind != "slide")
+            out[joint.get("name", "")] = JointLimit(float(lower), float(upper), kind != "slide", "MJCF range")
     return out

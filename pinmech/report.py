@@ -214,7 +214,7 @@ def to_text(analysis: Analysis) -> str:
         t.row(name, *_joint_cells(j.kind, j.q, j.v, j.a))
     violations = limit_violations(analysis.mechanism, analysis.motion)
     if violations:
-        t.head("Joint limits (URDF <limit>)")
+        t.head("Joint limits")
         t.lines += [f"  WARNING: {v.describe()}" for v in violations]
     _assembly_lines(t, analysis)
     acc = analysis.solution.accuracy

@@ -18,11 +18,13 @@ from pinmech.exceptions import ModelError
 
 @dataclass(frozen=True)
 class JointLimit:
-    """A joint's position limits from the URDF's `<limit>` [rad, or m when not angular]."""
+    """A joint's position limits [rad, or m when not angular], and the element of the model
+    file that states them (`element`, as a message names it: "URDF <limit>", "MJCF range")."""
 
     lower: float
     upper: float
     angular: bool
+    element: str = "URDF <limit>"
 
 
 @dataclass(frozen=True)

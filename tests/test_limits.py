@@ -62,7 +62,7 @@ def test_a_sweep_marks_the_poses_beyond_the_limits(tight, tmp_path, capsys):
     rows = list(csv.DictReader(out.open()))
     beyond = [float(r["A.q [deg]"]) for r in rows if r["beyond_limits"] == "B_slider"]
     assert beyond == [a for a in range(30, 391, 20) if math.cos(math.radians(a)) < 0.25]
-    assert "10 of 19 poses put joints beyond their URDF <limit>" in capsys.readouterr().err
+    assert "10 of 19 poses put joints beyond their limits" in capsys.readouterr().err
     assert main(["sweep", str(tight), "--steps", "19", "--csv", str(out), "--limits", "error"]) == 12
     assert "stopped at A = 90 deg: B_slider" in capsys.readouterr().err
 
@@ -103,7 +103,7 @@ def test_an_arm_path_beyond_a_limit_is_a_warning_or_stops(tmp_path, capsys):
                                                                       'urdf = "arm.urdf"'))
     assert main(["path", str(scene), "--duration", "0.02 s", "--csv", str(tmp_path / "p.csv")]) == 0
     err = capsys.readouterr().err
-    assert "path points put joints beyond their URDF <limit> (first at t = " in err and ": B = " in err
+    assert "path points put joints beyond their limits (first at t = " in err and ": B = " in err
     assert main(["path", str(scene), "--duration", "0.02 s", "--csv", str(tmp_path / "p.csv"), "--limits", "error"]) == 12
     assert "stopped at t = " in capsys.readouterr().err
 
@@ -132,7 +132,7 @@ def test_mjcf_ranges_are_mujocos_limits_and_are_checked(tmp_path, capsys):
     scene.write_text('mjcf = "arm.xml"\n[drivers.shoulder]\nangle = "90 deg"\n[drivers.slide]\nposition = "0 mm"\n'
                      '[report]\nlimits = "error"\n')
     assert main(["solve", str(scene)]) == 12
-    assert "shoulder = 90 deg is above its upper limit 60 deg" in capsys.readouterr().err
+    assert "shoulder = 90 deg is above its upper limit 60 deg (MJCF range)" in capsys.readouterr().err
     scene.write_text(scene.read_text().replace('"90 deg"', '"45 deg"'))
     assert main(["solve", str(scene)]) == 0
 
