@@ -164,8 +164,8 @@ class SweepPlot:
             columns.append([math.degrees(link.angle) for link in links])
         columns += [w, alpha]
         if self.sliders:
-            columns += [[m.joints[s].q for s in self.sliders], [m.joints[s].v for s in self.sliders],
-                        [m.joints[s].a for s in self.sliders]]
+            sliders = [m.sliders[name] for name in self.sliders]  # tree joints and cuts alike
+            columns += [[s.s for s in sliders], [s.s_dot for s in sliders], [s.s_ddot for s in sliders]]
         if self.points:
             columns += [[float(np.linalg.norm(m.points[p].velocity)) for p in self.points],
                         [float(np.linalg.norm(m.points[p].acceleration)) for p in self.points]]
