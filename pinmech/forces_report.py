@@ -91,7 +91,7 @@ def forces_text(f: ForceSolution, mechanism: Mechanism, *, static: bool, loads: 
             moment = float(normal @ r.moment) if normal is not None else float(np.linalg.norm(r.moment))
             moment = moment if abs(moment) > 1e-12 * size * mechanism.length_scale else 0.0  # rounding noise
             cells = cells[:1] + ["normal " + _vector(r.normal_force, planar_z, "N", size),
-                                 f"moment {_num(moment)} N m (about {name}'s origin)"]
+                                 f"moment {_num(moment)} N m (about {name}'s {'frame on ' + r.on if r.is_cut else 'origin'})"]
         lines.append(f"  {label:<10} " + "   ".join(cells))
     p = f.power
     lines += ["", (f"  power balance ({p.velocity} velocities): drivers {p.driver_power:.6g} W + gravity "
