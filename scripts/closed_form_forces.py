@@ -10,8 +10,9 @@ Shigley (Theory of Machines and Mechanisms, ch. 15) set it up. No Pinocchio, no 
 space, no constraint Jacobian.
 
 Notation: F_ij is the force link i exerts on link j (1 = ground, 2 = crank, 3 = coupler or
-connecting rod, 4 = rocker or piston; for the R-RTR 2 = crank, 3 = block, 4 = guide); vectors are (x, y) in the world frame; moments and
-angular quantities are their z components.
+connecting rod, 4 = rocker or piston; for the R-RTR 2 = crank, 3 = block, 4 = guide);
+vectors are (x, y) in the world frame; moments and angular quantities are their z
+components.
 
 Run: python scripts/closed_form_forces.py   (the slider-crank of models/slider_crank_dynamic.urdf)
 """
