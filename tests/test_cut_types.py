@@ -292,3 +292,37 @@ def test_every_output_takes_every_cut_type(name, output, tmp_path, capsys):
         assert set(result["sliders"]) == {k.split(".")[0] for k in case.expected(0.5) if k.endswith(".s [m]")}
     else:
         assert "Accuracy" in out
+
+
+@pytest.mark.parametrize("name", ["prismatic <constraint>, fixed guide", "prismatic <constraint>, turning guide"])
+def test_a_slide_cut_is_sketched_as_a_tree_slide_is(name, tmp_path):
+    """Drawings without visuals (figures, pages): a slide cut gets a block on one link and
+    its guide's line on the other, as a prismatic tree joint does. At the pose the block
+    sits on the guide's line and both run along the slide (the closed form's direction)."""
+    import pinocchio as pin
+
+    from pinmech.link_nodes import sketch_links
+
+    scene = Scene.load(CASES[name].scene(tmp_path))
+    sweep = Sweep.from_scene(scene)
+    mech = sweep.mechanism
+    pose = next(iter(sweep.poses(np.radians([40.0]))))
+    data = mech.model.createData()
+    pin.forwardKinematics(mech.model, data, sweep.last_q)
+    sketches = sketch_links(mech)
+    blocks = [s for s in sketches.values() if s.slide_axis is not None]
+    guides = [s for s in sketches.values() if s.guides]
+    assert len(blocks) == 1 and len(guides) == 1, name
+    block, guide = blocks[0], guides[0]
+    point, direction = guide.guides[0]
+    M_g, M_b = data.oMi[guide.joint], data.oMi[block.joint]
+    line_point, line_dir = M_g.act(point), M_g.rotation @ direction
+    if name.endswith("fixed guide"):  # the line y = 10 mm along x; the block's pin B on it
+        expected_dir, on_line = np.array([1.0, 0.0, 0.0]), pose.motion.points["B_pin"].position
+    else:  # the guide C -> D (link 3's x), the block at B
+        u = cf.r_rtr(math.radians(40.0), 0.0, 0.0).u
+        expected_dir, on_line = np.array([u[0], u[1], 0.0]), pose.motion.points["D"].position
+    np.testing.assert_allclose(abs(line_dir @ expected_dir), 1.0, atol=1e-12)
+    np.testing.assert_allclose(abs((M_b.rotation @ block.slide_axis) @ expected_dir), 1.0, atol=1e-12)
+    gap = (on_line - line_point) - ((on_line - line_point) @ line_dir) * line_dir
+    np.testing.assert_allclose(gap, 0.0, atol=1e-12)
