@@ -253,8 +253,10 @@ class ForceSolver:
             if not set(names) <= massless:
                 missing += [n for n in names if n not in massless] or [model.names[jid]]
         if missing:
+            give = "write its URDF with pinmech build and give them one" if str(mech.source).endswith(".toml") \
+                else "give one"  # a drawn linkage has no masses
             raise ModelError(f"forces need the masses of the moving links; {', '.join(missing)} "
-                             "have no <inertial> mass (give one, or list the links meant to be "
+                             f"have no <inertial> mass ({give}, or list the links meant to be "
                              "massless: [forces] massless = [...])", path=mech.source)
 
     # ------------------------------------------------------------------ solve

@@ -224,10 +224,7 @@ def _link_xml(linkage: Linkage, link: str, frame: _Frame, size: float, index: in
                            f'<box size="{_num(3 * width)} {_num(1.5 * width)} {_num(width)}"/>'))
         for p in local:
             shapes.append((p, 0.0, f'<cylinder radius="{_num(0.6 * width)}" length="{_num(1.2 * width)}"/>'))
-    out = [f"  <link name={quoteattr(link)}>"]
-    if link != GROUND:
-        out.append('    <inertial><mass value="1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" '
-                   'iyz="0"/></inertial>')
+    out = [f"  <link name={quoteattr(link)}>"]  # no <inertial>: a drawing gives no masses
     for p, phi, geometry in shapes:
         out.append(f'    <visual><origin xyz="{_xyz(p, z)}" rpy="0 0 {_num(phi)}"/><geometry>{geometry}</geometry>'
                    f'<material name="{material}"/></visual>')
@@ -325,10 +322,7 @@ def _spatial_link_xml(linkage: Linkage, link: str, origin: np.ndarray, size: flo
     width = 0.02 * size
     material = "ground" if link == GROUND else f"c{(index - 1) % len(_COLOURS)}"
     local = [linkage.points[n] - origin for n in linkage.links[link]]
-    out = [f"  <link name={quoteattr(link)}>"]
-    if link != GROUND:
-        out.append('    <inertial><mass value="1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" '
-                   'iyz="0"/></inertial>')
+    out = [f"  <link name={quoteattr(link)}>"]  # no <inertial>: a drawing gives no masses
     ring = [] if link == GROUND else local + local[:1] if len(local) > 2 else local[:2]  # outline, or a bar
     pairs = [(ring[i], ring[i + 1]) for i in range(len(ring) - 1)]
     for p, q in pairs:
