@@ -326,3 +326,26 @@ def test_a_slide_cut_is_sketched_as_a_tree_slide_is(name, tmp_path):
     np.testing.assert_allclose(abs((M_b.rotation @ block.slide_axis) @ expected_dir), 1.0, atol=1e-12)
     gap = (on_line - line_point) - ((on_line - line_point) @ line_dir) * line_dir
     np.testing.assert_allclose(gap, 0.0, atol=1e-12)
+
+
+def test_a_hand_check_reads_a_slot_cuts_travel_in_millimetres(tmp_path, capsys):
+    """`pinmech check` on the drawn R-RTR's slot: s [mm] and s_dot [mm/s] printed from the
+    closed form to 6 decimals (its own rounding: within the check's 2 units of the last
+    digit), and a length given for the speed is refused as the wrong kind (exit 4)."""
+    scene = _drawn_slot_scene(tmp_path)
+    expected = _drawn_slot(math.radians(30.0))
+    s, s_dot = expected["B_slide.s [m]"] * 1e3, expected["B_slide.v_rel [m/s]"] * 1e3
+    hand = tmp_path / "slot.hand.toml"
+
+    def write(speed_unit: str) -> None:
+        hand.write_text(f'scene = "{scene.name}"\nsource = "closed_form.r_rtr"\n'
+                        f'[[value]]\nlabel = "s"\nquantity = "sliders.B_slide.s"\nhand = ["{s:.6f}"]\nunit = "mm"\n'
+                        f'[[value]]\nlabel = "s_dot"\nquantity = "sliders.B_slide.s_dot"\nhand = ["{s_dot:.6f}"]\n'
+                        f'unit = "{speed_unit}"\n', encoding="utf-8")
+
+    write("mm/s")
+    assert main(["check", str(hand)]) == 0, capsys.readouterr()
+    assert "2 ok" in capsys.readouterr().out
+    write("mm")
+    assert main(["check", str(hand)]) == 4
+    assert "s_dot" in capsys.readouterr().err
