@@ -120,7 +120,10 @@ def sketch_links(mechanism: Mechanism) -> dict[str, LinkSketch]:
     }
 
 
-def _slides(mechanism: Mechanism) -> list[tuple[int, int, tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]]:
+_Line = tuple[np.ndarray, np.ndarray]  # a point of a line and its direction
+
+
+def _slides(mechanism: Mechanism) -> list[tuple[int, int, _Line, _Line]]:
     """Every slide, a prismatic tree joint or a prismatic loop cut: the joints its two links
     hang on (parent, child) and on each, (a point of the line, its direction) in that
     link's joint frame."""
@@ -128,8 +131,9 @@ def _slides(mechanism: Mechanism) -> list[tuple[int, int, tuple[np.ndarray, np.n
     for joint in mechanism.joints.values():
         if joint.kind == "prismatic":
             placement = model.jointPlacements[joint.id]
-            out.append((model.parents[joint.id], joint.id, (placement.translation.copy(), placement.rotation @ joint.axis),
-                        (np.zeros(3), np.asarray(joint.axis, dtype=float))))
+            on_parent = (placement.translation.copy(), placement.rotation @ joint.axis)
+            on_child = (np.zeros(3), np.asarray(joint.axis, dtype=float))
+            out.append((model.parents[joint.id], joint.id, on_parent, on_child))
     for c in mechanism.closures:
         if c.cut_type == "prismatic":
             sides = [(model.frames[f].parentJoint, model.frames[f].placement) for f in (c.parent_frame, c.child_frame)]

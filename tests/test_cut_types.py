@@ -230,12 +230,14 @@ def test_the_sweep_json_lines_hold_every_cut_type(name, tmp_path):
     """JSON lines: the slide's s and its rates along the guide, and the points, in SI."""
     case = CASES[name]
     out = tmp_path / "sweep.jsonl"
-    assert main(["sweep", *_sweep_args(case.scene(tmp_path)), "--json", str(out), "--csv", str(tmp_path / "s.csv")]) == 0
+    argv = ["sweep", *_sweep_args(case.scene(tmp_path)), "--json", str(out), "--csv", str(tmp_path / "s.csv")]
+    assert main(argv) == 0
     rows = []
     for line in out.read_text(encoding="utf-8").splitlines():
         entry, row = json.loads(line), {}
         for slider, s in entry["sliders"].items():
-            row |= _slide_columns(slider, s["s"], s["s_dot"], s["s_ddot"], float(np.linalg.norm(s["coriolis_acceleration"])))
+            coriolis = float(np.linalg.norm(s["coriolis_acceleration"]))
+            row |= _slide_columns(slider, s["s"], s["s_dot"], s["s_ddot"], coriolis)
             axis = np.array(s["axis"])
             np.testing.assert_allclose(np.array(s["relative_velocity"]), s["s_dot"] * axis, rtol=0, atol=1e-12)
         for point, p in entry["points"].items():

@@ -31,7 +31,8 @@ def _scene(tmp_path: Path, linkage: str, driver: str, extra: str = "") -> Path:
 def test_forces_on_a_drawing_name_the_links_without_mass(tmp_path, linkage, driver, links):
     """A drawing has no masses: a torque from placeholder masses would be a number nobody
     gave. Forces are refused up front, naming the links (exit 3 on the command line)."""
-    scene = pinmech.Scene.load(_scene(tmp_path, linkage, driver, "[gravity]\nacceleration = \"9.81 m/s^2\"\ndirection = [0, -1, 0]\n"))
+    gravity = '[gravity]\nacceleration = "9.81 m/s^2"\ndirection = [0, -1, 0]\n'
+    scene = pinmech.Scene.load(_scene(tmp_path, linkage, driver, gravity))
     with pytest.raises(ModelError, match="have no <inertial> mass") as info:
         pinmech.analyse(scene)
     assert all(name in str(info.value) for name in links)
