@@ -55,6 +55,9 @@ _KINDS = {
     "relative_velocity": "velocity",
     "relative_acceleration": "acceleration",
     "coriolis_acceleration": "acceleration",
+    "s": "length",          # a slider's position along its guide (sliders.S.s)
+    "s_dot": "velocity",
+    "s_ddot": "acceleration",
     "angle": "angle",
     "angular_velocity": "angular_velocity",
     "angular_acceleration": "angular_acceleration",

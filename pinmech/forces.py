@@ -72,7 +72,8 @@ class Reaction:
         joint: the joint (or `<constraint>`) name.
         kind: its type ("revolute", "continuous", "prismatic", "spherical", "fixed", ...).
         by, on: the link that exerts the wrench, the link it acts on.
-        point: where it acts [m]: the joint's origin (the cut point for a cut).
+        point: where it acts [m]: the joint's origin; for a cut, the origin of its cut
+            frame on `on` (a slide's two cut frames part along its axis).
         force: F_by,on [N].
         moment: moment about `point` [N m].
         axis: the joint's axis, world frame (zero for joints without one).
@@ -390,16 +391,18 @@ class ForceSolver:
         return out
 
     def _cut_wrenches(self, lam: np.ndarray) -> list[Reaction]:
-        """Each cut's wrench on its child link (by its parent), world frame, at the cut point."""
+        """Each cut's wrench on its child link (by its parent), world frame, about the child
+        cut frame's origin C: the cut's rows measure C's velocity relative to the parent's
+        material point at C, so the force acts there on both links (on a slide, the two cut
+        frames' origins part along the axis; at a closed pin they coincide)."""
         out, start = [], 0
         for c in self.mechanism.closures:
             f6 = c._rows6.T @ lam[start : start + c.rows]  # relative 6-vector of the cut, in P
             start += c.rows
-            M_P = self.data.oMf[c.parent_frame]
-            R = M_P.rotation
+            R = self.data.oMf[c.parent_frame].rotation
             axis = R @ c.axis if c.cut_type in ("revolute", "prismatic") else np.zeros(3)
-            out.append(Reaction(c.name, c.cut_type, c.parent_link, c.child_link, M_P.translation.copy(),
-                                R @ f6[:3], R @ f6[3:], axis, True))
+            out.append(Reaction(c.name, c.cut_type, c.parent_link, c.child_link,
+                                self.data.oMf[c.child_frame].translation.copy(), R @ f6[:3], R @ f6[3:], axis, True))
         return out
 
     def _as_external(self, cuts: list[Reaction]) -> list[pin.Force]:

@@ -88,10 +88,11 @@ def forces_text(f: ForceSolution, mechanism: Mechanism, *, static: bool, loads: 
         if angle is not None and r.magnitude > 1e-12 * size:
             cells.append(f"at {_num(math.degrees(angle))} deg")
         if r.kind == "prismatic":
+            about = f"frame on {r.on}" if r.is_cut else "origin"  # where a cut's wrench acts
             moment = float(normal @ r.moment) if normal is not None else float(np.linalg.norm(r.moment))
             moment = moment if abs(moment) > 1e-12 * size * mechanism.length_scale else 0.0  # rounding noise
             cells = cells[:1] + ["normal " + _vector(r.normal_force, planar_z, "N", size),
-                                 f"moment {_num(moment)} N m (about {name}'s origin)"]
+                                 f"moment {_num(moment)} N m (about {name}'s {about})"]
         lines.append(f"  {label:<10} " + "   ".join(cells))
     p = f.power
     lines += ["", (f"  power balance ({p.velocity} velocities): drivers {p.driver_power:.6g} W + gravity "

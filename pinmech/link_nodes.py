@@ -88,13 +88,7 @@ def sketch_links(mechanism: Mechanism) -> dict[str, LinkSketch]:
         _add(by_joint, frame.parentJoint, Node(name, frame.placement.translation.copy(), "point"), mechanism)
     blocks: dict[int, np.ndarray] = {}
     guides: dict[int, list[tuple[np.ndarray, np.ndarray]]] = {}
-    for joint in mechanism.joints.values():
-        if joint.kind != "prismatic":
-            continue
-        parent, child = model.parents[joint.id], joint.id
-        placement = model.jointPlacements[joint.id]
-        on_parent = (placement.translation.copy(), placement.rotation @ joint.axis)
-        on_child = (np.zeros(3), np.asarray(joint.axis, dtype=float))
+    for parent, child, on_parent, on_child in _slides(mechanism):
         block, guide = (parent, child) if len(by_joint.get(parent, [])) < len(by_joint.get(child, [])) else (child, parent)
         blocks[block] = (on_parent if block == parent else on_child)[1]
         guides.setdefault(guide, []).append(on_parent if guide == parent else on_child)
@@ -103,6 +97,29 @@ def sketch_links(mechanism: Mechanism) -> dict[str, LinkSketch]:
                                                  tuple(guides.get(j, ())))
         for j, nodes in by_joint.items()
     }
+
+
+_Line = tuple[np.ndarray, np.ndarray]  # a point of a line and its direction
+
+
+def _slides(mechanism: Mechanism) -> list[tuple[int, int, _Line, _Line]]:
+    """Every slide, a prismatic tree joint or a prismatic loop cut: the joints its two links
+    hang on (parent, child) and on each, (a point of the line, its direction) in that
+    link's joint frame."""
+    model, out = mechanism.model, []
+    for joint in mechanism.joints.values():
+        if joint.kind == "prismatic":
+            placement = model.jointPlacements[joint.id]
+            on_parent = (placement.translation.copy(), placement.rotation @ joint.axis)
+            on_child = (np.zeros(3), np.asarray(joint.axis, dtype=float))
+            out.append((model.parents[joint.id], joint.id, on_parent, on_child))
+    for c in mechanism.closures:
+        if c.cut_type == "prismatic":
+            sides = [(model.frames[f].parentJoint, model.frames[f].placement) for f in (c.parent_frame, c.child_frame)]
+            (parent, on_p), (child, on_c) = sides
+            out.append((parent, child, (on_p.translation.copy(), on_p.rotation @ c.axis),
+                        (on_c.translation.copy(), on_c.rotation @ c.child_axis)))
+    return out
 
 
 def world_nodes(link: LinkSketch, data: pin.Data) -> np.ndarray:

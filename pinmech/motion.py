@@ -66,12 +66,18 @@ class JointMotion:
 
 @dataclass(frozen=True)
 class SliderMotion:
-    """Motion of a prismatic joint's child relative to its parent, world frame.
+    """Motion of a prismatic joint's (or prismatic cut's) child relative to its parent,
+    world frame.
 
     Attributes:
         relative_velocity: velocity of the child's point relative to the parent [m/s].
         relative_acceleration: its acceleration seen from the parent [m/s^2].
         coriolis_acceleration: 2 w_parent x v_rel [m/s^2].
+        axis: the slide's unit direction, world frame (the parent's axis for a cut).
+        s: the child's position along `axis` [m]: a tree slider's coordinate, a cut's
+            offset of the child's cut frame from the parent's.
+        s_dot, s_ddot: its rate [m/s] and acceleration [m/s^2] seen from the parent
+            (`relative_velocity` and `relative_acceleration` along `axis`).
     """
 
     parent: str
@@ -79,6 +85,10 @@ class SliderMotion:
     relative_velocity: np.ndarray
     relative_acceleration: np.ndarray
     coriolis_acceleration: np.ndarray
+    axis: np.ndarray
+    s: float
+    s_dot: float
+    s_ddot: float
 
 
 @dataclass(frozen=True)
@@ -145,14 +155,15 @@ def evaluate_motion(
         joints=_joint_motions(mechanism, q, v, a),
         links=link_motion,
         points=point_motion,
-        sliders=_sliders(mechanism, data, v, a),
+        sliders=_sliders(mechanism, data, q, v, a),
     )
 
 
-def _sliders(mechanism: Mechanism, data: pin.Data, v: np.ndarray, a: np.ndarray) -> dict[str, SliderMotion]:
+def _sliders(mechanism: Mechanism, data: pin.Data, q: np.ndarray, v: np.ndarray,
+             a: np.ndarray) -> dict[str, SliderMotion]:
     """Every prismatic joint of the tree, and every prismatic loop cut (a drawn pin-in-slot
     is cut at its slide), by name."""
-    out = {n: _slider(mechanism, data, n, float(v[j.idx_v]), float(a[j.idx_v]))
+    out = {n: _slider(mechanism, data, n, mechanism.coordinate(q, n), float(v[j.idx_v]), float(a[j.idx_v]))
            for n, j in mechanism.joints.items() if j.kind == "prismatic"}
     for closure in mechanism.closures:
         if closure.cut_type == "prismatic" and closure.name not in out:
@@ -176,8 +187,10 @@ def _cut_slider(mechanism: Mechanism, data: pin.Data, closure) -> SliderMotion:
     v_rel = v_c - (vel_p.linear + _cross(w, r))
     coriolis = 2.0 * _cross(w, v_rel)
     a_rel = a_c - (acc_p.linear + _cross(alpha, r) + _cross(w, _cross(w, r))) - coriolis
+    axis = data.oMf[parent].rotation @ closure.axis
     return SliderMotion(parent=closure.parent_link, child=closure.child_link, relative_velocity=v_rel,
-                        relative_acceleration=a_rel, coriolis_acceleration=coriolis)
+                        relative_acceleration=a_rel, coriolis_acceleration=coriolis, axis=axis,
+                        s=float(axis @ r), s_dot=float(axis @ v_rel), s_ddot=float(axis @ a_rel))
 
 
 def _vector(x: Any, size: int, name: str, mechanism: Mechanism) -> np.ndarray:
@@ -302,7 +315,8 @@ def _coincident(mechanism: Mechanism, data: pin.Data, c: CoincidentPoint) -> Poi
     )
 
 
-def _slider(mechanism: Mechanism, data: pin.Data, name: str, rate: float, accel: float) -> SliderMotion:
+def _slider(mechanism: Mechanism, data: pin.Data, name: str, q: float, rate: float, accel: float) -> SliderMotion:
+    """A tree slider from its coordinate q [m], rate [m/s] and acceleration [m/s^2]."""
     joint = mechanism.joint(name)
     model = mechanism.model
     axis_world = data.oMi[joint.id].rotation @ joint.axis
@@ -315,4 +329,8 @@ def _slider(mechanism: Mechanism, data: pin.Data, name: str, rate: float, accel:
         relative_velocity=v_rel,
         relative_acceleration=accel * axis_world,
         coriolis_acceleration=2.0 * _cross(omega_parent, v_rel),
+        axis=axis_world,
+        s=q,
+        s_dot=rate,
+        s_ddot=accel,
     )

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from pinmech.exceptions import FrameNotFound, PinmechError
-from pinmech.display import colour_of, display_names, hex_colour, joint_colours
+from pinmech.display import colour_of, display_names, hex_colour
 from pinmech.plot_curves import BRANCH_STYLES, angles as _angles, branch_pieces, driver_axis as _driver_axis
 from pinmech.plot_curves import draw_markers, nearest as _nearest, spike_limits
 from pinmech.plot_paths import PathRecorder
@@ -144,9 +144,9 @@ class SweepPlot:
             self.points = [n for n, p in motion.points.items()
                            if p.link in mech.links and model.frames[mech.links[p.link]].parentJoint != 0]
         self.sliders = list(motion.sliders)
-        by_joint = joint_colours(mech)
         self.colours = {n: hex_colour(colour_of(mech, n)) for n in [*self.links, *self.points]}
-        self.colours.update({n: hex_colour(by_joint[mech.joint(n).id]) for n in self.sliders})
+        # a slider in the colour of its moving side (a tree joint's child, a loop cut's child link)
+        self.colours.update({n: hex_colour(colour_of(mech, s.child)) for n, s in motion.sliders.items()})
         # raw doubles, not lists of floats: the kept values would pin memory pools freed by the rest
         self.series = {title: {name: array("d") for name in names} for title, names in self._panels().items()}
 
@@ -182,8 +182,8 @@ class SweepPlot:
             columns.append([math.degrees(link.angle) for link in links])
         columns += [w, alpha]
         if self.sliders:
-            columns += [[m.joints[s].q for s in self.sliders], [m.joints[s].v for s in self.sliders],
-                        [m.joints[s].a for s in self.sliders]]
+            sliders = [m.sliders[name] for name in self.sliders]  # tree joints and cuts alike
+            columns += [[s.s for s in sliders], [s.s_dot for s in sliders], [s.s_ddot for s in sliders]]
         if self.points:
             columns += [[float(np.linalg.norm(m.points[p].velocity)) for p in self.points],
                         [float(np.linalg.norm(m.points[p].acceleration)) for p in self.points]]

@@ -49,6 +49,10 @@ def motion_dict(motion: Motion) -> dict[str, Any]:
                 "relative_velocity": _vec(s.relative_velocity),
                 "relative_acceleration": _vec(s.relative_acceleration),
                 "coriolis_acceleration": _vec(s.coriolis_acceleration),
+                "axis": _vec(s.axis),
+                "s": s.s,
+                "s_dot": s.s_dot,
+                "s_ddot": s.s_ddot,
             }
             for n, s in motion.sliders.items()
         },

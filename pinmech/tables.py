@@ -64,8 +64,8 @@ def row(sweep: Sweep, pose: SweepPose, width: int) -> list[object]:
     for p in m.points.values():
         v, a = p.velocity.tolist(), p.acceleration.tolist()
         out += p.position.tolist() + v + [math.hypot(*v)] + a + [math.hypot(*a)]
-    for name, s in m.sliders.items():
-        out += [m.joints[name].q, m.joints[name].v, m.joints[name].a, _norm(s.coriolis_acceleration)]
+    for s in m.sliders.values():
+        out += [s.s, s.s_dot, s.s_ddot, _norm(s.coriolis_acceleration)]
     out += design_of(sweep).cells(pose)
     acc = pose.accuracy
     beyond = " ".join(v.joint for v in limit_violations(sweep.mechanism, m))

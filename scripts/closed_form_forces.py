@@ -1,6 +1,7 @@
 """Planar dynamic force analysis by hand (Norton's matrix method), in pure numpy.
 
-The independent reference for pinmech's forces (tests/test_forces.py): the kinematics
+The independent reference for pinmech's forces (tests/test_forces.py, tests/test_cut_forces.py)
+for the slider-crank, the four-bar and the crank-and-slotted-lever (R-RTR): the kinematics
 come from the vector-loop closed forms of closed_form.py, and the forces from Newton's
 and Euler's laws written for each link separately, F = m a_G and M_G = I_G alpha, with
 one unknown per pin force component, the slider's normal force and moment and the driver
@@ -9,8 +10,9 @@ Shigley (Theory of Machines and Mechanisms, ch. 15) set it up. No Pinocchio, no 
 space, no constraint Jacobian.
 
 Notation: F_ij is the force link i exerts on link j (1 = ground, 2 = crank, 3 = coupler or
-connecting rod, 4 = rocker or piston); vectors are (x, y) in the world frame; moments and
-angular quantities are their z components.
+connecting rod, 4 = rocker or piston; for the R-RTR 2 = crank, 3 = block, 4 = guide);
+vectors are (x, y) in the world frame; moments and angular quantities are their z
+components.
 
 Run: python scripts/closed_form_forces.py   (the slider-crank of models/slider_crank_dynamic.urdf)
 """
@@ -162,6 +164,60 @@ def four_bar_forces(theta2: float, omega2: float, alpha2: float, a: float, b: fl
     eq.known(2, rocker.m, aG4, rocker.I, a4, rocker.m * g, np.zeros(2), couple=rocker_torque)
     x = eq.solve()
     return FourBarForces(float(x[8]), x[0:2], x[2:4], x[4:6], x[6:8])
+
+
+@dataclass(frozen=True)
+class RRTRForces:
+    """Driver torque T [N m] on the crank, the pin forces F12 (ground on crank at A), F23
+    (crank on block at B) and F14 (ground on guide at C) [N], and the block's push on the
+    guide: N34 [N] along n = k x u (u from C towards B) and the moment M34 [N m] about B."""
+
+    T: float
+    F12: np.ndarray
+    F23: np.ndarray
+    F14: np.ndarray
+    N34: float
+    M34: float
+
+
+def r_rtr_forces(phi: float, omega1: float, alpha1: float, crank: Body, block: Body, guide: Body,
+                 AB: float = 0.10, AC: float = 0.05, gravity=(0.0, 0.0)) -> RRTRForces:
+    """Inverse dynamics of the R-RTR (crank-and-slotted-lever) of closed_form.r_rtr: the
+    crank AB about A, its pin B carrying a block that slides along the guide, which turns
+    about C. The block turns with the guide; their contact is a normal force and a moment
+    (no friction), unknown at B.
+
+    Args:
+        phi, omega1, alpha1: crank angle [rad], rate [rad/s], acceleration [rad/s^2].
+        crank, block, guide: the bodies, in frames at A, B and C with x along A -> B,
+            along u and along u.
+        gravity: (g_x, g_y) [m/s^2].
+    """
+    k = cf.r_rtr(phi, omega1, alpha1, AB=AB, AC=AC)
+    phi3, w3, a3 = float(k.phi3), float(k.omega3), float(k.alpha3)
+    B, C, u = np.asarray(k.B, float), np.array([AC, 0.0]), np.asarray(k.u, float)
+    n = cf.perp(u)
+    g = np.asarray(gravity, float)
+    rho1, rho2, rho3 = crank.g_offset(phi), block.g_offset(phi3), guide.g_offset(phi3)
+    G1, G2, G3 = rho1, B + rho2, C + rho3
+    aG1 = _accel(np.zeros(2), alpha1, omega1, rho1)
+    aG2 = _accel(np.asarray(k.aB, float), a3, w3, rho2)  # the block is carried by the crank pin B
+    aG3 = _accel(np.zeros(2), a3, w3, rho3)
+    eq = _Equations(3, 9)  # unknowns: F12 (0, 1), F23 (2, 3), N34 (4), M34 (5), F14 (6, 7), T (8)
+    eq.force(0, 0, -G1)
+    eq.force(0, 2, B - G1, -1.0)
+    eq.A[2, 8] = 1.0
+    eq.known(0, crank.m, aG1, crank.I, alpha1, crank.m * g, np.zeros(2))
+    eq.force(1, 2, B - G2)
+    for link, sign, G in ((1, -1.0, G2), (2, 1.0, G3)):  # the block's push on the guide, and back
+        eq.A[3 * link : 3 * link + 2, 4] += sign * n
+        eq.A[3 * link + 2, 4] += sign * float(_cross_row(B - G) @ n)
+        eq.A[3 * link + 2, 5] += sign
+    eq.known(1, block.m, aG2, block.I, a3, block.m * g, np.zeros(2))
+    eq.force(2, 6, C - G3)
+    eq.known(2, guide.m, aG3, guide.I, a3, guide.m * g, np.zeros(2))
+    x = eq.solve()
+    return RRTRForces(float(x[8]), x[0:2], x[2:4], x[6:8], float(x[4]), float(x[5]))
 
 
 #: The bodies of models/slider_crank_dynamic.urdf and models/four_bar_dynamic.urdf.
