@@ -120,7 +120,29 @@ def sweep_options(scene: Scene) -> dict[str, Any]:
     if "start" in table and table["start"] not in STARTS:
         raise SceneError(f"must be one of {', '.join(STARTS)}, got {table['start']!r}", path=str(scene.path),
                          key="sweep.start")
+    _check_ranges(scene, table)
     return table
+
+
+#: The `[sweep]` numbers' ranges: the least value, and what it counts.
+_LEAST = {"steps": (2, "poses, both ends included"), "interpolate": (1, "(1: every pose solved)")}
+
+
+def _check_ranges(scene: Scene, table: dict[str, Any]) -> None:
+    """`[sweep]` values in range, blamed on the file and key (not on the flags that
+    would override them): steps >= 2, interpolate >= 1, a known scheme, a gain >= 0."""
+    from pinmech.path import SCHEMES  # here: sweeping needs no path integration
+
+    def bad(key: str, message: str) -> SceneError:
+        return SceneError(message, path=str(scene.path), key=f"sweep.{key}")
+
+    for key, (least, what) in _LEAST.items():
+        if key in table and table[key] < least:
+            raise bad(key, f"must be at least {least} {what}, got {table[key]}")
+    if "scheme" in table and table["scheme"] not in SCHEMES:
+        raise bad("scheme", f"must be one of {', '.join(SCHEMES)}, got {table['scheme']!r}")
+    if "gain" in table and not 0 <= table["gain"] < math.inf:
+        raise bad("gain", f"must be a number from 0 (open loop) up, in 1/s, got {table['gain']!r}")
 
 
 @dataclass

@@ -1,0 +1,95 @@
+"""Messages in the user's terms: every option that can come from a scene file or the
+command line names where it came from (the file and the key, or the flag) and ends with
+the exit code of its class (README, "Errors and exit codes": a scene's key is exit 4, a
+flag a usage error, exit 2); units are named as people write them, not as pint's root
+units; each file is called by its kind (URDF, MJCF, linkage file).
+
+Each case runs `pinmech.cli.main` and asserts the contract of an error: its exit code,
+one line on stderr naming the file (and key), no traceback.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from pinmech.cli import main
+from tests.conftest import MODELS, SCENES
+
+
+def _copy(scene: str, tmp_path: Path) -> Path:
+    """A bundled scene copied beside its model files' absolute paths (so it can be edited)."""
+    text = (SCENES / scene).read_text(encoding="utf-8")
+    for key in ("urdf", "mjcf", "linkage", "sidecar"):
+        text = text.replace(f'{key} = "../', f'{key} = "{MODELS}/')
+    out = tmp_path / scene
+    out.write_text(text, encoding="utf-8")
+    return out
+
+
+def _error(capsys, argv: list[str]) -> tuple[int, str]:
+    """Run the CLI; the exit code and the one line it printed on stderr."""
+    code = main(argv)
+    err = capsys.readouterr().err.strip()
+    assert "Traceback" not in err
+    assert len(err.splitlines()) == 1, err
+    return code, err
+
+
+# ------------------------------------------------------------------ [sweep] keys
+SWEEP_KEYS = [  # a [sweep] value, the key it must be blamed on, and words the message must hold
+    ("sweep.steps=1", "sweep.steps", "at least 2"),
+    ("sweep.interpolate=0", "sweep.interpolate", "at least 1"),
+    ('sweep.from="2 m"', "sweep.from", "angle"),
+    ('sweep.to="1"', "sweep.to", "no unit"),
+]
+
+
+@pytest.mark.parametrize(("override", "key", "words"), SWEEP_KEYS)
+def test_a_bad_sweep_key_of_the_scene_is_blamed_on_the_file_and_key(override, key, words, tmp_path, capsys):
+    """`[sweep] steps = 1` is the scene's mistake (exit 4, file and key), not `--steps`'s."""
+    scene = _copy("r_rtr.toml", tmp_path)
+    code, err = _error(capsys, ["sweep", str(scene), "--set", override])
+    assert code == 4, err
+    assert str(scene) in err and key in err and words in err, err
+    assert " --" not in err, err  # no flag is blamed for the file's value
+
+
+@pytest.mark.parametrize(("flags", "flag"), [(["--steps", "1"], "--steps"), (["--interpolate", "0"], "--interpolate"),
+                                             (["--from", "2 m"], "--from")])
+def test_a_bad_flag_is_blamed_on_the_flag(flags, flag, tmp_path, capsys):
+    """The same value given as a flag is a usage error naming the flag (2), or a unit
+    error naming it (4)."""
+    scene = _copy("r_rtr.toml", tmp_path)
+    code, err = _error(capsys, ["sweep", str(scene), *flags])
+    assert code in (2, 4) and flag in err and "sweep." not in err, err
+
+
+PATH_KEYS = [
+    ('sweep.scheme="rk5"', "sweep.scheme", "euler, taylor, rk4"),
+    ("sweep.gain=-1", "sweep.gain", "from 0"),
+    ('sweep.duration="-1 s"', "sweep.duration", "positive"),
+    ('sweep.step="1 s"', "sweep.step", "sweep.duration"),
+    ('sweep.duration="0 s"', "sweep.duration", "positive"),
+]
+
+
+@pytest.mark.parametrize("command", ["path", "sweep"])
+@pytest.mark.parametrize(("override", "key", "words"), PATH_KEYS)
+def test_a_bad_path_key_of_a_task_scene_is_a_scene_error(command, override, key, words, tmp_path, capsys):
+    """A misspelt `scheme` (or a negative gain, a step longer than the duration) in the
+    scene is exit 4 naming the file and the key; it was exit 8 (a task error) or 2 with
+    "--step" named."""
+    scene = _copy("planar_arm.toml", tmp_path)
+    code, err = _error(capsys, [command, str(scene), "--set", override, "--csv", str(tmp_path / "p.csv")])
+    assert code == 4, err
+    assert str(scene) in err and key in err and words in err, err
+    assert "--step" not in err and "--duration" not in err and "--gain" not in err, err
+
+
+def test_a_bad_flag_of_a_path_is_blamed_on_the_flag(tmp_path, capsys):
+    scene = _copy("planar_arm.toml", tmp_path)
+    code, err = _error(capsys, ["path", str(scene), "--step", "1 s", "--csv", str(tmp_path / "p.csv")])
+    assert code == 2 and "--step" in err and "sweep.step" not in err, err
