@@ -93,3 +93,10 @@ def test_a_bad_flag_of_a_path_is_blamed_on_the_flag(tmp_path, capsys):
     scene = _copy("planar_arm.toml", tmp_path)
     code, err = _error(capsys, ["path", str(scene), "--step", "1 s", "--csv", str(tmp_path / "p.csv")])
     assert code == 2 and "--step" in err and "sweep.step" not in err, err
+
+
+def test_a_misspelt_rates_method_is_a_scene_error(tmp_path, capsys):
+    """`[rates] method = "exactt"` is the scene's mistake: exit 4 naming rates.method (was 8)."""
+    scene = _copy("ur5.toml", tmp_path)
+    code, err = _error(capsys, ["solve", str(scene), "--set", 'rates.method="exactt"'])
+    assert code == 4 and str(scene) in err and "rates.method" in err and "least_squares" in err, err
