@@ -228,7 +228,7 @@ def _factor(text: str, unit: str, kind: str, where: str) -> float:
 
 #: Newton-metres written glued ("Nm", "kNm", "Nmm"): pint reads "Nm" as a "number meter"
 #: (dimension m/kg), never what is meant.
-_GLUED_TORQUE = re.compile(r"([kmMµu]?)Nm(m|cm)?")
+_GLUED_TORQUE = re.compile(r"([kmMµu]?)N(m|mm|cm)")
 #: Unit names pint reads otherwise than people mean, refused with what pint would read.
 _MISREAD = {"a": "a year (annum): write 'year' if a year is meant"}
 
@@ -239,7 +239,7 @@ def _refuse_misread(text: str, unit: str, kind: str, where: str) -> None:
     for token in re.split(r"\*\*|[*/^()\s]+", unit):
         glued = _GLUED_TORQUE.fullmatch(token)
         if glued and kind == "torque":
-            fixed = text.replace(token, f"{glued.group(1)}N*{glued.group(2) or 'm'}", 1).strip()
+            fixed = text.replace(token, f"{glued.group(1)}N*{glued.group(2)}", 1).strip()
             raise UnitError(f"{text!r}: write '{fixed}' (a torque in newton-metres is written N*m; pint reads "
                             "'Nm' as a count times a metre)", key=where)
         if token in _MISREAD:
