@@ -128,6 +128,15 @@ class AssemblyStructure:
             labels.append(self._dyad_label(b, data) if b.dyad is not None and data is not None else _sign_word(s))
         return Assembly(self.names, tuple(signs), tuple(labels))
 
+    def change(self, reference: tuple[int, ...], signs: tuple[int, ...], data: pin.Data | None = None,
+               whose: str = "the reference's") -> str:
+        """In words, a pose's assembly `signs` that differs from `reference`: which loops
+        changed, and both assemblies as reports print them (`data`: at the pose)."""
+        changed = [n for n, s, r in zip(self.names, signs, reference) if s != r] or list(self.names)
+        found, expected = self.assembly(signs, data).describe(), self.assembly(reference).describe()
+        return (f"the other assembly of loop{'s' if len(changed) > 1 else ''} {', '.join(changed)} "
+                f"({found}; {whose} is {expected})")
+
     def _dyad_label(self, b: Block, data: pin.Data) -> str:
         j1, k, j2 = b.dyad
         cut = self._closures[k]

@@ -100,3 +100,24 @@ def test_a_misspelt_rates_method_is_a_scene_error(tmp_path, capsys):
     scene = _copy("ur5.toml", tmp_path)
     code, err = _error(capsys, ["solve", str(scene), "--set", 'rates.method="exactt"'])
     assert code == 4 and str(scene) in err and "rates.method" in err and "least_squares" in err, err
+
+
+# ------------------------------------------------------------------ assemblies in words
+@pytest.mark.parametrize(("scene", "start", "steps"), [("four_bar.toml", "cold", 73), ("jansen.toml", "cold", 73),
+                                                       ("marghitu_slider_crank.toml", "warm", 7)])
+def test_a_start_landing_on_another_assembly_is_named_by_its_loops_not_sign_tuples(scene, start, steps, capsys):
+    """A cold or warm start that lands on the other assembly printed "((1,) instead of
+    (-1,))": now the loops whose assembly changed, and each assembly in the report's words."""
+    code, err = _error(capsys, ["sweep", str(SCENES / scene), "--start", start, "--steps", str(steps)])
+    assert code == 10, err
+    assert "instead of (" not in err and "(1,)" not in err and "(-1," not in err, err
+    assert "the other assembly of loop" in err and "the sweep's" in err, err
+
+
+def test_a_warm_start_landing_on_a_dead_centre_is_an_assembly_error_not_a_traceback(capsys):
+    """Warm starts along the Marghitu slider-crank at 5 deg steps land on a singular pose:
+    an internal exception escaped as a traceback; now a named error (singular pose, 7, or
+    no assembly to keep, 10) naming the driver value."""
+    code, err = _error(capsys, ["sweep", str(SCENES / "marghitu_slider_crank.toml"), "--start", "warm",
+                                "--steps", "73"])
+    assert code in (7, 10) and "singular" in err and "A = " in err, err
