@@ -157,13 +157,23 @@ def parse_assembly(asked: object, structure: AssemblyStructure) -> dict[str, int
     if not isinstance(asked, dict):
         raise ValueError(f'must be "any" or a table of loop = "+"/"-" (loops: {", ".join(structure.names)})')  # noqa: TRY004 (one-line reason for the scene error)
     out = {}
-    for name, word in asked.items():
+    for written, word in asked.items():
+        name = _block_name(written, structure.names)
         if name not in structure.names:
             raise ValueError(f"names no loop block '{name}' (blocks: {', '.join(structure.names) or 'none'})")
         if word not in SIGN_WORDS:
             raise ValueError(f"{name} = {word!r}: use one of {', '.join(map(repr, SIGN_WORDS))}")
         out[name] = SIGN_WORDS[word]
     return out
+
+
+def _block_name(written: str, names: tuple[str, ...]) -> str:
+    """A block's name as a scene writes it: a hyphen may stand for the en dash of a loop
+    named by two frames ("closedloop1_A-closedloop1_B", robot.yaml)."""
+    if written in names:
+        return written
+    dashed = written.replace("-", "\u2013")
+    return dashed if dashed in names else written
 
 
 def _sign_word(s: int) -> str:

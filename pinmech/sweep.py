@@ -145,6 +145,17 @@ def _check_ranges(scene: Scene, table: dict[str, Any]) -> None:
         raise bad("gain", f"must be a number from 0 (open loop) up, in 1/s, got {table['gain']!r}")
 
 
+def _no_drivers(mechanism: Mechanism) -> str:
+    """What to add to a scene without `[drivers]` to sweep it."""
+    motors = mechanism.motors
+    if motors:
+        tables = " and ".join(f"[drivers.{m}]" for m in motors)
+        return (f"has no [drivers] to sweep: add {tables} with their angle and speed (the motors the sidecar "
+                f"names, {', '.join(motors)}, drive a solve at rest, but a sweep needs the ones it moves)")
+    return ("has no [drivers] to sweep: add a [drivers.JOINT] table (angle, speed) for each joint the scene drives "
+            f"({mechanism.mobility} for this mechanism)")
+
+
 @dataclass
 class Sweep:
     """A scene set up for sweeping one of its drivers.
@@ -170,10 +181,12 @@ class Sweep:
                 `pinmech path`), or a driver that is not one of the scene's.
         """
         sweep_options(scene)
-        if "task" in scene.raw or not scene.section("drivers"):
+        if "task" in scene.raw:
             raise SceneError("has no [drivers] to sweep; a task scene ([[task]]) is followed in time: "
                              "pinmech path SCENE --duration ...", path=str(scene.path), key="drivers")
         mechanism = load_mechanism(scene)
+        if not scene.section("drivers"):
+            raise SceneError(_no_drivers(mechanism), path=str(scene.path), key="drivers")
         drivers = scene_drivers(scene, mechanism)
         check_scene_names(scene, mechanism)
         scene.names("sweep", "links"), scene.names("sweep", "points")  # lists of names, or a SceneError now
