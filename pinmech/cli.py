@@ -525,12 +525,17 @@ def _check_outputs(args: argparse.Namespace, scene) -> Path | None:
     return figure
 
 
+#: What each kind of model file is called in messages.
+_MODEL_FILES = {"urdf": "the URDF", "robot": "the URDF", "linkage": "the linkage file", "mjcf": "the MJCF file"}
+
+
 def _inputs(scene, hand: str | None = None) -> dict[str, Path]:
     """What a run reads, which no output may overwrite: the scene, its model file, a
     sidecar (robot.yaml) and a hand file."""
-    out = {"the scene file": scene.path, "the URDF": _urdf_path(scene)}
+    out = {"the scene file": scene.path, _MODEL_FILES.get(getattr(scene, "model_kind", ""), "the model file"):
+           _urdf_path(scene)}
     if "sidecar" in scene.raw:
-        out["the sidecar"] = scene.model_file("sidecar")
+        out["the sidecar (robot.yaml)"] = scene.model_file("sidecar")
     if hand:
         out["the hand file"] = Path(hand)
     return out

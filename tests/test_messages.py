@@ -121,3 +121,20 @@ def test_a_warm_start_landing_on_a_dead_centre_is_an_assembly_error_not_a_traceb
     code, err = _error(capsys, ["sweep", str(SCENES / "marghitu_slider_crank.toml"), "--start", "warm",
                                 "--steps", "73"])
     assert code in (7, 10) and "singular" in err and "A = " in err, err
+
+
+# ------------------------------------------------------------------ files called by their kind
+@pytest.mark.parametrize(("scene", "model", "kind"), [("four_bar_mjcf.toml", "mjcf/four_bar.xml", "the MJCF file"),
+                                                     ("four_bar_drawn.toml", "linkages/four_bar.toml",
+                                                      "the linkage file"),
+                                                     ("four_bar.toml", "four_bar.urdf", "the URDF")])
+@pytest.mark.parametrize("command", ["sweep", "snapshot"])
+def test_an_output_over_the_model_file_names_the_file_by_its_kind(scene, model, kind, command, tmp_path, capsys):
+    """An MJCF or linkage file about to be overwritten was called "the URDF"."""
+    shutil.copytree(MODELS, tmp_path / "models")
+    target = tmp_path / "models" / model
+    before = target.read_bytes()
+    flag = ["--csv", str(target)] if command == "sweep" else ["-o", str(target)]
+    code, err = _error(capsys, [command, str(tmp_path / "models" / "scenes" / scene), *flag])
+    assert code == 2 and f"would overwrite {kind}" in err, err
+    assert target.read_bytes() == before
