@@ -145,15 +145,16 @@ def _check_ranges(scene: Scene, table: dict[str, Any]) -> None:
         raise bad("gain", f"must be a number from 0 (open loop) up, in 1/s, got {table['gain']!r}")
 
 
-def _no_drivers(mechanism: Mechanism) -> str:
+def _no_drivers(mechanism: Mechanism, arm_pose: bool = False) -> str:
     """What to add to a scene without `[drivers]` to sweep it."""
     motors = mechanism.motors
     if motors:
         tables = " and ".join(f"[drivers.{m}]" for m in motors)
         return (f"has no [drivers] to sweep: add {tables} with their angle and speed (the motors the sidecar "
                 f"names, {', '.join(motors)}, drive a solve at rest, but a sweep needs the ones it moves)")
+    arm = "; or, for an arm held at its [pose], a [[task]] to follow in time (pinmech path)" if arm_pose else ""
     return ("has no [drivers] to sweep: add a [drivers.JOINT] table (angle, speed) for each joint the scene drives "
-            f"({mechanism.mobility} for this mechanism)")
+            f"({mechanism.mobility} for this mechanism){arm}")
 
 
 @dataclass
@@ -186,7 +187,7 @@ class Sweep:
                              "pinmech path SCENE --duration ...", path=str(scene.path), key="drivers")
         mechanism = load_mechanism(scene)
         if not scene.section("drivers"):
-            raise SceneError(_no_drivers(mechanism), path=str(scene.path), key="drivers")
+            raise SceneError(_no_drivers(mechanism, "pose" in scene.raw), path=str(scene.path), key="drivers")
         drivers = scene_drivers(scene, mechanism)
         check_scene_names(scene, mechanism)
         scene.names("sweep", "links"), scene.names("sweep", "points")  # lists of names, or a SceneError now

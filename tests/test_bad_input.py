@@ -293,7 +293,8 @@ def test_sweeping_a_scene_without_drivers(tmp_path, capsys):
     scene = tmp_path / "s.toml"
     scene.write_text(f'urdf = "{MODELS / "planar_arm.urdf"}"\n[pose]\nA = "10 deg"\n')
     code, err = _run(capsys, "sweep", scene, "--steps", "3")
-    assert code == 4 and "drivers" in err and "pinmech path" in err
+    # what to add: the drivers to sweep, or (an arm at its [pose]) a task to follow in time
+    assert code == 4 and "add a [drivers.JOINT]" in err and "[[task]]" in err and "pinmech path" in err
     _one_line_error(code, err, "s.toml")
 
 
