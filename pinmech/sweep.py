@@ -291,11 +291,12 @@ class Sweep:
             raise ModelError(f"values of {self.driver} must be numbers [{unit}], got {values!r:.80}",
                              path=self.mechanism.source)
         for index, value in enumerate(values):
+            cast = isinstance(value, (str, bytes, bool, np.bool_, complex, np.complexfloating))  # never cast
             try:
-                number = float(value)
+                number = math.nan if cast else float(value)
             except (TypeError, ValueError):
                 number = math.nan
-            if isinstance(value, (str, bytes, bool)) or not math.isfinite(number):
+            if not math.isfinite(number):
                 raise ModelError(f"value {index} of {self.driver} is {value!r:.40}, not a finite number [{unit}]",
                                  path=self.mechanism.source)
             yield number

@@ -425,9 +425,9 @@ def r_rtr_analysis():
     [
         (lambda q, v, a: (q[:2], v, a), r"q must be 5 finite numbers \(SI\), got shape \(2,\)"),
         (lambda q, v, a: (q.reshape(1, -1), v, a), r"q must be 5 finite numbers \(SI\), got shape \(1, 5\)"),
-        (lambda q, v, a: (q, ["x"] * 3, a), "v must be 3 numbers"),
+        (lambda q, v, a: (q, ["x"] * 3, a), "v must be real numbers .SI., got text"),
         (lambda q, v, a: (q, v, [0.0, float("nan"), 0.0]), "a must be 3 finite numbers.*non-finite"),
-        (lambda q, v, a: (q, v, "0 0 0"), "a must be 3"),
+        (lambda q, v, a: (q, v, "0 0 0"), "a must be real numbers .SI., got text"),
     ],
 )
 def test_evaluate_motion_names_a_wrong_argument(r_rtr_analysis, change, message):

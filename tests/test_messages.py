@@ -13,6 +13,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from pinmech.cli import main
@@ -138,3 +139,57 @@ def test_an_output_over_the_model_file_names_the_file_by_its_kind(scene, model, 
     code, err = _error(capsys, [command, str(tmp_path / "models" / "scenes" / scene), *flag])
     assert code == 2 and f"would overwrite {kind}" in err, err
     assert target.read_bytes() == before
+
+
+# ------------------------------------------------------------------ the API's numbers
+def _not_real(nq: int) -> list:
+    """Configurations that are not real numbers: complex, boolean (array and list), text."""
+    return [np.full(nq, 0.5 + 0.1j), np.zeros(nq, dtype=bool), [True] + [0.0] * (nq - 1), np.array(["0"] * nq)]
+
+
+def test_evaluate_motion_and_the_rate_solver_refuse_a_q_that_is_not_real():
+    """A complex q was cast to its real part (numpy's ComplexWarning only) and a boolean q
+    to 0 and 1, in silence: now a ModelError naming q and its type."""
+    from pinmech import Mechanism, RateSolver, Task, evaluate_motion
+    from pinmech.exceptions import ModelError
+
+    mech = Mechanism.from_urdf(MODELS / "planar_arm.urdf")
+    nq = mech.model.nq
+    solver = RateSolver(mech, [Task("D", ("x", "y"), np.array([1.0, 0.0]), np.zeros(2))])
+    for q in _not_real(nq):
+        with pytest.raises(ModelError, match=r"q must be real numbers"):
+            evaluate_motion(mech, mech.model.createData(), q, np.zeros(mech.model.nv), np.zeros(mech.model.nv))
+        with pytest.raises(ModelError, match=r"q must be real numbers"):
+            solver.solve(q)
+    with pytest.raises(ModelError, match=r"velocity must be real numbers"):
+        solver.solve(mech.neutral(), velocity=np.array([1.0 + 1j, 0.0]))
+
+
+def test_the_loop_solver_refuses_driver_values_guesses_and_q_that_are_not_real():
+    from pinmech import LoopSolver, Mechanism
+    from pinmech.exceptions import PinmechError
+
+    mech = Mechanism.from_urdf(MODELS / "four_bar.urdf")
+    solver = LoopSolver(mech, ["O2"])
+    for bad in ([True], np.array([0.5 + 0.5j]), [np.True_]):
+        with pytest.raises(PinmechError, match="real numbers"):
+            solver.solve(bad)
+    q = solver.solve([0.5]).q
+    for guess in _not_real(mech.model.nq):
+        with pytest.raises(PinmechError, match="real numbers"):
+            solver.solve([0.5], guess=guess)
+        with pytest.raises(PinmechError, match="real numbers"):
+            solver.rates(guess, [1.0], [0.0])
+    v, _, _ = solver.rates(q, [1.0], [0.0])  # a real q is still served
+    assert np.all(np.isfinite(v))
+
+
+def test_a_sweep_refuses_boolean_and_complex_driver_values():
+    from pinmech import Scene
+    from pinmech.exceptions import ModelError
+    from pinmech.sweep import Sweep
+
+    sweep = Sweep.from_scene(Scene.load(SCENES / "four_bar.toml"))
+    for values in ([0.1, True], [0.1, 0.2 + 0j], np.array([0.1, 0.2], dtype=complex)):
+        with pytest.raises(ModelError, match="not a finite number|real numbers"):
+            list(sweep.poses(values))
