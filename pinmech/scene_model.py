@@ -290,17 +290,18 @@ def report_lists(scene: Scene) -> tuple[list[str] | None, list[str] | None]:
     if unknown:
         raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))} in [report]; known: points, links, limits",
                          path=str(scene.path), key="report")
+    limit_mode(scene)  # a misspelt value is refused by every command, not only by those that warn
     return scene.names("report", "points"), scene.names("report", "links")
 
 
 def limit_mode(scene: Scene, asked: str | None = None) -> str:
     """What a joint beyond its URDF limits is: "warn" (default) or "error"; `asked` (the
     command line's --limits) overrides the scene's `[report] limits`."""
-    mode = asked or scene.section("report").get("limits", "warn")
+    mode = scene.section("report").get("limits", "warn")  # the scene's value checked even when overridden
     if mode not in ("warn", "error"):
         raise SceneError(f"limits must be \"warn\" or \"error\", got {mode!r}", path=str(scene.path),
                          key="report.limits")
-    return mode
+    return asked or mode
 
 
 def check_scene_names(scene: Scene, mechanism: Mechanism) -> None:

@@ -193,3 +193,60 @@ def test_a_sweep_refuses_boolean_and_complex_driver_values():
     for values in ([0.1, True], [0.1, 0.2 + 0j], np.array([0.1, 0.2], dtype=complex)):
         with pytest.raises(ModelError, match="not a finite number|real numbers"):
             list(sweep.poses(values))
+
+
+# ------------------------------------------------------------------ every subcommand, bad scene values
+def _argv(command: str, scene: Path, tmp_path: Path) -> list[str]:
+    out = {"snapshot": ["-o", str(tmp_path / "s.html")], "animate": ["-o", str(tmp_path / "a.html"), "--steps", "3"],
+           "polygon": ["-o", str(tmp_path / "p.svg")], "report": ["-o", str(tmp_path / "r.html"), "--steps", "0"],
+           "sweep": ["--steps", "3", "--csv", str(tmp_path / "s.csv")]}
+    return [command, str(scene), *out.get(command, [])]
+
+
+BAD_VALUES = [  # an override, the exit code of its class, and the key the message must name
+    ('drivers.A.angle="30 blorps"', 4, "drivers.A.angle"),
+    ('drivers.A.speed="2 rad/a"', 4, "drivers.A.speed"),
+    ('drivers.A.angle="1,5 deg"', 4, "drivers.A.angle"),
+    ('guess.NOPE="1 deg"', 4, "NOPE"),
+    ("bogus=1", 4, "bogus"),
+    ('assembly.C="left-ish"', 4, "assembly"),
+    ('report.limits="loud"', 4, "report.limits"),
+    ("solver.tol=1.0", 4, "solver.tol"),
+]
+
+
+@pytest.mark.parametrize("command", ["solve", "forces", "sweep", "snapshot", "animate", "polygon", "report", "view"])
+@pytest.mark.parametrize(("override", "code", "key"), BAD_VALUES)
+def test_every_subcommand_names_the_file_and_key_of_a_bad_scene_value(command, override, code, key, tmp_path, capsys):
+    """Each subcommand that reads a scene: the documented exit code, one line on stderr, no
+    traceback, the scene file and the key named; nothing written."""
+    scene = _copy("r_rtr.toml", tmp_path)
+    got, err = _error(capsys, [*_argv(command, scene, tmp_path), "--set", override])
+    assert got == code and str(scene) in err and key in err, err
+    assert not any(tmp_path.glob("*.html")) and not any(tmp_path.glob("*.svg"))
+
+
+@pytest.mark.parametrize(("override", "key"), [('pose.A="50 a"', "pose.A"), ('task.0.velocity=["1 Nm", "0 m/s"]', "task"),
+                                               ('rates.method="exactt"', "rates.method")])
+@pytest.mark.parametrize("command", ["path", "sweep", "solve"])
+def test_task_scene_commands_name_the_file_and_key(command, override, key, tmp_path, capsys):
+    scene = _copy("planar_arm.toml", tmp_path)
+    if command in ("path", "sweep") and key == "rates.method":
+        pytest.skip("following a task in time takes no [rates] method")
+    got, err = _error(capsys, [command, str(scene), "--set", override, "--csv", str(tmp_path / "p.csv")]
+                      if command != "solve" else [command, str(scene), "--set", override])
+    assert got == 4 and str(scene) in err and key in err, err
+
+
+@pytest.mark.parametrize(("entry", "key", "words"), [
+    ('quantity = "forces.drivers.O.effort"\nhand = "116.253"\nunit = "Nm"\nkind = "torque"', "value[0]", "N*m"),
+    ('quantity = "points.B.velocity.x"\nhand = "1.0"\nunit = "m/a"', "value[0]", "year"),
+])
+def test_check_names_the_hand_file_and_entry_of_a_unit_in_pints_words(entry, key, words, tmp_path, capsys):
+    """A hand file's unit "Nm" or "m/a": refused naming the hand file and its entry, in a
+    user's words (N*m; 'a' is a year to pint)."""
+    _copy("slider_crank_dynamic.toml", tmp_path)
+    hand = tmp_path / "h.toml"
+    hand.write_text(f'scene = "slider_crank_dynamic.toml"\n[[value]]\n{entry}\n', encoding="utf-8")
+    got, err = _error(capsys, ["check", str(hand)])
+    assert got == 4 and str(hand) in err and key in err and words in err, err
