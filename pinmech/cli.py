@@ -405,9 +405,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                         interpolate=interpolate, through_folds=args.through_folds)
     forces = _sweep_forces(args, scene, sweep)
     if forces is not None and interpolate and interpolate > 1:  # before any pose is computed
-        raise interpolating.error(f"= {interpolate} gives interpolated poses, but forces need solved ones: their "
-                                  "rates miss the loops' equations by the interpolation error (the power balance "
-                                  f"fails); sweep without {interpolating.name} for forces")
+        raise interpolating.error(f"{interpolate}: forces need solved poses, and interpolated ones' rates miss the "
+                                  "loops' equations by the interpolation error (the power balance fails); sweep "
+                                  f"without {interpolating.name} for forces")
     limits = _LimitWatch(limit_mode(scene, args.limits), "poses")
     sinks = _sweep_sinks(args, sweep, steps, figure, forces)
     with sinks:

@@ -787,8 +787,9 @@ class LoopSolver:
             values = [values.get(n, 0.0) for n in self.drivers]
         wrong = not_real(values)
         if wrong:
+            hint = ": convert quantities first, e.g. pinmech.to_si('30 deg', 'angle')" if wrong == "text" else ""
             raise UnitError(f"driver values of {', '.join(self.drivers)} must be real numbers in SI (rad or m), "
-                            f"got {wrong}: pinmech does not cast them")
+                            f"got {wrong}, which pinmech does not cast{hint}")
         try:
             out = np.asarray(values, dtype=float).reshape(-1)
         except (TypeError, ValueError):
