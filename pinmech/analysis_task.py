@@ -33,7 +33,7 @@ from pinmech.scene_model import (
     scene_guess,
 )
 from pinmech.solve_loops import DEFAULT_TOL, SOLVER_RANGES, LoopSolver
-from pinmech.solve_rates import COMPONENTS, DAMPING_RANGE, RateSolver, Task
+from pinmech.solve_rates import COMPONENTS, DAMPING_RANGE, METHODS, RateSolver, Task
 
 _ORDER_KINDS = {True: ("angular_velocity", "angular_acceleration"), False: ("velocity", "acceleration")}
 
@@ -128,6 +128,9 @@ def _rate_options(scene: Scene) -> dict[str, Any]:
         if number and not ranges[key][0] <= value <= ranges[key][1]:
             raise SceneError(f"rates.{key} = {value!r} is outside [{ranges[key][0]:g}, {ranges[key][1]:g}]",
                              path=str(scene.path), key=f"rates.{key}")
+        if not number and value not in METHODS:  # a scene's misspelling, not an inconsistent task (8)
+            raise SceneError(f"must be one of {', '.join(METHODS)}, got {value!r}", path=str(scene.path),
+                             key="rates.method")
     return dict(options)
 
 

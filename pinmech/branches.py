@@ -128,6 +128,15 @@ class AssemblyStructure:
             labels.append(self._dyad_label(b, data) if b.dyad is not None and data is not None else _sign_word(s))
         return Assembly(self.names, tuple(signs), tuple(labels))
 
+    def change(self, reference: tuple[int, ...], signs: tuple[int, ...], data: pin.Data | None = None,
+               whose: str = "the reference's") -> str:
+        """In words, a pose's assembly `signs` that differs from `reference`: which loops
+        changed, and both assemblies as reports print them (`data`: at the pose)."""
+        changed = [n for n, s, r in zip(self.names, signs, reference) if s != r] or list(self.names)
+        found, expected = self.assembly(signs, data).describe(), self.assembly(reference).describe()
+        return (f"the other assembly of loop{'s' if len(changed) > 1 else ''} {', '.join(changed)} "
+                f"({found}; {whose} is {expected})")
+
     def _dyad_label(self, b: Block, data: pin.Data) -> str:
         j1, k, j2 = b.dyad
         cut = self._closures[k]
@@ -148,13 +157,23 @@ def parse_assembly(asked: object, structure: AssemblyStructure) -> dict[str, int
     if not isinstance(asked, dict):
         raise ValueError(f'must be "any" or a table of loop = "+"/"-" (loops: {", ".join(structure.names)})')  # noqa: TRY004 (one-line reason for the scene error)
     out = {}
-    for name, word in asked.items():
+    for written, word in asked.items():
+        name = _block_name(written, structure.names)
         if name not in structure.names:
             raise ValueError(f"names no loop block '{name}' (blocks: {', '.join(structure.names) or 'none'})")
         if word not in SIGN_WORDS:
             raise ValueError(f"{name} = {word!r}: use one of {', '.join(map(repr, SIGN_WORDS))}")
         out[name] = SIGN_WORDS[word]
     return out
+
+
+def _block_name(written: str, names: tuple[str, ...]) -> str:
+    """A block's name as a scene writes it: a hyphen may stand for the en dash of a loop
+    named by two frames ("closedloop1_A-closedloop1_B", robot.yaml)."""
+    if written in names:
+        return written
+    dashed = written.replace("-", "\u2013")
+    return dashed if dashed in names else written
 
 
 def _sign_word(s: int) -> str:

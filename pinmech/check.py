@@ -65,6 +65,13 @@ _KINDS = {
 #: The kind of each number of a joint reaction (forces.reactions.B.force ...).
 _REACTION_KINDS = {"force": "force", "normal_force": "force", "axial_force": "force", "magnitude": "force",
                    "moment": "torque", "axial_moment": "torque", "point": "length", "angle": "angle"}
+#: Numbers of the result without a unit (counts, signs, ratios of the solver): no hand
+#: value of a unit measures them. Paths as (first key, last key); None: any.
+PURE_NUMBERS = {("assembly", "sign"), ("accuracy", None), ("route", "continuation_steps"),
+                ("task", "condition_number"), ("task", "rank"), ("task", "nullspace_dim"), ("task", "sigma_min"),
+                ("forces", "condition_number"), ("forces", "equation_residual"), ("forces", "residual")}
+#: The kind a path of pure numbers has for `_path_kind`.
+NUMBER = "pure number"
 #: A joint type of the result, as a key of JOINT_KINDS.
 _JOINT_FAMILIES = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
 
@@ -178,6 +185,10 @@ def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue
         raise SceneError(f"{quantity!r} is one component: give one printed value, or list x, y (, z) on {base!r}",
                          path=path, key=where)
     known, _ = _path_kind(base)
+    if known == NUMBER:
+        raise SceneError(f"{base!r} is a pure number of the solver (a sign, a count or a ratio, without unit), "
+                         f"not {_a(declared) if declared else 'a quantity'} with unit = {entry['unit']!r}: a hand "
+                         "file checks lengths, angles, their rates, forces and torques", path=path, key=where)
     kind = known or declared
     if not kind:
         raise SceneError(f"cannot tell the kind of {base!r}: add kind = \"angle\" (or length, velocity, ...)",
@@ -271,8 +282,12 @@ def _path_kind(quantity: str, result: dict[str, Any] | None = None) -> tuple[str
     prismatic)"), or None. A joint's coordinate (joints.B.q, drivers.B.v) and a driver's
     effort (forces.drivers.B.effort) are known from the joint's type in `result` only."""
     parts = quantity.split(".")
+    if (parts[0], parts[-1]) in PURE_NUMBERS or (parts[0], None) in PURE_NUMBERS:
+        return NUMBER, ""
     if len(parts) == 3 and parts[0] in ("joints", "drivers") and parts[2] in ("q", "v", "a"):
         joint, index = parts[1], "qva".index(parts[2])
+    elif len(parts) == 3 and parts[:2] == ["route", "from"]:  # the driver's value the pose was reached from
+        joint, index = parts[2], 0
     elif len(parts) == 4 and parts[:2] == ["forces", "drivers"] and parts[3] == "effort":
         joint, index = parts[2], None
     elif len(parts) == 4 and parts[:2] == ["forces", "reactions"]:
@@ -335,7 +350,12 @@ def compare(result: dict[str, Any], values: list[HandValue], slack: float = DEFA
     check_slack(slack)
     for hv in values:  # the kinds first: no verdict on a value read in the wrong unit
         expected, why = _path_kind(hv.quantity, result)
-        if expected is not None and expected != hv.kind:
+        if expected is None or expected == NUMBER:  # a declared kind is never taken on trust
+            lookup(result, hv.quantity, hv.component, where=hv.where, path=hv.file or None)  # a missing path first
+            what = "is a pure number of the solver (without unit)" if expected else "holds no quantity pinmech can name"
+            raise SceneError(f"{hv.quantity!r} {what}: it cannot be checked as {_a(hv.kind)} in {hv.unit!r}",
+                             path=hv.file or None, key=hv.where)
+        if expected != hv.kind:
             raise _misfit(hv, expected, hv.where, hv.kind, why)
     out = []
     for hv in values:

@@ -18,10 +18,10 @@ import signal
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pinmech import __version__
-from pinmech.exceptions import PinmechError
+from pinmech.exceptions import PinmechError, SceneError
 from pinmech.interrupts import SIGNALS
 
 if TYPE_CHECKING:
@@ -260,6 +260,44 @@ def _given(value: str | None, option: str) -> str | None:
     return value
 
 
+class _Option(NamedTuple):
+    """An option's value and where it came from: its flag, or the scene's `[sweep]` key
+    (`key` set), so that an error blames the one the user wrote."""
+
+    value: Any
+    flag: str
+    key: str | None
+    scene: Any
+
+    @property
+    def name(self) -> str:
+        """How the user wrote it: "--steps", or "sweep.steps"."""
+        return self.key or self.flag
+
+    def error(self, message: str) -> PinmechError:
+        """A usage error naming the flag (exit 2), or a scene error naming the file and key (4)."""
+        if self.key is None:
+            return PinmechError(f"{self.flag} {message}")
+        return SceneError(message, path=str(self.scene.path), key=self.key)
+
+    def quantity(self, kind: str) -> float:
+        """The value in SI; a unit error names the flag, or the file and key."""
+        if self.key is None:
+            from pinmech.units import to_si
+
+            return to_si(self.value, kind, where=self.flag)
+        return self.scene.quantity(self.value, kind, self.key)
+
+
+def _option(given: Any, flag: str, scene, options: dict[str, Any], key: str, default: Any = None) -> _Option:
+    """A flag's value if given, else the scene's `[sweep] key`, else `default`."""
+    if given is not None:
+        return _Option(given, flag, None, scene)
+    if key in options:
+        return _Option(options[key], flag, f"sweep.{key}", scene)
+    return _Option(default, flag, None, scene)
+
+
 def _scene(args: argparse.Namespace):
     from pinmech.scene import Scene
 
@@ -318,7 +356,7 @@ def _sweep_forces(args: argparse.Namespace, scene, sweep):
         return None
     from pinmech.forces_sweep import SweepForces
 
-    flywheel = scene.quantity(args.flywheel, "moment_of_inertia", "--flywheel") if args.flywheel else None
+    flywheel = _option(args.flywheel, "--flywheel", scene, {}, "").quantity("moment_of_inertia") if args.flywheel else None
     if flywheel is not None and not flywheel > 0:
         raise PinmechError(f"--flywheel must be positive, got {args.flywheel}")
     forces = SweepForces(sweep, static=args.static, minimum_norm=args.minimum_norm, flywheel=flywheel)
@@ -345,16 +383,16 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     if "task" in scene.raw:
         return _follow(args, scene)
     figure = _check_outputs(args, scene)
-    options = sweep_options(scene)
-    steps = args.steps if args.steps is not None else options.get("steps", 361)
+    options = sweep_options(scene)  # the scene's values checked there, naming the file and key
+    steps = _option(args.steps, "--steps", scene, options, "steps", 361).value
     if steps < 2:
         raise PinmechError(f"--steps must be at least 2, got {steps}")
     sweep = Sweep.from_scene(scene, args.driver)
     kind = "angle" if sweep.is_angular else "length"
-    first = _given(args.first, "--from") or options.get("from")
-    last = _given(args.last, "--to") or options.get("to")
-    start = scene.quantity(first, kind, "--from") if first else sweep.start
-    stop = scene.quantity(last, kind, "--to") if last else start + (sweep.default_values(2)[1] - sweep.start)
+    first = _option(_given(args.first, "--from"), "--from", scene, options, "from")
+    last = _option(_given(args.last, "--to"), "--to", scene, options, "to")
+    start = first.quantity(kind) if first.value else sweep.start
+    stop = last.quantity(kind) if last.value else start + (sweep.default_values(2)[1] - sweep.start)
     if args.tol is not None:
         from pinmech.scene import SOLVER_RANGES
 
@@ -368,15 +406,18 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             raise PinmechError(f"--max-iterations must be at least 1, got {args.max_iterations}")
         sweep.solver.max_iterations = args.max_iterations
     mode = "cold" if args.cold_start else "warm" if args.no_predictor else args.start_mode or options.get("start")
-    interpolate = args.interpolate if args.interpolate is not None else options.get("interpolate", 1)
+    interpolating = _option(args.interpolate, "--interpolate", scene, options, "interpolate", 1)
+    if interpolating.value < 1:
+        raise interpolating.error(f"must be at least 1 (1: every pose solved), got {interpolating.value}")
+    interpolate = interpolating.value
     poses = sweep.poses(DriverValues(start, stop, steps), skip_failures=args.skip_failures,
                         start=mode or "predictor", batch=not args.no_batch and options.get("batch", True),
                         interpolate=interpolate, through_folds=args.through_folds)
     forces = _sweep_forces(args, scene, sweep)
     if forces is not None and interpolate and interpolate > 1:  # before any pose is computed
-        raise PinmechError(f"forces need solved poses: --interpolate {interpolate} gives interpolated ones, whose "
-                           "rates miss the loops' equations by the interpolation error (the power balance fails); "
-                           "sweep without --interpolate for forces")
+        raise interpolating.error(f"{interpolate}: forces need solved poses, and interpolated ones' rates miss the "
+                                  "loops' equations by the interpolation error (the power balance fails); sweep "
+                                  f"without {interpolating.name} for forces")
     limits = _LimitWatch(limit_mode(scene, args.limits), "poses")
     sinks = _sweep_sinks(args, sweep, steps, figure, forces)
     with sinks:
@@ -510,12 +551,17 @@ def _check_outputs(args: argparse.Namespace, scene) -> Path | None:
     return figure
 
 
+#: What each kind of model file is called in messages.
+_MODEL_FILES = {"urdf": "the URDF", "robot": "the URDF", "linkage": "the linkage file", "mjcf": "the MJCF file"}
+
+
 def _inputs(scene, hand: str | None = None) -> dict[str, Path]:
     """What a run reads, which no output may overwrite: the scene, its model file, a
     sidecar (robot.yaml) and a hand file."""
-    out = {"the scene file": scene.path, "the URDF": _urdf_path(scene)}
+    out = {"the scene file": scene.path, _MODEL_FILES.get(getattr(scene, "model_kind", ""), "the model file"):
+           _urdf_path(scene)}
     if "sidecar" in scene.raw:
-        out["the sidecar"] = scene.model_file("sidecar")
+        out["the sidecar (robot.yaml)"] = scene.model_file("sidecar")
     if hand:
         out["the hand file"] = Path(hand)
     return out
@@ -554,7 +600,7 @@ def _follow(args: argparse.Namespace, scene) -> int:
     from pinmech.analysis_task import scene_pose, scene_tasks
     from pinmech.limits import limits_at
     from pinmech.outputs import Outputs
-    from pinmech.path import check_timing, follow_path, step_count
+    from pinmech.path import follow_path, step_count
     from pinmech.scene_model import limit_mode, load_mechanism
     from pinmech.sweep import sweep_options
     from pinmech.tables import PathCsv
@@ -563,19 +609,9 @@ def _follow(args: argparse.Namespace, scene) -> int:
         raise PinmechError(f"{scene.path}: no [[task]] to follow; a scene with [drivers] is swept: "
                            "pinmech sweep SCENE")
     figure = _check_outputs(args, scene)
-    options = sweep_options(scene)
-    duration_text = args.duration or options.get("duration")
-    if not duration_text:
-        raise PinmechError(f"{scene.path}: say how long to follow the task: --duration '0.08 s' "
-                           "(or [sweep] duration = \"0.08 s\")")
-    duration = scene.quantity(duration_text, "time", "--duration")
-    step = scene.quantity(args.step or options.get("step", "1 ms"), "time", "--step")
-    if not (duration > 0 and 0 < step <= duration):
-        raise PinmechError(f"need 0 < --step <= --duration, got step {step} s, duration {duration} s")
+    options = sweep_options(scene)  # the scene's scheme and gain checked there, naming the file and key
+    duration, step, gain = _timing(args, scene, options)
     scheme = args.scheme or options.get("scheme", "taylor")
-    gain = args.gain if args.gain is not None else float(options.get("gain", 0.0))
-    check_timing(duration, step, gain, names=("--duration", "--step", "--gain" if args.gain is not None
-                                              else f"{scene.path}: [sweep] gain"))
     mechanism = load_mechanism(scene)
     q0, _, _ = scene_pose(scene, mechanism)
     total = step_count(duration, step) + 1
@@ -600,6 +636,34 @@ def _follow(args: argparse.Namespace, scene) -> int:
     limits.summary(total)
     print(f"largest drift of the path from the one asked: {worst:.3e} m", file=sys.stderr)
     return 0
+
+
+def _timing(args: argparse.Namespace, scene, options: dict[str, Any]) -> tuple[float, float, float]:
+    """A path's duration and step [s] and feedback gain [1/s], each error blaming the flag
+    or the scene's key it came from."""
+    from pinmech.path import check_timing
+
+    duration = _option(_given(args.duration, "--duration"), "--duration", scene, options, "duration")
+    if not duration.value:
+        raise PinmechError(f"{scene.path}: say how long to follow the task: --duration '0.08 s' "
+                           "(or [sweep] duration = \"0.08 s\")")
+    step = _option(_given(args.step, "--step"), "--step", scene, options, "step", "1 ms")
+    gain = _option(args.gain, "--gain", scene, options, "gain", 0.0)
+    values = {}
+    for option in (duration, step):
+        values[option.flag] = option.quantity("time")
+        if not values[option.flag] > 0:
+            raise option.error(f"must be a positive time, got {option.value!r}")
+    T, h = values["--duration"], values["--step"]
+    if h > T:
+        blamed = duration if step.key and not duration.key else step  # the flag just typed, else the step
+        raise blamed.error(f"the step ({step.name} = {h:g} s) must not be longer than the duration "
+                           f"({duration.name} = {T:g} s)")
+    if not 0 <= gain.value <= 1 / h:
+        raise gain.error(f"must be a number from 0 to 1/step = {1 / h:.6g} [1/s] (a larger feedback overshoots "
+                         f"within one step), got {gain.value!r}")
+    check_timing(T, h, float(gain.value), names=(duration.name, step.name, gain.name))
+    return T, h, float(gain.value)
 
 
 _ARROW_COLOURS = {"velocity": (0.1, 0.2, 0.9), "acceleration": (0.9, 0.5, 0.0)}
@@ -658,8 +722,8 @@ def cmd_animate(args: argparse.Namespace) -> int:
     _check_page(args, scene)
     sweep = Sweep.from_scene(scene)
     kind = "angle" if sweep.is_angular else "length"
-    start = scene.quantity(args.start, kind, "--from") if _given(args.start, "--from") else sweep.start
-    stop = (scene.quantity(args.stop, kind, "--to") if _given(args.stop, "--to")
+    start = _option(args.start, "--from", scene, {}, "").quantity(kind) if _given(args.start, "--from") else sweep.start
+    stop = (_option(args.stop, "--to", scene, {}, "").quantity(kind) if _given(args.stop, "--to")
             else start + (sweep.default_values(2)[1] - sweep.start))
     if not 2 <= args.steps <= _MAX_FRAMES:
         raise PinmechError(f"--steps must be between 2 and {_MAX_FRAMES} frames (each is kept in the page), "

@@ -190,7 +190,7 @@ class Path:
         if new.signs != node.signs:
             small = abs(h) * self.unit <= BIFURCATION_STEP
             if not (small and turn < 0.1 * MAX_TURN):
-                return None, f"the assembly changed ({_signs(node.signs)} -> {_signs(new.signs)})"
+                return None, f"the assembly changed ({self._words(node.signs)} -> {self._words(new.signs)})"
         return new, ""
 
     def _trust(self, h: float) -> float:
@@ -236,7 +236,7 @@ class Path:
                     raise DriverLimitError(
                         f"{self.solver.mechanism.source}: the drivers cannot go past "
                         f"{self.solver.describe_drivers(x_fold)} (a fold: the loops do not close "
-                        f"beyond it on this assembly, {_signs(node.signs)}); asked for "
+                        f"beyond it on this assembly, {self._words(node.signs)}); asked for "
                         f"{self.solver.describe_drivers(self.drivers(p_target))}",
                         limit=tuple(x_fold.tolist()), drivers=self.solver.drivers)
                 route.folds.append(tuple(x_fold.tolist()))
@@ -258,7 +258,7 @@ class Path:
         if folded or landed.signs == start.signs:
             return landed
         raise self._stuck(start, f"the path comes within rounding of another assembly here and would land on it "
-                                 f"({_signs(start.signs)} -> {_signs(landed.signs)}): the two cannot be told apart")
+                                 f"({self._words(start.signs)} -> {self._words(landed.signs)}): the two cannot be told apart")
 
     def _land(self, curve: _Curve, a: _CurvePoint, b: _CurvePoint, p_target: float) -> Node:
         """The pose at p_target between two curve points that bracket it (p monotonic
@@ -299,11 +299,16 @@ class Path:
         except _Singular:
             return Node(point.p, point.q, np.zeros(self.solver.model.nv), np.zeros(self.solver.model.nv), (), math.inf)
 
+    def _words(self, signs: tuple[int, ...]) -> str:
+        """An assembly as reports print it, loop by loop ("B: +"), not a bare sign tuple."""
+        return self.solver.structure.assembly(signs).describe()
+
     def _stuck(self, node: Node, why: str) -> PinmechError:
         x = self.solver.describe_drivers(self.drivers(node.p))
         return AssemblyError(
             f"{self.solver.mechanism.source}: cannot go on from {x} without leaving the assembly "
-            f"{_signs(node.signs)}: {why}", expected=node.signs, found=(), drivers=self.solver.drivers,
+            f"{self.solver.structure.assembly(node.signs).describe()}: {why}", expected=node.signs, found=(),
+            drivers=self.solver.drivers,
             value=tuple(self.drivers(node.p).tolist()))
 
 
@@ -462,8 +467,3 @@ class _Curve:
             else:
                 b = mid
         return a if abs(a.dp) < abs(b.dp) else b
-
-
-def _signs(signs: tuple[int, ...]) -> str:
-    return "(" + ", ".join("+" if s > 0 else "-" if s < 0 else "0" for s in signs) + ")"
-

@@ -381,6 +381,9 @@ def _slot(linkage: Linkage, reader: _Reader, name: str, spec: Any) -> None:
                          element=where)
     at = linkage.points[name]
     block = f"{name}_block"
+    if block in linkage.links:  # it was replaced by the block, in silence
+        raise ModelError(f"link '{block}' has the name pinmech gives slot {name}'s block (a hidden link): rename "
+                         "the link", path=linkage.source, element=f"[links] {block}")
     linkage.links[block] = [name]
     linkage.hidden.add(block)
     linkage.edges.append(Edge(f"{name}_pin", "revolute", (pin_link, block), at))
@@ -406,6 +409,22 @@ def _check_names(linkage: Linkage) -> None:
     for link, names in linkage.links.items():
         if link != GROUND and not names:
             raise ModelError("lists no joint", path=linkage.source, element=f"[links] {link}")
+    for name, what in _generated_names(linkage).items():
+        if name in seen:
+            raise ModelError(f"{seen[name]} '{name}' has the name pinmech gives {what} in the URDF it writes: "
+                             f"rename the {seen[name]}", path=linkage.source)
+
+
+def _generated_names(linkage: Linkage) -> dict[str, str]:
+    """URDF names pinmech makes up (a point's fixed joint, a ball's hinges and the links
+    between them), with what each names: a user's name equal to one would make two URDF
+    elements of one name (Pinocchio then refuses the generated file)."""
+    out = {f"point_{p}": f"point {p}'s fixed joint" for p in linkage.point_links}
+    for edge in linkage.edges:
+        if edge.kind == "spherical":
+            out.update({f"{edge.name}_{x}": f"ball {edge.name}'s hinge about {x}" for x in "xyz"})
+            out.update({f"{edge.name}_r{x}": f"ball {edge.name}'s link between hinges" for x in "xy"})
+    return out
 
 
 # ------------------------------------------------------------------------- loading
@@ -455,8 +474,9 @@ def load_linkage(path: str | Path, *, locked: dict[str, float] | None = None):
     def built(held: dict[str, float] | None):
         try:
             mech = Mechanism.from_urdf(urdf, locked=held, reference=reference)
-        except ModelError as exc:  # name the user's file, not the generated one
-            raise ModelError(str(exc).replace(str(urdf), str(path)), path=None) from exc
+        except ModelError as exc:  # pinmech's own URDF refused: say so, never "the user's file is no URDF"
+            said = str(exc).replace(f"{urdf}: ", "").replace(str(urdf), "it")
+            raise ModelError(f"the URDF pinmech generated from it ({urdf}) is refused: {said}", path=str(path)) from exc
         mech.source, mech.urdf_path = str(path), str(urdf)
         mech.mass_source = "mass under the linkage's [masses]"
         mech.massless_links = tuple(n for n in mech.links if n not in linkage.links or n in linkage.hidden)

@@ -474,7 +474,10 @@ class Mechanism:
 def checked_numbers(x: Any, shape: tuple[int | None, ...], name: str, source: str) -> np.ndarray:
     """x as a float array of `shape` (None: any length) of finite numbers, else a
     ModelError naming the argument and what it got. The one check of a vector argument
-    (q, v, a) of the Python API."""
+    (q, v, a) of the Python API: complex, boolean or text values are refused, never cast."""
+    wrong = not_real(x)
+    if wrong:
+        raise ModelError(f"{name} must be real numbers (SI), got {wrong}: pinmech does not cast them", path=source)
     try:
         out = np.asarray(x, dtype=float)
     except (TypeError, ValueError):
@@ -484,6 +487,32 @@ def checked_numbers(x: Any, shape: tuple[int | None, ...], name: str, source: st
         raise ModelError(f"{name} must be {_shape_words(shape)} finite numbers (SI), got shape {out.shape}"
                          + ("" if not right else " with a non-finite number"), path=source)
     return out
+
+
+_NOT_REAL = {"b": "booleans", "c": "complex numbers", "U": "text", "S": "text", "M": "dates", "m": "time spans"}
+
+
+def not_real(x: Any) -> str:
+    """What in `x` (an array, a list of numbers or of rows) is not a real number, numpy
+    would cast in silence (a complex's imaginary part dropped, True read as 1): "booleans",
+    "complex numbers", "text"; "" when it holds real numbers (or is no array at all)."""
+    if isinstance(x, np.ndarray) and x.dtype.kind in "fiu":
+        return ""
+    try:
+        kind = np.asarray(x).dtype.kind
+    except (TypeError, ValueError):
+        return ""  # ragged or odd: the conversion that follows names it
+    if kind in _NOT_REAL:
+        return _NOT_REAL[kind]
+    items = x.tolist() if isinstance(x, np.ndarray) else x
+    rows = items if isinstance(items, (list, tuple)) else [items]
+    for row in rows:
+        for v in row if isinstance(row, (list, tuple, np.ndarray)) else [row]:
+            if isinstance(v, (bool, np.bool_)):
+                return "booleans"
+            if isinstance(v, (complex, np.complexfloating)):
+                return "complex numbers"
+    return ""
 
 
 def _shape_words(shape: tuple[int | None, ...]) -> str:

@@ -176,3 +176,33 @@ def idle_joints(mech, drivers: list[str], q: np.ndarray | None) -> list[str]:
         if name not in names:
             names.append(name)
     return names
+
+
+def moving_joints(mech, drivers: list[str], q: np.ndarray | None) -> list[str]:
+    """Joints that move, with every driver held, in motions that carry some joint's
+    origin along: the mechanism itself still moves (a freedom left undriven). Largest
+    share first; [] when the only free motions turn links about axes through their joints
+    (a rod spinning about its own axis: an idle freedom, `idle_joints`)."""
+    if q is None:
+        return []
+    model, data = mech.model, mech.model.createData()
+    scale = mech.velocity_scale()
+    J = stacked_jacobian(mech, data, q, scale)  # also leaves the joint Jacobians at q in data
+    held = {mech.joints[n].idx_v for n in drivers if n in mech.joints}
+    free = [i for i in range(model.nv) if i not in held]
+    null = _null_space(J[:, free])
+    if null.shape[1] == 0:
+        return []
+    origins = np.vstack([pin.getJointJacobian(model, data, jid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)[:3]
+                         for jid in range(1, model.njoints)]) * scale / mech.length_scale
+    _, s, Wt = np.linalg.svd(origins[:, free] @ null)  # joint-origin speeds per unit free motion
+    moving = null @ Wt[: int(np.sum(s > RANK_TOL * max(1.0, float(s[0]) if s.size else 0.0)))].T
+    if moving.shape[1] == 0:
+        return []
+    share: dict[str, float] = {}
+    for joint in mech.joints.values():
+        cols = [k for k, i in enumerate(free) if joint.idx_v <= i < joint.idx_v + joint.nv]
+        if cols:
+            share[joint.name] = float(np.linalg.norm(moving[cols]))
+    top = max(share.values(), default=0.0)
+    return sorted((n for n, x in share.items() if x > 1e-6 * top), key=lambda n: -share[n])

@@ -221,15 +221,8 @@ def to_text(analysis: Analysis) -> str:
         t.head("Joint limits")
         t.lines += [f"  WARNING: {v.describe()}" for v in violations]
     _assembly_lines(t, analysis)
-    acc = analysis.solution.accuracy
     t.head("Accuracy")
-    t.lines.append(
-        f"  closure residual {acc.residual:.2g} (of each loop's size; the largest loop spans {analysis.mechanism.length_scale:.4g} m), "
-        f"{acc.iterations} Newton iterations, "
-        f"condition number {acc.condition:.4g} "
-        "(worst-case relative error about {:.0e} in positions, {:.0e} in velocities, {:.0e} in "
-        "accelerations)".format(*(max(b, 1e-16) for b in acc.error_bounds))
-    )
+    t.lines.append(_accuracy_line(analysis))
     for line in (analysis.extra or {}).get("_text", []):
         t.lines.append(line)
     if _has_design(analysis):
@@ -237,6 +230,21 @@ def to_text(analysis: Analysis) -> str:
 
         t.lines += design_lines(scene_design(analysis))
     return "\n".join(t.lines) + "\n"
+
+
+def _accuracy_line(analysis: Analysis) -> str:
+    """The closure residual and Newton iterations of a mechanism with loops (an open chain
+    has neither: its pose is the scene's), the condition number and the error bounds."""
+    acc = analysis.solution.accuracy
+    if analysis.mechanism.closures:
+        closure = (f"closure residual {acc.residual:.2g} (of each loop's size; the largest loop spans "
+                   f"{analysis.mechanism.length_scale:.4g} m), {acc.iterations} Newton iterations, ")
+    else:
+        closure = "an open chain (no loop to close: the pose is the scene's), "
+    bounds = (max(b, 1e-16) for b in acc.error_bounds)
+    return (f"  {closure}condition number {acc.condition:.4g} "
+            "(worst-case relative error about {:.0e} in positions, {:.0e} in velocities, {:.0e} in "
+            "accelerations)".format(*bounds))
 
 
 def _assembly_lines(t: _Text, analysis: Analysis) -> None:
@@ -252,7 +260,7 @@ def _assembly_lines(t: _Text, analysis: Analysis) -> None:
     if route is not None:
         start = ", ".join(f"{n} = {_angle_or_length(analysis, n, x)}" for n, x in zip(analysis.drivers.names, route.start))
         if route.steps == 0:
-            t.lines.append(f"  the scene's own pose ({start}), closed from its [guess]")
+            t.lines.append(f"  the scene's own pose ({start}), closed from {_closed_from(analysis)}")
         else:
             t.lines.append(f"  reached from the scene's pose ({start}) by continuation, {route.steps} steps")
         for x in route.change_points:
@@ -263,6 +271,15 @@ def _assembly_lines(t: _Text, analysis: Analysis) -> None:
                  else "was found from the neutral configuration")
         t.lines.append(f"  the scene has no [guess]: this assembly {found}; pin it with [guess] or "
                        f"{sol.assembly.pin_hint()}")
+
+
+def _closed_from(analysis: Analysis) -> str:
+    """Where the loops of the scene's own pose were closed from."""
+    if analysis.scene.section("guess"):
+        return "its [guess]"
+    if analysis.mechanism.reference is not None:
+        return "the pose as drawn (the model file's)"
+    return "the neutral configuration (every joint at 0)"
 
 
 def _angle_or_length(analysis: Analysis, name: str, q: float) -> str:

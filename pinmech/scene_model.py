@@ -8,6 +8,7 @@ Everything here is parsed and checked once, at the edge, before anything is solv
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -108,55 +109,22 @@ def _scene_joint(scene: Scene, mechanism: Mechanism, name: str, key: str):
 
 
 def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
-    """The `[drivers]` table in SI units, checked against the model's joints."""
+    """The `[drivers]` table in SI units, checked against the model's joints. A sidecar's
+    motors (robot.yaml's name_mot) drive a scene whose file has no `[drivers]`, at the
+    reference pose and at rest; a `--set` on some of them keeps the others so."""
     table = scene.driver_table()
-    if not table and mechanism.motors:  # a sidecar's motors, at the reference pose, at rest
-        reference = mechanism.neutral()
-        table = {name: {"angle" if mechanism.joint(name).kind != "prismatic" else "position": 0.0}
-                 for name in mechanism.motors}
-        values = [[mechanism.coordinate(reference, name), 0.0, 0.0] for name in mechanism.motors]
-        if len(values) == mechanism.mobility:
-            arr = np.array(values, dtype=float).reshape(-1, 3)
-            return Drivers(tuple(mechanism.motors), arr[:, 0].copy(), arr[:, 1].copy(), arr[:, 2].copy())
-    names, values = [], []
+    rows = _default_motors(scene, mechanism, table)
     for name, spec in table.items():
-        if name in mechanism.locked:
-            raise SceneError(f"joint '{name}' is both driven and locked", path=str(scene.path), key=f"drivers.{name}")
-        joint = _scene_joint(scene, mechanism, name, "drivers")
-        if name in mechanism.mimics:
-            leader = mechanism.mimics[name].leader
-            raise SceneError(f"joint '{name}' follows '{leader}' (URDF <mimic>): drive {leader} instead",
-                             path=str(scene.path), key=f"drivers.{name}")
-        row = [0.0, 0.0, 0.0]
-        given = [False, False, False]
-        for key, value in spec.items():
-            order = Scene.driver_order(key)
-            if given[order]:
-                raise SceneError(f"{key} repeats another key of the same order", path=str(scene.path), key=f"drivers.{name}")
-            row[order] = scene.joint_quantity(value, joint.kind, order, "drivers", name, key)
-            given[order] = True
-        if not given[0]:
-            raise SceneError("missing its angle (or position)", path=str(scene.path), key=f"drivers.{name}")
-        names.append(name)
-        values.append(row)
+        rows[name] = _driver_row(scene, mechanism, name, spec)
+    names = list(rows)
     if len(names) != mechanism.mobility:
-        given = ", ".join(names) or "none"
-        idle = ""
-        if len(names) < mechanism.mobility:
-            free = mechanism.idle_joints(names)
-            if free:
-                single = [n for n in free if n in mechanism.joints and mechanism.joints[n].nv == 1]
-                advice = (f"lock it where it stands ({_lock_lines(mechanism, single)}) or drive it"
-                          if len(single) == len(free) else
-                          "a ball joint cannot be locked by one value: give it two hinges across the rod instead "
-                          "(a universal joint), or lock or drive a one-freedom joint")
-                idle = (f"; with those held, {', '.join(free)} can still move (a joint spinning freely, as a rod "
-                        f"about its own axis): {advice}")
         raise MobilityError(f"{scene.path}, drivers: {mechanism.source} has mobility {mechanism.mobility} "
                             f"({mechanism.model.nv} joint freedoms, {mechanism.rank_report().rank} independent "
-                            f"closure equations): drive that many joints; the scene drives {len(names)} ({given})"
-                            f"{idle}", mobility=mechanism.mobility, drivers=len(names))
-    arr = np.array(values, dtype=float).reshape(-1, 3)
+                            f"closure equations): drive that many joints; the scene drives {len(names)} "
+                            f"({', '.join(names) or 'none'}){_still_free(mechanism, names)}"
+                            f"{_motors_note(scene, mechanism, table)}",
+                            mobility=mechanism.mobility, drivers=len(names))
+    arr = np.array(list(rows.values()), dtype=float).reshape(-1, 3)
     return Drivers(tuple(names), arr[:, 0].copy(), arr[:, 1].copy(), arr[:, 2].copy())
 
 
@@ -169,6 +137,79 @@ def _lock_lines(mechanism: Mechanism, names: list[str]) -> str:
         said = f"{np.degrees(value):.6g} deg" if mechanism.joints[name].is_angular else f"{value * 1e3:.6g} mm"
         lines.append(f'[lock] {name} = "{said}"')
     return "; ".join(lines)
+
+
+def _file_has_drivers(scene: Scene) -> bool:
+    return bool((scene.raw if scene.base is None else scene.base).get("drivers"))
+
+
+def _default_motors(scene: Scene, mechanism: Mechanism, table: dict[str, Any]) -> dict[str, list[float]]:
+    """The sidecar's motors at the reference pose, at rest [rad or m], that drive besides
+    the table: all of them when the scene file has no `[drivers]` and the table (from
+    `--set`) names motors only; none otherwise."""
+    motors = mechanism.motors
+    if not motors or _file_has_drivers(scene) or not set(table) <= set(motors):
+        return {}
+    reference = mechanism.neutral()
+    return {name: [mechanism.coordinate(reference, name), 0.0, 0.0] for name in motors}
+
+
+def _driver_row(scene: Scene, mechanism: Mechanism, name: str, spec: dict[str, Any]) -> list[float]:
+    """One `[drivers.NAME]` table as [q, v, a] in SI."""
+    if name in mechanism.locked:
+        raise SceneError(f"joint '{name}' is both driven and locked", path=str(scene.path), key=f"drivers.{name}")
+    joint = _scene_joint(scene, mechanism, name, "drivers")
+    if name in mechanism.mimics:
+        leader = mechanism.mimics[name].leader
+        raise SceneError(f"joint '{name}' follows '{leader}' (URDF <mimic>): drive {leader} instead",
+                         path=str(scene.path), key=f"drivers.{name}")
+    row = [0.0, 0.0, 0.0]
+    given = [False, False, False]
+    for key, value in spec.items():
+        order = Scene.driver_order(key)
+        if given[order]:
+            raise SceneError(f"{key} repeats another key of the same order", path=str(scene.path), key=f"drivers.{name}")
+        row[order] = scene.joint_quantity(value, joint.kind, order, "drivers", name, key)
+        given[order] = True
+    if not given[0]:
+        raise SceneError("missing its angle (or position)", path=str(scene.path), key=f"drivers.{name}")
+    return row
+
+
+def _still_free(mechanism: Mechanism, names: list[str]) -> str:
+    """What still moves with too few drivers held: the mechanism (an undriven freedom), or
+    a joint spinning on its own (a rod about its own axis)."""
+    if len(names) >= mechanism.mobility:
+        return ""
+    from pinmech.mobility import moving_joints
+
+    missing = mechanism.mobility - len(names)
+    moving = moving_joints(mechanism, names, mechanism.rank_report().q)
+    if moving:
+        first = next((m for m in mechanism.motors if m in moving), moving[0])
+        more = "one more joint" if missing == 1 else f"{missing} more joints"
+        held = "with those held" if names else "with no joint driven"
+        return (f"; {held}, the mechanism still moves ({', '.join(moving)} move together): drive {more}, "
+                f"e.g. {first}")
+    free = mechanism.idle_joints(names)
+    if not free:
+        return ""
+    single = [n for n in free if n in mechanism.joints and mechanism.joints[n].nv == 1]
+    advice = (f"lock it where it stands ({_lock_lines(mechanism, single)}) or drive it" if len(single) == len(free) else
+              "a ball joint cannot be locked by one value: give it two hinges across the rod instead "
+              "(a universal joint), or lock or drive a one-freedom joint")
+    return (f"; with those held, {', '.join(free)} can still turn on its own, moving no joint's centre (as a rod "
+            f"spinning about its own axis): {advice}")
+
+
+def _motors_note(scene: Scene, mechanism: Mechanism, table: dict[str, Any]) -> str:
+    """Why a sidecar's motors are not among the drivers, when the scene file names none."""
+    if not mechanism.motors or _file_has_drivers(scene) or set(table) <= set(mechanism.motors):
+        return ""
+    others = ", ".join(n for n in table if n not in mechanism.motors)
+    return (f" ({Path(scene.raw['sidecar']).name}'s motors {', '.join(mechanism.motors)} drive a scene without "
+            f"[drivers], and a --set on one of them keeps the others; {others} is not a motor, so the drivers "
+            "are the ones set)")
 
 
 def scene_guess(scene: Scene, mechanism: Mechanism) -> np.ndarray:
@@ -260,17 +301,18 @@ def report_lists(scene: Scene) -> tuple[list[str] | None, list[str] | None]:
     if unknown:
         raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))} in [report]; known: points, links, limits",
                          path=str(scene.path), key="report")
+    limit_mode(scene)  # a misspelt value is refused by every command, not only by those that warn
     return scene.names("report", "points"), scene.names("report", "links")
 
 
 def limit_mode(scene: Scene, asked: str | None = None) -> str:
     """What a joint beyond its URDF limits is: "warn" (default) or "error"; `asked` (the
     command line's --limits) overrides the scene's `[report] limits`."""
-    mode = asked or scene.section("report").get("limits", "warn")
+    mode = scene.section("report").get("limits", "warn")  # the scene's value checked even when overridden
     if mode not in ("warn", "error"):
         raise SceneError(f"limits must be \"warn\" or \"error\", got {mode!r}", path=str(scene.path),
                          key="report.limits")
-    return mode
+    return asked or mode
 
 
 def check_scene_names(scene: Scene, mechanism: Mechanism) -> None:

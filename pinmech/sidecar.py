@@ -8,7 +8,8 @@ The format of example-parallel-robots / toolbox-parallel-robots (arXiv 2504.0476
     joint_name: ['elbow']                                # optional: joints to change...
     joint_type: ['CARDAN']                               # ...into SPHERICAL, CARDAN (RX then RY) or FIXED
 
-Each pair becomes a loop cut between the two frames (3d: spherical, 6d: fixed), built as
+Each pair becomes a loop cut between the two frames (3d: spherical, 6d: fixed), named by
+them with an en dash ("closedloop1_A–closedloop1_B"; an `assembly` table may write a hyphen), built as
 Pinocchio `RigidConstraintModel`s exactly as Gepetto's loader does, then handed to
 `Mechanism.from_model`. A missing `type` entry means 6d, as there.
 """
@@ -120,7 +121,7 @@ def load_extended_urdf(urdf: str | Path, sidecar: str | Path, *,
         contact = pin.ContactType.CONTACT_3D if kind == "3d" else pin.ContactType.CONTACT_6D
         constraints.append(pin.RigidConstraintModel(contact, model, fa.parentJoint, fa.placement, fb.parentJoint,
                                                     fb.placement, pin.ReferenceFrame.LOCAL))
-        names.append(f"{a}C{b}")
+        names.append(f"{a}\u2013{b}")  # "closedloop1_A–closedloop1_B": an en dash between the two frames
     points = [n for n in _point_links(root) if frame_named(model, n, source=str(urdf)) is not None]
     mech = Mechanism.from_model(model, constraints, names=names, points=points, source=str(urdf),
                                 urdf_path=str(urdf), locked=locked)

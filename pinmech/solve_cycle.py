@@ -76,6 +76,9 @@ _SAFE_RATE = 1e100
 _FAILURES = (LoopClosureError, SingularPoseError, AssemblyError, DriverLimitError)
 
 
+_SWEEPS = "the sweep's"  # the assembly a sweep keeps, in messages
+
+
 @dataclass(frozen=True)
 class RangeChunk:
     """Consecutive poses of a range, as arrays.
@@ -431,11 +434,18 @@ class _Cycle:
         guess = ref.q if self.start == "warm" else self._cold_guess()
         self.q_drv[self.k] = p
         q, self._iterations, _ = solver.close(guess, self.q_drv)
-        new = path.node(p, q, at_q=True) if solver._cuts else path.node(p, q)
+        try:
+            new = path.node(p, q, at_q=True) if solver._cuts else path.node(p, q)
+        except _Singular:  # a dead centre: no assembly to name (it escaped as a traceback)
+            raise AssemblyError(
+                f"{solver.mechanism.source}: a {self.start} start at {solver.describe_drivers(self.q_drv)} lands on "
+                "a singular pose (a dead centre, where no assembly can be told): use the predictor start",
+                expected=ref.signs, found=(), drivers=solver.drivers, value=tuple(self.q_drv.tolist())) from None
         if ref.signs and new.signs != ref.signs:
             raise AssemblyError(
                 f"{solver.mechanism.source}: a {self.start} start at {solver.describe_drivers(self.q_drv)} "
-                f"lands on another assembly ({new.signs} instead of {ref.signs}): use the predictor start",
+                f"lands on {solver.structure.change(ref.signs, new.signs, solver.data, whose=_SWEEPS)}: use the "
+                "predictor start",
                 expected=ref.signs, found=new.signs, drivers=solver.drivers, value=tuple(self.q_drv.tolist()))
         return new
 

@@ -33,7 +33,7 @@ from pinmech.exceptions import (
     SingularPoseError,
     UnitError,
 )
-from pinmech.mechanism import Mechanism
+from pinmech.mechanism import Mechanism, not_real
 from pinmech.results import Accuracy, LoopSolution
 
 #: Default closure tolerance (dimensionless: metres per metre of mechanism, or radians).
@@ -559,6 +559,8 @@ class LoopSolver:
                 scales it), with how far apart each cut is [m, deg].
             SingularPoseError: the dependent-joint constraint Jacobian is singular.
         """
+        if not at_q and not (type(q) is np.ndarray and q.dtype == float):  # a user's q: checked, never cast
+            q = self.mechanism.checked_q(q)
         if at_q:
             for cut in self._cuts:
                 cut.place(self.data)
@@ -762,6 +764,9 @@ class LoopSolver:
                             assembly=assembly, route=route)
 
     def _guess(self, guess: np.ndarray | None) -> np.ndarray:
+        if guess is not None and not_real(guess):
+            raise ModelError(f"guess must be real numbers, got {not_real(guess)}: pinmech does not cast them",
+                             path=self.mechanism.source)
         q0 = self.mechanism.neutral() if guess is None else np.asarray(guess, dtype=float)
         if q0.shape != (self.model.nq,) or not math.isfinite(sum(q0.tolist())):
             raise ModelError(f"guess must be {self.model.nq} finite numbers, got shape {q0.shape}",
@@ -780,6 +785,11 @@ class LoopSolver:
                 raise MobilityError(f"{', '.join(sorted(unknown))} is not a driver ({', '.join(self.drivers)})",
                                     mobility=self.mechanism.mobility, drivers=len(self.drivers))
             values = [values.get(n, 0.0) for n in self.drivers]
+        wrong = not_real(values)
+        if wrong:
+            hint = ": convert quantities first, e.g. pinmech.to_si('30 deg', 'angle')" if wrong == "text" else ""
+            raise UnitError(f"driver values of {', '.join(self.drivers)} must be real numbers in SI (rad or m), "
+                            f"got {wrong}, which pinmech does not cast{hint}")
         try:
             out = np.asarray(values, dtype=float).reshape(-1)
         except (TypeError, ValueError):

@@ -33,8 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from pinmech.exceptions import SingularPoseError, TaskError
-from pinmech.mechanism import Mechanism
+from pinmech.exceptions import ModelError, SingularPoseError, TaskError
+from pinmech.mechanism import Mechanism, not_real
 from pinmech.results import RateSolution
 from pinmech.solve_loops import (
     DEFAULT_MAX_CONDITION,
@@ -296,6 +296,10 @@ class RateSolver:
     def _values(self, given: np.ndarray | None, default: np.ndarray, name: str) -> np.ndarray:
         if given is None:
             return default
+        wrong = not_real(given)
+        if wrong:
+            raise ModelError(f"{name} must be real numbers (SI), got {wrong}: pinmech does not cast them",
+                             path=self.mechanism.source)
         values = np.asarray(given, dtype=float)
         if values.shape != default.shape or not np.all(np.isfinite(values)):
             raise TaskError(f"{name} needs {default.size} finite values (rows {', '.join(self.row_names)}), "

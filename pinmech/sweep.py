@@ -120,7 +120,41 @@ def sweep_options(scene: Scene) -> dict[str, Any]:
     if "start" in table and table["start"] not in STARTS:
         raise SceneError(f"must be one of {', '.join(STARTS)}, got {table['start']!r}", path=str(scene.path),
                          key="sweep.start")
+    _check_ranges(scene, table)
     return table
+
+
+#: The `[sweep]` numbers' ranges: the least value, and what it counts.
+_LEAST = {"steps": (2, "poses, both ends included"), "interpolate": (1, "(1: every pose solved)")}
+
+
+def _check_ranges(scene: Scene, table: dict[str, Any]) -> None:
+    """`[sweep]` values in range, blamed on the file and key (not on the flags that
+    would override them): steps >= 2, interpolate >= 1, a known scheme, a gain >= 0."""
+    from pinmech.path import SCHEMES  # here: sweeping needs no path integration
+
+    def bad(key: str, message: str) -> SceneError:
+        return SceneError(message, path=str(scene.path), key=f"sweep.{key}")
+
+    for key, (least, what) in _LEAST.items():
+        if key in table and table[key] < least:
+            raise bad(key, f"must be at least {least} {what}, got {table[key]}")
+    if "scheme" in table and table["scheme"] not in SCHEMES:
+        raise bad("scheme", f"must be one of {', '.join(SCHEMES)}, got {table['scheme']!r}")
+    if "gain" in table and not 0 <= table["gain"] < math.inf:
+        raise bad("gain", f"must be a number from 0 (open loop) up, in 1/s, got {table['gain']!r}")
+
+
+def _no_drivers(mechanism: Mechanism, arm_pose: bool = False) -> str:
+    """What to add to a scene without `[drivers]` to sweep it."""
+    motors = mechanism.motors
+    if motors:
+        tables = " and ".join(f"[drivers.{m}]" for m in motors)
+        return (f"has no [drivers] to sweep: add {tables} with their angle and speed (the motors the sidecar "
+                f"names, {', '.join(motors)}, drive a solve at rest, but a sweep needs the ones it moves)")
+    arm = "; or, for an arm held at its [pose], a [[task]] to follow in time (pinmech path)" if arm_pose else ""
+    return ("has no [drivers] to sweep: add a [drivers.JOINT] table (angle, speed) for each joint the scene drives "
+            f"({mechanism.mobility} for this mechanism){arm}")
 
 
 @dataclass
@@ -148,10 +182,12 @@ class Sweep:
                 `pinmech path`), or a driver that is not one of the scene's.
         """
         sweep_options(scene)
-        if "task" in scene.raw or not scene.section("drivers"):
+        if "task" in scene.raw:
             raise SceneError("has no [drivers] to sweep; a task scene ([[task]]) is followed in time: "
                              "pinmech path SCENE --duration ...", path=str(scene.path), key="drivers")
         mechanism = load_mechanism(scene)
+        if not scene.section("drivers"):
+            raise SceneError(_no_drivers(mechanism, "pose" in scene.raw), path=str(scene.path), key="drivers")
         drivers = scene_drivers(scene, mechanism)
         check_scene_names(scene, mechanism)
         scene.names("sweep", "links"), scene.names("sweep", "points")  # lists of names, or a SceneError now
@@ -255,11 +291,12 @@ class Sweep:
             raise ModelError(f"values of {self.driver} must be numbers [{unit}], got {values!r:.80}",
                              path=self.mechanism.source)
         for index, value in enumerate(values):
+            cast = isinstance(value, (str, bytes, bool, np.bool_, complex, np.complexfloating))  # never cast
             try:
-                number = float(value)
+                number = math.nan if cast else float(value)
             except (TypeError, ValueError):
                 number = math.nan
-            if isinstance(value, (str, bytes, bool)) or not math.isfinite(number):
+            if not math.isfinite(number):
                 raise ModelError(f"value {index} of {self.driver} is {value!r:.40}, not a finite number [{unit}]",
                                  path=self.mechanism.source)
             yield number

@@ -212,25 +212,67 @@ def _factor(text: str, unit: str, kind: str, where: str) -> float:
     if unit in _COMMON_UNITS:
         factor, unit_kind = _COMMON_UNITS[unit]
         if unit_kind != kind:
-            raise UnitError(_wrong_kind(text, kind, unit_kind.startswith(("angle", "angular"))), key=where)
+            raise UnitError(_wrong_kind(text, kind, unit_kind.startswith(("angle", "angular")),
+                                        _DIMENSIONS[unit_kind]), key=where)
         return factor
+    _refuse_misread(text, unit, kind, where)
     try:
         quantity = _registry().Quantity(1.0, unit)
         root = quantity.to_root_units()
     except Exception as exc:  # pint raises several unrelated classes here
-        raise UnitError(f"cannot read quantity {text!r}: {type(exc).__name__} {exc}".rstrip(), key=where) from exc
+        names = getattr(exc, "unit_names", None)  # pint's UndefinedUnitError
+        said = (f"no unit is called {', '.join(map(repr, names))}" if names else f"{type(exc).__name__} {exc}")
+        raise UnitError(f"cannot read quantity {text!r}: {said} (write e.g. '1.5 {_example(kind)}')".rstrip(),
+                        key=where) from exc
     powers = {name: int(p) if float(p).is_integer() else float(p) for name, p in root.unit_items()}
     if powers != _DIMENSIONS[kind]:
         raise UnitError(_wrong_kind(text, kind, powers.get("radian", 0) != 0, powers), key=where)
     return float(quantity.to(SI_UNITS[kind]).magnitude)  # SI, with kilograms (not pint's root grams)
 
 
+#: Newton-metres written glued ("Nm", "kNm", "Nmm"): pint reads "Nm" as a "number meter"
+#: (dimension m/kg), never what is meant.
+_GLUED_TORQUE = re.compile(r"([kmMµu]?)N(m|mm|cm)")
+#: Unit names pint reads otherwise than people mean, refused with what pint would read.
+_MISREAD = {"a": "a year (annum): write 'year' if a year is meant"}
+
+
+def _refuse_misread(text: str, unit: str, kind: str, where: str) -> None:
+    """A unit name pint would read in another sense than a user means: refused, saying how
+    to write what is meant ("0.5 Nm": write '0.5 N*m')."""
+    for token in re.split(r"\*\*|[*/^()\s]+", unit):
+        glued = _GLUED_TORQUE.fullmatch(token)
+        if glued and kind == "torque":
+            fixed = text.replace(token, f"{glued.group(1)}N*{glued.group(2)}", 1).strip()
+            raise UnitError(f"{text!r}: write '{fixed}' (a torque in newton-metres is written N*m; pint reads "
+                            "'Nm' as a count times a metre)", key=where)
+        if token in _MISREAD:
+            raise UnitError(f"{text!r}: pint reads '{token}' as {_MISREAD[token]}", key=where)
+
+
+#: SI symbols of pint's root units; a mass is said in kilograms, not pint's grams.
+_SI_SYMBOLS = {"meter": "m", "gram": "kg", "second": "s", "radian": "rad", "ampere": "A", "kelvin": "K",
+               "mole": "mol", "candela": "cd", "bit": "bit", "count": "count"}
+
+
+def _dimension_words(powers: dict[str, Any]) -> str:
+    """A dimension as people write it: "a force", or its SI units ("m/kg", "rad^2")."""
+    for kind, dims in _DIMENSIONS.items():
+        if dims == powers:
+            return f"it is {_article(kind)} {kind.replace('_', ' ')}"
+    up = [f"{_SI_SYMBOLS.get(n, n)}" + (f"^{p}" if p != 1 else "") for n, p in powers.items() if p > 0]
+    down = [f"{_SI_SYMBOLS.get(n, n)}" + (f"^{-p}" if p != -1 else "") for n, p in powers.items() if p < 0]
+    units = "*".join(up) or "1"
+    if down:
+        units += "/" + ("*".join(down) if len(down) == 1 else "(" + "*".join(down) + ")")
+    return "it is a pure number" if not powers else f"its unit is {units}"
+
+
 def _wrong_kind(text: str, kind: str, has_angle: bool, powers: dict[str, Any] | None = None) -> str:
     name = kind.replace("_", " ")
     if kind.startswith(("angle", "angular")) and not has_angle:
         return f"{text!r} has no angle unit, so it is not an {name} (use e.g. {_example(kind)})"
-    dimension = "" if powers is None else " (its unit is " + (" ".join(
-        f"{n}^{p}" for n, p in powers.items()) or "dimensionless") + ")"
+    dimension = "" if powers is None else f" ({_dimension_words(powers)})"
     return f"{text!r} is not {_article(kind)} {name}{dimension} (use e.g. {_example(kind)})"
 
 

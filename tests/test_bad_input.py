@@ -293,7 +293,8 @@ def test_sweeping_a_scene_without_drivers(tmp_path, capsys):
     scene = tmp_path / "s.toml"
     scene.write_text(f'urdf = "{MODELS / "planar_arm.urdf"}"\n[pose]\nA = "10 deg"\n')
     code, err = _run(capsys, "sweep", scene, "--steps", "3")
-    assert code == 4 and "drivers" in err and "pinmech path" in err
+    # what to add: the drivers to sweep, or (an arm at its [pose]) a task to follow in time
+    assert code == 4 and "add a [drivers.JOINT]" in err and "[[task]]" in err and "pinmech path" in err
     _one_line_error(code, err, "s.toml")
 
 
@@ -424,9 +425,9 @@ def r_rtr_analysis():
     [
         (lambda q, v, a: (q[:2], v, a), r"q must be 5 finite numbers \(SI\), got shape \(2,\)"),
         (lambda q, v, a: (q.reshape(1, -1), v, a), r"q must be 5 finite numbers \(SI\), got shape \(1, 5\)"),
-        (lambda q, v, a: (q, ["x"] * 3, a), "v must be 3 numbers"),
+        (lambda q, v, a: (q, ["x"] * 3, a), "v must be real numbers .SI., got text"),
         (lambda q, v, a: (q, v, [0.0, float("nan"), 0.0]), "a must be 3 finite numbers.*non-finite"),
-        (lambda q, v, a: (q, v, "0 0 0"), "a must be 3"),
+        (lambda q, v, a: (q, v, "0 0 0"), "a must be real numbers .SI., got text"),
     ],
 )
 def test_evaluate_motion_names_a_wrong_argument(r_rtr_analysis, change, message):

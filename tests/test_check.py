@@ -250,3 +250,40 @@ def test_a_missing_scene_is_named_with_the_hand_file(tmp_path):
     path.write_text('scene = "nope.toml"\n' + _entry("points.D.velocity", '["0.9", "0.1"]', "m/s"))
     with pytest.raises(SceneError, match=r"h\.hand\.toml, scene: scene = 'nope.toml': no such scene file \(.*nope\.toml\)"):
         load_hand_file(path)
+
+
+NOT_QUANTITIES = [  # a result path that holds no quantity of a unit, the kind a hand file claims, and a word said
+    ("assembly.C.sign", "velocity", "m/s", "pure number"),
+    ("accuracy.condition_number", "length", "m", "pure number"),
+    ("accuracy.newton_iterations", "time", "s", "pure number"),
+    ("route.continuation_steps", "angle", "deg", "pure number"),
+]
+
+
+@pytest.mark.parametrize(("quantity", "kind", "unit", "said"), NOT_QUANTITIES)
+def test_a_dimensionless_result_is_not_checked_as_a_quantity_of_a_unit(quantity, kind, unit, said, tmp_path,
+                                                                       scenes_dir):
+    """The assembly sign (+1 or -1) was "checked" as a velocity in m/s and called ok: a
+    declared kind is trusted only where pinmech cannot tell the quantity's kind (a joint's
+    q, v, a), and it must agree with the result's; a pure number is refused."""
+    scene = tmp_path / "r_rtr.toml"
+    scene.write_text((scenes_dir / "r_rtr.toml").read_text().replace('"../', f'"{scenes_dir.parent}/'))
+    hand = tmp_path / "h.toml"
+    hand.write_text(f'scene = "r_rtr.toml"\n[[value]]\nquantity = "{quantity}"\nhand = "-1"\nunit = "{unit}"\n'
+                    f'kind = "{kind}"\n', encoding="utf-8")
+    with pytest.raises(SceneError, match=said) as caught:
+        values = load_hand_file(hand).values
+        compare(to_dict(analyse(Scene.load(scene))), values)
+    assert str(hand) in str(caught.value) and quantity in str(caught.value)
+
+
+def test_a_route_value_is_checked_in_its_driver_joints_kind(tmp_path, scenes_dir):
+    """route.from.A is the driver A's angle where the pose was reached from: an angle (30
+    deg in the R-RTR scene), so a length unit is refused and degrees are checked."""
+    scene = tmp_path / "r_rtr.toml"
+    scene.write_text((scenes_dir / "r_rtr.toml").read_text().replace('"../', f'"{scenes_dir.parent}/'))
+    result = to_dict(analyse(Scene.load(scene)))
+    good = HandValue("start", "route.from.A", None, "30", "deg", "angle")
+    assert compare(result, [good])[0].verdict == "ok"
+    with pytest.raises(UnitError, match="is an angle"):
+        compare(result, [HandValue("start", "route.from.A", None, "30", "mm", "length")])

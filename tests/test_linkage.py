@@ -605,3 +605,66 @@ def test_a_drawn_slider_has_no_invented_limits():
     """URDF needs a <limit> on a prismatic joint; the one written for a drawn slider (1000
     times the mechanism's size) is no fact of the drawing and is no limit of the model."""
     assert load_linkage(LINKAGES / "slider_crank.toml").limits == {}
+
+
+COLLIDING = [  # a linkage whose user name is one pinmech gives a generated URDF element, and that name
+    ("""ground = ["O2", "O4"]
+[joints]
+O2 = ["0 mm", "0 mm"]
+O4 = ["100 mm", "0 mm"]
+point_P = ["40 mm", "0 mm"]
+B = { from = ["point_P", "O4"], lengths = ["120 mm", "80 mm"], side = "left" }
+P = ["100 mm", "30 mm"]
+[links]
+crank = ["O2", "point_P"]
+coupler = ["point_P", "B", "P"]
+rocker = ["O4", "B"]
+""", "point_P"),
+    ("""ground = ["A", "C"]
+[joints]
+A = ["0 mm", "0 mm"]
+C = ["50 mm", "0 mm"]
+B = ["0 mm", "100 mm"]
+D = { from = "C", length = "150 mm", angle = "116.56505117707799 deg" }
+[links]
+crank = ["A", "B"]
+B_block = ["C", "D"]
+[slots]
+B = { pin = "crank", slot = "B_block", along = ["C", "B"] }
+""", "B_block"),
+]
+
+
+@pytest.mark.parametrize(("text", "name"), COLLIDING)
+def test_a_name_that_pinmech_generates_is_refused_naming_both(text, name, tmp_path, capsys):
+    """A joint named point_P beside a point P: `pinmech build` wrote a URDF with two joints
+    named point_P (exit 0), and a scene's error blamed the user's file for "not a valid URDF
+    model". Now the linkage file is refused (exit 3) naming the clash, and nothing is written."""
+    linkage = tmp_path / "clash.toml"
+    linkage.write_text(text, encoding="utf-8")
+    out = tmp_path / "clash.urdf"
+    assert main(["build", str(linkage), "-o", str(out)]) == 3
+    err = capsys.readouterr().err.strip()
+    assert str(linkage) in err and f"'{name}'" in err and "pinmech gives" in err and "rename" in err, err
+    assert len(err.splitlines()) == 1 and not out.exists()
+    scene = tmp_path / "clash_scene.toml"
+    first = "O2" if "O2" in text else "A"
+    scene.write_text(f'linkage = "clash.toml"\n[drivers.{first}]\nangle = "0 deg"\n', encoding="utf-8")
+    assert main(["solve", str(scene)]) == 3
+    err = capsys.readouterr().err
+    assert "valid URDF" not in err and "pinmech gives" in err, err
+
+
+def test_an_error_in_the_generated_urdf_is_not_blamed_on_the_linkage_file(tmp_path, monkeypatch):
+    """Should Pinocchio refuse the URDF pinmech generates (a pinmech defect), the error says
+    it is the generated URDF, and where it lies, not that the user's file is a bad URDF."""
+    from pinmech import mechanism
+
+    def refuse(path, **kwargs):
+        raise ModelError(f"The file {path} does not contain a valid URDF model.", path=str(path))
+
+    monkeypatch.setattr(mechanism.Mechanism, "from_urdf", staticmethod(refuse))
+    source = Path(__file__).resolve().parents[1] / "models" / "linkages" / "four_bar.toml"
+    with pytest.raises(ModelError, match="the URDF pinmech generated from it") as caught:
+        load_linkage(source)
+    assert str(source) in str(caught.value) and "linkage-" in str(caught.value)

@@ -79,3 +79,27 @@ def test_a_link_whose_x_axis_is_normal_to_the_plane_reports_its_y_axis_angle(tmp
     th = np.radians([50, -15, 18.376])
     np.testing.assert_allclose(analysis.motion.points["D"].position[:2],
                                np.array([np.cos(th), np.sin(th)]) @ [0.30, 0.30, 0.17], atol=1e-12)
+
+
+def test_without_a_guess_the_report_does_not_say_it_closed_from_one(scenes_dir):
+    """The five-bar without [guess] was reported "closed from its [guess]" and, two lines on,
+    "the scene has no [guess]"."""
+    from pinmech import Scene, analyse
+    from pinmech.report import to_text
+
+    text = to_text(analyse(Scene.load(scenes_dir / "five_bar.toml")))
+    assert "the scene has no [guess]" in text and "from its [guess]" not in text
+    assert "closed from the neutral configuration" in text
+
+
+def test_an_open_chain_accuracy_line_speaks_of_no_loop(scenes_dir):
+    """An arm (no loop) was given 'closure residual 0 (of each loop's size; the largest loop
+    spans ...), 0 Newton iterations'."""
+    from pinmech import Scene, analyse
+    from pinmech.report import to_text
+
+    for scene in ("planar_arm.toml", "ur5.toml"):
+        text = to_text(analyse(Scene.load(scenes_dir / scene)))
+        accuracy = text.split("\nAccuracy\n")[1].splitlines()[1]
+        assert "loop" in accuracy and "no loop" in accuracy and "Newton" not in accuracy, accuracy
+        assert "condition number" in accuracy

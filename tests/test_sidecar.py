@@ -289,3 +289,67 @@ def test_gepettos_five_bar_with_pins_at_its_6d_closure_says_which_lock_it_needs(
     P = solver.data.oMf[mech.frame_id("sphere")].translation[:2]
     # as the five-bar above: 1e-12 m on a 0.1 m mechanism
     np.testing.assert_allclose(P, five_bar_end(2 * math.pi / 3 - 0.2, math.pi / 3 + 0.3), atol=1e-12)
+
+
+def _five_bar_scene(tmp_path: Path, drivers: str = "") -> Path:
+    """A five-bar scene of the bundled URDF + robot.yaml, with the [drivers] given (default none)."""
+    scene = tmp_path / "five.toml"
+    scene.write_text(f'urdf = "{FIVE[0]}"\nsidecar = "{FIVE[1]}"\n[report]\npoints = ["closedloop1_A"]\n{drivers}',
+                     encoding="utf-8")
+    return scene
+
+
+def test_set_on_one_motor_keeps_the_other_default_motor(tmp_path, capsys):
+    """Without [drivers], robot.yaml's motors drive at the reference pose (q = 0). `--set` on
+    mot1 silently dropped mot2 (then the mobility error); mot2 now keeps its default, and the
+    end effector is where the two circles of the distal lengths meet (five_bar_end), within
+    1e-10 m (loops close to 1e-13 of 0.19 m, condition ~2)."""
+    import json
+
+    scene = _five_bar_scene(tmp_path)
+    assert main(["solve", str(scene), "--set", 'drivers.mot1.angle="10 deg"', "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert list(out["drivers"]) == ["mot1", "mot2"]
+    np.testing.assert_allclose([out["drivers"]["mot1"]["q"], out["drivers"]["mot2"]["q"]], [math.radians(10), 0.0],
+                               atol=1e-15)
+    end = five_bar_end(2 * math.pi / 3 + math.radians(10), math.pi / 3)
+    np.testing.assert_allclose(out["points"]["closedloop1_A"]["position"][:2], end, atol=1e-10)
+
+
+def test_a_driver_that_is_no_motor_replaces_the_motors_and_the_error_says_so(tmp_path, capsys):
+    """`--set` on a joint robot.yaml does not call a motor: the motors are not added to it,
+    and the mobility error names them and says why they are not driving."""
+    scene = _five_bar_scene(tmp_path)
+    assert main(["solve", str(scene), "--set", 'drivers.elbow1.angle="10 deg"']) == 5
+    err = capsys.readouterr().err
+    assert "robot.yaml" in err and "mot1, mot2" in err and "elbow1" in err, err
+
+
+def test_one_motor_of_two_the_mobility_error_says_the_mechanism_still_moves(tmp_path, capsys):
+    """With mot1 alone driven the five-bar still moves as a whole (mot2 and both elbows
+    turn together): the error called elbow2 'a rod spinning about its own axis'."""
+    scene = _five_bar_scene(tmp_path, '[drivers.mot1]\nangle = "10 deg"\n')
+    assert main(["solve", str(scene)]) == 5
+    err = capsys.readouterr().err
+    assert "own axis" not in err and "rod" not in err, err
+    assert "still move" in err and "mot2" in err and "drive one more joint" in err, err
+
+
+def test_sweeping_without_drivers_says_which_drivers_to_add(tmp_path, capsys):
+    """A robot.yaml scene without [drivers] was told about task scenes when swept."""
+    scene = _five_bar_scene(tmp_path)
+    assert main(["sweep", str(scene)]) == 4
+    err = capsys.readouterr().err.strip()
+    assert "task" not in err and "[drivers.mot1]" in err and "mot2" in err and str(scene) in err, err
+
+
+def test_the_loop_is_named_by_its_two_frames(tmp_path, capsys):
+    """The loop was labelled 'closedloop1_ACclosedloop1_B'; an assembly table may name it
+    with an en dash, as printed, or a plain hyphen."""
+    mech = load_extended_urdf(*FIVE)
+    assert [c.name for c in mech.closures] == ["closedloop1_A\u2013closedloop1_B"]
+    scene = tmp_path / "five.toml"
+    scene.write_text(f'urdf = "{FIVE[0]}"\nsidecar = "{FIVE[1]}"\n'
+                     'assembly = { "closedloop1_A-closedloop1_B" = "-" }\n', encoding="utf-8")
+    assert main(["solve", str(scene)]) == 0
+    assert "loop closedloop1_A\u2013closedloop1_B" in capsys.readouterr().out

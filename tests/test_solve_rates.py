@@ -352,7 +352,7 @@ def test_malformed_tasks(kwargs, message):
         (lambda q: q[:2], r"q must be 3 finite numbers \(SI\), got shape \(2,\)"),
         (lambda q: np.r_[q[:2], np.nan], r"q must be 3 finite numbers \(SI\), got shape \(3,\) with a non-finite"),
         (lambda q: q[None], r"q must be 3 finite numbers \(SI\), got shape \(1, 3\)"),
-        (lambda q: ["a", "b", "c"], "q must be 3 numbers"),
+        (lambda q: ["a", "b", "c"], "q must be real numbers .SI., got text"),  # text is never cast (not even "0")
     ],
 )
 def test_a_q_that_is_no_configuration_is_a_model_error_naming_q(arm, bad, message):

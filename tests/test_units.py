@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import pytest
 
@@ -91,8 +92,8 @@ def test_an_angle_in_degrees_minutes_and_seconds_is_their_sum(text, degrees):
         ("30 deg 20 arcmin", "angular_velocity", "more than one number"),
         ("1/2 deg", "angle", "more than one number"),
         ("2 3 mm", "length", "more than one number"),
-        ("1 mm2", "length", "cannot read quantity '1 mm2': UndefinedUnitError"),  # a name, not two numbers
-        ("10 deg deg", "angle", r"not an angle \(its unit is radian\^2\)"),
+        ("1 mm2", "length", "cannot read quantity '1 mm2': no unit is called 'mm2'"),  # a name, not two numbers
+        ("10 deg deg", "angle", r"not an angle \(its unit is rad\^2\)"),
         ("1 deg**2", "angle", "not an angle"),
         ("1 sr", "angle", "not an angle"),  # a solid angle is rad^2
         ("2 m m", "length", "not a length"),  # m^2, not 2 mm
@@ -199,3 +200,36 @@ def test_a_bare_non_finite_number_is_called_so_not_told_to_take_a_unit(value):
     """'nan' was told to be written 'nan rpm', which is refused in turn."""
     with pytest.raises(UnitError, match="is not a finite number"):
         to_si(value, "angular_velocity")
+
+
+@pytest.mark.parametrize("text, kind, written", [("0.5 Nm", "torque", "0.5 N*m"), ("2 kNm", "torque", "2 kN*m"),
+                                                 ("3 Nmm", "torque", "3 N*mm"), ("1.5 mNm", "torque", "1.5 mN*m")])
+def test_a_newton_metre_glued_as_nm_is_refused_with_the_spelling_that_works(text, kind, written):
+    """People write "Nm" for N·m; pint reads it as a "number meter" (dimension m/kg), which
+    was reported as "not a torque (its unit is meter^1 gram^-1)". The message now gives the
+    spelling pinmech reads, and no root unit of pint's (the gram)."""
+    with pytest.raises(UnitError, match=re.escape(f"write '{written}'")) as caught:
+        to_si(text, kind, where="load[0].torque")
+    assert "gram" not in str(caught.value) and "^1" not in str(caught.value)
+    assert to_si(written, kind) > 0  # the advice is itself read
+
+
+@pytest.mark.parametrize("text, kind", [("2 a", "time"), ("2 rad/a", "angular_velocity"), ("2 a", "length"),
+                                        ("3 deg/a", "angular_velocity")])
+def test_a_is_refused_as_a_unit_not_read_as_a_year(text, kind):
+    """pint reads "a" as a year (annum): "2 rad/a" was taken as 6.3e-8 rad/s in silence, and
+    "2 a" as a length was refused in pint's words (second^1)."""
+    with pytest.raises(UnitError, match="year") as caught:
+        to_si(text, kind)
+    assert "second^1" not in str(caught.value)
+    assert to_si("1 year", "time") == pytest.approx(365.25 * 86400, rel=1e-12)  # Julian year, pint's "year"
+
+
+@pytest.mark.parametrize("text, kind, said", [("1 kgf", "torque", "is a force"), ("1 N*m", "force", "is a torque"),
+                                              ("1 kg", "moment_of_inertia", "kg"),
+                                              ("1 m/kg", "length", "m/kg")])
+def test_a_unit_of_another_dimension_is_named_in_si_terms(text, kind, said):
+    """The dimension is said as a kind of quantity, or in SI units (kg, not pint's gram)."""
+    with pytest.raises(UnitError, match=re.escape(said)) as caught:
+        to_si(text, kind)
+    assert "gram" not in str(caught.value) and "^1" not in str(caught.value)
