@@ -63,10 +63,9 @@ def joint_colours(mechanism: Mechanism) -> dict[int, tuple[float, float, float]]
 
 
 def colour_of(mechanism: Mechanism, name: str) -> tuple[float, float, float]:
-    """The colour of a link, or of the link a point is on (grey: the ground)."""
-    fid = mechanism.links.get(name, mechanism.points.get(name))
-    if fid is None:
-        raise KeyError(name)
+    """The colour of a link, or of the link a point (or a drawn linkage's pin) is on (grey:
+    the ground). FrameNotFound for a name the model has no frame of."""
+    fid = mechanism.links[name] if name in mechanism.links else mechanism.frame_id(name)
     return joint_colours(mechanism)[mechanism.model.frames[fid].parentJoint]
 
 

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from pinmech.exceptions import PinmechError
+from pinmech.exceptions import FrameNotFound, PinmechError
 from pinmech.display import colour_of, display_names, hex_colour, joint_colours
 from pinmech.link_nodes import sketch_links, world_nodes
 from pinmech.motion import _plane_reference
@@ -88,7 +88,7 @@ class PathRecorder:
         """A point's path in its link's colour (pinmech.display); black for a point not on a link."""
         try:
             return hex_colour(colour_of(self.mechanism, name))
-        except KeyError:
+        except FrameNotFound:
             return "#111111"
 
     def _draw_3d(self, ax, q: np.ndarray | None, travel: str, backwards: bool = False) -> None:
