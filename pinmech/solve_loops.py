@@ -19,6 +19,7 @@ from typing import Any, TypeVar
 import numpy as np
 import pinocchio as pin
 
+from pinmech.assembly_check import check_guessed_pose
 from pinmech.branches import AssemblyStructure
 from pinmech.closures import CutEvaluator
 from pinmech.continuation import Path, Route
@@ -662,7 +663,8 @@ class LoopSolver:
         With a reference (`set_reference`) and no guess, the pose is reached from the
         reference by continuation along the straight driver path, on its assembly. With
         a guess (or no reference), Newton starts from the guess; a reference's assembly
-        is then checked.
+        is then checked: the pose must be the one continuation reaches (assembly_check.py),
+        which the signature alone cannot tell where a block has more than two assemblies.
 
         Args:
             driver_q: driver coordinates [rad or m], in the order of `drivers` or by name.
@@ -687,9 +689,13 @@ class LoopSolver:
         if guess is None and ref is not None:  # assembly "any": Newton from the reference pose
             guess = ref.q
         q, iterations, residual = self.close(self._guess(guess), dq)
+        route = None
         if ref is None:  # the first pose solved names the assembly of the later ones
             self.set_reference(dq, q)
-        return self._solution(q, dv, da, residual, iterations, None)
+        elif ref.keep and self._cuts:  # the pose continuation reaches, or AssemblyError
+            passed = check_guessed_pose(self, q, dq)
+            route = passed if passed.change_points else None
+        return self._solution(q, dv, da, residual, iterations, route)
 
     @serialized
     def follow(self, q0: np.ndarray, x0: np.ndarray, x1: np.ndarray, route: Route, *,
