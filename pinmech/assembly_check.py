@@ -30,9 +30,11 @@ GAP_FACTOR = 1e2
 GAP_FLOOR = 1e-9
 
 
-def check_guessed_pose(solver, q: np.ndarray, driver_q: np.ndarray) -> Route:
+def check_guessed_pose(solver, q: np.ndarray, driver_q: np.ndarray,
+                       start: tuple[np.ndarray, np.ndarray] | None = None) -> Route:
     """Raise AssemblyError unless q (closed at driver_q from a guess) is the pose that
-    continuation from `solver.reference` reaches there. Leaves the solver's data at q.
+    continuation from `solver.reference` (or from `start`, a closed pose on it and its
+    driver values) reaches there. Leaves the solver's data at q.
 
     Returns:
         the continuation's route (its change points, if it passed any).
@@ -42,16 +44,17 @@ def check_guessed_pose(solver, q: np.ndarray, driver_q: np.ndarray) -> Route:
             the reference's assembly cannot be followed to driver_q (its reason chained).
     """
     ref = solver.reference
-    route = Route(tuple(ref.driver_q.tolist()))
+    q0, x0 = start if start is not None else (ref.q, ref.driver_q)
+    route = Route(tuple(x0.tolist()))
     where = solver.describe_drivers(driver_q)
     try:
-        continued = solver.follow(ref.q, ref.driver_q, driver_q, route)
+        continued = solver.follow(q0, x0, driver_q, route)
     except PinmechError as exc:
         solver._residual(q)
         raise AssemblyError(
             f"{solver.mechanism.source}: at {where} the pose from the guess cannot be checked against the "
             f"reference's assembly, which cannot be followed there from "
-            f"{solver.describe_drivers(ref.driver_q)}: {exc}", expected=ref.signs, found=(),
+            f"{solver.describe_drivers(x0)}: {exc}", expected=ref.signs, found=(),
             drivers=solver.drivers, value=tuple(driver_q.tolist())) from exc
     q_guess, res_guess, sigma = _polished(solver, q, driver_q)
     q_cont, res_cont, _ = _polished(solver, continued, driver_q)
@@ -63,7 +66,7 @@ def check_guessed_pose(solver, q: np.ndarray, driver_q: np.ndarray) -> Route:
             f"{solver.mechanism.source}: at {where} the pose from the guess is on another assembly than the "
             f"reference's (a signature need not tell them apart): joint {joint} is {_joint_value(solver, joint, q_guess)} "
             f"there and {_joint_value(solver, joint, q_cont)} on the reference's assembly, followed by continuation "
-            f"from {solver.describe_drivers(ref.driver_q)} (a gap of {gap:.3g} rad or loop sizes, where one pose "
+            f"from {solver.describe_drivers(x0)} (a gap of {gap:.3g} rad or loop sizes, where one pose "
             f"would differ by {bound:.1g} at most): solve without a guess, or use a second solver for the other "
             f"assembly", expected=ref.signs, found=(), drivers=solver.drivers, value=tuple(driver_q.tolist()))
     return route

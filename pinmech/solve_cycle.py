@@ -34,6 +34,7 @@ from itertools import islice
 
 import numpy as np
 
+from pinmech.assembly_check import check_guessed_pose
 from pinmech.continuation import Node, Path, Route, _Singular
 from pinmech.core import core_for
 from pinmech.exceptions import (
@@ -429,6 +430,7 @@ class _Cycle:
             self._note(route)
             return node
         guess = ref.q if self.start == "warm" else self._cold_guess()
+        x_ref = self.q_drv.copy()
         self.q_drv[self.k] = p
         q, self._iterations, _ = solver.close(guess, self.q_drv)
         new = path.node(p, q, at_q=True) if solver._cuts else path.node(p, q)
@@ -437,6 +439,8 @@ class _Cycle:
                 f"{solver.mechanism.source}: a {self.start} start at {solver.describe_drivers(self.q_drv)} "
                 f"lands on another assembly ({new.signs} instead of {ref.signs}): use the predictor start",
                 expected=ref.signs, found=new.signs, drivers=solver.drivers, value=tuple(self.q_drv.tolist()))
+        if solver._cuts and solver.reference is not None and solver.reference.keep:  # as one sign may not tell
+            check_guessed_pose(solver, q, self.q_drv.copy(), start=(ref.q, x_ref))
         return new
 
     def _first(self, p: float) -> Node:

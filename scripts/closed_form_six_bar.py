@@ -57,19 +57,16 @@ def stephenson_far_crank(phi6: float, a, b, c, d, cx, cy, b2, c2, o6, samples: i
 
         grid = np.linspace(0.0, 2 * np.pi, samples + 1)
         values = f(grid)
-        for k in np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) < 0):
-            lo, hi = float(grid[k]), float(grid[k + 1])
-            for _ in range(200):  # bisection to the spacing of floats
-                mid = 0.5 * (lo + hi)
-                if mid in (lo, hi):
-                    break
-                if np.sign(f(mid)) == np.sign(f(lo)):
-                    lo = mid
-                else:
-                    hi = mid
-            theta2 = 0.5 * (lo + hi)
+        brackets = np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) < 0)
+        lo, hi, f_lo = grid[brackets], grid[brackets + 1], values[brackets]
+        for _ in range(56):  # bisection of every bracket at once, to the spacing of floats
+            mid = 0.5 * (lo + hi)
+            f_mid = f(mid)
+            left = np.sign(f_mid) == np.sign(f_lo)
+            lo, hi, f_lo = np.where(left, mid, lo), np.where(left, hi, mid), np.where(left, f_mid, f_lo)
+        for theta2 in 0.5 * (lo + hi):
             fb = four_bar(theta2, 0.0, 0.0, a, b, c, d, branch)
             e3 = np.array([np.cos(fb.theta3), np.sin(fb.theta3)])
             C = fb.A + cx * e3 + cy * perp(e3)
-            out.append({"theta2": theta2, "branch": branch, "A": fb.A, "B": fb.B, "C": C, "D": D})
+            out.append({"theta2": float(theta2), "branch": branch, "A": fb.A, "B": fb.B, "C": C, "D": D})
     return out

@@ -12,6 +12,7 @@ rounding).
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 
@@ -593,18 +594,25 @@ def _far_q(mech: Mechanism, pins: dict[str, np.ndarray]) -> np.ndarray:
     return q
 
 
-def _continued_far_assembly(phi0: float, phi1: float, theta0: float, branch: int) -> dict:
-    """The closed form's root reached from (theta0, branch) at phi0 by moving the far crank
-    to phi1 in 0.5 deg steps, each time the root of the same four-bar branch nearest the
-    last crank angle (the roots at one phi are at least 0.1 rad apart here)."""
+@functools.lru_cache(maxsize=1)
+def _far_track(phi0: float) -> dict[int, dict]:
+    """The closed form's root reached from the drawn pose (four-bar branch +1, crank at 0)
+    at the drawn far-crank angle phi0, moving the far crank up in steps to each whole
+    degree up to 245: at each step the root of the same four-bar branch nearest the last
+    crank angle (the roots at one angle are at least 0.1 rad apart here)."""
     from closed_form_six_bar import stephenson_far_crank
 
-    theta = theta0
-    for phi in np.linspace(phi0, phi1, int(abs(math.degrees(phi1 - phi0)) / 0.5) + 2)[1:]:
-        roots = [r for r in stephenson_far_crank(phi, **FAR, samples=4000) if r["branch"] == branch]
-        best = min(roots, key=lambda r: abs(math.remainder(r["theta2"] - theta, 2 * math.pi)))
-        theta = best["theta2"]
-    return best
+    theta, out = 0.0, {}
+    for degrees in range(math.ceil(math.degrees(phi0)), 246):
+        roots = [r for r in stephenson_far_crank(math.radians(degrees), **FAR, samples=2000) if r["branch"] == 1]
+        out[degrees] = min(roots, key=lambda r: abs(math.remainder(r["theta2"] - theta, 2 * math.pi)))
+        theta = out[degrees]["theta2"]
+    return out
+
+
+def _continued_far_assembly(phi0: float, degrees: float) -> dict:
+    """The pins of the continued root at a whole number of degrees of the far crank."""
+    return _far_track(phi0)[round(degrees)]
 
 
 def test_a_guess_on_another_assembly_of_a_two_loop_block_is_refused_though_its_sign_is_the_same():
@@ -624,7 +632,7 @@ def test_a_guess_on_another_assembly_of_a_two_loop_block_is_refused_though_its_s
     assert solver.structure.names == ("B+C",)
     drawn = min((r for r in stephenson_far_crank(phi0, **FAR) if r["branch"] == 1), key=lambda r: abs(r["theta2"]))
     np.testing.assert_allclose(drawn["C"], _far_pins(mech, ref.q)["C"], rtol=0, atol=1e-12 * 0.2)
-    expected = _continued_far_assembly(phi0, phi, drawn["theta2"], drawn["branch"])
+    expected = _continued_far_assembly(phi0, 240)
     continued = solver.solve([phi])
     for pin_name in "ABCD":
         np.testing.assert_allclose(_far_pins(mech, continued.q)[pin_name], expected[pin_name], rtol=0, atol=1e-12 * 0.2)
@@ -644,3 +652,33 @@ def test_a_guess_on_another_assembly_of_a_two_loop_block_is_refused_though_its_s
             with pytest.raises(AssemblyError, match="O6 = (240|-120) deg"):
                 solver.solve([phi], guess=guess)
     assert same_sign >= 1  # the case the sign alone let through
+
+
+@pytest.mark.parametrize("start", ["cold", "warm"])
+def test_a_cold_or_warm_sweep_of_a_two_loop_block_never_lands_on_another_assembly_of_its_sign(start):
+    """The same six-bar swept at 236..244 deg from the guess of an assembly that has the
+    continued one's sign but is another (closed form, as above): each row is the closed
+    form's continued assembly (to 1e-12 of the size) or an AssemblyError, never the other."""
+    from closed_form_six_bar import stephenson_far_crank
+
+    mech = pinmech.load_linkage(Path(__file__).parents[1] / "models" / "linkages" / "stephenson.toml")
+    solver = LoopSolver(mech, ["O6"])
+    q0 = mech.neutral()
+    phi0, phi = mech.coordinate(q0, "O6"), math.radians(240)
+    solver.set_reference([phi0], q0)
+    signs = solver.solve([phi]).assembly.signs
+    expected = _continued_far_assembly(phi0, 240)
+    others = [r for r in stephenson_far_crank(phi, **FAR) if not np.allclose(r["C"], expected["C"], atol=1e-9)]
+    twin = next(r for r in others if LoopSolver(mech, ["O6"]).solve([phi], guess=_far_q(mech, r)).assembly.signs
+                == signs)
+    values = np.radians([240.0, 242.0, 244.0])
+    chunks = list(solve_range(solver, "O6", values, driver_q=np.zeros(1), driver_v=np.ones(1), driver_a=np.zeros(1),
+                              guess=_far_q(mech, twin), start=start))
+    q = np.concatenate([c.solution.q for c in chunks])
+    errors = {c.start + j: e for c in chunks for j, e in c.errors.items()}
+    for i, value in enumerate(values):
+        if i in errors:
+            assert isinstance(errors[i], AssemblyError)
+            continue
+        right = _continued_far_assembly(phi0, math.degrees(value))
+        np.testing.assert_allclose(_far_pins(mech, q[i])["C"], right["C"], rtol=0, atol=1e-12 * 0.2)
