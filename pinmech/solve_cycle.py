@@ -293,7 +293,7 @@ class _Cycle:
             guesses = self._hermite(x, q, d1, d2, solved, targets)[0]
             count = len(targets)
             out = self.batch.try_solve(guesses, self._drivers(x[targets]), np.tile(self.unit_v, (count, 1)),
-                                       np.tile(self.zero, (count, 1)))
+                                       np.tile(self.zero, (count, 1)), _on_path=True)
             if out is None or (ref.signs and np.any(out.signs != np.array(ref.signs))):
                 raise _Fallback
             q[targets], d1[targets], d2[targets] = out.q, out.v, out.a
@@ -587,7 +587,7 @@ class _Cycle:
         pose by pose (a guess too far for the batch)."""
         n, ref = len(at), self.ref
         out = self.measurer.try_solve(guesses, self._drivers(at), np.tile(self.unit_v, (n, 1)),
-                                      np.tile(self.zero, (n, 1)), max_step=MEASURE_STEP)
+                                      np.tile(self.zero, (n, 1)), max_step=MEASURE_STEP, _on_path=True)
         if out is not None and not (ref.signs and np.any(out.signs != np.array(ref.signs))):
             return out.q, out.v, out.a
         solver = self.solver

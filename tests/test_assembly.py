@@ -682,3 +682,22 @@ def test_a_cold_or_warm_sweep_of_a_two_loop_block_never_lands_on_another_assembl
             continue
         right = _continued_far_assembly(phi0, math.degrees(value))
         np.testing.assert_allclose(_far_pins(mech, q[i])["C"], right["C"], rtol=0, atol=1e-12 * 0.2)
+
+
+def test_the_batch_solver_never_takes_a_guess_on_another_assembly_of_a_two_loop_block():
+    """BatchSolver.try_solve from the guess of the same-sign twin assembly (closed form, as
+    above): None (the pose-by-pose solver decides), never that pose; a four-bar's dyad,
+    whose sign names both of its assemblies, is still batched."""
+    from closed_form_six_bar import stephenson_far_crank
+
+    mech = pinmech.load_linkage(Path(__file__).parents[1] / "models" / "linkages" / "stephenson.toml")
+    solver = LoopSolver(mech, ["O6"])
+    q0 = mech.neutral()
+    phi0, phi = mech.coordinate(q0, "O6"), math.radians(240)
+    solver.set_reference([phi0], q0)
+    signs = solver.solve([phi]).assembly.signs
+    expected = _continued_far_assembly(phi0, 240)
+    twin = next(r for r in stephenson_far_crank(phi, **FAR) if not np.allclose(r["C"], expected["C"], atol=1e-9)
+                and LoopSolver(mech, ["O6"]).solve([phi], guess=_far_q(mech, r)).assembly.signs == signs)
+    zeros = np.zeros((1, 1))
+    assert pinmech.BatchSolver(solver).try_solve(_far_q(mech, twin)[None], np.array([[phi]]), zeros, zeros) is None
