@@ -212,6 +212,14 @@ class Reference:
     keep: bool = True
     iterations: int = 0
 
+    def __post_init__(self) -> None:
+        """The arrays are read-only copies: the solver goes on from them, so a write into
+        the ones the API returns must not change its reference."""
+        for name in ("driver_q", "q"):
+            array = np.array(getattr(self, name), dtype=float)
+            array.flags.writeable = False
+            object.__setattr__(self, name, array)
+
 
 class LoopSolver:
     """Solves one mechanism pose after pose, keeping Pinocchio `Data` and buffers alive.
