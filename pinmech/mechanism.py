@@ -29,6 +29,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.closures import CUT_TYPES, Closure
+from pinmech.directions import unit_vector
 from pinmech.exceptions import FrameNotFound, ModelError
 from pinmech.urdf_joints import JointLimit, MimicJoint, joint_limits, mimic_joints, with_followers
 
@@ -584,10 +585,11 @@ def _parse_constraint(el: ET.Element, model: pin.Model, links: list[str], source
         xyz = _vector(origin, "xyz", "0 0 0", where, source)
         rpy = _vector(origin, "rpy", "0 0 0", where, source)
         axis = _vector(el.find(f"{side}_axis"), "xyz", "0 0 1", where, source)
-        norm = np.linalg.norm(axis)
-        if norm == 0:
-            raise ModelError(f"<{side}_axis xyz=\"0 0 0\"/> is not a direction", path=source, element=where)
-        sides[side] = (link, pin.SE3(pin.rpy.rpyToMatrix(rpy), xyz), axis / norm)
+        unit = unit_vector(axis)
+        if unit is None:
+            raise ModelError(f"<{side}_axis xyz=\"{el.find(f'{side}_axis').get('xyz')}\"/> is not a direction",
+                             path=source, element=where)
+        sides[side] = (link, pin.SE3(pin.rpy.rpyToMatrix(rpy), xyz), unit)
     return _Cut(name, cut_type, sides["parent"][0], sides["child"][0], sides["parent"][1], sides["child"][1],
                 sides["parent"][2], sides["child"][2], source)
 

@@ -44,6 +44,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from pinmech.directions import unit_vector
 from pinmech.exceptions import ModelError
 from pinmech.mechanism import Mechanism, pinocchio_build, read_xml
 
@@ -274,10 +275,9 @@ def _eulers_as_quaternions(root: ET.Element, source: str) -> None:
 def _z_to(vector: np.ndarray) -> np.ndarray:
     """The quaternion (w x y z) turning z onto `vector` by the shortest way, as MuJoCo's
     mju_quatZ2Vec (a half turn about x for -z)."""
-    length = np.linalg.norm(vector)
-    if not length > 0:
+    v = unit_vector(vector)
+    if v is None:
         return np.array([1.0, 0, 0, 0])
-    v = vector / length
     axis = np.cross([0.0, 0.0, 1.0], v)
     sine = np.linalg.norm(axis)
     if sine < 1e-15:
