@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from pinmech import __version__
+from pinmech.counts import checked_count
 from pinmech.exceptions import PinmechError
 from pinmech.interrupts import SIGNALS
 
@@ -339,6 +340,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     steps = args.steps if args.steps is not None else options.get("steps", 361)
     if steps < 2:
         raise PinmechError(f"--steps must be at least 2, got {steps}")
+    checked_count(steps, "--steps" if args.steps is not None else f"{scene.path}: [sweep] steps", f"steps = {steps}")
     sweep = Sweep.from_scene(scene, args.driver)
     kind = "angle" if sweep.is_angular else "length"
     first = _given(args.first, "--from") or options.get("from")
@@ -548,6 +550,8 @@ def _follow(args: argparse.Namespace, scene) -> int:
         raise PinmechError(f"need 0 < --step <= --duration, got step {step} s, duration {duration} s")
     scheme = args.scheme or options.get("scheme", "taylor")
     gain = args.gain if args.gain is not None else float(options.get("gain", 0.0))
+    step_key = f"{scene.path}: [sweep] step" if not args.step and "step" in options else "--step"
+    checked_count(duration / step, step_key, f"{duration:g} s of path at a step of {step!r} s")
     check_timing(duration, step, gain, names=("--duration", "--step", "--gain" if args.gain is not None
                                               else f"{scene.path}: [sweep] gain"))
     mechanism = load_mechanism(scene)
@@ -672,6 +676,7 @@ def cmd_report(args: argparse.Namespace) -> int:
 
     if args.steps < 0 or args.steps == 1:
         raise PinmechError(f"--steps must be 0 (no sweep) or at least 2, got {args.steps}")
+    checked_count(args.steps, "--steps", f"steps = {args.steps}")
     hand_text = None
     scene = _scene(args)
     _check_page(args, scene, hand=args.hand)

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from pinmech.counts import checked_count
 from pinmech.exceptions import ModelError, SceneError, SweepError
 from pinmech.mechanism import Mechanism
 from pinmech.motion import Motion, evaluate_motion
@@ -69,8 +70,8 @@ class SweepPose:
 @dataclass(frozen=True)
 class DriverValues(Sequence):
     """`steps` evenly spaced driver values from `first` to `last` [rad or m], both ends
-    included, as `np.linspace` gives them but computed when read: a sweep of 1e10 poses
-    streams in constant memory."""
+    included, as `np.linspace` gives them but computed when read: a sweep streams in
+    constant memory. At most counts.MAX_POSES steps (OptionError beyond)."""
 
     first: float
     last: float
@@ -79,6 +80,7 @@ class DriverValues(Sequence):
     def __post_init__(self) -> None:
         if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
             raise ModelError(f"steps must be a positive whole number, got {self.steps!r}")
+        checked_count(self.steps, "steps", f"a sweep of {self.steps} steps")
         if not (math.isfinite(self.first) and math.isfinite(self.last)):
             raise ModelError(f"the driver's range must be finite numbers, got {self.first!r} to {self.last!r}")
 
