@@ -26,7 +26,8 @@ def checked_count(count: float, name: str, what: str) -> None:
     Raises:
         OptionError: naming `name`, the count and the limit.
     """
-    if not count <= MAX_POSES or not math.isfinite(count):
+    if not count <= MAX_POSES:
+        count = float(count) if count < 1e300 else math.inf
         raise OptionError(f"{name}: {what} is {count:.3g} poses, more than the {MAX_POSES:,} one run computes "
                           f"(minutes of work and gigabytes of rows already; this would not end): take a coarser "
                           f"step or split the range", option=name, value=count)

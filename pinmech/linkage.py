@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from pinmech.arguments import file_path
 from pinmech.directions import unit_vector, written
 from pinmech.exceptions import ModelError, UnitError
 from pinmech.units import to_si
@@ -98,7 +99,7 @@ def parse_linkage(path: str | Path) -> Linkage:
         ModelError: a missing file, malformed TOML, an unknown key or name, a value without
             units, a construction that cannot be drawn (circles that do not meet).
     """
-    path = Path(path)
+    path = file_path(path, "the linkage file")
     source = str(path)
     if not path.is_file():
         raise ModelError("no such linkage file", path=source)

@@ -29,6 +29,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.closures import CUT_TYPES, Closure
+from pinmech.arguments import file_path
 from pinmech.directions import unit_vector
 from pinmech.exceptions import FrameNotFound, ModelError
 from pinmech.urdf_joints import JointLimit, MimicJoint, joint_limits, mimic_joints, with_followers
@@ -156,7 +157,7 @@ class Mechanism:
             ModelError: malformed XML or URDF, or a malformed `<constraint>`.
             FrameNotFound: a locked joint that is not in the model.
         """
-        path = Path(path)
+        path = file_path(path, "the URDF")
         source = str(path)
         root = _parse_xml(path)
         _check_urdf_spelling(root, source)
@@ -471,7 +472,7 @@ def checked_numbers(x: Any, shape: tuple[int | None, ...], name: str, source: st
     (q, v, a) of the Python API."""
     try:
         out = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ModelError(f"{name} must be {_shape_words(shape)} numbers (SI), got {x!r:.80}", path=source) from None
     right = out.ndim == len(shape) and all(n is None or n == k for n, k in zip(shape, out.shape))
     if not right or not np.all(np.isfinite(out)):

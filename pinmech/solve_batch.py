@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from pinmech.arguments import float_array
 from pinmech.assembly_check import check_guessed_pose
 from pinmech.cut_arrays import ArrayCut, RowCut
 from pinmech.exceptions import AssemblyError
@@ -104,8 +105,11 @@ class BatchSolver:
             continuation found, as a sweep's.
         """
         s = self.solver
-        n = len(guesses)
-        Q = self._set_drivers(np.array(guesses, dtype=float), driver_q)
+        guesses = float_array(guesses, "guesses", (None, self.model.nq)).copy()
+        n, k = len(guesses), len(s.drivers)
+        driver_q, driver_v, driver_a = (float_array(x, name, (n, k)) for x, name in
+                                        ((driver_q, "driver_q"), (driver_v, "driver_v"), (driver_a, "driver_a")))
+        Q = self._set_drivers(guesses, driver_q)
         for cut in self._cuts:
             cut.allocate(n, self.model.nv)
         self._read_positions(Q, range(n))

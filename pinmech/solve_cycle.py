@@ -41,6 +41,7 @@ from pinmech.exceptions import (
     AssemblyError,
     DriverLimitError,
     LoopClosureError,
+    MobilityError,
     OptionError,
     PinmechError,
     SingularPoseError,
@@ -136,10 +137,18 @@ def solve_range(solver: LoopSolver, driver: str, values: Iterable[float], *, dri
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
         raise OptionError(f"chunk = {chunk!r} must be a whole number of poses, at least 1", option="chunk", value=chunk)
     cycle = _Cycle(solver, driver, driver_q, driver_v, driver_a, guess, start, batch, interpolate, through_folds)
-    values = iter(values)
+    try:
+        values = iter(values)
+    except TypeError:
+        raise OptionError(f"values must be an iterable of numbers (rad or m), got {values!r:.60}", option="values",
+                          value=values) from None
     index = 0
     while True:
-        xs = np.fromiter(islice(values, chunk), dtype=float)
+        try:
+            xs = np.fromiter(islice(values, chunk), dtype=float)
+        except (TypeError, ValueError, OverflowError) as exc:
+            raise OptionError(f"the driver values of {driver} must be numbers (rad or m) from position {index} on: "
+                              f"{exc}", option="values", value=None) from None
         if not xs.size:
             return
         if not np.all(np.isfinite(xs)):
@@ -154,13 +163,16 @@ class _Cycle:
     def __init__(self, solver: LoopSolver, driver: str, driver_q: np.ndarray, driver_v: np.ndarray,
                  driver_a: np.ndarray, guess: np.ndarray | None, start: str, batch: bool, interpolate: int,
                  through_folds: bool = False) -> None:
-        if start not in STARTS:
+        if not isinstance(start, str) or start not in STARTS:
             raise PinmechError(f"start must be one of {', '.join(STARTS)}, got {start!r}")
-        if int(interpolate) != interpolate or interpolate < 1:
+        if isinstance(interpolate, bool) or not isinstance(interpolate, (int, np.integer)) or interpolate < 1:
             raise PinmechError(f"interpolate must be a whole number of poses, at least 1, got {interpolate!r}")
+        if not isinstance(driver, str) or driver not in solver.drivers:
+            raise MobilityError(f"{driver!r} is not a driver ({', '.join(solver.drivers)})",
+                                mobility=solver.mechanism.mobility, drivers=len(solver.drivers))
         self.solver, self.k = solver, solver.drivers.index(driver)
-        self.q_drv = np.array(driver_q, dtype=float)
-        self.v_drv, self.a_drv = np.array(driver_v, dtype=float), np.array(driver_a, dtype=float)
+        self.q_drv = solver._ordered(driver_q).copy()
+        self.v_drv, self.a_drv = solver._ordered(driver_v).copy(), solver._ordered(driver_a).copy()
         others = np.delete(np.concatenate((self.v_drv, self.a_drv)), [self.k, self.k + len(self.v_drv)])
         self.alone = not np.any(others)  # only the swept driver moves
         if interpolate > 1 and (start != "predictor" or not self.alone):

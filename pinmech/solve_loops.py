@@ -19,6 +19,7 @@ from typing import Any, TypeVar
 import numpy as np
 import pinocchio as pin
 
+from pinmech.arguments import float_array, names
 from pinmech.assembly_check import check_guessed_pose
 from pinmech.branches import AssemblyStructure
 from pinmech.closures import CutEvaluator
@@ -82,7 +83,10 @@ def checked_option(name: str, value: Any) -> float | int:
     """
     low, high = SOLVER_RANGES[name]
     whole = name == "max_iterations"
-    number = float(value) if isinstance(value, (int, float, np.number)) and not isinstance(value, bool) else math.nan
+    try:
+        number = float(value) if isinstance(value, (int, float, np.number)) and not isinstance(value, bool) else math.nan
+    except OverflowError:  # an int beyond float64
+        number = math.inf
     ok = low <= number <= high and (not whole or number == int(number))  # NaN is in no range
     if not ok:
         kind = "a whole number" if whole else "a number"
@@ -264,7 +268,7 @@ class LoopSolver:
         self.mechanism = mechanism
         self.model = mechanism.model
         self.data = self.model.createData()
-        self.drivers = tuple(drivers)
+        self.drivers = names(drivers, "drivers")
         self.lock = threading.RLock()
         self.tol = tol
         self.max_iterations = max_iterations
@@ -568,6 +572,8 @@ class LoopSolver:
                 scales it), with how far apart each cut is [m, deg].
             SingularPoseError: the dependent-joint constraint Jacobian is singular.
         """
+        if not at_q:
+            q = float_array(q, "q", (self.model.nq,))
         if at_q:
             for cut in self._cuts:
                 cut.place(self.data)
@@ -776,11 +782,12 @@ class LoopSolver:
                             assembly=assembly, route=route)
 
     def _guess(self, guess: np.ndarray | None) -> np.ndarray:
-        q0 = self.mechanism.neutral() if guess is None else np.asarray(guess, dtype=float)
-        if q0.shape != (self.model.nq,) or not math.isfinite(sum(q0.tolist())):
-            raise ModelError(f"guess must be {self.model.nq} finite numbers, got shape {q0.shape}",
-                             path=self.mechanism.source)
-        return q0
+        if guess is None:
+            return self.mechanism.neutral()
+        try:
+            return float_array(guess, "guess", (self.model.nq,))
+        except ModelError as exc:
+            raise ModelError(str(exc), path=self.mechanism.source) from None
 
     def _ordered(self, values: Sequence[float] | Mapping[str, float] | None) -> np.ndarray:
         if (type(values) is np.ndarray and values.shape == (len(self.drivers),) and values.dtype == float
@@ -796,7 +803,7 @@ class LoopSolver:
             values = [values.get(n, 0.0) for n in self.drivers]
         try:
             out = np.asarray(values, dtype=float).reshape(-1)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise UnitError(f"driver values of {', '.join(self.drivers)} must be numbers in SI (rad or m), "
                             f"got {values!r:.80}: convert quantities first, e.g. pinmech.to_si('30 deg', "
                             f"'angle')") from None

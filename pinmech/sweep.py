@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from pinmech.arguments import real_number
 from pinmech.counts import checked_count
 from pinmech.exceptions import ModelError, SceneError, SweepError
 from pinmech.mechanism import Mechanism
@@ -81,6 +82,8 @@ class DriverValues(Sequence):
         if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
             raise ModelError(f"steps must be a positive whole number, got {self.steps!r}")
         checked_count(self.steps, "steps", f"a sweep of {self.steps} steps")
+        object.__setattr__(self, "first", real_number(self.first, "the driver's first value"))
+        object.__setattr__(self, "last", real_number(self.last, "the driver's last value"))
         if not (math.isfinite(self.first) and math.isfinite(self.last)):
             raise ModelError(f"the driver's range must be finite numbers, got {self.first!r} to {self.last!r}")
 
