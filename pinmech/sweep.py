@@ -28,7 +28,6 @@ from typing import Any
 import numpy as np
 
 from pinmech.arguments import real_number
-from pinmech.counts import checked_count
 from pinmech.exceptions import ModelError, SceneError, SweepError
 from pinmech.mechanism import Mechanism
 from pinmech.motion import Motion, evaluate_motion
@@ -72,7 +71,8 @@ class SweepPose:
 class DriverValues(Sequence):
     """`steps` evenly spaced driver values from `first` to `last` [rad or m], both ends
     included, as `np.linspace` gives them but computed when read: a sweep streams in
-    constant memory. At most counts.MAX_POSES steps (OptionError beyond)."""
+    constant memory (a sweep of 1e10 poses too: the commands refuse more than
+    counts.MAX_POSES before any work, as a study that would not end)."""
 
     first: float
     last: float
@@ -81,7 +81,6 @@ class DriverValues(Sequence):
     def __post_init__(self) -> None:
         if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
             raise ModelError(f"steps must be a positive whole number, got {self.steps!r}")
-        checked_count(self.steps, "steps", f"a sweep of {self.steps} steps")
         object.__setattr__(self, "first", real_number(self.first, "the driver's first value"))
         object.__setattr__(self, "last", real_number(self.last, "the driver's last value"))
         if not (math.isfinite(self.first) and math.isfinite(self.last)):
