@@ -101,9 +101,21 @@ class AssemblyStructure:
         self.names = tuple(b.name for b in self.blocks)
         self.plane_normal = plane_normal
         self._closures = closures
+        self._col_nv = [model.joints[_joint_of_v(model, int(v))].nv for v in dep_v]
         n = len(dep_v)
         whole = len(self.blocks) == 1 and len(self.blocks[0].rows) == n
         self._index = None if whole else [np.ix_(b.rows, b.cols) for b in self.blocks]
+
+    @property
+    def signs_name_every_assembly(self) -> bool:
+        """Whether the signature tells every assembly apart: a planar mechanism whose
+        blocks are each one loop in two one-freedom joints (a dyad, RRR, RRP, RPR...: at
+        most two assemblies, a circle or a line meeting a circle). Elsewhere a pose from a
+        guess is checked against continuation (assembly_check.py)."""
+        if self.plane_normal is None:
+            return False
+        return all(len(b.loops) == 1 and len(b.rows) == len(b.cols) == 2 and all(self._col_nv[c] == 1 for c in b.cols)
+                   for b in self.blocks)
 
     def signs(self, J_dep: np.ndarray) -> tuple[int, ...]:
         """The sign of each block's determinant (J_dep: dependent columns, any positive

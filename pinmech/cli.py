@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pinmech import __version__
+from pinmech.counts import checked_count
 from pinmech.exceptions import PinmechError, SceneError
 from pinmech.interrupts import SIGNALS
 
@@ -274,6 +275,13 @@ class _Option(NamedTuple):
         """How the user wrote it: "--steps", or "sweep.steps"."""
         return self.key or self.flag
 
+    @property
+    def where(self) -> str:
+        """Where the user wrote it, for a message: "--steps", or "scene.toml: [sweep] steps"."""
+        if self.key is None:
+            return self.flag
+        return f"{self.scene.path}: [sweep] {self.key.removeprefix('sweep.')}"
+
     def error(self, message: str) -> PinmechError:
         """A usage error naming the flag (exit 2), or a scene error naming the file and key (4)."""
         if self.key is None:
@@ -384,9 +392,11 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         return _follow(args, scene)
     figure = _check_outputs(args, scene)
     options = sweep_options(scene)  # the scene's values checked there, naming the file and key
-    steps = _option(args.steps, "--steps", scene, options, "steps", 361).value
+    given_steps = _option(args.steps, "--steps", scene, options, "steps", 361)
+    steps = given_steps.value
     if steps < 2:
-        raise PinmechError(f"--steps must be at least 2, got {steps}")
+        raise given_steps.error(f"must be at least 2, got {steps}")
+    checked_count(steps, given_steps.where, f"steps = {steps}")
     sweep = Sweep.from_scene(scene, args.driver)
     kind = "angle" if sweep.is_angular else "length"
     first = _option(_given(args.first, "--from"), "--from", scene, options, "from")
@@ -662,7 +672,7 @@ def _timing(args: argparse.Namespace, scene, options: dict[str, Any]) -> tuple[f
     if not 0 <= gain.value <= 1 / h:
         raise gain.error(f"must be a number from 0 to 1/step = {1 / h:.6g} [1/s] (a larger feedback overshoots "
                          f"within one step), got {gain.value!r}")
-    check_timing(T, h, float(gain.value), names=(duration.name, step.name, gain.name))
+    check_timing(T, h, float(gain.value), names=(duration.where, step.where, gain.where))
     return T, h, float(gain.value)
 
 
@@ -764,6 +774,7 @@ def cmd_report(args: argparse.Namespace) -> int:
 
     if args.steps < 0 or args.steps == 1:
         raise PinmechError(f"--steps must be 0 (no sweep) or at least 2, got {args.steps}")
+    checked_count(args.steps, "--steps", f"steps = {args.steps}")
     hand_text = None
     scene = _scene(args)
     _check_page(args, scene, hand=args.hand)

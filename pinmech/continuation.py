@@ -31,7 +31,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.core import core_for
-from pinmech.exceptions import AssemblyError, DriverLimitError, PinmechError
+from pinmech.exceptions import AssemblyError, DriverLimitError, PinmechError, SingularPoseError
 
 #: Largest step, in radians or mechanism sizes of driver motion.
 MAX_STEP = 0.25
@@ -127,15 +127,23 @@ class Path:
             if math.isfinite(sum(d1.tolist()) + sum(d2.tolist())):  # else the Python path names the overflow
                 signs = tuple(signs)
                 if not condition <= SINGULAR_NODE or 0 in signs:
-                    raise _Singular
+                    raise self._singular(q, condition, sigma_min)
                 return Node(p, q, d1, d2, signs, condition, sigma_min, v_res, a_res,
                             res if not at_q or residual is None else residual)
         if not at_q or residual is None:
             residual = max(max(map(abs, solver._residual(q).tolist()), default=0.0), solver._full_residual())
         d1, d2, condition, sigma_min, v_res, a_res, signs = solver._rates(q, self.d, self.zero, limit=math.inf)
         if not condition <= SINGULAR_NODE or 0 in signs:
-            raise _Singular
+            raise self._singular(q, condition, sigma_min)
         return Node(p, q, d1, d2, signs, condition, sigma_min, v_res, a_res, residual)
+
+    def _singular(self, q: np.ndarray, condition: float, sigma_min: float) -> _Singular:
+        solver = self.solver
+        return _Singular(
+            f"{solver.mechanism.source}: at {solver.describe_drivers(solver._driver_values(q))} the pose is too near "
+            f"a singular one to follow a path from (condition number {condition:.3g} > {SINGULAR_NODE:g}: its "
+            f"tangent is rounding noise, whatever max_condition allows); start from a pose farther from it",
+            condition=float(condition), sigma_min=float(sigma_min), partial=q)
 
     # ------------------------------------------------------------------ following
     def follow(self, node: Node, p_target: float, route: Route) -> Node:
@@ -312,8 +320,10 @@ class Path:
             value=tuple(self.drivers(node.p).tolist()))
 
 
-class _Singular(Exception):
-    """The dependent Jacobian is numerically singular at a node."""
+class _Singular(SingularPoseError):
+    """The dependent Jacobian is numerically singular at a node (condition number over
+    SINGULAR_NODE): no path goes on from there. Caught inside, where another step is tried;
+    where it leaves pinmech it is the SingularPoseError it derives from, named."""
 
 
 @dataclass

@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from pinmech.arguments import float_array
 from pinmech.closures import _cross
 from pinmech.exceptions import BalanceError, IndeterminateForcesError, ModelError, OptionError
 from pinmech.mechanism import Mechanism
@@ -211,10 +212,11 @@ class ForceSolver:
     ) -> None:
         self.mechanism = mechanism
         self.model = pin.Model(mechanism.model)  # a copy: its gravity is ours, not the user's
-        self.gravity = np.asarray(gravity, dtype=float).reshape(3)
-        if not np.all(np.isfinite(self.gravity)):
-            raise OptionError(f"gravity = {tuple(gravity)!r} must be three finite numbers [m/s^2]",
-                              option="gravity", value=gravity)
+        try:
+            self.gravity = float_array(gravity, "gravity", (3,))
+        except ModelError:
+            raise OptionError(f"gravity = {gravity!r:.80} must be three finite numbers [m/s^2]",
+                              option="gravity", value=gravity) from None
         self.model.gravity = pin.Motion(self.gravity, np.zeros(3))
         self.lock = threading.RLock()  # one Data: threads sharing the solver take turns
         self.data = self.model.createData()

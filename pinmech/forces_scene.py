@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from pinmech.directions import unit_vector, written
 from pinmech.exceptions import FrameNotFound, SceneError
 from pinmech.forces import ForceSolver, Load, advantage_unit, mechanical_advantage
 from pinmech.mechanism import Mechanism
@@ -100,11 +101,11 @@ def _gravity(scene: Scene) -> np.ndarray:
         raise SceneError("give acceleration = \"9.81 m/s^2\" and direction = [0, -1, 0] (world frame)",
                          path=where, key="gravity")
     size = scene.quantity(table["acceleration"], "acceleration", "gravity", "acceleration")
-    direction = _numbers(table["direction"], where, "gravity.direction")
-    norm = float(np.linalg.norm(direction))
-    if norm == 0:
-        raise SceneError("[0, 0, 0] is not a direction", path=where, key="gravity.direction")
-    return size * direction / norm
+    direction = unit_vector(_numbers(table["direction"], where, "gravity.direction"))
+    if direction is None:
+        raise SceneError(f"{written(table['direction'])} is not a direction (all zero)", path=where,
+                         key="gravity.direction")
+    return size * direction
 
 
 def _numbers(value: Any, where: str, key: str) -> np.ndarray:

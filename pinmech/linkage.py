@@ -26,6 +26,8 @@ from typing import Any
 
 import numpy as np
 
+from pinmech.arguments import file_path
+from pinmech.directions import unit_vector, written
 from pinmech.exceptions import ModelError, UnitError
 from pinmech.linkage_expr import check_param_name, length
 from pinmech.linkage_masses import LinkMass, parse_masses
@@ -99,7 +101,7 @@ def parse_linkage(path: str | Path) -> Linkage:
         ModelError: a missing file, malformed TOML, an unknown key or name, a value without
             units, a construction that cannot be drawn (circles that do not meet).
     """
-    path = Path(path)
+    path = file_path(path, "the linkage file")
     source = str(path)
     if not path.is_file():
         raise ModelError("no such linkage file", path=source)
@@ -289,11 +291,10 @@ def _spatial(linkage: Linkage, raw: dict[str, Any], source: str) -> None:
         if (not isinstance(value, list) or len(value) != 3
                 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
             raise ModelError(f"an axis is three numbers, e.g. [0, 0, 1], got {value!r}", path=source, element=where)
-        axis = np.array(value, dtype=float)
-        norm = float(np.linalg.norm(axis))
-        if not (math.isfinite(norm) and norm > 0):
-            raise ModelError(f"{value!r} is not a direction", path=source, element=where)
-        linkage.axes[name] = axis / norm
+        axis = unit_vector(value)
+        if axis is None:
+            raise ModelError(f"{written(value)} is not a direction (zero or not finite)", path=source, element=where)
+        linkage.axes[name] = axis
     for name in balls:
         if name not in linkage.points:
             raise ModelError(f"'{name}' is not a joint of [joints]", path=source, element="balls")

@@ -29,6 +29,8 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.closures import CUT_TYPES, Closure
+from pinmech.arguments import file_path, float_array
+from pinmech.directions import unit_vector
 from pinmech.exceptions import FrameNotFound, ModelError
 from pinmech.frame_names import frame_named, frames_of_kind, reduced_model
 from pinmech.inertia_check import model_inertia_caveats, urdf_inertia_caveats
@@ -162,7 +164,7 @@ class Mechanism:
             ModelError: malformed XML or URDF, or a malformed `<constraint>`.
             FrameNotFound: a locked joint that is not in the model.
         """
-        path = Path(path)
+        path = file_path(path, "the URDF")
         source = str(path)
         root = _parse_xml(path)
         _check_urdf_spelling(root, source)
@@ -435,7 +437,7 @@ class Mechanism:
                 joint and its norm).
         """
         nq = self.model.nq
-        out = checked_numbers(q, (None, nq) if many else (nq,), name, self.source)
+        out = float_array(q, name, (None, nq) if many else (nq,), self.source)
         rows = out if many else out[None]
         parts = self.__dict__.get("_unit_parts")
         if parts is None:  # the joints' types are fixed: found once
@@ -469,56 +471,6 @@ class Mechanism:
         if j.kind == "continuous":
             return float(np.arctan2(q[j.idx_q + 1], q[j.idx_q]))
         return float(q[j.idx_q])
-
-
-def checked_numbers(x: Any, shape: tuple[int | None, ...], name: str, source: str) -> np.ndarray:
-    """x as a float array of `shape` (None: any length) of finite numbers, else a
-    ModelError naming the argument and what it got. The one check of a vector argument
-    (q, v, a) of the Python API: complex, boolean or text values are refused, never cast."""
-    wrong = not_real(x)
-    if wrong:
-        raise ModelError(f"{name} must be real numbers (SI), got {wrong}: pinmech does not cast them", path=source)
-    try:
-        out = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise ModelError(f"{name} must be {_shape_words(shape)} numbers (SI), got {x!r:.80}", path=source) from None
-    right = out.ndim == len(shape) and all(n is None or n == k for n, k in zip(shape, out.shape))
-    if not right or not np.all(np.isfinite(out)):
-        raise ModelError(f"{name} must be {_shape_words(shape)} finite numbers (SI), got shape {out.shape}"
-                         + ("" if not right else " with a non-finite number"), path=source)
-    return out
-
-
-_NOT_REAL = {"b": "booleans", "c": "complex numbers", "U": "text", "S": "text", "M": "dates", "m": "time spans"}
-
-
-def not_real(x: Any) -> str:
-    """What in `x` (an array, a list of numbers or of rows) is not a real number, numpy
-    would cast in silence (a complex's imaginary part dropped, True read as 1): "booleans",
-    "complex numbers", "text"; "" when it holds real numbers (or is no array at all)."""
-    if isinstance(x, np.ndarray) and x.dtype.kind in "fiu":
-        return ""
-    try:
-        kind = np.asarray(x).dtype.kind
-    except (TypeError, ValueError):
-        return ""  # ragged or odd: the conversion that follows names it
-    if kind in _NOT_REAL:
-        return _NOT_REAL[kind]
-    items = x.tolist() if isinstance(x, np.ndarray) else x
-    rows = items if isinstance(items, (list, tuple)) else [items]
-    for row in rows:
-        for v in row if isinstance(row, (list, tuple, np.ndarray)) else [row]:
-            if isinstance(v, (bool, np.bool_)):
-                return "booleans"
-            if isinstance(v, (complex, np.complexfloating)):
-                return "complex numbers"
-    return ""
-
-
-def _shape_words(shape: tuple[int | None, ...]) -> str:
-    if len(shape) == 1 and shape[0] is not None:
-        return str(shape[0])
-    return "an (" + ", ".join("N" if n is None else str(n) for n in shape) + ") array of"
 
 
 # -------------------------------------------------------------------- XML reading
@@ -620,10 +572,11 @@ def _parse_constraint(el: ET.Element, model: pin.Model, links: list[str], source
         xyz = _vector(origin, "xyz", "0 0 0", where, source)
         rpy = _vector(origin, "rpy", "0 0 0", where, source)
         axis = _vector(el.find(f"{side}_axis"), "xyz", "0 0 1", where, source)
-        norm = np.linalg.norm(axis)
-        if norm == 0:
-            raise ModelError(f"<{side}_axis xyz=\"0 0 0\"/> is not a direction", path=source, element=where)
-        sides[side] = (link, pin.SE3(pin.rpy.rpyToMatrix(rpy), xyz), axis / norm)
+        unit = unit_vector(axis)
+        if unit is None:
+            raise ModelError(f"<{side}_axis xyz=\"{el.find(f'{side}_axis').get('xyz')}\"/> is not a direction",
+                             path=source, element=where)
+        sides[side] = (link, pin.SE3(pin.rpy.rpyToMatrix(rpy), xyz), unit)
     return _Cut(name, cut_type, sides["parent"][0], sides["child"][0], sides["parent"][1], sides["child"][1],
                 sides["parent"][2], sides["child"][2], source)
 

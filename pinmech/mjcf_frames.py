@@ -24,6 +24,8 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
+from pinmech.directions import unit_vector
+
 from pinmech.exceptions import ModelError
 
 ORIENTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
@@ -117,31 +119,31 @@ def _too_small(el: ET.Element, key: str, what: str, source: str) -> ModelError:
 def _quaternion(el: ET.Element, key: str, degrees: bool, sequence: str, source: str) -> np.ndarray:
     """The unit quaternion MuJoCo's compiler makes of one orientation attribute."""
     if key == "quat":
-        q = numbers(el, key, 4, source)
-        if not np.linalg.norm(q) >= _EPS:
+        q = unit_vector(numbers(el, key, 4, source))  # MuJoCo refuses only the zero quaternion
+        if q is None:
             raise _too_small(el, key, "a zero quaternion", source)
-        return q / np.linalg.norm(q)
+        return q
     if key == "axisangle":
         values = numbers(el, key, 4, source)
         axis, angle = values[:3], np.radians(values[3]) if degrees else values[3]
         if not np.linalg.norm(axis) >= _EPS:
             raise _too_small(el, key, "the axis has no length", source)
-        return np.array([np.cos(angle / 2), *(np.sin(angle / 2) * axis / np.linalg.norm(axis))])
+        return np.array([np.cos(angle / 2), *(np.sin(angle / 2) * unit_vector(axis))])
     if key == "zaxis":
         z = numbers(el, key, 3, source)
         if not np.linalg.norm(z) >= _EPS:
             raise _too_small(el, key, "the z axis has no length", source)
-        return z_to(z / np.linalg.norm(z))
+        return z_to(unit_vector(z))
     if key == "xyaxes":
         values = numbers(el, key, 6, source)
         x, y = values[:3], values[3:]
         if not np.linalg.norm(x) >= _EPS:
             raise _too_small(el, key, "the x axis has no length", source)
-        x = x / np.linalg.norm(x)
+        x = unit_vector(x)
         y = y - x * (x @ y)  # y made orthogonal to x, as MuJoCo does
         if not np.linalg.norm(y) >= _EPS:
             raise _too_small(el, key, "the y axis is parallel to the x axis (or has no length)", source)
-        y = y / np.linalg.norm(y)
+        y = unit_vector(y)
         return _from_matrix(np.column_stack([x, y, np.cross(x, y)]))
     angles = numbers(el, key, 3, source)  # euler: each axis of eulerseq in turn, moving (lower) or fixed (upper)
     angles = np.radians(angles) if degrees else angles

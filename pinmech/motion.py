@@ -19,7 +19,8 @@ import pinocchio as pin
 
 from pinmech.closures import _cross
 from pinmech.exceptions import FrameNotFound, ModelError
-from pinmech.mechanism import Mechanism, checked_numbers
+from pinmech.arguments import float_array
+from pinmech.mechanism import Mechanism
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -195,7 +196,7 @@ def _cut_slider(mechanism: Mechanism, data: pin.Data, closure) -> SliderMotion:
 
 def _vector(x: Any, size: int, name: str, mechanism: Mechanism) -> np.ndarray:
     """x as `size` finite floats, else a ModelError naming the argument and what it got."""
-    return checked_numbers(x, (size,), name, mechanism.source)
+    return float_array(x, name, (size,), mechanism.source)
 
 
 def _joint_motions(mechanism: Mechanism, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict[str, JointMotion]:

@@ -30,6 +30,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.closures import _cross
+from pinmech.counts import checked_count
 from pinmech.exceptions import TaskError
 from pinmech.mechanism import Mechanism
 from pinmech.results import RateSolution
@@ -183,6 +184,7 @@ def check_timing(duration: float, step: float, gain: float, *, names: tuple[str,
             raise TaskError(f"{name} must be a positive, finite time [s], got {value!r}")
     if step > duration:
         raise TaskError(f"{names[1]} ({step:g} s) must not be longer than {names[0]} ({duration:g} s)")
+    checked_count(duration / step, names[1], f"{duration:g} s of path at a step of {step!r} s")
     if isinstance(gain, bool) or not isinstance(gain, (int, float)) or not 0 <= gain <= 1 / step:
         raise TaskError(f"{names[2]} must be a number from 0 to 1/{names[1]} = {1 / step:.6g} [1/s] "
                         f"(a larger feedback overshoots within one step), got {gain!r}")

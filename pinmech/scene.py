@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from pinmech.arguments import file_path
 from pinmech.exceptions import SceneError
 from pinmech.units import JOINT_KINDS, to_si
 
@@ -67,7 +68,7 @@ class Scene:
         Raises:
             SceneError: missing file, malformed TOML, unknown keys, bad override.
         """
-        path = Path(path)
+        path = file_path(path, "the scene", SceneError)
         if not path.is_file():
             raise SceneError("no such scene file", path=str(path))
         try:

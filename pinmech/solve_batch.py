@@ -18,7 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from pinmech.arguments import float_array
+from pinmech.assembly_check import check_guessed_pose
 from pinmech.cut_arrays import ArrayCut, RowCut
+from pinmech.exceptions import AssemblyError
 from pinmech.results import Accuracy, LoopSolution
 from pinmech.solve_loops import DEFAULT_TOL, POLISH, LoopSolver, serialized
 
@@ -86,7 +89,8 @@ class BatchSolver:
 
     @serialized
     def try_solve(self, guesses: np.ndarray, driver_q: np.ndarray, driver_v: np.ndarray,
-                  driver_a: np.ndarray, max_step: float = MAX_BATCH_STEP) -> BatchSolution | None:
+                  driver_a: np.ndarray, max_step: float = MAX_BATCH_STEP, *,
+                  _on_path: bool = False) -> BatchSolution | None:
         """Solve N poses: guesses (N, nq), drivers' q, v, a (N, number of drivers).
 
         Returns:
@@ -94,11 +98,18 @@ class BatchSolver:
             guess too far from its solution (a Newton step over `max_step`), a loop
             that does not close within the iteration cap, a singular Jacobian, or a pose
             on another assembly than the solver's reference (branches.py). That solver
-            then says which pose, and why, in its own words.
+            then says which pose, and why, in its own words. Where the signature cannot
+            name every assembly (a block of several loops, a spatial loop), each pose is
+            compared with the one continuation reaches from the reference
+            (assembly_check.py), unless `_on_path`: the guesses lie between poses
+            continuation found, as a sweep's.
         """
         s = self.solver
-        n = len(guesses)
-        Q = self._set_drivers(np.array(guesses, dtype=float), driver_q)
+        guesses = float_array(guesses, "guesses", (None, self.model.nq)).copy()
+        n, k = len(guesses), len(s.drivers)
+        driver_q, driver_v, driver_a = (float_array(x, name, (n, k)) for x, name in
+                                        ((driver_q, "driver_q"), (driver_v, "driver_v"), (driver_a, "driver_a")))
+        Q = self._set_drivers(guesses, driver_q)
         for cut in self._cuts:
             cut.allocate(n, self.model.nv)
         self._read_positions(Q, range(n))
@@ -127,7 +138,19 @@ class BatchSolver:
         ref = s.reference
         if out is not None and ref is not None and ref.keep and np.any(out.signs != np.array(ref.signs)):
             return None  # a pose on another assembly than the solver's reference
+        if out is not None and ref is not None and ref.keep and not _on_path \
+                and not s.structure.signs_name_every_assembly and not self._on_reference(out.q, driver_q):
+            return None
         return out
+
+    def _on_reference(self, Q: np.ndarray, driver_q: np.ndarray) -> bool:
+        """Whether every pose is the one continuation reaches from the reference."""
+        try:
+            for q, x in zip(Q, driver_q):
+                check_guessed_pose(self.solver, q, np.array(x, dtype=float))
+        except AssemblyError:
+            return False
+        return True
 
     @serialized
     def measure(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> BatchSolution:

@@ -34,12 +34,14 @@ from itertools import islice
 
 import numpy as np
 
+from pinmech.assembly_check import check_guessed_pose
 from pinmech.continuation import Node, Path, Route, _Singular
 from pinmech.core import core_for
 from pinmech.exceptions import (
     AssemblyError,
     DriverLimitError,
     LoopClosureError,
+    MobilityError,
     OptionError,
     PinmechError,
     SingularPoseError,
@@ -138,10 +140,18 @@ def solve_range(solver: LoopSolver, driver: str, values: Iterable[float], *, dri
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
         raise OptionError(f"chunk = {chunk!r} must be a whole number of poses, at least 1", option="chunk", value=chunk)
     cycle = _Cycle(solver, driver, driver_q, driver_v, driver_a, guess, start, batch, interpolate, through_folds)
-    values = iter(values)
+    try:
+        values = iter(values)
+    except TypeError:
+        raise OptionError(f"values must be an iterable of numbers (rad or m), got {values!r:.60}", option="values",
+                          value=values) from None
     index = 0
     while True:
-        xs = np.fromiter(islice(values, chunk), dtype=float)
+        try:
+            xs = np.fromiter(islice(values, chunk), dtype=float)
+        except (TypeError, ValueError, OverflowError) as exc:
+            raise OptionError(f"the driver values of {driver} must be numbers (rad or m) from position {index} on: "
+                              f"{exc}", option="values", value=None) from None
         if not xs.size:
             return
         if not np.all(np.isfinite(xs)):
@@ -156,13 +166,16 @@ class _Cycle:
     def __init__(self, solver: LoopSolver, driver: str, driver_q: np.ndarray, driver_v: np.ndarray,
                  driver_a: np.ndarray, guess: np.ndarray | None, start: str, batch: bool, interpolate: int,
                  through_folds: bool = False) -> None:
-        if start not in STARTS:
+        if not isinstance(start, str) or start not in STARTS:
             raise PinmechError(f"start must be one of {', '.join(STARTS)}, got {start!r}")
-        if int(interpolate) != interpolate or interpolate < 1:
+        if isinstance(interpolate, bool) or not isinstance(interpolate, (int, np.integer)) or interpolate < 1:
             raise PinmechError(f"interpolate must be a whole number of poses, at least 1, got {interpolate!r}")
+        if not isinstance(driver, str) or driver not in solver.drivers:
+            raise MobilityError(f"{driver!r} is not a driver ({', '.join(solver.drivers)})",
+                                mobility=solver.mechanism.mobility, drivers=len(solver.drivers))
         self.solver, self.k = solver, solver.drivers.index(driver)
-        self.q_drv = np.array(driver_q, dtype=float)
-        self.v_drv, self.a_drv = np.array(driver_v, dtype=float), np.array(driver_a, dtype=float)
+        self.q_drv = solver._ordered(driver_q).copy()
+        self.v_drv, self.a_drv = solver._ordered(driver_v).copy(), solver._ordered(driver_a).copy()
         others = np.delete(np.concatenate((self.v_drv, self.a_drv)), [self.k, self.k + len(self.v_drv)])
         self.alone = not np.any(others)  # only the swept driver moves
         if interpolate > 1 and (start != "predictor" or not self.alone):
@@ -295,7 +308,7 @@ class _Cycle:
             guesses = self._hermite(x, q, d1, d2, solved, targets)[0]
             count = len(targets)
             out = self.batch.try_solve(guesses, self._drivers(x[targets]), np.tile(self.unit_v, (count, 1)),
-                                       np.tile(self.zero, (count, 1)))
+                                       np.tile(self.zero, (count, 1)), _on_path=True)
             if out is None or (ref.signs and np.any(out.signs != np.array(ref.signs))):
                 raise _Fallback
             q[targets], d1[targets], d2[targets] = out.q, out.v, out.a
@@ -432,6 +445,7 @@ class _Cycle:
             self._note(route)
             return node
         guess = ref.q if self.start == "warm" else self._cold_guess()
+        x_ref = self.q_drv.copy()
         self.q_drv[self.k] = p
         q, self._iterations, _ = solver.close(guess, self.q_drv)
         try:
@@ -447,6 +461,8 @@ class _Cycle:
                 f"lands on {solver.structure.change(ref.signs, new.signs, solver.data, whose=_SWEEPS)}: use the "
                 "predictor start",
                 expected=ref.signs, found=new.signs, drivers=solver.drivers, value=tuple(self.q_drv.tolist()))
+        if solver._cuts and solver.reference is not None and solver.reference.keep:  # as one sign may not tell
+            check_guessed_pose(solver, q, self.q_drv.copy(), start=(ref.q, x_ref))
         return new
 
     def _first(self, p: float) -> Node:
@@ -593,7 +609,7 @@ class _Cycle:
         pose by pose (a guess too far for the batch)."""
         n, ref = len(at), self.ref
         out = self.measurer.try_solve(guesses, self._drivers(at), np.tile(self.unit_v, (n, 1)),
-                                      np.tile(self.zero, (n, 1)), max_step=MEASURE_STEP)
+                                      np.tile(self.zero, (n, 1)), max_step=MEASURE_STEP, _on_path=True)
         if out is not None and not (ref.signs and np.any(out.signs != np.array(ref.signs))):
             return out.q, out.v, out.a
         solver = self.solver

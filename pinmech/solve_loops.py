@@ -19,6 +19,8 @@ from typing import Any, TypeVar
 import numpy as np
 import pinocchio as pin
 
+from pinmech.arguments import float_array, names, not_real
+from pinmech.assembly_check import check_guessed_pose
 from pinmech.branches import AssemblyStructure
 from pinmech.closures import CutEvaluator
 from pinmech.continuation import Path, Route
@@ -33,7 +35,7 @@ from pinmech.exceptions import (
     SingularPoseError,
     UnitError,
 )
-from pinmech.mechanism import Mechanism, not_real
+from pinmech.mechanism import Mechanism
 from pinmech.results import Accuracy, LoopSolution
 
 #: Default closure tolerance (dimensionless: metres per metre of mechanism, or radians).
@@ -81,7 +83,10 @@ def checked_option(name: str, value: Any) -> float | int:
     """
     low, high = SOLVER_RANGES[name]
     whole = name == "max_iterations"
-    number = float(value) if isinstance(value, (int, float, np.number)) and not isinstance(value, bool) else math.nan
+    try:
+        number = float(value) if isinstance(value, (int, float, np.number)) and not isinstance(value, bool) else math.nan
+    except OverflowError:  # an int beyond float64
+        number = math.inf
     ok = low <= number <= high and (not whole or number == int(number))  # NaN is in no range
     if not ok:
         kind = "a whole number" if whole else "a number"
@@ -211,6 +216,14 @@ class Reference:
     keep: bool = True
     iterations: int = 0
 
+    def __post_init__(self) -> None:
+        """The arrays are read-only copies: the solver goes on from them, so a write into
+        the ones the API returns must not change its reference."""
+        for name in ("driver_q", "q"):
+            array = np.array(getattr(self, name), dtype=float)
+            array.flags.writeable = False
+            object.__setattr__(self, name, array)
+
 
 class LoopSolver:
     """Solves one mechanism pose after pose, keeping Pinocchio `Data` and buffers alive.
@@ -255,7 +268,7 @@ class LoopSolver:
         self.mechanism = mechanism
         self.model = mechanism.model
         self.data = self.model.createData()
-        self.drivers = tuple(drivers)
+        self.drivers = names(drivers, "drivers")
         self.lock = threading.RLock()
         self.tol = tol
         self.max_iterations = max_iterations
@@ -559,7 +572,7 @@ class LoopSolver:
                 scales it), with how far apart each cut is [m, deg].
             SingularPoseError: the dependent-joint constraint Jacobian is singular.
         """
-        if not at_q and not (type(q) is np.ndarray and q.dtype == float):  # a user's q: checked, never cast
+        if not at_q:  # a user's q: checked (shape, finite, real, unit norms), never cast
             q = self.mechanism.checked_q(q)
         if at_q:
             for cut in self._cuts:
@@ -664,7 +677,8 @@ class LoopSolver:
         With a reference (`set_reference`) and no guess, the pose is reached from the
         reference by continuation along the straight driver path, on its assembly. With
         a guess (or no reference), Newton starts from the guess; a reference's assembly
-        is then checked.
+        is then checked: the pose must be the one continuation reaches (assembly_check.py),
+        which the signature alone cannot tell where a block has more than two assemblies.
 
         Args:
             driver_q: driver coordinates [rad or m], in the order of `drivers` or by name.
@@ -689,9 +703,13 @@ class LoopSolver:
         if guess is None and ref is not None:  # assembly "any": Newton from the reference pose
             guess = ref.q
         q, iterations, residual = self.close(self._guess(guess), dq)
+        route = None
         if ref is None:  # the first pose solved names the assembly of the later ones
             self.set_reference(dq, q)
-        return self._solution(q, dv, da, residual, iterations, None)
+        elif ref.keep and self._cuts:  # the pose continuation reaches, or AssemblyError
+            passed = check_guessed_pose(self, q, dq)
+            route = passed if passed.change_points else None
+        return self._solution(q, dv, da, residual, iterations, route)
 
     @serialized
     def follow(self, q0: np.ndarray, x0: np.ndarray, x1: np.ndarray, route: Route, *,
@@ -764,14 +782,9 @@ class LoopSolver:
                             assembly=assembly, route=route)
 
     def _guess(self, guess: np.ndarray | None) -> np.ndarray:
-        if guess is not None and not_real(guess):
-            raise ModelError(f"guess must be real numbers, got {not_real(guess)}: pinmech does not cast them",
-                             path=self.mechanism.source)
-        q0 = self.mechanism.neutral() if guess is None else np.asarray(guess, dtype=float)
-        if q0.shape != (self.model.nq,) or not math.isfinite(sum(q0.tolist())):
-            raise ModelError(f"guess must be {self.model.nq} finite numbers, got shape {q0.shape}",
-                             path=self.mechanism.source)
-        return q0
+        if guess is None:
+            return self.mechanism.neutral()
+        return float_array(guess, "guess", (self.model.nq,), self.mechanism.source)
 
     def _ordered(self, values: Sequence[float] | Mapping[str, float] | None) -> np.ndarray:
         if (type(values) is np.ndarray and values.shape == (len(self.drivers),) and values.dtype == float
@@ -792,7 +805,7 @@ class LoopSolver:
                             f"got {wrong}, which pinmech does not cast{hint}")
         try:
             out = np.asarray(values, dtype=float).reshape(-1)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise UnitError(f"driver values of {', '.join(self.drivers)} must be numbers in SI (rad or m), "
                             f"got {values!r:.80}: convert quantities first, e.g. pinmech.to_si('30 deg', "
                             f"'angle')") from None

@@ -33,8 +33,9 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from pinmech.arguments import not_real
 from pinmech.exceptions import ModelError, SingularPoseError, TaskError
-from pinmech.mechanism import Mechanism, not_real
+from pinmech.mechanism import Mechanism
 from pinmech.results import RateSolution
 from pinmech.solve_loops import (
     DEFAULT_MAX_CONDITION,

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from pinmech.arguments import real_number
 from pinmech.exceptions import ModelError, SceneError, SweepError
 from pinmech.mechanism import Mechanism
 from pinmech.motion import Motion, evaluate_motion
@@ -69,8 +70,9 @@ class SweepPose:
 @dataclass(frozen=True)
 class DriverValues(Sequence):
     """`steps` evenly spaced driver values from `first` to `last` [rad or m], both ends
-    included, as `np.linspace` gives them but computed when read: a sweep of 1e10 poses
-    streams in constant memory."""
+    included, as `np.linspace` gives them but computed when read: a sweep streams in
+    constant memory (a sweep of 1e10 poses too: the commands refuse more than
+    counts.MAX_POSES before any work, as a study that would not end)."""
 
     first: float
     last: float
@@ -79,6 +81,8 @@ class DriverValues(Sequence):
     def __post_init__(self) -> None:
         if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
             raise ModelError(f"steps must be a positive whole number, got {self.steps!r}")
+        object.__setattr__(self, "first", real_number(self.first, "the driver's first value"))
+        object.__setattr__(self, "last", real_number(self.last, "the driver's last value"))
         if not (math.isfinite(self.first) and math.isfinite(self.last)):
             raise ModelError(f"the driver's range must be finite numbers, got {self.first!r} to {self.last!r}")
 

@@ -138,7 +138,7 @@ def to_si(value: Any, kind: str, *, where: str = "") -> float:
         UnitError: unknown unit, wrong dimension, missing unit, a decimal comma, two
             numbers, or not finite.
     """
-    if kind not in SI_UNITS:
+    if not isinstance(kind, str) or kind not in SI_UNITS:
         raise UnitError(f"unknown kind of quantity {kind!r}; one of {', '.join(SI_UNITS)}", key=where)
     if isinstance(value, bool) or not isinstance(value, (int, float, str)):
         raise UnitError(f"expected a quantity such as '1.5 {_example(kind)}', got {value!r}", key=where)
@@ -278,6 +278,8 @@ def _wrong_kind(text: str, kind: str, has_angle: bool, powers: dict[str, Any] | 
 
 def _no_unit(value: Any, kind: str) -> str:
     number = value if isinstance(value, (int, float)) else _leading_number(value)
+    if isinstance(number, int) and abs(number) > 1e308:  # an int beyond float64
+        number = math.inf
     if number is not None and not math.isfinite(number):  # "nan rpm" is refused too: say what is wrong
         return f"{value!r} is not a finite number ({kind.replace('_', ' ')})"
     return f"{value!r} has no unit: write it as '{value} {_example(kind)}' ({kind.replace('_', ' ')})"

@@ -12,7 +12,9 @@ rounding).
 
 from __future__ import annotations
 
+import functools
 import math
+from pathlib import Path
 
 import closed_form
 import numpy as np
@@ -553,3 +555,149 @@ def test_the_return_message_speaks_only_of_whole_turns_it_saw(tmp_path, capsys):
     scene.write_text('urdf = "g.urdf"\n[drivers.O2]\nangle = "60 deg"\n[solver]\ntol = 1e-3\n')
     assert main(["sweep", str(scene), "--steps", "9", "--csv", str(tmp_path / "s.csv")]) == 0
     assert "the mechanism is back where it began" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------------- a block of two loops: four assemblies
+#: The bundled Stephenson six-bar (models/linkages/stephenson.toml) in the closed form's
+#: terms: four-bar O2-A-B-O4, coupler point C (AC = BC = 70 mm, left of A->B), dyad C-D-O6.
+FAR = {"a": 0.04, "b": 0.12, "c": 0.08, "d": 0.10, "cx": 0.06, "cy": math.sqrt(0.07**2 - 0.06**2),
+       "b2": 0.08, "c2": 0.06, "o6": (0.16, 0.11)}
+_PIVOTS = {"O2": np.zeros(2), "O4": np.array([0.10, 0.0]), "O6": np.array([0.16, 0.11])}
+#: Each joint's link, as the direction between two pins, and the joint it hangs from.
+_LINK_OF = {"O2": ("O2", "A", None), "A": ("A", "B", "O2"), "O4": ("O4", "B", None), "O6": ("O6", "D", None),
+            "D": ("D", "C", "O6")}
+
+
+def _far_pins(mech: Mechanism, q: np.ndarray) -> dict[str, np.ndarray]:
+    import pinocchio as pin
+
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, q)
+    frame = {"A": "A", "B": "B__parent", "C": "C__parent", "D": "D"}
+    return {k: data.oMf[mech.model.getFrameId(f)].translation[:2].copy() for k, f in frame.items()} | _PIVOTS
+
+
+def _far_q(mech: Mechanism, pins: dict[str, np.ndarray]) -> np.ndarray:
+    """The joint coordinates of a pose given by its pins: each joint turns its link by the
+    change of the link's direction since the drawing, less its parent link's."""
+    q0 = mech.neutral()
+    drawn, pins = _far_pins(mech, q0), pins | _PIVOTS
+
+    def turned(joint):
+        tail, head, _ = _LINK_OF[joint]
+        now, then = pins[head] - pins[tail], drawn[head] - drawn[tail]
+        return math.atan2(now[1], now[0]) - math.atan2(then[1], then[0])
+
+    q = q0.copy()
+    for joint, (_, _, parent) in _LINK_OF.items():
+        mech.set_coordinate(q, joint, mech.coordinate(q0, joint) + turned(joint) - (turned(parent) if parent else 0.0))
+    return q
+
+
+@functools.lru_cache(maxsize=1)
+def _far_track(phi0: float) -> dict[int, dict]:
+    """The closed form's root reached from the drawn pose (four-bar branch +1, crank at 0)
+    at the drawn far-crank angle phi0, moving the far crank up in steps to each whole
+    degree up to 245: at each step the root of the same four-bar branch nearest the last
+    crank angle (the roots at one angle are at least 0.1 rad apart here)."""
+    from closed_form_six_bar import stephenson_far_crank
+
+    theta, out = 0.0, {}
+    for degrees in range(math.ceil(math.degrees(phi0)), 246):
+        roots = [r for r in stephenson_far_crank(math.radians(degrees), **FAR, samples=2000) if r["branch"] == 1]
+        out[degrees] = min(roots, key=lambda r: abs(math.remainder(r["theta2"] - theta, 2 * math.pi)))
+        theta = out[degrees]["theta2"]
+    return out
+
+
+def _continued_far_assembly(phi0: float, degrees: float) -> dict:
+    """The pins of the continued root at a whole number of degrees of the far crank."""
+    return _far_track(phi0)[round(degrees)]
+
+
+def test_a_guess_on_another_assembly_of_a_two_loop_block_is_refused_though_its_sign_is_the_same():
+    """Issue 22 item 11: the Stephenson six-bar driven at its far crank O6 has one block of
+    two loops (B+C) and, at O6 = 240 deg, four assemblies (the closed form: the coupler curve
+    of C meets the circle about D four times). From the drawn pose, continuation reaches one
+    of them; a guess on each of the four is accepted on that one only (AssemblyError on the
+    three others, two of which share its determinant's sign). Positions to 1e-12 of the
+    0.2 m size: closed to 1e-13, condition numbers below 1e2 at these poses."""
+    from closed_form_six_bar import stephenson_far_crank
+
+    mech = pinmech.load_linkage(Path(__file__).parents[1] / "models" / "linkages" / "stephenson.toml")
+    solver = LoopSolver(mech, ["O6"])
+    q0 = mech.neutral()
+    phi0, phi = mech.coordinate(q0, "O6"), math.radians(240)
+    ref = solver.set_reference([phi0], q0)
+    assert solver.structure.names == ("B+C",)
+    drawn = min((r for r in stephenson_far_crank(phi0, **FAR) if r["branch"] == 1), key=lambda r: abs(r["theta2"]))
+    np.testing.assert_allclose(drawn["C"], _far_pins(mech, ref.q)["C"], rtol=0, atol=1e-12 * 0.2)
+    expected = _continued_far_assembly(phi0, 240)
+    continued = solver.solve([phi])
+    for pin_name in "ABCD":
+        np.testing.assert_allclose(_far_pins(mech, continued.q)[pin_name], expected[pin_name], rtol=0, atol=1e-12 * 0.2)
+    assemblies = stephenson_far_crank(phi, **FAR)
+    assert len(assemblies) == 4
+    same_sign = 0
+    for other in assemblies:
+        guess = _far_q(mech, other)
+        np.testing.assert_allclose(_far_pins(mech, guess)["C"], other["C"], rtol=0, atol=1e-12 * 0.2)
+        is_it = np.allclose(other["C"], expected["C"], rtol=0, atol=1e-9)
+        sign = LoopSolver(mech, ["O6"]).solve([phi], guess=guess).assembly.signs
+        same_sign += sign == continued.assembly.signs and not is_it
+        if is_it:
+            sol = solver.solve([phi], guess=guess)
+            np.testing.assert_allclose(_far_pins(mech, sol.q)["C"], expected["C"], rtol=0, atol=1e-12 * 0.2)
+        else:
+            with pytest.raises(AssemblyError, match="O6 = (240|-120) deg"):
+                solver.solve([phi], guess=guess)
+    assert same_sign >= 1  # the case the sign alone let through
+
+
+@pytest.mark.parametrize("start", ["cold", "warm"])
+def test_a_cold_or_warm_sweep_of_a_two_loop_block_never_lands_on_another_assembly_of_its_sign(start):
+    """The same six-bar swept at 236..244 deg from the guess of an assembly that has the
+    continued one's sign but is another (closed form, as above): each row is the closed
+    form's continued assembly (to 1e-12 of the size) or an AssemblyError, never the other."""
+    from closed_form_six_bar import stephenson_far_crank
+
+    mech = pinmech.load_linkage(Path(__file__).parents[1] / "models" / "linkages" / "stephenson.toml")
+    solver = LoopSolver(mech, ["O6"])
+    q0 = mech.neutral()
+    phi0, phi = mech.coordinate(q0, "O6"), math.radians(240)
+    solver.set_reference([phi0], q0)
+    signs = solver.solve([phi]).assembly.signs
+    expected = _continued_far_assembly(phi0, 240)
+    others = [r for r in stephenson_far_crank(phi, **FAR) if not np.allclose(r["C"], expected["C"], atol=1e-9)]
+    twin = next(r for r in others if LoopSolver(mech, ["O6"]).solve([phi], guess=_far_q(mech, r)).assembly.signs
+                == signs)
+    values = np.radians([240.0, 242.0, 244.0])
+    chunks = list(solve_range(solver, "O6", values, driver_q=np.zeros(1), driver_v=np.ones(1), driver_a=np.zeros(1),
+                              guess=_far_q(mech, twin), start=start))
+    q = np.concatenate([c.solution.q for c in chunks])
+    errors = {c.start + j: e for c in chunks for j, e in c.errors.items()}
+    for i, value in enumerate(values):
+        if i in errors:
+            assert isinstance(errors[i], AssemblyError)
+            continue
+        right = _continued_far_assembly(phi0, math.degrees(value))
+        np.testing.assert_allclose(_far_pins(mech, q[i])["C"], right["C"], rtol=0, atol=1e-12 * 0.2)
+
+
+def test_the_batch_solver_never_takes_a_guess_on_another_assembly_of_a_two_loop_block():
+    """BatchSolver.try_solve from the guess of the same-sign twin assembly (closed form, as
+    above): None (the pose-by-pose solver decides), never that pose; a four-bar's dyad,
+    whose sign names both of its assemblies, is still batched."""
+    from closed_form_six_bar import stephenson_far_crank
+
+    mech = pinmech.load_linkage(Path(__file__).parents[1] / "models" / "linkages" / "stephenson.toml")
+    solver = LoopSolver(mech, ["O6"])
+    q0 = mech.neutral()
+    phi0, phi = mech.coordinate(q0, "O6"), math.radians(240)
+    solver.set_reference([phi0], q0)
+    signs = solver.solve([phi]).assembly.signs
+    expected = _continued_far_assembly(phi0, 240)
+    twin = next(r for r in stephenson_far_crank(phi, **FAR) if not np.allclose(r["C"], expected["C"], atol=1e-9)
+                and LoopSolver(mech, ["O6"]).solve([phi], guess=_far_q(mech, r)).assembly.signs == signs)
+    zeros = np.zeros((1, 1))
+    assert pinmech.BatchSolver(solver).try_solve(_far_q(mech, twin)[None], np.array([[phi]]), zeros, zeros) is None

@@ -346,3 +346,28 @@ def test_a_static_sweeps_json_lines_carry_the_mechanical_advantage(scenes_dir, t
     column = [float(r["mechanical_advantage [1]"]) for r in csv.DictReader(out.open())]
     json_values = [json.loads(line)["forces"]["mechanical_advantage"] for line in lines.read_text().splitlines()]
     assert json_values == pytest.approx(column, rel=1e-9)
+
+
+@pytest.mark.parametrize(("direction", "unit"), [
+    ("[0, -1e200, 0]", (0.0, -1.0, 0.0)),          # its norm overflowed: gravity went off in silence
+    ("[1e-200, 0, 0]", (1.0, 0.0, 0.0)),           # its norm underflowed: refused as [0, 0, 0]
+    ("[0, -1e308, 1e308]", (0.0, -2**-0.5, 2**-0.5)),  # a NaN direction, refused with numpy's words
+    ("[3e-320, -4e-320, 0]", (0.6, -0.8, 0.0)),    # subnormal components: still a 3-4-5 triangle
+])
+def test_a_gravity_direction_at_any_scale_is_its_unit_vector(tmp_path, direction, unit):
+    """Issue 22 item 9: gravity is 9.81 m/s^2 along direction / |direction|, whatever the
+    components' scale. The expected unit vectors are exact (0, +-1, 1/sqrt 2, 3-4-5), so the
+    tolerance is a few units in the last place (rtol 1e-15)."""
+    path = tmp_path / "scene.toml"
+    text = SCENE.read_text().replace('urdf = "../', f'urdf = "{SCENE.parent.parent}/')
+    path.write_text(text.replace("direction = [0, -1, 0]", f"direction = {direction}"))
+    gravity = pinmech.force_settings(pinmech.Scene.load(path)).gravity
+    np.testing.assert_allclose(gravity, 9.81 * np.array(unit), rtol=1e-15, atol=1e-300)
+
+
+def test_a_zero_gravity_direction_is_named_as_written(tmp_path, capsys):
+    path = tmp_path / "scene.toml"
+    text = SCENE.read_text().replace('urdf = "../', f'urdf = "{SCENE.parent.parent}/')
+    path.write_text(text.replace("direction = [0, -1, 0]", "direction = [0.0, -0.0, 0]"))
+    assert main(["forces", str(path)]) == 4
+    assert "gravity.direction: [0.0, -0.0, 0] is not a direction" in capsys.readouterr().err

@@ -249,3 +249,28 @@ def test_a_mimic_pair_with_a_continuous_joint_is_refused_in_one_line(tmp_path, m
     with pytest.raises(ModelError, match="'A' is a continuous joint") as info:
         Mechanism.from_urdf(write(tmp_path, "r.urdf", text))
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("written", ["0 0 1e200", "0 0 1e-200", "0 0 3e-320"])
+def test_a_cut_axis_at_any_scale_is_its_unit_vector(tmp_path, written):
+    """Issue 22 item 9 (its class: every user vector normalised): a <constraint>'s axis is
+    xyz / |xyz| whatever the scale; 1e200 overflowed the norm and 1e-200 underflowed it.
+    Expected: the z axis, exactly."""
+    from tests._mechanisms import four_bar_urdf, write
+
+    text = four_bar_urdf().replace('<parent_axis xyz="0 0 1"/>', f'<parent_axis xyz="{written}"/>')
+    assert written in text
+    closure = Mechanism.from_urdf(write(tmp_path, "fb.urdf", text)).closures[0]
+    np.testing.assert_allclose(closure.axis, [0.0, 0.0, 1.0], rtol=0, atol=0)
+
+
+@pytest.mark.parametrize("axis", ["[0.0, 0.0, 1e200]", "[0.0, 0.0, 1e-200]"])
+def test_a_drawn_linkage_axis_at_any_scale_is_its_unit_vector(tmp_path, axis, models_dir):
+    """The same for a linkage file's [axes]: R1's axis, written at 1e200 or 1e-200 of the
+    bundled RSUR's [0, 0, 1], gives the same mechanism (the z axis, exactly)."""
+    from pinmech.linkage import parse_linkage
+
+    text = (models_dir / "linkages" / "rsur.toml").read_text().replace("R1 = [0.0, 0.0, 1.0]", f"R1 = {axis}")
+    path = tmp_path / "rsur.toml"
+    path.write_text(text)
+    np.testing.assert_allclose(parse_linkage(path).axes["R1"], [0.0, 0.0, 1.0], rtol=0, atol=0)

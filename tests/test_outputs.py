@@ -112,7 +112,7 @@ def test_driver_values_are_linspace_without_its_array():
     assert len(huge) == 10**10 and huge[-1] == 1.0 and huge[1] == pytest.approx(1 / (10**10 - 1), rel=1e-15)
 
 
-def _sweep_process(scene: Path, folder: Path, steps: str = "10000000000") -> subprocess.Popen:
+def _sweep_process(scene: Path, folder: Path, steps: str = "10000000") -> subprocess.Popen:  # counts.MAX_POSES
     return subprocess.Popen(
         [sys.executable, "-m", "pinmech", "sweep", str(scene), "--from", "-20 deg", "--to", "-10 deg",
          "--steps", steps, "--csv", str(folder / "b.csv"), "--json", str(folder / "b.jsonl")],
@@ -129,7 +129,7 @@ def _wait_for_rows(folder: Path, process: subprocess.Popen) -> None:
 
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
-def test_a_signal_stops_a_sweep_of_1e10_poses_with_one_line_and_agreeing_partial_files(singular_at_zero, tmp_path, signum):
+def test_a_signal_stops_a_sweep_of_1e7_poses_with_one_line_and_agreeing_partial_files(singular_at_zero, tmp_path, signum):
     process = _sweep_process(singular_at_zero, tmp_path)
     _wait_for_rows(tmp_path, process)
     process.send_signal(signum)

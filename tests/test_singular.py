@@ -305,3 +305,48 @@ def test_the_report_shows_the_condition_number_and_the_bounds(scenes_dir, capsys
     assert accuracy["relative_error_bound_velocity"] == pytest.approx(4 * k**2 * m)
     assert accuracy["relative_error_bound_acceleration"] == pytest.approx(16 * k**3 * m)
     assert accuracy["estimated_relative_error"] == accuracy["relative_error_bound_acceleration"]
+
+
+# ---------------------------------------------------------------------- internal signals never leave pinmech
+def _parallelogram_at(tmp_path, theta: float, max_condition: float):
+    """The parallelogram a = c = 50 mm, b = d = 100 mm closed on its parallelogram branch
+    at crank angle theta (coupler parallel to the ground: A's coordinate -theta, rocker
+    theta), as the solver's reference. At theta = 0 its two branches cross: the
+    dependent Jacobian's condition number grows as 1/theta."""
+    mech = Mechanism.from_urdf(write(tmp_path, "pg.urdf", four_bar_urdf(0.05, 0.1, 0.05, 0.1)))
+    q = mech.neutral()
+    for name, value in (("O2", theta), ("A", -theta), ("O4", theta)):
+        mech.set_coordinate(q, name, value)
+    solver = LoopSolver(mech, ["O2"], max_condition=max_condition)
+    return mech, solver, solver.set_reference([theta], q)
+
+
+def test_a_reference_on_a_crossing_under_a_raised_max_condition_is_a_singular_pose_error(tmp_path):
+    """Issue 22 item 13: with max_condition = 1e15 (allowed), a reference 1e-11 rad from the
+    parallelogram's crossing (condition number about 1e11, above the 1e10 where a path's
+    tangent is noise) let continuation's internal signal out, with no message. Now:
+    SingularPoseError naming the pose and its condition number, from solve and from a sweep."""
+    from pinmech.solve_cycle import solve_range
+
+    _, solver, _ = _parallelogram_at(tmp_path, 1e-11, 1e15)
+    with pytest.raises(SingularPoseError, match=r"O2 = .*condition number") as info:
+        solver.solve([0.5])
+    assert info.value.condition > 1e10
+    chunks = solve_range(solver, "O2", [0.3, 0.5], driver_q=np.zeros(1), driver_v=np.ones(1), driver_a=np.zeros(1))
+    try:
+        errors = [e for c in chunks for e in c.errors.values()]
+    except SingularPoseError as exc:
+        errors = [exc]
+    assert errors and all(isinstance(e, SingularPoseError) and str(e) for e in errors)
+
+
+def test_the_reference_the_api_returns_cannot_be_written_into(tmp_path):
+    """Issue 22 item 13: writing into `Reference.q` corrupted the solver's reference (the
+    next solve raised an internal signal with an empty message). Its arrays are read-only;
+    the solver then still answers the closed form: on the parallelogram branch the rocker
+    turns with the crank (theta4 = theta2), to 1e-12 rad (closed to 1e-13, condition ~5)."""
+    mech, solver, ref = _parallelogram_at(tmp_path, 1.0, 1e4)
+    for array in (ref.q, ref.driver_q):
+        with pytest.raises(ValueError, match="read-only"):
+            array[:] = 0.0
+    np.testing.assert_allclose(mech.coordinate(solver.solve([1.3]).q, "O4"), 1.3, rtol=0, atol=1e-12)

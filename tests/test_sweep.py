@@ -234,3 +234,20 @@ def test_the_progress_bar_shows_on_a_terminal_only(monkeypatch):
     monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
     bar = _progress(range(3), 3)
     assert type(bar).__name__ == "tqdm" and list(bar) == [0, 1, 2]
+
+
+def test_a_sweep_of_absurdly_many_steps_is_refused_before_any_work(scenes_dir, tmp_path, capsys):
+    """Issue 22 item 16's class: `--steps 100000000000` (or `[sweep] steps`) is over
+    counts.MAX_POSES (10 million): exit 2 before the first row, naming where it was asked
+    and the count (the signal tests of test_outputs.py run the limit itself)."""
+
+    out = tmp_path / "rows.csv"
+    assert main(["sweep", str(scenes_dir / "four_bar.toml"), "--steps", "100000000000", "--csv", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "--steps" in err and "1e+11 poses" in err and "10,000,000" in err and not out.exists()
+    scene = tmp_path / "fb.toml"
+    text = (scenes_dir / "four_bar.toml").read_text().replace('urdf = "../', f'urdf = "{scenes_dir.parent}/')
+    assert "[sweep]\n" in text
+    scene.write_text(text.replace("[sweep]\n", "[sweep]\nsteps = 20000000\n"))
+    assert main(["sweep", str(scene)]) == 2
+    assert "fb.toml: [sweep] steps" in capsys.readouterr().err

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from pinmech.directions import unit_vector, written
 from pinmech.exceptions import PinmechError
 
 
@@ -50,12 +51,10 @@ def _floats(value: Any, n: int, argument: str, why: str = "") -> np.ndarray:
 
 def _unit(value: Any, argument: str) -> np.ndarray:
     v = _vector3(value, argument)
-    n = float(np.linalg.norm(v))
-    if n < 1e-12:
-        raise DrawError(
-            f"{argument} must be a non-zero vector, got {v}", argument=argument, value=v
-        )
-    return v / n
+    unit = unit_vector(v)
+    if unit is None:
+        raise DrawError(f"{argument} must be a non-zero vector, got {written(v)}", argument=argument, value=v)
+    return unit
 
 
 def _points(points: Mapping[str, Any]) -> dict[str, np.ndarray]:
