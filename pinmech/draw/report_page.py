@@ -50,7 +50,7 @@ def _polygons(analysis: Analysis) -> str:
     from pinmech.draw.polygon_svg import polygon_svg
     from pinmech.polygon import acceleration_polygon, velocity_polygon
 
-    return "".join(f'<div class="figure">{polygon_svg(make(analysis))}</div>'
+    return "".join(f'<div class="figure">{polygon_svg(make(analysis), analysis)}</div>'
                    for make in (velocity_polygon, acceleration_polygon))
 
 
