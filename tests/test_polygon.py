@@ -292,7 +292,7 @@ def test_no_vector_hides_another(scene, make):
     a^t_B3C (perpendicular to CB). Each is drawn beside the other, no two lines along one
     another (0.5 mm: a line's width and arrowhead), and still measures its value."""
     analysis = analyse(Scene.load(SCENES / f"{scene}.toml"))
-    _, _, _, root = read_svg(polygon_svg(make(analysis), analysis))
+    _, _, _, root = read_svg(polygon_svg(make(analysis)))
     lines = list(_lines(root).items())
     for i, (n1, s1) in enumerate(lines):
         for n2, s2 in lines[i + 1:]:
