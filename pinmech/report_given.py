@@ -8,8 +8,8 @@ angles in degrees, rates in rad/s and rpm, as a problem statement writes them.
 from __future__ import annotations
 
 import itertools
-from pathlib import Path
 import math
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
