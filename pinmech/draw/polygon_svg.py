@@ -113,7 +113,12 @@ def hides(s1: tuple[np.ndarray, np.ndarray], s2: tuple[np.ndarray, np.ndarray]) 
 
 def scale_text(per_mm: float, unit: str) -> str:
     """The scale as written on the drawing: "scale: 1 mm = 0.02 m/s"."""
-    return f"scale: 1 mm = {per_mm:.6g} {unit}"
+    return f"scale: 1 mm = {per_mm:.6g} {_printed(unit)}"
+
+
+def _printed(unit: str) -> str:
+    """A unit as printed on paper: m/s^2 -> m/s²."""
+    return unit.replace("^2", "²")
 
 
 def _round_up(x: float) -> float:
@@ -185,7 +190,7 @@ def _magnitudes(polygon: Polygon, at, per_mm: float, offsets: list[np.ndarray], 
     boxes = [*boxes, *(_box(p / per_mm + np.array([0.0, -1.5]), 1.6, "middle") for p in polygon.images.values())]
     out = []
     for v, (a, b) in zip(polygon.vectors, segments):
-        magnitude = f"{float(np.linalg.norm(v.head - v.tail)):.4g} {polygon.unit}"
+        magnitude = f"{float(np.linalg.norm(v.head - v.tail)):.4g} {_printed(polygon.unit)}"
         width = 0.55 * 2.8 * (len(v.label) + 3 + len(magnitude))  # the text's length on paper [mm]
         u = (b - a) / max(float(np.linalg.norm(b - a)), 1e-300)
         n = np.array([-u[1], u[0]])
@@ -307,7 +312,7 @@ def _footer(polygon: Polygon, per_mm: float, height: float, width: float) -> lis
     bar_mm = 20.0
     y = height - FOOTER + 8
     out = [f'<line x1="6" y1="{y:.2f}" x2="{6 + bar_mm:.2f}" y2="{y:.2f}" stroke="black" stroke-width="0.6"/>',
-           f'<text x="{8 + bar_mm:.2f}" y="{y + 1.3:.2f}" font-size="3.4">{bar_mm * per_mm:.6g} {polygon.unit}</text>']
+           f'<text x="{8 + bar_mm:.2f}" y="{y + 1.3:.2f}" font-size="3.4">{bar_mm * per_mm:.6g} {_printed(polygon.unit)}</text>']
     kinds = [k for k in KINDS if any(v.kind == k for v in polygon.vectors)]
     for i, kind in enumerate(kinds):
         col, row = i % 2, i // 2

@@ -15,7 +15,7 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from pinmech.display import hex_colour, joint_colours, labelled_places
+from pinmech.display import display_names, hex_colour, joint_colours
 from pinmech.draw.inputs import DrawError
 from pinmech.link_nodes import LinkSketch, sketch_links, world_nodes
 from pinmech.motion import _plane_reference
@@ -44,8 +44,8 @@ def space_diagram(analysis: Analysis, box: tuple[float, float, float, float]) ->
     data = mech.model.createData()
     pin.forwardKinematics(mech.model, data, analysis.solution.q)
     sketches = sketch_links(mech)
-    places = {n: axes @ p for n, p in labelled_places(mech, analysis.solution.q).items()}
     nodes = {name: world_nodes(s, data) @ axes.T for name, s in sketches.items()}
+    places = _named_places(sketches, nodes, display_names(mech), mech.length_scale)
     everything = np.vstack([*nodes.values(), *places.values()]).reshape(-1, 2)
     lo, hi = everything.min(axis=0), everything.max(axis=0)
     x, y, width, height = box
@@ -61,8 +61,9 @@ def space_diagram(analysis: Analysis, box: tuple[float, float, float, float]) ->
     out = [f'<g class="space-diagram" data-per-mm="{per_mm:.12g}">',
            f'<text x="{x + 4:.2f}" y="{y + 4:.2f}" font-size="3.2" fill="#555555">space diagram</text>']
     for name, sketch in sketches.items():
+        margin = 0.08 * float(np.max(hi - lo))
         out += _link(sketch, nodes[name], at, hex_colour(colours[sketch.joint]), axes, data,
-                     float(np.max(hi - lo)))
+                     (lo - margin, hi + margin))
     out += _pins_and_labels(sketches, nodes, places, at)
     bar = 20.0
     yb = y + height - 3
@@ -85,16 +86,16 @@ def pose_svg(analysis: Analysis, width: float = 160.0, height: float = 110.0) ->
 
 
 def _link(sketch: LinkSketch, nodes: np.ndarray, at, colour: str, axes: np.ndarray, data: pin.Data,
-          span: float) -> list[str]:
-    """One link: a bar, a plate or a block; the ground: its guides, `span` [m] long (pivots
-    come with the pins)."""
+          box: tuple[np.ndarray, np.ndarray]) -> list[str]:
+    """One link: a bar, a plate or a block; the ground: its guides, across the drawing's
+    `box` (lowest and highest corner in the plane [m]; pivots come with the pins)."""
     out = []
     frame = data.oMi[sketch.joint]
     for point, direction in sketch.guides:
         p, d = axes @ frame.act(point), axes @ (frame.rotation @ direction)
         d = d / max(float(np.linalg.norm(d)), 1e-300)
         if sketch.is_ground:
-            (x1, y1), (x2, y2) = at(p - 0.6 * span * d), at(p + 0.6 * span * d)
+            (x1, y1), (x2, y2) = at(p - _inside(p, -d, box) * d), at(p + _inside(p, d, box) * d)
             out.append(f'<line class="guide" x1="{x1:.3f}" y1="{y1:.3f}" x2="{x2:.3f}" y2="{y2:.3f}" '
                        f'stroke="{GROUND}" stroke-width="0.6" stroke-dasharray="2,1"/>')
     if sketch.is_ground:
@@ -119,6 +120,28 @@ def _link(sketch: LinkSketch, nodes: np.ndarray, at, colour: str, axes: np.ndarr
         out.append(f'<line class="link" data-link="{name}" x1="{ends[0][0]:.3f}" y1="{ends[0][1]:.3f}" '
                    f'x2="{ends[1][0]:.3f}" y2="{ends[1][1]:.3f}" stroke="{colour}" stroke-width="1.6" '
                    f'stroke-linecap="round"/>')
+    return out
+
+
+def _inside(p: np.ndarray, d: np.ndarray, box: tuple[np.ndarray, np.ndarray]) -> float:
+    """How far from p along the unit vector d the box's edge is [m] (p inside the box)."""
+    reach = [((box[1] if di > 0 else box[0])[i] - p[i]) / di for i, di in enumerate(d) if abs(di) > 1e-12]
+    return max(min(reach, default=0.0), 0.0)
+
+
+def _named_places(sketches: dict[str, LinkSketch], nodes: dict[str, np.ndarray], shown: dict[str, str],
+                  scale: float) -> dict[str, np.ndarray]:
+    """Printed name -> place in the plane [m] of every pin and named point, one name a place
+    (a pin's wins); a slide has no place of its own to name."""
+    found: list[tuple[int, str, np.ndarray]] = []
+    for sketch in sketches.values():
+        for node, p in zip(sketch.nodes, nodes[sketch.name]):
+            if node.kind in ("revolute", "point"):
+                found.append((node.kind != "revolute", shown.get(node.name, node.name), p))
+    out: dict[str, np.ndarray] = {}
+    for _, name, p in sorted(found, key=lambda f: f[0]):
+        if not any(np.linalg.norm(p - q) <= 1e-9 * scale for q in out.values()):
+            out.setdefault(name, p)
     return out
 
 
@@ -154,9 +177,9 @@ def _pins_and_labels(sketches: dict[str, LinkSketch], nodes: dict[str, np.ndarra
 
 
 def _round_up(x: float) -> float:
-    """The smallest of 1, 2, 2.5, 5 times a power of ten that is at least x (> 0)."""
+    """The smallest of 1, 2, 2.5, 4, 5 times a power of ten that is at least x (> 0)."""
     power = 10.0 ** math.floor(math.log10(x))
-    return next(m * power for m in (1, 2, 2.5, 5, 10) if m * power >= x * (1 - 1e-9))
+    return next(m * power for m in (1, 2, 2.5, 4, 5, 10) if m * power >= x * (1 - 1e-9))
 
 
 def _length(metres: float) -> str:
