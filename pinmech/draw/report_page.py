@@ -15,6 +15,7 @@ from __future__ import annotations
 import base64
 import datetime
 import html
+import os
 import tempfile
 from pathlib import Path
 
@@ -51,8 +52,9 @@ def _meta(analysis: Analysis) -> str:
     from pinmech import __version__
 
     when = datetime.datetime.now().astimezone().strftime("%Y-%m-%d %H:%M %Z")
-    return html.escape(f"pinmech {__version__} · {when} · scene {analysis.scene.path} · model "
-                       f"{analysis.mechanism.source}")
+    scene = Path(analysis.scene.path)
+    model = Path(os.path.relpath(Path(str(analysis.mechanism.source)).resolve(), scene.resolve().parent))
+    return html.escape(f"pinmech {__version__} · {when} · scene {scene} · model {model} (from the scene's folder)")
 
 
 def _given(analysis: Analysis) -> str:

@@ -170,9 +170,11 @@ def _pins_and_labels(sketches: dict[str, LinkSketch], nodes: dict[str, np.ndarra
     for name, p in places.items():
         away = p - centre
         away = away / np.linalg.norm(away) if np.linalg.norm(away) > 0 else np.array([0.0, 1.0])
+        away = np.array([away[0], max(away[1], 0.45)])  # never down onto a ground symbol
+        away = away / np.linalg.norm(away)
         x, y = at(p)
-        out.append(f'<text class="place" x="{x + 3.2 * away[0]:.3f}" y="{y - 3.2 * away[1] + 1.1:.3f}" '
-                   f'font-size="3.2" font-style="italic" text-anchor="middle">{html.escape(name)}</text>')
+        out.append(f'<text class="place" x="{x + 4.2 * away[0]:.3f}" y="{y - 4.2 * away[1] + 1.2:.3f}" '
+                   f'font-size="3.6" font-style="italic" text-anchor="middle">{html.escape(name)}</text>')
     return out
 
 
