@@ -763,7 +763,7 @@ def cmd_polygon(args: argparse.Namespace) -> int:
         raise PinmechError(f"-o {args.output}: the polygon is an SVG drawing; name the file *.svg")
     analysis = analyse(scene)
     polygon = (acceleration_polygon if args.acceleration_polygon else velocity_polygon)(analysis)
-    _write_text(args.output, polygon_svg(polygon), "SVG drawing")
+    _write_text(args.output, polygon_svg(polygon, analysis), "SVG drawing")
     return 0
 
 

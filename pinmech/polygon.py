@@ -23,9 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from pinmech.display import colour_of, display_names, hex_colour
 from pinmech.draw.inputs import DrawError
-from pinmech.link_nodes import pin_links, sketch_links
-from pinmech.motion import _plane_reference, evaluate_motion
+from pinmech.link_nodes import pin_links, sketch_links, world_nodes
+from pinmech.motion import PointMotion, _plane_reference, evaluate_motion
 from pinmech.results import Analysis
 from pinmech.scene_model import coincident_points
 
@@ -70,6 +71,9 @@ class Polygon:
         vectors: what is drawn, absolute vectors first.
         axes: the plane's x and y axes in world coordinates, shape (2, 3).
         title: what the polygon shows (scene, driver value and rates).
+        figures: moving link -> the image labels of its places (fixed pivots first): the
+            link's velocity (acceleration) image, similar to the link.
+        colours: moving link -> its colour (`pinmech.display`), "#rrggbb".
     """
 
     quantity: str
@@ -79,6 +83,8 @@ class Polygon:
     vectors: list[PolygonVector]
     axes: np.ndarray
     title: str
+    figures: dict[str, list[str]]
+    colours: dict[str, str]
 
     @property
     def closure_error(self) -> float:
@@ -99,7 +105,7 @@ def acceleration_polygon(analysis: Analysis) -> Polygon:
 
 
 def _polygon(analysis: Analysis, quantity: str) -> Polygon:
-    mech, motion = analysis.mechanism, analysis.motion
+    mech = analysis.mechanism
     normal = mech.plane_normal
     if normal is None:
         raise DrawError(f"{analysis.scene.path}: velocity and acceleration polygons are drawn for planar "
@@ -108,26 +114,38 @@ def _polygon(analysis: Analysis, quantity: str) -> Polygon:
     axes = np.array([e1, np.cross(normal, e1)])
     acc = quantity == "acceleration"
     prime = "'" if acc else ""
-    labels = {name: name.lower() + prime for name in motion.points}
+    places, members = _places_and_links(analysis)
+    shown = display_names(mech)
+    labels = {name: _image_label(shown.get(name, name), place, prime) for name, place in places.items()}
     images = {"o" + prime: np.zeros(2)}
-    for name, p in motion.points.items():
-        images[labels[name]] = axes @ (p.acceleration if acc else p.velocity)
-    vectors = [PolygonVector("absolute", np.zeros(2), images[labels[n]], "o" + prime, labels[n], f"{quantity[0]}_{n}")
-               for n in motion.points if np.linalg.norm(images[labels[n]]) > 0]
-    members = _link_members(analysis)
+    for name, place in places.items():
+        images[labels[name]] = axes @ (place.acceleration if acc else place.velocity)
+    vectors = [PolygonVector("absolute", np.zeros(2), images[labels[n]], "o" + prime, labels[n],
+                             f"{quantity[0]}_{shown.get(n, n)}")
+               for n in analysis.motion.points if np.linalg.norm(images[labels[n]]) > 0]
     coincident = [c for c in coincident_points(analysis.scene) if c.name in labels and c.at in labels]
     rates = _link_rates(analysis, [*members, *(c.link for c in coincident)])
     for link, names in members.items():
         for base, name in itertools.pairwise(names):  # a chain: each point about the one before
-            vectors += _relative(analysis, axes, labels, images, base, name, *rates[link], acc)
+            vectors += _relative(places, shown, axes, labels, images, base, name, *rates[link], acc)
     for c in coincident:
-        vectors += _sliding(analysis, axes, labels, images, c, rates[c.link][0], acc)
+        vectors += _sliding(places, shown, axes, labels, images, c, rates[c.link][0], acc)
     drawn = _drawn(vectors, images)
     if not drawn:
         raise DrawError(f"{analysis.scene.path}: no reported point has a {quantity}: nothing to draw in the "
                         f"{quantity} polygon; report moving points ([report] points)", argument="scene",
                         value=list(labels))
-    return Polygon(quantity, "m/s^2" if acc else "m/s", images, labels, drawn, axes, _title(analysis, quantity))
+    figures = {link: [labels[n] for n in names] for link, names in members.items()}
+    colours = {link: hex_colour(colour_of(mech, link)) for link in members}
+    return Polygon(quantity, "m/s^2" if acc else "m/s", images, labels, drawn, axes, _title(analysis, quantity),
+                   figures, colours)
+
+
+def _image_label(shown: str, place: PointMotion, prime: str) -> str:
+    """A point's image label: its printed name in lower case (a moving point that would read
+    as the pole "o" keeps its capital)."""
+    moving = np.linalg.norm(place.velocity) > 0 or np.linalg.norm(place.acceleration) > 0
+    return (shown if moving and shown.lower() == "o" else shown.lower()) + prime
 
 
 def _drawn(vectors: list[PolygonVector], images: dict[str, np.ndarray]) -> list[PolygonVector]:
@@ -143,24 +161,43 @@ def _drawn(vectors: list[PolygonVector], images: dict[str, np.ndarray]) -> list[
     return [v for v in vectors if np.linalg.norm(v.head - v.tail) > tol and not twice(v)]
 
 
-def _link_members(analysis: Analysis) -> dict[str, list[str]]:
-    """Moving link -> the reported points on it (a pin's point on both links), fixed ones
-    first, then in the report's order."""
+def _places_and_links(analysis: Analysis) -> tuple[dict[str, PointMotion], dict[str, list[str]]]:
+    """The reported points and the fixed pivots of the moving links (at rest, image at the
+    pole), and moving link -> the places on it (a pin's on both links), fixed ones first,
+    then in the report's order. The fixed pivots let a point at the end of a rocker be
+    reached by both routes of the graphical method: about the coupler's pin and about the
+    rocker's pivot."""
     mech, motion = analysis.mechanism, analysis.motion
     coincident = {c.name for c in coincident_points(analysis.scene)}
     data = mech.model.createData()
     pin.forwardKinematics(mech.model, data, analysis.solution.q)
     sketches = sketch_links(mech)
     joint_of = {name: sketch.joint for name, sketch in sketches.items()}
+    places = dict(motion.points)
+    places.update(_fixed_pivots(sketches, data, places, mech.length_scale))
     members: dict[str, list[str]] = {}
-    for name, p in motion.points.items():
+    for name, p in places.items():
         on = {p.link} if name in coincident else {p.link, *pin_links(sketches, data, p.position, mech.length_scale)}
         for link in on:
             if joint_of.get(link, 0) != 0 and link in mech.links:
                 members.setdefault(link, []).append(name)
     for names in members.values():
-        names.sort(key=lambda n: np.linalg.norm(motion.points[n].velocity) > 0)  # stable: fixed pivots first
-    return {link: names for link, names in members.items() if len(names) > 1}
+        names.sort(key=lambda n: np.linalg.norm(places[n].velocity) > 0)  # stable: fixed pivots first
+    return places, {link: names for link, names in members.items() if len(names) > 1}
+
+
+def _fixed_pivots(sketches: dict, data: pin.Data, reported: dict[str, PointMotion],
+                  scale: float) -> dict[str, PointMotion]:
+    """The ground's pins that no reported point marks, as points at rest on the ground."""
+    ground = next((s for s in sketches.values() if s.is_ground), None)
+    if ground is None:
+        return {}
+    out = {}
+    for node, p in zip(ground.nodes, world_nodes(ground, data)):
+        taken = any(np.linalg.norm(p - q.position) <= 1e-6 * scale for q in [*reported.values(), *out.values()])
+        if node.kind == "revolute" and not taken and node.name not in reported:
+            out[node.name] = PointMotion(p, np.zeros(3), np.zeros(3), ground.name)
+    return out
 
 
 def _link_rates(analysis: Analysis, links: list[str]) -> dict[str, tuple[float, float]]:
@@ -173,14 +210,13 @@ def _link_rates(analysis: Analysis, links: list[str]) -> dict[str, tuple[float, 
             for name, m in motion.links.items()}
 
 
-def _relative(analysis, axes, labels, images, base: str, name: str, w: float, alpha: float,
+def _relative(places, shown, axes, labels, images, base: str, name: str, w: float, alpha: float,
               acc: bool) -> list[PolygonVector]:
     """The relative motion of `name` about `base`, points of one link turning at w [rad/s],
     alpha [rad/s^2]."""
-    points = analysis.motion.points
-    r = axes @ (points[name].position - points[base].position)
+    r = axes @ (places[name].position - places[base].position)
     tail, end = images[labels[base]], labels[name]
-    pair = f"{name}{base}"
+    pair = f"{shown.get(name, name)}{shown.get(base, base)}"
     if not acc:
         return [PolygonVector("relative", tail, images[end], labels[base], end, f"v_{pair}")]
     normal = -w * w * r
@@ -189,13 +225,12 @@ def _relative(analysis, axes, labels, images, base: str, name: str, w: float, al
             PolygonVector("tangential", tail + normal, tail + normal + tangential, "", end, f"a^t_{pair}")]
 
 
-def _sliding(analysis, axes, labels, images, c, w: float, acc: bool) -> list[PolygonVector]:
+def _sliding(places, shown, axes, labels, images, c, w: float, acc: bool) -> list[PolygonVector]:
     """The point `c.at` about the point `c.name` of the guide link under it (turning at w [rad/s])."""
-    motion = analysis.motion
-    on_guide, moving = motion.points[c.name], motion.points[c.at]
+    on_guide, moving = places[c.name], places[c.at]
     v_rel = axes @ (moving.velocity - on_guide.velocity)
     tail, end = images[labels[c.name]], labels[c.at]
-    pair = f"{c.at}{c.name}"
+    pair = f"{shown.get(c.at, c.at)}{shown.get(c.name, c.name)}"
     if not acc:
         return [PolygonVector("sliding", tail, images[end], labels[c.name], end, f"v_{pair}")]
     coriolis = 2.0 * w * np.array([-v_rel[1], v_rel[0]])

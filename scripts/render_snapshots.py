@@ -13,7 +13,9 @@ route as the browser tests (tests/browser.py).
   without any: their links sketched from their joints and points.
 - `docs/images/sweep_r_rtr.png`, `docs/images/paths_four_bar.png`, `paths_jansen_leg.png`:
   `pinmech sweep --plot` and `--paths`; `docs/images/path_planar_arm.png`: `pinmech path --plot`; `docs/images/torque_slider_crank.png`: `--torque-plot`; `docs/images/polygon_v_r_rtr.png`,
-  `polygon_a_r_rtr.png`: `pinmech polygon`.
+  `polygon_a_r_rtr.png`, `polygon_a_four_bar.png`: `pinmech polygon`;
+  `docs/images/report_r_rtr_page1.png`: the first page of `pinmech report`, printed to PDF by
+  chromium (poppler's `pdftoppm` makes the picture).
 
 Poses and rates of the first two come from the independent closed forms in
 scripts/closed_form.py; the models are built from the URDF files directly. The others run
@@ -129,6 +131,36 @@ def cli_pictures(chromium: str, tmp: Path) -> None:
         svg = tmp / f"polygon_{kind}.svg"
         pinmech(["polygon", str(scenes / "r_rtr.toml"), "-o", str(svg)] + (["--acceleration"] if kind == "a" else []))
         photograph(chromium, svg, IMAGES / f"polygon_{kind}_r_rtr.png", window=_svg_pixels(svg))
+    svg = tmp / "polygon_a_four_bar.svg"
+    pinmech(["polygon", str(scenes / "four_bar.toml"), "-o", str(svg), "--acceleration"])
+    photograph(chromium, svg, IMAGES / "polygon_a_four_bar.png", window=_svg_pixels(svg))
+    report_picture(chromium, tmp)
+
+
+def report_picture(chromium: str, tmp: Path) -> None:
+    """The first page of the R-RTR's report as it prints (A4 PDF, then a PNG of page 1)."""
+    import shutil
+    import subprocess
+
+    from pinmech.cli import main as pinmech
+
+    if shutil.which("pdftoppm") is None:
+        print("the report's picture needs poppler-utils: apt-get install poppler-utils")
+        return
+    page, pdf = tmp / "report.html", tmp / "report.pdf"
+    import os
+
+    here = os.getcwd()
+    os.chdir(ROOT)  # the page names the scene as a user types it: models/scenes/r_rtr.toml
+    try:
+        pinmech(["report", "models/scenes/r_rtr.toml", "-o", str(page), "--steps", "0"])
+    finally:
+        os.chdir(here)
+    subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
+                    f"--user-data-dir={tmp / 'profile'}", f"--print-to-pdf={pdf}", page.resolve().as_uri()],
+                   check=True, capture_output=True, timeout=120)
+    subprocess.run(["pdftoppm", "-png", "-r", "80", "-f", "1", "-l", "1", "-singlefile", str(pdf),
+                    str(IMAGES / "report_r_rtr_page1")], check=True)
 
 
 def figure_pictures(tmp: Path) -> None:

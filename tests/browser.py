@@ -101,3 +101,15 @@ def _hues(pixels: np.ndarray, value: np.ndarray, spread: np.ndarray) -> np.ndarr
         value == r, (g - b) / safe, np.where(value == g, 2.0 + (b - r) / safe, 4.0 + (r - g) / safe)
     )
     return (hue / 6.0) % 1.0
+
+
+def print_pdf(html_file: Path, pdf: Path) -> Path:
+    """The page printed to PDF by headless chromium (as a reader's "print to PDF")."""
+    import subprocess
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as profile:
+        subprocess.run([require_browser(), "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
+                        f"--user-data-dir={profile}", f"--print-to-pdf={pdf}", Path(html_file).resolve().as_uri()],
+                       check=True, capture_output=True, timeout=120)
+    return pdf

@@ -20,6 +20,7 @@ import pytest
 
 from pinmech import Scene, analyse
 from pinmech.cli import main
+from pinmech.display import display_names
 from pinmech.draw import DrawError
 from pinmech.draw.polygon_svg import PAPER, polygon_svg
 from pinmech.polygon import acceleration_polygon, velocity_polygon
@@ -97,10 +98,11 @@ def test_every_point_drawn_from_the_pole_as_pinmech_computes_it(scene, make):
     polygon = make(analysis)
     per_mm, vectors, _, _ = read_svg(polygon_svg(polygon))
     letter = polygon.quantity[0]
+    shown = display_names(analysis.mechanism)  # A_pin is drawn as the textbook's A
     for name, p in analysis.motion.points.items():
         value = polygon.axes @ (p.velocity if letter == "v" else p.acceleration)
         if np.linalg.norm(value) > 0:
-            np.testing.assert_allclose(vectors[f"{letter}_{name}"], value, atol=READ_MM * per_mm)
+            np.testing.assert_allclose(vectors[f"{letter}_{shown.get(name, name)}"], value, atol=READ_MM * per_mm)
     largest = max(np.linalg.norm(x) for x in polygon.images.values())
     assert polygon.closure_error <= 1e-12 * largest
     assert any(v.kind != "absolute" for v in polygon.vectors)  # relative motion is drawn too
@@ -113,7 +115,7 @@ def test_four_bar_relative_velocity_is_perpendicular_to_the_coupler():
     points = analysis.motion.points
     AB = (points["B_pin"].position - points["A_pin"].position)[:2]
     w3 = analysis.motion.links["coupler"].angular_velocity[2]
-    relative = v["v_B_pinA_pin"]
+    relative = v["v_BA"]
     assert abs(relative @ AB) <= READ_MM * per_mm * np.linalg.norm(AB)
     assert np.linalg.norm(relative) == pytest.approx(abs(w3) * np.linalg.norm(AB), abs=READ_MM * per_mm)
 
@@ -125,7 +127,8 @@ def test_the_scale_is_round_and_the_drawing_fits_the_paper(make):
     per_mm, _, _, root = read_svg(polygon_svg(polygon))
     mantissa = per_mm / 10 ** math.floor(math.log10(per_mm))
     assert min(abs(mantissa - m) for m in (1, 2, 5)) < 1e-9
-    ends = np.array([[float(c.get("cx")), float(c.get("cy"))] for c in root.iter(f"{SVG}circle")])
+    ends = np.array([[float(c.get("cx")), float(c.get("cy"))] for c in root.iter(f"{SVG}circle")
+                     if c.get("class") == "image"])
     span = float(np.max(np.ptp(ends, axis=0)))
     assert PAPER / 5 - 1e-6 <= span <= PAPER + 1e-6
 
@@ -203,3 +206,157 @@ def test_a_polygon_is_written_only_under_an_svg_name(tmp_path, capsys):
     out = tmp_path / "p.png"
     assert main(["polygon", str(SCENES / "r_rtr.toml"), "-o", str(out)]) == 2
     assert "name the file *.svg" in capsys.readouterr().err and not out.exists()
+
+
+# ----------------------------------------------------------------- the figure a lecturer prints
+
+def _drawn_four_bar(tmp_path, d, a, b, c, theta):
+    """A drawn four-bar O2 (0, 0), O4 (d, 0), crank a, coupler b, rocker c [mm], B left of
+    A -> O4 (the closed form's branch +1), the crank at theta [deg] turning at 60 rpm."""
+    (tmp_path / "fb.toml").write_text(f"""title = "four-bar"
+ground = ["O2", "O4"]
+[joints]
+O2 = ["0 mm", "0 mm"]
+O4 = ["{d} mm", "0 mm"]
+A = {{ from = "O2", length = "{a} mm", angle = "{theta} deg" }}
+B = {{ from = ["A", "O4"], lengths = ["{b} mm", "{c} mm"], side = "left" }}
+[links]
+crank = ["O2", "A"]
+coupler = ["A", "B"]
+rocker = ["O4", "B"]
+""", encoding="utf-8")
+    scene = tmp_path / "scene.toml"
+    scene.write_text(f'title = "four-bar"\nlinkage = "fb.toml"\n[drivers.O2]\nangle = "{theta} deg"\n'
+                     'speed = "60 rpm"\n[report]\npoints = ["A", "B"]\n', encoding="utf-8")
+    return analyse(Scene.load(scene))
+
+
+def _lines(root: ET.Element) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Vector label -> its drawn ends on paper [mm], y up."""
+    out = {}
+    for line in root.iter(f"{SVG}line"):
+        if line.get("class") == "vector":
+            x1, y1, x2, y2 = (float(line.get(k)) for k in ("x1", "y1", "x2", "y2"))
+            out[line.get("data-label")] = (np.array([x1, -y1]), np.array([x2, -y2]))
+    return out
+
+
+# (d, a, b, c) [mm] and crank angles [deg]: one four-bar of each Grashof class that turns or
+# rocks through these poses (Norton §2.12), B left of A -> O4.
+FOUR_BARS = [((100, 40, 120, 80), (40, 130, 250)),  # crank-rocker: the crank shortest
+             ((40, 90, 110, 100), (0, 130)),  # double-crank: the ground shortest
+             ((100, 80, 40, 90), (55, 70)),  # double-rocker: the coupler shortest
+             ((100, 45, 50, 55), (-8, 9))]  # non-Grashof triple rocker
+
+
+@pytest.mark.parametrize(("lengths", "angles"), FOUR_BARS, ids=["crank-rocker", "double-crank", "double-rocker",
+                                                                 "triple-rocker"])
+def test_four_bar_acceleration_polygon_reaches_b_by_both_routes(tmp_path, lengths, angles):
+    """The graphical method: b' = a' + a^n_BA + a^t_BA = o' + a^n_BO4 + a^t_BO4. Each part is
+    measured off the SVG against Norton's closed form (scripts/closed_form.py): normal parts
+    -w^2 r, tangential parts alpha k x r, with w3, alpha3 of the coupler, w4, alpha4 of the
+    rocker; both chains end at the drawn b' within the drawing's precision (READ_MM)."""
+    d, a, b, c = (x / 1000 for x in lengths)
+    for theta in angles:
+        ref = cf.four_bar(math.radians(theta), 2 * math.pi, 0.0, a, b, c, d)
+        polygon = acceleration_polygon(_drawn_four_bar(tmp_path, *lengths, theta))
+        per_mm, parts, _, root = read_svg(polygon_svg(polygon))
+        atol = READ_MM * per_mm
+        AB, O4B = ref.B - ref.A, ref.B - np.array([d, 0.0])
+        np.testing.assert_allclose(parts["a_B"], ref.aB, atol=atol)
+        for name, r, w, alpha in (("BA", AB, ref.omega3, ref.alpha3), ("BO4", O4B, ref.omega4, ref.alpha4)):
+            np.testing.assert_allclose(parts[f"a^n_{name}"], -(w**2) * r, atol=atol)
+            np.testing.assert_allclose(parts[f"a^t_{name}"], alpha * np.array([-r[1], r[0]]), atol=atol)
+        lines = _lines(root)
+        b_image = next(np.array([float(e.get("cx")), -float(e.get("cy"))]) for e in root.iter(f"{SVG}circle")
+                       if e.get("class") == "image" and e.get("data-label") == "b'")
+        for route in ("a^t_BA", "a^t_BO4"):  # each chain ends at the image b' (5e-4 mm: the printed digits)
+            np.testing.assert_allclose(lines[route][1], b_image, atol=5e-4)
+
+
+def _segments_lie_along(s1, s2, within: float = 0.5, shared: float = 0.5) -> bool:
+    """Two segments on paper [mm] lie along each other (one would hide the other): both ends
+    of the second within `within` mm of the first's line, sharing more than `shared` mm."""
+    (a, b), (c, d) = s1, s2
+    u = (b - a) / np.linalg.norm(b - a)
+    off = [abs(u[0] * (p - a)[1] - u[1] * (p - a)[0]) for p in (c, d)]
+    lo, hi = sorted([(c - a) @ u, (d - a) @ u])
+    return max(off) < within and min(np.linalg.norm(b - a), hi) - max(0.0, lo) > shared
+
+
+@pytest.mark.parametrize("scene", ["r_rtr", "four_bar", "slider_crank", "crank_shaper", "jansen_leg"])
+@pytest.mark.parametrize("make", [velocity_polygon, acceleration_polygon])
+def test_no_vector_hides_another(scene, make):
+    """In the R-RTR, C, B3 and D lie on one line through the fixed pivot: v_D runs along
+    o-b3-d, and the Coriolis part (perpendicular to the guide) along the tangential part
+    a^t_B3C (perpendicular to CB). Each is drawn beside the other, no two lines along one
+    another (0.5 mm: a line's width and arrowhead), and still measures its value."""
+    analysis = analyse(Scene.load(SCENES / f"{scene}.toml"))
+    _, _, _, root = read_svg(polygon_svg(make(analysis)))
+    lines = list(_lines(root).items())
+    for i, (n1, s1) in enumerate(lines):
+        for n2, s2 in lines[i + 1:]:
+            assert not _segments_lie_along(s1, s2), f"{n1} and {n2} drawn along one another"
+
+
+@pytest.mark.parametrize(("overrides", "theta", "omega", "alpha"), CASES[:2])
+def test_each_vector_is_named_with_its_magnitude_beside_it(overrides, theta, omega, alpha):
+    """The R-RTR's vectors written on the drawing as 'v_D = 1.160 m/s': the number is the
+    closed form's magnitude at the 4 significant digits printed (rtol 5e-4 and a hair)."""
+    ref = cf.r_rtr(math.radians(theta), omega, alpha)
+    expected = {"velocity": {"v_B": ref.vB, "v_D": ref.vD, "v_B3": ref.vB3, "v_BB3": ref.v_rel},
+                "acceleration": {"a_B": ref.aB, "a_D": ref.aD, "a^c_BB3": ref.coriolis, "a^r_BB3": ref.a_rel}}
+    analysis = r_rtr(overrides)
+    for make in (velocity_polygon, acceleration_polygon):
+        polygon = make(analysis)
+        root = ET.fromstring(polygon_svg(polygon, analysis))
+        written = {t.get("data-label"): "".join(t.itertext()) for t in root.iter(f"{SVG}text")
+                   if t.get("class") == "magnitude"}
+        assert set(written) == {v.label for v in polygon.vectors}  # every vector drawn is named
+        for label, vector in expected[polygon.quantity].items():
+            number = re.search(r"= ([0-9.e+-]+) m/s", written[label]).group(1)
+            assert float(number) == pytest.approx(np.linalg.norm(vector), rel=5.01e-4), label
+
+
+def test_the_coupler_image_is_the_coupler_turned_and_scaled():
+    """The velocity image a-b-p of the four-bar's coupler is closed, shaded in the coupler's
+    colour, and similar to the coupler A-B-P with ratio |w3| (Norton's closed form): each
+    side drawn [mm] times the scale is |w3| times the side of the link [m]; the acceleration
+    image a'-b'-p' with ratio sqrt(w3^4 + alpha3^2). Tolerance 1e-3 mm on paper (READ_MM)."""
+    from pinmech.display import colour_of, hex_colour
+
+    analysis = analyse(Scene.load(SCENES / "four_bar.toml"))
+    ref = cf.four_bar(math.radians(60.0), 4 * math.pi, 0.0, 0.04, 0.12, 0.08, 0.10)
+    P = ref.A + 0.06 * np.array([math.cos(ref.theta3), math.sin(ref.theta3)]) + 0.03 * np.array(
+        [-math.sin(ref.theta3), math.cos(ref.theta3)])  # P at (60, 30) mm in the coupler's frame
+    sides = sorted(np.linalg.norm(x - y) for x, y in ((ref.A, ref.B), (ref.B, P), (P, ref.A)))
+    for make, ratio in ((velocity_polygon, abs(ref.omega3)), (acceleration_polygon, math.hypot(ref.omega3**2,
+                                                                                                 ref.alpha3))):
+        per_mm, _, _, root = read_svg(polygon_svg(make(analysis), analysis))
+        (image,) = [e for e in root.iter(f"{SVG}polygon") if e.get("class") == "image-figure"
+                    and e.get("data-link") == "coupler"]
+        corners = np.array([[float(c) for c in xy.split(",")] for xy in image.get("points").split()])
+        drawn = sorted(np.linalg.norm(corners[i] - corners[i - 1]) * per_mm for i in range(3))
+        np.testing.assert_allclose(drawn, ratio * np.array(sides), atol=2 * READ_MM * per_mm)
+        assert image.get("fill") == hex_colour(colour_of(analysis.mechanism, "coupler"))
+
+
+def test_the_space_diagram_is_drawn_to_its_scale_beside_the_polygon():
+    """The four-bar's links drawn to the scale written under them: crank 40 mm, coupler
+    120 mm (A to B, P off the line: a plate), rocker 80 mm (the URDF's lengths); pins at
+    A, B and the ground pivots O2, O4 100 mm apart. Tolerance 1e-3 mm on paper."""
+    analysis = analyse(Scene.load(SCENES / "four_bar.toml"))
+    root = ET.fromstring(polygon_svg(velocity_polygon(analysis), analysis))
+    (space,) = [g for g in root.iter(f"{SVG}g") if g.get("class") == "space-diagram"]
+    per_mm = float(space.get("data-per-mm"))
+    bars = {e.get("data-link"): e for e in space.iter(f"{SVG}line") if e.get("class") == "link"}
+    for link, length in (("crank", 0.04), ("rocker", 0.08)):
+        e = bars[link]
+        drawn = math.dist((float(e.get("x1")), float(e.get("y1"))), (float(e.get("x2")), float(e.get("y2"))))
+        assert drawn * per_mm == pytest.approx(length, abs=1e-3 * per_mm)
+    plate = [e for e in space.iter(f"{SVG}polygon") if e.get("data-link") == "coupler"]
+    assert len(plate) == 1 and len(plate[0].get("points").split()) == 3
+    grounds = [e for e in space.iter(f"{SVG}path") if e.get("class") == "ground"]
+    assert len(grounds) == 2
+    names = {t.text for t in space.iter(f"{SVG}text") if t.get("class") == "place"}
+    assert {"O2", "O4", "A", "B", "P"} <= names

@@ -8,6 +8,7 @@ nothing is fetched (no script, link or image points off the page).
 from __future__ import annotations
 
 import html
+import math
 import re
 
 import numpy as np
@@ -209,3 +210,65 @@ def test_an_animation_joins_labels_only_of_points_together_in_every_frame():
     frames = [{"B": np.zeros(3), "B3": np.zeros(3), "P": np.zeros(3)},
               {"B": np.ones(3), "B3": np.ones(3), "P": np.zeros(3)}]
     assert _together(frames, 1e-9) == [["B", "B3"], ["P"]]
+
+
+def _pdf_words(pdf) -> tuple[list[tuple[float, float, str]], float]:
+    """Every word of the PDF with its left and right edge [pt], and the page width [pt]
+    (`pdftotext -bbox`, poppler-utils)."""
+    import subprocess
+
+    out = subprocess.run(["pdftotext", "-bbox", str(pdf), "-"], check=True, capture_output=True, text=True).stdout
+    width = float(re.search(r'<page width="([0-9.]+)"', out).group(1))
+    words = [(float(a), float(b), html.unescape(w)) for a, b, w in
+             re.findall(r'<word xMin="([0-9.]+)" yMin="[0-9.]+" xMax="([0-9.]+)" yMax="[0-9.]+">([^<]*)</word>', out)]
+    return words, width
+
+
+@pytest.mark.browser
+def test_the_report_prints_the_drawing_and_whole_tables(tmp_path):
+    """Printed to PDF by chromium: the pose is on paper (the WebGL view printed blank: the
+    R-RTR's red crank and green guide are found in the first page's pixels), every word lies
+    on the page (a table cut at the right edge loses its last column), and the points
+    table's last column is there: |a_D| of the closed form (scripts/closed_form.py) at the
+    6 significant digits printed."""
+    import subprocess
+
+    import closed_form as cf
+
+    from tests.browser import print_pdf, read_png
+
+    out = tmp_path / "page.html"
+    assert main(["report", str(SCENES / "r_rtr.toml"), "-o", str(out), "--steps", "0"]) == 0
+    pdf = print_pdf(out, tmp_path / "page.pdf")
+    words, width = _pdf_words(pdf)
+    assert words and max(right for _, right, _ in words) <= width
+    text = " ".join(w for *_, w in words)
+    a_D = np.linalg.norm(cf.r_rtr(math.radians(30.0), -50.0 * math.pi / 30.0, 0.0).aD)
+    assert f"{a_D:.6g}" in text and "|a|" in text
+    for part in ("Given", "Figure 1.", "Figure 2.", "Figure 3.", "pinmech 0.", "r_rtr.toml"):
+        assert part in text
+    subprocess.run(["pdftoppm", "-png", "-r", "60", "-f", "1", "-l", "1", str(pdf), str(tmp_path / "p")], check=True)
+    pixels = read_png(next(tmp_path.glob("p*.png")))
+    assert colour_mask(pixels, CRANK_RED).sum() > 100 and colour_mask(pixels, GUIDE_GREEN).sum() > 100
+
+
+def test_the_page_is_a_lab_report(tmp_path):
+    """Given first, then figures numbered 1, 2, ... each once with a caption (the pose, the two
+    polygons, the sweep, the paths), the full text folded under <details>, and the version,
+    the date and the scene file on top."""
+    import datetime
+
+    from pinmech import __version__
+
+    out = tmp_path / "page.html"
+    assert main(["report", str(SCENES / "four_bar.toml"), "-o", str(out), "--steps", "9"]) == 0
+    page = out.read_text(encoding="utf-8")
+    numbers = [int(n) for n in re.findall(r"<b>Figure (\d+)\.</b>", page)]
+    assert numbers == list(range(1, 6))  # pose, velocity, acceleration, sweep, paths
+    assert page.index("<h2>Given</h2>") < page.index("<h2>Figures</h2>") < page.index("<h2>Results</h2>")
+    assert page.count('data-quantity="velocity"') == 1 and page.count('data-quantity="acceleration"') == 1
+    assert page.count('class="pose"') == 1 and page.count('class="space-diagram"') == 1  # the mechanism once
+    assert re.search(r"<details><summary>[^<]*<code>pinmech solve</code>[^<]*</summary><pre>", page)
+    assert f"pinmech {__version__}" in page and str(SCENES / "four_bar.toml") in page
+    assert datetime.date.today().isoformat() in page
+    assert "@media print" in page and "O2O4 = 100 mm" in page

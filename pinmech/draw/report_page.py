@@ -1,13 +1,21 @@
-"""One offline HTML page about a scene: the drawing (meshcat, in a frame of its own), the text
-report's tables, the velocity and acceleration polygons, the sweep figures and paths, and the
-hand-check verdicts when a hand file is given. Everything is inlined (figures as data: URIs,
-the drawing as the frame's `srcdoc`): the page opens in any browser with no network.
+"""One offline HTML page about a scene, laid out as a lab report: what was given (the
+model's dimensions, the driver and its sense, gravity, loads, assumptions), numbered figures
+with captions (the pose drawn to scale, the velocity and acceleration polygons, the sweep and
+the paths), the motion tables, the hand-check verdicts when a hand file is given, and the
+full text report folded away. pinmech's version, the date and the scene file head it.
+
+Everything is inlined (figures as SVG or data: URIs, the interactive meshcat view as a
+frame's `srcdoc`): the page opens in any browser with no network. It prints: the drawings
+are plain SVG (a WebGL view prints blank, so the interactive view is left off paper), and
+tables wrap within the page's width.
 """
 
 from __future__ import annotations
 
 import base64
+import datetime
 import html
+import os
 import tempfile
 from pathlib import Path
 
@@ -27,34 +35,77 @@ def report_html(analysis: Analysis, *, steps: int = 121, hand_text: str | None =
     """
     from pinmech.report import to_text
 
-    sections = [("Drawing", _caption(_CAPTIONS["drawing"]) + _drawing(analysis)),
-                ("Motion", _caption(_CAPTIONS["motion"]) + motion_table_html(analysis)),
-                ("Report", _pre(to_text(analysis)))]
-    if analysis.mechanism.plane_normal is not None:
-        sections.append(("Velocity and acceleration polygons", _caption(_CAPTIONS["polygons"]) + _polygons(analysis)))
-    if steps and "task" not in analysis.scene.raw:
-        sections.append(("Over a turn of the driver", _caption(_CAPTIONS["sweep"]) + _sweep(analysis, steps)))
+    figures = _figures(analysis, steps)
+    sections = [("Given", _given(analysis)),
+                ("Figures", "\n".join(_figure(n, body, caption) for n, (body, caption) in enumerate(figures, 1))),
+                ("Results", _caption(_CAPTIONS["motion"]) + motion_table_html(analysis))]
     if hand_text is not None:
         sections.append(("Hand calculation checked", _caption(_CAPTIONS["hand"]) + _pre(hand_text)))
+    sections.append(("Full text report", '<details><summary>As <code>pinmech solve</code> prints it (click to '
+                     f'open)</summary>{_pre(to_text(analysis))}</details>'))
     body = "\n".join(f"<section><h2>{html.escape(t)}</h2>\n{content}</section>" for t, content in sections)
-    title = html.escape(analysis.scene.title)
-    return _PAGE.format(title=title, body=body)
+    return _PAGE.format(title=html.escape(analysis.scene.title), meta=_meta(analysis), body=body)
 
 
-def _drawing(analysis: Analysis) -> str:
+def _meta(analysis: Analysis) -> str:
+    """pinmech's version, the date and the scene and model files, one line."""
+    from pinmech import __version__
+
+    when = datetime.datetime.now().astimezone().strftime("%Y-%m-%d %H:%M %Z")
+    scene = Path(analysis.scene.path)
+    model = Path(os.path.relpath(Path(str(analysis.mechanism.source)).resolve(), scene.resolve().parent))
+    return html.escape(f"pinmech {__version__} · {when} · scene {scene} · model {model} (from the scene's folder)")
+
+
+def _given(analysis: Analysis) -> str:
+    from pinmech.report_given import given
+
+    rows = "".join(f"<tr><th>{html.escape(h)}</th><td>" + "<br>".join(html.escape(x) for x in lines) + "</td></tr>"
+                   for h, lines in given(analysis))
+    return f'<table class="given">{rows}</table>'
+
+
+def _figures(analysis: Analysis, steps: int) -> list[tuple[str, str]]:
+    """(figure body, caption) in order: each figure once."""
+    out = []
+    if analysis.mechanism.plane_normal is not None:
+        from pinmech.draw.space_svg import pose_svg
+
+        out.append((pose_svg(analysis) + _interactive(analysis, "Interactive 3-D view"), _CAPTIONS["pose"]))
+        out += [(svg, caption) for svg, caption in _polygons(analysis)]
+    else:
+        out.append((_interactive(analysis, None), _CAPTIONS["drawing"]))
+    if steps and "task" not in analysis.scene.raw:
+        out += _sweep(analysis, steps)
+    return out
+
+
+def _figure(number: int, body: str, caption: str) -> str:
+    return (f'<figure id="figure-{number}">{body}<figcaption><b>Figure {number}.</b> {html.escape(caption)}'
+            f"</figcaption></figure>")
+
+
+def _interactive(analysis: Analysis, folded: str | None) -> str:
+    """The meshcat view in a frame; folded under `folded` (a summary) when a static drawing
+    stands for it. Not printed (WebGL prints blank): a line on paper says so."""
     page = snapshot(analysis).html
-    return f'<iframe class="drawing" title="the mechanism at the scene\'s pose" srcdoc="{html.escape(page)}"></iframe>'
+    frame = f'<iframe class="drawing" title="the mechanism at the scene\'s pose" srcdoc="{html.escape(page)}"></iframe>'
+    if folded:
+        frame = f"<details><summary>{html.escape(folded)} (drag to turn, scroll to zoom)</summary>{frame}</details>"
+    note = '<p class="print-only">The interactive 3-D view is on the HTML page (it does not print).</p>'
+    return f'<div class="screen-only">{frame}</div>' + ("" if folded else note)
 
 
-def _polygons(analysis: Analysis) -> str:
+def _polygons(analysis: Analysis) -> list[tuple[str, str]]:
+    """The velocity and acceleration polygons (the space diagram is Figure 1), captioned."""
     from pinmech.draw.polygon_svg import polygon_svg
     from pinmech.polygon import acceleration_polygon, velocity_polygon
 
-    return "".join(f'<div class="figure">{polygon_svg(make(analysis))}</div>'
-                   for make in (velocity_polygon, acceleration_polygon))
+    return [(polygon_svg(make(analysis)), _CAPTIONS[key]) for make, key in
+            ((velocity_polygon, "velocity"), (acceleration_polygon, "acceleration"))]
 
 
-def _sweep(analysis: Analysis, steps: int) -> str:
+def _sweep(analysis: Analysis, steps: int) -> list[tuple[str, str]]:
     from pinmech.plot import SweepPlot
     from pinmech.sweep import Sweep
 
@@ -68,19 +119,25 @@ def _sweep(analysis: Analysis, steps: int) -> str:
             if recorder.points:
                 figures.append(recorder.save_paths(Path(folder) / "paths.png"))
         except PinmechError as exc:  # every pose failed: the page says so, the rest stands
-            return f"<p>No sweep figure: {html.escape(str(exc))}</p>"
-        return "".join(f'<img alt="{p.stem}" src="data:image/png;base64,{base64.b64encode(p.read_bytes()).decode()}">'
-                       for p in figures)
+            return [(f"<p>No sweep figure: {html.escape(str(exc))}</p>", _CAPTIONS["sweep"])]
+        return [(f'<img alt="{p.stem}" src="data:image/png;base64,{base64.b64encode(p.read_bytes()).decode()}">',
+                 _CAPTIONS[p.stem]) for p in figures]
 
 
 _CAPTIONS = {
+    "pose": "The mechanism at the scene's pose, drawn to scale (space diagram): each link in its colour, "
+            "pins as open circles, named points as dots, fixed pivots and guides hatched grey.",
     "drawing": "The mechanism at the scene's pose, named points as black dots (drag to turn, scroll to zoom).",
-    "motion": "World frame, SI units; φ, ω, α about the plane's normal for a planar mechanism.",
-    "polygons": "From the pole o: each point's velocity (acceleration); between points of one link their "
-                "relative motion (normal and tangential parts), between a guide and its slider the sliding "
-                "and Coriolis parts. The scale is written on each drawing.",
-    "sweep": "Every quantity against the driver over one turn (the scene's pose dashed), and the paths of "
-             "the points with the mechanism at the scene's pose.",
+    "velocity": "Velocity polygon at the pose of Figure 1: from the pole o each point's velocity; between points "
+                "of one link their relative velocity; between a guide and its slider the sliding velocity. Each "
+                "link's velocity image shaded in its colour; scale written on the drawing.",
+    "acceleration": "Acceleration polygon at the pose of Figure 1: from the pole o' each point's acceleration; "
+                    "relative accelerations as their normal and tangential parts, a slider's as its Coriolis and "
+                    "sliding parts; a point on two links reached by both routes. Scale written on the drawing.",
+    "sweep": "Every quantity against the driver over one turn (the scene's pose dashed).",
+    "paths": "The paths of the named points over one turn, with the mechanism at the scene's pose.",
+    "motion": "Table 1: the points; Table 2: the links. World frame, SI units; φ, ω, α about the plane's normal "
+              "for a planar mechanism.",
     "hand": "Each hand value against pinmech's, within the rounding of its printed digits.",
 }
 
@@ -125,15 +182,31 @@ def _vec(v: np.ndarray) -> str:
 _PAGE = """<!DOCTYPE html>
 <html><head><meta charset="utf-8"><title>{title}</title>
 <style>
-body {{font: 14px sans-serif; margin: 16px auto; max-width: 1100px; color: #222}}
-h1 {{font-size: 20px}} h2 {{font-size: 16px; border-bottom: 1px solid #ccc}}
+body {{font: 14px sans-serif; margin: 16px auto; max-width: 1100px; color: #222; padding: 0 8px}}
+h1 {{font-size: 20px; margin-bottom: 2px}} h2 {{font-size: 16px; border-bottom: 1px solid #ccc}}
+.meta {{color: #666; font-size: 12px; margin-top: 0}}
 iframe.drawing {{width: 100%; height: 520px; border: 1px solid #ccc}}
 .caption {{color: #555; margin: 4px 0 8px}}
 pre {{font-size: 12px; background: #f7f7f7; padding: 8px; overflow-x: auto}}
-img, .figure svg {{max-width: 100%; height: auto}} img[alt="paths"] {{max-width: 760px}} .figure {{display: inline-block; width: 49%; vertical-align: top}}
-table {{border-collapse: collapse; margin: 6px 0}} td, th {{border: 1px solid #ccc; padding: 2px 6px}}
+figure {{margin: 12px 0}} figcaption {{color: #444; font-size: 13px; margin-top: 4px; max-width: 760px}}
+figure svg, figure img {{display: block; max-width: 100%; height: auto}} figure svg.pose {{max-width: 640px}}
+img[alt="paths"] {{max-width: 760px}} figure > svg:not(.pose) {{max-width: 760px}}
+table {{border-collapse: collapse; margin: 6px 0; max-width: 100%}}
+td, th {{border: 1px solid #ccc; padding: 2px 6px; overflow-wrap: anywhere; vertical-align: top}}
+table.given th {{text-align: left; white-space: nowrap; background: #f4f4f4}}
+.print-only {{display: none}}
+@page {{size: A4; margin: 12mm}}
+@media print {{
+  body {{max-width: none; margin: 0; padding: 0; font-size: 10pt}}
+  .screen-only {{display: none}} .print-only {{display: block}}
+  figure {{break-inside: avoid}} h2 {{break-after: avoid}} tr {{break-inside: avoid}}
+  figure svg, figure img {{width: 100%; max-width: 170mm}} figure svg.pose {{max-width: 130mm}}
+  table {{width: 100%; font-size: 8pt; table-layout: auto}}
+  pre {{white-space: pre-wrap; font-size: 7.5pt}}
+}}
 </style></head>
 <body><h1>{title}</h1>
+<p class="meta">{meta}</p>
 {body}
 <p style="color:#777">Written by pinmech; offline: everything is on this page.</p>
 </body></html>
