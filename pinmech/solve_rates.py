@@ -289,7 +289,7 @@ class RateSolver:
                          [[int(k) for k in t.rows] for t in self.tasks],
                          [int(t.reference == "local") for t in self.tasks],
                          self._scales(n_c)[0])
-            cached = (core.ModelCopy(self.model, frames), value)
+            cached = (core.ModelShape(self.model, frames), value)
             self.__dict__["_core"] = cached
         return cached[1]
 

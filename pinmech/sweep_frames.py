@@ -104,6 +104,6 @@ def _core_for(mechanism: Mechanism, fids: list[int]):
             built = core.CompiledModel(model, fids).kinematics(model)
         except KeyError:
             built = None
-        cached = (core.ModelCopy(model, fids), None if built is None else (built, threading.Lock()))
+        cached = (core.ModelShape(model, fids), None if built is None else (built, threading.Lock()))
         cache[tuple(fids)] = cached
     return cached[1]
