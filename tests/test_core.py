@@ -258,6 +258,7 @@ from pinmech import LoopSolver, SingularPoseError  # noqa: E402
 from pinmech.solve_cycle import solve_range  # noqa: E402
 from tests.test_assembly import _four_bar, _four_bar_guess, _rocker_tip  # noqa: E402
 from tests.test_assembly import _sweep as _sweep_solver  # noqa: E402
+from tests._mechanisms import write  # noqa: E402
 
 
 @settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
@@ -540,3 +541,164 @@ def test_pinocchio_passes_compute_pinocchios_kinematics(scenes_dir, name):
                                    atol=1e-13 * size * (1 + np.max(np.abs(V))) ** 2)
     with pytest.raises(ValueError, match="wrong shapes"):
         compiled.pinocchio_passes(Q[:, :-1], V, 1)
+
+
+# ---------------------------------------------------------------------- every joint Pinocchio has
+def _tilted(x: float, y: float, z: float) -> pin.SE3:
+    return pin.SE3(pin.rpy.rpyToMatrix(0.1, -0.2, 0.3), np.array([x, y, z]))
+
+
+def _kind(model: pin.Model, kind: str) -> int:
+    """The joint (or joints) of `kind` from the ground; returns the joint the cut's P chain
+    goes on from."""
+    joints = {
+        "helical": lambda: pin.JointModelHelicalUnaligned(np.array([0.0, 0.6, 0.8]), 0.05),
+        "helical_z": lambda: pin.JointModelHZ(0.03),
+        "universal": lambda: pin.JointModelUniversal(np.array([1.0, 0, 0]), np.array([0, 1.0, 0])),
+        "ellipsoid": lambda: pin.JointModelEllipsoid(0.02, 0.03, 0.04),
+        "spherical_zyx": pin.JointModelSphericalZYX,
+        "spherical": pin.JointModelSpherical,
+        "planar": pin.JointModelPlanar,
+        "free_flyer": pin.JointModelFreeFlyer,
+        "translation": pin.JointModelTranslation,
+        "prismatic_unaligned": lambda: pin.JointModelPrismaticUnaligned(np.array([0.6, 0.0, 0.8])),
+    }
+    if kind == "composite":  # MJCF's several hinges (and a slide) in one body
+        composite = pin.JointModelComposite()
+        composite.addJoint(pin.JointModelRX(), _tilted(0, 0, 0))
+        composite.addJoint(pin.JointModelPY(), _tilted(0.01, 0, 0))
+        return model.addJoint(0, composite, _tilted(0.05, 0, 0), "k")
+    if kind == "mimic":  # a gear in the chain: the follower turns 2x its leader + 0.1 rad
+        leader = model.addJoint(0, pin.JointModelRX(), _tilted(0.05, 0, 0), "leader")
+        return model.addJoint(leader, pin.JointModelMimic(model.joints[leader], 2.0, 0.1), _tilted(0.02, 0.03, 0), "k")
+    return model.addJoint(0, joints[kind](), _tilted(0.05, 0, 0), "k")
+
+
+def _two_chains(kind: str):
+    """A joint of `kind` and a hinge carrying the cut frame P, and a hinge from the ground
+    carrying the cut frame C (with "mimic": the follower of P's leader on C's side too).
+    Returns the model and a spherical Closure between P and C."""
+    from pinmech.closures import Closure
+
+    model = pin.Model()
+    k = _kind(model, kind)
+    hinge = model.addJoint(k, pin.JointModelRZ(), _tilted(0.1, 0.02, 0.0), "r")
+    P = model.addFrame(pin.Frame("P", hinge, pin.SE3(np.eye(3), np.array([0.08, 0.0, 0.01])), pin.FrameType.OP_FRAME))
+    if kind == "mimic":  # a follower on C's side as well: P's and C's columns add up in one
+        other = model.addJoint(0, pin.JointModelMimic(model.joints[1], -1.5, 0.0), _tilted(0.2, 0.05, 0.03), "m2")
+    else:
+        other = 0
+    hinge2 = model.addJoint(other, pin.JointModelRY(), _tilted(0.2, 0.05, 0.03), "s")
+    C = model.addFrame(pin.Frame("C", hinge2, pin.SE3(np.eye(3), np.array([0.0, 0.07, 0.0])), pin.FrameType.OP_FRAME))
+    axis = np.array([0.0, 0.0, 1.0])
+    return model, Closure("cut", "spherical", P, C, axis, axis)
+
+
+def _relative_position(model: pin.Model, closure, q: np.ndarray) -> np.ndarray:
+    """R_P^T (p_C - p_P) from Pinocchio's own frame placements [m]."""
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    M_P, M_C = data.oMf[closure.parent_frame], data.oMf[closure.child_frame]
+    return M_P.rotation.T @ (M_C.translation - M_P.translation)
+
+
+@pytest.mark.parametrize("kind", ["helical", "helical_z", "universal", "ellipsoid", "spherical_zyx", "spherical",
+                                  "planar", "free_flyer", "translation", "prismatic_unaligned", "composite",
+                                  "mimic"])
+def test_the_core_serves_every_joint_kind(kind):
+    """On a model with the joint kind (built in code, tilted placements, a spherical cut),
+    at three seeded configurations: the core's closure rows are Pinocchio's R_P^T (p_C - p_P)
+    (to 1e-15, rounding of numbers of 0.3); its Jacobian is their central difference on the
+    configuration manifold (pin.integrate, h = 1e-6: truncation h^2 ~ 1e-12, rounding
+    eps / h ~ 1e-10; atol 1e-8); its drift (J-dot v) is the central difference of J v
+    along q + t v (same h, atol 1e-7 for numbers of order 1)."""
+    model, closure = _two_chains(kind)
+    built = core.compile_loops(model, [closure], np.ones(model.nv))
+    assert built is not None
+    compiled, rng, h = built[0], np.random.default_rng(11), 1e-6
+    for _ in range(3):
+        q = pin.integrate(model, pin.neutral(model), rng.uniform(-1.0, 1.0, model.nv))
+        np.testing.assert_allclose(compiled.residual(q), _relative_position(model, closure, q), rtol=0, atol=1e-15)
+        J = compiled.jacobian(False)
+        for k in range(model.nv):
+            e = np.zeros(model.nv)
+            e[k] = h
+            fd = (_relative_position(model, closure, pin.integrate(model, q, e))
+                  - _relative_position(model, closure, pin.integrate(model, q, -e))) / (2 * h)
+            np.testing.assert_allclose(J[:, k], fd, rtol=0, atol=1e-8, err_msg=f"column {k}")
+        v = rng.normal(size=model.nv)
+        drift = compiled.drift(q, v)
+        compiled.residual(pin.integrate(model, q, h * v))
+        Jv_plus = compiled.jacobian(False) @ v
+        compiled.residual(pin.integrate(model, q, -h * v))
+        Jv_minus = compiled.jacobian(False) @ v
+        np.testing.assert_allclose(drift, (Jv_plus - Jv_minus) / (2 * h), rtol=0, atol=1e-7)
+
+
+GEARED = {"a": 0.04, "a2": 0.05, "d": 0.12, "b": 0.11, "c": 0.12, "offset": 0.5}
+
+
+def _geared_five_bar_urdf(a, a2, d, b, c, offset) -> str:
+    """Two cranks geared 1:-1 (URDF <mimic>: O5 = -O2 + offset), carrying links b and c
+    pinned together at C (the cut): a five-bar of one freedom."""
+    return f"""<?xml version="1.0"?>
+<robot name="geared_five_bar">
+  <link name="ground"/> <link name="crank1"/> <link name="link1"/> <link name="crank2"/> <link name="link2"/>
+  <joint name="O2" type="revolute"><parent link="ground"/><child link="crank1"/><axis xyz="0 0 1"/>
+    <limit lower="-10" upper="10" effort="1" velocity="1"/></joint>
+  <joint name="A" type="continuous"><parent link="crank1"/><child link="link1"/>
+    <origin xyz="{a} 0 0"/><axis xyz="0 0 1"/></joint>
+  <joint name="O5" type="revolute"><parent link="ground"/><child link="crank2"/>
+    <origin xyz="{d} 0 0"/><axis xyz="0 0 1"/><limit lower="-10" upper="10" effort="1" velocity="1"/>
+    <mimic joint="O2" multiplier="-1" offset="{offset}"/></joint>
+  <joint name="E" type="continuous"><parent link="crank2"/><child link="link2"/>
+    <origin xyz="{a2} 0 0"/><axis xyz="0 0 1"/></joint>
+  <constraint name="C" type="revolute">
+    <parent link="link1"/> <parent_origin xyz="{b} 0 0"/> <parent_axis xyz="0 0 1"/>
+    <child link="link2"/> <child_origin xyz="{c} 0 0"/> <child_axis xyz="0 0 1"/>
+  </constraint>
+</robot>
+"""
+
+
+def _geared_c(theta: float, a, a2, d, b, c, offset) -> tuple[np.ndarray, float, float]:
+    """The closed form: A = a e(theta), E = (d, 0) + a2 e(offset - theta), C the crossing of
+    the circles (A, b) and (E, c) left of A -> E; returns C and the angles of b and c."""
+    A = a * np.array([math.cos(theta), math.sin(theta)])
+    E = np.array([d, 0.0]) + a2 * np.array([math.cos(offset - theta), math.sin(offset - theta)])
+    w = E - A
+    L = math.hypot(*w)
+    x = (L * L + b * b - c * c) / (2 * L)
+    C = A + x * w / L + math.sqrt(b * b - x * x) * np.array([-w[1], w[0]]) / L
+    return C, math.atan2(*(C - A)[::-1]), math.atan2(*(C - E)[::-1])
+
+
+def test_a_geared_five_bar_with_a_mimic_joint_meets_its_closed_form(tmp_path):
+    """Two cranks geared by a URDF <mimic> (a Pinocchio mimic joint, no freedom of its own)
+    swept by the core every 10 degrees: pin C within 1e-12 of its size of the two-circle
+    closed form, and C's velocity within 1e-8 of the closed form's central difference in
+    theta (h = 1e-6: truncation h^2 ~ 1e-12, rounding eps / h ~ 1e-10 of 0.1 m)."""
+    g = GEARED
+    mech = pinmech.Mechanism.from_urdf(write(tmp_path, "geared.urdf", _geared_five_bar_urdf(**g)))
+    assert any(mech.model.joints[j].shortname() == "JointModelMimic" for j in range(1, mech.model.njoints))
+    solver = LoopSolver(mech, ["O2"])
+    assert core.core_for(solver) is not None
+    theta0 = 0.2
+    C, phi_b, phi_c = _geared_c(theta0, **g)
+    guess = mech.neutral()
+    mech.set_coordinate(guess, "O2", theta0)
+    mech.set_coordinate(guess, "A", phi_b - theta0)
+    mech.set_coordinate(guess, "E", phi_c - (g["offset"] - theta0))
+    solver.set_reference([theta0], guess)
+    theta = theta0 + np.radians(np.arange(0.0, 360.0, 10.0))
+    chunk = next(solve_range(solver, "O2", theta, driver_q=np.zeros(1), driver_v=np.ones(1), driver_a=np.zeros(1)))
+    assert not chunk.errors
+    model, data, h = mech.model, mech.model.createData(), 1e-6
+    cut = mech.closures[0].parent_frame
+    lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    for i, th in enumerate(theta):
+        pin.forwardKinematics(model, data, chunk.solution.q[i], chunk.solution.v[i])
+        got = pin.updateFramePlacement(model, data, cut).translation[:2]
+        np.testing.assert_allclose(got, _geared_c(th, **g)[0], rtol=0, atol=1e-12 * g["d"])
+        want_v = (_geared_c(th + h, **g)[0] - _geared_c(th - h, **g)[0]) / (2 * h)
+        np.testing.assert_allclose(pin.getFrameVelocity(model, data, cut, lwa).linear[:2], want_v, rtol=0, atol=1e-8)
