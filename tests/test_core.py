@@ -14,6 +14,7 @@ the formulas of closures.py; at every pose the two must agree to rounding. Toler
 from __future__ import annotations
 
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -51,6 +52,33 @@ def test_the_core_states_the_python_paths_constants():
     assert core._core.CORRECTOR_ITERATIONS == CORRECTOR_ITERATIONS
     assert core._core.SINGULAR_NODE == SINGULAR_NODE
     assert core._core.MAX_TURN == pytest.approx(MAX_TURN, rel=1e-15)
+
+
+def test_the_core_is_built_against_the_pinocchio_pin_loads():
+    """The core shares pin's Model objects: pyproject.toml pins the build's libpinocchio and
+    the run's pin to one version, and this core was compiled against the pin installed."""
+    tomllib = pytest.importorskip("tomllib")  # Python 3.11+
+    project = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())
+    built = [r for r in project["build-system"]["requires"] if r.startswith("libpinocchio")]
+    loaded = [r for r in project["project"]["dependencies"] if r.startswith("pin")]
+    assert built == [f"libpinocchio=={pin.__version__}"] and loaded[0].split("#")[0].strip() == f"pin=={pin.__version__}"
+    assert core._core.PINOCCHIO_VERSION == pin.__version__
+
+
+def test_a_pin_of_another_version_is_refused_in_one_line(tmp_path):
+    """pin reporting another version than the core's: `pinmech solve` prints one line that
+    names both versions and what to do, exits 2 (a CoreBuildError), no traceback."""
+    import subprocess
+
+    (tmp_path / "sitecustomize.py").write_text('import pinocchio\npinocchio.__version__ = "4.0.9"\n')
+    root = Path(__file__).resolve().parents[1]
+    run = subprocess.run([sys.executable, "-m", "pinmech", "solve", str(root / "models/scenes/r_rtr.toml")],
+                         capture_output=True, text=True, env={**os.environ, "PYTHONPATH": f"{tmp_path}:{root}"})
+    assert run.returncode == 2 and run.stdout == ""
+    assert run.stderr.count("\n") == 1 and "Traceback" not in run.stderr
+    assert f"built against Pinocchio {pin.__version__} but pin 4.0.9 is installed" in run.stderr
+    with pytest.raises(pinmech.exceptions.CoreBuildError, match="install pin=="):
+        core.check_pinocchio(pin.__version__, "4.0.9")
 
 
 @pytest.mark.parametrize("name", LOOP_SCENES)
