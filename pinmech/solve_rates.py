@@ -271,7 +271,7 @@ class RateSolver:
 
     def _compiled(self):
         """The core with this solver's loops and task frames, and the task rows as it takes
-        them (built once; again when a frame it copied was moved), or None."""
+        them (built once per model tree: it reads placements changed in the model), or None."""
         from pinmech import core
 
         if not core.ENABLED:

@@ -1,8 +1,8 @@
-"""The compiled core (pinmech/csrc/core.cpp) against the Python path it stands in for, the
-closed form, and finite differences.
+"""The compiled core (pinmech/csrc) against the Python path it stands in for, the closed
+forms, and finite differences.
 
-The core rebuilds the model from its joints and frames and computes the closure rows with
-the formulas of closures.py; at every pose the two must agree to rounding. Tolerances:
+The core works on the user's own pin.Model and computes the closure rows with the
+formulas of closures.py; at every pose the two must agree to rounding. Tolerances:
 - closure rows, Jacobians and drift: 1e-13 of their size (the same formulas, evaluated in
   another order: a few units in the last place of numbers of order one);
 - sweeps, core against Python path: 1e-12 in q (radians, or loop sizes: the closure
@@ -705,7 +705,8 @@ def test_a_geared_five_bar_with_a_mimic_joint_meets_its_closed_form(tmp_path):
     """Two cranks geared by a URDF <mimic> (a Pinocchio mimic joint, no freedom of its own)
     swept by the core every 10 degrees: pin C within 1e-12 of its size of the two-circle
     closed form, and C's velocity within 1e-8 of the closed form's central difference in
-    theta (h = 1e-6: truncation h^2 ~ 1e-12, rounding eps / h ~ 1e-10 of 0.1 m)."""
+    theta (h = 1e-6: truncation h^2 ~ 1e-12, rounding eps / h ~ 1e-10 of 0.1 m); the
+    follower's link, read by the core's frame_paths, where the gear puts it."""
     g = GEARED
     mech = pinmech.Mechanism.from_urdf(write(tmp_path, "geared.urdf", _geared_five_bar_urdf(**g)))
     assert any(mech.model.joints[j].shortname() == "JointModelMimic" for j in range(1, mech.model.njoints))
@@ -730,3 +731,11 @@ def test_a_geared_five_bar_with_a_mimic_joint_meets_its_closed_form(tmp_path):
         np.testing.assert_allclose(got, _geared_c(th, **g)[0], rtol=0, atol=1e-12 * g["d"])
         want_v = (_geared_c(th + h, **g)[0] - _geared_c(th - h, **g)[0]) / (2 * h)
         np.testing.assert_allclose(pin.getFrameVelocity(model, data, cut, lwa).linear[:2], want_v, rtol=0, atol=1e-8)
+    # the follower's link through the core's frame_paths: E = (d, 0) + a2 e(offset - theta),
+    # E' = a2 e_perp(offset - theta) * (-1) at theta' = 1 (exact to rounding: 1e-15 of 0.1 m)
+    paths = pinmech.frame_paths(mech, ["link2"], chunk.solution.q, chunk.solution.v, chunk.solution.a)
+    psi = g["offset"] - theta
+    E = np.stack([g["d"] + g["a2"] * np.cos(psi), g["a2"] * np.sin(psi)], axis=1)
+    np.testing.assert_allclose(paths.position[:, 0, :2], E, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(paths.velocity[:, 0, :2], -g["a2"] * np.stack([-np.sin(psi), np.cos(psi)], axis=1),
+                               rtol=0, atol=1e-15)
