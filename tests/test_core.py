@@ -219,6 +219,23 @@ def test_a_moved_cut_frame_is_read_by_the_same_core(scenes_dir):
     np.testing.assert_allclose(first.residual(q) - before, want, rtol=0, atol=1e-15)
 
 
+def test_a_changed_tree_builds_a_new_core(scenes_dir):
+    """A frame added to the model once its core is built: the core (whose Pinocchio Data
+    was sized for the old tree) refuses to run, naming both trees, and `core_for` builds a
+    new one, whose closure rows are the same at the same q (to rounding)."""
+    sweep = _sweep(scenes_dir, "four_bar.toml")
+    solver = sweep.solver
+    first = core.core_for(solver)
+    q = solver.reference.q
+    before = first.residual(q)
+    solver.model.addFrame(pin.Frame("extra", 1, pin.SE3.Identity(), pin.FrameType.OP_FRAME))
+    with pytest.raises(ValueError, match="joints or frames changed since its core was built"):
+        first.residual(q)
+    second = core.core_for(solver)
+    assert second is not first and second.same_structure
+    np.testing.assert_allclose(second.residual(q), before, rtol=0, atol=1e-15)
+
+
 def test_dimensions_changed_in_the_model_are_used_without_a_rebuild(tmp_path):
     """A four-bar (a, b, c, d) = (40, 120, 80, 100) mm swept through the core, then its
     crank a, ground d (joint placements) and coupler pin b (the cut frame's placement)
