@@ -16,6 +16,7 @@ pyproject.toml); a mismatch is refused here, at import, with a `CoreBuildError`.
 
 from __future__ import annotations
 
+import importlib.util
 import os
 
 import numpy as np
@@ -30,11 +31,12 @@ def _import_core():
     """pinmech._core, or a CoreBuildError saying what to do."""
     try:
         from pinmech import _core
-    except ModuleNotFoundError as error:  # e.g. `python -m pinmech` in a checkout installed with `pip install .`
-        raise ImportError(f"pinmech's compiled core is missing from {os.path.dirname(__file__)}, a source tree "
-                          "without its build: run pinmech from outside the checkout, or install the checkout "
-                          f"with `pip install -e .` ({error})") from error
-    except ImportError as error:  # a library of another pin/Boost than it was linked to
+    except ImportError as error:
+        if importlib.util.find_spec("pinmech._core") is None:  # e.g. `python -m pinmech` in a checkout
+            raise ImportError(f"pinmech's compiled core is missing from {os.path.dirname(__file__)}, a source "
+                              "tree without its build: run pinmech from outside the checkout, or install the "
+                              f"checkout with `pip install -e .` ({error})") from error
+        # there, but it does not load: a library of another pin/Boost than it was linked to
         raise CoreBuildError(f"pinmech's compiled core does not load beside pin {pin.__version__} ({error}): "
                              f"{_REINSTALL}", loaded=pin.__version__) from error
     check_pinocchio(_core.PINOCCHIO_VERSION, pin.__version__)

@@ -81,6 +81,23 @@ def test_a_pin_of_another_version_is_refused_in_one_line(tmp_path):
         core.check_pinocchio(pin.__version__, "4.0.9")
 
 
+def test_a_core_that_does_not_load_is_named_in_one_line(tmp_path):
+    """A compiled core that is there but does not load (here a file that is no library; in
+    use, one linked to another pin's libraries): `pinmech solve` says so in one line with
+    what to do (a CoreBuildError, exit 2), not a traceback nor "missing"."""
+    import shutil
+    import subprocess
+
+    source = Path(pinmech.__file__).parent
+    shutil.copytree(source, tmp_path / "pinmech", ignore=shutil.ignore_patterns("*.so", "__pycache__", "csrc"))
+    (tmp_path / "pinmech" / Path(core._core.__file__).name).write_bytes(b"not a library")
+    root = Path(__file__).resolve().parents[1]
+    run = subprocess.run([sys.executable, "-m", "pinmech", "solve", str(root / "models/scenes/r_rtr.toml")],
+                         capture_output=True, text=True, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(tmp_path)})
+    assert run.returncode == 2 and run.stderr.count("\n") == 1, run.stderr
+    assert "compiled core does not load beside pin" in run.stderr and "pip install --force-reinstall" in run.stderr
+
+
 @pytest.mark.parametrize("name", LOOP_SCENES)
 def test_closure_rows_equal_the_python_formulas(scenes_dir, name):
     """Residual, both Jacobians, drift and the full residual at random configurations,
