@@ -226,6 +226,23 @@ class BalanceError(PinmechError):
         self.bound = bound
 
 
+class CoreBuildError(PinmechError, ImportError):
+    """pinmech's compiled core does not fit the installed `pin`: it was compiled against
+    another Pinocchio (or Boost) than the one `pin` loads. Raised at import.
+
+    Attributes:
+        built: the Pinocchio version the core was compiled against ("" if unknown).
+        loaded: the version the installed `pin` loads.
+    """
+
+    exit_code = 2
+
+    def __init__(self, message: str, *, built: str = "", loaded: str = ""):
+        super().__init__(message)
+        self.built = built
+        self.loaded = loaded
+
+
 class Interrupted(KeyboardInterrupt):
     """The run was stopped by a signal: Ctrl-C (SIGINT), SIGTERM or SIGHUP (the terminal
     closed). A KeyboardInterrupt, so code that stops on Ctrl-C stops on all three.

@@ -272,7 +272,7 @@ class RateSolver:
 
     def _compiled(self):
         """The core with this solver's loops and task frames, and the task rows as it takes
-        them (built once; again when a frame it copied was moved), or None."""
+        them (built once per model tree: it reads placements changed in the model), or None."""
         from pinmech import core
 
         if not core.ENABLED:
@@ -290,7 +290,7 @@ class RateSolver:
                          [[int(k) for k in t.rows] for t in self.tasks],
                          [int(t.reference == "local") for t in self.tasks],
                          self._scales(n_c)[0])
-            cached = (core.ModelCopy(self.model, frames), value)
+            cached = (core.ModelShape(self.model, frames), value)
             self.__dict__["_core"] = cached
         return cached[1]
 

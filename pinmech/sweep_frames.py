@@ -91,9 +91,8 @@ def _pose_by_pose(model: pin.Model, names: tuple[str, ...], fids: list[int], q: 
 
 
 def _core_for(mechanism: Mechanism, fids: list[int]):
-    """A compiled model of the mechanism with these frames and its lock (built once per set
-    of frames, again when the model's placements changed), or None where the core does not
-    rebuild its joints or its rebuild disagrees (`core.agrees`)."""
+    """A core on the mechanism's model with these frames and its lock (built once per set of
+    frames and per model tree: placements changed in the model are read at every call)."""
     if not core.ENABLED:
         return None
     model = mechanism.model
@@ -104,6 +103,6 @@ def _core_for(mechanism: Mechanism, fids: list[int]):
             built = core.CompiledModel(model, fids).kinematics(model)
         except KeyError:
             built = None
-        cached = (core.ModelCopy(model, fids), None if built is None else (built, threading.Lock()))
+        cached = (core.ModelShape(model, fids), None if built is None else (built, threading.Lock()))
         cache[tuple(fids)] = cached
     return cached[1]

@@ -1,8 +1,8 @@
-"""The compiled core (pinmech/csrc/core.cpp) against the Python path it stands in for, the
-closed form, and finite differences.
+"""The compiled core (pinmech/csrc) against the Python path it stands in for, the closed
+forms, and finite differences.
 
-The core rebuilds the model from its joints and frames and computes the closure rows with
-the formulas of closures.py; at every pose the two must agree to rounding. Tolerances:
+The core works on the user's own pin.Model and computes the closure rows with the
+formulas of closures.py; at every pose the two must agree to rounding. Tolerances:
 - closure rows, Jacobians and drift: 1e-13 of their size (the same formulas, evaluated in
   another order: a few units in the last place of numbers of order one);
 - sweeps, core against Python path: 1e-12 in q (radians, or loop sizes: the closure
@@ -14,6 +14,7 @@ the formulas of closures.py; at every pose the two must agree to rounding. Toler
 from __future__ import annotations
 
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -51,6 +52,50 @@ def test_the_core_states_the_python_paths_constants():
     assert core._core.CORRECTOR_ITERATIONS == CORRECTOR_ITERATIONS
     assert core._core.SINGULAR_NODE == SINGULAR_NODE
     assert core._core.MAX_TURN == pytest.approx(MAX_TURN, rel=1e-15)
+
+
+def test_the_core_is_built_against_the_pinocchio_pin_loads():
+    """The core shares pin's Model objects: pyproject.toml pins the build's libpinocchio and
+    the run's pin to one version, and this core was compiled against the pin installed."""
+    tomllib = pytest.importorskip("tomllib")  # Python 3.11+
+    project = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())
+    built = [r for r in project["build-system"]["requires"] if r.startswith("libpinocchio")]
+    loaded = [r for r in project["project"]["dependencies"] if r.startswith("pin")]
+    assert built == [f"libpinocchio=={pin.__version__}"] and loaded[0].split("#")[0].strip() == f"pin=={pin.__version__}"
+    assert core._core.PINOCCHIO_VERSION == pin.__version__
+
+
+def test_a_pin_of_another_version_is_refused_in_one_line(tmp_path):
+    """pin reporting another version than the core's: `pinmech solve` prints one line that
+    names both versions and what to do, exits 2 (a CoreBuildError), no traceback."""
+    import subprocess
+
+    (tmp_path / "sitecustomize.py").write_text('import pinocchio\npinocchio.__version__ = "4.0.9"\n')
+    root = Path(__file__).resolve().parents[1]
+    run = subprocess.run([sys.executable, "-m", "pinmech", "solve", str(root / "models/scenes/r_rtr.toml")],
+                         capture_output=True, text=True, env={**os.environ, "PYTHONPATH": f"{tmp_path}:{root}"})
+    assert run.returncode == 2 and run.stdout == ""
+    assert run.stderr.count("\n") == 1 and "Traceback" not in run.stderr
+    assert f"built against Pinocchio {pin.__version__} but pin 4.0.9 is installed" in run.stderr
+    with pytest.raises(pinmech.exceptions.CoreBuildError, match="install pin=="):
+        core.check_pinocchio(pin.__version__, "4.0.9")
+
+
+def test_a_core_that_does_not_load_is_named_in_one_line(tmp_path):
+    """A compiled core that is there but does not load (here a file that is no library; in
+    use, one linked to another pin's libraries): `pinmech solve` says so in one line with
+    what to do (a CoreBuildError, exit 2), not a traceback nor "missing"."""
+    import shutil
+    import subprocess
+
+    source = Path(pinmech.__file__).parent
+    shutil.copytree(source, tmp_path / "pinmech", ignore=shutil.ignore_patterns("*.so", "__pycache__", "csrc"))
+    (tmp_path / "pinmech" / Path(core._core.__file__).name).write_bytes(b"not a library")
+    root = Path(__file__).resolve().parents[1]
+    run = subprocess.run([sys.executable, "-m", "pinmech", "solve", str(root / "models/scenes/r_rtr.toml")],
+                         capture_output=True, text=True, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(tmp_path)})
+    assert run.returncode == 2 and run.stderr.count("\n") == 1, run.stderr
+    assert "compiled core does not load beside pin" in run.stderr and "pip install --force-reinstall" in run.stderr
 
 
 @pytest.mark.parametrize("name", LOOP_SCENES)
@@ -170,33 +215,95 @@ def test_path_derivatives_are_finite_differences_of_the_poses(scenes_dir):
     np.testing.assert_allclose((a[1] - v[1] / w * alpha) / w**2, dq2, rtol=0, atol=1e-4)
 
 
-def test_a_moved_ground_frame_rebuilds_the_core(scenes_dir):
+def test_a_moved_cut_frame_is_read_by_the_same_core(scenes_dir):
+    """A cut's parent frame moved in the user's model (by dp in its joint's axes) after the
+    core was built: the same core (nothing rebuilt) reads the new placement at its next
+    call. The position rows are rows6[:, :3] R_P^T (p_C - p_P), and p_P moves by R_J dp
+    (R_J its joint's rotation, R_P = R_J R_f): the rows change by -rows6[:, :3] R_f^T dp
+    exactly (numbers of 1e-5, to rounding: 1e-15)."""
     sweep = _sweep(scenes_dir, "four_bar.toml")
     solver = sweep.solver
     first = core.core_for(solver)
-    assert core.core_for(solver) is first  # built once
     closure = solver.mechanism.closures[0]
-    frame = solver.model.frames[closure.parent_frame]
-    placement = frame.placement.copy()
-    placement.translation = placement.translation + np.array([1e-6, 0.0, 0.0])
+    q = solver.reference.q
+    before = first.residual(q)
+    placement = solver.model.frames[closure.parent_frame].placement.copy()
+    dp = np.array([1e-6, -2e-6, 0.0])
+    placement.translation = placement.translation + dp
     solver.model.frames[closure.parent_frame].placement = placement
-    assert core.core_for(solver) is not first
+    assert core.core_for(solver) is first
+    want = -closure._rows6[:, :3] @ (placement.rotation.T @ dp)
+    np.testing.assert_allclose(first.residual(q) - before, want, rtol=0, atol=1e-15)
 
 
-def test_joints_the_core_does_not_rebuild_leave_the_python_path():
-    model = pin.Model()
-    model.addJoint(0, pin.JointModelUniversal(np.array([1.0, 0, 0]), np.array([0, 1.0, 0])), pin.SE3.Identity(), "u")
-    with pytest.raises(KeyError):
-        core.CompiledModel(model, [])
+def test_a_changed_tree_builds_a_new_core(scenes_dir):
+    """A frame added to the model once its core is built: the core (whose Pinocchio Data
+    was sized for the old tree) refuses to run, naming both trees, and `core_for` builds a
+    new one, whose closure rows are the same at the same q (to rounding)."""
+    sweep = _sweep(scenes_dir, "four_bar.toml")
+    solver = sweep.solver
+    first = core.core_for(solver)
+    q = solver.reference.q
+    before = first.residual(q)
+    solver.model.addFrame(pin.Frame("extra", 1, pin.SE3.Identity(), pin.FrameType.OP_FRAME))
+    with pytest.raises(ValueError, match="joints or frames changed since its core was built"):
+        first.residual(q)
+    second = core.core_for(solver)
+    assert second is not first and second.same_structure
+    np.testing.assert_allclose(second.residual(q), before, rtol=0, atol=1e-15)
 
 
-def test_a_model_the_core_does_not_rebuild_is_swept_by_the_python_path(scenes_dir):
-    """The MJCF leg hangs its rod on a universal joint, which the core does not rebuild: the
-    whole sweep goes through the Python path, and closes."""
+def test_dimensions_changed_in_the_model_are_used_without_a_rebuild(tmp_path):
+    """A four-bar (a, b, c, d) = (40, 120, 80, 100) mm swept through the core, then its
+    crank a, ground d (joint placements) and coupler pin b (the cut frame's placement)
+    changed in the model in place, to (50, 110, 80, 105) mm: the same core, swept again,
+    meets the law-of-cosines closed form of the new four-bar at every 5 degrees: pin B to
+    1e-12 of its size (the closure tolerance, 1e-13 of the loop's size), omega4 to 1e-10
+    (the rates carry the condition number, below 20 here)."""
+    a, b, c, d = 0.04, 0.12, 0.08, 0.10
+    mech = _four_bar(tmp_path, a, b, c, d)
+    solver = LoopSolver(mech, ["O2"])
+    solver.set_reference([0.3], _four_bar_guess(mech, 0.3, a, b, c, d, +1))
+    theta = 0.3 + np.radians(np.arange(0.0, 360.0, 5.0))
+    _sweep_solver(solver, theta)
+    first = core.core_for(solver)
+    assert first is not None
+    model, (a, b, d) = mech.model, (0.05, 0.11, 0.105)
+    for name, length in (("A", a), ("O4", d)):
+        M = model.jointPlacements[mech.joint(name).id].copy()
+        M.translation = np.array([length, 0.0, 0.0])
+        model.jointPlacements[mech.joint(name).id] = M
+    cut_frame = mech.closures[0].parent_frame  # on the coupler, at b
+    M = model.frames[cut_frame].placement.copy()
+    M.translation = np.array([b, 0.0, 0.0])
+    model.frames[cut_frame].placement = M
+    solver.set_reference([0.3], _four_bar_guess(mech, 0.3, a, b, c, d, +1))
+    q, errors, _ = _sweep_solver(solver, theta)
+    chunk = next(solve_range(solver, "O2", theta, driver_q=np.zeros(1), driver_v=np.ones(1), driver_a=np.zeros(1)))
+    assert core.core_for(solver) is first and not errors
+    for i, th in enumerate(theta):
+        ref = closed_form.four_bar(th, 1.0, 0.0, a, b, c, d, +1)
+        np.testing.assert_allclose(_rocker_tip(mech, q[i], c, d), ref.B, rtol=0, atol=1e-12 * d)
+        omega4 = chunk.solution.v[i][mech.joint("O4").idx_v]
+        np.testing.assert_allclose(omega4, float(ref.omega4), rtol=0, atol=1e-10 * (1 + abs(float(ref.omega4))))
+
+
+def test_a_model_with_a_composite_joint_is_swept_by_the_core(scenes_dir):
+    """The MJCF leg hangs its rod on two hinges in one body (a Pinocchio composite joint):
+    the core sweeps it, the loops close to the tolerance at every pose, and its rates are
+    central differences of its own poses (h = 1e-4 rad: truncation h^2 ~ 1e-8)."""
     sweep = _sweep(scenes_dir, "leg_mjcf.toml")
-    assert core.core_for(sweep.solver) is None
-    q, v, a, errors, _ = _rows(sweep, sweep.start + np.radians(np.arange(0.0, 15.0, 3.0)))
-    assert not errors and np.all(np.isfinite(q)) and np.all(np.isfinite(a))
+    solver = sweep.solver
+    assert core.core_for(solver) is not None
+    assert any(solver.model.joints[j].shortname() == "JointModelComposite" for j in range(1, solver.model.njoints))
+    x, h = sweep.start + np.radians(9.0), 1e-4
+    q, v, a, errors, _ = _rows(sweep, np.array([x - h, x, x + h]))
+    assert not errors
+    for qi in q:
+        assert np.abs(solver._residual(qi)).max() <= 1e-12 and solver._full_residual() <= 1e-12
+    w = float(sweep.drivers.v[sweep.drivers.names.index(sweep.driver)])
+    dq1 = pin.difference(solver.model, q[0], q[2]) / (2 * h)
+    np.testing.assert_allclose(v[1] / w, dq1, rtol=0, atol=1e-7)
 
 
 def test_the_core_can_be_ruled_out(monkeypatch, scenes_dir):
@@ -213,6 +320,7 @@ from pinmech import LoopSolver, SingularPoseError  # noqa: E402
 from pinmech.solve_cycle import solve_range  # noqa: E402
 from tests.test_assembly import _four_bar, _four_bar_guess, _rocker_tip  # noqa: E402
 from tests.test_assembly import _sweep as _sweep_solver  # noqa: E402
+from tests._mechanisms import write  # noqa: E402
 
 
 @settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
@@ -272,17 +380,18 @@ def test_four_bars_from_micrometres_to_kilometres_meet_the_closed_form(tmp_path,
         assert abs(omega4 - float(ref.omega4)) <= 1e-10 * (1 + abs(float(ref.omega4))), i
 
 
-def test_a_new_tolerance_rebuilds_the_core(scenes_dir):
+def test_a_new_tolerance_is_set_on_the_same_core(scenes_dir):
     sweep = _sweep(scenes_dir, "four_bar.toml")
     first = core.core_for(sweep.solver)
     sweep.solver.tol = 1e-9
     second = core.core_for(sweep.solver)
-    assert second is not first and second.tol == 1e-9
+    assert second is first and second.tol == 1e-9
 
 
 def test_a_link_lengthened_in_the_model_after_a_sweep_is_seen(scenes_dir, monkeypatch):
     """A joint placement changed in place once the core is built (a link made longer in
-    code): the next sweep rebuilds the core and equals the Python path on the new model."""
+    code): the next sweep reads it (nothing rebuilt) and equals the Python path on the new
+    model."""
     def run():
         sweep = _sweep(scenes_dir, "four_bar.toml")
         model = sweep.solver.model
@@ -302,16 +411,17 @@ def test_a_link_lengthened_in_the_model_after_a_sweep_is_seen(scenes_dir, monkey
     np.testing.assert_allclose(with_core[1], plain[1], rtol=0, atol=1e-10)
 
 
-def test_a_rebuild_that_disagrees_is_refused(scenes_dir, monkeypatch):
-    """Whatever the core reads wrongly (here: every z revolute rebuilt about x), its model
-    is checked against Pinocchio's before use and left to the Python path."""
+def test_closure_rows_that_disagree_are_refused(scenes_dir, monkeypatch):
+    """Whatever the core reads wrongly (here: each cut's two frames swapped, P for C), its
+    closure rows are checked against closures.py before use and left to the Python path."""
     sweep = _sweep(scenes_dir, "r_rtr.toml")
-    codes = dict(core.JOINT_CODES)
-    codes["JointModelRZ"] = codes["JointModelRUBZ"] = codes["JointModelRX"]
-    monkeypatch.setattr(core, "JOINT_CODES", codes)
+    built = core._core.Core
+
+    def swapped(model, frames, types, parents, children, *rest):
+        return built(model, frames, types, children, parents, *rest)
+
+    monkeypatch.setattr(core._core, "Core", swapped)
     assert core.core_for(sweep.solver) is None
-    assert core.CompiledModel(sweep.mechanism.model, [sweep.mechanism.frame_id("D")]).kinematics(
-        sweep.mechanism.model) is None
 
 
 # ---------------------------------------------------------------------- chains and condition numbers
@@ -493,3 +603,173 @@ def test_pinocchio_passes_compute_pinocchios_kinematics(scenes_dir, name):
                                    atol=1e-13 * size * (1 + np.max(np.abs(V))) ** 2)
     with pytest.raises(ValueError, match="wrong shapes"):
         compiled.pinocchio_passes(Q[:, :-1], V, 1)
+
+
+# ---------------------------------------------------------------------- every joint Pinocchio has
+def _tilted(x: float, y: float, z: float) -> pin.SE3:
+    return pin.SE3(pin.rpy.rpyToMatrix(0.1, -0.2, 0.3), np.array([x, y, z]))
+
+
+def _kind(model: pin.Model, kind: str) -> int:
+    """The joint (or joints) of `kind` from the ground; returns the joint the cut's P chain
+    goes on from."""
+    joints = {
+        "helical": lambda: pin.JointModelHelicalUnaligned(np.array([0.0, 0.6, 0.8]), 0.05),
+        "helical_z": lambda: pin.JointModelHZ(0.03),
+        "universal": lambda: pin.JointModelUniversal(np.array([1.0, 0, 0]), np.array([0, 1.0, 0])),
+        "ellipsoid": lambda: pin.JointModelEllipsoid(0.02, 0.03, 0.04),
+        "spherical_zyx": pin.JointModelSphericalZYX,
+        "spherical": pin.JointModelSpherical,
+        "planar": pin.JointModelPlanar,
+        "free_flyer": pin.JointModelFreeFlyer,
+        "translation": pin.JointModelTranslation,
+        "prismatic_unaligned": lambda: pin.JointModelPrismaticUnaligned(np.array([0.6, 0.0, 0.8])),
+    }
+    if kind == "composite":  # MJCF's several hinges (and a slide) in one body
+        composite = pin.JointModelComposite()
+        composite.addJoint(pin.JointModelRX(), _tilted(0, 0, 0))
+        composite.addJoint(pin.JointModelPY(), _tilted(0.01, 0, 0))
+        return model.addJoint(0, composite, _tilted(0.05, 0, 0), "k")
+    if kind == "mimic":  # a gear in the chain: the follower turns 2x its leader + 0.1 rad
+        leader = model.addJoint(0, pin.JointModelRX(), _tilted(0.05, 0, 0), "leader")
+        return model.addJoint(leader, pin.JointModelMimic(model.joints[leader], 2.0, 0.1), _tilted(0.02, 0.03, 0), "k")
+    return model.addJoint(0, joints[kind](), _tilted(0.05, 0, 0), "k")
+
+
+def _two_chains(kind: str):
+    """A joint of `kind` and a hinge carrying the cut frame P, and a hinge from the ground
+    carrying the cut frame C (with "mimic": the follower of P's leader on C's side too).
+    Returns the model and a spherical Closure between P and C."""
+    from pinmech.closures import Closure
+
+    model = pin.Model()
+    k = _kind(model, kind)
+    hinge = model.addJoint(k, pin.JointModelRZ(), _tilted(0.1, 0.02, 0.0), "r")
+    P = model.addFrame(pin.Frame("P", hinge, pin.SE3(np.eye(3), np.array([0.08, 0.0, 0.01])), pin.FrameType.OP_FRAME))
+    if kind == "mimic":  # a follower on C's side as well: P's and C's columns add up in one
+        other = model.addJoint(0, pin.JointModelMimic(model.joints[1], -1.5, 0.0), _tilted(0.2, 0.05, 0.03), "m2")
+    else:
+        other = 0
+    hinge2 = model.addJoint(other, pin.JointModelRY(), _tilted(0.2, 0.05, 0.03), "s")
+    C = model.addFrame(pin.Frame("C", hinge2, pin.SE3(np.eye(3), np.array([0.0, 0.07, 0.0])), pin.FrameType.OP_FRAME))
+    axis = np.array([0.0, 0.0, 1.0])
+    return model, Closure("cut", "spherical", P, C, axis, axis)
+
+
+def _relative_position(model: pin.Model, closure, q: np.ndarray) -> np.ndarray:
+    """R_P^T (p_C - p_P) from Pinocchio's own frame placements [m]."""
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    M_P, M_C = data.oMf[closure.parent_frame], data.oMf[closure.child_frame]
+    return M_P.rotation.T @ (M_C.translation - M_P.translation)
+
+
+@pytest.mark.parametrize("kind", ["helical", "helical_z", "universal", "ellipsoid", "spherical_zyx", "spherical",
+                                  "planar", "free_flyer", "translation", "prismatic_unaligned", "composite",
+                                  "mimic"])
+def test_the_core_serves_every_joint_kind(kind):
+    """On a model with the joint kind (built in code, tilted placements, a spherical cut),
+    at three seeded configurations: the core's closure rows are Pinocchio's R_P^T (p_C - p_P)
+    (to 1e-15, rounding of numbers of 0.3); its Jacobian is their central difference on the
+    configuration manifold (pin.integrate, h = 1e-6: truncation h^2 ~ 1e-12, rounding
+    eps / h ~ 1e-10; atol 1e-8); its drift (J-dot v) is the central difference of J v
+    along q + t v (same h, atol 1e-7 for numbers of order 1)."""
+    model, closure = _two_chains(kind)
+    built = core.compile_loops(model, [closure], np.ones(model.nv))
+    assert built is not None
+    compiled, rng, h = built[0], np.random.default_rng(11), 1e-6
+    for _ in range(3):
+        q = pin.integrate(model, pin.neutral(model), rng.uniform(-1.0, 1.0, model.nv))
+        np.testing.assert_allclose(compiled.residual(q), _relative_position(model, closure, q), rtol=0, atol=1e-15)
+        J = compiled.jacobian(False)
+        for k in range(model.nv):
+            e = np.zeros(model.nv)
+            e[k] = h
+            fd = (_relative_position(model, closure, pin.integrate(model, q, e))
+                  - _relative_position(model, closure, pin.integrate(model, q, -e))) / (2 * h)
+            np.testing.assert_allclose(J[:, k], fd, rtol=0, atol=1e-8, err_msg=f"column {k}")
+        v = rng.normal(size=model.nv)
+        drift = compiled.drift(q, v)
+        compiled.residual(pin.integrate(model, q, h * v))
+        Jv_plus = compiled.jacobian(False) @ v
+        compiled.residual(pin.integrate(model, q, -h * v))
+        Jv_minus = compiled.jacobian(False) @ v
+        np.testing.assert_allclose(drift, (Jv_plus - Jv_minus) / (2 * h), rtol=0, atol=1e-7)
+
+
+GEARED = {"a": 0.04, "a2": 0.05, "d": 0.12, "b": 0.11, "c": 0.12, "offset": 0.5}
+
+
+def _geared_five_bar_urdf(a, a2, d, b, c, offset) -> str:
+    """Two cranks geared 1:-1 (URDF <mimic>: O5 = -O2 + offset), carrying links b and c
+    pinned together at C (the cut): a five-bar of one freedom."""
+    return f"""<?xml version="1.0"?>
+<robot name="geared_five_bar">
+  <link name="ground"/> <link name="crank1"/> <link name="link1"/> <link name="crank2"/> <link name="link2"/>
+  <joint name="O2" type="revolute"><parent link="ground"/><child link="crank1"/><axis xyz="0 0 1"/>
+    <limit lower="-10" upper="10" effort="1" velocity="1"/></joint>
+  <joint name="A" type="continuous"><parent link="crank1"/><child link="link1"/>
+    <origin xyz="{a} 0 0"/><axis xyz="0 0 1"/></joint>
+  <joint name="O5" type="revolute"><parent link="ground"/><child link="crank2"/>
+    <origin xyz="{d} 0 0"/><axis xyz="0 0 1"/><limit lower="-10" upper="10" effort="1" velocity="1"/>
+    <mimic joint="O2" multiplier="-1" offset="{offset}"/></joint>
+  <joint name="E" type="continuous"><parent link="crank2"/><child link="link2"/>
+    <origin xyz="{a2} 0 0"/><axis xyz="0 0 1"/></joint>
+  <constraint name="C" type="revolute">
+    <parent link="link1"/> <parent_origin xyz="{b} 0 0"/> <parent_axis xyz="0 0 1"/>
+    <child link="link2"/> <child_origin xyz="{c} 0 0"/> <child_axis xyz="0 0 1"/>
+  </constraint>
+</robot>
+"""
+
+
+def _geared_c(theta: float, a, a2, d, b, c, offset) -> tuple[np.ndarray, float, float]:
+    """The closed form: A = a e(theta), E = (d, 0) + a2 e(offset - theta), C the crossing of
+    the circles (A, b) and (E, c) left of A -> E; returns C and the angles of b and c."""
+    A = a * np.array([math.cos(theta), math.sin(theta)])
+    E = np.array([d, 0.0]) + a2 * np.array([math.cos(offset - theta), math.sin(offset - theta)])
+    w = E - A
+    L = math.hypot(*w)
+    x = (L * L + b * b - c * c) / (2 * L)
+    C = A + x * w / L + math.sqrt(b * b - x * x) * np.array([-w[1], w[0]]) / L
+    return C, math.atan2(*(C - A)[::-1]), math.atan2(*(C - E)[::-1])
+
+
+def test_a_geared_five_bar_with_a_mimic_joint_meets_its_closed_form(tmp_path):
+    """Two cranks geared by a URDF <mimic> (a Pinocchio mimic joint, no freedom of its own)
+    swept by the core every 10 degrees: pin C within 1e-12 of its size of the two-circle
+    closed form, and C's velocity within 1e-8 of the closed form's central difference in
+    theta (h = 1e-6: truncation h^2 ~ 1e-12, rounding eps / h ~ 1e-10 of 0.1 m); the
+    follower's link, read by the core's frame_paths, where the gear puts it."""
+    g = GEARED
+    mech = pinmech.Mechanism.from_urdf(write(tmp_path, "geared.urdf", _geared_five_bar_urdf(**g)))
+    assert any(mech.model.joints[j].shortname() == "JointModelMimic" for j in range(1, mech.model.njoints))
+    solver = LoopSolver(mech, ["O2"])
+    assert core.core_for(solver) is not None
+    theta0 = 0.2
+    C, phi_b, phi_c = _geared_c(theta0, **g)
+    guess = mech.neutral()
+    mech.set_coordinate(guess, "O2", theta0)
+    mech.set_coordinate(guess, "A", phi_b - theta0)
+    mech.set_coordinate(guess, "E", phi_c - (g["offset"] - theta0))
+    solver.set_reference([theta0], guess)
+    theta = theta0 + np.radians(np.arange(0.0, 360.0, 10.0))
+    chunk = next(solve_range(solver, "O2", theta, driver_q=np.zeros(1), driver_v=np.ones(1), driver_a=np.zeros(1)))
+    assert not chunk.errors
+    model, data, h = mech.model, mech.model.createData(), 1e-6
+    cut = mech.closures[0].parent_frame
+    lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    for i, th in enumerate(theta):
+        pin.forwardKinematics(model, data, chunk.solution.q[i], chunk.solution.v[i])
+        got = pin.updateFramePlacement(model, data, cut).translation[:2]
+        np.testing.assert_allclose(got, _geared_c(th, **g)[0], rtol=0, atol=1e-12 * g["d"])
+        want_v = (_geared_c(th + h, **g)[0] - _geared_c(th - h, **g)[0]) / (2 * h)
+        np.testing.assert_allclose(pin.getFrameVelocity(model, data, cut, lwa).linear[:2], want_v, rtol=0, atol=1e-8)
+    # the follower's link through the core's frame_paths: E = (d, 0) + a2 e(offset - theta),
+    # E' = a2 e_perp(offset - theta) * (-1) at theta' = 1 (exact to rounding: 1e-15 of 0.1 m)
+    paths = pinmech.frame_paths(mech, ["link2"], chunk.solution.q, chunk.solution.v, chunk.solution.a)
+    psi = g["offset"] - theta
+    E = np.stack([g["d"] + g["a2"] * np.cos(psi), g["a2"] * np.sin(psi)], axis=1)
+    np.testing.assert_allclose(paths.position[:, 0, :2], E, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(paths.velocity[:, 0, :2], -g["a2"] * np.stack([-np.sin(psi), np.cos(psi)], axis=1),
+                               rtol=0, atol=1e-15)

@@ -1,0 +1,334 @@
+// pinmech's compiled core: condition numbers (see core.hpp for the whole).
+// ---------------------------------------------------------------- condition numbers
+// Above 3x3 the singular values come from a bidiagonalization B = U^T A V: plane
+// rotations that keep the band for a band matrix (band_bidiagonalize), Householder
+// reflections otherwise (bidiagonalize). Both are backward stable (B's singular values are
+// those of A + E, |E| <= c n eps |A|: sigma_max exact to rounding, sigma_min to about eps
+// x condition, as an SVD gives them). The extreme singular values of B are then
+// eigenvalues of its Golub-Kahan matrix: the 2n x 2n symmetric tridiagonal with zero
+// diagonal and off-diagonals d0, e0, d1, e1, ..., d(n-1), whose eigenvalues are +-sigma_i.
+// Counting its eigenvalues below x (Sturm count; exact for a matrix within a few eps
+// relative of it) brackets a singular value; Laguerre's method on det(T - x I) finds it in
+// a few passes (cubic convergence, monotone for a polynomial with real roots), and two
+// counts certify the result to 4 (2n) eps relative. Where Laguerre has not converged (a
+// cluster of singular values acts as a multiple root), plain bisection on the counts finds
+// it. Cost and accuracy against numpy's SVD: scripts/condition_time.py (README);
+// tests/test_core.py checks against numpy's SVD.
+
+#include "condition.hpp"
+
+#include <Eigen/Householder>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace pinmech {
+
+using Eigen::Index;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+namespace {
+
+constexpr double EPS = std::numeric_limits<double>::epsilon();
+constexpr double PIVMIN = std::numeric_limits<double>::min();
+constexpr int LAGUERRE_PASSES = 20;
+
+
+// Upper bidiagonalization in place by Householder reflections from both sides (values only:
+// the reflections are not kept), as Eigen's upperbidiagonalization_inplace_unblocked.
+void bidiagonalize(ConditionWork& w) {
+  MatrixXd& B = w.B;
+  const Index n = B.rows();
+  w.d.resize(n);
+  w.e.resize(n - 1);
+  w.tmp.resize(n);
+  for (Index k = 0;; ++k) {
+    const Index rows = n - k, cols = n - k - 1;
+    double tau, beta;
+    B.col(k).tail(rows).makeHouseholderInPlace(tau, beta);
+    w.d(k) = beta;
+    B.bottomRightCorner(rows, cols).applyHouseholderOnTheLeft(B.col(k).tail(rows - 1), tau, w.tmp.data());
+    if (k == n - 1) break;
+    B.row(k).tail(cols).makeHouseholderInPlace(tau, beta);
+    w.e(k) = beta;
+    B.bottomRightCorner(rows - 1, cols)
+        .applyHouseholderOnTheRight(B.row(k).tail(cols - 1).transpose(), tau, w.tmp.data());
+  }
+}
+
+// A plane rotation [c s; -s c] taking (a, b) to (r, 0).
+struct Rotation {
+  double c, s;
+};
+
+Rotation rotation(double a, double b) {
+  if (b == 0.0) return {1.0, 0.0};
+  double r = std::sqrt(a * a + b * b);
+  if (!(r > 1e-150 && r < 1e150)) r = std::hypot(a, b);  // no under- or overflow in the squares
+  const double inv = 1.0 / r;
+  return {a * inv, b * inv};
+}
+
+void rotate_rows(MatrixXd& R, Index p, Index q, Index from, Index to, Rotation g) {
+  for (Index t = from; t <= to; ++t) {
+    const double x = R(p, t), y = R(q, t);
+    R(p, t) = g.c * x + g.s * y;
+    R(q, t) = g.c * y - g.s * x;
+  }
+}
+
+void rotate_columns(MatrixXd& R, Index p, Index q, Index from, Index to, Rotation g) {
+  double *cp = &R(0, p), *cq = &R(0, q);
+  for (Index t = from; t <= to; ++t) {
+    const double x = cp[t], y = cq[t];
+    cp[t] = g.c * x + g.s * y;
+    cq[t] = g.c * y - g.s * x;
+  }
+}
+
+// Upper bidiagonalization of a band matrix (nonzeros at most kl below and ku above the
+// diagonal) in place by plane rotations, which keep the band: a QR clears the lower band
+// (R then has upper bandwidth w = kl + ku), then each row's entries beyond the
+// superdiagonal are cleared from the outside in by a column rotation, and the bulge this
+// leaves below the diagonal is chased down the band, w rows a step, by alternating row and
+// column rotations (as LAPACK's dgbbrd). About n^2 w rotations against the dense
+// reflections' 8 n^3 / 3 flops; condition_of takes them where the band is narrow enough
+// for that to pay (scripts/condition_time.py times both).
+void band_bidiagonalize(ConditionWork& w, Index kl, Index ku) {
+  MatrixXd& R = w.B;
+  const Index n = R.rows(), width = kl + ku;
+  for (Index j = 0; j + 1 < n; ++j)
+    for (Index i = std::min(n - 1, j + kl); i > j; --i) {
+      if (R(i, j) == 0.0) continue;
+      rotate_rows(R, i - 1, i, j, std::min(n - 1, i + width), rotation(R(i - 1, j), R(i, j)));
+      R(i, j) = 0.0;
+    }
+  for (Index k = 0; k + 2 < n && width >= 2; ++k)
+    for (Index j = std::min(n - 1, k + width); j >= k + 2; --j) {
+      if (R(k, j) == 0.0) continue;
+      rotate_columns(R, j - 1, j, k, j, rotation(R(k, j - 1), R(k, j)));
+      R(k, j) = 0.0;
+      for (Index r = j;;) {  // the bulge at (r, r - 1), below the diagonal
+        if (R(r, r - 1) != 0.0) {
+          rotate_rows(R, r - 1, r, r - 1, std::min(n - 1, r + width), rotation(R(r - 1, r - 1), R(r, r - 1)));
+          R(r, r - 1) = 0.0;
+        }
+        const Index c = r + width;  // the bulge at (r - 1, c), beyond the band
+        if (c > n - 1 || R(r - 1, c) == 0.0) break;
+        rotate_columns(R, c - 1, c, r - 1, c, rotation(R(r - 1, c - 1), R(r - 1, c)));
+        R(r - 1, c) = 0.0;
+        r = c;
+      }
+    }
+  w.d.resize(n);
+  w.e.resize(n - 1);
+  for (Index i = 0; i < n; ++i) {
+    w.d(i) = R(i, i);
+    if (i + 1 < n) w.e(i) = R(i, i + 1);
+  }
+}
+
+// Eigenvalues of the Golub-Kahan matrix (squared off-diagonals beta) below each of K
+// values x: K independent recurrences in one loop, so their divisions overlap.
+template <int K>
+void counts_below(const VectorXd& beta, const double* x, int* count) {
+  double t[K];
+  for (int k = 0; k < K; ++k) {
+    t[k] = std::abs(x[k]) <= PIVMIN ? -PIVMIN : -x[k];
+    count[k] = t[k] < 0;
+  }
+  for (Index j = 0; j < beta.size(); ++j) {
+    const double b = beta(j);
+    for (int k = 0; k < K; ++k) {
+      double u = -x[k] - b / t[k];
+      if (std::abs(u) <= PIVMIN) u = -PIVMIN;
+      t[k] = u;
+      count[k] += u < 0;
+    }
+  }
+}
+
+int count_below(const VectorXd& beta, double x) {
+  int count;
+  counts_below<1>(beta, &x, &count);
+  return count;
+}
+
+// One Laguerre step for det(T - x I) = prod t_j (the pivots of the Sturm count, with their
+// first and second derivatives in x): G = p'/p, H = -(ln p)''. `right`: the step towards
+// the next root above x, else the one below. K steps at once, as counts_below.
+template <int K>
+void laguerre_steps(const VectorXd& beta, const double* x, const bool* right, double* next) {
+  double t[K], t1[K], t2[K], r[K], G[K], H[K];
+  for (int k = 0; k < K; ++k) {
+    t[k] = std::abs(x[k]) <= PIVMIN ? -PIVMIN : -x[k];
+    t1[k] = -1.0;
+    t2[k] = 0.0;
+    r[k] = 1.0 / t[k];
+    G[k] = t1[k] * r[k];
+    H[k] = G[k] * G[k];
+  }
+  for (Index j = 0; j < beta.size(); ++j) {
+    const double b = beta(j);
+    for (int k = 0; k < K; ++k) {
+      const double rr = r[k] * r[k];
+      t2[k] = b * rr * (t2[k] - 2.0 * r[k] * t1[k] * t1[k]);
+      t1[k] = -1.0 + b * rr * t1[k];
+      double u = -x[k] - b * r[k];
+      if (std::abs(u) <= PIVMIN) u = -PIVMIN;
+      t[k] = u;
+      r[k] = 1.0 / u;
+      const double v = t1[k] * r[k];
+      G[k] += v;
+      H[k] += v * v - t2[k] * r[k];
+    }
+  }
+  const double m = double(beta.size() + 1);
+  for (int k = 0; k < K; ++k) {
+    const double disc = std::sqrt(std::max(0.0, (m - 1.0) * (m * H[k] - G[k] * G[k])));
+    next[k] = x[k] - m / (right[k] ? G[k] - disc : G[k] + disc);
+  }
+}
+
+// A search for the eigenvalue with `index` eigenvalues below it, from x below it (`right`)
+// or above, within the bracket lo < it <= hi (bisection's start where Laguerre fails).
+struct EigenvalueSearch {
+  int index;
+  double x;
+  bool right;
+  double lo, hi;
+  bool moving = true, converged = false;
+};
+
+// Both searches at once (sigma_max and sigma_min): Laguerre passes while either moves, two
+// counts on either side of each result to certify it to 4 (2n) eps relative, and
+// bisection on the counts for a search Laguerre did not bring there (it left the bracket,
+// or a cluster of eigenvalues slowed it down).
+void find_eigenvalues(const VectorXd& beta, EigenvalueSearch (&searches)[2], double (&found)[2]) {
+  const double delta = 4.0 * double(beta.size() + 1) * EPS;
+  for (int pass = 0; pass < LAGUERRE_PASSES; ++pass) {
+    EigenvalueSearch* live[2];
+    int count = 0;
+    for (EigenvalueSearch& s : searches)
+      if (s.moving) live[count++] = &s;
+    if (count == 0) break;
+    double x[2], next[2];
+    bool right[2];
+    for (int k = 0; k < count; ++k) {
+      x[k] = live[k]->x;
+      right[k] = live[k]->right;
+    }
+    if (count == 2) laguerre_steps<2>(beta, x, right, next);
+    else laguerre_steps<1>(beta, x, right, next);
+    for (int k = 0; k < count; ++k) {
+      EigenvalueSearch& s = *live[k];
+      if (!(next[k] > s.lo && next[k] <= s.hi)) {  // left the bracket (or NaN): bisect
+        s.moving = false;
+        continue;
+      }
+      s.converged = std::abs(next[k] - s.x) <= 2.0 * EPS * next[k];
+      s.moving = !s.converged;
+      s.x = next[k];
+    }
+  }
+  const double sides[4] = {searches[0].x * (1.0 - delta), searches[0].x * (1.0 + delta),
+                           searches[1].x * (1.0 - delta), searches[1].x * (1.0 + delta)};
+  int counts[4];
+  counts_below<4>(beta, sides, counts);
+  for (int i = 0; i < 2; ++i) {
+    EigenvalueSearch& s = searches[i];
+    if (s.converged && counts[2 * i] == s.index && counts[2 * i + 1] > s.index) {
+      found[i] = s.x;
+      continue;
+    }
+    double lo = s.lo, hi = s.hi;
+    while (hi - lo > 2.0 * EPS * hi && hi > PIVMIN) {
+      const double mid = lo > 0.0 && hi > 4.0 * lo ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
+      (count_below(beta, mid) > s.index ? hi : lo) = mid;
+    }
+    found[i] = 0.5 * (lo + hi);
+  }
+}
+
+}  // namespace
+
+// 2-norm condition number and smallest singular value, as solve_loops._condition: closed
+// forms up to 2x2, bidiagonalization from 3x3 up (Eigen's closed-form 3x3 eigenvalues of
+// A^T A lost 1e-9 of the condition number at a repeated singular value, where rounding
+// allows 1e-14: tests/test_core.py found it).
+// `singular`: the caller's factorization of A (which it also solves with) met an exact zero
+// pivot (used above 3x3).
+std::pair<double, double> condition_of(const MatrixXd& A, bool singular, ConditionWork& work) {
+  const Index n = A.rows();
+  if (n == 0) return {1.0, 1.0};
+  if (n == 1) {
+    const double s = std::abs(A(0, 0));
+    return {s > 0 ? 1.0 : INFINITY, s};
+  }
+  if (n == 2) {
+    // sigma_max = |(a+e, c-d)|/2 + |(a-e, c+d)|/2, a sum of two non-negative terms (no
+    // cancellation, where sqrt(frob^4 - 4 det^2) lost 1e-12 near condition 1); then
+    // sigma_min = |det| / sigma_max.
+    const double a = A(0, 0), c = A(0, 1), d = A(1, 0), e = A(1, 1);
+    const double s_max = 0.5 * (std::hypot(a + e, c - d) + std::hypot(a - e, c + d));
+    const double det = std::abs(a * e - c * d);
+    const double s_min = s_max > 0 ? det / s_max : 0.0;
+    return {det > 0 ? s_max * s_max / det : INFINITY, s_min};
+  }
+  if (singular) return {INFINITY, 0.0};
+  const double largest_entry = A.cwiseAbs().maxCoeff();
+  if (!std::isfinite(largest_entry)) return {INFINITY, 0.0};
+  int exponent = 0;  // B = A / 2^exponent, its largest entry in [1/2, 1): exact, and no over- or underflow
+  std::frexp(largest_entry, &exponent);
+  work.B = A * std::ldexp(1.0, -exponent);
+  // The band of exact zeros (J_dep's structure: a chain of loops has kl = 2, ku = 1); the
+  // rotations where they are cheaper than the reflections (measured crossover).
+  Index kl = 0, ku = 0;
+  for (Index j = 0; j < n; ++j)
+    for (Index i = 0; i < n; ++i)
+      if (work.B(i, j) != 0.0) {
+        kl = std::max(kl, i - j);
+        ku = std::max(ku, j - i);
+      }
+  if (11 * (kl + ku) <= 2 * n + 16) band_bidiagonalize(work, kl, ku);
+  else bidiagonalize(work);
+  const VectorXd &d = work.d, &e = work.e;
+  VectorXd& beta = work.beta;
+  beta.resize(2 * n - 1);
+  double frobenius = 0.0, largest = 0.0, gershgorin = 0.0, inverse_frobenius = 0.0, column = 0.0;
+  for (Index i = 0; i < n; ++i) {
+    if (d(i) == 0.0) return {INFINITY, 0.0};  // det B = prod d_i
+    beta(2 * i) = d(i) * d(i);
+    largest = std::max(largest, std::abs(d(i)));
+    // a Golub-Kahan row holds two neighbouring off-diagonals: e_(i-1), d_i and d_i, e_i
+    gershgorin = std::max(gershgorin, std::abs(d(i)) + (i ? std::abs(e(i - 1)) : 0.0));
+    if (i + 1 < n) {
+      beta(2 * i + 1) = e(i) * e(i);
+      largest = std::max(largest, std::abs(e(i)));
+      gershgorin = std::max(gershgorin, std::abs(d(i)) + std::abs(e(i)));
+    }
+    // |B^-1 e_i|^2 = (1 + e_(i-1)^2 |B^-1 e_(i-1)|^2) / d_i^2: B^-1's columns, no cancellation
+    column = (1.0 + (i ? e(i - 1) * e(i - 1) * column : 0.0)) / (d(i) * d(i));
+    inverse_frobenius += column;
+  }
+  frobenius = std::sqrt(beta.sum());
+  // sigma_max in [largest entry, min(|B|_F, Gershgorin's bound)]: Laguerre from above (the
+  // nearer the start, the fewer passes where the largest singular values cluster, as in a
+  // chain of alike loops). sigma_min in [1/|B^-1|_F, min(|d_0|, |d_(n-1)|)] (a row and a
+  // column of B): from below, or from above if rounding put the lower bound past it.
+  const double hi_max = std::min(frobenius, gershgorin) * (1.0 + 4.0 * EPS);
+  const double lo_min = (1.0 - 4.0 * EPS) / std::sqrt(inverse_frobenius);
+  const double hi_min = std::min(std::abs(d(0)), std::abs(d(n - 1))) * (1.0 + 4.0 * EPS);
+  const bool below = count_below(beta, lo_min) == n;
+  EigenvalueSearch searches[2] = {{int(2 * n - 1), hi_max, false, largest * (1.0 - 4.0 * EPS), hi_max},
+                                  {int(n), below ? lo_min : hi_min, below, below ? lo_min : 0.0, hi_min}};
+  double found[2];
+  find_eigenvalues(beta, searches, found);
+  const double s_max = found[0], s_min = found[1];
+  if (!(s_min > 0.0)) return {INFINITY, 0.0};
+  return {s_max / s_min, std::ldexp(s_min, exponent)};
+}
+
+}  // namespace pinmech

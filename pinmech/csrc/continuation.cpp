@@ -1,0 +1,275 @@
+// pinmech's compiled core: the corrector, the predictor-corrector steps and the sweeps
+// (see core.hpp for the whole).
+#include "core.hpp"
+
+#include <pinocchio/algorithm/joint-configuration.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace pinmech {
+
+namespace {
+
+// Steps between two looks at Python's signal handlers in a long loop run without the GIL.
+constexpr long SIGNAL_EVERY = 4096;
+
+// Run Python's signal handlers (Ctrl-C, SIGTERM: pinmech's raise Interrupted) from a loop
+// that released the GIL, and leave the loop with the exception they raised.
+void check_signals() {
+  nb::gil_scoped_acquire acquire;
+  if (PyErr_CheckSignals() != 0) throw nb::python_error();
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- the corrector
+// LoopSolver.correct(strict=True): full Newton steps, each at least halving the
+// residual; the polish step of `close`; the full-residual check. False: no root here.
+bool Core::correct(VectorXd& q, const VectorXd& drivers, int max_iterations, double& residual_left) {
+  set_drivers(q, drivers);
+  VectorXd& r = r_;
+  residual_into(q, r);
+  double norm = max_abs(r);
+  iterations_ = 0;
+  moved_ = 0.0;
+  for (int it = 0; it < max_iterations; ++it) {
+    if (norm <= tol_) break;
+    jacobian_into(true);
+    ++iterations_;
+    rhs_ = -r;
+    square_.factor(Jdep_);
+    square_.solve(rhs_, dstep_);
+    if (!dstep_.allFinite()) return false;
+    move_into(q, dstep_, q_new_);
+    residual_into(q_new_, r_new_);
+    const double new_norm = max_abs(r_new_);
+    if (new_norm > 0.5 * norm && new_norm > tol_) {
+      residual_into(q, r);
+      return false;
+    }
+    q.swap(q_new_);
+    r.swap(r_new_);
+    norm = new_norm;
+  }
+  if (POLISH < norm && norm <= tol_ && tol_ <= DEFAULT_TOL) {
+    polish(q, r, norm);
+    ++iterations_;
+  }
+  const double full = full_residual();
+  if (norm > tol_ || full > std::max(tol_, 1e-12) * 10) return false;
+  residual_left = std::max(norm, full);
+  return true;
+}
+
+// ---------------------------------------------------------------- nodes and steps
+// Path.node at a closed q whose placements and Jacobians are in data_: the path
+// derivatives at driver velocity d, the condition number and the signature.
+void Core::node_at(Node& node, const VectorXd& d) {
+  // One factorization of the dimensionless J_dep (columns times dep_scale_) serves the
+  // condition number and both solves; a dependent rate is dep_scale_ times its unknown.
+  jacobian_into(false);
+  scaled_ = Jdep_ * dep_scale_.asDiagonal();
+  square_.factor(scaled_);
+  // The condition number of J_dep with its rows and columns in block order (a
+  // permutation: the same singular values), where a chain of loops is a band matrix.
+  const MatrixXd* conditioned = &scaled_;
+  if (!block_rows_.empty()) {
+    permuted_ = scaled_(block_rows_, block_cols_);
+    conditioned = &permuted_;
+  }
+  auto [condition, sigma_min] = condition_of(*conditioned, square_.singular(), condition_work_);
+  node.condition = condition;
+  node.sigma_min = sigma_min;
+  signs_into(Jdep_, node.signs);
+  VectorXd &v = node.d1, &a = node.d2;
+  v.setZero(model_.nv);
+  a.setZero(model_.nv);
+  for (size_t i = 0; i < drv_v_.size(); ++i) v(drv_v_[i]) = d(Index(i));
+  rhs_.noalias() = -(J_ * v);  // driver columns only: v is zero elsewhere yet
+  square_.solve(rhs_, dstep_);
+  for (size_t i = 0; i < dep_v_.size(); ++i) v(dep_v_[i]) = dep_scale_(Index(i)) * dstep_(Index(i));
+  drift_into(node.q, v, drift_);
+  rhs_ = -drift_;
+  square_.solve(rhs_, dstep_);
+  for (size_t i = 0; i < dep_v_.size(); ++i) a(dep_v_[i]) = dep_scale_(Index(i)) * dstep_(Index(i));
+  rhs_.noalias() = J_ * v;
+  node.velocity_residual = max_abs(rhs_);
+  rhs_.noalias() = J_ * a;
+  rhs_ += drift_;
+  node.acceleration_residual = max_abs(rhs_);
+}
+
+// Path.step from `from` to p; 0 and `out` filled on success, else why it failed:
+// 1 corrector, 2 trust region, 3 singular, 4 turn, 5 signature changed (a change point
+// when `change` is set: the Python path takes it and names it).
+int Core::step(const Node& from, double p, const VectorXd& x0, const VectorXd& d, double unit, Node& out, bool& change) {
+  change = false;
+  const double h = p - from.p;
+  predicted_ = from.d1 * h + from.d2 * (0.5 * h * h);
+  VectorXd& q = out.q;
+  q.resize(model_.nq);
+  pin::integrate(model_, from.q, predicted_, q);
+  double residual_left = 0.0;
+  x_ = x0 + p * d;
+  if (!correct(q, x_, CORRECTOR_ITERATIONS, residual_left)) return 1;
+  const double trust = std::min(TRUST, 2.0 * std::abs(h) * unit);
+  if (moved_ > trust * max_abs(predicted_.cwiseProduct(v_scale_inv_)) + 1e3 * tol_) return 2;
+  out.p = p;
+  out.residual = residual_left;
+  node_at(out, d);
+  for (int s : out.signs)
+    if (s == 0) return 3;
+  if (!(out.condition <= SINGULAR_NODE)) return 3;
+  const double turn = turn_between(from, out, unit);
+  if (turn > MAX_TURN) return 4;
+  if (out.signs != from.signs) {
+    change = std::abs(h) * unit <= 1e-3 && turn < 0.1 * MAX_TURN;
+    return 5;
+  }
+  return 0;
+}
+
+
+// The range mode of solve_cycle._Cycle: from the node (p0, q0, d1, d2) along drivers
+// x(p) = x0 + p d to each of `targets` in turn (Path.follow: first step at most
+// MAX_STEP, doubled after a success, halved after a failure down to PIVOT_BELOW).
+// Returns (poses done, why it stopped, q, d1, d2, accuracy columns).
+nb::tuple Core::follow(double p0, const VectorXd& q0, const VectorXd& d1, const VectorXd& d2, const std::vector<int>& signs0,
+                 double condition0, const VectorXd& x0, const VectorXd& d, double unit, const VectorXd& targets,
+                 double max_condition) {
+  check_structure();
+  if (Index(dep_v_.size()) != rows_) throw std::invalid_argument("the dependent Jacobian must be square");
+  const Index n = targets.size();
+  RowMatrix Q(n, model_.nq), D1(n, model_.nv), D2(n, model_.nv);
+  RowMatrix acc(n, 7);  // residual, iterations, condition, sigma_min, velocity and acceleration residuals, steps
+  Index done = 0;
+  int stop = DONE;
+  long attempts = 0;
+  {
+    nb::gil_scoped_release release;
+    Node node, next;
+    node.p = p0;
+    node.q = q0;
+    node.d1 = d1;
+    node.d2 = d2;
+    node.signs = signs0;
+    node.condition = condition0;
+    for (; done < n && stop == DONE; ++done) {
+      const double target = targets(done);
+      double h = std::copysign(std::min(std::abs(target - node.p), MAX_STEP / unit), target - node.p);
+      long iterations = 0, steps = 0;
+      while (node.p != target) {
+        if (++attempts % SIGNAL_EVERY == 0) check_signals();  // a span of many turns takes long
+        const double remaining = target - node.p;
+        h = std::copysign(std::min(std::abs(h), std::abs(remaining)), remaining);
+        bool change = false;
+        const int why = step(node, std::abs(h) < std::abs(remaining) ? node.p + h : target, x0, d, unit, next, change);
+        if (why == 0) {
+          std::swap(node, next);
+          iterations += iterations_;
+          ++steps;
+          h *= 2.0;
+          continue;
+        }
+        if (why == 5 && change) {
+          stop = SIGNATURE_CHANGED;
+          break;
+        }
+        if (std::abs(h) * unit > PIVOT_BELOW) {
+          h *= 0.5;
+          continue;
+        }
+        stop = NEEDS_PIVOT;
+        break;
+      }
+      if (stop != DONE) break;
+      if (node.condition > max_condition) {
+        stop = CONDITION;
+        break;
+      }
+      if (!node.d1.allFinite() || !node.d2.allFinite()) {
+        stop = NOT_FINITE;
+        break;
+      }
+      Q.row(done) = node.q.transpose();
+      D1.row(done) = node.d1.transpose();
+      D2.row(done) = node.d2.transpose();
+      acc.row(done) << node.residual, double(iterations), node.condition, node.sigma_min, node.velocity_residual,
+          node.acceleration_residual, double(steps);
+    }
+  }
+  return nb::make_tuple(done, stop, Q.topRows(done).eval(), D1.topRows(done).eval(), D2.topRows(done).eval(),
+                        acc.topRows(done).eval());
+}
+
+// Path.node at a closed q: the path derivatives at driver velocity d, the signature,
+// the condition number and the residuals (closure, velocity, acceleration).
+nb::tuple Core::node(const VectorXd& q, const VectorXd& d) {
+  check_structure();
+  if (q.size() != model_.nq || d.size() != Index(drv_v_.size())) throw std::invalid_argument("q or d of the wrong size");
+  Node out;
+  out.q = q;
+  residual_into(q, r_);
+  out.residual = std::max(max_abs(r_), full_residual());
+  node_at(out, d);
+  return nb::make_tuple(out.d1, out.d2, out.signs, out.condition, out.sigma_min, out.velocity_residual,
+                        out.acceleration_residual, out.residual);
+}
+
+void Core::set_drivers(VectorXd& q, const VectorXd& drivers) const {
+  for (size_t i = 0; i < drv_q_.size(); ++i) {
+    const double x = drivers(Index(i));
+    if (drv_continuous_[i]) {
+      q(drv_q_[i]) = std::cos(x);
+      q(drv_q_[i] + 1) = std::sin(x);
+    } else {
+      q(drv_q_[i]) = x;
+    }
+  }
+}
+
+// LoopSolver._move: q moved by a step of the dependent joints, at most MAX_NEWTON_STEP.
+void Core::move_into(const VectorXd& q, const VectorXd& step, VectorXd& out) {
+  const double size = max_abs(step.cwiseQuotient(dep_scale_));
+  const double shrink = size > MAX_NEWTON_STEP ? MAX_NEWTON_STEP / size : 1.0;
+  moved_ += std::min(size, MAX_NEWTON_STEP);
+  step_.setZero();
+  for (size_t i = 0; i < dep_v_.size(); ++i) step_(dep_v_[i]) = shrink * step(Index(i));
+  out.resize(model_.nq);
+  pin::integrate(model_, q, step_, out);
+}
+
+
+// LoopSolver._newton_update at the polish: the full step if it lowers the residual,
+// else the step halved until it does (a square regular J_dep: least squares is Newton).
+void Core::polish(VectorXd& q, VectorXd& r, double& norm) {
+  jacobian_into(true);
+  rhs_ = -r;
+  square_.factor(Jdep_);
+  square_.solve(rhs_, dstep_);
+  if (!dstep_.allFinite()) return;
+  double alpha = 1.0;
+  for (int k = 0; k <= LINE_SEARCH_HALVINGS; ++k, alpha *= 0.5) {
+    move_into(q, alpha * dstep_, q_new_);
+    residual_into(q_new_, r_new_);
+    const double trial_norm = max_abs(r_new_);
+    if (trial_norm < norm) {
+      q.swap(q_new_);
+      r.swap(r_new_);
+      norm = trial_norm;
+      return;
+    }
+  }
+  residual_into(q, r);  // data back at q
+}
+
+double Core::turn_between(const Node& a, const Node& b, double unit) const {
+  const VectorXd ta = a.d1.cwiseProduct(v_scale_inv_), tb = b.d1.cwiseProduct(v_scale_inv_);
+  const double na = std::sqrt(ta.squaredNorm() + unit * unit), nb_ = std::sqrt(tb.squaredNorm() + unit * unit);
+  const double c = (ta.dot(tb) + unit * unit) / (na * nb_);
+  return std::acos(std::max(-1.0, std::min(1.0, c)));
+}
+
+}  // namespace pinmech

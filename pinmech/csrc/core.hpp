@@ -1,0 +1,201 @@
+// pinmech's compiled core: a sweep of one driver followed pose by pose, in C++ on
+// Pinocchio, on the user's own pin.Model (taken by reference from Python: model_ref.cpp).
+//
+// It computes what pinmech/solve_loops.py (closure rows, corrector, rates) and
+// pinmech/continuation.py (predictor, trust region, tangent turn, assembly signature)
+// compute, with the same rules and constants, for the regular steps of a sweep: where a
+// step needs anything more (a signature change, a pivot below PIVOT_BELOW, a singular or
+// overflowing pose, a pose worse conditioned than max_condition) it stops and hands the
+// pose back to the Python path, which names what happened. pinmech/core.py builds it from
+// a LoopSolver; tests/test_core.py checks every number against the closed forms and
+// finite differences.
+//
+// One translation unit per concern, so that a change recompiles little and the compile
+// stays within modest memory: condition.cpp (condition numbers), closure.cpp (the model,
+// closure rows, their Jacobians and drift, assembly blocks), continuation.cpp (corrector,
+// predictor-corrector steps, sweeps), rates.cpp (rate problems, frames along a sweep),
+// model_ref.cpp (the pin.Model from Python), module.cpp (the Python bindings). Pinocchio's
+// algorithms come compiled from libpinocchio_default (PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION),
+// the library the installed `pin` loads: the same version, pinned in pyproject.toml.
+#pragma once
+
+#include <nanobind/nanobind.h>
+#include <nanobind/eigen/dense.h>
+#include <nanobind/stl/pair.h>
+#include <nanobind/stl/tuple.h>
+#include <nanobind/stl/vector.h>
+
+#include <pinocchio/multibody.hpp>
+
+#include <cmath>
+#include <vector>
+
+#include "condition.hpp"
+#include "square_solve.hpp"
+
+namespace pinmech {
+
+namespace nb = nanobind;
+namespace pin = pinocchio;
+
+using Eigen::Index;
+using Eigen::Matrix3d;
+using Eigen::MatrixXd;
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6Xd = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+// At most six rows of six columns (a cut's closure rows), sized at run time: products with
+// a 6-vector are unrolled, where a dynamic matrix would go through Eigen's general kernel.
+using Rows6 = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor, 6, 6>;
+
+// The constants of solve_loops.py and continuation.py (tests/test_core.py reads them back).
+constexpr double DEFAULT_TOL = 1e-13;
+constexpr double POLISH = 1e-15;
+constexpr double MAX_NEWTON_STEP = 1.0;  // solve_loops.MAX_STEP
+constexpr double MAX_STEP = 0.25;        // continuation.MAX_STEP
+constexpr double TRUST = 0.25;
+constexpr double MAX_TURN = 30.0 * M_PI / 180.0;
+constexpr double PIVOT_BELOW = 1e-4;
+constexpr int CORRECTOR_ITERATIONS = 8;
+constexpr double SINGULAR_NODE = 1e10;
+constexpr int LINE_SEARCH_HALVINGS = 30;
+
+enum CutType { REVOLUTE, PRISMATIC, SPHERICAL_CUT, FIXED };
+
+// Why a sweep stopped before its last pose (the Python path then takes that pose).
+enum Stop { DONE = 0, NEEDS_PIVOT = 1, SIGNATURE_CHANGED = 2, CONDITION = 3, NOT_FINITE = 4 };
+
+// The pin.Model inside a Python object made by the installed `pin` (model_ref.cpp), or
+// nullptr where the object is no pin.Model.
+pin::Model* borrow_model(PyObject* obj);
+
+// A column of data.J (Pinocchio's joint Jacobians, nvExtended columns: a mimic joint has
+// its own, already times its scaling) and the velocity column it adds to (a mimic
+// joint's is its leader's).
+struct JointColumn {
+  Index extended, v;
+};
+
+struct Cut {
+  int type;
+  pin::FrameIndex parent, child;
+  Vector3d axis, child_axis;
+  Rows6 rows6;  // (k, 6): basis @ selection @ diag(scale), as Closure._rows6
+  Rows6 full;   // (n_sel, 6): selection @ diag(scale), every selected row
+  Index offset;    // first row in the stacked residual
+  bool ground;     // P is a frame of the ground: no Jacobian, velocity or acceleration
+  // The velocity columns that move C relative to P: joints supporting C and not P, and
+  // joints supporting P and not C. A joint supporting both moves P and C together, so its
+  // column of the relative Jacobian is zero (exactly, where the full difference would
+  // leave rounding): a cut costs the joints of its own loop, not the depth of the tree.
+  std::vector<JointColumn> child_cols, parent_cols;
+  // Velocity columns several data.J columns add to (mimic joints): zeroed, then summed.
+  bool shared_columns = false;
+};
+
+struct Node {
+  double p = 0.0;
+  VectorXd q, d1, d2;
+  std::vector<int> signs;
+  double condition = 1.0, sigma_min = 1.0, velocity_residual = 0.0, acceleration_residual = 0.0, residual = 0.0;
+};
+
+class Core {
+ public:
+  // `model`: a pin.Model, kept alive and read at every call (a joint or frame placement
+  // changed in it is used at the next call); `frame_ids`: its frames the core may name by
+  // their index in this list (cuts' frames, task frames).
+  Core(nb::object model, const std::vector<int>& frame_ids, const std::vector<int>& cut_types,
+       const std::vector<int>& cut_parent, const std::vector<int>& cut_child,
+       const Eigen::Ref<const RowMatrix>& cut_axes, const Eigen::Ref<const RowMatrix>& cut_child_axes,
+       const std::vector<MatrixXd>& rows6, const std::vector<MatrixXd>& full, const std::vector<int>& drv_v,
+       const std::vector<int>& dep_v, const std::vector<int>& drv_q, const std::vector<int>& drv_continuous,
+       const VectorXd& v_scale, const std::vector<std::vector<int>>& block_rows,
+       const std::vector<std::vector<int>>& block_cols, double tol);
+
+  int nq() const { return model_.nq; }
+  int nv() const { return model_.nv; }
+  std::vector<int> idx_q() const { return std::vector<int>(model_.idx_qs.begin() + 1, model_.idx_qs.end()); }
+  std::vector<int> idx_v() const { return std::vector<int>(model_.idx_vs.begin() + 1, model_.idx_vs.end()); }
+  nb::object model() const { return model_object_; }
+  // Whether the model still has the joints and frames this core was built on (a
+  // placement may have changed, not the tree); every entry point checks it.
+  bool same_structure() const;
+
+  // ------------------------------------------------------------ closure rows (closure.cpp)
+  VectorXd residual(const VectorXd& q);
+  void residual_into(const VectorXd& q, VectorXd& r);
+  double full_residual() const;
+  MatrixXd jacobian(bool newton);
+  void jacobian_into(bool newton);
+  VectorXd drift(const VectorXd& q, const VectorXd& v);
+  void drift_into(const VectorXd& q, const VectorXd& v, VectorXd& out);
+  std::vector<int> signs(const MatrixXd& J_dep);
+  void signs_into(const MatrixXd& J_dep, std::vector<int>& out);
+
+  // ------------------------------------------------------------ continuation.cpp
+  bool correct(VectorXd& q, const VectorXd& drivers, int max_iterations, double& residual_left);
+  void node_at(Node& node, const VectorXd& d);
+  int step(const Node& from, double p, const VectorXd& x0, const VectorXd& d, double unit, Node& out, bool& change);
+  nb::tuple follow(double p0, const VectorXd& q0, const VectorXd& d1, const VectorXd& d2, const std::vector<int>& signs0,
+                   double condition0, const VectorXd& x0, const VectorXd& d, double unit, const VectorXd& targets,
+                   double max_condition);
+  nb::tuple node(const VectorXd& q, const VectorXd& d);
+
+  // ------------------------------------------------------------ rates.cpp
+  nb::tuple rates(const Eigen::Ref<const RowMatrix>& Q, const std::vector<int>& task_frames,
+                  const std::vector<std::vector<int>>& task_rows, const std::vector<int>& task_local,
+                  const VectorXd& x_dot, const VectorXd& x_ddot, const VectorXd& row_scale, double max_condition);
+  nb::tuple frame_motion(const Eigen::Ref<const RowMatrix>& Q, const Eigen::Ref<const RowMatrix>& V,
+                         const Eigen::Ref<const RowMatrix>& A, const std::vector<int>& frames);
+  RowMatrix pinocchio_passes(const Eigen::Ref<const RowMatrix>& Q, const Eigen::Ref<const RowMatrix>& V,
+                             int jacobians);
+
+  double tol() const { return tol_; }
+  void set_tol(double tol) { tol_ = tol; }
+  int iterations() const { return iterations_; }
+  // Diagonal blocks the dependent solves go through (0: the whole matrix at once).
+  int solve_blocks() const { return int(square_.blocks()); }
+  double moved() const { return moved_; }
+  // Throws (a ValueError in Python) where the model's joints or frames changed.
+  void check_structure() const;
+
+ private:
+  Vector6d error6(const Cut& cut) const;
+  void relative_columns(Cut& cut) const;
+  void relative_jacobian(const Cut& cut, bool newton);
+  std::vector<DiagonalBlock> ordered_blocks() const;
+  void set_drivers(VectorXd& q, const VectorXd& drivers) const;
+  void move_into(const VectorXd& q, const VectorXd& step, VectorXd& out);
+  void polish(VectorXd& q, VectorXd& r, double& norm);
+  double turn_between(const Node& a, const Node& b, double unit) const;
+
+  nb::object model_object_;  // the Python pin.Model: alive as long as this core
+  const pin::Model& model_;
+  pin::Data data_;
+  // what the core was built on: the tree (parents), and the sizes Data is allocated to
+  std::vector<pin::JointIndex> parents_;
+  int nq_ = 0, nv_ = 0, nv_extended_ = 0;
+  size_t nframes_ = 0;
+  std::vector<pin::FrameIndex> frames_;
+  std::vector<Cut> cuts_;
+  Index rows_ = 0;
+  std::vector<int> drv_v_, dep_v_, drv_q_, drv_continuous_;
+  VectorXd dep_scale_, v_scale_, v_scale_inv_, step_, zero_;
+  std::vector<std::vector<int>> blocks_rows_, blocks_cols_;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> tmp3_;
+  // work buffers, sized once: a pose allocates nothing
+  MatrixXd J_, Jdep_, scaled_, permuted_;
+  std::vector<Index> block_rows_, block_cols_;  // J_dep's rows and columns in block order
+  std::vector<MatrixXd> block_buffers_;
+  VectorXd r_, r_new_, rhs_, dstep_, drift_, q_new_, predicted_, x_;
+  SquareSolve square_;
+  ConditionWork condition_work_;
+  double tol_;
+  int iterations_ = 0;
+  double moved_ = 0.0;
+};
+
+}  // namespace pinmech

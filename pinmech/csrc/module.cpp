@@ -1,0 +1,71 @@
+// pinmech's compiled core: the Python bindings, pinmech._core (see core.hpp for the whole
+// and pinmech/core.py for its Python face).
+#include "core.hpp"
+
+#include <pinocchio/config.hpp>
+
+#include <boost/version.hpp>
+
+#include <Eigen/LU>
+
+#include <stdexcept>
+
+using namespace pinmech;
+
+NB_MODULE(_core, m) {
+  m.doc() = "pinmech's compiled core: sweeps of closed-loop mechanisms on Pinocchio (see pinmech/core.py)";
+  m.attr("DEFAULT_TOL") = DEFAULT_TOL;
+  m.attr("POLISH") = POLISH;
+  m.attr("MAX_NEWTON_STEP") = MAX_NEWTON_STEP;
+  m.attr("MAX_STEP") = MAX_STEP;
+  m.attr("TRUST") = TRUST;
+  m.attr("MAX_TURN") = MAX_TURN;
+  m.attr("PIVOT_BELOW") = PIVOT_BELOW;
+  m.attr("CORRECTOR_ITERATIONS") = CORRECTOR_ITERATIONS;
+  m.attr("SINGULAR_NODE") = SINGULAR_NODE;
+  // What the core was compiled against: pinmech/core.py refuses a pin that differs.
+  m.attr("PINOCCHIO_VERSION") = PINOCCHIO_VERSION;
+  m.attr("BOOST_VERSION") = BOOST_VERSION;
+  m.def(
+      "condition",
+      [](const MatrixXd& A) {
+        if (A.rows() != A.cols()) throw std::invalid_argument("condition: A must be square");
+        ConditionWork work;
+        const Eigen::PartialPivLU<MatrixXd> lu(A);
+        return condition_of(A, A.rows() > 0 && lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0, work);
+      },
+      "2-norm condition number and smallest singular value of a square A, as the core computes them");
+  nb::class_<Core>(m, "Core")
+      .def(nb::init<nb::object, const std::vector<int>&, const std::vector<int>&, const std::vector<int>&,
+                    const std::vector<int>&, const Eigen::Ref<const RowMatrix>&, const Eigen::Ref<const RowMatrix>&,
+                    const std::vector<MatrixXd>&, const std::vector<MatrixXd>&, const std::vector<int>&,
+                    const std::vector<int>&, const std::vector<int>&, const std::vector<int>&, const VectorXd&,
+                    const std::vector<std::vector<int>>&, const std::vector<std::vector<int>>&, double>())
+      .def_prop_ro("model", &Core::model)
+      .def_prop_ro("same_structure", &Core::same_structure)
+      .def_prop_ro("nq", &Core::nq)
+      .def_prop_ro("nv", &Core::nv)
+      .def_prop_ro("idx_q", &Core::idx_q)
+      .def_prop_ro("idx_v", &Core::idx_v)
+      .def_prop_rw("tol", &Core::tol, &Core::set_tol)
+      .def_prop_ro("iterations", &Core::iterations)
+      .def_prop_ro("solve_blocks", &Core::solve_blocks)
+      .def_prop_ro("moved", &Core::moved)
+      .def("residual", &Core::residual)
+      .def("full_residual", &Core::full_residual)
+      .def("jacobian", &Core::jacobian, nb::arg("newton") = false)
+      .def("drift", &Core::drift)
+      .def("signs", &Core::signs)
+      .def("correct",
+           [](Core& core, VectorXd q, const VectorXd& drivers, int max_iterations) {
+             core.check_structure();
+             double residual = NAN;
+             const bool ok = core.correct(q, drivers, max_iterations, residual);
+             return nb::make_tuple(q, ok ? nb::cast(residual) : nb::none());
+           })
+      .def("follow", &Core::follow)
+      .def("node", &Core::node)
+      .def("rates", &Core::rates)
+      .def("frame_motion", &Core::frame_motion)
+      .def("pinocchio_passes", &Core::pinocchio_passes);
+}
