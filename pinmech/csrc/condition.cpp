@@ -1,6 +1,6 @@
 // pinmech's compiled core: condition numbers (see core.hpp for the whole).
 // ---------------------------------------------------------------- condition numbers
-// Above 3x3 the singular values come from a bidiagonalization B = U^T A V: plane
+// From 3x3 up the singular values come from a bidiagonalization B = U^T A V: plane
 // rotations that keep the band for a band matrix (band_bidiagonalize), Householder
 // reflections otherwise (bidiagonalize). Both are backward stable (B's singular values are
 // those of A + E, |E| <= c n eps |A|: sigma_max exact to rounding, sigma_min to about eps
