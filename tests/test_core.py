@@ -92,8 +92,11 @@ def test_a_core_that_does_not_load_is_named_in_one_line(tmp_path):
     shutil.copytree(source, tmp_path / "pinmech", ignore=shutil.ignore_patterns("*.so", "__pycache__", "csrc"))
     (tmp_path / "pinmech" / Path(core._core.__file__).name).write_bytes(b"not a library")
     root = Path(__file__).resolve().parents[1]
-    run = subprocess.run([sys.executable, "-m", "pinmech", "solve", str(root / "models/scenes/r_rtr.toml")],
-                         capture_output=True, text=True, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(tmp_path)})
+    # the copy, not an editable install's redirect to the checkout (scikit-build-core's finder)
+    code = ("import runpy, sys; sys.meta_path[:] = [f for f in sys.meta_path if 'ScikitBuild' not in "
+            "type(f).__name__]; sys.path.insert(0, sys.argv.pop(1)); runpy.run_module('pinmech', run_name='__main__')")
+    run = subprocess.run([sys.executable, "-c", code, str(tmp_path), "solve", str(root / "models/scenes/r_rtr.toml")],
+                         capture_output=True, text=True, cwd=tmp_path)
     assert run.returncode == 2 and run.stderr.count("\n") == 1, run.stderr
     assert "compiled core does not load beside pin" in run.stderr and "pip install --force-reinstall" in run.stderr
 
