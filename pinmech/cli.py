@@ -116,6 +116,9 @@ def _sweep_parser(sub) -> None:
     sweep.add_argument("--points", nargs="*", help="points to plot (default: all moving points)")
     sweep.add_argument("--paths", dest="paths_path",
                        help="also draw the points' paths, with the mechanism at the scene's pose, here (PNG, PDF, SVG)")
+    sweep.add_argument("--timing-marks", dest="timing_marks", nargs="?", const="30 deg", metavar="STEP",
+                       help="mark the paths every STEP of the driver (default 30 deg; a slide's driver: a "
+                            "length, e.g. '10 mm'), each mark solved at that driver value")
     sweep.add_argument("--angles", choices=("continuous", "wrapped"), default="continuous",
                        help="link angles in the figure: continuous (default, no jump at 180 deg) or wrapped "
                        "to (-180, 180] deg")
@@ -378,6 +381,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                            "rates miss the loops' equations by the interpolation error (the power balance fails); "
                            "sweep without --interpolate for forces")
     limits = _LimitWatch(limit_mode(scene, args.limits), "poses")
+    args.timing_step = _timing_step(args, scene, kind)
     sinks = _sweep_sinks(args, sweep, steps, figure, forces)
     with sinks:
         for pose in _progress(poses, steps):
@@ -395,6 +399,16 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     if not args.through_folds:  # past a fold the driver turns back: no whole turns to speak of
         _say_return(sweep, stop - start)
     return 0
+
+
+def _timing_step(args: argparse.Namespace, scene, kind: str) -> float | None:
+    """--timing-marks' spacing [rad or m], checked before the sweep runs."""
+    if args.timing_marks is None:
+        return None
+    step = scene.quantity(args.timing_marks, kind, "--timing-marks")
+    if not step > 0:
+        raise PinmechError(f"--timing-marks must be a positive {kind}, got {args.timing_marks!r}")
+    return step
 
 
 def _design_summary(sweep, span: float, through_folds: bool) -> list[str]:
@@ -467,7 +481,7 @@ def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | Non
         from pinmech.plot import SweepPlot
 
         recorder = SweepPlot(sweep, links=args.links, points=args.points, total=steps, angles=args.angles,
-                             plane=args.path_plane)
+                             plane=args.path_plane, timing=args.timing_step)
         if figure is not None:
             sinks.plot(recorder, figure)
         if args.paths_path:

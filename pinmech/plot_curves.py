@@ -17,6 +17,16 @@ BRANCH_STYLES = ("-", "--", "-.", ":")
 SPIKE_FACTOR = 1.0
 
 
+#: Mechanisms smaller than this [m] are drawn in mm, larger ones in m (one unit a figure).
+MM_BELOW = 5.0
+
+
+def length_unit(size: float) -> tuple[float, str]:
+    """(factor from m, unit) a figure draws lengths in, for a mechanism of `size` [m]:
+    mm below MM_BELOW (a textbook linkage, an arm), m above."""
+    return (1000.0, "mm") if size < MM_BELOW else (1.0, "m")
+
+
 def driver_axis(x: np.ndarray, angular: bool) -> tuple[np.ndarray, np.ndarray, bool]:
     """The driver values as drawn, the order of the poses along them, and whether they
     make one whole turn (then drawn from 0 to 360 deg, whatever angle the sweep began at;
@@ -90,4 +100,4 @@ def draw_markers(axes, markers: list[tuple[float, str]]) -> None:
             if k == 0:
                 ax.annotate(label, (x, 1.0), xycoords=("data", "axes fraction"), xytext=(2, -2),
                             textcoords="offset points", ha="left", va="top", fontsize=7.5, color="0.25",
-                            rotation=90)
+                            rotation=90, gid="marker")

@@ -1,0 +1,194 @@
+"""The design diagnostics in the sweep figures, read back from matplotlib's own objects
+against closed forms derived apart from Pinocchio (Norton, Design of Machinery, §4.10):
+the least transmission angle marked where the law of cosines puts it, the limit positions
+drawn as vertical lines where the rocker's extremes (crank and coupler in line) and the
+slider's dead centres are, ghost outlines of the mechanism there in the paths figure,
+timing marks at the closed-form coupler points, and one length unit per figure.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+import pytest
+from closed_form import four_bar
+
+from pinmech.cli import main
+from tests.conftest import SCENES
+from tests.test_design import _four_bar_files
+
+pytest.importorskip("matplotlib", reason='plots need pip install "pinmech[plot]"')
+
+DEG = math.pi / 180
+#: Driver values of the marks: the least angle is refined by golden section to 1e-10 rad,
+#: limit positions bisected to 1e-12 rad (limit_positions.BISECTION_TOL); where the
+#: angle is least it is flat, so its place is known only to sqrt(closure tol ~ 1e-13)
+#: ~ 3e-7 rad: 1e-4 deg (2e-6 rad) is a margin of 5 on that, 1e-5 deg on the limits.
+LEAST_AT_TOL_DEG = 1e-4
+LIMIT_TOL_DEG = 1e-5
+#: Angles of solved poses against the closed form: exact to the closure's rounding.
+ANGLE_TOL_DEG = 1e-8
+#: Places drawn [mm]: loops closed to 1e-13 of a 0.1 m mechanism: 1e-6 mm leaves 1e5.
+PLACE_TOL_MM = 1e-6
+
+
+@pytest.fixture
+def figures(monkeypatch):
+    """The figures pinmech saves, kept open to be read."""
+    import pinmech.plot
+
+    kept = []
+
+    def keep(plt, fig, path):
+        kept.append(fig)
+        return path
+
+    monkeypatch.setattr(pinmech.plot, "_save", keep)
+    return kept
+
+
+def _panel(fig, start: str):
+    return next(ax for ax in fig.axes if start in ax.get_title())
+
+
+def _four_bar_mu(theta_deg: np.ndarray, a, b, c, d) -> np.ndarray:
+    """Norton §4.10: cos mu = (b² + c² - a² - d² + 2 a d cos theta) / (2 b c), acute form [deg]."""
+    cos_mu = (b**2 + c**2 - a**2 - d**2 + 2 * a * d * np.cos(np.radians(theta_deg))) / (2 * b * c)
+    mu = np.degrees(np.arccos(cos_mu))
+    return np.minimum(mu, 180 - mu)
+
+
+# (d, a, b, c) [mm] and the crank angle where the acute angle is least: the diagonal O4 A
+# is shortest (theta 0) or longest (theta 180), and mu is farthest from 90 deg at one of them.
+FOUR_BARS = [((100, 40, 120, 80), "crank-rocker"), ((40, 90, 110, 100), "double-crank")]
+
+
+@pytest.mark.parametrize("lengths, label", FOUR_BARS, ids=[f[1] for f in FOUR_BARS])
+def test_least_transmission_angle_is_marked_where_the_law_of_cosines_puts_it(figures, tmp_path, lengths, label):
+    d, a, b, c = lengths
+    scene = _four_bar_files(tmp_path, d, a, b, c)
+    # 50 poses from 5 deg: the least (at 0 or 180 deg) is on no pose, it is found between them
+    assert main(["sweep", str(scene), "--steps", "50", "--from", "5 deg", "--to", "365 deg", "--plot", str(tmp_path / "f.png"), "--csv",
+                 str(tmp_path / "f.csv")]) == 0
+    ax = _panel(figures[0], "transmission angle")
+    (curve,) = [line for line in ax.get_lines() if line.get_label().startswith("B") and line.get_gid() is None]
+    x, y = (np.asarray(v, dtype=float) for v in curve.get_data())
+    np.testing.assert_allclose(y, _four_bar_mu(x, a, b, c, d), rtol=0, atol=ANGLE_TOL_DEG)
+    (least,) = [line for line in ax.get_lines() if line.get_gid() == "least transmission angle"]
+    (at,), (mu,) = least.get_data()
+    extremes = np.array([0.0, 180.0])
+    where = extremes[np.argmin(_four_bar_mu(extremes, a, b, c, d))]
+    assert abs((at - where + 180) % 360 - 180) < LEAST_AT_TOL_DEG
+    np.testing.assert_allclose(mu, _four_bar_mu(np.array([where]), a, b, c, d)[0], rtol=0, atol=ANGLE_TOL_DEG)
+    assert any(f"μ = {mu:.1f}°" in t.get_text() for t in ax.get_legend().get_texts())
+
+
+def test_least_transmission_angle_of_the_offset_slider_crank(figures, tmp_path):
+    """mu = 90 deg - asin(|r sin theta - e| / l): least where r sin theta - e is most
+    negative, theta = 270 deg (r 50, l 150, e 10 mm)."""
+    assert main(["sweep", str(SCENES / "slider_crank.toml"), "--steps", "40", "--plot", str(tmp_path / "f.png")]) == 0
+    ax = _panel(figures[0], "transmission angle")
+    (least,) = [line for line in ax.get_lines() if line.get_gid() == "least transmission angle"]
+    (at,), (mu,) = least.get_data()
+    assert abs((at - 270.0 + 180) % 360 - 180) < LEAST_AT_TOL_DEG
+    np.testing.assert_allclose(mu, 90 - math.degrees(math.asin(0.06 / 0.15)), rtol=0, atol=ANGLE_TOL_DEG)
+
+
+def _rocker_extremes(a=0.04, b=0.12, c=0.08, d=0.10):
+    """Crank angles [deg] and B [m] where crank and coupler are in line: |O2 B| = b + a
+    (extended) and b - a (folded), B above the ground line (the drawn assembly)."""
+    out = []
+    for reach, flip in ((b + a, 0.0), (b - a, math.pi)):
+        x = (reach**2 - c**2 + d**2) / (2 * d)
+        B = np.array([x, math.sqrt(reach**2 - x**2)])
+        out.append((math.degrees((math.atan2(B[1], B[0]) + flip) % (2 * math.pi)), B))
+    return out
+
+
+def _markers(ax) -> list[float]:
+    return sorted(float(line.get_xdata()[0]) for line in ax.get_lines() if line.get_gid() == "marker")
+
+
+def test_limit_positions_are_vertical_lines_in_every_panel(figures, tmp_path):
+    assert main(["sweep", str(SCENES / "four_bar.toml"), "--steps", "37", "--plot", str(tmp_path / "f.png")]) == 0
+    expected = sorted(theta for theta, _ in _rocker_extremes())
+    panels = [ax for ax in figures[0].axes if ax.get_lines() and "paths" not in ax.get_title()]
+    assert len(panels) >= 4
+    for ax in panels:
+        np.testing.assert_allclose(_markers(ax), expected, rtol=0, atol=LIMIT_TOL_DEG)
+
+
+def test_dead_centres_are_vertical_lines(figures, tmp_path):
+    """TDC: crank and rod extended, |OB| = l + r on y = e: theta = atan2(e, x_TDC); BDC
+    folded: theta = atan2(-e, -x_BDC) (r 50, l 150, e 10 mm)."""
+    r, l, e = 0.05, 0.15, 0.01
+    x_tdc, x_bdc = math.sqrt((l + r) ** 2 - e**2), math.sqrt((l - r) ** 2 - e**2)
+    expected = sorted(math.degrees(t) % 360 for t in (math.atan2(e, x_tdc), math.atan2(-e, -x_bdc)))
+    assert main(["sweep", str(SCENES / "slider_crank.toml"), "--steps", "37", "--plot", str(tmp_path / "f.png")]) == 0
+    ax = _panel(figures[0], "angle")
+    np.testing.assert_allclose(_markers(ax), expected, rtol=0, atol=LIMIT_TOL_DEG)
+    labels = " ".join(t.get_text() for t in ax.texts)
+    assert "TDC" in labels and "BDC" in labels
+
+
+def test_ghost_outlines_at_the_rocker_extremes(figures, tmp_path):
+    """The paths figure outlines the mechanism at each limit position: the rocker's end B
+    is where the circles (O2, b +- a) and (O4, c) meet."""
+    assert main(["sweep", str(SCENES / "four_bar.toml"), "--steps", "37", "--paths", str(tmp_path / "p.png")]) == 0
+    ax = figures[0].axes[0]
+    ghosts = [line for line in ax.get_lines() if line.get_gid() == "ghost"]
+    assert ghosts
+    drawn = np.vstack([np.column_stack(line.get_data()) for line in ghosts])
+    for _, B in _rocker_extremes():
+        nearest = np.min(np.linalg.norm(drawn - 1000 * B, axis=1))
+        assert nearest < PLACE_TOL_MM, nearest
+
+
+def _coupler_point(theta_deg: np.ndarray) -> np.ndarray:
+    """P of models/linkages/four_bar.toml [mm]: drawn at (100, 30) mm with the crank at 0,
+    carried by the coupler (closed form A, theta3 of the open assembly)."""
+    a, b, c, d = 0.04, 0.12, 0.08, 0.10
+    drawn = four_bar(0.0, 0.0, 0.0, a, b, c, d)
+    rel = np.array([0.100, 0.030]) - drawn.A
+    t3 = drawn.theta3
+    local = np.array([math.cos(t3) * rel[0] + math.sin(t3) * rel[1], -math.sin(t3) * rel[0] + math.cos(t3) * rel[1]])
+    fb = four_bar(np.radians(theta_deg), 0.0, 0.0, a, b, c, d)
+    ct, st = np.cos(fb.theta3), np.sin(fb.theta3)
+    return 1000 * np.column_stack([fb.A[:, 0] + ct * local[0] - st * local[1], fb.A[:, 1] + st * local[0] + ct * local[1]])
+
+
+def test_timing_marks_sit_at_the_closed_form_coupler_points(figures, tmp_path):
+    """--timing-marks: a mark every 30 deg of the crank on P's coupler curve, at the closed
+    form's P there, though no pose of the 50 falls on those angles."""
+    assert main(["sweep", str(SCENES / "four_bar_drawn.toml"), "--steps", "50", "--points", "P",
+                 "--paths", str(tmp_path / "p.png"), "--timing-marks"]) == 0
+    ax = figures[0].axes[0]
+    (marks,) = [line for line in ax.get_lines() if line.get_gid() == "timing P"]
+    drawn = np.column_stack(marks.get_data())
+    labels = [t.get_text() for t in ax.texts if t.get_gid() == "timing P"]
+    angles = np.array([float(t.rstrip("°")) for t in labels])
+    assert sorted(angles % 360) == list(range(0, 360, 30))
+    np.testing.assert_allclose(drawn, _coupler_point(angles), rtol=0, atol=PLACE_TOL_MM)
+
+
+def test_timing_marks_need_a_paths_figure(tmp_path, capsys):
+    assert main(["sweep", str(SCENES / "four_bar.toml"), "--steps", "5", "--timing-marks"]) == 2
+    assert "--timing-marks" in capsys.readouterr().err
+
+
+def test_one_length_unit_in_a_figure(figures, tmp_path):
+    """The R-RTR (150 mm): the paths are in mm, so are the slider's and the points' panels;
+    the slider's place is the closed form's in mm (s = -|CB|, as tests/test_figures.py)."""
+    import closed_form as cf
+
+    assert main(["sweep", str(SCENES / "r_rtr.toml"), "--steps", "13", "--plot", str(tmp_path / "f.png")]) == 0
+    fig = figures[0]
+    texts = " ".join([ax.get_title() + ax.get_ylabel() + ax.get_xlabel() for ax in fig.axes])
+    assert "[mm]" in texts and "[mm/s]" in texts and "[mm/s²]" in texts
+    assert not re.search(r"\[m(/s²?)?\]", texts), texts
+    ax = _panel(fig, "position along its guide")
+    (line,) = [x for x in ax.get_lines() if x.get_label().startswith("B")]
+    x, s = (np.asarray(v, dtype=float) for v in line.get_data())
+    np.testing.assert_allclose(s, -1000 * cf.r_rtr(np.radians(x), 1.0, 0.0).s, rtol=0, atol=PLACE_TOL_MM)
