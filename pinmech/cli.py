@@ -595,7 +595,7 @@ def _follow(args: argparse.Namespace, scene) -> int:
     total = step_count(duration, step) + 1
     sinks = Outputs()
     if args.plot_path:
-        from pinmech.plot import PathPlot
+        from pinmech.plot_task import PathPlot
 
         note = f" ({scheme}, step {step:g} s" + (f", feedback {gain:g}/s)" if gain else ")")
         sinks.plot(PathPlot(mechanism, scene.title, note=note, total=total), figure)

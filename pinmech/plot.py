@@ -5,8 +5,8 @@ position, velocity and acceleration along their guide, and the speed and acceler
 magnitudes of chosen points, against the driver (0 to 360 deg for a whole turn, whatever
 angle it starts at), with the scene's own pose marked (dashed line, dots, and its values in
 a panel), the driver's rates in the title, constant quantities named instead of drawn, and
-a last panel with the points' paths (`pinmech.plot_paths`). A path's figure: joint
-coordinates, rates, accelerations and the drift against time.
+a last panel with the points' paths (`pinmech.plot_paths`). A task's figure against time
+is `pinmech.plot_task`.
 
 The recorders (`SweepPlot`, `PathPlot`) take poses one at a time while a sweep streams
 and keep at most `max_points` of them (every n-th), so memory stays bounded.
@@ -23,15 +23,15 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from pinmech.exceptions import FrameNotFound, PinmechError
-from pinmech.display import colour_of, display_names, hex_colour, joint_colours
+from pinmech.display import colour_of, display_names, hex_colour
 from pinmech.plot_curves import BRANCH_STYLES, angles as _angles, branch_pieces, driver_axis as _driver_axis
 from pinmech.plot_curves import draw_markers, length_unit, nearest as _nearest, spike_limits
 from pinmech.plot_design import DesignTrace, mark_least
 from pinmech.plot_paths import PathRecorder
+from pinmech.slide_values import slide_link, slide_values
 
 if TYPE_CHECKING:
     from pinmech.mechanism import Mechanism
-    from pinmech.path import PathPoint
     from pinmech.sweep import Sweep, SweepPose
 
 MAX_POINTS = 20_000
@@ -136,7 +136,7 @@ class SweepPlot:
         kept = pose.index % self.every == 0 or pose.index == self.last
         if not (nearer or kept):
             return
-        values = self._values(pose)
+        values = self._values(pose, q)
         if nearer:
             self.mark = (pose.value, values)
             self.mark_q = None if self.sweep.last_q is None else self.sweep.last_q.copy()
@@ -159,9 +159,9 @@ class SweepPlot:
             self.points = [n for n, p in motion.points.items()
                            if p.link in mech.links and model.frames[mech.links[p.link]].parentJoint != 0]
         self.sliders = list(motion.sliders)
-        by_joint = joint_colours(mech)
         self.colours = {n: hex_colour(colour_of(mech, n)) for n in [*self.links, *self.points]}
-        self.colours.update({n: hex_colour(by_joint[mech.joint(n).id]) for n in self.sliders})
+        self.colours.update({n: hex_colour(colour_of(mech, slide_link(mech, n))) for n in self.sliders})
+        self._data = model.createData()  # a slot's place along it is read off its cut frames
         for dyad, name in zip(self.design.dyads, self.design.names):  # a dyad in its output's colour
             coupler, output = (self.design.design.linkage.names[k] for k in (dyad.coupler, dyad.output))
             self.colours[name] = hex_colour(colour_of(mech, output)) if output in mech.links else "#111111"
@@ -193,7 +193,7 @@ class SweepPlot:
             panels["acceleration, |a| [m/s²]"] = self.points
         return panels
 
-    def _values(self, pose: SweepPose) -> dict[str, dict[str, float]]:
+    def _values(self, pose: SweepPose, q: np.ndarray) -> dict[str, dict[str, float]]:
         m, n = pose.motion, self.normal
         links = [m.links[name] for name in self.links]
         if n is not None:
@@ -210,8 +210,7 @@ class SweepPlot:
         if self.design.dyads:
             columns.append(self._mus)
         if self.sliders:
-            columns += [[m.joints[s].q for s in self.sliders], [m.joints[s].v for s in self.sliders],
-                        [m.joints[s].a for s in self.sliders]]
+            columns += [list(c) for c in zip(*slide_values(self.sweep.mechanism, m, q, self._data, self.sliders))]
         if self.points:
             columns += [[float(np.linalg.norm(m.points[p].velocity)) for p in self.points],
                         [float(np.linalg.norm(m.points[p].acceleration)) for p in self.points]]
@@ -436,62 +435,6 @@ def plot_sweep(sweep: Sweep, poses: Iterable[SweepPose], path: str | Path, *,
     for pose in poses:
         recorder.add(pose)
     return recorder.save(path)
-
-
-class PathPlot:
-    """Records an arm path point by point, then draws joint coordinates, rates,
-    accelerations and the drift against time (`save`)."""
-
-    def __init__(self, mechanism: Mechanism, title: str, *, note: str = "", total: int | None = None,
-                 max_points: int = MAX_POINTS) -> None:
-        _pyplot()
-        self.mechanism, self.title, self.note = mechanism, title, note
-        self.joints = [j for j in mechanism.joints.values() if j.nv == 1]
-        self.every = max(1, math.ceil(total / max_points)) if total else 1
-        self.total = total
-        self.t: list[float] = []
-        self.rows: list[list[float]] = []
-        self.count = 0
-
-    def add(self, point: PathPoint) -> None:
-        self.count += 1
-        if (self.count - 1) % self.every and self.count != self.total:  # the last point is always drawn
-            return
-        q = [self.mechanism.coordinate(point.q, j.name) for j in self.joints]
-        q = [math.degrees(x) if j.is_angular else x for x, j in zip(q, self.joints)]
-        idx = [j.idx_v for j in self.joints]
-        self.t.append(point.time)
-        self.rows.append(q + point.v[idx].tolist() + point.a[idx].tolist() + [point.drift, point.angular_drift])
-
-    def save(self, path: str | Path) -> Path:
-        if not self.rows:
-            raise PinmechError(f"no path point: nothing to plot in {path}")
-        plt = _pyplot()
-        t, data, n = np.array(self.t), np.array(self.rows), len(self.joints)
-        angular = all(j.is_angular for j in self.joints)
-        units = ("deg", "rad/s", "rad/s²") if angular else ("deg or m", "rad/s or m/s", "rad/s² or m/s²")
-        fig, axes = plt.subplots(2, 2, figsize=(11, 6.4), sharex=True)
-        for k, (ax, name) in enumerate(zip(axes.flat[:3], ("joint coordinate q", "joint rate q̇", "joint acceleration q̈"))):
-            for i, joint in enumerate(self.joints):
-                ax.plot(t, data[:, k * n + i], linewidth=1.5, label=joint.name)
-            ax.set_title(f"{name} [{units[k]}]", fontsize=10)
-            ax.set_ylabel(f"[{units[k]}]")
-        ax = axes.flat[3]
-        drift, angle = data[:, 3 * n], data[:, 3 * n + 1]
-        floor = 1e-16
-        ax.semilogy(t, np.maximum(drift, floor), linewidth=1.5, label="position drift [m]")
-        if np.any(angle > 0):
-            ax.semilogy(t, np.maximum(angle, floor), linewidth=1.5, label="angle drift [rad]")
-        ax.set_title("drift of the achieved path from the asked one", fontsize=10)
-        ax.set_ylabel("[m] or [rad]")
-        for ax in axes.flat:
-            ax.grid(True, alpha=0.35)
-            ax.legend(fontsize=8, loc="best")
-        for ax in axes[-1]:
-            ax.set_xlabel("time t [s]")
-        fig.suptitle(f"{self.title}: task followed in time{self.note}", fontsize=11)
-        fig.tight_layout()
-        return _save(plt, fig, path)
 
 
 #: Agg draws a long line in pieces of this many vertices: a million-pose sweep's curves

@@ -110,8 +110,8 @@ class PathRecorder:
                     zorder=5, gid=f"timing {name}", label=f"{self.labels.get(name, name)} every "
                     f"{timing.label(timing.step if not timing.sweep.is_angular else np.degrees(timing.step))} "
                     "of the driver")
-            for key, p in zip(keys, uv):
-                ax.annotate(timing.label(key), p, xytext=(4, 4), textcoords="offset points", fontsize=6.5,
+            for text, p in _merged([timing.label(k) for k in keys], uv, 1e-6 * max(self._size() * scale, 1e-300)):
+                ax.annotate(text, p, xytext=(4, 4), textcoords="offset points", fontsize=6.5,
                             color=colour, zorder=6, gid=f"timing {name}")
 
     def _colour(self, name: str) -> str:
@@ -158,6 +158,18 @@ class PathRecorder:
         values = [np.abs(np.array(c)) for xyz in self.xyz.values() for c in xyz]
         finite = [x[np.isfinite(x)] for x in values]
         return float(max((np.max(x) for x in finite if x.size), default=0.0))
+
+
+def _merged(texts: list[str], places: np.ndarray, tol: float) -> list[tuple[str, np.ndarray]]:
+    """One label a place: the texts of marks within tol of each other joined ("90°, 270°")."""
+    out: list[tuple[str, np.ndarray]] = []
+    for text, p in zip(texts, places):
+        same = next((k for k, (_, q) in enumerate(out) if np.linalg.norm(p - q) <= tol), None)
+        if same is None:
+            out.append((text, p))
+        else:
+            out[same] = (f"{out[same][0]}, {text}", out[same][1])
+    return out
 
 
 def _arrows(ax, u: np.ndarray, v: np.ndarray, colour: str, count: int = 4) -> None:
