@@ -106,6 +106,20 @@ class DriverValues(Sequence):
         return float(self.first + i * step)
 
 
+def _no_drivers(mechanism) -> str:
+    """What to add to a scene without [drivers] for a driver's cycle to be swept: a driver
+    table for each of the model's motors (a robot.yaml's name_mot), else for a joint."""
+    motors = list(mechanism.motors)
+    if motors:
+        tables = ", ".join(f"[drivers.{m}]" for m in motors)
+        return (f"has no [drivers] to sweep: add {tables} (the motors its robot.yaml names), each with its "
+                f"angle, and a speed on the one to sweep, e.g. [drivers.{motors[0]}] angle = \"0 deg\", "
+                "speed = \"1 rad/s\"")
+    joint = next((n for n, j in mechanism.joints.items() if j.nv == 1), "JOINT")
+    return (f"has no [drivers] to sweep: add one per degree of freedom, e.g. [drivers.{joint}] "
+            "angle = \"0 deg\", speed = \"1 rad/s\"")
+
+
 def sweep_options(scene: Scene) -> dict[str, Any]:
     """The scene's `[sweep]` table, checked (names and types)."""
     table = scene.section("sweep")
@@ -148,10 +162,13 @@ class Sweep:
                 `pinmech path`), or a driver that is not one of the scene's.
         """
         sweep_options(scene)
-        if "task" in scene.raw or not scene.section("drivers"):
+        if "task" in scene.raw:
             raise SceneError("has no [drivers] to sweep; a task scene ([[task]]) is followed in time: "
-                             "pinmech path SCENE --duration ...", path=str(scene.path), key="drivers")
+                             "pinmech path SCENE --duration ... (pinmech animate SCENE --duration ... "
+                             "animates it)", path=str(scene.path), key="drivers")
         mechanism = load_mechanism(scene)
+        if not scene.section("drivers"):
+            raise SceneError(_no_drivers(mechanism), path=str(scene.path), key="drivers")
         drivers = scene_drivers(scene, mechanism)
         check_scene_names(scene, mechanism)
         scene.names("sweep", "links"), scene.names("sweep", "points")  # lists of names, or a SceneError now

@@ -101,3 +101,18 @@ def _hues(pixels: np.ndarray, value: np.ndarray, spread: np.ndarray) -> np.ndarr
         value == r, (g - b) / safe, np.where(value == g, 2.0 + (b - r) / safe, 4.0 + (r - g) / safe)
     )
     return (hue / 6.0) % 1.0
+
+
+def page_dom(html_file: Path, *, fragment: str = "") -> str:
+    """The page's DOM as chromium holds it once its scripts have run (`--dump-dom`)."""
+    import subprocess
+    import tempfile
+
+    from pinmech.draw.browser import chromium_command
+
+    with tempfile.TemporaryDirectory() as profile:
+        command = [c for c in chromium_command(require_browser(), html_file, Path(profile) / "x.png", Path(profile),
+                                               fragment=fragment) if not c.startswith("--screenshot")]
+        done = subprocess.run([*command[:-1], "--dump-dom", command[-1]], capture_output=True, text=True,
+                              timeout=90, check=True)
+    return done.stdout

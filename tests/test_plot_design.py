@@ -168,9 +168,9 @@ def test_timing_marks_sit_at_the_closed_form_coupler_points(figures, tmp_path):
     (marks,) = [line for line in ax.get_lines() if line.get_gid() == "timing P"]
     drawn = np.column_stack(marks.get_data())
     labels = [t.get_text() for t in ax.texts if t.get_gid() == "timing P"]
-    angles = np.array([float(a.rstrip("°")) for t in labels for a in t.split(", ")])
-    assert sorted(angles % 360) == list(range(0, 360, 30))
-    np.testing.assert_allclose(drawn, _coupler_point(angles), rtol=0, atol=PLACE_TOL_MM)
+    angles = sorted(float(a.rstrip("°")) for t in labels for a in t.split(", "))
+    assert angles == list(range(0, 360, 30))  # the marks are drawn in this order
+    np.testing.assert_allclose(drawn, _coupler_point(np.array(angles)), rtol=0, atol=PLACE_TOL_MM)
 
 
 def test_timing_marks_need_a_paths_figure(tmp_path, capsys):
