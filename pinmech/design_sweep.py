@@ -17,7 +17,7 @@ import numpy as np
 from pinmech.design import advantage_unit
 from pinmech.exceptions import DiagnosticError, PinmechError
 from pinmech.grashof import loop_classes
-from pinmech.limit_positions import LimitFinder, LimitPosition, travel
+from pinmech.limit_positions import LimitFinder, LimitPosition, extreme_label, travel
 from pinmech.planar_linkage import planar_linkage
 from pinmech.transmission import dyad_angles, find_dyads, find_outputs, output_rate
 
@@ -179,7 +179,7 @@ class DesignSweep:
                     x, q = self.finder.bisect(output, q0, x0, x1, r0)
                 except PinmechError:  # a pose between that does not close: no limit stated there
                     continue
-                found.append((self.finder.limit(output, q, x, "max" if r0 > 0 else "min"), q))
+                found.append((self.finder.limit(output, q, x, extreme_label(r0, x1 - x0)), q))
             out.append(found)
         self._limits = (self.count, out)
         return out

@@ -93,7 +93,10 @@ def spike_limits(curves: list[np.ndarray]) -> tuple[float, float, float] | None:
 
 def draw_markers(axes, markers: list[tuple[float, str]]) -> None:
     """Vertical lines at driver values (limit, toggle, fold positions) in every panel, each
-    labelled once, at the top of the first panel."""
+    labelled once, at the top of the first panel; a marker met again (each pass through
+    folds meets the same limits) is drawn once."""
+    seen: set[tuple[float, str]] = set()
+    markers = [m for m in markers if (round(m[0], 6), m[1]) not in seen and not seen.add((round(m[0], 6), m[1]))]
     for k, ax in enumerate(axes):
         for x, label in markers:
             ax.axvline(x, color="0.3", linestyle=(0, (4, 2, 1, 2)), linewidth=0.9, zorder=1, gid="marker")
