@@ -189,3 +189,27 @@ def test_the_slider_moves_the_mechanism_and_the_readout_follows(tmp_path):
         assert "\u25b6 play" in dom  # the slider stopped it
         pixels = screenshot(page, tmp_path / f"r{k}.png", fragment=f"slider={k}")
         assert _angle_gap(crank_angle_deg(pixels), (30.0 + 30 * k) % 180) < 3.0
+
+
+def test_animation_html_refuses_frames_it_cannot_draw_by_name():
+    """Frames naming different points (a KeyError before), readouts or traces that do not
+    fit the frames: each a DrawError naming the argument."""
+    pytest.importorskip("meshcat", reason='needs pip install "pinmech[viz]"')
+    import pinocchio as pin
+
+    from pinmech.draw import DrawError, animation_html, load_visuals
+    from tests.conftest import MODELS
+    from tests.test_draw import r_rtr_pose
+
+    urdf = MODELS / "r_rtr.urdf"
+    model = pin.buildModelFromUrdf(str(urdf))
+    visuals = load_visuals(urdf, model)
+    qs = [r_rtr_pose(0.1), r_rtr_pose(0.2)]
+    here = {"A": np.zeros(3), "B": np.ones(3)}
+    with pytest.raises(DrawError, match=r"points_per_frame\[1\] names A, the first frame A, B") as caught:
+        animation_html(model, visuals, qs, points_per_frame=[here, {"A": np.zeros(3)}])
+    assert caught.value.argument == "points_per_frame"
+    with pytest.raises(DrawError, match="3 readouts for 2 poses"):
+        animation_html(model, visuals, qs, readouts=["a", "b", "c"])
+    with pytest.raises(DrawError, match="traces of points not in points_per_frame: D"):
+        animation_html(model, visuals, qs, points_per_frame=[here, here], traces={"D": (1.0, 0.0, 0.0)})

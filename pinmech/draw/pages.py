@@ -104,7 +104,7 @@ def snapshot_html(
         show_grid: draw meshcat's grid (cells of a round length, named in the legend) and axes.
         title: the page's title, before the legend.
     """
-    scene = _Scene(model, visual_model, _OfflineWindow(), show_grid=show_grid)
+    scene = _Scene(model, visual_model, _OfflineWindow(), show_grid=show_grid, orthographic=True)
     legend = _draw_pose(scene, _configuration(model, q, "q"), points, arrows, plane_normal)
     return scene.vis.window.page(title, legend)
 
@@ -169,7 +169,7 @@ def animation_html(
             argument="points_per_frame",
             value=len(frames),
         )
-    scene = _Scene(model, visual_model, _OfflineWindow(), show_grid=show_grid)
+    scene = _Scene(model, visual_model, _OfflineWindow(), show_grid=show_grid, orthographic=True)
     scene.orient(plane_normal)
     body = np.vstack([scene.corners(q) for q in qs] + [_stack(p) for p in frames])
     labels = scene.label_boxes([p for f in frames for p in f.values()], _size(body))

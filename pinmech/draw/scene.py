@@ -93,11 +93,23 @@ def _meshcat() -> Any:
 
 
 class _Scene:
-    """One meshcat scene: the model's visuals under ROOT, points, labels, arrows, camera."""
+    """One meshcat scene: the model's visuals under ROOT, points, labels, arrows, camera.
+
+    `orthographic`: a planar view is drawn through an orthographic camera (offline pages,
+    whose script keeps it centred when the window's shape changes); else nearly without
+    perspective (a far camera, zoomed in).
+    """
 
     def __init__(
-        self, model: pin.Model, visual_model: pin.GeometryModel, window: Any, *, show_grid: bool
+        self,
+        model: pin.Model,
+        visual_model: pin.GeometryModel,
+        window: Any,
+        *,
+        show_grid: bool,
+        orthographic: bool = False,
     ) -> None:
+        self.orthographic = orthographic
         meshcat = _meshcat()
         from pinocchio.visualize import MeshcatVisualizer
 
@@ -137,7 +149,7 @@ class _Scene:
     def orient(self, plane_normal: np.ndarray | None) -> None:
         """Choose the view: along a planar mechanism's normal (world y up), else oblique."""
         self.back = _unit(plane_normal, "plane_normal") if plane_normal is not None else _OBLIQUE
-        self.planar = plane_normal is not None
+        self.planar = plane_normal is not None and self.orthographic
         self.zoom = _PLANAR_ZOOM if plane_normal is not None else _OBLIQUE_ZOOM
         self.up = _screen_up(self.back)
         self.right = np.cross(self.up, self.back)
