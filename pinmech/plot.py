@@ -25,7 +25,7 @@ import numpy as np
 from pinmech.exceptions import FrameNotFound, PinmechError
 from pinmech.display import colour_of, display_names, hex_colour
 from pinmech.plot_curves import BRANCH_STYLES, angles as _angles, branch_pieces, driver_axis as _driver_axis
-from pinmech.plot_curves import draw_markers, length_unit, nearest as _nearest, spike_limits
+from pinmech.plot_curves import draw_markers, legend_beside, length_unit, nearest as _nearest, spike_limits
 from pinmech.plot_design import DesignTrace, mark_least
 from pinmech.plot_paths import PathRecorder
 from pinmech.slide_values import slide_link, slide_values
@@ -324,7 +324,7 @@ class SweepPlot:
             x = self._x(least.at) % 360.0 if turn else self._x(least.at)
             mark_least(ax, least, x, self.colours.get(least.name, "k"), self.names.get(least.name, least.name),
                        "°" if self.sweep.is_angular else f" {self.length[1]}")
-        _legend(ax)
+        legend_beside(ax)
 
     def _speed(self) -> float:
         """The swept driver's speed in the scene [rad/s or m/s]."""
@@ -385,7 +385,7 @@ class SweepPlot:
         ax.set_title(f"{name}: {quantity}" if len(series) == 1 else quantity, fontsize=10)
         ax.set_ylabel(label + (f", {self.angles}" if angle else ""))
         ax.grid(True, alpha=0.35)
-        _legend(ax)
+        legend_beside(ax)
 
     def _length_dim(self, dim: str) -> tuple[float, str]:
         """(factor, unit) a quantity in SI `dim` is drawn in: the figure's length unit for
@@ -421,11 +421,6 @@ class SweepPlot:
             for name, value in values.items():
                 lines.append(f"  {self.names.get(name, name) + ' ' + symbol:<18} {scale * value: .5g} {dim}")
         return "\n".join(lines)
-
-
-def _legend(ax) -> None:
-    """A panel's legend beside it, never over its curves."""
-    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
 
 
 def plot_sweep(sweep: Sweep, poses: Iterable[SweepPose], path: str | Path, *,

@@ -91,6 +91,11 @@ def spike_limits(curves: list[np.ndarray]) -> tuple[float, float, float] | None:
     return max(low, float(values.min())), min(high, float(values.max())), float(np.max(np.abs(values)))
 
 
+def legend_beside(ax) -> None:
+    """A panel's legend beside it, never over its curves."""
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+
+
 def draw_markers(axes, markers: list[tuple[float, str]]) -> None:
     """Vertical lines at driver values (limit, toggle, fold positions) in every panel, each
     labelled once, at the top of the first panel; a marker met again (each pass through

@@ -279,3 +279,12 @@ def test_a_slot_cut_slider_is_drawn_along_its_slot(figures, tmp_path):
     v = np.sum(CB * dB, axis=1) / np.linalg.norm(CB, axis=1)
     # rates: closure rounding times the condition number, 1e-9 mm/s on 300 mm/s
     np.testing.assert_allclose(line.get_ydata(), 1000 * v, rtol=0, atol=1e-6)
+
+
+@pytest.mark.parametrize("step, said", [("0 deg", "--timing-marks must be a positive angle"),
+                                        ("10 mm", "--timing-marks")])
+def test_timing_marks_take_a_positive_angle_for_a_crank(tmp_path, capsys, step, said):
+    assert main(["sweep", str(SCENES / "four_bar.toml"), "--steps", "5", "--paths", str(tmp_path / "p.png"),
+                 "--timing-marks", step]) in (2, 4)
+    err = capsys.readouterr().err
+    assert said in err and "Traceback" not in err and not (tmp_path / "p.png").exists()
