@@ -63,8 +63,11 @@ def joint_colours(mechanism: Mechanism) -> dict[int, tuple[float, float, float]]
 
 
 def colour_of(mechanism: Mechanism, name: str) -> tuple[float, float, float]:
-    """The colour of a link, or of the link a point is on (grey: the ground)."""
+    """The colour of a link, or of the link a point (or a named frame: a drawn linkage's
+    pin `B`) is on (grey: the ground)."""
     fid = mechanism.links.get(name, mechanism.points.get(name))
+    if fid is None and mechanism.model.existFrame(name):
+        fid = mechanism.model.getFrameId(name)
     if fid is None:
         raise KeyError(name)
     return joint_colours(mechanism)[mechanism.model.frames[fid].parentJoint]

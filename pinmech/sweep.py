@@ -117,7 +117,8 @@ def _no_drivers(mechanism) -> str:
                 "speed = \"1 rad/s\"")
     joint = next((n for n, j in mechanism.joints.items() if j.nv == 1), "JOINT")
     return (f"has no [drivers] to sweep: add one per degree of freedom, e.g. [drivers.{joint}] "
-            "angle = \"0 deg\", speed = \"1 rad/s\"")
+            "angle = \"0 deg\", speed = \"1 rad/s\"; or a [[task]] to follow in time (pinmech path "
+            "SCENE --duration ...)")
 
 
 def sweep_options(scene: Scene) -> dict[str, Any]:
