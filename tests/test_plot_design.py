@@ -46,7 +46,11 @@ def figures(monkeypatch):
         return path
 
     monkeypatch.setattr(pinmech.plot, "_save", keep)
-    return kept
+    yield kept
+    import matplotlib.pyplot as plt
+
+    for fig in kept:
+        plt.close(fig)
 
 
 def _panel(fig, start: str):
