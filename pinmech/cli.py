@@ -117,6 +117,9 @@ def _sweep_parser(sub) -> None:
     sweep.add_argument("--points", nargs="*", help="points to plot (default: all moving points)")
     sweep.add_argument("--paths", dest="paths_path",
                        help="also draw the points' paths, with the mechanism at the scene's pose, here (PNG, PDF, SVG)")
+    sweep.add_argument("--timing-marks", dest="timing_marks", nargs="?", const="30 deg", metavar="STEP",
+                       help="mark the paths every STEP of the driver (default 30 deg; a slide's driver: a "
+                            "length, e.g. '10 mm'), each mark solved at that driver value")
     sweep.add_argument("--angles", choices=("continuous", "wrapped"), default="continuous",
                        help="link angles in the figure: continuous (default, no jump at 180 deg) or wrapped "
                        "to (-180, 180] deg")
@@ -177,11 +180,16 @@ def _snapshot_parser(sub) -> None:
 
 
 def _animate_parser(sub) -> None:
-    anim = sub.add_parser("animate", help="save a driver cycle as an offline meshcat animation (pinmech[viz])")
+    anim = sub.add_parser("animate", help="save a driver cycle (or a task in time) as an offline meshcat "
+                          "animation (pinmech[viz]), a GIF or an MP4")
     _add_scene_arguments(anim)
-    anim.add_argument("-o", "--output", required=True, help="the HTML file to write")
+    anim.add_argument("-o", "--output", help="the HTML page to write (play/pause, a driver slider, traced paths)")
+    anim.add_argument("--gif", help="also write a GIF for slides (Pillow: pinmech[plot])")
+    anim.add_argument("--mp4", help="also write an MP4 for slides (needs ffmpeg installed)")
     anim.add_argument("--from", dest="start", help="first driver value (default: the scene's)")
     anim.add_argument("--to", dest="stop", help="last driver value (default: one turn on)")
+    anim.add_argument("--duration", help="task scenes: how long to follow the task, e.g. '0.5 s' "
+                      "(default: the scene's [sweep] duration)")
     anim.add_argument("--steps", type=int, default=91, help="frames (default 91)")
     anim.add_argument("--fps", type=int, default=30, help="frames per second (default 30)")
     anim.add_argument("--skip-failures", action="store_true", help="leave out poses that cannot close")
@@ -429,6 +437,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                                   "loops' equations by the interpolation error (the power balance fails); sweep "
                                   f"without {interpolating.name} for forces")
     limits = _LimitWatch(limit_mode(scene, args.limits), "poses")
+    args.timing_step = _timing_step(args, scene, kind)
     sinks = _sweep_sinks(args, sweep, steps, figure, forces)
     with sinks:
         for pose in _progress(poses, steps):
@@ -446,6 +455,16 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     if not args.through_folds:  # past a fold the driver turns back: no whole turns to speak of
         _say_return(sweep, stop - start)
     return 0
+
+
+def _timing_step(args: argparse.Namespace, scene, kind: str) -> float | None:
+    """--timing-marks' spacing [rad or m], checked before the sweep runs."""
+    if args.timing_marks is None:
+        return None
+    step = scene.quantity(args.timing_marks, kind, "--timing-marks")
+    if not step > 0:
+        raise PinmechError(f"--timing-marks must be a positive {kind}, got {args.timing_marks!r}")
+    return step
 
 
 def _design_summary(sweep, span: float, through_folds: bool) -> list[str]:
@@ -518,7 +537,7 @@ def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | Non
         from pinmech.plot import SweepPlot
 
         recorder = SweepPlot(sweep, links=args.links, points=args.points, total=steps, angles=args.angles,
-                             plane=args.path_plane)
+                             plane=args.path_plane, timing=args.timing_step)
         if figure is not None:
             sinks.plot(recorder, figure)
         if args.paths_path:
@@ -627,7 +646,7 @@ def _follow(args: argparse.Namespace, scene) -> int:
     total = step_count(duration, step) + 1
     sinks = Outputs()
     if args.plot_path:
-        from pinmech.plot import PathPlot
+        from pinmech.plot_task import PathPlot
 
         note = f" ({scheme}, step {step:g} s" + (f", feedback {gain:g}/s)" if gain else ")")
         sinks.plot(PathPlot(mechanism, scene.title, note=note, total=total), figure)
@@ -724,30 +743,64 @@ _MAX_FRAMES = 20_000
 
 
 def cmd_animate(args: argparse.Namespace) -> int:
-    """`pinmech animate SCENE -o FILE.html`: a driver cycle, each frame a solved, closed pose."""
-    from pinmech.draw import animation_html
-    from pinmech.sweep import DriverValues, Sweep
+    """`pinmech animate SCENE -o FILE.html [--gif FILE] [--mp4 FILE]`: a driver cycle (a task
+    scene: its task followed in time), each frame a solved, closed pose."""
+    from pinmech.animation import driver_frames, task_frames
 
+    outputs = {"-o": args.output, "--gif": args.gif, "--mp4": args.mp4}
+    if not any(outputs.values()):
+        raise PinmechError("animate writes -o PAGE.html, --gif FILE.gif or --mp4 FILE.mp4: give at least one")
     scene = _scene(args)
-    _check_page(args, scene)
-    sweep = Sweep.from_scene(scene)
-    kind = "angle" if sweep.is_angular else "length"
-    start = _option(args.start, "--from", scene, {}, "").quantity(kind) if _given(args.start, "--from") else sweep.start
-    stop = (_option(args.stop, "--to", scene, {}, "").quantity(kind) if _given(args.stop, "--to")
-            else start + (sweep.default_values(2)[1] - sweep.start))
+    _check_animation(args, scene)
     if not 2 <= args.steps <= _MAX_FRAMES:
         raise PinmechError(f"--steps must be between 2 and {_MAX_FRAMES} frames (each is kept in the page), "
                            f"got {args.steps}")
-    qs = []
-    for pose in sweep.poses(DriverValues(start, stop, args.steps), skip_failures=args.skip_failures):
-        if pose.motion is not None:
-            qs.append(sweep.last_q.copy())
-    if not qs:
-        raise PinmechError("no pose of the range could be closed")
-    mechanism = sweep.mechanism
-    _write(args.output, animation_html(mechanism.model, _visuals(mechanism), qs, fps=args.fps,
-                                       plane_normal=mechanism.plane_normal, show_grid=not args.no_grid))
+    if not args.fps > 0:
+        raise PinmechError(f"--fps must be positive, got {args.fps}")
+    if "task" in scene.raw:
+        frames = task_frames(scene, _given(args.duration, "--duration"), args.steps)
+    else:
+        frames = driver_frames(scene, _given(args.start, "--from"), _given(args.stop, "--to"), args.steps,
+                               skip_failures=args.skip_failures)
+    if args.output:
+        from pinmech.draw import animation_html
+
+        mechanism = frames.mechanism
+        _write(args.output, animation_html(mechanism.model, _visuals(mechanism), frames.qs, fps=args.fps,
+                                           points_per_frame=frames.places, plane_normal=mechanism.plane_normal,
+                                           show_grid=not args.no_grid, title=frames.title,
+                                           readouts=frames.readouts, traces=frames.traces()))
+    if args.gif:
+        from pinmech.animation_export import write_gif
+
+        print(f"wrote {write_gif(frames, args.gif, args.fps)} ({len(frames.qs)} frames)", file=sys.stderr)
+    if args.mp4:
+        from pinmech.animation_export import write_mp4
+
+        print(f"wrote {write_mp4(frames, args.mp4, args.fps)} ({len(frames.qs)} frames)", file=sys.stderr)
     return 0
+
+
+def _check_animation(args: argparse.Namespace, scene) -> None:
+    """Before solving: the outputs are distinct and writable in kind, ffmpeg is there for
+    --mp4, and the range options fit the scene (a driver's range, or a task's duration)."""
+    from pinmech.exceptions import OptionRefused
+    from pinmech.outputs import check_distinct
+
+    for option, path, suffix in (("--gif", args.gif, ".gif"), ("--mp4", args.mp4, ".mp4")):
+        if path and Path(path).suffix.lower() != suffix:
+            raise PinmechError(f"{option} {path}: the file must end in {suffix}")
+    check_distinct({"-o": args.output, "--gif": args.gif, "--mp4": args.mp4}, _inputs(scene))
+    if args.mp4:
+        from pinmech.animation_export import check_mp4
+
+        check_mp4(args.mp4)
+    task = "task" in scene.raw
+    wrong = ["--from"] * bool(task and args.start) + ["--to"] * bool(task and args.stop)
+    wrong += ["--duration"] * bool(not task and args.duration)
+    if wrong:
+        kind = "a task ([[task]]) followed in time: give --duration" if task else "a driver's cycle: give --from/--to"
+        raise OptionRefused(f"{', '.join(wrong)}: this scene animates {kind}", options=wrong, scene=str(scene.path))
 
 
 def cmd_polygon(args: argparse.Namespace) -> int:

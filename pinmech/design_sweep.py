@@ -17,7 +17,7 @@ import numpy as np
 from pinmech.design import advantage_unit
 from pinmech.exceptions import DiagnosticError, PinmechError
 from pinmech.grashof import loop_classes
-from pinmech.limit_positions import LimitFinder, LimitPosition, travel
+from pinmech.limit_positions import LimitFinder, LimitPosition, extreme_label, travel
 from pinmech.planar_linkage import planar_linkage
 from pinmech.transmission import dyad_angles, find_dyads, find_outputs, output_rate
 
@@ -50,6 +50,7 @@ class DesignSweep:
 
         self.sweep, self.reason = sweep, ""
         self._cache: tuple[int, dict] = (-1, {})
+        self._limits: tuple[int, list] = (-1, [])
         self.count = 0
         try:
             self.linkage = planar_linkage(sweep.mechanism)
@@ -163,6 +164,13 @@ class DesignSweep:
     # ------------------------------------------------------------------ summary
     def limits(self) -> list[list[LimitPosition]]:
         """Each output's limit positions, bisected between the poses that bracket them."""
+        return [[limit for limit, _ in found] for found in self.limit_poses()]
+
+    def limit_poses(self) -> list[list[tuple[LimitPosition, np.ndarray]]]:
+        """Each output's limit positions and the closed configuration at each (bisected
+        once for the poses seen so far: the summary and the figures share them)."""
+        if self._limits[0] == self.count:
+            return self._limits[1]
         out = []
         for output, brackets in zip(self.outputs, self.brackets):
             found = []
@@ -171,8 +179,9 @@ class DesignSweep:
                     x, q = self.finder.bisect(output, q0, x0, x1, r0)
                 except PinmechError:  # a pose between that does not close: no limit stated there
                     continue
-                found.append(self.finder.limit(output, q, x, "max" if r0 > 0 else "min"))
+                found.append((self.finder.limit(output, q, x, extreme_label(r0, x1 - x0)), q))
             out.append(found)
+        self._limits = (self.count, out)
         return out
 
     def summary(self, span: float | None = None) -> list[str]:

@@ -12,6 +12,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from pinmech.mechanism import Mechanism
 
 #: One colour a moving link (RGB in [0, 1]), in the order of the model's joints.

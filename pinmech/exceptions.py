@@ -307,3 +307,20 @@ class OptionRefused(PinmechError):
         super().__init__(f"{scene}: {message}" if scene else message)
         self.options = options
         self.scene = scene
+
+
+class MissingTool(PinmechError):
+    """An option needs an external program that is not installed (`animate --mp4` without
+    ffmpeg): said before anything is computed, with what to install.
+
+    Attributes:
+        tool: the program ("ffmpeg").
+        option: the option that needs it ("--mp4").
+    """
+
+    exit_code = 2
+
+    def __init__(self, message: str, *, tool: str, option: str):
+        super().__init__(message)
+        self.tool = tool
+        self.option = option

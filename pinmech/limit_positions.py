@@ -125,7 +125,7 @@ class LimitFinder:
             if r0 is None or r1 is None or not (r0 * r1 < 0 or (r0 == 0 and i > 0)):
                 continue
             x, q = self.bisect(output, qs[i], float(values[i]), float(values[i + 1]), r0)
-            out.append(self.limit(output, q, x, "max" if r0 > 0 else "min"))
+            out.append(self.limit(output, q, x, extreme_label(r0, float(values[i + 1] - values[i]))))
         return out
 
     def bisect(self, output: Output, q0: np.ndarray, a: float, b: float, ra: float) -> tuple[float, np.ndarray]:
@@ -152,6 +152,13 @@ class LimitFinder:
         dyad = next((d for d in self.dyads if d.output == output.output), None)
         lay = toggle(self.linkage, dyad) if dyad is not None else ""
         return LimitPosition(name, kind, label, x, output_position(self.linkage, output), lay)
+
+
+def extreme_label(rate: float, step: float) -> str:
+    """"max" or "min": the output's extreme met moving the driver by `step` [rad or m] from
+    where its rate per unit driver rate is `rate` (a driver swept backwards, or turning back
+    past a fold, meets a maximum where the rate per unit driver is negative)."""
+    return "max" if rate * step > 0 else "min"
 
 
 def travel(limits: list[LimitPosition], span: float | None) -> Travel | None:

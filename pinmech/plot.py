@@ -5,8 +5,8 @@ position, velocity and acceleration along their guide, and the speed and acceler
 magnitudes of chosen points, against the driver (0 to 360 deg for a whole turn, whatever
 angle it starts at), with the scene's own pose marked (dashed line, dots, and its values in
 a panel), the driver's rates in the title, constant quantities named instead of drawn, and
-a last panel with the points' paths (`pinmech.plot_paths`). A path's figure: joint
-coordinates, rates, accelerations and the drift against time.
+a last panel with the points' paths (`pinmech.plot_paths`). A task's figure against time
+is `pinmech.plot_task`.
 
 The recorders (`SweepPlot`, `PathPlot`) take poses one at a time while a sweep streams
 and keep at most `max_points` of them (every n-th), so memory stays bounded.
@@ -25,15 +25,16 @@ import numpy as np
 from pinmech.exceptions import FrameNotFound, PinmechError
 from pinmech.display import colour_of, display_names, hex_colour
 from pinmech.plot_curves import BRANCH_STYLES, angles as _angles, branch_pieces, driver_axis as _driver_axis
-from pinmech.plot_curves import draw_markers, nearest as _nearest, spike_limits
+from pinmech.plot_curves import draw_markers, legend_beside, length_unit, nearest as _nearest, spike_limits
+from pinmech.plot_design import DesignTrace, mark_least
 from pinmech.plot_paths import PathRecorder
 
 if TYPE_CHECKING:
-    from pinmech.mechanism import Mechanism
-    from pinmech.path import PathPoint
     from pinmech.sweep import Sweep, SweepPose
 
 MAX_POINTS = 20_000
+#: The panel of Norton's transmission angles (acute, 90 deg best) of a planar linkage's dyads.
+TRANSMISSION = "transmission angle, μ [deg]"
 ANGLE_STYLES = ("continuous", "wrapped")
 
 
@@ -67,17 +68,25 @@ class SweepPlot:
             (-180, 180] deg, with a gap where an angle wraps.
         plane: the world plane ("xy", "yz", "zx") a spatial mechanism's paths are
             projected on (None: the mechanism's own plane, or xy), or "3d": a 3-D view.
+        timing: marks on the paths every `timing` of the driver [rad or m] (None: none).
+
+    Lengths are drawn in one unit a figure, mm or m from the mechanism's size
+    (`plot_curves.length_unit`); a planar linkage's figure has a panel of transmission
+    angles (least marked) and its limit positions as vertical lines (`plot_design`).
     """
 
     def __init__(self, sweep: Sweep, *, links: list[str] | None = None, points: list[str] | None = None,
                  total: int | None = None, max_points: int = MAX_POINTS, angles: str = "continuous",
-                 plane: str | None = None) -> None:
+                 plane: str | None = None, timing: float | None = None) -> None:
         _pyplot()  # fail early, before the sweep runs, when matplotlib is missing
         if angles not in ANGLE_STYLES:
             raise PinmechError(f"angles must be one of {', '.join(ANGLE_STYLES)}, got {angles!r}")
         chosen = sweep.scene.section("sweep")
         self.sweep, self.angles = sweep, angles
-        self.paths = PathRecorder(sweep.mechanism, plane)
+        self.length = length_unit(sweep.mechanism.length_scale)  # (scale from m, unit): one a figure
+        self.paths = PathRecorder(sweep.mechanism, plane, length=self.length)
+        self.design, self.timing_step, self.timing = DesignTrace(sweep), timing, None
+        self._mus: list[float] = []
         self.mark_q = None  # configuration of the pose nearest the scene's (drawn under the paths)
         self.links, self.points = links or chosen.get("links"), points or chosen.get("points")
         _check_names(sweep, "link", self.links, sweep.mechanism.links, "--links" if links else "[sweep] links")
@@ -98,13 +107,17 @@ class SweepPlot:
         self.mark: tuple[float, dict[str, dict[str, float]]] | None = None  # nearest pose to the scene's
 
     def _x(self, value: float) -> float:
-        return math.degrees(value) if self.sweep.is_angular else value
+        return math.degrees(value) if self.sweep.is_angular else value * self.length[0]
 
     def add(self, pose: SweepPose) -> None:
         if "fold" in pose.note:  # the engine crossed a limit position: the driver turns back there,
             self._branch = 1 - self._branch  # and the assembly changes (two of them, in turn)
             self._folded = True
             self.markers.append((self._x(pose.value), f"fold ({self.sweep.driver} limit)"))
+        q = None if pose.motion is None or self.sweep.last_q is None else self.sweep.last_q
+        self._mus = self.design.add(pose, q)  # every pose: the least angle is looked for among them all
+        if self.timing is not None:
+            self.timing.add(pose.value, q)
         if pose.motion is None:
             self.failed.append(self._x(pose.value))
             if self.series:
@@ -121,7 +134,7 @@ class SweepPlot:
         kept = pose.index % self.every == 0 or pose.index == self.last
         if not (nearer or kept):
             return
-        values = self._values(pose)
+        values = self._values(pose, q)
         if nearer:
             self.mark = (pose.value, values)
             self.mark_q = None if self.sweep.last_q is None else self.sweep.last_q.copy()
@@ -147,6 +160,15 @@ class SweepPlot:
         self.colours = {n: hex_colour(colour_of(mech, n)) for n in [*self.links, *self.points]}
         # a slider in the colour of its moving side (a tree joint's child, a loop cut's child link)
         self.colours.update({n: hex_colour(colour_of(mech, s.child)) for n, s in motion.sliders.items()})
+        for dyad, name in zip(self.design.dyads, self.design.names):  # a dyad in its output's colour
+            coupler, output = (self.design.design.linkage.names[k] for k in (dyad.coupler, dyad.output))
+            self.colours[name] = hex_colour(colour_of(mech, output)) if output in mech.links else "#111111"
+            self.names[name] = f"{self.names.get(name, name)} ({coupler}-{output})"
+        if self.timing_step is not None and self.points:
+            from pinmech.plot_timing import TimingMarks
+
+            self.timing = TimingMarks(self.sweep, self.points, self.timing_step)
+            self.timing.add(pose.value, self.sweep.last_q)
         # raw doubles, not lists of floats: the kept values would pin memory pools freed by the rest
         self.series = {title: {name: array("d") for name in names} for title, names in self._panels().items()}
 
@@ -158,6 +180,8 @@ class SweepPlot:
             panels["angle, φ [deg]"] = self.links
         panels["angular velocity, ω [rad/s]" if planar else "angular speed, |ω| [rad/s]"] = self.links
         panels["angular acceleration, α [rad/s²]" if planar else "angular acceleration, |α| [rad/s²]"] = self.links
+        if self.design.dyads:
+            panels[TRANSMISSION] = self.design.names
         if self.sliders:
             panels["position along its guide, s [m]"] = self.sliders
             panels["velocity along its guide, v_rel [m/s]"] = self.sliders
@@ -167,7 +191,7 @@ class SweepPlot:
             panels["acceleration, |a| [m/s²]"] = self.points
         return panels
 
-    def _values(self, pose: SweepPose) -> dict[str, dict[str, float]]:
+    def _values(self, pose: SweepPose, q: np.ndarray) -> dict[str, dict[str, float]]:
         m, n = pose.motion, self.normal
         links = [m.links[name] for name in self.links]
         if n is not None:
@@ -181,6 +205,8 @@ class SweepPlot:
         if n is not None:
             columns.append([math.degrees(link.angle) for link in links])
         columns += [w, alpha]
+        if self.design.dyads:
+            columns.append(self._mus)
         if self.sliders:
             sliders = [m.sliders[name] for name in self.sliders]  # tree joints and cuts alike
             columns += [[s.s for s in sliders], [s.s_dot for s in sliders], [s.s_ddot for s in sliders]]
@@ -197,7 +223,7 @@ class SweepPlot:
         if not self.series:
             raise PinmechError(f"no pose of the sweep could be solved: nothing to plot in {path}")
         plt = _pyplot()
-        sweep, unit = self.sweep, "deg" if self.sweep.is_angular else "m"
+        unit = "deg" if self.sweep.is_angular else self.length[1]
         x, order, turn = _driver_axis(np.array(self.x), self.sweep.is_angular and self._comes_back())
         mark_x = self._x(self.mark[0]) % 360.0 if turn else self._x(self.mark[0])
         lo, hi = np.nanmin(x), np.nanmax(x)
@@ -209,6 +235,8 @@ class SweepPlot:
         fig, axes = plt.subplots(rows, cols, figsize=(13, 3.2 * rows), squeeze=False)
         for ax, (title, series) in zip(axes.flat, panels):
             self._panel(ax, title, series, x, order, mark_x if marked else None)
+            if title == TRANSMISSION:
+                self._mark_least(ax, turn)
             ax.set_xlim(lo, hi)
             if turn:
                 ax.set_xticks(np.arange(0, 361, 60))
@@ -217,14 +245,15 @@ class SweepPlot:
                 failed = np.mod(self.failed, 360.0) if turn else self.failed
                 ax.plot(failed, np.zeros(len(failed)), "x", color="red", markersize=6,
                         transform=ax.get_xaxis_transform(), clip_on=False)
-        markers = [(m % 360.0 if turn else m, label) for m, label in self.markers]
+        limits = [(self._x(at), label) for label, at, _ in self.design.limits()]
+        markers = [(m % 360.0 if turn else m, label) for m, label in self.markers + limits]
         draw_markers(list(axes.flat[:len(panels)]), markers)
         if drawn_paths:
             ax = axes.flat[len(panels)]
             if self.paths.is_3d:  # a 3-D panel in the same place
                 ax.remove()
                 ax = fig.add_subplot(rows, cols, len(panels) + 1, projection="3d")
-            self.paths.draw(ax, self.mark_q, self._travel(), backwards=self._backwards())
+            self._draw_paths(ax)
         spare = list(axes.flat[len(panels) + drawn_paths:])
         for ax in spare:
             ax.set_visible(False)
@@ -241,7 +270,7 @@ class SweepPlot:
         """The driver axis' label, with the sense its angle is counted in (planar mechanisms)."""
         sweep, mech = self.sweep, self.sweep.mechanism
         if not sweep.is_angular:
-            return f"driver {sweep.driver}: s [m] along its guide"
+            return f"driver {sweep.driver}: s [{self.length[1]}] along its guide"
         if self.normal is None:
             return f"driver {sweep.driver}: θ [deg]"
         import pinocchio as pin
@@ -276,10 +305,25 @@ class SweepPlot:
         plt = _pyplot()
         fig = plt.figure(figsize=(8, 6.5))
         ax = fig.add_subplot(projection="3d" if self.paths.is_3d else None)
-        self.paths.draw(ax, self.mark_q, self._travel(), backwards=self._backwards())
+        self._draw_paths(ax)
         fig.suptitle(f"{self.sweep.scene.title}: paths over the sweep", fontsize=11)
         fig.tight_layout()
         return _save(plt, fig, path)
+
+    def _draw_paths(self, ax) -> None:
+        """The paths, the mechanism at the scene's pose, ghost outlines at the limit
+        positions and the timing marks asked for."""
+        ghosts = [(q, label) for label, _, q in self.design.limits()]
+        self.paths.draw(ax, self.mark_q, self._travel(), backwards=self._backwards(), ghosts=ghosts,
+                        timing=self.timing)
+
+    def _mark_least(self, ax, turn: bool) -> None:
+        """The least transmission angle of each dyad, refined between the poses, on its panel."""
+        for least in self.design.least():
+            x = self._x(least.at) % 360.0 if turn else self._x(least.at)
+            mark_least(ax, least, x, self.colours.get(least.name, "k"), self.names.get(least.name, least.name),
+                       "°" if self.sweep.is_angular else f" {self.length[1]}")
+        legend_beside(ax)
 
     def _speed(self) -> float:
         """The swept driver's speed in the scene [rad/s or m/s]."""
@@ -296,7 +340,7 @@ class SweepPlot:
         return self._speed() != 0 and (self._speed() > 0) != self._increasing()
 
     def _travel(self) -> str:
-        unit = "deg" if self.sweep.is_angular else "m"
+        unit = "deg" if self.sweep.is_angular else self.length[1]
         if self._speed() == 0:
             return f"arrows: travel as {self.sweep.driver} {'grows' if self._increasing() else 'falls'} [{unit}]"
         spec = self.sweep.scene.section("drivers").get(self.sweep.driver, {})
@@ -309,8 +353,10 @@ class SweepPlot:
         style a branch), constant ones said in the legend, a fold's spike clipped."""
         quantity, label = title.split(", ")
         symbol, dim = label.split(" [")
+        scale, dim = self._length_dim(dim.rstrip("]"))
+        label, dim = f"{symbol} [{dim}]", dim + "]"
         angle = title.startswith("angle")
-        curves = {name: _angles(np.array(v)[order], self.angles) if angle else np.array(v)[order]
+        curves = {name: _angles(np.array(v)[order], self.angles) if angle else scale * np.array(v)[order]
                   for name, v in series.items()}
         largest = max((float(np.nanmax(np.abs(y))) for y in curves.values() if np.any(np.isfinite(y))), default=0.0)
         flat = max(1e-9 * largest, 1e-12)  # changes below this are rounding (1e-12: noise about an exact 0)
@@ -324,7 +370,7 @@ class SweepPlot:
             drawn.append(y)
             self._curve(ax, name, x, y, branch)
             if mark_x is not None:
-                at = _nearest(x, y, mark_x, self.mark[1][title][name])
+                at = _nearest(x, y, mark_x, scale * self.mark[1][title][name])
                 ax.plot([mark_x], [at], "o", color=self.colours.get(name, "k"), markersize=5)
         for text in constants:  # in the legend, not in a box over the curves
             ax.plot([], [], " ", label=text)
@@ -338,7 +384,14 @@ class SweepPlot:
         ax.set_title(f"{name}: {quantity}" if len(series) == 1 else quantity, fontsize=10)
         ax.set_ylabel(label + (f", {self.angles}" if angle else ""))
         ax.grid(True, alpha=0.35)
-        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+        legend_beside(ax)
+
+    def _length_dim(self, dim: str) -> tuple[float, str]:
+        """(factor, unit) a quantity in SI `dim` is drawn in: the figure's length unit for
+        lengths, speeds and accelerations ("m/s" -> "mm/s"), else as it is."""
+        if dim in ("m", "m/s", "m/s²"):
+            return self.length[0], self.length[1] + dim[1:]
+        return 1.0, dim
 
     def _curve(self, ax, name: str, x: np.ndarray, y: np.ndarray, branch: np.ndarray) -> None:
         """One name's curve, in its link's colour, one line style for each branch."""
@@ -363,8 +416,9 @@ class SweepPlot:
         lines = [f"At the scene's pose, {self.sweep.driver} = {mark_x:.4g} {unit}:", ""]
         for title, values in self.mark[1].items():
             symbol, dim = title.split(", ")[1].split(" [")
+            scale, dim = self._length_dim(dim.rstrip("]"))
             for name, value in values.items():
-                lines.append(f"  {name + ' ' + symbol:<18} {value: .5g} {dim.rstrip(']')}")
+                lines.append(f"  {self.names.get(name, name) + ' ' + symbol:<18} {scale * value: .5g} {dim}")
         return "\n".join(lines)
 
 
@@ -375,62 +429,6 @@ def plot_sweep(sweep: Sweep, poses: Iterable[SweepPose], path: str | Path, *,
     for pose in poses:
         recorder.add(pose)
     return recorder.save(path)
-
-
-class PathPlot:
-    """Records an arm path point by point, then draws joint coordinates, rates,
-    accelerations and the drift against time (`save`)."""
-
-    def __init__(self, mechanism: Mechanism, title: str, *, note: str = "", total: int | None = None,
-                 max_points: int = MAX_POINTS) -> None:
-        _pyplot()
-        self.mechanism, self.title, self.note = mechanism, title, note
-        self.joints = [j for j in mechanism.joints.values() if j.nv == 1]
-        self.every = max(1, math.ceil(total / max_points)) if total else 1
-        self.total = total
-        self.t: list[float] = []
-        self.rows: list[list[float]] = []
-        self.count = 0
-
-    def add(self, point: PathPoint) -> None:
-        self.count += 1
-        if (self.count - 1) % self.every and self.count != self.total:  # the last point is always drawn
-            return
-        q = [self.mechanism.coordinate(point.q, j.name) for j in self.joints]
-        q = [math.degrees(x) if j.is_angular else x for x, j in zip(q, self.joints)]
-        idx = [j.idx_v for j in self.joints]
-        self.t.append(point.time)
-        self.rows.append(q + point.v[idx].tolist() + point.a[idx].tolist() + [point.drift, point.angular_drift])
-
-    def save(self, path: str | Path) -> Path:
-        if not self.rows:
-            raise PinmechError(f"no path point: nothing to plot in {path}")
-        plt = _pyplot()
-        t, data, n = np.array(self.t), np.array(self.rows), len(self.joints)
-        angular = all(j.is_angular for j in self.joints)
-        units = ("deg", "rad/s", "rad/s²") if angular else ("deg or m", "rad/s or m/s", "rad/s² or m/s²")
-        fig, axes = plt.subplots(2, 2, figsize=(11, 6.4), sharex=True)
-        for k, (ax, name) in enumerate(zip(axes.flat[:3], ("joint coordinate q", "joint rate q̇", "joint acceleration q̈"))):
-            for i, joint in enumerate(self.joints):
-                ax.plot(t, data[:, k * n + i], linewidth=1.5, label=joint.name)
-            ax.set_title(f"{name} [{units[k]}]", fontsize=10)
-            ax.set_ylabel(f"[{units[k]}]")
-        ax = axes.flat[3]
-        drift, angle = data[:, 3 * n], data[:, 3 * n + 1]
-        floor = 1e-16
-        ax.semilogy(t, np.maximum(drift, floor), linewidth=1.5, label="position drift [m]")
-        if np.any(angle > 0):
-            ax.semilogy(t, np.maximum(angle, floor), linewidth=1.5, label="angle drift [rad]")
-        ax.set_title("drift of the achieved path from the asked one", fontsize=10)
-        ax.set_ylabel("[m] or [rad]")
-        for ax in axes.flat:
-            ax.grid(True, alpha=0.35)
-            ax.legend(fontsize=8, loc="best")
-        for ax in axes[-1]:
-            ax.set_xlabel("time t [s]")
-        fig.suptitle(f"{self.title}: task followed in time{self.note}", fontsize=11)
-        fig.tight_layout()
-        return _save(plt, fig, path)
 
 
 #: Agg draws a long line in pieces of this many vertices: a million-pose sweep's curves

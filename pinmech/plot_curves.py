@@ -17,6 +17,16 @@ BRANCH_STYLES = ("-", "--", "-.", ":")
 SPIKE_FACTOR = 1.0
 
 
+#: Mechanisms smaller than this [m] are drawn in mm, larger ones in m (one unit a figure).
+MM_BELOW = 5.0
+
+
+def length_unit(size: float) -> tuple[float, str]:
+    """(factor from m, unit) a figure draws lengths in, for a mechanism of `size` [m]:
+    mm below MM_BELOW (a textbook linkage, an arm), m above."""
+    return (1000.0, "mm") if size < MM_BELOW else (1.0, "m")
+
+
 def driver_axis(x: np.ndarray, angular: bool) -> tuple[np.ndarray, np.ndarray, bool]:
     """The driver values as drawn, the order of the poses along them, and whether they
     make one whole turn (then drawn from 0 to 360 deg, whatever angle the sweep began at;
@@ -81,13 +91,21 @@ def spike_limits(curves: list[np.ndarray]) -> tuple[float, float, float] | None:
     return max(low, float(values.min())), min(high, float(values.max())), float(np.max(np.abs(values)))
 
 
+def legend_beside(ax) -> None:
+    """A panel's legend beside it, never over its curves."""
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+
+
 def draw_markers(axes, markers: list[tuple[float, str]]) -> None:
     """Vertical lines at driver values (limit, toggle, fold positions) in every panel, each
-    labelled once, at the top of the first panel."""
+    labelled once, at the top of the first panel; a marker met again (each pass through
+    folds meets the same limits) is drawn once."""
+    seen: set[tuple[float, str]] = set()
+    markers = [m for m in markers if (round(m[0], 6), m[1]) not in seen and not seen.add((round(m[0], 6), m[1]))]
     for k, ax in enumerate(axes):
         for x, label in markers:
             ax.axvline(x, color="0.3", linestyle=(0, (4, 2, 1, 2)), linewidth=0.9, zorder=1, gid="marker")
             if k == 0:
                 ax.annotate(label, (x, 1.0), xycoords=("data", "axes fraction"), xytext=(2, -2),
                             textcoords="offset points", ha="left", va="top", fontsize=7.5, color="0.25",
-                            rotation=90)
+                            rotation=90, gid="marker")

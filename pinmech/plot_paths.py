@@ -33,9 +33,12 @@ class PathRecorder:
         mechanism: the model (its plane, or `plane` for a spatial one).
         plane: None (the mechanism's plane; "xy" for a spatial mechanism), one of PLANES
             (a projection on that world plane), or "3d" (a 3-D view).
+        length: (factor from m, unit) the figure draws lengths in (None: mm for paths
+            within a metre of the origin, else m).
     """
 
-    def __init__(self, mechanism: Mechanism, plane: str | None = None) -> None:
+    def __init__(self, mechanism: Mechanism, plane: str | None = None,
+                 length: tuple[float, str] | None = None) -> None:
         if plane is not None and plane not in (*PLANES, "3d"):
             raise PinmechError(f"the path plane must be one of {', '.join(PLANES)} or 3d, got {plane!r}")
         self.mechanism, self.is_3d = mechanism, plane == "3d"
@@ -51,6 +54,7 @@ class PathRecorder:
         self.xyz: dict[str, tuple[array, array, array]] = {}
         self.labels = display_names(mechanism)
         self.count = 0
+        self.length = length
 
     def add(self, positions: dict[str, np.ndarray]) -> None:
         """One pose: point name -> world position [m] (NaN where the pose failed)."""
@@ -64,13 +68,18 @@ class PathRecorder:
         """The paths in the drawing plane's coordinates [m]."""
         return {name: tuple(self.axes @ np.array(xyz)) for name, xyz in self.xyz.items()}
 
-    def draw(self, ax, q: np.ndarray | None, travel: str, *, backwards: bool = False) -> None:
+    def draw(self, ax, q: np.ndarray | None, travel: str, *, backwards: bool = False,
+             ghosts: list[tuple[np.ndarray, str]] = (), timing=None) -> None:
         """Paths, the mechanism at q (if given) and arrows of travel, on matplotlib axes
         (3-D axes when the recorder is 3-D); `backwards`: the points move against the order
-        they were recorded in (a driver turning at a negative speed), and the arrows say so."""
+        they were recorded in (a driver turning at a negative speed), and the arrows say so;
+        `ghosts`: (q, label) of poses outlined thinly (limit positions); `timing`: a
+        `plot_timing.TimingMarks` whose marks are drawn on the paths."""
         if self.is_3d:
             return self._draw_3d(ax, q, travel, backwards)
-        scale, unit = (1000.0, "mm") if self._size() < 1.0 else (1.0, "m")
+        scale, unit = self._unit()
+        for k, (ghost, label) in enumerate(ghosts):
+            draw_ghost(ax, self.mechanism, ghost, self.axes, scale, "outlines: limit positions" if k == 0 else None)
         if q is not None:
             draw_linkage(ax, self.mechanism, q, self.axes, scale)
         for k, (name, (u, v)) in enumerate(self.uv.items()):
@@ -78,11 +87,32 @@ class PathRecorder:
             (line,) = ax.plot(u, v, linewidth=1.6, color=self._colour(name), linestyle=("-", "--", "-.", ":")[k % 4],
                               label=f"path of {self.labels.get(name, name)}", zorder=4)
             _arrows(ax, u[::-1], v[::-1], line.get_color()) if backwards else _arrows(ax, u, v, line.get_color())
+        if timing is not None:
+            self._timing(ax, timing, scale)
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_xlabel(f"{self.names[0]} [{unit}]", fontsize=9)
         ax.set_ylabel(f"{self.names[1]} [{unit}]", fontsize=9)
         self._finish(ax, travel)
         return None
+
+    def _unit(self) -> tuple[float, str]:
+        if self.length is not None:
+            return self.length
+        return (1000.0, "mm") if self._size() < 1.0 else (1.0, "m")
+
+    def _timing(self, ax, timing, scale: float) -> None:
+        """A dot on each path at every timing mark, the driver's value beside it."""
+        keys = sorted(timing.marks)
+        for name in timing.points:
+            uv = np.array([self.axes @ timing.marks[k][name] for k in keys]).reshape(-1, 2) * scale
+            colour = self._colour(name)
+            ax.plot(uv[:, 0], uv[:, 1], "o", markersize=4, markerfacecolor="white", markeredgecolor=colour,
+                    zorder=5, gid=f"timing {name}", label=f"{self.labels.get(name, name)} every "
+                    f"{timing.label(timing.step if not timing.sweep.is_angular else np.degrees(timing.step))} "
+                    "of the driver")
+            for text, p in _merged([timing.label(k) for k in keys], uv, 1e-6 * max(self._size() * scale, 1e-300)):
+                ax.annotate(text, p, xytext=(4, 4), textcoords="offset points", fontsize=6.5,
+                            color=colour, zorder=6, gid=f"timing {name}")
 
     def _colour(self, name: str) -> str:
         """A point's path in its link's colour (pinmech.display); black for a point not on a link."""
@@ -92,7 +122,7 @@ class PathRecorder:
             return "#111111"
 
     def _draw_3d(self, ax, q: np.ndarray | None, travel: str, backwards: bool = False) -> None:
-        scale, unit = (1000.0, "mm") if self._size() < 1.0 else (1.0, "m")
+        scale, unit = self._unit()
         if q is not None:
             draw_linkage_3d(ax, self.mechanism, q, scale)
         for k, (name, xyz) in enumerate(self.xyz.items()):
@@ -128,6 +158,18 @@ class PathRecorder:
         values = [np.abs(np.array(c)) for xyz in self.xyz.values() for c in xyz]
         finite = [x[np.isfinite(x)] for x in values]
         return float(max((np.max(x) for x in finite if x.size), default=0.0))
+
+
+def _merged(texts: list[str], places: np.ndarray, tol: float) -> list[tuple[str, np.ndarray]]:
+    """One label a place: the texts of marks within tol of each other joined ("90°, 270°")."""
+    out: list[tuple[str, np.ndarray]] = []
+    for text, p in zip(texts, places):
+        same = next((k for k, (_, q) in enumerate(out) if np.linalg.norm(p - q) <= tol), None)
+        if same is None:
+            out.append((text, p))
+        else:
+            out[same] = (f"{out[same][0]}, {text}", out[same][1])
+    return out
 
 
 def _arrows(ax, u: np.ndarray, v: np.ndarray, colour: str, count: int = 4) -> None:
@@ -172,6 +214,24 @@ def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scal
         for node, p in zip(link.nodes, uv):
             if node.kind == "revolute":
                 ax.plot(*p, "o", markersize=5, markerfacecolor="white", markeredgecolor="0.15", zorder=3)
+
+
+def draw_ghost(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scale: float = 1.0,
+               label: str | None = None) -> None:
+    """The mechanism at q outlined thinly (a limit position beside the drawn pose): each
+    moving link's bar or plate edge, dashed in its colour [m x scale]."""
+    data = mechanism.model.createData()
+    pin.forwardKinematics(mechanism.model, data, q)
+    colours = joint_colours(mechanism)
+    for link in sketch_links(mechanism).values():
+        uv = (world_nodes(link, data) @ axes.T) * scale
+        if link.is_ground or len(uv) < 2:
+            continue
+        hull = _hull(uv) if link.is_plate and len(uv) >= 3 else np.empty((0, 2))
+        ring = np.vstack([hull, hull[:1]]) if len(hull) >= 3 else uv[list(_farthest(uv))]
+        ax.plot(ring[:, 0], ring[:, 1], color=colours[link.joint], linewidth=1.0, linestyle=(0, (3, 2)),
+                alpha=0.55, zorder=1.5, gid="ghost", label=label)
+        label = None
 
 
 def _labels(ax, mechanism: Mechanism, sketches: dict, data: pin.Data, axes: np.ndarray, scale: float,

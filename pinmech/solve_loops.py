@@ -29,7 +29,6 @@ from pinmech.exceptions import (
     AssemblyError,
     LoopClosureError,
     MobilityError,
-    ModelError,
     OptionError,
     RateOverflowError,
     SingularPoseError,

@@ -25,7 +25,6 @@ rows cannot all hold is a TaskError and a singular pose a SingularPoseError.
 
 from __future__ import annotations
 
-import math
 import threading
 from collections.abc import Sequence
 from dataclasses import dataclass

@@ -188,7 +188,8 @@ class Sweep:
         sweep_options(scene)
         if "task" in scene.raw:
             raise SceneError("has no [drivers] to sweep; a task scene ([[task]]) is followed in time: "
-                             "pinmech path SCENE --duration ...", path=str(scene.path), key="drivers")
+                             "pinmech path SCENE --duration ... (pinmech animate SCENE --duration ... "
+                             "animates it)", path=str(scene.path), key="drivers")
         mechanism = load_mechanism(scene)
         if not scene.section("drivers"):
             raise SceneError(_no_drivers(mechanism, "pose" in scene.raw), path=str(scene.path), key="drivers")

@@ -3,7 +3,7 @@
 `pinmech sweep` on a task scene follows the task in time: none of a driver sweep's options
 (its range, its solver settings, its forces, `--paths`, `--torque-plot`) means anything
 there; on a driven scene the options of a task (`--duration`, ...) mean nothing. A figure's
-settings (`--links`, `--points`, `--angles`, `--path-plane`) need the figure they set.
+settings (`--links`, `--points`, `--angles`, `--path-plane`, `--timing-marks`) need the figure they set.
 Each was ignored in silence: now each is an `OptionRefused` (exit 2) before anything runs.
 """
 
@@ -21,13 +21,13 @@ DRIVER_SWEEP = {
     "cold_start": "--cold-start", "no_batch": "--no-batch", "interpolate": "--interpolate", "tol": "--tol",
     "max_iterations": "--max-iterations", "through_folds": "--through-folds", "forces": "--forces",
     "static": "--static", "minimum_norm": "--minimum-norm", "flywheel": "--flywheel",
-    "torque_plot": "--torque-plot",
+    "torque_plot": "--torque-plot", "timing_marks": "--timing-marks",
 }
 #: Options only a task followed in time reads.
 TASK = {"duration": "--duration", "step": "--step", "scheme": "--scheme", "gain": "--gain"}
 #: Settings of the sweep figure (`--plot`) alone, and of both it and the paths figure (`--paths`).
 PLOT_SETTINGS = {"links": "--links", "angles": "--angles"}
-PATH_SETTINGS = {"points": "--points", "path_plane": "--path-plane"}
+PATH_SETTINGS = {"points": "--points", "path_plane": "--path-plane", "timing_marks": "--timing-marks"}
 _DEFAULTS = {"angles": "continuous"}
 
 

@@ -11,8 +11,10 @@ route as the browser tests (tests/browser.py).
   `pinmech snapshot` draws them; `docs/images/four_bar_bare.png`: the four-bar with every
   `<visual>` taken out (a user's model), and `docs/images/jansen_leg.png`, a model written
   without any: their links sketched from their joints and points.
-- `docs/images/sweep_r_rtr.png`, `docs/images/paths_four_bar.png`, `paths_jansen_leg.png`:
-  `pinmech sweep --plot` and `--paths`; `docs/images/path_planar_arm.png`: `pinmech path --plot`; `docs/images/torque_slider_crank.png`: `--torque-plot`; `docs/images/polygon_v_r_rtr.png`,
+- `docs/images/sweep_r_rtr.png`, `sweep_four_bar.png`, `docs/images/paths_four_bar.png`
+  (with `--timing-marks`), `paths_jansen_leg.png`: `pinmech sweep --plot` and `--paths`;
+  `docs/images/animate_four_bar.gif` and `.png`: `pinmech animate --gif`, and its page with
+  the slider moved to frame 30; `docs/images/path_planar_arm.png`: `pinmech path --plot`; `docs/images/torque_slider_crank.png`: `--torque-plot`; `docs/images/polygon_v_r_rtr.png`,
   `polygon_a_r_rtr.png`, `polygon_a_four_bar.png`: `pinmech polygon`;
   `docs/images/report_r_rtr_page1.png`: the first page of `pinmech report`, printed to PDF by
   chromium (poppler's `pdftoppm` makes the picture).
@@ -127,6 +129,9 @@ def cli_pictures(chromium: str, tmp: Path) -> None:
         html = tmp / f"{name}.html"
         pinmech(["snapshot", str(scene_file), "-o", str(html), "--no-grid"])
         photograph(chromium, html, IMAGES / f"{name}.png")
+    page = tmp / "animate_four_bar.html"
+    pinmech(["animate", str(scenes / "four_bar.toml"), "-o", str(page), "--steps", "91"])
+    photograph(chromium, page, IMAGES / "animate_four_bar.png", fragment="slider=30")
     for kind in ("v", "a"):
         svg = tmp / f"polygon_{kind}.svg"
         pinmech(["polygon", str(scenes / "r_rtr.toml"), "-o", str(svg)] + (["--acceleration"] if kind == "a" else []))
@@ -170,8 +175,12 @@ def figure_pictures(tmp: Path) -> None:
 
     scenes = MODELS / "scenes"
     pinmech(["sweep", str(scenes / "r_rtr.toml"), "--plot", str(IMAGES / "sweep_r_rtr.png"), "--csv", str(tmp / "s.csv")])
-    for name in ("four_bar", "jansen_leg"):
-        pinmech(["sweep", str(scenes / f"{name}.toml"), "--paths", str(IMAGES / f"paths_{name}.png")])
+    pinmech(["sweep", str(scenes / "four_bar.toml"), "--plot", str(IMAGES / "sweep_four_bar.png"),
+             "--csv", str(tmp / "f.csv")])
+    pinmech(["sweep", str(scenes / "four_bar.toml"), "--paths", str(IMAGES / "paths_four_bar.png"), "--timing-marks"])
+    pinmech(["sweep", str(scenes / "jansen_leg.toml"), "--paths", str(IMAGES / "paths_jansen_leg.png")])
+    pinmech(["animate", str(scenes / "four_bar.toml"), "--steps", "37", "--fps", "12",
+             "--gif", str(IMAGES / "animate_four_bar.gif")])
     pinmech(["sweep", str(scenes / "slider_crank_dynamic.toml"), "--torque-plot",
              str(IMAGES / "torque_slider_crank.png"), "--csv", str(tmp / "t.csv")])
     pinmech(["path", str(scenes / "planar_arm.toml"), "--csv", str(tmp / "arm.csv"),

@@ -113,3 +113,18 @@ def print_pdf(html_file: Path, pdf: Path) -> Path:
                         f"--user-data-dir={profile}", f"--print-to-pdf={pdf}", Path(html_file).resolve().as_uri()],
                        check=True, capture_output=True, timeout=120)
     return pdf
+
+
+def page_dom(html_file: Path, *, fragment: str = "") -> str:
+    """The page's DOM as chromium holds it once its scripts have run (`--dump-dom`)."""
+    import subprocess
+    import tempfile
+
+    from pinmech.draw.browser import chromium_command
+
+    with tempfile.TemporaryDirectory() as profile:
+        command = [c for c in chromium_command(require_browser(), html_file, Path(profile) / "x.png", Path(profile),
+                                               fragment=fragment) if not c.startswith("--screenshot")]
+        done = subprocess.run([*command[:-1], "--dump-dom", command[-1]], capture_output=True, text=True,
+                              timeout=90, check=True)
+    return done.stdout

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 import pytest
-from closed_form import four_bar, slider_crank
+from closed_form import four_bar
 
 import pinmech
 from pinmech.cli import main
@@ -300,3 +300,29 @@ def test_fixed_centrode_of_the_coupler_is_the_meeting_point_of_crank_and_rocker_
         np.testing.assert_allclose(f, t[0] * A, rtol=1e-9)  # closed form vs Kennedy: rounding x 1e6
         linkage.place(q)
         np.testing.assert_allclose(linkage.point(coupler, m), f, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("first, last", [("0 deg", "360 deg"), ("420 deg", "60 deg")], ids=["forward", "backward"])
+def test_rocker_extremes_are_named_by_the_rocker_not_by_the_sweeps_direction(tmp_path, first, last):
+    """The crank-rocker swept either way: the rocker's largest angle is at the folded toggle
+    and its least at the extended one (angles of B from the circles (O2, b -+ a) and (O4, c)),
+    and the swing is their difference (swept backwards it was named the other way round and
+    the swing given as 286 deg)."""
+    a, b, c, d = 0.04, 0.12, 0.08, 0.10
+    theta4 = {}
+    for reach, lay in ((b + a, "extended"), (b - a, "folded")):
+        x = (reach**2 - c**2 + d**2) / (2 * d)
+        theta4[lay] = math.atan2(math.sqrt(reach**2 - x**2), x - d)
+    scene = pinmech.Scene.load(SCENES / "four_bar.toml", [f'sweep.from="{first}"', f'sweep.to="{last}"'])
+    sweep = pinmech.Sweep.from_scene(scene)
+    design = design_of(sweep)
+    start, stop = (scene.quantity(v, "angle") for v in (first, last))
+    for pose in sweep.poses(np.linspace(start, stop, 73)):
+        design.add(pose)
+    (found,) = design.limits()
+    labels = {x.toggle: x.label for x in found}
+    assert labels == {"folded": "max", "extended": "min"}
+    np.testing.assert_allclose(sorted(x.value for x in found), sorted(theta4.values()), rtol=0, atol=1e-10)
+    from pinmech.limit_positions import travel
+
+    np.testing.assert_allclose(travel(found, None).travel, theta4["folded"] - theta4["extended"], rtol=0, atol=1e-10)

@@ -9,7 +9,6 @@ torque in play, as tests/test_forces.py (the force equations' condition numbers 
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 

@@ -104,7 +104,7 @@ def snapshot_html(
         show_grid: draw meshcat's grid (cells of a round length, named in the legend) and axes.
         title: the page's title, before the legend.
     """
-    scene = _Scene(model, visual_model, _OfflineWindow(), show_grid=show_grid)
+    scene = _Scene(model, visual_model, _OfflineWindow(), show_grid=show_grid, orthographic=True)
     legend = _draw_pose(scene, _configuration(model, q, "q"), points, arrows, plane_normal)
     return scene.vis.window.page(title, legend)
 
@@ -119,8 +119,10 @@ def animation_html(
     plane_normal: np.ndarray | None = None,
     show_grid: bool = True,
     title: str = "pinmech",
+    readouts: Sequence[str] | None = None,
+    traces: Mapping[str, tuple[float, float, float]] | None = None,
 ) -> str:
-    """A self-contained HTML page playing the poses qs in a loop (meshcat's play controls).
+    """A self-contained HTML page playing the poses qs in a loop.
 
     The page shows one still frame when its address ends in `#frame=K` (K from 0).
 
@@ -128,6 +130,10 @@ def animation_html(
         qs: configurations, one per frame, each of shape (model.nq,).
         fps: frames per second [1/s].
         points_per_frame: named points of each frame, world frame [m] (same names in all).
+        readouts: one text a frame (the driver's value, "A = 30 deg"): the page then has a
+            bar of controls, play/pause, a slider over the frames and this readout.
+        traces: points of `points_per_frame` whose paths over the frames are drawn, each in
+            its colour (RGB in [0, 1]).
         Others: as in `snapshot_html`. The drawing is framed for all poses at once.
     """
     qs = [_configuration(model, q, f"qs[{i}]") for i, q in enumerate(qs)]
@@ -138,21 +144,44 @@ def animation_html(
     frames = (
         [_points(p) for p in points_per_frame] if points_per_frame is not None else [{}] * len(qs)
     )
+    for i, frame in enumerate(frames[1:], 1):
+        if set(frame) != set(frames[0]):
+            raise DrawError(
+                f"points_per_frame[{i}] names {', '.join(sorted(frame)) or 'no point'}, the first frame "
+                f"{', '.join(sorted(frames[0])) or 'no point'}: every frame names the same points",
+                argument="points_per_frame",
+                value=i,
+            )
+    if readouts is not None and len(readouts) != len(qs):
+        raise DrawError(
+            f"{len(readouts)} readouts for {len(qs)} poses", argument="readouts", value=len(readouts)
+        )
+    unknown = sorted(set(traces or {}) - set(frames[0]))
+    if unknown:
+        raise DrawError(
+            f"traces of points not in points_per_frame: {', '.join(unknown)}",
+            argument="traces",
+            value=unknown[0],
+        )
     if len(frames) != len(qs):
         raise DrawError(
             f"{len(frames)} sets of points for {len(qs)} poses",
             argument="points_per_frame",
             value=len(frames),
         )
-    scene = _Scene(model, visual_model, _OfflineWindow(), show_grid=show_grid)
+    scene = _Scene(model, visual_model, _OfflineWindow(), show_grid=show_grid, orthographic=True)
     scene.orient(plane_normal)
     body = np.vstack([scene.corners(q) for q in qs] + [_stack(p) for p in frames])
     labels = scene.label_boxes([p for f in frames for p in f.values()], _size(body))
     size, grid = scene.frame(np.vstack([body, labels]))
     scene.pose(scene.vis, qs[0])
     scene.add_points(frames[0], size, _together(frames, 1e-6 * size))
+    for name, colour in (traces or {}).items():
+        scene.add_trace(name, np.array([f[name] for f in frames]), colour)
     _animate(scene, qs, frames, fps)
-    return scene.vis.window.page(title, _legend(grid if show_grid else None, {}), fps=fps)
+    return scene.vis.window.page(
+        title, _legend(grid if show_grid else None, {}), fps=fps, readouts=list(readouts or ())
+    )
 
 
 class LiveView:

@@ -93,11 +93,23 @@ def _meshcat() -> Any:
 
 
 class _Scene:
-    """One meshcat scene: the model's visuals under ROOT, points, labels, arrows, camera."""
+    """One meshcat scene: the model's visuals under ROOT, points, labels, arrows, camera.
+
+    `orthographic`: a planar view is drawn through an orthographic camera (offline pages,
+    whose script keeps it centred when the window's shape changes); else nearly without
+    perspective (a far camera, zoomed in).
+    """
 
     def __init__(
-        self, model: pin.Model, visual_model: pin.GeometryModel, window: Any, *, show_grid: bool
+        self,
+        model: pin.Model,
+        visual_model: pin.GeometryModel,
+        window: Any,
+        *,
+        show_grid: bool,
+        orthographic: bool = False,
     ) -> None:
+        self.orthographic = orthographic
         meshcat = _meshcat()
         from pinocchio.visualize import MeshcatVisualizer
 
@@ -137,6 +149,7 @@ class _Scene:
     def orient(self, plane_normal: np.ndarray | None) -> None:
         """Choose the view: along a planar mechanism's normal (world y up), else oblique."""
         self.back = _unit(plane_normal, "plane_normal") if plane_normal is not None else _OBLIQUE
+        self.planar = plane_normal is not None and self.orthographic
         self.zoom = _PLANAR_ZOOM if plane_normal is not None else _OBLIQUE_ZOOM
         self.up = _screen_up(self.back)
         self.right = np.cross(self.up, self.back)
@@ -195,8 +208,14 @@ class _Scene:
         if abs(back[2]) > 0.999:  # along world z (the orbit's up axis): tilt a hair so y is up
             eye = eye - math.copysign(1e-3, back[2]) * distance * self.up
         camera = self.vis["/Cameras/default/rotated/<object>"]
+        if self.planar:  # a drawing of the plane: orthographic, no perspective at all
+            half = max(float(np.max(np.abs(points @ self.up), initial=0.0)),
+                       float(np.max(np.abs(points @ self.right), initial=0.0)) / _ASPECT, 1e-9) / _FILL
+            g = _meshcat().geometry
+            camera.set_object(g.OrthographicCamera(-half * _ASPECT, half * _ASPECT, half, -half,
+                                                   distance / 100, distance * 100))
         camera.set_property("position", [eye[0], eye[2], -eye[1]])  # the camera's frame: x +90 deg
-        camera.set_property("zoom", self.zoom)
+        camera.set_property("zoom", 1.0 if self.planar else self.zoom)
         camera.set_property("near", distance / 100)
         camera.set_property("far", distance * 100)
 
@@ -217,6 +236,17 @@ class _Scene:
             node.set_transform(_translation(p))
         for names in groups if groups is not None else coincident_groups(points, 1e-6 * size):
             self.add_label(f"points/{_node(names[0])}/label", ", ".join(names), self._label_offset(size), size)
+
+    def add_trace(self, name: str, path: np.ndarray, colour: tuple[float, float, float]) -> None:
+        """The path of a point over the frames (world frame [m], shape (n, 3)), a thin line in
+        a pale shade of its colour (the links stay the strongest colours on the page)."""
+        g = _meshcat().geometry
+        finite = path[np.all(np.isfinite(path), axis=1)]
+        if len(finite) < 2:
+            return
+        pale = tuple(0.5 + 0.5 * c for c in colour)
+        line = g.Line(g.PointsGeometry(finite.T.astype(np.float32)), g.LineBasicMaterial(color=_hex(pale)))
+        self.vis[f"{ROOT}/traces/{_node(name)}"].set_object(line)
 
     def move_points(self, frame: Any, points: Mapping[str, np.ndarray]) -> None:
         """Move the named points in one animation frame."""
