@@ -46,6 +46,7 @@ import pinocchio as pin
 from pinmech.exceptions import ModelError
 from pinmech.frame_names import frame_named
 from pinmech.inertia_check import check_mjcf_inertias
+from pinmech.mjcf_composite import place_composites_as_mujoco
 from pinmech.mjcf_limits import mjcf_limits
 from pinmech.mjcf_frames import angles_in_radians, fromto_sites, hoist_to_moving_bodies, orientations_as_quaternions
 from pinmech.mechanism import Mechanism, pinocchio_build, read_xml
@@ -398,6 +399,7 @@ def load_mjcf(path: str | Path, *, locked: dict[str, float] | None = None) -> Me
     wrapped = _wrapped(root, source)
     model, points, frames = _build(wrapped, source)
     _check_everything_read(root, model, source)
+    place_composites_as_mujoco(model, points + frames, root, source)
     if len(points) != len(connects) or len(frames) != len(welds):
         raise ModelError(f"Pinocchio read {len(points)} connect and {len(frames)} weld constraints, the file has "
                          f"{len(connects)} and {len(welds)}", path=source, element="<equality>")
