@@ -48,7 +48,8 @@ from pinmech.frame_names import frame_named
 from pinmech.inertia_check import check_mjcf_inertias
 from pinmech.mjcf_composite import place_composites_as_mujoco
 from pinmech.mjcf_limits import mjcf_limits
-from pinmech.mjcf_frames import angles_in_radians, fromto_sites, hoist_to_moving_bodies, orientations_as_quaternions
+from pinmech.mjcf_frames import (angles_in_radians, fromto_sites, hoist_to_moving_bodies, orientations_as_quaternions,
+                                 sites_on)
 from pinmech.mechanism import Mechanism, pinocchio_build, read_xml
 from pinmech.user_cache import cached_text
 
@@ -363,6 +364,9 @@ def _wrapped(root: ET.Element, source: str) -> Path:
 
         world.remove(body)
         wrapper.append(body)
+    for site in world.findall("site"):  # a site of the world is one of the wrapper at the origin
+        world.remove(site)
+        wrapper.append(site)
     world.append(wrapper)
     for eq in root.findall("equality"):  # Pinocchio knows no body "world": the wrapper is fixed to it
         for el in eq:
@@ -400,6 +404,7 @@ def load_mjcf(path: str | Path, *, locked: dict[str, float] | None = None) -> Me
     model, points, frames = _build(wrapped, source)
     _check_everything_read(root, model, source)
     place_composites_as_mujoco(model, points + frames, root, source)
+    _add_fixed_sites(model, root, source)
     if len(points) != len(connects) or len(frames) != len(welds):
         raise ModelError(f"Pinocchio read {len(points)} connect and {len(frames)} weld constraints, the file has "
                          f"{len(connects)} and {len(welds)}", path=source, element="<equality>")
@@ -431,6 +436,16 @@ def _check_everything_read(root: ET.Element, model: pin.Model, source: str) -> N
     if freedoms != model.nv:  # (default classes are written out: every type is on its joint)
         raise ModelError(f"the file's joints have {freedoms} freedoms, Pinocchio's model {model.nv}", path=source,
                          element="<joint>")
+
+
+def _add_fixed_sites(model: pin.Model, root: ET.Element, source: str) -> None:
+    """The sites that never move (of the world, or on jointless bodies hung from it), which
+    Pinocchio's parser drops, as frames of the wrapper body (in place)."""
+    wrapper = next(b for b in root.find("worldbody").findall("body") if b.get("name") == WRAPPER)
+    parent = model.getFrameId(WRAPPER, pin.FrameType.BODY)
+    for name, pos, rotation in sites_on(wrapper, source):
+        if not any(f.name == name and f.type == pin.FrameType.OP_FRAME for f in model.frames):
+            model.addFrame(pin.Frame(name, 0, parent, pin.SE3(rotation, pos), pin.FrameType.OP_FRAME))
 
 
 def _qpos0(model: pin.Model) -> np.ndarray:

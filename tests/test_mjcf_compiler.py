@@ -298,3 +298,29 @@ def test_a_loop_on_a_composite_with_ref_closes_where_mujoco_closes_it(tmp_path):
         rows = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
         assert abs(d.qpos[m.joint("knee").qposadr[0]]) > 0.01  # the leg has moved from qpos0
         np.testing.assert_allclose(d.efc_pos[rows], 0.0, atol=1e-13)
+
+
+def test_sites_that_never_move_are_points_where_mujoco_puts_them(tmp_path):
+    """A site of <worldbody> itself and one on jointless bodies hung from the world: Pinocchio's
+    parser dropped both (a scene naming them was told "unknown point"); they are points that
+    stay where MuJoCo puts them (1e-12 m: the same products of rotations)."""
+    path = tmp_path / "model.xml"
+    path.write_text('<mujoco><compiler angle="degree"/><worldbody><site name="mark" pos="0.3 0 0.1" euler="0 0 30"/>'
+                    '<body name="base" pos="0 0.02 0.1" euler="10 0 45"><geom size="0.01"/>'
+                    '<body name="plate" pos="0.05 0 0" axisangle="0 1 0 20"><site name="corner" pos="0.01 0.02 0"/>'
+                    '</body><body name="arm"><joint name="h" axis="0 0 1"/><geom size="0.01"/>'
+                    '<site name="tip" pos="0.1 0 0"/></body></body></worldbody></mujoco>')
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    mech = load_mjcf(path)
+    data = mech.model.createData()
+    for value in (0.0, 0.7):
+        d.qpos[0] = value
+        mujoco.mj_kinematics(m, d)
+        q = mech.neutral()
+        mech.set_coordinate(q, "h", value)
+        pin.framesForwardKinematics(mech.model, data, q)
+        for name in ("mark", "corner", "tip"):
+            frame = data.oMf[mech.points[name]]
+            np.testing.assert_allclose(frame.translation, d.site(name).xpos, atol=1e-12)
+            np.testing.assert_allclose(frame.rotation, d.site(name).xmat.reshape(3, 3), atol=1e-12)
