@@ -68,6 +68,7 @@ def _parse(path: Path) -> ET.Element:
     _check_depth(root, str(path))
     _apply_defaults(root, str(path))
     _check_spelling(root, str(path))
+    _check_names(root, str(path))
     _check_keywords(root, str(path))
     _check_numbers(root, str(path))
     check_mjcf_inertias(root, str(path))
@@ -224,6 +225,29 @@ def _check_spelling(root: ET.Element, source: str) -> None:
                     raise ModelError(f"unknown attribute {key}=\"{el.get(key)}\": did you mean {near[0]}? "
                                      "(Pinocchio's parser would skip it)", path=source,
                                      element=f"<{el.tag} name=\"{el.get('name', '')}\">")
+
+
+_NAMED = ("body", "joint", "site", "geom", "connect", "weld")
+
+
+def _check_names(root: ET.Element, source: str) -> None:
+    """Names unique per kind of element, and no joint after a ball joint in one body, as
+    MuJoCo's compiler requires (Pinocchio's parser took both: `[drivers.h]` or a point
+    then picked one of two elements in silence, and a ball then a hinge made a joint
+    MuJoCo has no model of)."""
+    for tag in _NAMED:
+        seen: set[str] = set()
+        for el in root.iter(tag):
+            name = el.get("name")
+            if name and name in seen:
+                raise ModelError(f"repeated name '{name}' in <{tag}> (MuJoCo refuses it; name each once)",
+                                 path=source, element=f"<{tag} name=\"{name}\">")
+            seen.add(name)
+    for body in root.iter("body"):
+        kinds = [j.get("type", "hinge") for j in body.findall("joint")]
+        if "ball" in kinds[:-1]:
+            raise ModelError(f"a ball joint followed by another joint ({', '.join(kinds)}; MuJoCo refuses it): "
+                             "put the ball joint last", path=source, element=f"<body name=\"{body.get('name', '')}\">")
 
 
 # ---------------------------------------------------------------- keywords
@@ -433,6 +457,10 @@ def _check_everything_read(root: ET.Element, model: pin.Model, source: str) -> N
             raise ModelError("Pinocchio's parser left this body out of the model", path=source,
                              element=f"<body name=\"{name}\">")
     freedoms = sum(_DOFS.get(j.get("type", "hinge"), 0) for j in root.find("worldbody").iter("joint"))
+    unnamed = [b for b in root.find("worldbody").iter("body") if not b.get("name") and b.find("joint") is not None]
+    if freedoms != model.nv and unnamed:
+        raise ModelError("a body with joints has no name, and Pinocchio's parser leaves such a body's joints out: "
+                         "name it", path=source, element=f"<body> of <joint name=\"{unnamed[0].find('joint').get('name', '')}\">")
     if freedoms != model.nv:  # (default classes are written out: every type is on its joint)
         raise ModelError(f"the file's joints have {freedoms} freedoms, Pinocchio's model {model.nv}", path=source,
                          element="<joint>")

@@ -192,6 +192,11 @@ REFUSED = {
     "ball range from 10": (dict(joint='type="ball" range="0.1 0.5"'), "0 max"),
     "range without limited, autolimits off": (dict(compiler='angle="radian" autolimits="false"',
                                                    joint='range="0 1"'), "autolimits"),
+    # repeated names: [drivers.k] or a point named s would pick one of two in silence
+    "repeated joint name": (dict(joint='/><joint name="k"'), "repeated name 'k'"),
+    "repeated site name": (dict(site='/><site name="s" pos="0.1 0 0"'), "repeated name 's'"),
+    "repeated body name": (dict(body='><body name="b"/'), "repeated name 'b'"),
+    "ball followed by a hinge": (dict(joint='type="ball"/><joint name="h2"'), "ball joint followed"),
 }
 
 
@@ -324,3 +329,15 @@ def test_sites_that_never_move_are_points_where_mujoco_puts_them(tmp_path):
             frame = data.oMf[mech.points[name]]
             np.testing.assert_allclose(frame.translation, d.site(name).xpos, atol=1e-12)
             np.testing.assert_allclose(frame.rotation, d.site(name).xmat.reshape(3, 3), atol=1e-12)
+
+
+def test_a_body_with_joints_but_no_name_is_named_as_the_cause(tmp_path):
+    """MuJoCo takes it; Pinocchio's parser leaves its joints out. The error said only that the
+    file's joints have 1 freedom and the model 0; it now says which body and what to do."""
+    text = ('<mujoco><worldbody><body><joint name="h" axis="0 0 1"/><geom size="0.01"/><site name="tip" '
+            'pos="0.1 0 0"/></body></worldbody></mujoco>')
+    mujoco.MjModel.from_xml_string(text)  # MuJoCo's compiler takes it
+    path = tmp_path / "arm.xml"
+    path.write_text(text)
+    with pytest.raises(ModelError, match='<joint name="h">.*has no name'):
+        load_mjcf(path)
