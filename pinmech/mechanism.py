@@ -755,6 +755,24 @@ def _joint_kind(joint: pin.JointModel) -> str:
     return "other"
 
 
+def _written_axis(source: str, name: str) -> str | None:
+    """The axis a URDF (`<axis xyz>`) or MJCF (`axis`) file writes for joint `name`, as written
+    (`xyz="0 0 1e-200"`), or None (no such file or joint, or not three numbers)."""
+    try:
+        root = ET.parse(source).getroot()
+    except (OSError, ET.ParseError):
+        return None
+    for joint in root.iter("joint"):
+        if joint.get("name") == name:
+            axis = joint.find("axis")
+            key, text = ("xyz", axis.get("xyz")) if axis is not None else ("axis", joint.get("axis"))
+            try:
+                return f'{key}="{text}"' if text is not None and len([float(v) for v in text.split()]) == 3 else None
+            except ValueError:
+                return None
+    return None
+
+
 def _joint_axis(joint: pin.JointModel, name: str, source: str) -> np.ndarray:
     """Unit axis of a one-dof joint in its own frame (motion subspace).
 
@@ -772,6 +790,11 @@ def _joint_axis(joint: pin.JointModel, name: str, source: str) -> np.ndarray:
     part = S[3:] if np.linalg.norm(S[3:]) > 0 else S[:3]
     norm = float(np.linalg.norm(part))
     if not (norm > 0 and np.isfinite(norm)):
+        text = _written_axis(source, name)
+        if text is not None and unit_vector([float(v) for v in text.split("\"")[1].split()]) is not None:
+            raise ModelError(f"{text} is a direction Pinocchio's reader cannot normalise (its length "
+                             "under- or overflows in double precision, the axis read as [0, 0, 0]): write it as a "
+                             "unit vector", path=source, element=f"<joint name=\"{name}\"> <axis>")
         raise ModelError(f"the axis of joint {name} is {np.round(part, 6).tolist()}: not a direction, the joint "
                          "would move nothing", path=source, element=f"<joint name=\"{name}\"> <axis>")
     return part / norm

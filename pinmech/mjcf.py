@@ -46,8 +46,10 @@ import pinocchio as pin
 from pinmech.exceptions import ModelError
 from pinmech.frame_names import frame_named
 from pinmech.inertia_check import check_mjcf_inertias
+from pinmech.mjcf_composite import place_composites_as_mujoco
 from pinmech.mjcf_limits import mjcf_limits
-from pinmech.mjcf_frames import angles_in_radians, fromto_sites, hoist_to_moving_bodies, orientations_as_quaternions
+from pinmech.mjcf_frames import (angles_in_radians, fromto_sites, hoist_to_moving_bodies, orientations_as_quaternions,
+                                 sites_on)
 from pinmech.mechanism import Mechanism, pinocchio_build, read_xml
 from pinmech.user_cache import cached_text
 
@@ -66,6 +68,7 @@ def _parse(path: Path) -> ET.Element:
     _check_depth(root, str(path))
     _apply_defaults(root, str(path))
     _check_spelling(root, str(path))
+    _check_names(root, str(path))
     _check_keywords(root, str(path))
     _check_numbers(root, str(path))
     check_mjcf_inertias(root, str(path))
@@ -224,6 +227,29 @@ def _check_spelling(root: ET.Element, source: str) -> None:
                                      element=f"<{el.tag} name=\"{el.get('name', '')}\">")
 
 
+_NAMED = ("body", "joint", "site", "geom", "connect", "weld")
+
+
+def _check_names(root: ET.Element, source: str) -> None:
+    """Names unique per kind of element, and no joint after a ball joint in one body, as
+    MuJoCo's compiler requires (Pinocchio's parser took both: `[drivers.h]` or a point
+    then picked one of two elements in silence, and a ball then a hinge made a joint
+    MuJoCo has no model of)."""
+    for tag in _NAMED:
+        seen: set[str] = set()
+        for el in root.iter(tag):
+            name = el.get("name")
+            if name and name in seen:
+                raise ModelError(f"repeated name '{name}' in <{tag}> (MuJoCo refuses it; name each once)",
+                                 path=source, element=f"<{tag} name=\"{name}\">")
+            seen.add(name)
+    for body in root.iter("body"):
+        kinds = [j.get("type", "hinge") for j in body.findall("joint")]
+        if "ball" in kinds[:-1]:
+            raise ModelError(f"a ball joint followed by another joint ({', '.join(kinds)}; MuJoCo refuses it): "
+                             "put the ball joint last", path=source, element=f"<body name=\"{body.get('name', '')}\">")
+
+
 # ---------------------------------------------------------------- keywords
 #: (element, attribute) -> the keywords MuJoCo takes there (case-sensitive); anything else it refuses
 _KEYWORDS = {
@@ -362,6 +388,9 @@ def _wrapped(root: ET.Element, source: str) -> Path:
 
         world.remove(body)
         wrapper.append(body)
+    for site in world.findall("site"):  # a site of the world is one of the wrapper at the origin
+        world.remove(site)
+        wrapper.append(site)
     world.append(wrapper)
     for eq in root.findall("equality"):  # Pinocchio knows no body "world": the wrapper is fixed to it
         for el in eq:
@@ -398,6 +427,8 @@ def load_mjcf(path: str | Path, *, locked: dict[str, float] | None = None) -> Me
     wrapped = _wrapped(root, source)
     model, points, frames = _build(wrapped, source)
     _check_everything_read(root, model, source)
+    place_composites_as_mujoco(model, points + frames, root, source)
+    _add_fixed_sites(model, root, source)
     if len(points) != len(connects) or len(frames) != len(welds):
         raise ModelError(f"Pinocchio read {len(points)} connect and {len(frames)} weld constraints, the file has "
                          f"{len(connects)} and {len(welds)}", path=source, element="<equality>")
@@ -426,9 +457,23 @@ def _check_everything_read(root: ET.Element, model: pin.Model, source: str) -> N
             raise ModelError("Pinocchio's parser left this body out of the model", path=source,
                              element=f"<body name=\"{name}\">")
     freedoms = sum(_DOFS.get(j.get("type", "hinge"), 0) for j in root.find("worldbody").iter("joint"))
+    unnamed = [b for b in root.find("worldbody").iter("body") if not b.get("name") and b.find("joint") is not None]
+    if freedoms != model.nv and unnamed:
+        raise ModelError("a body with joints has no name, and Pinocchio's parser leaves such a body's joints out: "
+                         "name it", path=source, element=f"<body> of <joint name=\"{unnamed[0].find('joint').get('name', '')}\">")
     if freedoms != model.nv:  # (default classes are written out: every type is on its joint)
         raise ModelError(f"the file's joints have {freedoms} freedoms, Pinocchio's model {model.nv}", path=source,
                          element="<joint>")
+
+
+def _add_fixed_sites(model: pin.Model, root: ET.Element, source: str) -> None:
+    """The sites that never move (of the world, or on jointless bodies hung from it), which
+    Pinocchio's parser drops, as frames of the wrapper body (in place)."""
+    wrapper = next(b for b in root.find("worldbody").findall("body") if b.get("name") == WRAPPER)
+    parent = model.getFrameId(WRAPPER, pin.FrameType.BODY)
+    for name, pos, rotation in sites_on(wrapper, source):
+        if not any(f.name == name and f.type == pin.FrameType.OP_FRAME for f in model.frames):
+            model.addFrame(pin.Frame(name, 0, parent, pin.SE3(rotation, pos), pin.FrameType.OP_FRAME))
 
 
 def _qpos0(model: pin.Model) -> np.ndarray:

@@ -271,3 +271,14 @@ def hoist_to_moving_bodies(root: ET.Element, top: ET.Element, source: str) -> No
                     anchor = numbers(el, "anchor", 3, source) if el.get("anchor") is not None else np.zeros(3)
                     el.set("anchor", _text(pos + _rotation(quat) @ anchor))
                 el.set(key, carrier.get("name"))
+
+
+def sites_on(top: ET.Element, source: str) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """(name, pos [m], rotation matrix) of each named site carried by `top` (the world's wrapper
+    at the origin): sites that never move, which Pinocchio's parser drops."""
+    out = []
+    for site in top.findall("site"):
+        if site.get("name"):
+            pos, quat = _pose(site, source)
+            out.append((site.get("name"), pos, _rotation(quat)))
+    return out

@@ -183,6 +183,9 @@ LAUGHS = ('<!DOCTYPE robot [<!ENTITY a "aaaaaaaaaa">' + "".join(
         (R_RTR_CUT, R_RTR_CUT.replace('type=', 'kind="pin" type='), 3, 'unknown attribute kind="pin"'),
         # a joint's zero axis: a numpy warning, then "out of reach for these dimensions" (exit 6)
         ('<axis xyz="1 0 0"/>', '<axis xyz="0 0 0"/>', 3, "the axis of joint B_slider is [0.0, 0.0, 0.0]"),
+        # a direction at the edge of float: urdfdom's norm under- or overflows, the axis read as zero
+        ('<axis xyz="1 0 0"/>', '<axis xyz="1e-200 0 0"/>', 3, 'xyz="1e-200 0 0" is a direction Pinocchio'),
+        ('<axis xyz="1 0 0"/>', '<axis xyz="1e200 1e200 0"/>', 3, 'xyz="1e200 1e200 0" is a direction Pinocchio'),
         # urdfdom skips a misspelled element or attribute: the joint at the identity, the mass at zero
         ('<origin xyz="0.10 0 0" rpy="0 0 0"/>', '<orgin xyz="0.10 0 0" rpy="0 0 0"/>', 3,
          "unknown element <orgin>: did you mean <origin>?"),
@@ -192,7 +195,8 @@ LAUGHS = ('<!DOCTYPE robot [<!ENTITY a "aaaaaaaaaa">' + "".join(
     ids=["nan origin", "inf origin", "1e300 origin", "nan cut origin", "zero axis", "negative length",
          "unknown link", "cut to itself", "unknown cut type", "over-constrained", "out of plane",
          "joint cycle", "duplicate cut", "unused external entity", "external entity", "billion laughs",
-         "misspelled element", "misspelled attribute", "unknown constraint attribute", "zero joint axis", "misspelled origin", "swapped xyz",
+         "misspelled element", "misspelled attribute", "unknown constraint attribute", "zero joint axis",
+         "tiny joint axis", "huge joint axis", "misspelled origin", "swapped xyz",
          "misspelled mass value"],
 )
 def test_urdf_mistakes(copies, capsys, old, new, code, message):

@@ -192,6 +192,11 @@ REFUSED = {
     "ball range from 10": (dict(joint='type="ball" range="0.1 0.5"'), "0 max"),
     "range without limited, autolimits off": (dict(compiler='angle="radian" autolimits="false"',
                                                    joint='range="0 1"'), "autolimits"),
+    # repeated names: [drivers.k] or a point named s would pick one of two in silence
+    "repeated joint name": (dict(joint='/><joint name="k"'), "repeated name 'k'"),
+    "repeated site name": (dict(site='/><site name="s" pos="0.1 0 0"'), "repeated name 's'"),
+    "repeated body name": (dict(body='><body name="b"/'), "repeated name 'b'"),
+    "ball followed by a hinge": (dict(joint='type="ball"/><joint name="h2"'), "ball joint followed"),
 }
 
 
@@ -218,4 +223,121 @@ def test_nesting_deeper_than_mujoco_reads_is_refused(tmp_path):
     path = tmp_path / "deep.xml"
     path.write_text(text)
     with pytest.raises(ModelError, match="too deep"):
+        load_mjcf(path)
+
+
+# ---------------------------------------------------------------- several joints in one body (a composite)
+COMPOSITE = """<mujoco><compiler angle="{angle}"/><worldbody>
+  <body name="arm" pos="0.1 0 0.02" euler="{turn}"><geom size="0.01"/>{joints}
+    <site name="s" pos="0.1 0.05 0.02" euler="{turn}"/>
+    <body name="fore" pos="0.1 0 0"><joint name="k" axis="0 1 0" ref="{ref}"/><geom size="0.01"/>
+      <site name="tip" pos="0.05 0 0.01"/></body>
+  </body></worldbody></mujoco>"""
+COMPOSITE_CASES = {
+    "hinge with ref, then a hinge": dict(angle="degree", turn="10 20 30", ref="15", joints=(
+        '<joint name="a" axis="0 0 1" pos="0.01 0.02 0" ref="30"/><joint name="b" axis="1 0 0"/>')),
+    "slide with ref, then a hinge": dict(angle="radian", turn="0.1 0.2 0.3", ref="0", joints=(
+        '<joint name="a" type="slide" axis="1 1 0" ref="0.02"/><joint name="b" axis="0 0 1" ref="0.4"/>')),
+    "three joints, every ref": dict(angle="radian", turn="0 0 0", ref="-0.3", joints=(
+        '<joint name="a" axis="1 0 1" ref="-0.7"/><joint name="b" type="slide" axis="0 1 0" ref="0.01"/>'
+        '<joint name="c" axis="0 0 1" pos="0 0.01 0" ref="1.1"/>')),
+}
+
+
+def _composite_q(mech, m, qpos: np.ndarray) -> np.ndarray:
+    """Pinocchio's q of MuJoCo's qpos: a body's joints are the parts of `Composite_<first>`, in
+    file order (a hinge or slide is one coordinate in both)."""
+    q = mech.neutral()
+    for j in range(m.njnt):
+        body = m.jnt_bodyid[j]
+        first = m.body_jntadr[body]
+        name = m.joint(j).name if m.body_jntnum[body] == 1 else f"Composite_{m.joint(first).name}"
+        q[mech.model.joints[mech.model.getJointId(name)].idx_q + (j - first)] = qpos[m.jnt_qposadr[j]]
+    return q
+
+
+@pytest.mark.parametrize("case", sorted(COMPOSITE_CASES))
+def test_a_composites_sites_sit_where_mujoco_puts_them_ref_included(tmp_path, case):
+    """MuJoCo draws a body at qpos0 (every `ref`) where the file places it; Pinocchio's parser
+    left the first joint's `ref` of a composite in the placement (a site 0.02 m off at qpos0)."""
+    path = tmp_path / "model.xml"
+    path.write_text(COMPOSITE.format(**COMPOSITE_CASES[case]))
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    mech = load_mjcf(path)
+    data = mech.model.createData()
+    np.testing.assert_allclose(mech.neutral(), _composite_q(mech, m, m.qpos0), atol=1e-15)  # qpos0 is the reference
+    rng = np.random.default_rng(3)
+    for k in range(4):
+        d.qpos[:] = m.qpos0 + (k > 0) * rng.uniform(-0.8, 0.8, m.nq)
+        mujoco.mj_kinematics(m, d)
+        pin.framesForwardKinematics(mech.model, data, _composite_q(mech, m, d.qpos))
+        for i in range(m.nsite):  # same products of rotations in double precision: 1e-12
+            frame = data.oMf[mech.points[m.site(i).name]]
+            np.testing.assert_allclose(frame.translation, d.site_xpos[i], atol=1e-12)
+            np.testing.assert_allclose(frame.rotation, d.site_xmat[i].reshape(3, 3), atol=1e-12)
+
+
+def test_a_loop_on_a_composite_with_ref_closes_where_mujoco_closes_it(tmp_path):
+    """The leg's rod (pitch and roll hinges in one body) given `ref`s, its connect anchored in
+    the rod: at the poses pinmech solves, MuJoCo's own connect residual is zero (1e-13 m: the
+    loop solver's tolerance on a 0.5 m leg). The parser had taken the rod's side of the cut
+    from the rod turned by its first `ref` (MuJoCo's residual 1-3 mm)."""
+    from pinmech.solve_loops import LoopSolver
+
+    text = (MJCF_DIR / "leg.xml").read_text()
+    text = text.replace('name="rod_pitch" type="hinge" axis="0 1 0"', 'name="rod_pitch" type="hinge" axis="0 1 0" ref="0.3"')
+    text = text.replace('name="rod_roll" type="hinge" axis="1 0 0"', 'name="rod_roll" type="hinge" axis="1 0 0" ref="0.2"')
+    path = tmp_path / "leg_ref.xml"
+    path.write_text(text)
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    mech = load_mjcf(path)
+    solver = LoopSolver(mech, ["hip"])
+    q = mech.neutral()
+    for value in (0.02, 0.04, 0.06):
+        q = solver.solve([value], [0.0], [0.0], guess=q).q
+        d.qpos[:] = [q[mech.model.joints[mech.model.getJointId(n)].idx_q] for n in ("hip", "knee")] + list(
+            q[mech.model.joints[mech.model.getJointId("Composite_rod_pitch")].idx_q:][:2])
+        mujoco.mj_forward(m, d)
+        rows = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+        assert abs(d.qpos[m.joint("knee").qposadr[0]]) > 0.01  # the leg has moved from qpos0
+        np.testing.assert_allclose(d.efc_pos[rows], 0.0, atol=1e-13)
+
+
+def test_sites_that_never_move_are_points_where_mujoco_puts_them(tmp_path):
+    """A site of <worldbody> itself and one on jointless bodies hung from the world: Pinocchio's
+    parser dropped both (a scene naming them was told "unknown point"); they are points that
+    stay where MuJoCo puts them (1e-12 m: the same products of rotations)."""
+    path = tmp_path / "model.xml"
+    path.write_text('<mujoco><compiler angle="degree"/><worldbody><site name="mark" pos="0.3 0 0.1" euler="0 0 30"/>'
+                    '<body name="base" pos="0 0.02 0.1" euler="10 0 45"><geom size="0.01"/>'
+                    '<body name="plate" pos="0.05 0 0" axisangle="0 1 0 20"><site name="corner" pos="0.01 0.02 0"/>'
+                    '</body><body name="arm"><joint name="h" axis="0 0 1"/><geom size="0.01"/>'
+                    '<site name="tip" pos="0.1 0 0"/></body></body></worldbody></mujoco>')
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    mech = load_mjcf(path)
+    data = mech.model.createData()
+    for value in (0.0, 0.7):
+        d.qpos[0] = value
+        mujoco.mj_kinematics(m, d)
+        q = mech.neutral()
+        mech.set_coordinate(q, "h", value)
+        pin.framesForwardKinematics(mech.model, data, q)
+        for name in ("mark", "corner", "tip"):
+            frame = data.oMf[mech.points[name]]
+            np.testing.assert_allclose(frame.translation, d.site(name).xpos, atol=1e-12)
+            np.testing.assert_allclose(frame.rotation, d.site(name).xmat.reshape(3, 3), atol=1e-12)
+
+
+def test_a_body_with_joints_but_no_name_is_named_as_the_cause(tmp_path):
+    """MuJoCo takes it; Pinocchio's parser leaves its joints out. The error said only that the
+    file's joints have 1 freedom and the model 0; it now says which body and what to do."""
+    text = ('<mujoco><worldbody><body><joint name="h" axis="0 0 1"/><geom size="0.01"/><site name="tip" '
+            'pos="0.1 0 0"/></body></worldbody></mujoco>')
+    mujoco.MjModel.from_xml_string(text)  # MuJoCo's compiler takes it
+    path = tmp_path / "arm.xml"
+    path.write_text(text)
+    with pytest.raises(ModelError, match='<joint name="h">.*has no name'):
         load_mjcf(path)
