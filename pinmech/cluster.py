@@ -20,7 +20,7 @@ from pinmech.study_file import StudySpec
 from pinmech.tolerance import Batch, BatchResult, run_batch
 
 _EXTRA = 'pip install "pinmech[study]"'
-#: StudySpec -> (StudyMechanism, Outputs), built once per process.
+#: StudySpec -> (StudyMechanism, StudyOutputs), built once per process.
 _BUILT: dict[StudySpec, tuple] = {}
 
 
@@ -34,13 +34,13 @@ def require_dask():
 
 
 def built(spec: StudySpec) -> tuple:
-    """This process's (StudyMechanism, Outputs) of the study, built on first use."""
+    """This process's (StudyMechanism, StudyOutputs) of the study, built on first use."""
     if spec not in _BUILT:
-        from pinmech.sensitivity import Outputs
+        from pinmech.sensitivity import StudyOutputs
         from pinmech.study_variant import StudyMechanism
 
         sm = StudyMechanism(spec)
-        _BUILT[spec] = (sm, Outputs(sm))
+        _BUILT[spec] = (sm, StudyOutputs(sm))
     return _BUILT[spec]
 
 

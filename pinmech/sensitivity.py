@@ -28,7 +28,7 @@ from pinmech.study_variant import StudyMechanism
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
-class Outputs:
+class StudyOutputs:
     """A study's outputs: names, values at a pose, and their derivatives.
 
     Attributes:
@@ -117,14 +117,14 @@ def configuration_sensitivity(sm: StudyMechanism, data: pin.Data) -> np.ndarray:
     return dq
 
 
-def output_sensitivity(sm: StudyMechanism, outputs: Outputs, q: np.ndarray) -> np.ndarray:
+def output_sensitivity(sm: StudyMechanism, outputs: StudyOutputs, q: np.ndarray) -> np.ndarray:
     """dy/dp (n_out, n_par) at the closed pose q [m/m, rad/m]."""
     data = sm.at(q)
     Y_q, Y_p = outputs.jacobians(data)
     return Y_q @ configuration_sensitivity(sm, data) + Y_p
 
 
-def cycle_sensitivity(sm: StudyMechanism, outputs: Outputs, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def cycle_sensitivity(sm: StudyMechanism, outputs: StudyOutputs, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The outputs (steps, n_out) and dy/dp (steps, n_out, n_par) at each pose of a cycle."""
     y = np.array([outputs.values(sm.at(qi)) for qi in q])
     dy = np.array([output_sensitivity(sm, outputs, qi) for qi in q])

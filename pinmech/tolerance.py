@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pinmech.sensitivity import Outputs, cycle_sensitivity
+from pinmech.sensitivity import StudyOutputs, cycle_sensitivity
 from pinmech.study_variant import StudyMechanism
 
 PERCENTILES = (0.5, 50.0, 99.5)
@@ -52,7 +52,7 @@ def draw(sm: StudyMechanism, batch: Batch) -> np.ndarray:
                             for param, nominal in zip(sm.spec.params, sm.nominal)]).reshape(batch.count, -1)
 
 
-def run_batch(sm: StudyMechanism, outputs: Outputs, batch: Batch) -> BatchResult:
+def run_batch(sm: StudyMechanism, outputs: StudyOutputs, batch: Batch) -> BatchResult:
     """Solve the batch's variants over the cycle (the model is left at the nominal)."""
     p = draw(sm, batch)
     y = np.full((batch.count, len(sm.values), len(outputs.names)), np.nan)
@@ -95,7 +95,7 @@ class Spread:
     solved: int
 
 
-def spread(sm: StudyMechanism, outputs: Outputs, results: list[BatchResult]) -> Spread:
+def spread(sm: StudyMechanism, outputs: StudyOutputs, results: list[BatchResult]) -> Spread:
     """Gather the batches (in order) into a Spread against the nominal's linear estimate."""
     nominal_cycle = sm.cycle(sm.nominal)
     y0, dy = cycle_sensitivity(sm, outputs, nominal_cycle.q)

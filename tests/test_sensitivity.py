@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from pinmech.exceptions import FrameNotFound, SceneError
-from pinmech.sensitivity import Outputs, cycle_sensitivity
+from pinmech.sensitivity import StudyOutputs, cycle_sensitivity
 from pinmech.study_file import load_study, parse_study
 from pinmech.study_variant import StudyMechanism
 
@@ -30,7 +30,7 @@ def _study(scene: str, params: dict, points=(), links=(), steps: int = 25) -> St
     return StudyMechanism(parse_study(raw, STUDIES / "inline.toml"))
 
 
-def _resolved_differences(sm: StudyMechanism, outputs: Outputs, h: float) -> np.ndarray:
+def _resolved_differences(sm: StudyMechanism, outputs: StudyOutputs, h: float) -> np.ndarray:
     """(steps, n_out, n_par) central differences of variants re-solved over the cycle at p +- h e_k."""
     columns = []
     for k in range(len(sm.nominal)):
@@ -54,7 +54,7 @@ def test_four_bar_sensitivities_are_the_law_of_cosines_differentiated():
     rad/m; the IFT derivative carries the closure tolerance times the condition number
     (< 1e-10). Tolerance 1e-7 (rad/m or m/m) against values of order 10."""
     sm = StudyMechanism(load_study(STUDIES / "four_bar_sensitivity.toml"))
-    outputs = Outputs(sm)
+    outputs = StudyOutputs(sm)
     assert outputs.names == ["P.x", "P.y", "rocker.angle"]
     cycle = sm.cycle(sm.nominal)
     y, dy = cycle_sensitivity(sm, outputs, cycle.q)
@@ -98,7 +98,7 @@ def test_sensitivities_are_central_differences_of_resolved_variants(scene, param
         if target == "cut":
             table[name]["side"] = "parent" if name != "F" else "child"
     sm = _study(scene, table, points, links)
-    outputs = Outputs(sm)
+    outputs = StudyOutputs(sm)
     cycle = sm.cycle(sm.nominal)
     assert not cycle.cause, cycle.detail
     _, dy = cycle_sensitivity(sm, outputs, cycle.q)
@@ -113,6 +113,6 @@ def test_a_study_file_names_what_the_model_lacks():
     with pytest.raises(FrameNotFound, match=r"unknown cut 'Z'"):
         _study("four_bar.toml", {"x": {"cut": "Z", "component": "x"}}, ["P"])
     with pytest.raises(SceneError, match=r"outputs.links: unknown link 'bogus'"):
-        Outputs(_study("four_bar.toml", {"x": {"joint": "A", "component": "x"}}, ["P"], ["bogus"]))
+        StudyOutputs(_study("four_bar.toml", {"x": {"joint": "A", "component": "x"}}, ["P"], ["bogus"]))
     with pytest.raises(SceneError, match=r"params.x.tolerance: '0.1' .*"):
         _study("four_bar.toml", {"x": {"joint": "A", "component": "x", "tolerance": "0.1"}}, ["P"])

@@ -8,7 +8,7 @@ from pathlib import Path
 import closed_form
 import numpy as np
 
-from pinmech.sensitivity import Outputs
+from pinmech.sensitivity import StudyOutputs
 from pinmech.study_file import load_study, parse_study
 from pinmech.study_variant import StudyMechanism
 from pinmech.tolerance import batches, deviation, run_batch, spread
@@ -27,7 +27,7 @@ def _four_bar_study(params: dict, samples: int, steps: int = 37, seed: int = 7) 
 
 
 def _run(sm: StudyMechanism):
-    outputs = Outputs(sm)
+    outputs = StudyOutputs(sm)
     return outputs, [run_batch(sm, outputs, b) for b in batches(sm.spec.samples, sm.spec.batch)]
 
 
