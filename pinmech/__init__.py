@@ -59,7 +59,7 @@ _LAZY = {
     "pinmech.solve_cycle": ("RangeChunk", "solve_range"),
     "pinmech.solve_loops": ("LoopSolver", "Reference"),
     "pinmech.solve_rates": ("RateBatch", "RateSolver", "Task"),
-    "pinmech.study": ("StudyResult", "study"),
+    "pinmech.study_run": ("StudyResult", "study"),
     "pinmech.study_file": ("StudySpec", "load_study"),
     "pinmech.sweep": ("Sweep", "SweepPose"),
     "pinmech.units": ("to_si",),

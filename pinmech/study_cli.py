@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 
@@ -40,9 +39,11 @@ def add_parser(sub) -> None:
 
 def cmd_study(args: argparse.Namespace) -> int:
     """Run the study; print its summary; write the table, JSON and figures asked."""
+    import json
+
     from pinmech.cluster import scheduler_address
     from pinmech.exceptions import OptionRefused
-    from pinmech.study import study
+    from pinmech.study_run import study
     from pinmech.study_report import summary, text, write
 
     if args.plot and not args.out:

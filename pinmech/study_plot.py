@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.study import StudyResult
+from pinmech.study_run import StudyResult
 from pinmech.tolerance import deviation
 
 _SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg")}

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pinmech.study import study
+from pinmech.study_run import study
 from pinmech.study_file import load_study
 
 distributed = pytest.importorskip("distributed")
