@@ -19,6 +19,7 @@ from pinmech.exceptions import FrameNotFound, SceneError
 from pinmech.sensitivity import StudyOutputs, cycle_sensitivity
 from pinmech.study_file import load_study, parse_study
 from pinmech.study_variant import StudyMechanism
+from pinmech.tolerance import deviation
 
 STUDIES = Path(__file__).resolve().parents[1] / "models" / "studies"
 SCENES = STUDIES.parent / "scenes"
@@ -41,7 +42,7 @@ def _resolved_differences(sm: StudyMechanism, outputs: StudyOutputs, h: float) -
             cycle = sm.cycle(p)  # leaves p in the model: the outputs are read on that variant
             assert not cycle.cause, cycle.detail
             ys.append(np.array([outputs.values(sm.at(q)) for q in cycle.q]))
-        columns.append((ys[0] - ys[1]) / (2 * h))
+        columns.append(deviation(ys[0], ys[1], outputs.kinds) / (2 * h))  # angles: across +-pi too
     sm.write(sm.nominal)
     return np.stack(columns, axis=-1)
 
@@ -80,6 +81,9 @@ def test_four_bar_sensitivities_are_the_law_of_cosines_differentiated():
 @pytest.mark.parametrize("scene, params, points, links", [
     ("four_bar.toml", {"crank": ("joint", "A", "x"), "crank_y": ("joint", "A", "y"), "ground_y": ("joint", "O4", "y"),
                        "coupler_y": ("cut", "B", "y")}, ["P", "B_pin"], ["coupler", "rocker"]),
+    ("four_bar.toml", {"O2_x": ("joint", "O2", "x"), "O2_y": ("joint", "O2", "y")}, ["P"], ["coupler"]),  # the driver's own origin
+    ("r_rtr.toml", {"A_x": ("joint", "A", "x"), "B_y": ("joint", "B", "y"), "C_ground": ("cut", "C", "x"),
+                    "C_y": ("cut", "C", "y")}, ["B", "D"], ["link2", "link3"]),  # a cut frame on the ground
     ("slider_crank.toml", {"offset": ("joint", "slide", "y"), "rod": ("cut", "B", "x"), "crank": ("joint", "A", "x")},
      ["B_pin"], ["rod"]),
     ("jansen_leg.toml", {"crank": ("joint", "A1", "x"), "rocker": ("joint", "D_pin", "x"),
@@ -87,8 +91,8 @@ def test_four_bar_sensitivities_are_the_law_of_cosines_differentiated():
      ["G", "C"], ["foot_triangle"]),
 ])
 def test_sensitivities_are_central_differences_of_resolved_variants(scene, params, points, links):
-    """Every parameter kind (a joint origin's x or y, either side of a cut, a prismatic
-    joint's origin), on one loop and on Jansen's three: dy/dp at 25 poses of a turn equals
+    """Every parameter kind (a joint origin's x or y, the driver's own, either side of a cut,
+    a cut frame on the ground, a prismatic joint's origin), on one loop and on Jansen's three: dy/dp at 25 poses of a turn equals
     central differences of variants re-solved from scratch. h = 1e-6 m (1e-5 of the loop):
     truncation (h/L)^2 ~ 1e-10 relative, the closure tolerance 1e-13 L over h gives
     ~1e-8 absolute; tolerance 1e-6 + 1e-6 relative."""
@@ -96,7 +100,7 @@ def test_sensitivities_are_central_differences_of_resolved_variants(scene, param
     for name, (target, element, axis) in params.items():
         table[name] = {target: element, "component": axis}
         if target == "cut":
-            table[name]["side"] = "parent" if name != "F" else "child"
+            table[name]["side"] = "child" if name in ("F", "C_y") else "parent"
     sm = _study(scene, table, points, links)
     outputs = StudyOutputs(sm)
     cycle = sm.cycle(sm.nominal)
