@@ -79,7 +79,7 @@ def study(path: str | Path | StudySpec, *, workers: int = 0, scheduler: str | No
         from pinmech.exceptions import SweepError
 
         raise SweepError(f"{spec.path}: the nominal fails over the cycle ({cycle.cause}): {cycle.detail}",
-                         driver=sm.sweep.driver, value=float("nan"), cause=None)
+                         driver=sm.sweep.driver, value=float("nan"), cause=cycle.error) from cycle.error
     y0, dy = cycle_sensitivity(sm, outputs, cycle.q)
     common = dict(spec=spec, driver=sm.sweep.driver, values=sm.values, outputs=outputs.names, kinds=outputs.kinds,
                   params=[p.name for p in spec.params], nominal_p=sm.nominal.copy(), nominal=y0, sensitivity=dy)

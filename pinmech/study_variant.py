@@ -15,7 +15,14 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from pinmech.exceptions import AssemblyError, DriverLimitError, LoopClosureError, PinmechError, SingularPoseError
+from pinmech.exceptions import (
+    AssemblyError,
+    DriverLimitError,
+    LoopClosureError,
+    PinmechError,
+    SceneError,
+    SingularPoseError,
+)
 from pinmech.scene import Scene
 from pinmech.study_file import StudySpec
 from pinmech.study_params import Placement, placements, subtrees
@@ -33,6 +40,7 @@ class VariantCycle:
     q: np.ndarray | None
     cause: str = ""
     detail: str = ""
+    error: PinmechError | None = None  # the error behind the cause (None: outside bounds)
 
 
 class StudyMechanism:
@@ -53,6 +61,9 @@ class StudyMechanism:
             if p.nominal is not None:
                 place.write(p.nominal)
         self.nominal = np.array([place.read() for place in self.placements])
+        outside = _outside(spec, self.nominal)
+        if outside:
+            raise SceneError(f"the nominal {outside}", path=str(spec.path), key="params")
         self.subtree = subtrees(self.model)
         self.values = np.asarray(self.sweep.default_values(spec.steps), dtype=float)
         self.solver.refresh()
@@ -77,9 +88,9 @@ class StudyMechanism:
         try:
             self.solver.set_reference(self.reference.driver_q, self.reference.q, assembly=self.assembly)
         except (LoopClosureError, SingularPoseError) as exc:
-            return VariantCycle(self.values, None, "cannot assemble", str(exc))
+            return VariantCycle(self.values, None, "cannot assemble", str(exc), exc)
         except AssemblyError as exc:
-            return VariantCycle(self.values, None, "other assembly", str(exc))
+            return VariantCycle(self.values, None, "other assembly", str(exc), exc)
         return self._swept()
 
     def _swept(self) -> VariantCycle:
@@ -87,9 +98,11 @@ class StudyMechanism:
         for chunk in self.sweep.chunks(self.values):
             if chunk.errors:
                 exc = next(iter(chunk.errors.values()))
-                return VariantCycle(self.values, None, _cause(exc), str(exc))
+                return VariantCycle(self.values, None, _cause(exc), str(exc), exc)
             if chunk.notes:
-                return VariantCycle(self.values, None, "changes assembly", next(iter(chunk.notes.values())))
+                note = next(iter(chunk.notes.values()))
+                return VariantCycle(self.values, None, "changes assembly", note,
+                                    AssemblyError(note, expected=(), found=()))
             rows.append(chunk.solution.q)
         return VariantCycle(self.values, np.vstack(rows))
 
@@ -114,6 +127,6 @@ def _cause(exc: PinmechError) -> str:
 def _outside(spec: StudySpec, p: np.ndarray) -> str:
     for x, value in zip(spec.params, p):
         if not x.lower <= value <= x.upper:
-            return (f"{spec.path}, params.{x.name}: {value * 1e3:.6g} mm is outside "
+            return (f"params.{x.name}: {value * 1e3:.6g} mm is outside "
                     f"{x.lower * 1e3:.6g} .. {x.upper * 1e3:.6g} mm")
     return ""

@@ -78,3 +78,19 @@ def test_without_dask_the_error_names_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "distributed", None)
     with pytest.raises(ImportError, match=r'pip install "pinmech\[study\]"'):
         require_dask()
+
+
+def test_a_nominal_that_fails_is_its_error_on_one_line(tmp_path, capsys):
+    """Marghitu's slider-crank meets a dead centre within the turn (a singular pose, exit 7);
+    a nominal outside its own bounds is a study-file error (exit 4)."""
+    file = tmp_path / "m.toml"
+    file.write_text(f'scene = "{STUDIES.parent}/scenes/marghitu_slider_crank.toml"\n'
+                    '[params.a]\njoint = "B"\ncomponent = "x"\n[outputs]\npoints = ["C_pin"]\n')
+    assert main(["study", str(file), "--workers", "0"]) == 7
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "the nominal fails over the cycle (singular pose)" in err, err
+    file.write_text(f'scene = "{STUDIES.parent}/scenes/four_bar.toml"\n'
+                    '[params.a]\njoint = "A"\ncomponent = "x"\nbounds = ["41 mm", "42 mm"]\n[outputs]\npoints = ["P"]\n')
+    assert main(["study", str(file), "--workers", "0"]) == 4
+    err = capsys.readouterr().err
+    assert "params: the nominal params.a: 40 mm is outside 41 .. 42 mm" in err, err

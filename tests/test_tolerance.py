@@ -107,3 +107,18 @@ def test_non_grashof_failures_are_counted_by_the_law_of_cosines():
     s = spread(sm, outputs, results)
     assert s.failures == {"cannot assemble": int((~assembles).sum()),
                           "fold within the range": int((assembles & ~turns).sum())}
+
+
+def test_variants_outside_their_bounds_are_counted_not_solved():
+    """Crank sigma 0.1 mm with bounds 39.9 .. 40.1 mm (1 sigma): about a third of the
+    variants fall outside; each is counted as "outside bounds", its outputs left NaN,
+    and every one inside is solved."""
+    sm = _four_bar_study({"crank": {"sigma": "0.1 mm", "bounds": ["39.9 mm", "40.1 mm"]}}, samples=120)
+    outputs, results = _run(sm)
+    p = np.concatenate([r.p for r in results])[:, 0]
+    y = np.concatenate([r.y for r in results])
+    causes = np.array([c for r in results for c in r.causes])
+    outside = (p < 0.0399) | (p > 0.0401)
+    np.testing.assert_array_equal(causes == "outside bounds", outside)
+    np.testing.assert_array_equal(causes == "", ~outside)
+    assert 20 < outside.sum() < 60 and np.all(np.isnan(y[outside])) and not np.any(np.isnan(y[~outside]))
