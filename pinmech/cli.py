@@ -24,6 +24,7 @@ from pinmech import __version__
 from pinmech.counts import checked_count
 from pinmech.exceptions import PinmechError, SceneError
 from pinmech.interrupts import SIGNALS
+from pinmech.study_cli import add_parser as add_study_parser
 
 if TYPE_CHECKING:
     from pinmech.outputs import Outputs
@@ -256,6 +257,7 @@ _SUBCOMMANDS = {
     "view": _view_parser,
     "build": _build_parser,
     "check": _check_parser,
+    "study": add_study_parser,
 }
 
 

@@ -19,6 +19,7 @@ import pytest
         ("sweep_memory", ["--poses", "200"]),
         ("singular_accuracy", []),
         ("condition_time", ["--sizes", "1", "5", "--rounds", "1"]),
+        ("benchmark_study", ["--samples", "40", "--rounds", "1"]),
     ],
 )
 def test_script_runs(name, argv, capsys):
