@@ -26,7 +26,6 @@ from __future__ import annotations
 import difflib
 import math
 import re
-import sys
 from dataclasses import dataclass
 from decimal import Decimal, InvalidOperation
 from pathlib import Path
@@ -35,10 +34,7 @@ from typing import Any
 from pinmech.exceptions import SceneError, UnitError
 from pinmech.units import JOINT_KINDS, SI_UNITS, format_si, to_si
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
+from pinmech.toml_file import read_toml
 
 #: How many units of the last printed digit count as "rounding" rather than a mismatch,
 #: and the most a user may allow (more would call any value rounding).
@@ -131,12 +127,7 @@ def load_hand_file(path: str | Path) -> HandFile:
             a printed number, an unknown unit.
     """
     path = Path(path)
-    if not path.is_file():
-        raise SceneError("no such hand-value file", path=str(path))
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise SceneError(f"malformed TOML: {exc}", path=str(path)) from exc
+    raw = read_toml(path, "hand-value", SceneError)
     if not isinstance(raw.get("scene"), str):
         raise SceneError("missing scene = \"scene.toml\"", path=str(path), key="scene")
     _refuse_unknown_keys(raw, _FILE_KEYS, str(path), "")

@@ -19,7 +19,6 @@ Conventions of the generated URDF (all in the plane z = 0, axes along z):
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -33,10 +32,7 @@ from pinmech.linkage_expr import check_param_name, length
 from pinmech.linkage_masses import LinkMass, parse_masses
 from pinmech.units import to_si
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
+from pinmech.toml_file import read_toml
 
 GROUND = "ground"
 _KEYS = {"title", "ground", "params", "joints", "links", "sliders", "slots", "colors", "axes", "balls", "masses"}
@@ -103,12 +99,7 @@ def parse_linkage(path: str | Path) -> Linkage:
     """
     path = file_path(path, "the linkage file")
     source = str(path)
-    if not path.is_file():
-        raise ModelError("no such linkage file", path=source)
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise ModelError(f"malformed TOML: {exc}", path=source) from exc
+    raw = read_toml(path, "linkage", ModelError)
     unknown = set(raw) - _KEYS
     if unknown:
         raise ModelError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_KEYS))}",

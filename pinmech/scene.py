@@ -8,7 +8,6 @@ type). See the README section "Scene files" for the format.
 from __future__ import annotations
 
 import copy
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -17,10 +16,7 @@ from pinmech.arguments import file_path
 from pinmech.exceptions import SceneError
 from pinmech.units import JOINT_KINDS, to_si
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
+from pinmech.toml_file import TOMLDecodeError, read_toml, toml_value
 
 #: Top-level keys a scene may have; other modules (tasks, sweeps) register theirs here.
 KNOWN_KEYS = {
@@ -69,12 +65,7 @@ class Scene:
             SceneError: missing file, malformed TOML, unknown keys, bad override.
         """
         path = file_path(path, "the scene", SceneError)
-        if not path.is_file():
-            raise SceneError("no such scene file", path=str(path))
-        try:
-            raw = tomllib.loads(path.read_text(encoding="utf-8"))
-        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-            raise SceneError(f"malformed TOML: {exc}", path=str(path)) from exc
+        raw = read_toml(path, "scene", SceneError)
         scene = cls(path=path, raw=raw, base=copy.deepcopy(raw))
         for item in overrides or []:
             scene.override(item)
@@ -87,8 +78,8 @@ class Scene:
         if not sep or not key.strip():
             raise SceneError(f"override {item!r} is not KEY=VALUE (e.g. drivers.A.angle='45 deg')", path=str(self.path))
         try:
-            value = tomllib.loads(f"v = {text}")["v"]
-        except tomllib.TOMLDecodeError:
+            value = toml_value(text)
+        except TOMLDecodeError:
             value = text.strip().strip("'\"")
         node = self.raw
         parts = key.strip().split(".")

@@ -30,7 +30,6 @@ Every mistake is a SceneError naming the study file, the key and the value as wr
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -39,10 +38,7 @@ from pinmech.exceptions import SceneError
 from pinmech.study_params import AXES, DISTRIBUTIONS, Parameter
 from pinmech.units import to_si
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
+from pinmech.toml_file import read_toml
 
 KINDS = ("sensitivity", "tolerance")
 _TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs", "batch"}
@@ -81,12 +77,7 @@ class StudySpec:
 def load_study(path: str | Path) -> StudySpec:
     """Read and check a study file. Raises SceneError naming the file and the key."""
     path = Path(path)
-    if not path.is_file():
-        raise SceneError("no such study file", path=str(path))
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise SceneError(f"malformed TOML: {exc}", path=str(path)) from exc
+    raw = read_toml(path, "study", SceneError)
     return parse_study(raw, path)
 
 

@@ -28,3 +28,22 @@ def scenes_dir() -> Path:
 @pytest.fixture
 def r_rtr_scene() -> Path:
     return SCENES / "r_rtr.toml"
+
+
+@pytest.fixture
+def figures(monkeypatch):
+    """The figures pinmech saves, kept open to be read (closed after the test)."""
+    import pinmech.plot
+
+    kept = []
+
+    def keep(plt, fig, path):
+        kept.append(fig)
+        return path
+
+    monkeypatch.setattr(pinmech.plot, "_save", keep)
+    yield kept
+    import matplotlib.pyplot as plt
+
+    for fig in kept:
+        plt.close(fig)

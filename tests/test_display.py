@@ -19,20 +19,6 @@ from tests.conftest import MODELS, SCENES
 pytest.importorskip("matplotlib", reason='plots need pip install "pinmech[plot]"')
 
 
-@pytest.fixture
-def figures(monkeypatch):
-    """The figures pinmech saves, kept open to be read."""
-    import pinmech.plot
-
-    kept = []
-
-    def keep(plt, fig, path):
-        kept.append(fig)
-        return path
-
-    monkeypatch.setattr(pinmech.plot, "_save", keep)
-    return kept
-
 
 def _urdf_colours(urdf) -> dict[str, tuple[float, ...]]:
     """Link name -> the RGB of its <visual>'s material, read from the URDF itself."""

@@ -18,20 +18,6 @@ from tests.conftest import SCENES
 pytest.importorskip("matplotlib", reason='plots need pip install "pinmech[plot]"')
 
 
-@pytest.fixture
-def figures(monkeypatch):
-    """The figures pinmech saves, kept open to be read."""
-    import pinmech.plot
-
-    kept = []
-
-    def keep(plt, fig, path):
-        kept.append(fig)
-        return path
-
-    monkeypatch.setattr(pinmech.plot, "_save", keep)
-    return kept
-
 
 def _axes(fig, title_start: str):
     return next(ax for ax in fig.axes if ax.get_title().startswith(title_start))

@@ -34,24 +34,6 @@ ANGLE_TOL_DEG = 1e-8
 PLACE_TOL_MM = 1e-6
 
 
-@pytest.fixture
-def figures(monkeypatch):
-    """The figures pinmech saves, kept open to be read."""
-    import pinmech.plot
-
-    kept = []
-
-    def keep(plt, fig, path):
-        kept.append(fig)
-        return path
-
-    monkeypatch.setattr(pinmech.plot, "_save", keep)
-    yield kept
-    import matplotlib.pyplot as plt
-
-    for fig in kept:
-        plt.close(fig)
-
 
 def _panel(fig, start: str):
     return next(ax for ax in fig.axes if start in ax.get_title())
