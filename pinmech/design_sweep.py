@@ -16,6 +16,7 @@ import numpy as np
 
 from pinmech.design import advantage_unit
 from pinmech.exceptions import DiagnosticError, PinmechError
+from pinmech.extremum import Tracked
 from pinmech.grashof import loop_classes
 from pinmech.limit_positions import LimitFinder, LimitPosition, extreme_label, travel
 from pinmech.planar_linkage import planar_linkage
@@ -38,6 +39,22 @@ class _Extreme:
             self.high, self.high_at = value, at
 
 
+@dataclass(frozen=True)
+class AngleExtremes:
+    """A dyad's (named by its pin B) least and largest acute transmission angle and largest
+    pressure angle [deg], each with its driver value [rad or m]; `refined` False where
+    one is the value over the poses only (a fold beside it)."""
+
+    name: str
+    low: float
+    low_at: float
+    high: float
+    high_at: float
+    pressure: float
+    pressure_at: float
+    refined: bool
+
+
 class DesignSweep:
     """The diagnostics of each pose of a sweep, and of the whole sweep.
 
@@ -51,6 +68,7 @@ class DesignSweep:
         self.sweep, self.reason = sweep, ""
         self._cache: tuple[int, dict] = (-1, {})
         self._limits: tuple[int, list] = (-1, [])
+        self._extremes: tuple[int, list] = (-1, [])
         self.count = 0
         try:
             self.linkage = planar_linkage(sweep.mechanism)
@@ -64,8 +82,11 @@ class DesignSweep:
         self.solver = LoopSolver(sweep.mechanism, names, **sweep.scene.solver_options())
         self.finder = LimitFinder(self.solver, self.linkage, self.k, sweep.drivers.q, self.dyads)
         self.unit = np.eye(len(names))[self.k]
-        self.angles = [_Extreme() for _ in self.dyads]
-        self.pressures = [_Extreme() for _ in self.dyads]
+        self.angles = [(Tracked(1.0), Tracked(-1.0)) for _ in self.dyads]  # least, largest acute mu [deg]
+        self.pressures = [Tracked(-1.0) for _ in self.dyads]  # largest pressure angle [deg]
+        self._previous: float | None = None  # the last solved pose's driver value
+        self._step: float | None = None  # the driver's last step between solved poses [rad or m]
+        self._folds: list[float] = []
         self.advantages = [_Extreme() for _ in self.outputs]
         self.previous: list[tuple | None] = [None] * len(self.outputs)
         self.brackets: list[list[tuple]] = [[] for _ in self.outputs]
@@ -81,6 +102,10 @@ class DesignSweep:
         if self._cache[0] == pose.index:
             return self._cache[1]
         out: dict = {}
+        if self.applicable:
+            self._fold(pose)
+        if self.applicable and pose.motion is None:
+            self._previous = None
         if self.applicable and pose.motion is not None:
             q = self._q(pose.motion)
             v, _, _ = self.solver.rates(q, self.unit, np.zeros(len(self.unit)), closed=not pose.interpolated)
@@ -100,11 +125,27 @@ class DesignSweep:
             mech.set_coordinate(q, name, joint.q)
         return q
 
+    def _fold(self, pose) -> None:
+        """A fold met before this pose: the DriverLimitError's value, or, crossed with
+        `--through-folds` (the driver turns back there, the values past it mirrored), the
+        point p with p - x0 + p - x1 = the step (x0, x1 the driver values either side)."""
+        if pose.fold is not None and not any(abs(pose.fold - x) <= 1e-12 for x in self._folds):
+            self._folds.append(pose.fold)
+        if "crossed a fold" not in pose.note:
+            return
+        if self._previous is not None and self._step is not None and pose.motion is not None:
+            self._folds.append(0.5 * (self._previous + pose.value + self._step))
+        self._step = None if self._step is None else -self._step
+
     def _record(self, pose, q: np.ndarray, rates: list[float], out: dict) -> None:
         self.count += 1
-        for stat, pressure, (_, acute, phi) in zip(self.angles, self.pressures, out["angles"]):
-            stat.add(acute, pose.value)
-            pressure.add(phi, pose.value)
+        for (least, largest), pressure, (_, acute, phi) in zip(self.angles, self.pressures, out["angles"]):
+            least.add(acute, pose.value, q, self._previous)
+            largest.add(acute, pose.value, q, self._previous)
+            pressure.add(phi, pose.value, q, self._previous)
+        if self._previous is not None and "crossed a fold" not in pose.note:
+            self._step = pose.value - self._previous
+        self._previous = pose.value
         for i, (stat, value) in enumerate(zip(self.advantages, out["advantage"])):
             if math.isfinite(value):
                 stat.add(abs(value), pose.value)
@@ -184,6 +225,36 @@ class DesignSweep:
         self._limits = (self.count, out)
         return out
 
+    def angle_extremes(self) -> list[AngleExtremes]:
+        """Each dyad's least and largest acute transmission angle and largest pressure angle
+        [deg], located between the poses (to extremum.TOL of the driver); where a trial pose
+        cannot close (a fold beside it) the value over the poses stands, `refined` False."""
+        if self._extremes[0] != self.count:
+            self._extremes = (self.count, [self._dyad_extremes(*x) for x in
+                                           zip(self.dyads, self.angles, self.pressures)])
+        return self._extremes[1]
+
+    def _dyad_extremes(self, dyad, angles: tuple[Tracked, Tracked], pressure: Tracked) -> AngleExtremes:
+        found, refined = [], True
+        for tracked, what in ((angles[0], "mu_acute"), (angles[1], "mu_acute"), (pressure, "pressure")):
+            try:
+                found.append(tracked.refine(lambda x, t=tracked, w=what: self._angle(dyad, t, x, w)))
+            except PinmechError:  # a trial pose beside a fold: the value over the poses stands
+                found.append((tracked.at, tracked.value))
+                refined = False
+        (low_at, low), (high_at, high), (p_at, p) = found
+        return AngleExtremes(dyad.joint.name, low, low_at, high, high_at, p, p_at, refined)
+
+    def _angle(self, dyad, tracked: Tracked, x: float, what: str) -> float:
+        """An angle of the dyad [deg] at driver value x, the pose followed from the tracked one."""
+        self.linkage.place(self.finder.pose(tracked.q, tracked.at, x))
+        return getattr(dyad_angles(self.linkage, dyad), what)
+
+    def folds(self) -> list[float]:
+        """The driver values of the folds the sweep met [rad or m]: where it stopped
+        (DriverLimitError) or, with `--through-folds`, where the driver turned back."""
+        return list(self._folds)
+
     def summary(self, span: float | None = None) -> list[str]:
         """Lines for the end of a sweep; `span`: the driver's travel [rad] when it was one
         whole turn (then the time ratio of each output with two limit positions)."""
@@ -194,11 +265,14 @@ class DesignSweep:
         lines = [f"design: loop {'-'.join(x.links)}: {x.kind}, {x.label} ({x.condition})"
                  for x in loop_classes(self.linkage)]
         fmt = self._driver
-        for d, mu, phi in zip(self.dyads, self.angles, self.pressures):
+        for d, x in zip(self.dyads, self.angle_extremes()):
             what = "transmission angle (acute)" if d.kind == "pin" else "90 deg - pressure angle"
-            lines.append(f"design: {d.name(self.linkage)}: {what} from {mu.low:.6g} deg at {fmt(mu.low_at)} to "
-                         f"{mu.high:.6g} deg at {fmt(mu.high_at)}; pressure angle up to {phi.high:.6g} deg at "
-                         f"{fmt(phi.high_at)} (over the {self.count} poses)")
+            where = "located between" if x.refined else "over"
+            lines.append(f"design: {d.name(self.linkage)}: {what} from {x.low:.6g} deg at {fmt(x.low_at)} to "
+                         f"{x.high:.6g} deg at {fmt(x.high_at)}; pressure angle up to {x.pressure:.6g} deg at "
+                         f"{fmt(x.pressure_at)} ({where} the {self.count} poses)")
+        lines += [f"design: {self.sweep.driver}: fold (limit position of the driver) at {fmt(x)}"
+                  for x in self.folds()]
         for output, found, stat in zip(self.outputs, self.limits(), self.advantages):
             name = self.linkage.names[output.output]
             lines += self._travel_lines(name, found, span)

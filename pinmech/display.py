@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import pinocchio as pin
+
 if TYPE_CHECKING:
     import numpy as np
 
@@ -57,10 +59,21 @@ def display_names(mechanism: Mechanism) -> dict[str, str]:
 
 
 def joint_colours(mechanism: Mechanism) -> dict[int, tuple[float, float, float]]:
-    """Pinocchio joint id (0: the ground) -> the colour of the link hanging on it."""
+    """Pinocchio joint id (0: the ground) -> the colour of the link hanging on it: the
+    colour the model's URDF gives that link's visuals (pinmech.file_colours; a drawn
+    linkage's generated URDF too), else the palette's (the ground grey)."""
+    from pinmech.file_colours import urdf_link_colours
+
     out: dict[int, tuple[float, float, float]] = {0: GROUND_GREY}
     for k, joint in enumerate(range(1, mechanism.model.njoints)):
         out[joint] = PALETTE[k % len(PALETTE)]
+    path = mechanism.urdf_path or mechanism.source
+    filed = urdf_link_colours(str(path)) if str(path).endswith(".urdf") else {}
+    taken: set[int] = set()
+    for frame in mechanism.model.frames:  # a joint's first coloured body (the link on it)
+        if frame.type == pin.FrameType.BODY and frame.name in filed and frame.parentJoint not in taken:
+            out[frame.parentJoint] = filed[frame.name]
+            taken.add(frame.parentJoint)
     return out
 
 

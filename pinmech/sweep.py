@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from pinmech.arguments import real_number
-from pinmech.exceptions import ModelError, SceneError, SweepError
+from pinmech.exceptions import DriverLimitError, ModelError, SceneError, SweepError
 from pinmech.mechanism import Mechanism
 from pinmech.motion import Motion, evaluate_motion
 from pinmech.results import Accuracy
@@ -65,6 +65,7 @@ class SweepPose:
     error: str = ""
     interpolated: bool = False
     note: str = ""
+    fold: float | None = None  # a failed pose's DriverLimitError: the swept driver's fold [rad or m]
 
 
 @dataclass(frozen=True)
@@ -268,7 +269,7 @@ class Sweep:
                     if not skip_failures:
                         raise SweepError(f"sweep stopped at {self.driver} = {self._format(value)}: {exc}",
                                          driver=self.driver, value=value, cause=exc) from exc
-                    yield SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}")
+                    yield SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}", fold=self._fold(exc))
                     continue
                 sol = chunk.solution
                 self.last_q = sol.q[j]
@@ -279,6 +280,12 @@ class Sweep:
                                              points=points, links=links, coincident=coincident)
                 yield SweepPose(index, value, motion, sol.accuracy(j), interpolated=bool(chunk.interpolated[j]),
                                 note=chunk.notes.get(j, ""))
+
+    def _fold(self, exc: Exception) -> float | None:
+        """The swept driver's value at the fold a DriverLimitError names [rad or m], else None."""
+        if not isinstance(exc, DriverLimitError) or len(exc.limit) != len(self.drivers.names):
+            return None
+        return float(exc.limit[self.drivers.names.index(self.driver)])
 
     def return_gap(self) -> float:
         """How far the sweep's last pose is from its first: the largest joint difference,

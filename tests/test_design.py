@@ -326,3 +326,49 @@ def test_rocker_extremes_are_named_by_the_rocker_not_by_the_sweeps_direction(tmp
     from pinmech.limit_positions import travel
 
     np.testing.assert_allclose(travel(found, None).travel, theta4["folded"] - theta4["extended"], rtol=0, atol=1e-10)
+
+
+def test_least_and_largest_transmission_angle_are_located_between_the_poses():
+    """Crank-rocker a = 40, coupler b = 120, rocker c = 80, ground d = 100 mm (Norton §4.10):
+    cos mu = (b^2 + c^2 - a^2 - d^2 + 2 a d cos theta) / (2 b c) is extreme where cos theta
+    is, so the least mu is at theta = 0 and the largest at theta = 180 deg. The sweep's poses
+    (every 30 deg from 7 deg) miss both; the summary locates them between the poses."""
+    a, b, c, d = 0.04, 0.12, 0.08, 0.10
+
+    def mu(theta):
+        return math.degrees(math.acos((b**2 + c**2 - a**2 - d**2 + 2 * a * d * math.cos(theta)) / (2 * b * c)))
+
+    scene = pinmech.Scene.load(SCENES / "four_bar.toml", ['sweep.from="7 deg"', 'sweep.to="367 deg"'])
+    sweep = pinmech.Sweep.from_scene(scene)
+    design = design_of(sweep)
+    for pose in sweep.poses(sweep.default_values(13)):
+        design.add(pose)
+    ((low, low_at, high, high_at),) = [(x.low, x.low_at, x.high, x.high_at) for x in design.angle_extremes()]
+    # The driver value is refined to 1e-10 rad where mu is flat (a minimum): mu is then
+    # exact to ~(1e-10)^2, the angle to the closure's rounding; 1e-8 rad and 1e-9 deg margins.
+    np.testing.assert_allclose(low_at % (2 * math.pi), 2 * math.pi, rtol=0, atol=DRIVER_TOL)
+    np.testing.assert_allclose(high_at, math.pi, rtol=0, atol=DRIVER_TOL)
+    np.testing.assert_allclose([low, high], [mu(0.0), mu(math.pi)], rtol=0, atol=ANGLE_TOL)
+    summary = "\n".join(design.summary(2 * math.pi))
+    assert f"from {mu(0.0):.6g} deg at O2 = 360 deg to {mu(math.pi):.6g} deg at O2 = 180 deg" in summary
+
+
+@pytest.mark.parametrize("through_folds", [False, True], ids=["stops at the fold", "through the folds"])
+def test_folds_of_a_non_grashof_crank_are_listed_with_the_limit_positions(tmp_path, through_folds):
+    """Triple rocker d = 100, a = 45, b = 50, c = 55 mm: the crank stops where coupler and
+    rocker are in line, |O4 A| = b + c; by the law of cosines
+    cos theta = (a^2 + d^2 - (b + c)^2) / (2 a d), theta = +-83.62 deg (Norton §2.12)."""
+    a, b, c, d = 45, 50, 55, 100
+    fold = math.degrees(math.acos((a**2 + d**2 - (b + c) ** 2) / (2 * a * d)))
+    scene = _four_bar_files(tmp_path, d, a, b, c)
+    sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(scene))
+    design = design_of(sweep)
+    for pose in sweep.poses(sweep.default_values(13), skip_failures=True, through_folds=through_folds):
+        design.add(pose)
+    found = sorted(math.degrees(x) for x in design.folds())
+    # The engine locates a fold to rounding (DriverLimitError); through the folds the fold is
+    # halfway between the poses' mirrored values, exact to rounding too: 1e-8 deg margin.
+    expected = [fold] if not through_folds else [-fold, fold]
+    np.testing.assert_allclose(found, expected, rtol=0, atol=1e-8)
+    summary = "\n".join(design.summary(2 * math.pi))
+    assert f"design: O2: fold (limit position of the driver) at O2 = {fold:.6g} deg" in summary

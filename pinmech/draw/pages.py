@@ -76,7 +76,20 @@ def mechanism_visuals(mechanism) -> tuple[pin.GeometryModel, list[str]]:
         visuals = mjcf_visuals(path, mechanism.model)
     else:
         visuals, skipped = package_visuals(path, mechanism.model)
+        _paint_uncoloured(mechanism, visuals)
     return sketch_visuals(mechanism, visuals), skipped
+
+
+def _paint_uncoloured(mechanism, visuals: pin.GeometryModel) -> None:
+    """A URDF visual without a material takes its link's colour (pinmech.display), as the
+    curves and polygons draw that link; a visual with one keeps the file's colour."""
+    from pinmech.display import joint_colours
+
+    colours = joint_colours(mechanism)
+    for obj in visuals.geometryObjects:
+        if not obj.overrideMaterial:
+            obj.meshColor = np.array([*colours[obj.parentJoint], 1.0])
+            obj.overrideMaterial = True
 
 
 def snapshot_html(
