@@ -24,7 +24,7 @@ from pinmech import __version__
 from pinmech.counts import checked_count
 from pinmech.exceptions import PinmechError, SceneError
 from pinmech.interrupts import SIGNALS
-from pinmech.study_cli import add_parser as add_study_parser
+from pinmech.design.study_cli import add_parser as add_study_parser
 
 if TYPE_CHECKING:
     from pinmech.outputs import Outputs
@@ -317,7 +317,7 @@ def _option(given: Any, flag: str, scene, options: dict[str, Any], key: str, def
 
 
 def _scene(args: argparse.Namespace):
-    from pinmech.scene import Scene
+    from pinmech.io.scene import Scene
 
     overrides = list(args.overrides)
     shortcuts = {"angle": args.angle, "speed": args.speed, "acceleration": args.acceleration}
@@ -339,10 +339,10 @@ def _scene(args: argparse.Namespace):
 
 def cmd_solve(args: argparse.Namespace) -> int:
     """`pinmech solve SCENE`: the textbook-ordered report, or `--json`."""
-    from pinmech.analysis import analyse
-    from pinmech.limits import enforce, limit_violations
-    from pinmech.report import to_json, to_text
-    from pinmech.scene_model import limit_mode
+    from pinmech.io.analysis import analyse
+    from pinmech.solve.limits import enforce, limit_violations
+    from pinmech.io.report import to_json, to_text
+    from pinmech.io.scene_model import limit_mode
 
     scene = _scene(args)
     mode = limit_mode(scene, args.limits)
@@ -357,8 +357,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
 def cmd_forces(args: argparse.Namespace) -> int:
     """`pinmech forces SCENE`: the report with driver efforts and joint reactions (or `--json`)."""
-    from pinmech.analysis import analyse
-    from pinmech.report import to_json, to_text
+    from pinmech.io.analysis import analyse
+    from pinmech.io.report import to_json, to_text
 
     analysis = analyse(_scene(args), forces=True, static=args.static, minimum_norm=args.minimum_norm)
     print(to_json(analysis) if args.json else to_text(analysis), end="" if not args.json else "\n")
@@ -367,12 +367,12 @@ def cmd_forces(args: argparse.Namespace) -> int:
 
 def _sweep_forces(args: argparse.Namespace, scene, sweep):
     """The forces of a sweep when asked (flags or the scene's force tables), else None."""
-    from pinmech.scene import wants_forces
+    from pinmech.io.scene import wants_forces
 
     asked = args.forces or args.static or args.minimum_norm or args.flywheel or args.torque_plot
     if not (asked or wants_forces(scene)):
         return None
-    from pinmech.forces_sweep import SweepForces
+    from pinmech.draw.forces_sweep import SweepForces
 
     flywheel = _option(args.flywheel, "--flywheel", scene, {}, "").quantity("moment_of_inertia") if args.flywheel else None
     if flywheel is not None and not flywheel > 0:
@@ -390,11 +390,11 @@ def _sweep_forces(args: argparse.Namespace, scene, sweep):
 def cmd_sweep(args: argparse.Namespace) -> int:
     """`pinmech sweep SCENE`: every pose of a cycle, streamed as CSV (and JSON lines, a plot);
     a task scene is followed in time instead (as `pinmech path`)."""
-    from pinmech.limits import limit_violations
-    from pinmech.scene_model import limit_mode
-    from pinmech.sweep import DriverValues, Sweep, sweep_options
+    from pinmech.solve.limits import limit_violations
+    from pinmech.io.scene_model import limit_mode
+    from pinmech.io.sweep import DriverValues, Sweep, sweep_options
 
-    from pinmech.unused_options import refuse_sweep_options
+    from pinmech.io.unused_options import refuse_sweep_options
 
     scene = _scene(args)
     refuse_sweep_options(args, str(scene.path), task="task" in scene.raw)
@@ -414,7 +414,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     start = first.quantity(kind) if first.value else sweep.start
     stop = last.quantity(kind) if last.value else start + (sweep.default_values(2)[1] - sweep.start)
     if args.tol is not None:
-        from pinmech.scene import SOLVER_RANGES
+        from pinmech.io.scene import SOLVER_RANGES
 
         low, high = SOLVER_RANGES["tol"]
         if not low <= args.tol <= high:
@@ -474,7 +474,7 @@ def _design_summary(sweep, span: float, through_folds: bool) -> list[str]:
     driver made exactly one turn."""
     import math
 
-    from pinmech.design_sweep import design_of
+    from pinmech.solve.diagnostics_sweep import design_of
 
     turn = sweep.is_angular and not through_folds and abs(abs(span) - 2 * math.pi) <= 1e-9
     return design_of(sweep).summary(2 * math.pi if turn else None)
@@ -507,7 +507,7 @@ class _LimitWatch:
         self.count, self.first = 0, ""
 
     def check(self, violations: list, at: str) -> None:
-        from pinmech.limits import enforce
+        from pinmech.solve.limits import enforce
 
         if violations:
             enforce(violations, self.mode, f"stopped {at}")
@@ -522,21 +522,21 @@ class _LimitWatch:
 
 def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | None, forces=None) -> Outputs:
     from pinmech.outputs import Outputs, plot_path
-    from pinmech.tables import SweepCsv, SweepJsonLines
+    from pinmech.io.tables import SweepCsv, SweepJsonLines
 
     csv_kind, json_kind, source = SweepCsv, SweepJsonLines, sweep
     sinks = Outputs()
-    from pinmech.design_sweep import design_of
+    from pinmech.solve.diagnostics_sweep import design_of
 
     sinks.plot(design_of(sweep), None)  # every pose, for the design summary, whatever is written
     if forces is not None:
-        from pinmech.forces_sweep import ForceCsv, ForceJsonLines, TorquePlot
+        from pinmech.draw.forces_sweep import ForceCsv, ForceJsonLines, TorquePlot
 
         csv_kind, json_kind, source = ForceCsv, ForceJsonLines, forces
         torque = plot_path(args.torque_plot, "--torque-plot") if args.torque_plot else None
         sinks.plot(TorquePlot(forces), torque)  # collects every pose's forces; drawn if a path is given
     if figure is not None or args.paths_path:
-        from pinmech.plot import SweepPlot
+        from pinmech.draw.plot import SweepPlot
 
         recorder = SweepPlot(sweep, links=args.links, points=args.points, total=steps, angles=args.angles,
                              plane=args.path_plane, timing=args.timing_step)
@@ -621,20 +621,20 @@ def _progress(items, total: int):
 
 def cmd_path(args: argparse.Namespace) -> int:
     """`pinmech path SCENE --duration T`: the task integrated in time, with its drift."""
-    from pinmech.scene import Scene
+    from pinmech.io.scene import Scene
 
     return _follow(args, Scene.load(args.scene, args.overrides))
 
 
 def _follow(args: argparse.Namespace, scene) -> int:
     """A task scene followed in time: CSV (JSON lines, a figure) of the joint trajectory."""
-    from pinmech.analysis_task import scene_pose, scene_tasks
-    from pinmech.limits import limits_at
+    from pinmech.io.analysis_task import scene_pose, scene_tasks
+    from pinmech.solve.limits import limits_at
     from pinmech.outputs import Outputs
-    from pinmech.path import follow_path, step_count
-    from pinmech.scene_model import limit_mode, load_mechanism
-    from pinmech.sweep import sweep_options
-    from pinmech.tables import PathCsv
+    from pinmech.solve.path import follow_path, step_count
+    from pinmech.io.scene_model import limit_mode, load_mechanism
+    from pinmech.io.sweep import sweep_options
+    from pinmech.io.tables import PathCsv
 
     if "task" not in scene.raw:
         raise PinmechError(f"{scene.path}: no [[task]] to follow; a scene with [drivers] is swept: "
@@ -648,7 +648,7 @@ def _follow(args: argparse.Namespace, scene) -> int:
     total = step_count(duration, step) + 1
     sinks = Outputs()
     if args.plot_path:
-        from pinmech.plot_task import PathPlot
+        from pinmech.draw.plot_task import PathPlot
 
         note = f" ({scheme}, step {step:g} s" + (f", feedback {gain:g}/s)" if gain else ")")
         sinks.plot(PathPlot(mechanism, scene.title, note=note, total=total), figure)
@@ -672,7 +672,7 @@ def _follow(args: argparse.Namespace, scene) -> int:
 def _timing(args: argparse.Namespace, scene, options: dict[str, Any]) -> tuple[float, float, float]:
     """A path's duration and step [s] and feedback gain [1/s], each error blaming the flag
     or the scene's key it came from."""
-    from pinmech.path import check_timing
+    from pinmech.solve.path import check_timing
 
     duration = _option(_given(args.duration, "--duration"), "--duration", scene, options, "duration")
     if not duration.value:
@@ -715,13 +715,13 @@ def _visuals(mechanism):
 
 def cmd_snapshot(args: argparse.Namespace) -> int:
     """`pinmech snapshot SCENE -o FILE.html`: the solved pose, framed, with points and arrows."""
-    from pinmech.analysis import analyse
+    from pinmech.io.analysis import analyse
     from pinmech.draw import Arrow, snapshot_html
 
     scene = _scene(args)
     _check_page(args, scene)
     analysis = analyse(scene)
-    from pinmech.display import labelled_places
+    from pinmech.model.display import labelled_places
 
     points = labelled_places(analysis.mechanism, analysis.solution.q)  # joints and points, as the textbook names them
     arrows = []
@@ -747,7 +747,7 @@ _MAX_FRAMES = 20_000
 def cmd_animate(args: argparse.Namespace) -> int:
     """`pinmech animate SCENE -o FILE.html [--gif FILE] [--mp4 FILE]`: a driver cycle (a task
     scene: its task followed in time), each frame a solved, closed pose."""
-    from pinmech.animation import driver_frames, task_frames
+    from pinmech.draw.animation import driver_frames, task_frames
 
     outputs = {"-o": args.output, "--gif": args.gif, "--mp4": args.mp4}
     if not any(outputs.values()):
@@ -773,11 +773,11 @@ def cmd_animate(args: argparse.Namespace) -> int:
                                            show_grid=not args.no_grid, title=frames.title,
                                            readouts=frames.readouts, traces=frames.traces()))
     if args.gif:
-        from pinmech.animation_export import write_gif
+        from pinmech.draw.animation_export import write_gif
 
         print(f"wrote {write_gif(frames, args.gif, args.fps)} ({len(frames.qs)} frames)", file=sys.stderr)
     if args.mp4:
-        from pinmech.animation_export import write_mp4
+        from pinmech.draw.animation_export import write_mp4
 
         print(f"wrote {write_mp4(frames, args.mp4, args.fps)} ({len(frames.qs)} frames)", file=sys.stderr)
     return 0
@@ -794,7 +794,7 @@ def _check_animation(args: argparse.Namespace, scene) -> None:
             raise PinmechError(f"{option} {path}: the file must end in {suffix}")
     check_distinct({"-o": args.output, "--gif": args.gif, "--mp4": args.mp4}, _inputs(scene))
     if args.mp4:
-        from pinmech.animation_export import check_mp4
+        from pinmech.draw.animation_export import check_mp4
 
         check_mp4(args.mp4)
     task = "task" in scene.raw
@@ -807,9 +807,9 @@ def _check_animation(args: argparse.Namespace, scene) -> None:
 
 def cmd_polygon(args: argparse.Namespace) -> int:
     """`pinmech polygon SCENE -o v.svg [--acceleration]`: the graphical method's polygon."""
-    from pinmech.analysis import analyse
+    from pinmech.io.analysis import analyse
     from pinmech.draw.polygon_svg import polygon_svg
-    from pinmech.polygon import acceleration_polygon, velocity_polygon
+    from pinmech.draw.polygon import acceleration_polygon, velocity_polygon
 
     args.acceleration = None  # the flag names the polygon here, not the driver's acceleration
     scene = _scene(args)
@@ -824,7 +824,7 @@ def cmd_polygon(args: argparse.Namespace) -> int:
 
 def cmd_report(args: argparse.Namespace) -> int:
     """`pinmech report SCENE -o page.html [--hand FILE]`: everything about the scene on one offline page."""
-    from pinmech.analysis import analyse
+    from pinmech.io.analysis import analyse
     from pinmech.draw.report_page import report_html
 
     if args.steps < 0 or args.steps == 1:
@@ -835,9 +835,9 @@ def cmd_report(args: argparse.Namespace) -> int:
     _check_page(args, scene, hand=args.hand)
     analysis = analyse(scene)
     if args.hand:
-        from pinmech.check import DEFAULT_SLACK, compare, format_verdicts, load_hand_file
-        from pinmech.report import to_dict
-        from pinmech.scene import Scene
+        from pinmech.io.check import DEFAULT_SLACK, compare, format_verdicts, load_hand_file
+        from pinmech.io.report import to_dict
+        from pinmech.io.scene import Scene
 
         hand = load_hand_file(args.hand)
         checked = analyse(Scene.load(hand.scene))
@@ -849,8 +849,8 @@ def cmd_report(args: argparse.Namespace) -> int:
 
 def cmd_build(args: argparse.Namespace) -> int:
     """`pinmech build LINKAGE -o FILE.urdf`: the URDF of a drawn linkage, written whole or not at all."""
-    from pinmech.linkage import build_urdf
-    from pinmech.linkage_urdf import spanning_tree
+    from pinmech.model.linkage_model import build_urdf
+    from pinmech.model.linkage_urdf import spanning_tree
     from pinmech.outputs import check_distinct
 
     check_distinct({"-o": args.output}, {"the linkage file": args.linkage})
@@ -866,7 +866,7 @@ def cmd_build(args: argparse.Namespace) -> int:
 
 def cmd_view(args: argparse.Namespace) -> int:
     """`pinmech view SCENE`: the solved pose in a live meshcat server; prints its URL."""
-    from pinmech.analysis import analyse
+    from pinmech.io.analysis import analyse
     from pinmech.draw import live_viewer
 
     analysis = analyse(_scene(args))
@@ -924,10 +924,10 @@ class _PathJsonLines:
 
 def cmd_check(args: argparse.Namespace) -> int:
     """`pinmech check HAND_FILE`: hand values against pinmech, non-zero exit on a mismatch."""
-    from pinmech.analysis import analyse
-    from pinmech.check import DEFAULT_SLACK, check_slack, compare, format_verdicts, load_hand_file
-    from pinmech.report import to_dict
-    from pinmech.scene import Scene
+    from pinmech.io.analysis import analyse
+    from pinmech.io.check import DEFAULT_SLACK, check_slack, compare, format_verdicts, load_hand_file
+    from pinmech.io.report import to_dict
+    from pinmech.io.scene import Scene
 
     slack = args.slack if args.slack is not None else DEFAULT_SLACK
     try:

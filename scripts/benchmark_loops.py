@@ -27,8 +27,8 @@ angular acceleration, from a reference assembled at 0 (the closed form's pose, s
 branch is known). Timing, in this one process, interleaved: after a warm-up, each round
 times every (k, path) once, in an order rotated from round to round, garbage collection
 paused; the table gives the median time per pose over the rounds and its spread (fastest
-and slowest round). Two paths: with pinmech's compiled core (pinmech/core.py) and the
-Python path (`pinmech.core.ENABLED = False`).
+and slowest round). Two paths: with pinmech's compiled core (pinmech/solve/core.py) and the
+Python path (`pinmech.solve.core.ENABLED = False`).
 
 Correctness: every loop's coupler and output angles (and their rates) against the closed
 form of the four-bar (`chain_closed_form`: the law of cosines, loop after loop, numpy
@@ -199,8 +199,8 @@ def chain_guess(mech, cf: ChainMotion, pose: int) -> np.ndarray:
 
 def sweep(solver, thetas: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """q, v, a of every pose of a sweep of the crank through thetas (the path as it is:
-    the caller sets pinmech.core.ENABLED)."""
-    from pinmech.solve_cycle import solve_range
+    the caller sets pinmech.solve.core.ENABLED)."""
+    from pinmech.solve.cycle import solve_range
 
     chunks = list(solve_range(solver, "O0", thetas, driver_q=np.zeros(1), driver_v=np.array([OMEGA]),
                               driver_a=np.array([ALPHA])))
@@ -262,7 +262,7 @@ class Row:
 
 def make_row(k: int, path: str, poses: int, lengths=LENGTHS) -> Row:
     """Build the chain's solver (timed apart) and a run() that sweeps it on `path`."""
-    import pinmech.core as core
+    import pinmech.solve.core as core
 
     thetas = np.radians(np.arange(poses) * (360.0 / poses))
     t0 = time.perf_counter()
@@ -305,7 +305,7 @@ def measure(loops=LOOPS, poses: int = 360, rounds: int = 7, sample_time: float =
 def one_sweep(k: int, poses: int, path: str, lengths=LENGTHS) -> None:
     """A whole run in this process (under callgrind): set-up, then one sweep of `poses`
     poses 1 degree apart from 0."""
-    import pinmech.core as core
+    import pinmech.solve.core as core
 
     core.ENABLED = path == "core"
     _, solver = chain_solver(k, lengths)

@@ -541,18 +541,18 @@ def pinmech_p1_paths(phi: np.ndarray):
 
 
 def pinmech_p1_python_path(phi: np.ndarray):
-    """`Sweep.chunks` with the compiled core ruled out (pinmech.core.ENABLED = False, as
+    """`Sweep.chunks` with the compiled core ruled out (pinmech.solve.core.ENABLED = False, as
     PINMECH_CORE=0 does): the Python path the core stands in for."""
-    import pinmech.core
+    import pinmech.solve.core
 
     run, read, _ = pinmech_p1_chunks(phi)
 
     def python_path():
-        pinmech.core.ENABLED = False
+        pinmech.solve.core.ENABLED = False
         try:
             return run()
         finally:
-            pinmech.core.ENABLED = True
+            pinmech.solve.core.ENABLED = True
     return python_path, read, ""
 
 
@@ -560,8 +560,8 @@ def pinmech_p1_core_follow(phi: np.ndarray):
     """The compiled core's `follow` alone, from the sweep's first pose: the C++ loop
     (Pinocchio's kinematics, the closure rows, the corrector, rates, signature, condition
     number) with no Python between poses. Its time is the floor the Python layer adds to."""
-    from pinmech.core import core_for
-    from pinmech.solve_cycle import _Cycle
+    from pinmech.solve.core import core_for
+    from pinmech.solve.cycle import _Cycle
 
     pinmech, sweep = _pinmech_p1_sweep()
     solver = sweep.solver
@@ -589,7 +589,7 @@ def pinocchio_passes_p1(phi: np.ndarray):
     core: joint Jacobians twice (the Newton step at the predicted q, then the certifying
     residual and the velocity Jacobian at the corrected q) and the kinematics at (q, v, 0)
     once (the acceleration drift). No certified closed-loop answer calls Pinocchio less."""
-    from pinmech.core import core_for
+    from pinmech.solve.core import core_for
 
     pinmech, sweep = _pinmech_p1_sweep()
     compiled = core_for(sweep.solver)

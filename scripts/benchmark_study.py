@@ -19,9 +19,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from interleave import Timed, time_rounds  # noqa: E402
 
-from pinmech.cluster import run_batches  # noqa: E402
-from pinmech.study_file import load_study  # noqa: E402
-from pinmech.tolerance import batches  # noqa: E402
+from pinmech.design.cluster import run_batches  # noqa: E402
+from pinmech.design.study_file import load_study  # noqa: E402
+from pinmech.design.tolerance import batches  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> None:

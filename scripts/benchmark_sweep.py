@@ -42,9 +42,9 @@ import closed_form
 from interleave import Timed, time_rounds
 
 import pinmech
-import pinmech.scene_model
-from pinmech.solve_batch import difference_many
-from pinmech.sweep import Sweep
+import pinmech.io.scene_model
+from pinmech.solve.batch import difference_many
+from pinmech.io.sweep import Sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "models" / "scenes" / "r_rtr.toml"
@@ -67,7 +67,7 @@ def finite_differences(sweep: Sweep, phis: np.ndarray):
     accelerations by central differences in time of q on the manifold (periodic cycle)."""
     solver, model = sweep.solver, sweep.mechanism.model
     omega = float(sweep.drivers.v[0])
-    q = pinmech.scene_model.scene_guess(sweep.scene, sweep.mechanism)
+    q = pinmech.io.scene_model.scene_guess(sweep.scene, sweep.mechanism)
     Q = np.empty((len(phis), model.nq))
     for i, phi in enumerate(phis):
         q, _, _ = solver.close(q, [phi])
@@ -206,9 +206,9 @@ def verdicts(rows: list[dict]) -> str:
 
 def path_rows(repeats: int) -> list[dict]:
     """Text 17.110's task followed for 0.08 s with each scheme, step and gain."""
-    from pinmech.scene_model import load_mechanism
-    from pinmech.analysis_task import scene_pose, scene_tasks
-    from pinmech.path import follow_path
+    from pinmech.io.scene_model import load_mechanism
+    from pinmech.io.analysis_task import scene_pose, scene_tasks
+    from pinmech.solve.path import follow_path
 
     scene = pinmech.Scene.load(ROOT / "models" / "scenes" / "planar_arm.toml")
     mech = load_mechanism(scene)

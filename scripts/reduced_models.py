@@ -44,7 +44,7 @@ def _median_time(fn, repeats: int) -> float:
 def _models(scene, robot: str) -> list[tuple[str, object]]:
     """(label, loader) pairs: each loader builds one Mechanism of the scene's robot."""
     from pinmech import Mechanism, load_mechanism
-    from pinmech.robots import robot_root_joint
+    from pinmech.model.robots import robot_root_joint
 
     urdf, root = scene.urdf, robot_root_joint(robot)
     models = [("full", lambda: Mechanism.from_urdf(urdf, root_joint=root))]
@@ -58,7 +58,7 @@ def measure(scene_name: str, robot: str) -> list[dict]:
     """One row per model of the scene's robot: size, load time [ms], solve time [us], method,
     and the largest rate the minimum-norm answer gives a joint the scene holds still."""
     import pinmech
-    from pinmech.analysis_task import scene_pose, scene_tasks
+    from pinmech.io.analysis_task import scene_pose, scene_tasks
 
     scene = pinmech.Scene.load(SCENES / scene_name)
     moved = set(pinmech.load_mechanism(scene).joints)

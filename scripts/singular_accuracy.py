@@ -23,7 +23,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import closed_form
 
 from pinmech import LoopSolver, Mechanism, evaluate_motion
-from pinmech.solve_rates import RateSolver, Task
+from pinmech.solve.rates import RateSolver, Task
 
 L = np.longdouble
 PI = L("3.14159265358979323846264338327950288")

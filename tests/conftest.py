@@ -33,7 +33,7 @@ def r_rtr_scene() -> Path:
 @pytest.fixture
 def figures(monkeypatch):
     """The figures pinmech saves, kept open to be read (closed after the test)."""
-    import pinmech.plot
+    import pinmech.draw.plot
 
     kept = []
 
@@ -41,7 +41,7 @@ def figures(monkeypatch):
         kept.append(fig)
         return path
 
-    monkeypatch.setattr(pinmech.plot, "_save", keep)
+    monkeypatch.setattr(pinmech.draw.plot, "_save", keep)
     yield kept
     import matplotlib.pyplot as plt
 

@@ -17,8 +17,8 @@ import pytest
 
 import closed_form
 from pinmech import LoopSolver, Mechanism, Scene, analyse, evaluate_motion
-from pinmech.solve_rates import RateSolver, Task
-from pinmech.sweep import Sweep
+from pinmech.solve.rates import RateSolver, Task
+from pinmech.io.sweep import Sweep
 
 ANGLES = [np.pi, -np.pi, np.nextafter(np.pi, 0), -np.nextafter(np.pi, 0), np.pi - 1e-12, 1e6, -1e6,
           2 * np.pi * 1e5 + 0.5, 1e15 + 0.25, 7 * np.pi]

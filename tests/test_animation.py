@@ -50,8 +50,8 @@ def _dot_near(pixels: np.ndarray, at: np.ndarray) -> float:
 def test_gif_has_a_frame_a_pose_and_p_follows_the_closed_form(tmp_path):
     """13 poses of the drawn four-bar from the scene's 60 deg, one every 30 deg: 13 frames;
     in frames 0, 4 and 9 the dot of P sits where the closed-form coupler point is."""
-    from pinmech.animation import driver_frames
-    from pinmech.animation_export import FrameRenderer
+    from pinmech.draw.animation import driver_frames
+    from pinmech.draw.animation_export import FrameRenderer
 
     gif = tmp_path / "fb.gif"
     assert main(["animate", str(SCENES / "four_bar_drawn.toml"), "--steps", "13", "--gif", str(gif)]) == 0
@@ -73,8 +73,8 @@ def test_gif_has_a_frame_a_pose_and_p_follows_the_closed_form(tmp_path):
 def test_a_task_scene_animates_its_path(tmp_path):
     """The planar arm's task: D moves at 1 m/s along x from its place at the scene's pose,
     D(t) = D0 + (t, 0); 9 frames over the scene's 0.08 s, one every 10 ms."""
-    from pinmech.animation import task_frames
-    from pinmech.animation_export import FrameRenderer
+    from pinmech.draw.animation import task_frames
+    from pinmech.draw.animation_export import FrameRenderer
 
     gif, page = tmp_path / "arm.gif", tmp_path / "arm.html"
     assert main(["animate", str(SCENES / "planar_arm.toml"), "--steps", "9", "--gif", str(gif), "-o", str(page)]) == 0
@@ -92,11 +92,11 @@ def test_a_task_scene_animates_its_path(tmp_path):
 
 
 def test_mp4_without_ffmpeg_is_a_named_error_before_anything_is_solved(tmp_path, monkeypatch, capsys):
-    import pinmech.animation_export
-    import pinmech.sweep
+    import pinmech.draw.animation_export
+    import pinmech.io.sweep
 
-    monkeypatch.setattr(pinmech.animation_export.shutil, "which", lambda name: None)
-    monkeypatch.setattr(pinmech.sweep.Sweep, "poses", lambda *a, **k: pytest.fail("solved before refusing"))
+    monkeypatch.setattr(pinmech.draw.animation_export.shutil, "which", lambda name: None)
+    monkeypatch.setattr(pinmech.io.sweep.Sweep, "poses", lambda *a, **k: pytest.fail("solved before refusing"))
     assert main(["animate", str(SCENES / "four_bar.toml"), "--mp4", str(tmp_path / "a.mp4")]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "ffmpeg" in err and "--mp4" in err and "Traceback" not in err
@@ -104,7 +104,7 @@ def test_mp4_without_ffmpeg_is_a_named_error_before_anything_is_solved(tmp_path,
 
 
 def test_missing_tool_is_a_pinmech_error():
-    from pinmech.animation_export import check_mp4
+    from pinmech.draw.animation_export import check_mp4
     from pinmech.exceptions import MissingTool, PinmechError
 
     assert issubclass(MissingTool, PinmechError) and MissingTool.exit_code == 2

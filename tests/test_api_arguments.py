@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 
 import pinmech
 from pinmech import LoopSolver, Mechanism
-from pinmech.solve_cycle import solve_range
-from pinmech.sweep import DriverValues
+from pinmech.solve.cycle import solve_range
+from pinmech.io.sweep import DriverValues
 from tests.conftest import MODELS
 
 HOSTILE = [float("nan"), float("inf"), -float("inf"), 1e308, -1e308, 5e-324, 10**400, 1j, True, None, "x", "30 deg",

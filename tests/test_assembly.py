@@ -26,7 +26,7 @@ from hypothesis import strategies as st
 import pinmech
 from pinmech import AssemblyError, DriverLimitError, LoopSolver, Mechanism, SingularPoseError
 from pinmech.cli import main
-from pinmech.solve_cycle import solve_range
+from pinmech.solve.cycle import solve_range
 from tests._mechanisms import four_bar_urdf, spatial_rsur_urdf, stephenson_six_bar_urdf, write
 
 SIX = {"a": 0.04, "b": 0.12, "c": 0.08, "d": 0.10, "cx": 0.06, "cy": 0.04, "b2": 0.10, "c2": 0.09, "o6": (0.16, 0.10)}
@@ -291,9 +291,9 @@ def test_a_parallelogram_swept_onto_its_change_points_keeps_its_branch_after_eac
     parallelogram (rocker parallel to the crank) after a note. A failed singular pose used
     to become the sweep's reference, and the next pose, followed from a point where both
     branches meet, came out on the antiparallelogram in silence (from -600 deg on)."""
-    import pinmech.core
+    import pinmech.solve.core
 
-    monkeypatch.setattr(pinmech.core, "ENABLED", core)
+    monkeypatch.setattr(pinmech.solve.core, "ENABLED", core)
     mech, solver = _parallelogram(tmp_path, 0.04, 0.10)
     values = np.radians(60 - 60.0 * np.arange(1, 14))
     qs, errors, notes = _sweep(solver, values)

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import pinmech
-from pinmech.sweep import Sweep
+from pinmech.io.sweep import Sweep
 
 SCENES = ["r_rtr.toml", "four_bar.toml", "slider_crank.toml", "four_bar_dynamic.toml", "slider_crank_dynamic.toml"]
 

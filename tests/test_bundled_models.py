@@ -8,7 +8,7 @@ import pytest
 
 import closed_form
 from pinmech import Scene, analyse
-from pinmech.sweep import Sweep
+from pinmech.io.sweep import Sweep
 
 
 def _close(ours, theirs):

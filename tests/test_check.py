@@ -13,9 +13,9 @@ from __future__ import annotations
 import pytest
 
 from pinmech import SceneError, analyse, compare, load_hand_file, to_dict
-from pinmech.check import HandValue, format_verdicts
+from pinmech.io.check import HandValue, format_verdicts
 from pinmech.exceptions import UnitError
-from pinmech.scene import Scene
+from pinmech.io.scene import Scene
 
 
 @pytest.fixture(scope="module")

@@ -12,7 +12,7 @@ import pinocchio as pin
 import pytest
 
 from pinmech import Mechanism
-from pinmech.closures import CutEvaluator
+from pinmech.model.closures import CutEvaluator
 from tests._mechanisms import (
     four_bar_urdf,
     slider_crank_prismatic_cut_urdf,
@@ -51,7 +51,7 @@ def test_spatial_spherical_cut_keeps_three_rows(tmp_path):
     [("revolute", 5), ("prismatic", 5), ("spherical", 3), ("fixed", 6)],
 )
 def test_selection_rows_per_cut_type(cut_type, expected_rows):
-    from pinmech.closures import selection_matrix
+    from pinmech.model.closures import selection_matrix
 
     S = selection_matrix(cut_type, np.array([0.0, 0.0, 1.0]))
     assert S.shape == (expected_rows, 6)

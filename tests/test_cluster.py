@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pinmech.study_run import study
-from pinmech.study_file import load_study
+from pinmech.design.study import study
+from pinmech.design.study_file import load_study
 
 distributed = pytest.importorskip("distributed")
 ROOT = Path(__file__).resolve().parents[1]
@@ -91,8 +91,8 @@ def test_local_cluster_and_a_dask_command_line_cluster_give_the_serial_variants(
 
 def test_the_variants_do_not_depend_on_the_order_batches_run_in():
     """Batch 3 alone, in a fresh process state, equals batch 3 of the whole run."""
-    from pinmech.cluster import _BUILT, solve_batch
-    from pinmech.tolerance import batches
+    from pinmech.design.cluster import _BUILT, solve_batch
+    from pinmech.design.tolerance import batches
 
     spec = _small_spec()
     whole = study(spec).batches[3]

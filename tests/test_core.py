@@ -23,11 +23,11 @@ import pinocchio as pin
 import pytest
 
 import pinmech
-import pinmech.core as core
-from pinmech.continuation import CORRECTOR_ITERATIONS, MAX_STEP, MAX_TURN, PIVOT_BELOW, SINGULAR_NODE, TRUST
-from pinmech.solve_loops import DEFAULT_TOL, POLISH, _condition
-from pinmech.solve_loops import MAX_STEP as MAX_NEWTON_STEP
-from pinmech.sweep import Sweep
+import pinmech.solve.core as core
+from pinmech.solve.continuation import CORRECTOR_ITERATIONS, MAX_STEP, MAX_TURN, PIVOT_BELOW, SINGULAR_NODE, TRUST
+from pinmech.solve.loops import DEFAULT_TOL, POLISH, _condition
+from pinmech.solve.loops import MAX_STEP as MAX_NEWTON_STEP
+from pinmech.io.sweep import Sweep
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
 import benchmark_loops as chain  # noqa: E402
@@ -320,7 +320,7 @@ from hypothesis import HealthCheck, assume, example, given, settings  # noqa: E4
 from hypothesis import strategies as st  # noqa: E402
 
 from pinmech import LoopSolver, SingularPoseError  # noqa: E402
-from pinmech.solve_cycle import solve_range  # noqa: E402
+from pinmech.solve.cycle import solve_range  # noqa: E402
 from tests.test_assembly import _four_bar, _four_bar_guess, _rocker_tip  # noqa: E402
 from tests.test_assembly import _sweep as _sweep_solver  # noqa: E402
 from tests._mechanisms import write  # noqa: E402
@@ -643,7 +643,7 @@ def _two_chains(kind: str):
     """A joint of `kind` and a hinge carrying the cut frame P, and a hinge from the ground
     carrying the cut frame C (with "mimic": the follower of P's leader on C's side too).
     Returns the model and a spherical Closure between P and C."""
-    from pinmech.closures import Closure
+    from pinmech.model.closures import Closure
 
     model = pin.Model()
     k = _kind(model, kind)

@@ -1,4 +1,4 @@
-"""Forces on every kind of loop cut (pinmech/forces.py): a prismatic cut's wrench is a
+"""Forces on every kind of loop cut (pinmech/solve/forces.py): a prismatic cut's wrench is a
 force across the slide and a moment, acting on both bodies at one material point; a
 revolute, spherical or fixed cut's likewise, in 3-D as in the plane.
 
@@ -23,8 +23,8 @@ import pinocchio as pin
 import pytest
 
 import pinmech
-from pinmech.forces import ForceSolver, Load
-from pinmech.mjcf import load_mjcf
+from pinmech.solve.forces import ForceSolver, Load
+from pinmech.model.mjcf import load_mjcf
 from tests._mechanisms import spatial_rsur_revolute_cut_urdf, spatial_rsur_urdf
 
 MODELS = Path(__file__).resolve().parents[1] / "models"

@@ -26,7 +26,7 @@ import pytest
 
 from pinmech import Scene
 from pinmech.cli import main
-from pinmech.sweep import Sweep
+from pinmech.io.sweep import Sweep
 from tests._mechanisms import slider_crank_prismatic_cut_urdf
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
@@ -250,7 +250,7 @@ def test_the_sweep_json_lines_hold_every_cut_type(name, tmp_path):
 def test_the_sweep_figure_draws_every_cut_type(name, tmp_path):
     """The figure's series (what is drawn) against the closed form, then the file itself."""
     pytest.importorskip("matplotlib")
-    from pinmech.plot import SweepPlot
+    from pinmech.draw.plot import SweepPlot
 
     case = CASES[name]
     sweep = Sweep.from_scene(Scene.load(case.scene(tmp_path)))
@@ -303,7 +303,7 @@ def test_a_slide_cut_is_sketched_as_a_tree_slide_is(name, tmp_path):
     sits on the guide's line and both run along the slide (the closed form's direction)."""
     import pinocchio as pin
 
-    from pinmech.link_nodes import sketch_links
+    from pinmech.model.link_nodes import sketch_links
 
     scene = Scene.load(CASES[name].scene(tmp_path))
     sweep = Sweep.from_scene(scene)

@@ -15,11 +15,11 @@ from closed_form import four_bar
 
 import pinmech
 from pinmech.cli import main
-from pinmech.design_sweep import design_of
+from pinmech.solve.diagnostics_sweep import design_of
 from pinmech.exceptions import DiagnosticError
-from pinmech.grashof import loop_classes
-from pinmech.instant_centres import instant_centres
-from pinmech.planar_linkage import planar_linkage
+from pinmech.solve.grashof import loop_classes
+from pinmech.solve.instant_centres import instant_centres
+from pinmech.model.planar_linkage import planar_linkage
 
 from .conftest import MODELS, SCENES
 
@@ -60,7 +60,7 @@ def _solve(scene, angle_deg: float):
 
 def analysis_design(analysis):
     """The design section `pinmech solve` reports (with the mechanical advantage)."""
-    from pinmech.report import scene_design
+    from pinmech.io.report import scene_design
 
     return scene_design(analysis)
 
@@ -169,7 +169,7 @@ def test_crank_shaper_time_ratio_is_two():
     crank = sorted(x.driver % (2 * math.pi) for x in found)
     expected = sorted(((-90 + s * math.degrees(math.acos(r / d))) % 360) * DEG for s in (-1, 1))
     np.testing.assert_allclose(crank, expected, rtol=0, atol=DRIVER_TOL)
-    from pinmech.limit_positions import travel
+    from pinmech.solve.limit_positions import travel
 
     t = travel(found, 2 * math.pi)
     np.testing.assert_allclose(t.travel, 2 * math.asin(r / d), rtol=0, atol=1e-10)
@@ -191,7 +191,7 @@ def test_rocker_extremes_swing_and_time_ratio_of_the_crank_rocker():
     sweep, design = _sweep_design(SCENES / "four_bar.toml")
     (found,) = design.limits()
     np.testing.assert_allclose(sorted(x.driver % (2 * math.pi) for x in found), sorted(crank), rtol=0, atol=DRIVER_TOL)
-    from pinmech.limit_positions import travel
+    from pinmech.solve.limit_positions import travel
 
     t = travel(found, 2 * math.pi)
     np.testing.assert_allclose(t.travel, abs(angles[1] - angles[0]), rtol=0, atol=1e-10)
@@ -285,7 +285,7 @@ def test_cli_solve_json_and_sweep_columns_carry_the_diagnostics(tmp_path, capsys
 def test_fixed_centrode_of_the_coupler_is_the_meeting_point_of_crank_and_rocker_lines():
     """The fixed centrode of the coupler traces I13 (lines O2A and O4B meet), the moving
     centrode is that point in the coupler's frame: mapped back, it is the same point."""
-    from pinmech.instant_centres import centrodes
+    from pinmech.solve.instant_centres import centrodes
 
     sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(SCENES / "four_bar.toml"))
     thetas = np.radians([60.0, 100.0, 200.0])
@@ -323,7 +323,7 @@ def test_rocker_extremes_are_named_by_the_rocker_not_by_the_sweeps_direction(tmp
     labels = {x.toggle: x.label for x in found}
     assert labels == {"folded": "max", "extended": "min"}
     np.testing.assert_allclose(sorted(x.value for x in found), sorted(theta4.values()), rtol=0, atol=1e-10)
-    from pinmech.limit_positions import travel
+    from pinmech.solve.limit_positions import travel
 
     np.testing.assert_allclose(travel(found, None).travel, theta4["folded"] - theta4["extended"], rtol=0, atol=1e-10)
 

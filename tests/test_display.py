@@ -1,4 +1,4 @@
-"""Names and colours every figure shares (pinmech/display.py), the paths figure's labels and
+"""Names and colours every figure shares (pinmech/model/display.py), the paths figure's labels and
 arrows of motion, and a sweep figure past folds: spikes clipped, assemblies styled apart,
 the folds marked where the closed form puts the limit positions."""
 
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from pinmech.cli import main
-from pinmech.display import display_name
+from pinmech.model.display import display_name
 from tests.conftest import MODELS, SCENES
 
 pytest.importorskip("matplotlib", reason='plots need pip install "pinmech[plot]"')
@@ -64,10 +64,10 @@ def test_the_four_bar_has_one_colour_a_link_in_the_curves_the_paths_and_its_urdf
 
 def test_the_sketched_links_take_the_figures_colours(figures, tmp_path):
     """A model without <visual>: the 3-D sketch colours each link as the figures do."""
-    from pinmech.display import joint_colours
+    from pinmech.model.display import joint_colours
     from pinmech.draw.sketch import sketch_visuals
-    from pinmech.scene import Scene
-    from pinmech.scene_model import load_mechanism
+    from pinmech.io.scene import Scene
+    from pinmech.io.scene_model import load_mechanism
 
     mechanism = load_mechanism(Scene.load(SCENES / "four_bar.toml"))
     urdf = _urdf_colours(MODELS / "four_bar.urdf")
@@ -138,9 +138,9 @@ def test_the_snapshot_names_every_joint_and_point_where_the_four_bar_puts_them()
     g = 100 mm): O2 at the origin, O4 at (g, 0), A = a (cos 60°, sin 60°), and B where
     |AB| = b and |O4 B| = c (the loop's own equations). Each place named once, by the
     textbook's letter (A, not A_pin). Tolerance 1e-12 m: loops closed to 1e-13 of 0.1 m."""
-    from pinmech.analysis import analyse
-    from pinmech.display import labelled_places
-    from pinmech.scene import Scene
+    from pinmech.io.analysis import analyse
+    from pinmech.model.display import labelled_places
+    from pinmech.io.scene import Scene
 
     analysis = analyse(Scene.load(SCENES / "four_bar.toml"))
     places = labelled_places(analysis.mechanism, analysis.solution.q)

@@ -13,7 +13,7 @@ import pytest
 
 from pinmech import LoopClosureError, LoopSolver, Mechanism, Scene, SingularPoseError, SweepError
 from pinmech.cli import main
-from pinmech.sweep import Sweep
+from pinmech.io.sweep import Sweep
 from tests._mechanisms import four_bar_urdf, write
 
 #: A number followed by neither a unit nor more digits: a value in bare radians.

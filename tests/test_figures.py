@@ -120,8 +120,8 @@ def test_a_fixed_points_path_is_a_dot(figures, tmp_path):
 def test_a_turn_that_does_not_come_back_is_drawn_as_swept(figures, tmp_path):
     """Were the mechanism elsewhere after its turn, folding 360..390 onto 0..30 would draw a
     jump at 30 deg: then the axis runs as swept, 30..390 (the last pose is moved to mimic it)."""
-    from pinmech.plot import SweepPlot
-    from pinmech.sweep import Sweep
+    from pinmech.draw.plot import SweepPlot
+    from pinmech.io.sweep import Sweep
 
     sweep = Sweep.from_scene(Scene.load(SCENES / "r_rtr.toml"))
     recorder = SweepPlot(sweep)
@@ -152,7 +152,7 @@ def test_a_decimated_sweep_figure_keeps_its_last_pose(scenes_dir):
     import math
 
     import pinmech
-    from pinmech.plot import MAX_POINTS, SweepPlot
+    from pinmech.draw.plot import MAX_POINTS, SweepPlot
 
     sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(scenes_dir / "r_rtr.toml"))
     total = MAX_POINTS + 2

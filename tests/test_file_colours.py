@@ -1,6 +1,6 @@
 """One colour per link across every output: the colour a URDF paints a link's visuals
 with (its `<material>`, inline or named at the top level) is the link's colour in the
-curves (pinmech.display.colour_of), the polygons and the 3-D page's visuals; a URDF
+curves (pinmech.model.display.colour_of), the polygons and the 3-D page's visuals; a URDF
 without materials gets the palette everywhere. Expected colours are the ones written into
 the test's own files, compared exactly (they pass through float32 in Pinocchio's visuals:
 atol 1e-7)."""
@@ -12,7 +12,7 @@ import re
 import numpy as np
 
 import pinmech
-from pinmech.display import PALETTE, colour_of, hex_colour
+from pinmech.model.display import PALETTE, colour_of, hex_colour
 from pinmech.draw.pages import mechanism_visuals
 
 from .conftest import MODELS, SCENES

@@ -1,11 +1,11 @@
-"""Energy fluctuation and flywheel sizing (pinmech/flywheel.py) against closed forms."""
+"""Energy fluctuation and flywheel sizing (pinmech/solve/flywheel.py) against closed forms."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from pinmech.flywheel import energy_fluctuation
+from pinmech.solve.flywheel import energy_fluctuation
 
 
 def test_a_sine_torque_curve_stores_twice_its_amplitude():

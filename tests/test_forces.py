@@ -1,4 +1,4 @@
-"""Forces on closed loops (pinmech/forces.py) against checks that cannot agree by accident.
+"""Forces on closed loops (pinmech/solve/forces.py) against checks that cannot agree by accident.
 
 - Newton-Euler by hand (scripts/closed_form_forces.py): each link's F = m a_G and
   M_G = I alpha with the kinematics of the vector-loop closed forms, no Pinocchio.
@@ -21,7 +21,7 @@ import pytest
 
 import pinmech
 from pinmech.exceptions import IndeterminateForcesError, ModelError
-from pinmech.forces import ForceSolver, Load
+from pinmech.solve.forces import ForceSolver, Load
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 G = 9.81

@@ -14,8 +14,8 @@ import pinocchio as pin
 import pytest
 
 from pinmech.cli import main
-from pinmech.mjcf import load_mjcf
-from pinmech.solve_loops import LoopSolver
+from pinmech.model.mjcf import load_mjcf
+from pinmech.solve.loops import LoopSolver
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -93,7 +93,7 @@ def _two_link_arm() -> pin.Model:
 
 
 def test_a_model_built_in_code_with_shared_names_locks_and_reports_its_points():
-    from pinmech.mechanism import Mechanism
+    from pinmech.model.mechanism import Mechanism
 
     mech = Mechanism.from_model(_two_link_arm(), locked={"tip": 0.3})
     q = np.array([0.5])

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 import pinmech
-import pinmech.core as core
+import pinmech.solve.core as core
 from pinmech.exceptions import FrameNotFound, ModelError
-from pinmech.sweep_frames import frame_paths
+from pinmech.solve.sweep_frames import frame_paths
 
 
 @pytest.fixture(params=[True, False], ids=["core", "python"])

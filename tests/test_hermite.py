@@ -8,7 +8,7 @@ import pinocchio as pin
 import pytest
 
 from pinmech import Mechanism
-from pinmech.hermite import interpolate_poses
+from pinmech.solve.hermite import interpolate_poses
 
 
 def _poses(model, coeffs, x):

@@ -18,10 +18,10 @@ import pytest
 
 from pinmech.cli import main
 from pinmech.exceptions import ModelError
-from pinmech.forces import ForceSolver
-from pinmech.inertia_check import inertia_problem
-from pinmech.mechanism import Mechanism
-from pinmech.solve_loops import LoopSolver
+from pinmech.solve.forces import ForceSolver
+from pinmech.model.inertia_check import inertia_problem
+from pinmech.model.mechanism import Mechanism
+from pinmech.solve.loops import LoopSolver
 from tests.conftest import MODELS, SCENES
 
 ROD = 'ixx="1e-5" iyy="2e-4" izz="2e-4"'  # the crank's line of models/slider_crank_dynamic.urdf
@@ -100,7 +100,7 @@ def test_an_mjcf_inertia_mujoco_refuses_is_refused(tmp_path, inertial, words):
         mujoco.MjModel.from_xml_string(text)
     path = tmp_path / "bar.xml"
     path.write_text(text)
-    from pinmech.mjcf import load_mjcf
+    from pinmech.model.mjcf import load_mjcf
 
     with pytest.raises(ModelError, match=words) as error:
         load_mjcf(path)

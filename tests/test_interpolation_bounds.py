@@ -21,8 +21,8 @@ import pinocchio as pin
 import pytest
 
 from pinmech import LoopSolver, Mechanism, Scene
-from pinmech.solve_cycle import solve_range
-from pinmech.sweep import Sweep
+from pinmech.solve.cycle import solve_range
+from pinmech.io.sweep import Sweep
 from tests._mechanisms import four_bar_urdf, write
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED

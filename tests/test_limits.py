@@ -119,7 +119,7 @@ def test_mjcf_ranges_are_mujocos_limits_and_are_checked(tmp_path, capsys):
     """`range` in the compiler's default unit (degrees) for a hinge, metres for a slide, read as
     MuJoCo reads them (its jnt_range, in radians); driving the shoulder to 90 deg is beyond 60 deg."""
     mujoco = pytest.importorskip("mujoco")
-    from pinmech.mjcf import load_mjcf
+    from pinmech.model.mjcf import load_mjcf
 
     (tmp_path / "arm.xml").write_text(ARM_MJCF)
     m = mujoco.MjModel.from_xml_string(ARM_MJCF)
@@ -144,8 +144,8 @@ def test_a_limited_ball_joint_is_checked_where_mujoco_finds_it_beyond(tmp_path):
     mujoco = pytest.importorskip("mujoco")
     import numpy as np
 
-    from pinmech.limits import limits_at
-    from pinmech.mjcf import load_mjcf
+    from pinmech.solve.limits import limits_at
+    from pinmech.model.mjcf import load_mjcf
 
     text = ('<mujoco><worldbody><body name="rod"><joint name="ball" type="ball" range="0 30"/><geom size="0.01"/>'
             '</body></worldbody></mujoco>')

@@ -27,9 +27,10 @@ from hypothesis import strategies as st
 from pinmech import LoopSolver, Mechanism, Scene, analyse
 from pinmech.cli import main
 from pinmech.exceptions import ModelError
-from pinmech.linkage import load_linkage, parse_linkage
-from pinmech.linkage_urdf import linkage_urdf
-from pinmech.motion import evaluate_motion
+from pinmech.model.linkage import parse_linkage
+from pinmech.model.linkage_model import load_linkage
+from pinmech.model.linkage_urdf import linkage_urdf
+from pinmech.solve.motion import evaluate_motion
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
 import closed_form as cf
@@ -658,7 +659,7 @@ def test_a_name_that_pinmech_generates_is_refused_naming_both(text, name, tmp_pa
 def test_an_error_in_the_generated_urdf_is_not_blamed_on_the_linkage_file(tmp_path, monkeypatch):
     """Should Pinocchio refuse the URDF pinmech generates (a pinmech defect), the error says
     it is the generated URDF, and where it lies, not that the user's file is a bad URDF."""
-    from pinmech import mechanism
+    from pinmech.model import mechanism
 
     def refuse(path, **kwargs):
         raise ModelError(f"The file {path} does not contain a valid URDF model.", path=str(path))

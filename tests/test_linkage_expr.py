@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from pinmech.exceptions import ModelError
-from pinmech.linkage import parse_linkage
+from pinmech.model.linkage import parse_linkage
 
 A_MM, B_MM = 30.0, 12.0
 

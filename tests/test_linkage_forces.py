@@ -1,4 +1,4 @@
-"""Forces on linkages drawn in TOML (pinmech/linkage_urdf.py): the drawing gives no masses,
+"""Forces on linkages drawn in TOML (pinmech/model/linkage_urdf.py): the drawing gives no masses,
 so forces name the links that need one; declared massless, statics is virtual work."""
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pinmech.exceptions import ModelError
-from pinmech.linkage import load_linkage
+from pinmech.model.linkage_model import load_linkage
 
 VALID = {
     "ground": '["O2", "O4"]',

@@ -20,7 +20,8 @@ import pytest
 from pinmech import ForceSolver, Scene, analyse
 from pinmech.cli import main
 from pinmech.exceptions import ModelError
-from pinmech.linkage import load_linkage, parse_linkage
+from pinmech.model.linkage import parse_linkage
+from pinmech.model.linkage_model import load_linkage
 
 ROOT = Path(__file__).resolve().parents[1]
 LINKAGES = ROOT / "models" / "linkages"

@@ -20,8 +20,9 @@ import closed_form as cf
 from pinmech import LoopSolver
 from pinmech.cli import main
 from pinmech.exceptions import ModelError
-from pinmech.linkage import load_linkage, parse_linkage
-from pinmech.linkage_urdf import linkage_urdf
+from pinmech.model.linkage import parse_linkage
+from pinmech.model.linkage_model import load_linkage
+from pinmech.model.linkage_urdf import linkage_urdf
 
 FOUR_BAR = """ground = ["O2", "O4"]
 [joints]

@@ -21,8 +21,8 @@ import pytest
 
 import closed_form
 import pinmech
-import pinmech.core as core
-from pinmech import solve_cycle
+import pinmech.solve.core as core
+from pinmech.solve import cycle as solve_cycle
 
 chain = importlib.import_module("benchmark_loops")
 

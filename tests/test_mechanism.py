@@ -206,9 +206,9 @@ def test_a_chain_of_2000_links_is_refused_in_one_line_before_allocating(tmp_path
 
 
 def test_locking_brings_a_long_chain_within_the_limit(tmp_path, monkeypatch):
-    import pinmech.mechanism
+    import pinmech.model.mechanism
 
-    monkeypatch.setattr(pinmech.mechanism, "MAX_DOF", 20)
+    monkeypatch.setattr(pinmech.model.mechanism, "MAX_DOF", 20)
     urdf = _chain(tmp_path, 25)
     with pytest.raises(ModelError, match="keeps 25 degrees of freedom"):
         Mechanism.from_urdf(urdf)
@@ -268,7 +268,7 @@ def test_a_cut_axis_at_any_scale_is_its_unit_vector(tmp_path, written):
 def test_a_drawn_linkage_axis_at_any_scale_is_its_unit_vector(tmp_path, axis, models_dir):
     """The same for a linkage file's [axes]: R1's axis, written at 1e200 or 1e-200 of the
     bundled RSUR's [0, 0, 1], gives the same mechanism (the z axis, exactly)."""
-    from pinmech.linkage import parse_linkage
+    from pinmech.model.linkage import parse_linkage
 
     text = (models_dir / "linkages" / "rsur.toml").read_text().replace("R1 = [0.0, 0.0, 1.0]", f"R1 = {axis}")
     path = tmp_path / "rsur.toml"

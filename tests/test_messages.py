@@ -190,7 +190,7 @@ def test_the_loop_solver_refuses_driver_values_guesses_and_q_that_are_not_real()
 def test_a_sweep_refuses_boolean_and_complex_driver_values():
     from pinmech import Scene
     from pinmech.exceptions import ModelError
-    from pinmech.sweep import Sweep
+    from pinmech.io.sweep import Sweep
 
     sweep = Sweep.from_scene(Scene.load(SCENES / "four_bar.toml"))
     for values in ([0.1, True], [0.1, 0.2 + 0j], np.array([0.1, 0.2], dtype=complex)):

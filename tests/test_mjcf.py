@@ -22,8 +22,8 @@ import pytest
 
 from pinmech.cli import main
 from pinmech.exceptions import ModelError
-from pinmech.mjcf import load_mjcf
-from pinmech.solve_loops import LoopSolver
+from pinmech.model.mjcf import load_mjcf
+from pinmech.solve.loops import LoopSolver
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -374,7 +374,7 @@ def test_defaults_euler_sequences_and_fromto_sites_as_mujoco_compiles_them(tmp_p
 
 def test_a_joint_type_from_a_default_class_is_read(tmp_path):
     """The scene reads driver kinds from the file: a slide set by a class is prismatic."""
-    from pinmech.mjcf import mjcf_joint_types
+    from pinmech.model.mjcf import mjcf_joint_types
 
     path = _chain(tmp_path, **CHAIN_CASES["joint type slide from a childclass"])
     assert mjcf_joint_types(path) == {"ja": "prismatic", "jb": "prismatic"}
@@ -428,7 +428,7 @@ def test_forces_refuse_what_pinocchio_does_not_model_as_mujoco(tmp_path, capsys,
     """A mesh's inertia (Pinocchio's parser: 1 kg m^2, 24 times MuJoCo's torque here), a
     compiler mass option, passive joint forces: forces refuse, in one line naming the file
     and the element; kinematics still run."""
-    from pinmech.forces import ForceSolver
+    from pinmech.solve.forces import ForceSolver
 
     path = _pendulum(tmp_path, **change)
     mech = load_mjcf(path)
@@ -451,7 +451,7 @@ def test_armature_is_in_the_torque_and_the_power_balance(tmp_path):
     driver torque is MuJoCo's inverse dynamics (rigid body 0.4508 + armature 2 N m), and
     the power balance holds (it left the armature out: residual 0.82). 1e-12: the same
     arithmetic."""
-    from pinmech.forces import ForceSolver
+    from pinmech.solve.forces import ForceSolver
 
     path = _pendulum(tmp_path, joint='armature="0.2"')
     mech = load_mjcf(path)
@@ -471,7 +471,7 @@ def test_forces_that_fail_their_power_balance_are_an_error(tmp_path, monkeypatch
     the armature again, patched back out of it) is a BalanceError naming the pose, exit
     13 in one line, never a printed answer."""
     from pinmech.exceptions import BalanceError
-    from pinmech.forces import ForceSolver
+    from pinmech.solve.forces import ForceSolver
 
     original = ForceSolver._power_terms
 

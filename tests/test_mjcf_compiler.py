@@ -18,7 +18,7 @@ import pinocchio as pin
 import pytest
 
 from pinmech.exceptions import ModelError
-from pinmech.mjcf import load_mjcf
+from pinmech.model.mjcf import load_mjcf
 
 mujoco = pytest.importorskip("mujoco")
 MJCF_DIR = Path(__file__).resolve().parents[1] / "models" / "mjcf"
@@ -148,7 +148,7 @@ def test_a_connect_on_jointless_bodies_closes_where_mujoco_closes_it(tmp_path):
     """The four-bar's loop named on jointless end bodies of the coupler and the rocker: at
     pinmech's poses MuJoCo's own connect residual is zero (1e-13 m: the loop solver's
     tolerance on a 0.1 m loop), and the pose has moved from qpos0."""
-    from pinmech.solve_loops import LoopSolver
+    from pinmech.solve.loops import LoopSolver
 
     text = (MJCF_DIR / "four_bar.xml").read_text()
     text = text.replace('<site name="P" pos="0.06 0.03 0"/>', '<site name="P" pos="0.06 0.03 0"/><body name="end" '
@@ -283,7 +283,7 @@ def test_a_loop_on_a_composite_with_ref_closes_where_mujoco_closes_it(tmp_path):
     the rod: at the poses pinmech solves, MuJoCo's own connect residual is zero (1e-13 m: the
     loop solver's tolerance on a 0.5 m leg). The parser had taken the rod's side of the cut
     from the rod turned by its first `ref` (MuJoCo's residual 1-3 mm)."""
-    from pinmech.solve_loops import LoopSolver
+    from pinmech.solve.loops import LoopSolver
 
     text = (MJCF_DIR / "leg.xml").read_text()
     text = text.replace('name="rod_pitch" type="hinge" axis="0 1 0"', 'name="rod_pitch" type="hinge" axis="0 1 0" ref="0.3"')

@@ -13,7 +13,7 @@ import pytest
 from pinmech import LoopSolver, Mechanism, Scene, analyse
 from pinmech.cli import main
 from pinmech.exceptions import ModelError
-from pinmech.linkage import load_linkage
+from pinmech.model.linkage_model import load_linkage
 
 from ._mechanisms import four_bar_urdf, write
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from pinmech.cli import main
-from pinmech.sweep import DriverValues
+from pinmech.io.sweep import DriverValues
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -9,10 +9,10 @@ import pytest
 
 import pinmech
 from pinmech import Scene, TaskError
-from pinmech.scene_model import load_mechanism
-from pinmech.analysis_task import scene_pose, scene_tasks
+from pinmech.io.scene_model import load_mechanism
+from pinmech.io.analysis_task import scene_pose, scene_tasks
 from pinmech.cli import main
-from pinmech.path import follow_path
+from pinmech.solve.path import follow_path
 
 
 @pytest.fixture(scope="module")
@@ -93,7 +93,7 @@ def test_cd_stays_vertical_with_every_scheme(arm_task):
 
 def test_paths_of_closed_loops_and_unknown_schemes_are_errors(arm_task, models_dir):
     from pinmech import Mechanism
-    from pinmech.solve_rates import Task
+    from pinmech.solve.rates import Task
 
     mech, tasks, q0 = arm_task
     with pytest.raises(TaskError, match="scheme must be one of"):
@@ -174,7 +174,7 @@ def test_a_path_whose_step_count_never_ends_is_refused_before_any_work(scenes_di
     import time
 
     from pinmech.counts import MAX_POSES
-    from pinmech.path import check_timing
+    from pinmech.solve.path import check_timing
 
     scene = tmp_path / "arm.toml"
     text = (scenes_dir / "planar_arm.toml").read_text()

@@ -15,8 +15,8 @@ import pinocchio as pin
 import pytest
 
 from pinmech import Scene, analyse, compare, load_hand_file, to_dict
-from pinmech.scene_model import load_mechanism
-from pinmech.analysis_task import scene_pose
+from pinmech.io.scene_model import load_mechanism
+from pinmech.io.analysis_task import scene_pose
 from pinmech.cli import main
 from tests.conftest import SCENES
 

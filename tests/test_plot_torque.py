@@ -1,4 +1,4 @@
-"""The driver torque figure (pinmech/plot_torque.py): what it draws is the textbook's
+"""The driver torque figure (pinmech/draw/plot_torque.py): what it draws is the textbook's
 energy fluctuation, ΔE = max E − min E with E(θ) = ∫ (T̄ − T) dθ, checked against closed
 forms and against an independent trapezoid integration of the hand torque curve."""
 
@@ -12,9 +12,9 @@ import pytest
 
 pytest.importorskip("matplotlib", reason='needs pip install "pinmech[plot]"')
 
-import pinmech.plot_torque as plot_torque  # noqa: E402
+import pinmech.draw.plot_torque as plot_torque  # noqa: E402
 from pinmech.cli import main  # noqa: E402
-from pinmech.plot_torque import torque_curve, torque_figure  # noqa: E402
+from pinmech.draw.plot_torque import torque_curve, torque_figure  # noqa: E402
 
 SCENE = Path(__file__).resolve().parents[1] / "models" / "scenes" / "slider_crank_dynamic.toml"
 OMEGA = 3000 * np.pi / 30  # the scene's 3000 rpm [rad/s]

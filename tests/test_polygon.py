@@ -20,10 +20,10 @@ import pytest
 
 from pinmech import Scene, analyse
 from pinmech.cli import main
-from pinmech.display import display_names
+from pinmech.model.display import display_names
 from pinmech.draw import DrawError
 from pinmech.draw.polygon_svg import PAPER, polygon_svg
-from pinmech.polygon import acceleration_polygon, velocity_polygon
+from pinmech.draw.polygon import acceleration_polygon, velocity_polygon
 from tests.conftest import SCENES
 
 SVG = "{http://www.w3.org/2000/svg}"
@@ -162,9 +162,9 @@ def test_a_polygon_of_fixed_points_only_is_a_named_error(capsys, tmp_path):
 
 def test_bad_recorder_options_are_named_errors():
     from pinmech.exceptions import PinmechError
-    from pinmech.plot import SweepPlot
-    from pinmech.plot_paths import PathRecorder
-    from pinmech.sweep import Sweep
+    from pinmech.draw.plot import SweepPlot
+    from pinmech.draw.plot_paths import PathRecorder
+    from pinmech.io.sweep import Sweep
 
     sweep = Sweep.from_scene(Scene.load(SCENES / "r_rtr.toml"))
     with pytest.raises(PinmechError, match="angles must be one of continuous, wrapped"):
@@ -323,7 +323,7 @@ def test_the_coupler_image_is_the_coupler_turned_and_scaled():
     colour, and similar to the coupler A-B-P with ratio |w3| (Norton's closed form): each
     side drawn [mm] times the scale is |w3| times the side of the link [m]; the acceleration
     image a'-b'-p' with ratio sqrt(w3^4 + alpha3^2). Tolerance 1e-3 mm on paper (READ_MM)."""
-    from pinmech.display import colour_of, hex_colour
+    from pinmech.model.display import colour_of, hex_colour
 
     analysis = analyse(Scene.load(SCENES / "four_bar.toml"))
     ref = cf.four_bar(math.radians(60.0), 4 * math.pi, 0.0, 0.04, 0.12, 0.08, 0.10)

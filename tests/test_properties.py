@@ -23,7 +23,7 @@ from hypothesis import strategies as st
 
 import closed_form
 from pinmech import LoopClosureError, LoopSolver, Mechanism, SingularPoseError, evaluate_motion
-from pinmech.solve_rates import RateSolver, Task
+from pinmech.solve.rates import RateSolver, Task
 from tests._mechanisms import four_bar_urdf, scaled_urdf
 from tests.conftest import MODELS
 

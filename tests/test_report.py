@@ -85,7 +85,7 @@ def test_without_a_guess_the_report_does_not_say_it_closed_from_one(scenes_dir):
     """The five-bar without [guess] was reported "closed from its [guess]" and, two lines on,
     "the scene has no [guess]"."""
     from pinmech import Scene, analyse
-    from pinmech.report import to_text
+    from pinmech.io.report import to_text
 
     text = to_text(analyse(Scene.load(scenes_dir / "five_bar.toml")))
     assert "the scene has no [guess]" in text and "from its [guess]" not in text
@@ -96,7 +96,7 @@ def test_an_open_chain_accuracy_line_speaks_of_no_loop(scenes_dir):
     """An arm (no loop) was given 'closure residual 0 (of each loop's size; the largest loop
     spans ...), 0 Newton iterations'."""
     from pinmech import Scene, analyse
-    from pinmech.report import to_text
+    from pinmech.io.report import to_text
 
     for scene in ("planar_arm.toml", "ur5.toml"):
         text = to_text(analyse(Scene.load(scenes_dir / scene)))

@@ -13,7 +13,7 @@ import math
 import pytest
 
 from pinmech import Scene, analyse
-from pinmech.report_given import given
+from pinmech.io.report_given import given
 from tests.conftest import SCENES
 
 

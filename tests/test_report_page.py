@@ -18,7 +18,7 @@ from pinmech import Scene, analyse, snapshot
 from pinmech.cli import main
 from pinmech.draw import load_visuals
 from pinmech.draw.sketch import sketch_visuals
-from pinmech.link_nodes import sketch_links
+from pinmech.model.link_nodes import sketch_links
 from tests.browser import colour_mask, screenshot, span_share
 from tests.conftest import MODELS, SCENES
 
@@ -158,10 +158,10 @@ def rsur(tmp_path):
 
 def _sweep_m(scene, plane: str, monkeypatch) -> tuple[np.ndarray, object]:
     """M's places from the CSV [mm], and the paths figure pinmech drew, kept open."""
-    import pinmech.plot
+    import pinmech.draw.plot
 
     kept = []
-    monkeypatch.setattr(pinmech.plot, "_save", lambda plt, fig, path: kept.append(fig) or path)
+    monkeypatch.setattr(pinmech.draw.plot, "_save", lambda plt, fig, path: kept.append(fig) or path)
     csv = scene.parent / f"{plane}.csv"
     assert main(["sweep", str(scene), "--from", "0 deg", "--to", "120 deg", "--steps", "25", "--csv", str(csv),
                  "--paths", str(scene.parent / f"{plane}.png"), "--path-plane", plane]) == 0

@@ -24,7 +24,7 @@ from pinmech import (
     analyse,
     load_mechanism,
 )
-from pinmech.analysis_task import scene_pose, scene_tasks
+from pinmech.io.analysis_task import scene_pose, scene_tasks
 from pinmech.cli import main
 from tests.conftest import SCENES
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from pinmech import FrameNotFound, ModelError, Scene, SceneError, UnitError, analyse
-from pinmech.scene_model import load_mechanism, scene_drivers
+from pinmech.io.scene_model import load_mechanism, scene_drivers
 
 
 def _scene(tmp_path, body: str, name: str = "s.toml"):

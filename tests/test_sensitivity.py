@@ -1,6 +1,6 @@
 """Sensitivities by the implicit-function theorem, checked against finite differences.
 
-Two references, neither of which uses the derivative formulas of pinmech/sensitivity.py:
+Two references, neither of which uses the derivative formulas of pinmech/design/sensitivity.py:
 - central differences of the closed-form four-bar (scripts/closed_form.py, the law of
   cosines), no pinmech at all;
 - central differences of re-solved variants: each parameter written into the model at
@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 
 from pinmech.exceptions import FrameNotFound, SceneError
-from pinmech.sensitivity import StudyOutputs, cycle_sensitivity
-from pinmech.study_file import load_study, parse_study
-from pinmech.study_variant import StudyMechanism
-from pinmech.tolerance import deviation
+from pinmech.design.sensitivity import StudyOutputs, cycle_sensitivity
+from pinmech.design.study_file import load_study, parse_study
+from pinmech.design.study_variant import StudyMechanism
+from pinmech.design.tolerance import deviation
 
 STUDIES = Path(__file__).resolve().parents[1] / "models" / "studies"
 SCENES = STUDIES.parent / "scenes"

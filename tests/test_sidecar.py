@@ -21,8 +21,8 @@ import pytest
 from pinmech import Scene, analyse
 from pinmech.cli import main
 from pinmech.exceptions import ModelError
-from pinmech.sidecar import load_extended_urdf
-from pinmech.solve_loops import LoopSolver
+from pinmech.model.sidecar import load_extended_urdf
+from pinmech.solve.loops import LoopSolver
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 FIVE = (MODELS / "five_bar" / "robot.urdf", MODELS / "five_bar" / "robot.yaml")

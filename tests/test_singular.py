@@ -23,8 +23,8 @@ import pytest
 
 import closed_form
 from pinmech import LoopClosureError, LoopSolver, Mechanism, SingularPoseError, evaluate_motion
-from pinmech.results import EPS
-from pinmech.solve_rates import RateSolver, Task
+from pinmech.solve.results import EPS
+from pinmech.solve.rates import RateSolver, Task
 from tests._mechanisms import four_bar_urdf, write
 from tests.conftest import MODELS
 
@@ -326,7 +326,7 @@ def test_a_reference_on_a_crossing_under_a_raised_max_condition_is_a_singular_po
     parallelogram's crossing (condition number about 1e11, above the 1e10 where a path's
     tangent is noise) let continuation's internal signal out, with no message. Now:
     SingularPoseError naming the pose and its condition number, from solve and from a sweep."""
-    from pinmech.solve_cycle import solve_range
+    from pinmech.solve.cycle import solve_range
 
     _, solver, _ = _parallelogram_at(tmp_path, 1e-11, 1e15)
     with pytest.raises(SingularPoseError, match=r"O2 = .*condition number") as info:

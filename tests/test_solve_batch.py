@@ -9,7 +9,7 @@ import pinocchio as pin
 import pytest
 
 from pinmech import LoopSolver
-from pinmech.solve_batch import (
+from pinmech.solve.batch import (
     BatchSolver,
     condition_batch,
     difference_many,

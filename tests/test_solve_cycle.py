@@ -14,9 +14,9 @@ import pinocchio as pin
 import pytest
 
 from pinmech import PinmechError, Scene
-from pinmech.solve_batch import BatchSolver
-from pinmech.solve_cycle import CHUNK
-from pinmech.sweep import Sweep
+from pinmech.solve.batch import BatchSolver
+from pinmech.solve.cycle import CHUNK
+from pinmech.io.sweep import Sweep
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 

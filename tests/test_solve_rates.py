@@ -25,7 +25,7 @@ from pinmech import (
     TaskError,
     core,
 )
-from pinmech.solve_rates import DAMPING_RANGE
+from pinmech.solve.rates import DAMPING_RANGE
 from tests.conftest import MODELS
 
 DEG = np.pi / 180
@@ -295,7 +295,7 @@ def test_solve_many_measures_each_cut_type_as_the_closures_do(build, tmp_path):
     ball_loop, its ball's quaternion in q) and the four-bar's revolute cut: to 1e-12 of
     1 + the residual (the same formulas in C++, rounding apart; tests/test_core.py holds
     the rows to 1e-13 of their size)."""
-    from pinmech.mjcf import load_mjcf
+    from pinmech.model.mjcf import load_mjcf
     from tests import _mechanisms
 
     if build == "fixed":

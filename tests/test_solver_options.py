@@ -24,9 +24,9 @@ from pinmech import (
     RateOverflowError,
     Scene,
 )
-from pinmech.solve_batch import BatchSolver
-from pinmech.solve_cycle import solve_range
-from pinmech.sweep import Sweep
+from pinmech.solve.batch import BatchSolver
+from pinmech.solve.cycle import solve_range
+from pinmech.io.sweep import Sweep
 from tests._mechanisms import four_bar_urdf, write
 
 A, B, C, D = 0.04, 0.12, 0.08, 0.10

@@ -17,7 +17,7 @@ import pytest
 
 import closed_form
 from pinmech import LoopSolver, Mechanism, evaluate_motion
-from pinmech.solve_rates import RateSolver, Task
+from pinmech.solve.rates import RateSolver, Task
 from tests._mechanisms import scaled_urdf, slider_crank_prismatic_cut_urdf, spatial_rsur_revolute_cut_urdf, spatial_rsur_urdf
 from tests.conftest import MODELS
 

@@ -20,13 +20,13 @@ from pinmech import cli
 #: it is used (forces, task scenes, sweeps, drawings, linkage files, MJCF, sidecars, hand
 #: checks, output files, JSON), so the command does not pay for it.
 NOT_FOR_A_SOLVE = (
-    "pinmech.analysis_task", "pinmech.solve_rates",  # task scenes ([[task]])
-    "pinmech.forces", "pinmech.forces_scene", "pinmech.forces_report", "pinmech.forces_sweep",
-    "pinmech.flywheel",  # force analyses
-    "pinmech.sweep", "pinmech.solve_cycle", "pinmech.solve_batch", "pinmech.hermite", "pinmech.cut_arrays",
-    "pinmech.tables", "pinmech.outputs", "pinmech.path",  # sweeps, paths, their output files
-    "pinmech.draw", "pinmech.draw.report_page", "pinmech.polygon", "pinmech.plot", "pinmech.link_nodes",
-    "pinmech.check", "pinmech.linkage", "pinmech.linkage_urdf", "pinmech.mjcf", "pinmech.sidecar",
+    "pinmech.io.analysis_task", "pinmech.solve.rates",  # task scenes ([[task]])
+    "pinmech.solve.forces", "pinmech.io.forces_scene", "pinmech.solve.forces_report", "pinmech.draw.forces_sweep",
+    "pinmech.solve.flywheel",  # force analyses
+    "pinmech.io.sweep", "pinmech.solve.cycle", "pinmech.solve.batch", "pinmech.solve.hermite", "pinmech.solve.cut_arrays",
+    "pinmech.io.tables", "pinmech.outputs", "pinmech.solve.path",  # sweeps, paths, their output files
+    "pinmech.draw", "pinmech.draw.report_page", "pinmech.draw.polygon", "pinmech.draw.plot", "pinmech.model.link_nodes",
+    "pinmech.io.check", "pinmech.model.linkage", "pinmech.model.linkage_urdf", "pinmech.model.mjcf", "pinmech.model.sidecar",
     "json", "pint", "matplotlib", "meshcat",
 )
 
@@ -51,7 +51,7 @@ def test_a_plain_solve_imports_none_of_the_modules_it_does_not_use(r_rtr_scene):
     run = _solve_in_a_fresh_process(str(r_rtr_scene))
     assert run["code"] == 0 and "Accuracy" in run["report"]
     imported = set(run["modules"])
-    assert "pinmech.analysis" in imported and "pinocchio" in imported  # the solve did run
+    assert "pinmech.io.analysis" in imported and "pinocchio" in imported  # the solve did run
     assert sorted(imported & set(NOT_FOR_A_SOLVE)) == []
 
 
@@ -63,7 +63,7 @@ def test_the_json_report_still_imports_json(r_rtr_scene):
 
 def test_importing_pinmech_imports_its_modules_on_first_use():
     code = ("import sys, pinmech; before = {m for m in sys.modules if m.startswith('pinmech.')}; "
-            "pinmech.Sweep; print(sorted(before), 'pinmech.sweep' in sys.modules)")
+            "pinmech.Sweep; print(sorted(before), 'pinmech.io.sweep' in sys.modules)")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.strip() == "['pinmech.exceptions'] True"
 
@@ -74,7 +74,7 @@ def test_every_public_name_resolves_to_its_module():
         module = getattr(value, "__module__", None)
         assert name == "__version__" or (module or "").startswith("pinmech."), name
     assert set(pinmech.__all__) <= set(dir(pinmech))
-    assert pinmech.Sweep is __import__("pinmech.sweep", fromlist=["Sweep"]).Sweep
+    assert pinmech.Sweep is __import__("pinmech.io.sweep", fromlist=["Sweep"]).Sweep
     with pytest.raises(AttributeError, match="no attribute 'Nothing'"):
         pinmech.Nothing  # noqa: B018
 
@@ -125,8 +125,8 @@ def test_a_valid_solve_command_line_builds_the_solve_parser_only(monkeypatch, r_
 def test_loops_of_full_rank_on_their_first_closed_pose_are_not_sampled_around(monkeypatch, models_dir):
     """The mobility check closes one pose; only a rank below the row count (loops that may
     repeat each other) sends it to close neighbouring poses (tests/test_mobility.py)."""
-    from pinmech import mobility
-    from pinmech.mechanism import Mechanism
+    from pinmech.model import mobility
+    from pinmech.model.mechanism import Mechanism
 
     closings = []
     close = mobility.close_least_squares

@@ -73,7 +73,7 @@ def test_usage_errors_exit_2(capsys):
 
 
 def test_without_dask_the_error_names_the_extra(monkeypatch):
-    from pinmech.cluster import require_dask
+    from pinmech.design.cluster import require_dask
 
     monkeypatch.setitem(sys.modules, "distributed", None)
     with pytest.raises(ImportError, match=r'pip install "pinmech\[study\]"'):

@@ -14,8 +14,8 @@ import pytest
 
 from pinmech import Scene, SweepError
 from pinmech.cli import main
-from pinmech.sweep import Sweep
-from pinmech.tables import write_csv
+from pinmech.io.sweep import Sweep
+from pinmech.io.tables import write_csv
 
 OMEGA1 = -50 * np.pi / 30
 
@@ -184,7 +184,7 @@ def test_a_task_scene_is_followed_in_time(scenes_dir, tmp_path, capsys):
 def test_the_figure_marks_failures_and_stays_bounded(tmp_path, models_dir):
     """A failing pose leaves a gap (NaN) and a red mark; a long sweep keeps every n-th pose."""
     pytest.importorskip("matplotlib", reason='plots need pip install "pinmech[plot]"')
-    from pinmech.plot import SweepPlot
+    from pinmech.draw.plot import SweepPlot
 
     sweep = Sweep.from_scene(_singular_scene(tmp_path, models_dir))
     recorder = SweepPlot(sweep, total=41, max_points=20)

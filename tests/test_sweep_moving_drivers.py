@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import pinmech
-import pinmech.core as core
+import pinmech.solve.core as core
 
 
 @pytest.mark.parametrize("enabled", [True, False], ids=["core", "python"])

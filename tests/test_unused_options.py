@@ -1,5 +1,5 @@
 """Every draw (and force, range) option of `pinmech sweep` either does its work or is
-refused out loud: an `OptionRefused` on one line, exit 2, no file written (pinmech/unused_options.py).
+refused out loud: an `OptionRefused` on one line, exit 2, no file written (pinmech/io/unused_options.py).
 Before, `sweep planar_arm --paths X` wrote nothing and said nothing."""
 
 from __future__ import annotations

@@ -21,8 +21,8 @@ import pytest
 
 import closed_form as cf
 from pinmech import LoopSolver, user_cache
-from pinmech.linkage import load_linkage
-from pinmech.mjcf import load_mjcf
+from pinmech.model.linkage_model import load_linkage
+from pinmech.model.mjcf import load_mjcf
 
 ROOT = Path(__file__).resolve().parents[1]
 LINKAGE = ROOT / "models" / "linkages" / "four_bar.toml"

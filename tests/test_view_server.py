@@ -25,7 +25,7 @@ def _listening(pid: int) -> list[tuple[str, int]]:
 
 
 def test_the_server_listens_on_loopback_only():
-    from pinmech.view_server import start_server
+    from pinmech.draw.view_server import start_server
 
     process, zmq_url, web_url = start_server()
     try:

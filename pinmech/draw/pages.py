@@ -45,7 +45,7 @@ def package_visuals(
         package_dirs: folders holding `package://NAME/...` meshes; by default the URDF's
             own folder and its parents.
     """
-    from pinmech.visual_files import drop_outside, package_roots
+    from pinmech.model.visual_files import drop_outside, package_roots
 
     path = Path(urdf_path)
     if not path.is_file():
@@ -71,7 +71,7 @@ def mechanism_visuals(mechanism) -> tuple[pin.GeometryModel, list[str]]:
     path = mechanism.urdf_path or mechanism.source
     skipped: list[str] = []
     if str(path).endswith(".xml"):
-        from pinmech.mjcf import mjcf_visuals
+        from pinmech.model.mjcf import mjcf_visuals
 
         visuals = mjcf_visuals(path, mechanism.model)
     else:
@@ -81,9 +81,9 @@ def mechanism_visuals(mechanism) -> tuple[pin.GeometryModel, list[str]]:
 
 
 def _paint_uncoloured(mechanism, visuals: pin.GeometryModel) -> None:
-    """A URDF visual without a material takes its link's colour (pinmech.display), as the
+    """A URDF visual without a material takes its link's colour (pinmech.model.display), as the
     curves and polygons draw that link; a visual with one keeps the file's colour."""
-    from pinmech.display import joint_colours
+    from pinmech.model.display import joint_colours
 
     colours = joint_colours(mechanism)
     for obj in visuals.geometryObjects:
@@ -239,7 +239,7 @@ def live_viewer(
     """
     meshcat = _meshcat()
     q = _configuration(model, q, "q")
-    from pinmech.view_server import start_server
+    from pinmech.draw.view_server import start_server
 
     process, zmq_url, _ = start_server()  # on 127.0.0.1 only, and stopping with pinmech (view_server.py)
     try:

@@ -16,8 +16,8 @@ import math
 
 import numpy as np
 
-from pinmech.polygon import KINDS, Polygon, PolygonVector
-from pinmech.results import Analysis
+from pinmech.draw.polygon import KINDS, Polygon, PolygonVector
+from pinmech.io.analysis_result import Analysis
 
 COLOURS = {
     "absolute": "#1f3fbf",

@@ -19,10 +19,10 @@ import os
 import tempfile
 from pathlib import Path
 
-import numpy as np
 
 from pinmech.exceptions import PinmechError
-from pinmech.results import Analysis
+from pinmech.io.analysis_result import Analysis
+from pinmech.io.html_tables import motion_table_html
 
 
 def report_html(analysis: Analysis, *, steps: int = 121, hand_text: str | None = None) -> str:
@@ -33,12 +33,12 @@ def report_html(analysis: Analysis, *, steps: int = 121, hand_text: str | None =
         steps: poses of the sweep drawn (a whole turn of the first driver); 0: no sweep.
         hand_text: the hand-check verdicts, as `pinmech check` prints them, or None.
     """
-    from pinmech.report import to_text
+    from pinmech.io.report import to_text
 
     figures = _figures(analysis, steps)
     sections = [("Given", _given(analysis)),
                 ("Figures", "\n".join(_figure(n, body, caption) for n, (body, caption) in enumerate(figures, 1))),
-                ("Results", _caption(_CAPTIONS["motion"]) + motion_table_html(analysis))]
+                ("Results", _caption(_CAPTIONS["motion"]) + motion_table_html(analysis.motion, analysis.mechanism.plane_normal))]
     if hand_text is not None:
         sections.append(("Hand calculation checked", _caption(_CAPTIONS["hand"]) + _pre(hand_text)))
     sections.append(("Full text report", '<details><summary>As <code>pinmech solve</code> prints it (click to '
@@ -58,7 +58,7 @@ def _meta(analysis: Analysis) -> str:
 
 
 def _given(analysis: Analysis) -> str:
-    from pinmech.report_given import given
+    from pinmech.io.report_given import given
 
     rows = "".join(f"<tr><th>{html.escape(h)}</th><td>" + "<br>".join(html.escape(x) for x in lines) + "</td></tr>"
                    for h, lines in given(analysis))
@@ -99,15 +99,15 @@ def _interactive(analysis: Analysis, folded: str | None) -> str:
 def _polygons(analysis: Analysis) -> list[tuple[str, str]]:
     """The velocity and acceleration polygons (the space diagram is Figure 1), captioned."""
     from pinmech.draw.polygon_svg import polygon_svg
-    from pinmech.polygon import acceleration_polygon, velocity_polygon
+    from pinmech.draw.polygon import acceleration_polygon, velocity_polygon
 
     return [(polygon_svg(make(analysis)), _CAPTIONS[key]) for make, key in
             ((velocity_polygon, "velocity"), (acceleration_polygon, "acceleration"))]
 
 
 def _sweep(analysis: Analysis, steps: int) -> list[tuple[str, str]]:
-    from pinmech.plot import SweepPlot
-    from pinmech.sweep import Sweep
+    from pinmech.draw.plot import SweepPlot
+    from pinmech.io.sweep import Sweep
 
     sweep = Sweep.from_scene(analysis.scene)
     recorder = SweepPlot(sweep, total=steps)
@@ -148,35 +148,6 @@ def _caption(text: str) -> str:
 
 def _pre(text: str) -> str:
     return f"<pre>{html.escape(text)}</pre>"
-
-
-def _html_table(rows: list[list[str]]) -> str:
-    """A plain HTML table, the first row its header."""
-    head, *rest = rows
-    cells = "".join(f"<th>{html.escape(c)}</th>" for c in head)
-    body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in rest)
-    return f"<table><tr>{cells}</tr>{body}</table>"
-
-
-def motion_table_html(analysis: Analysis) -> str:
-    """The points' and links' motion as HTML tables (SI units; angles in degrees)."""
-    m = analysis.motion
-    normal = analysis.mechanism.plane_normal
-    points = [["point", "link", "position [m]", "velocity [m/s]", "|v| [m/s]", "acceleration [m/s²]", "|a| [m/s²]"]]
-    for name, p in m.points.items():
-        points.append([name, p.link, _vec(p.position), _vec(p.velocity), f"{np.linalg.norm(p.velocity):.6g}",
-                       _vec(p.acceleration), f"{np.linalg.norm(p.acceleration):.6g}"])
-    links = [["link", "φ [deg]", "ω [rad/s]", "α [rad/s²]"]]
-    for name, link in m.links.items():
-        w = link.angular_velocity if normal is None else [float(normal @ link.angular_velocity)]
-        a = link.angular_acceleration if normal is None else [float(normal @ link.angular_acceleration)]
-        angle = "" if link.angle is None else f"{np.degrees(link.angle):.6g}"
-        links.append([name, angle, _vec(np.asarray(w)), _vec(np.asarray(a))])
-    return _html_table(points) + _html_table(links)
-
-
-def _vec(v: np.ndarray) -> str:
-    return ", ".join(f"{x:.6g}" for x in np.ravel(v)) if np.size(v) != 1 else f"{float(np.ravel(v)[0]):.6g}"
 
 
 _PAGE = """<!DOCTYPE html>
@@ -237,7 +208,7 @@ def snapshot(analysis: Analysis) -> HtmlPage:
     from pinmech.draw.pages import mechanism_visuals
 
     visuals = mechanism_visuals(mech)[0]  # the model's own file: a URDF, a drawn linkage's, an MJCF file
-    from pinmech.display import labelled_places
+    from pinmech.model.display import labelled_places
 
     points = labelled_places(mech, analysis.solution.q)  # joints and points, as the textbook names them
     return HtmlPage(snapshot_html(mech.model, visuals, analysis.solution.q, points=points,

@@ -1,4 +1,4 @@
-"""Visual geometry for links that have none: each drawn from its nodes (`pinmech.link_nodes`).
+"""Visual geometry for links that have none: each drawn from its nodes (`pinmech.model.link_nodes`).
 
 A link with two nodes is a bar between them, with three or more a plate over them (a
 planar mechanism) or bars joining them in turn (a spatial one); a slider block is a box
@@ -14,9 +14,9 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.draw.geometry import _screen_up
-from pinmech.display import joint_colours
-from pinmech.link_nodes import LinkSketch, sketch_links
-from pinmech.mechanism import Mechanism
+from pinmech.model.display import joint_colours
+from pinmech.model.link_nodes import LinkSketch, sketch_links
+from pinmech.model.mechanism import Mechanism
 
 _BAR = 0.05  # bar width, as a share of the longest link
 _BLOCK = (0.2, 0.11)  # slider block length and width, shares of the longest link
@@ -42,7 +42,7 @@ def sketch_visuals(mechanism: Mechanism, visual_model: pin.GeometryModel | None 
     normal = mechanism.plane_normal
     data = mechanism.model.createData()  # link frames at the neutral pose: their plane normal
     pin.forwardKinematics(mechanism.model, data, mechanism.neutral())
-    colours = joint_colours(mechanism)  # as in every figure (pinmech.display)
+    colours = joint_colours(mechanism)  # as in every figure (pinmech.model.display)
     for link in sketches.values():
         if link.joint in drawn:
             continue

@@ -1,7 +1,7 @@
 """The space diagram: a planar mechanism at its solved pose drawn to scale in plain SVG, as
 a textbook draws it beside its polygons (no extra needed, and it prints, unlike a WebGL page).
 
-Each moving link in its colour (`pinmech.display`): a bar between its pins, a plate over
+Each moving link in its colour (`pinmech.model.display`): a bar between its pins, a plate over
 three or more, a block on a slider; pins as open circles, named points as dots, the ground
 as hatched pivots and guides. One SVG user unit is one millimetre of paper; the length
 scale, a round number, is written under the drawing.
@@ -15,11 +15,11 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from pinmech.display import display_names, hex_colour, joint_colours
+from pinmech.model.display import display_names, hex_colour, joint_colours
 from pinmech.draw.inputs import DrawError
-from pinmech.link_nodes import LinkSketch, sketch_links, world_nodes
-from pinmech.motion import _plane_reference
-from pinmech.results import Analysis
+from pinmech.model.link_nodes import LinkSketch, sketch_links, world_nodes
+from pinmech.solve.motion import _plane_reference
+from pinmech.io.analysis_result import Analysis
 
 GROUND = "#777777"
 BLOCK = 5.0  # a slider block's length on paper [mm]

@@ -1,0 +1,1 @@
+"""pinmech.solve.diagnostics: see the README's Layout."""

@@ -1,0 +1,91 @@
+"""Design studies, the Python face: `study("models/studies/four_bar_tolerance.toml")`.
+
+    import pinmech
+    result = pinmech.study("models/studies/four_bar_tolerance.toml", workers=2)
+    print(result.summary())
+
+Kinds: "sensitivity" (exact dy/dp over the cycle, sensitivity.py) and "tolerance"
+(seeded Monte Carlo beside the linear estimate, tolerance.py), run in batches here or on
+Dask (cluster.py).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from pinmech.design.cluster import built, run_batches
+from pinmech.design.sensitivity import cycle_sensitivity
+from pinmech.design.study_file import StudySpec, load_study
+from pinmech.design.tolerance import BatchResult, Spread, batches, spread
+
+
+@dataclass(frozen=True)
+class StudyResult:
+    """A study's results (SI).
+
+    Attributes:
+        spec: the study file, validated; driver: the swept driver; values: its values [rad or m].
+        outputs: output names; kinds: "length" or "angle" each; params: parameter names.
+        nominal_p: the parameters' nominal values [m].
+        nominal: (steps, n_out) outputs of the nominal; sensitivity: (steps, n_out, n_par) dy/dp.
+        spread: the tolerance study's Spread (None for a sensitivity study).
+        batches: the tolerance study's variants, batch by batch (empty otherwise).
+    """
+
+    spec: StudySpec
+    driver: str
+    values: np.ndarray
+    outputs: list[str]
+    kinds: list[str]
+    params: list[str]
+    nominal_p: np.ndarray
+    nominal: np.ndarray
+    sensitivity: np.ndarray
+    spread: Spread | None = None
+    batches: tuple[BatchResult, ...] = ()
+
+    @property
+    def variants(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
+        """The variants' parameters (N, n_par) [m], outputs (N, steps, n_out) and causes."""
+        if not self.batches:
+            return np.zeros((0, len(self.params))), np.zeros((0, len(self.values), len(self.outputs))), []
+        return (np.concatenate([b.p for b in self.batches]), np.concatenate([b.y for b in self.batches]),
+                [c for b in self.batches for c in b.causes])
+
+
+def study(path: str | Path | StudySpec, *, workers: int = 0, scheduler: str | None = None,
+          progress: Callable[[int, int], None] | None = None) -> StudyResult:
+    """Run a study file.
+
+    Args:
+        path: the study file (or a StudySpec already loaded).
+        workers: 0 runs the variants in this process, n > 0 on a Dask LocalCluster of n
+            processes; scheduler: a running Dask scheduler's address instead.
+        progress: called with (batches done, batches) during a tolerance study.
+
+    Raises:
+        SceneError, FrameNotFound: a bad study file; the scene's and model's errors; the
+        nominal's own (a LoopClosureError where the nominal does not assemble, a
+        SweepError where its cycle fails). ImportError naming `pinmech[study]` without Dask.
+    """
+    spec = path if isinstance(path, StudySpec) else load_study(path)
+    sm, outputs = built(spec)
+    cycle = sm.cycle(sm.nominal)
+    if cycle.cause:
+        from pinmech.exceptions import SweepError
+
+        raise SweepError(f"{spec.path}: the nominal fails over the cycle ({cycle.cause}): {cycle.detail}",
+                         driver=sm.sweep.driver, value=float("nan"), cause=cycle.error) from cycle.error
+    y0, dy = cycle_sensitivity(sm, outputs, cycle.q)
+    common = dict(spec=spec, driver=sm.sweep.driver, values=sm.values, outputs=outputs.names, kinds=outputs.kinds,
+                  params=[p.name for p in spec.params], nominal_p=sm.nominal.copy(), nominal=y0, sensitivity=dy)
+    if spec.kind == "sensitivity":
+        return StudyResult(**common)
+    todo = batches(spec.samples, spec.batch)
+    tick = (lambda done: progress(done, len(todo))) if progress else None
+    results = run_batches(spec, todo, workers=workers, scheduler=scheduler, progress=tick)
+    return StudyResult(**common, spread=spread(sm, outputs, results), batches=tuple(results))

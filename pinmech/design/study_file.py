@@ -1,0 +1,207 @@
+"""Study files (`models/studies/*.toml`): parsed and validated once into a `StudySpec`.
+
+    title = "Four-bar: how the tolerances move the rocker"
+    scene = "../scenes/four_bar.toml"   # the mechanism, its drivers and assembly
+    kind = "tolerance"                   # or "sensitivity"
+    steps = 73                           # poses over one turn of the scene's first driver
+    samples = 400                        # tolerance: Monte Carlo variants
+    seed = 2025                          # tolerance: the random stream's seed
+
+    [params.crank]                       # a joint origin component [length]
+    joint = "A"
+    component = "x"
+    tolerance = "0.1 mm"                 # +-0.1 mm at k sigma (k = 3 unless given)
+    distribution = "normal"              # or "uniform" (+-tolerance), "fixed"
+
+    [params.coupler]                     # a cut frame's origin component
+    cut = "B"
+    side = "parent"
+    component = "x"
+    sigma = "0.02 mm"
+    bounds = ["119.9 mm", "120.1 mm"]
+
+    [outputs]
+    points = ["P"]                       # world x, y, z of these points [m]
+    links = ["rocker"]                   # angle of these links about the plane normal [rad]
+
+Every mistake is a SceneError naming the study file, the key and the value as written.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from pinmech.exceptions import SceneError
+from pinmech.design.study_params import AXES, DISTRIBUTIONS, Parameter
+from pinmech.units import to_si
+
+from pinmech.toml_file import read_toml
+
+KINDS = ("sensitivity", "tolerance")
+_TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs", "batch"}
+_PARAM_KEYS = {"joint", "cut", "side", "component", "nominal", "bounds", "tolerance", "k", "sigma", "distribution"}
+_OUTPUT_KEYS = {"points", "links"}
+_LIMITS = {"steps": (1, 100_000), "samples": (1, 10_000_000), "seed": (0, 2**63 - 1), "batch": (1, 1_000_000)}
+
+
+@dataclass(frozen=True)
+class StudySpec:
+    """A validated study file (lengths in m).
+
+    Attributes:
+        path: the study file; scene: the scene file it names.
+        kind: "sensitivity" or "tolerance".
+        steps: poses over one turn of the scene's first driver, both ends included.
+        samples, seed: Monte Carlo variants and the seed of their random stream.
+        batch: variants per batch (a Dask task); results do not depend on it.
+        params: the parameters, in the file's order.
+        points, links: the outputs (point positions, link angles).
+    """
+
+    path: Path
+    title: str
+    scene: Path
+    kind: str
+    steps: int
+    samples: int
+    seed: int
+    batch: int
+    params: tuple[Parameter, ...]
+    points: tuple[str, ...]
+    links: tuple[str, ...]
+
+
+def load_study(path: str | Path) -> StudySpec:
+    """Read and check a study file. Raises SceneError naming the file and the key."""
+    path = Path(path)
+    raw = read_toml(path, "study", SceneError)
+    return parse_study(raw, path)
+
+
+def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
+    """The StudySpec of a study file's TOML content `raw` (relative paths: from its folder)."""
+    where = _Where(path)
+    where.known(raw, _TOP, "")
+    kind = raw.get("kind", "sensitivity")
+    if kind not in KINDS:
+        raise where.error("kind", f"kind = {kind!r} is not one of {', '.join(KINDS)}")
+    scene = raw.get("scene")
+    if not isinstance(scene, str):
+        raise where.error("scene", f"scene = {scene!r}: give the scene file, e.g. \"../scenes/four_bar.toml\"")
+    params = raw.get("params")
+    if not isinstance(params, dict) or not params:
+        raise where.error("params", "give at least one [params.NAME] table")
+    outputs = raw.get("outputs", {})
+    where.known(outputs, _OUTPUT_KEYS, "outputs")
+    points, links = (_names(outputs.get(k, []), where, f"outputs.{k}") for k in ("points", "links"))
+    if not points and not links:
+        raise where.error("outputs", "name at least one output: points = [\"P\"] or links = [\"rocker\"]")
+    counts = {k: where.whole(raw, k, default) for k, default in
+              (("steps", 73), ("samples", 200), ("seed", 0), ("batch", 64))}
+    return StudySpec(path, str(raw.get("title", path.stem)), (path.parent / scene), kind, counts["steps"],
+                     counts["samples"], counts["seed"], counts["batch"],
+                     tuple(_parameter(name, table, where) for name, table in params.items()), points, links)
+
+
+def _parameter(name: str, table: Any, where: _Where) -> Parameter:
+    key = f"params.{name}"
+    if not isinstance(table, dict):
+        raise where.error(key, "must be a table (joint = \"A\", component = \"x\", tolerance = \"0.1 mm\")")
+    where.known(table, _PARAM_KEYS, key)
+    if ("joint" in table) == ("cut" in table):
+        raise where.error(key, "give one of joint = \"NAME\" (its origin) or cut = \"NAME\" (a cut frame's origin)")
+    target = "joint" if "joint" in table else "cut"
+    side = table.get("side", "parent" if target == "cut" else "")
+    if target == "cut" and side not in ("parent", "child"):
+        raise where.error(f"{key}.side", f"side = {side!r} must be \"parent\" or \"child\"")
+    if target == "joint" and "side" in table:
+        raise where.error(f"{key}.side", "side is for a cut's frames; a joint has one origin")
+    component = table.get("component")
+    if component not in AXES:
+        raise where.error(f"{key}.component", f"component = {component!r} must be \"x\", \"y\" or \"z\"")
+    nominal = where.length(table, "nominal", key) if "nominal" in table else None
+    lower, upper = _bounds(table, key, where, nominal)
+    distribution, spread = _distribution(table, key, where)
+    return Parameter(name, target, str(table[target]), side, AXES[component], nominal, lower, upper,
+                     distribution, spread)
+
+
+def _bounds(table: dict, key: str, where: _Where, nominal: float | None) -> tuple[float, float]:
+    if "bounds" not in table:
+        return -math.inf, math.inf
+    bounds = table["bounds"]
+    if not isinstance(bounds, list) or len(bounds) != 2:
+        raise where.error(f"{key}.bounds", f"bounds = {bounds!r} must be [lower, upper], e.g. [\"119 mm\", \"121 mm\"]")
+    lower, upper = (to_si(b, "length", where=f"{where.path}, {key}.bounds") for b in bounds)
+    if not lower < upper:
+        raise where.error(f"{key}.bounds", f"lower {bounds[0]} is not below upper {bounds[1]}")
+    if nominal is not None and not lower <= nominal <= upper:
+        raise where.error(f"{key}.nominal", f"nominal {table['nominal']} is outside bounds {bounds[0]} .. {bounds[1]}")
+    return lower, upper
+
+
+def _distribution(table: dict, key: str, where: _Where) -> tuple[str, float]:
+    given = "sigma" in table or "tolerance" in table
+    distribution = table.get("distribution", "normal" if given else "fixed")
+    if distribution not in DISTRIBUTIONS:
+        raise where.error(f"{key}.distribution", f"distribution = {distribution!r} is not one of "
+                          f"{', '.join(DISTRIBUTIONS)}")
+    if distribution == "fixed":
+        return distribution, 0.0
+    if "sigma" in table and ("tolerance" in table or distribution == "uniform"):
+        raise where.error(f"{key}.sigma", "give sigma (normal) or tolerance (+-, normal at k sigma, or uniform)")
+    if "sigma" in table:
+        return distribution, where.positive(table, "sigma", key)
+    if "tolerance" not in table:
+        raise where.error(key, f"a {distribution} distribution needs tolerance = \"0.1 mm\" or sigma = \"0.03 mm\"")
+    tol = where.positive(table, "tolerance", key)
+    if distribution == "uniform":
+        if "k" in table:
+            raise where.error(f"{key}.k", "k (tolerance at k sigma) is for a normal distribution")
+        return distribution, tol
+    k = table.get("k", 3)
+    if isinstance(k, bool) or not isinstance(k, (int, float)) or not 0 < k < 100:
+        raise where.error(f"{key}.k", f"k = {k!r} must be a number of sigmas between 0 and 100, e.g. 3")
+    return distribution, tol / float(k)
+
+
+def _names(value: Any, where: _Where, key: str) -> tuple[str, ...]:
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise where.error(key, f"{value!r} must be a list of names")
+    return tuple(value)
+
+
+class _Where:
+    """The study file, for errors naming it and the key."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+
+    def error(self, key: str, message: str) -> SceneError:
+        return SceneError(message, path=str(self.path), key=key)
+
+    def known(self, table: Any, keys: set[str], key: str) -> None:
+        if not isinstance(table, dict):
+            raise self.error(key, f"must be a table, got {table!r}")
+        unknown = sorted(set(table) - keys)
+        if unknown:
+            raise self.error(key or unknown[0], f"unknown key(s) {', '.join(unknown)}; known: {', '.join(sorted(keys))}")
+
+    def whole(self, raw: dict, key: str, default: int) -> int:
+        value = raw.get(key, default)
+        low, high = _LIMITS[key]
+        if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+            raise self.error(key, f"{key} = {value!r} must be a whole number from {low} to {high}")
+        return value
+
+    def length(self, table: dict, name: str, key: str) -> float:
+        return to_si(table[name], "length", where=f"{self.path}, {key}.{name}")
+
+    def positive(self, table: dict, name: str, key: str) -> float:
+        value = self.length(table, name, key)
+        if not value > 0:
+            raise self.error(f"{key}.{name}", f"{name} = {table[name]!r} must be a positive length")
+        return value

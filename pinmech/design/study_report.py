@@ -1,0 +1,126 @@
+"""A study's results for people and programs: a terminal summary, a table (CSV, and Parquet
+through pyarrow), a JSON summary, and figures (matplotlib). Users' units at this edge:
+lengths in mm, angles in deg, sensitivities in mm/mm and deg/mm.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from pinmech.design.study import StudyResult
+from pinmech.design.tolerance import PERCENTILES, deviation
+
+_SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg")}
+
+
+def _unit(kind: str) -> tuple[float, str]:
+    return _SCALE[kind]
+
+
+def summary(result: StudyResult) -> dict:
+    """The JSON summary: per output, the largest |dy/dp| over the cycle for each parameter,
+    and for a tolerance study the spread beside the linear estimate and the failures."""
+    spec = result.spec
+    out = {"study": str(spec.path), "title": spec.title, "kind": spec.kind, "driver": result.driver,
+           "poses": len(result.values), "parameters": {}, "outputs": {}}
+    for k, p in enumerate(spec.params):
+        out["parameters"][p.name] = {"nominal_mm": result.nominal_p[k] * 1e3, "distribution": p.distribution,
+                                     "sigma_mm": p.sigma * 1e3}
+    for j, name in enumerate(result.outputs):
+        scale, unit = _unit(result.kinds[j])
+        entry = {"unit": unit, "nominal_min": float(result.nominal[:, j].min() * scale),
+                 "nominal_max": float(result.nominal[:, j].max() * scale),
+                 f"max_abs_sensitivity_{unit}_per_mm": {p: float(np.abs(result.sensitivity[:, j, k]).max() * scale / 1e3)
+                                                       for k, p in enumerate(result.params)}}
+        if result.spread is not None:
+            s = result.spread
+            entry.update(sigma_max=_finite(s.sigma[:, j].max() * scale),
+                         sigma_linear_max=float(s.sigma_linear[:, j].max() * scale),
+                         worst=_finite(s.worst[j] * scale), worst_linear=float(s.worst_linear[j] * scale),
+                         percentiles={f"{q:g}": _finite(s.percentiles[i, :, j].min() * scale if q < 50 else
+                                                        s.percentiles[i, :, j].max() * scale)
+                                      for i, q in enumerate(PERCENTILES)})
+        out["outputs"][name] = entry
+    if result.spread is not None:
+        out.update(samples=spec.samples, seed=spec.seed, solved=result.spread.solved,
+                   failures=dict(result.spread.failures))
+    return out
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+def text(result: StudyResult) -> str:
+    """The terminal summary."""
+    s = summary(result)
+    lines = [f"{s['title']} ({s['kind']}, {s['poses']} poses of {s['driver']}"
+             + (f", {s['samples']} variants, seed {s['seed']})" if "samples" in s else ")")]
+    lines.append("parameters: " + ", ".join(f"{n} {p['nominal_mm']:.6g} mm"
+                                            + (f" (sigma {p['sigma_mm']:.3g} mm, {p['distribution']})"
+                                               if p["distribution"] != "fixed" else "")
+                                            for n, p in s["parameters"].items()))
+    lines.append("largest |dy/dp| over the cycle: " + "; ".join(
+        f"{o}: " + ", ".join(f"{p} {v:.4g}" for p, v in e[f"max_abs_sensitivity_{e['unit']}_per_mm"].items())
+        + f" {e['unit']}/mm" for o, e in s["outputs"].items()))
+    if "samples" in s:
+        lines.append(f"{'output':<16}{'sigma max':>12}{'linear':>12}{'worst':>12}{'linear':>12}")
+        for o, e in s["outputs"].items():
+            lines.append(f"{o + ' [' + e['unit'] + ']':<16}" + "".join(
+                f"{v:>12.4g}" if v is not None else f"{'-':>12}"
+                for v in (e["sigma_max"], e["sigma_linear_max"], e["worst"], e["worst_linear"])))
+        failed = ", ".join(f"{c}: {n}" for c, n in s["failures"].items()) or "none"
+        lines.append(f"solved {s['solved']} of {s['samples']} variants; failed: {failed}")
+    return "\n".join(lines)
+
+
+def table(result: StudyResult) -> dict[str, list]:
+    """The study's table as columns: one row a pose and output (sensitivity), or one row
+    a variant (tolerance: its parameters, its cause, its largest deviation of each output)."""
+    if result.spread is None:
+        rows: dict[str, list] = {f"{result.driver} [deg]": [], "output": [], "unit": [], "value": []}
+        rows.update({f"d/d {p} [per mm]": [] for p in result.params})
+        for i, x in enumerate(result.values):
+            for j, name in enumerate(result.outputs):
+                scale, unit = _unit(result.kinds[j])
+                rows[f"{result.driver} [deg]"].append(math.degrees(x))
+                rows["output"].append(name), rows["unit"].append(unit)
+                rows["value"].append(result.nominal[i, j] * scale)
+                for k, p in enumerate(result.params):
+                    rows[f"d/d {p} [per mm]"].append(result.sensitivity[i, j, k] * scale / 1e3)
+        return rows
+    p, y, causes = result.variants
+    rows = {"variant": list(range(len(causes)))}
+    rows.update({f"{name} [mm]": (p[:, k] * 1e3).tolist() for k, name in enumerate(result.params)})
+    rows["cause"] = list(causes)
+    dev = np.abs(deviation(y, result.nominal, result.kinds)).max(axis=1)
+    for j, name in enumerate(result.outputs):
+        scale, unit = _unit(result.kinds[j])
+        rows[f"max |d {name}| [{unit}]"] = (dev[:, j] * scale).tolist()
+    return rows
+
+
+def write(result: StudyResult, prefix: str | Path, *, parquet: bool = True) -> list[Path]:
+    """PREFIX.csv, PREFIX.json and (with pyarrow) PREFIX.parquet; the paths written."""
+    prefix = Path(prefix)
+    columns = table(result)
+    paths = [prefix.with_suffix(".csv"), prefix.with_suffix(".json")]
+    with paths[0].open("w", newline="", encoding="utf-8") as f:
+        writer = csv.writer(f)
+        writer.writerow(columns)
+        writer.writerows(zip(*columns.values()))
+    paths[1].write_text(json.dumps(summary(result), indent=2) + "\n", encoding="utf-8")
+    if parquet:
+        try:
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+        except ImportError as exc:
+            raise ImportError(f'a Parquet table needs pyarrow: pip install "pinmech[study]" ({exc})') from exc
+        pq.write_table(pa.table(columns), prefix.with_suffix(".parquet"))
+        paths.append(prefix.with_suffix(".parquet"))
+    return paths

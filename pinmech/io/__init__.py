@@ -1,0 +1,1 @@
+"""pinmech.io: see the README's Layout."""

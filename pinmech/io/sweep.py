@@ -1,0 +1,317 @@
+"""Cycles: one driver swept through a range, every pose solved, closed and rated.
+
+One `LoopSolver` (one `pin.Data`) serves the whole sweep, and each pose starts from the
+previous one, so the sweep stays on the assembly branch it started on (solve_cycle.py:
+how, and the accuracy choices). Poses are produced lazily, a chunk at a time, so a sweep
+of a million poses streams to a CSV file in bounded memory.
+
+Scene keys, all optional:
+
+    [sweep]
+    links = ["link3"]         # what --plot draws (default: every moving link ...)
+    points = ["D"]            # ... and every moving point)
+    steps = 361               # poses, both ends included
+    from = "0 deg"            # first value (default: the scene's)
+    to = "360 deg"            # last value (default: one turn on, or one mechanism size)
+    start = "predictor"       # or "warm", "cold" (see solve_cycle.py)
+    batch = true              # batched poses between exact ones on dense sweeps
+    interpolate = 1           # > 1: every n-th pose solved, the others interpolated
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from pinmech.arguments import real_number
+from pinmech.exceptions import DriverLimitError, ModelError, SceneError, SweepError
+from pinmech.model.mechanism import Mechanism
+from pinmech.solve.motion import Motion, evaluate_motion
+from pinmech.solve.results import Accuracy
+from pinmech.io.scene import Scene
+from pinmech.io.scene_model import (
+    Drivers,
+    check_scene_names,
+    coincident_points,
+    load_mechanism,
+    report_lists,
+    scene_drivers,
+    scene_solver,
+)
+from pinmech.solve.cycle import STARTS, RangeChunk, solve_range
+from pinmech.solve.loops import LoopSolver
+
+#: The `[sweep]` keys and their types.
+SWEEP_KEYS = {"links": list, "points": list, "steps": int, "from": str, "to": str, "start": str,
+              "batch": bool, "interpolate": int, "duration": str, "step": str, "scheme": str, "gain": (int, float)}
+
+
+@dataclass(frozen=True)
+class SweepPose:
+    """One pose of a sweep: the driver value, and the motion (None where the pose failed).
+
+    `interpolated` poses were not solved but interpolated between solved ones; their
+    accuracy is the one measured where the interpolation error peaks (solve_cycle.py).
+    """
+
+    index: int
+    value: float
+    motion: Motion | None
+    accuracy: Accuracy | None
+    error: str = ""
+    interpolated: bool = False
+    note: str = ""
+    fold: float | None = None  # a failed pose's DriverLimitError: the swept driver's fold [rad or m]
+
+
+@dataclass(frozen=True)
+class DriverValues(Sequence):
+    """`steps` evenly spaced driver values from `first` to `last` [rad or m], both ends
+    included, as `np.linspace` gives them but computed when read: a sweep streams in
+    constant memory (a sweep of 1e10 poses too: the commands refuse more than
+    counts.MAX_POSES before any work, as a study that would not end)."""
+
+    first: float
+    last: float
+    steps: int
+
+    def __post_init__(self) -> None:
+        if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
+            raise ModelError(f"steps must be a positive whole number, got {self.steps!r}")
+        object.__setattr__(self, "first", real_number(self.first, "the driver's first value"))
+        object.__setattr__(self, "last", real_number(self.last, "the driver's last value"))
+        if not (math.isfinite(self.first) and math.isfinite(self.last)):
+            raise ModelError(f"the driver's range must be finite numbers, got {self.first!r} to {self.last!r}")
+
+    def __len__(self) -> int:
+        return self.steps
+
+    def __getitem__(self, index):  # int -> float, slice -> array
+        if isinstance(index, slice):
+            return np.array([self._at(i) for i in range(*index.indices(self.steps))])
+        i = index + self.steps if index < 0 else index
+        if not 0 <= i < self.steps:
+            raise IndexError(f"pose {index} of {self.steps}")
+        return self._at(i)
+
+    def __iter__(self) -> Iterator[float]:
+        return (self._at(i) for i in range(self.steps))
+
+    def __array__(self, dtype=None, copy=None) -> np.ndarray:
+        return np.linspace(self.first, self.last, self.steps, dtype=dtype)
+
+    def _at(self, i: int) -> float:
+        if i == self.steps - 1 and self.steps > 1:
+            return float(self.last)
+        step = (self.last - self.first) / (self.steps - 1) if self.steps > 1 else 0.0
+        return float(self.first + i * step)
+
+
+def sweep_options(scene: Scene) -> dict[str, Any]:
+    """The scene's `[sweep]` table, checked (names and types)."""
+    table = scene.section("sweep")
+    for key, value in table.items():
+        kind = SWEEP_KEYS.get(key)
+        if kind is None:
+            raise SceneError(f"unknown key {key}; known: {', '.join(SWEEP_KEYS)}", path=str(scene.path),
+                             key=f"sweep.{key}")
+        if not isinstance(value, kind) or (kind is int and isinstance(value, bool)):
+            raise SceneError(f"must be {getattr(kind, '__name__', 'a number')}, got {value!r}",
+                             path=str(scene.path), key=f"sweep.{key}")
+    if "start" in table and table["start"] not in STARTS:
+        raise SceneError(f"must be one of {', '.join(STARTS)}, got {table['start']!r}", path=str(scene.path),
+                         key="sweep.start")
+    _check_ranges(scene, table)
+    return table
+
+
+#: The `[sweep]` numbers' ranges: the least value, and what it counts.
+_LEAST = {"steps": (2, "poses, both ends included"), "interpolate": (1, "(1: every pose solved)")}
+
+
+def _check_ranges(scene: Scene, table: dict[str, Any]) -> None:
+    """`[sweep]` values in range, blamed on the file and key (not on the flags that
+    would override them): steps >= 2, interpolate >= 1, a known scheme, a gain >= 0."""
+    from pinmech.solve.path import SCHEMES  # here: sweeping needs no path integration
+
+    def bad(key: str, message: str) -> SceneError:
+        return SceneError(message, path=str(scene.path), key=f"sweep.{key}")
+
+    for key, (least, what) in _LEAST.items():
+        if key in table and table[key] < least:
+            raise bad(key, f"must be at least {least} {what}, got {table[key]}")
+    if "scheme" in table and table["scheme"] not in SCHEMES:
+        raise bad("scheme", f"must be one of {', '.join(SCHEMES)}, got {table['scheme']!r}")
+    if "gain" in table and not 0 <= table["gain"] < math.inf:
+        raise bad("gain", f"must be a number from 0 (open loop) up, in 1/s, got {table['gain']!r}")
+
+
+def _no_drivers(mechanism: Mechanism, arm_pose: bool = False) -> str:
+    """What to add to a scene without `[drivers]` to sweep it."""
+    motors = mechanism.motors
+    if motors:
+        tables = " and ".join(f"[drivers.{m}]" for m in motors)
+        return (f"has no [drivers] to sweep: add {tables} with their angle and speed (the motors the sidecar "
+                f"names, {', '.join(motors)}, drive a solve at rest, but a sweep needs the ones it moves)")
+    arm = "; or, for an arm held at its [pose], a [[task]] to follow in time (pinmech path)" if arm_pose else ""
+    return ("has no [drivers] to sweep: add a [drivers.JOINT] table (angle, speed) for each joint the scene drives "
+            f"({mechanism.mobility} for this mechanism){arm}")
+
+
+@dataclass
+class Sweep:
+    """A scene set up for sweeping one of its drivers.
+
+    Attributes:
+        driver: the swept joint (the scene's first driver unless named).
+        start: the scene's value of the driver [rad or m], where the sweep starts by default.
+    """
+
+    scene: Scene
+    mechanism: Mechanism
+    solver: LoopSolver
+    driver: str
+    start: float
+    drivers: Drivers
+    last_q: np.ndarray | None = None  # configuration of the last pose, None if it failed (drawings, return_gap)
+    first_q: np.ndarray | None = None  # configuration of the first pose, None if it failed
+
+    @classmethod
+    def from_scene(cls, scene: Scene, driver: str | None = None) -> Sweep:
+        """Raises:
+            SceneError: a scene without drivers (a task scene is followed in time by
+                `pinmech path`), or a driver that is not one of the scene's.
+        """
+        sweep_options(scene)
+        if "task" in scene.raw:
+            raise SceneError("has no [drivers] to sweep; a task scene ([[task]]) is followed in time: "
+                             "pinmech path SCENE --duration ... (pinmech animate SCENE --duration ... "
+                             "animates it)", path=str(scene.path), key="drivers")
+        mechanism = load_mechanism(scene)
+        if not scene.section("drivers"):
+            raise SceneError(_no_drivers(mechanism, "pose" in scene.raw), path=str(scene.path), key="drivers")
+        drivers = scene_drivers(scene, mechanism)
+        check_scene_names(scene, mechanism)
+        scene.names("sweep", "links"), scene.names("sweep", "points")  # lists of names, or a SceneError now
+        name = driver or drivers.names[0]
+        if name not in drivers.names:
+            raise SceneError(f"'{name}' is not a driver of the scene ({', '.join(drivers.names)})",
+                             path=str(scene.path), key="drivers")
+        solver = scene_solver(scene, mechanism, drivers)
+        return cls(scene, mechanism, solver, name, float(drivers.q[drivers.names.index(name)]), drivers)
+
+    @property
+    def is_angular(self) -> bool:
+        return self.mechanism.joint(self.driver).is_angular
+
+    def default_values(self, steps: int = 361) -> DriverValues:
+        """One full turn from the scene's angle (both ends included), or +-the mechanism's
+        size; computed when read (a `DriverValues`)."""
+        span = 2 * math.pi if self.is_angular else self.mechanism.length_scale
+        return DriverValues(self.start, self.start + span, steps)
+
+    def chunks(self, values: Iterable[float], *, start: str = "predictor", batch: bool = True,
+               interpolate: int = 1, through_folds: bool = False) -> Iterator[RangeChunk]:
+        """The poses' q, v, a and accuracy as arrays, a chunk at a time (no motion read-out):
+        the quickest way through a long sweep. Options: see `poses`."""
+        d = self.drivers
+        numeric = isinstance(values, np.ndarray) and values.dtype.kind in "fiu"  # solve_range checks finiteness
+        return solve_range(self.solver, self.driver, values if numeric else self._checked(values), driver_q=d.q,
+                           driver_v=d.v, driver_a=d.a, start=start, batch=batch, interpolate=interpolate,
+                           through_folds=through_folds)
+
+    def poses(self, values: Iterable[float], *, skip_failures: bool = False, start: str = "predictor",
+              batch: bool = True, interpolate: int = 1, warm_start: bool | None = None,
+              predictor: bool | None = None, through_folds: bool = False) -> Iterator[SweepPose]:
+        """Solve the poses one after the other, each from the previous one (lazy).
+
+        Args:
+            skip_failures: keep a failing pose as a row with its error instead of stopping.
+            start: "predictor" (default): from the previous pose moved along its path
+                derivatives (q' dx + q'' dx^2 / 2 on the manifold), one Newton step;
+                "warm": from the previous pose as it is; "cold": every pose from the
+                scene's guess (slower, and it may change branch).
+            batch: on dense sweeps, solve the poses between exactly solved ones together
+                from interpolated guesses (same tolerance, several times faster).
+            interpolate: > 1 solves every n-th pose and interpolates the others (quintic
+                Hermite in q, q', q''), for dense plots: faster, less accurate, with the
+                accuracy measured in each interval.
+            warm_start, predictor: older spelling of `start` ("warm" is predictor=False,
+                "cold" warm_start=False).
+            through_folds: at a fold of the driver (a limit angle), go on onto the other
+                branch with the driver turning back, values past the fold mirrored at it
+                (a whole coupler curve of a non-Grashof linkage); the pose after it carries
+                a note. Without it, the poses past a fold fail with DriverLimitError.
+
+        Raises:
+            SweepError: a pose where the loop cannot close or the Jacobian is singular,
+                naming the driver value, unless `skip_failures` (then the row says why).
+        """
+        if warm_start is False:
+            start = "cold"
+        elif predictor is False:
+            start = "warm"
+        points, links = report_lists(self.scene)
+        coincident = coincident_points(self.scene)
+        for chunk in self.chunks(values, start=start, batch=batch, interpolate=interpolate,
+                                 through_folds=through_folds):
+            for j, value in enumerate(chunk.values.tolist()):
+                index = chunk.start + j
+                if j in chunk.errors:
+                    exc = chunk.errors[j]
+                    self.last_q = None  # the sweep did not end on a solved pose (return_gap: NaN)
+                    if index == 0:
+                        self.first_q = None
+                    if not skip_failures:
+                        raise SweepError(f"sweep stopped at {self.driver} = {self._format(value)}: {exc}",
+                                         driver=self.driver, value=value, cause=exc) from exc
+                    yield SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}", fold=self._fold(exc))
+                    continue
+                sol = chunk.solution
+                self.last_q = sol.q[j]
+                if index == 0:
+                    self.first_q = sol.q[j]
+                with self.solver.lock:  # the solver's Data, which another thread may be using
+                    motion = evaluate_motion(self.mechanism, self.solver.data, sol.q[j], sol.v[j], sol.a[j],
+                                             points=points, links=links, coincident=coincident)
+                yield SweepPose(index, value, motion, sol.accuracy(j), interpolated=bool(chunk.interpolated[j]),
+                                note=chunk.notes.get(j, ""))
+
+    def _fold(self, exc: Exception) -> float | None:
+        """The swept driver's value at the fold a DriverLimitError names [rad or m], else None."""
+        if not isinstance(exc, DriverLimitError) or len(exc.limit) != len(self.drivers.names):
+            return None
+        return float(exc.limit[self.drivers.names.index(self.driver)])
+
+    def return_gap(self) -> float:
+        """How far the sweep's last pose is from its first: the largest joint difference,
+        angles modulo a turn [rad], slides in mechanism sizes (NaN where either failed).
+        After a sweep of whole turns of the driver, a mechanism back on its start has a gap
+        at the closure tolerance."""
+        if self.first_q is None or self.last_q is None:
+            return math.nan
+        return self.solver.turn_gap(self.first_q, self.last_q)
+
+    def _checked(self, values: Iterable[float]) -> Iterator[float]:
+        """The driver values as floats, or a ModelError naming the first that is not a finite number."""
+        unit = "rad" if self.is_angular else "m"
+        if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
+            raise ModelError(f"values of {self.driver} must be numbers [{unit}], got {values!r:.80}",
+                             path=self.mechanism.source)
+        for index, value in enumerate(values):
+            cast = isinstance(value, (str, bytes, bool, np.bool_, complex, np.complexfloating))  # never cast
+            try:
+                number = math.nan if cast else float(value)
+            except (TypeError, ValueError):
+                number = math.nan
+            if not math.isfinite(number):
+                raise ModelError(f"value {index} of {self.driver} is {value!r:.40}, not a finite number [{unit}]",
+                                 path=self.mechanism.source)
+            yield number
+
+    def _format(self, value: float) -> str:
+        return f"{math.degrees(value):.6g} deg" if self.is_angular else f"{value:.6g} m"

@@ -1,0 +1,1 @@
+"""pinmech.model: see the README's Layout."""

@@ -1,0 +1,1 @@
+"""pinmech.solve: see the README's Layout."""

@@ -1,0 +1,313 @@
+"""Design diagnostics over a sweep: a few CSV columns and a JSON object per pose
+(transmission and pressure angles [deg in CSV, rad in JSON], mechanical advantage), and
+the summary printed when the sweep ends: each angle's least and largest value and where,
+the outputs' limit positions (refined between the poses), swing or stroke, time ratio.
+
+`DesignSweep` is fed every pose (as a figure recorder is); the tables ask it for the
+pose's cells, computed once per pose.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from pinmech.solve.diagnostics import advantage_unit
+from pinmech.exceptions import DiagnosticError, PinmechError
+from pinmech.extremum import Tracked
+from pinmech.solve.grashof import loop_classes
+from pinmech.solve.limit_positions import LimitFinder, LimitPosition, extreme_label, travel
+from pinmech.model.planar_linkage import planar_linkage
+from pinmech.solve.transmission import dyad_angles, find_dyads, find_outputs, output_rate
+
+
+@dataclass
+class _Extreme:
+    """The least and largest of a quantity over the poses, and the driver values there."""
+
+    low: float = math.inf
+    low_at: float = math.nan
+    high: float = -math.inf
+    high_at: float = math.nan
+
+    def add(self, value: float, at: float) -> None:
+        if value < self.low:
+            self.low, self.low_at = value, at
+        if value > self.high:
+            self.high, self.high_at = value, at
+
+
+@dataclass(frozen=True)
+class AngleExtremes:
+    """A dyad's (named by its pin B) least and largest acute transmission angle and largest
+    pressure angle [deg], each with its driver value [rad or m]; `refined` False where
+    one is the value over the poses only (a fold beside it)."""
+
+    name: str
+    low: float
+    low_at: float
+    high: float
+    high_at: float
+    pressure: float
+    pressure_at: float
+    refined: bool
+
+
+class DesignSweep:
+    """The diagnostics of each pose of a sweep, and of the whole sweep.
+
+    Args:
+        sweep: the `Sweep` (its mechanism, drivers and solver options).
+    """
+
+    def __init__(self, sweep) -> None:
+        from pinmech.solve.loops import LoopSolver
+
+        self.sweep, self.reason = sweep, ""
+        self._cache: tuple[int, dict] = (-1, {})
+        self._limits: tuple[int, list] = (-1, [])
+        self._extremes: tuple[int, list] = (-1, [])
+        self.count = 0
+        try:
+            self.linkage = planar_linkage(sweep.mechanism)
+        except DiagnosticError as exc:
+            self.linkage, self.reason = None, str(exc).split(": ", 1)[-1]
+            return
+        names = list(sweep.drivers.names)
+        self.dyads = find_dyads(self.linkage, names)
+        self.outputs = find_outputs(self.linkage, names)
+        self.k = names.index(sweep.driver)
+        self.solver = LoopSolver(sweep.mechanism, names, **sweep.scene.solver_options())
+        self.finder = LimitFinder(self.solver, self.linkage, self.k, sweep.drivers.q, self.dyads)
+        self.unit = np.eye(len(names))[self.k]
+        self.angles = [(Tracked(1.0), Tracked(-1.0)) for _ in self.dyads]  # least, largest acute mu [deg]
+        self.pressures = [Tracked(-1.0) for _ in self.dyads]  # largest pressure angle [deg]
+        self._previous: float | None = None  # the last solved pose's driver value
+        self._step: float | None = None  # the driver's last step between solved poses [rad or m]
+        self._folds: list[float] = []
+        self.advantages = [_Extreme() for _ in self.outputs]
+        self.previous: list[tuple | None] = [None] * len(self.outputs)
+        self.brackets: list[list[tuple]] = [[] for _ in self.outputs]
+
+    @property
+    def applicable(self) -> bool:
+        return self.linkage is not None
+
+    # ------------------------------------------------------------------ per pose
+    def evaluate(self, pose) -> dict:
+        """{"angles": [(mu, acute, pressure) deg per dyad], "advantage": [per output]} at a
+        pose (empty where it failed); statistics and limit brackets updated once."""
+        if self._cache[0] == pose.index:
+            return self._cache[1]
+        out: dict = {}
+        if self.applicable:
+            self._fold(pose)
+        if self.applicable and pose.motion is None:
+            self._previous = None
+        if self.applicable and pose.motion is not None:
+            q = self._q(pose.motion)
+            v, _, _ = self.solver.rates(q, self.unit, np.zeros(len(self.unit)), closed=not pose.interpolated)
+            self.linkage.place(q, v)
+            rates = [output_rate(self.linkage, o) for o in self.outputs]
+            angles = [dyad_angles(self.linkage, d) for d in self.dyads]
+            out = {"angles": [(a.mu, a.mu_acute, a.pressure) for a in angles],
+                   "advantage": [math.inf if r == 0 else 1.0 / r for r in rates]}
+            self._record(pose, q, rates, out)
+        self._cache = (pose.index, out)
+        return out
+
+    def _q(self, motion) -> np.ndarray:
+        mech = self.sweep.mechanism
+        q = mech.neutral()
+        for name, joint in motion.joints.items():
+            mech.set_coordinate(q, name, joint.q)
+        return q
+
+    def _fold(self, pose) -> None:
+        """A fold met before this pose: the DriverLimitError's value, or, crossed with
+        `--through-folds` (the driver turns back there, the values past it mirrored), the
+        point p with p - x0 + p - x1 = the step (x0, x1 the driver values either side)."""
+        if pose.fold is not None and not any(abs(pose.fold - x) <= 1e-12 for x in self._folds):
+            self._folds.append(pose.fold)
+        if "crossed a fold" not in pose.note:
+            return
+        if self._previous is not None and self._step is not None and pose.motion is not None:
+            self._folds.append(0.5 * (self._previous + pose.value + self._step))
+        self._step = None if self._step is None else -self._step
+
+    def _record(self, pose, q: np.ndarray, rates: list[float], out: dict) -> None:
+        self.count += 1
+        for (least, largest), pressure, (_, acute, phi) in zip(self.angles, self.pressures, out["angles"]):
+            least.add(acute, pose.value, q, self._previous)
+            largest.add(acute, pose.value, q, self._previous)
+            pressure.add(phi, pose.value, q, self._previous)
+        if self._previous is not None and "crossed a fold" not in pose.note:
+            self._step = pose.value - self._previous
+        self._previous = pose.value
+        for i, (stat, value) in enumerate(zip(self.advantages, out["advantage"])):
+            if math.isfinite(value):
+                stat.add(abs(value), pose.value)
+            before = self.previous[i]
+            if before is not None and not pose.note and not pose.interpolated and before[2] * rates[i] < 0:
+                self.brackets[i].append((before[0], before[1], before[2], pose.value))
+            self.previous[i] = None if pose.interpolated else (pose.value, q, rates[i])
+
+    def add(self, pose) -> None:
+        """A pose of the sweep (the recorder interface of `Outputs`)."""
+        self.evaluate(pose)
+
+    def save(self, path) -> None:  # a recorder with no figure
+        return None
+
+    # ------------------------------------------------------------------ tables
+    def columns(self) -> list[str]:
+        """CSV columns: per dyad (named by its pin B) mu and the pressure angle, per output
+        its mechanical advantage, with units."""
+        if not self.applicable:
+            return []
+        cols = []
+        for d in self.dyads:
+            b = d.joint.name
+            cols += [f"{b}.transmission_angle [deg]", f"{b}.pressure_angle [deg]"]
+        for o in self.outputs:
+            cols.append(f"{self.linkage.names[o.output]}.mechanical_advantage [{self._unit(o)}]")
+        return cols
+
+    def cells(self, pose) -> list[object]:
+        """One CSV row of `columns` (blank where the pose failed)."""
+        out = self.evaluate(pose)
+        if not out:
+            return [""] * len(self.columns())
+        cells: list[object] = []
+        for mu, _, phi in out["angles"]:
+            cells += [mu, phi]
+        return cells + [x if math.isfinite(x) else "inf" for x in out["advantage"]]
+
+    def entry(self, pose) -> dict | None:
+        """The pose's `design` object of the JSON lines (SI: angles [rad])."""
+        out = self.evaluate(pose)
+        if not out:
+            return None
+        names = self.linkage.names
+        return {
+            "dyads": {d.joint.name: {"transmission_angle": math.radians(mu), "transmission_angle_acute":
+                                     math.radians(acute), "pressure_angle": math.radians(phi)}
+                      for d, (mu, acute, phi) in zip(self.dyads, out["angles"])},
+            "mechanical_advantage": {names[o.output]: (x if math.isfinite(x) else None)
+                                     for o, x in zip(self.outputs, out["advantage"])},
+        }
+
+    def _unit(self, output) -> str:
+        return advantage_unit(self.sweep.is_angular, output)
+
+    # ------------------------------------------------------------------ summary
+    def limits(self) -> list[list[LimitPosition]]:
+        """Each output's limit positions, bisected between the poses that bracket them."""
+        return [[limit for limit, _ in found] for found in self.limit_poses()]
+
+    def limit_poses(self) -> list[list[tuple[LimitPosition, np.ndarray]]]:
+        """Each output's limit positions and the closed configuration at each (bisected
+        once for the poses seen so far: the summary and the figures share them)."""
+        if self._limits[0] == self.count:
+            return self._limits[1]
+        out = []
+        for output, brackets in zip(self.outputs, self.brackets):
+            found = []
+            for x0, q0, r0, x1 in brackets:
+                try:
+                    x, q = self.finder.bisect(output, q0, x0, x1, r0)
+                except PinmechError:  # a pose between that does not close: no limit stated there
+                    continue
+                found.append((self.finder.limit(output, q, x, extreme_label(r0, x1 - x0)), q))
+            out.append(found)
+        self._limits = (self.count, out)
+        return out
+
+    def angle_extremes(self) -> list[AngleExtremes]:
+        """Each dyad's least and largest acute transmission angle and largest pressure angle
+        [deg], located between the poses (to extremum.TOL of the driver); where a trial pose
+        cannot close (a fold beside it) the value over the poses stands, `refined` False."""
+        if self._extremes[0] != self.count:
+            self._extremes = (self.count, [self._dyad_extremes(*x) for x in
+                                           zip(self.dyads, self.angles, self.pressures)])
+        return self._extremes[1]
+
+    def _dyad_extremes(self, dyad, angles: tuple[Tracked, Tracked], pressure: Tracked) -> AngleExtremes:
+        found, refined = [], True
+        for tracked, what in ((angles[0], "mu_acute"), (angles[1], "mu_acute"), (pressure, "pressure")):
+            try:
+                found.append(tracked.refine(lambda x, t=tracked, w=what: self._angle(dyad, t, x, w)))
+            except PinmechError:  # a trial pose beside a fold: the value over the poses stands
+                found.append((tracked.at, tracked.value))
+                refined = False
+        (low_at, low), (high_at, high), (p_at, p) = found
+        return AngleExtremes(dyad.joint.name, low, low_at, high, high_at, p, p_at, refined)
+
+    def _angle(self, dyad, tracked: Tracked, x: float, what: str) -> float:
+        """An angle of the dyad [deg] at driver value x, the pose followed from the tracked one."""
+        self.linkage.place(self.finder.pose(tracked.q, tracked.at, x))
+        return getattr(dyad_angles(self.linkage, dyad), what)
+
+    def folds(self) -> list[float]:
+        """The driver values of the folds the sweep met [rad or m]: where it stopped
+        (DriverLimitError) or, with `--through-folds`, where the driver turned back."""
+        return list(self._folds)
+
+    def summary(self, span: float | None = None) -> list[str]:
+        """Lines for the end of a sweep; `span`: the driver's travel [rad] when it was one
+        whole turn (then the time ratio of each output with two limit positions)."""
+        if not self.applicable:
+            return [f"design: planar diagnostics: not applicable ({self.reason})"]
+        if not self.count:
+            return []
+        lines = [f"design: loop {'-'.join(x.links)}: {x.kind}, {x.label} ({x.condition})"
+                 for x in loop_classes(self.linkage)]
+        fmt = self._driver
+        for d, x in zip(self.dyads, self.angle_extremes()):
+            what = "transmission angle (acute)" if d.kind == "pin" else "90 deg - pressure angle"
+            where = "located between" if x.refined else "over"
+            lines.append(f"design: {d.name(self.linkage)}: {what} from {x.low:.6g} deg at {fmt(x.low_at)} to "
+                         f"{x.high:.6g} deg at {fmt(x.high_at)}; pressure angle up to {x.pressure:.6g} deg at "
+                         f"{fmt(x.pressure_at)} ({where} the {self.count} poses)")
+        lines += [f"design: {self.sweep.driver}: fold (limit position of the driver) at {fmt(x)}"
+                  for x in self.folds()]
+        for output, found, stat in zip(self.outputs, self.limits(), self.advantages):
+            name = self.linkage.names[output.output]
+            lines += self._travel_lines(name, found, span)
+            if math.isfinite(stat.low):
+                lines.append(f"design: {name}: mechanical advantage |driver rate / {name}'s rate| least "
+                             f"{stat.low:.6g} [{self._unit(output)}] at {self._driver(stat.low_at)} over the poses "
+                             "(infinite at its limit positions)")
+        return lines
+
+    def _travel_lines(self, name: str, found: list[LimitPosition], span: float | None) -> list[str]:
+        if not found:
+            return []
+        t = travel(found, span)
+        fmt, lines = self._driver, []
+        for x in t.limits:
+            value = f"{math.degrees(x.value):.6g} deg" if x.kind == "rocker extreme" else f"{x.value:.6g} m"
+            lay = f", driving link and coupler {x.toggle} (toggle)" if x.toggle else ""
+            lines.append(f"design: {name}: {x.kind} ({x.label}) {value} at {fmt(x.driver)}{lay}")
+        if t.travel is not None:
+            word = (f"swing {math.degrees(t.travel):.6g} deg" if t.kind == "rocker extreme"
+                    else f"stroke {t.travel:.6g} m")
+            lines.append(f"design: {name}: {word}")
+        if t.ratio is not None:
+            lines.append(f"design: {name}: time ratio Q = {t.ratio:.6g} (strokes over {math.degrees(t.alpha):.6g} "
+                         f"and {math.degrees(t.beta):.6g} deg of the driver)")
+        return lines
+
+    def _driver(self, value: float) -> str:
+        unit = f"{math.degrees(value):.6g} deg" if self.sweep.is_angular else f"{value:.6g} m"
+        return f"{self.sweep.driver} = {unit}"
+
+
+def design_of(sweep) -> DesignSweep:
+    """The sweep's one `DesignSweep` (made on first use), shared by its tables and summary."""
+    design = sweep.__dict__.get("_design")
+    if design is None:
+        design = sweep.__dict__["_design"] = DesignSweep(sweep)
+    return design
