@@ -23,8 +23,8 @@ from pinmech import (
     SingularPoseError,
     Task,
     TaskError,
-    core,
 )
+from pinmech.solve import core
 from pinmech.solve.rates import DAMPING_RANGE
 from tests.conftest import MODELS
 
