@@ -266,7 +266,7 @@ class DesignSweep:
                  for x in loop_classes(self.linkage)]
         fmt = self._driver
         for d, x in zip(self.dyads, self.angle_extremes()):
-            what = "transmission angle (acute)" if d.kind == "pin" else "90 deg - pressure angle"
+            what = "transmission angle (acute)" if d.kind == "pin" else "transmission angle (90 deg - pressure angle)"
             where = "located between" if x.refined else "over"
             lines.append(f"design: {d.name(self.linkage)}: {what} from {x.low:.6g} deg at {fmt(x.low_at)} to "
                          f"{x.high:.6g} deg at {fmt(x.high_at)}; pressure angle up to {x.pressure:.6g} deg at "

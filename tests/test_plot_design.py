@@ -255,12 +255,12 @@ def test_a_slot_cut_slider_is_drawn_along_its_slot(figures, tmp_path):
     the crank at 60 rpm. (The figure refused this scene before: "unknown joint 'B_slide'".)"""
     r, d, omega = 0.05, 0.10, 2 * math.pi
     assert main(["sweep", str(SCENES / "crank_shaper.toml"), "--steps", "37", "--plot", str(tmp_path / "f.png")]) == 0
-    (line,) = [x for x in _panel(figures[0], "position along its guide").get_lines() if x.get_label() == "B_slide"]
+    (line,) = [x for x in _panel(figures[0], "position along its guide").get_lines() if x.get_label().startswith("B_slide")]
     theta, s = (np.asarray(v, dtype=float) for v in line.get_data())
     B = r * np.column_stack([np.cos(np.radians(theta)), np.sin(np.radians(theta))])
     CB = B - np.array([0.0, -d])
     np.testing.assert_allclose(s, 1000 * (np.linalg.norm(CB, axis=1) - 0.15), rtol=0, atol=PLACE_TOL_MM)
-    (line,) = [x for x in _panel(figures[0], "velocity along its guide").get_lines() if x.get_label() == "B_slide"]
+    (line,) = [x for x in _panel(figures[0], "velocity along its guide").get_lines() if x.get_label().startswith("B_slide")]
     dB = r * omega * np.column_stack([-np.sin(np.radians(theta)), np.cos(np.radians(theta))])
     v = np.sum(CB * dB, axis=1) / np.linalg.norm(CB, axis=1)
     # rates: closure rounding times the condition number, 1e-9 mm/s on 300 mm/s
