@@ -274,3 +274,32 @@ def test_timing_marks_take_a_positive_angle_for_a_crank(tmp_path, capsys, step, 
                  "--timing-marks", step]) in (2, 4)
     err = capsys.readouterr().err
     assert said in err and "Traceback" not in err and not (tmp_path / "p.png").exists()
+
+
+@pytest.mark.parametrize("flag", ["--skip-failures", "--through-folds"])
+def test_fold_outlines_of_a_triple_rocker_are_at_the_law_of_cosines_angle(figures, tmp_path, flag):
+    """Triple rocker d = 100, a = 45, b = 50, c = 55 mm (Norton §2.12): the crank stops where
+    coupler and rocker are in line, |O4 A| = b + c, cos theta = (a^2 + d^2 - (b + c)^2) /
+    (2 a d) = 1/9, theta = 83.62 deg (and -83.62 deg through the folds). The paths figure
+    outlines the mechanism there: the crank's end A = a (cos theta, sin theta) and the
+    rocker's end B on O4 A at c from O4."""
+    a, b, c, d = 45.0, 50.0, 55.0, 100.0
+    theta = math.acos((a**2 + d**2 - (b + c) ** 2) / (2 * a * d))
+    scene = _four_bar_files(tmp_path, d, a, b, c)
+    scene.write_text(scene.read_text() + '[report]\npoints = ["B"]\n')
+    assert main(["sweep", str(scene), "--steps", "13", flag, "--paths", str(tmp_path / "p.png")]) == 0
+    ax = figures[0].axes[0]
+    folds = [line for line in ax.get_lines() if line.get_gid() == "fold"]
+    assert any("fold" in line.get_label() for line in folds)
+    drawn = np.vstack([np.column_stack(line.get_data()) for line in folds])
+    O4 = np.array([d, 0.0])
+    for t in ([theta] if flag == "--skip-failures" else [theta, -theta]):
+        A = a * np.array([math.cos(t), math.sin(t)])
+        B = O4 + c * (A - O4) / np.linalg.norm(A - O4)
+        # A is set by the driver's value at the fold, located to rounding: PLACE_TOL_MM.
+        # B: at a fold the loop's other angles move as the square root of the driver's
+        # distance to it; the fold is located to ~1e-13 rad, so B to ~sqrt(1e-13) * 100 mm
+        # ~ 3e-5 mm: 1e-3 mm leaves a margin of 30.
+        for point, tol in ((A, PLACE_TOL_MM), (B, 1e-3)):
+            nearest = np.min(np.linalg.norm(drawn - point, axis=1))
+            assert nearest < tol, (t, point, nearest)
