@@ -312,9 +312,10 @@ class SweepPlot:
 
     def _draw_paths(self, ax) -> None:
         """The paths, the mechanism at the scene's pose, ghost outlines at the limit
-        positions and the timing marks asked for."""
+        positions and folds, and the timing marks asked for."""
         ghosts = [(q, label) for label, _, q in self.design.limits()]
-        self.paths.draw(ax, self.mark_q, self._travel(), backwards=self._backwards(), ghosts=ghosts,
+        folds = [q for _, q in self.design.design.fold_poses()] if self.design.design.applicable else []
+        self.paths.draw(ax, self.mark_q, self._travel(), backwards=self._backwards(), ghosts=ghosts, folds=folds,
                         timing=self.timing)
 
     def _mark_least(self, ax, turn: bool) -> None:
