@@ -93,6 +93,7 @@ class SweepPlot:
         named = [n for n in self.points or () if sweep.mechanism.model.existFrame(n)]  # a drawn linkage's pins
         _check_names(sweep, "point", self.points, [*sweep.mechanism.points, *named],
                      "--points" if points else "[sweep] points")
+        sweep.need_points(n for n in named if n not in sweep.mechanism.points)  # evaluated at every pose
         self.every = max(1, math.ceil(total / max_points)) if total else 1
         self.last = total - 1 if total else None  # drawn whatever every is: a turn ends where it ends
         self.normal = sweep.mechanism.plane_normal
