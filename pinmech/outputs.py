@@ -224,7 +224,11 @@ class Outputs:
         for recorder, output in self.figures:
             if output is None:
                 continue
-            recorder.save(output.temporary)
+            try:
+                recorder.save(output.temporary)
+            except PinmechError as exc:  # named by the file the user asked for, not its temporary
+                exc.args = (str(exc).replace(str(output.temporary), str(output.path)), *exc.args[1:])
+                raise
             output.commit()
             print(f"figure written to {output.path}", file=sys.stderr)
 

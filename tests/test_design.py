@@ -8,6 +8,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -372,3 +373,54 @@ def test_folds_of_a_non_grashof_crank_are_listed_with_the_limit_positions(tmp_pa
     np.testing.assert_allclose(found, expected, rtol=0, atol=1e-8)
     summary = "\n".join(design.summary(2 * math.pi))
     assert f"design: O2: fold (limit position of the driver) at O2 = {fold:.6g} deg" in summary
+
+
+def _shaper_files(tmp_path, along: str):
+    """The crank-shaper of models/linkages/crank_shaper.toml (crank r = 50 mm about A,
+    lever pivot C 100 mm below A) with its slot drawn through B along `along`."""
+    text = (MODELS / "linkages" / "crank_shaper.toml").read_text()
+    (tmp_path / "shaper.toml").write_text(text.replace('along = ["C", "B"]', f"along = {along}"))
+    scene = tmp_path / "shaper_scene.toml"
+    scene.write_text('title = "shaper"\nlinkage = "shaper.toml"\n[drivers.A]\nangle = "90 deg"\nspeed = "60 rpm"\n')
+    return scene
+
+
+@pytest.mark.parametrize("along, offset", [('["C", "B"]', 0.0), ('"80 deg"', 0.15 * math.cos(80 * DEG))])
+def test_pressure_angle_of_the_inverted_slider_crank_is_set_by_the_slots_offset(tmp_path, along, offset):
+    """Inverted slider-crank (Norton §4.7): the block on the crank pin P pushes the lever,
+    without friction, normal to the slot; the lever's point at P moves normal to C P. The
+    pressure angle is the angle between the two, i.e. between the slot and C P: sin phi =
+    e / |C P|, e the slot's offset from the pivot C (drawn through B = (0, 50) mm at 80 deg:
+    e = 150 mm cos 80 deg = 26.05 mm, less than |C P| >= d - r = 50 mm), P = r (cos theta, sin theta), C = (0, -d). A slot
+    through the pivot (the crank-shaper) transmits at mu = 90 deg in every pose."""
+    r, d = 0.05, 0.10
+    scene = _shaper_files(tmp_path, along)
+    for theta in (0.0, 75.0, 160.0, 230.0, 300.0):
+        ((dyad, angles),) = analysis_design(pinmech.analyse(pinmech.Scene.load(
+            scene, [f'drivers.A.angle="{theta} deg"']))).dyads
+        cp = math.hypot(r * math.cos(theta * DEG), r * math.sin(theta * DEG) + d)
+        phi = math.degrees(math.asin(offset / cp))
+        assert dyad.kind == "slot"
+        np.testing.assert_allclose(angles.pressure, phi, rtol=0, atol=ANGLE_TOL)
+        np.testing.assert_allclose(angles.mu, 90 - phi, rtol=0, atol=ANGLE_TOL)
+
+
+def test_sweep_of_the_inverted_slider_crank_reports_its_transmission_angle(tmp_path, capsys):
+    """mu = 90 deg - asin(e / |C P|) is least where |C P| is least, the crank pointing at C
+    (theta = 270 deg, |C P| = d - r = 50 mm), and largest pointing away (90 deg, d + r);
+    the slot along 80 deg: e = 150 mm cos 80 deg = 26.05 mm."""
+    scene = _shaper_files(tmp_path, '"80 deg"')
+    out = tmp_path / "sweep.csv"
+    assert main(["sweep", str(scene), "--csv", str(out)]) == 0
+    e = 0.15 * math.cos(80 * DEG)
+    low, high = 90 - math.degrees(math.asin(e / 0.05)), 90 - math.degrees(math.asin(e / 0.15))
+    line = next(x for x in capsys.readouterr().err.splitlines() if "B_slide: transmission angle" in x)
+    found = re.search(r"from (\S+) deg at A = (\S+) deg to (\S+) deg at A = (\S+) deg", line).groups()
+    got = [float(x) for x in found]
+    got[1::2] = [x % 360 for x in got[1::2]]
+    # the extremes are located by golden-section search to 1e-10 rad of the driver; the
+    # report prints 6 significant digits: rtol 1e-5
+    np.testing.assert_allclose(got, [low, 270, high, 90], rtol=1e-5)
+    with open(out) as f:
+        rows = list(csv.DictReader(f))
+    assert any("transmission_angle" in k for k in rows[0])

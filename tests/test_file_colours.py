@@ -62,3 +62,26 @@ def test_a_urdf_without_materials_gets_the_palette_everywhere(tmp_path):
         hex_colour(c) for n, c in zip(names, expected) if n in polygon.colours]
     page = _visual_colours(mech)
     np.testing.assert_allclose([page[j] for j in joints], expected, atol=1e-7)
+
+
+def test_an_mjcf_files_geom_colours_are_used_by_curves_and_pages(tmp_path):
+    """An MJCF four-bar whose crank geom is orange (rgba) and whose coupler geom has no
+    colour: the crank is MuJoCo's geom_rgba in the curves and on the page; the coupler,
+    which the file does not colour (MuJoCo's default grey), takes the palette's colour in
+    both, so the two outputs agree."""
+    mujoco = __import__("pytest").importorskip("mujoco")
+    text = (MODELS / "mjcf" / "four_bar.xml").read_text()
+    assert 'rgba="0.85 0.15 0.15 1"' in text and 'rgba="0.15 0.35 0.85 1"' in text
+    text = text.replace('rgba="0.85 0.15 0.15 1"', 'rgba="0.9 0.6 0.1 1"').replace(' rgba="0.15 0.35 0.85 1"', "")
+    path = tmp_path / "four_bar.xml"
+    path.write_text(text)
+    compiled = mujoco.MjModel.from_xml_path(str(path))
+    crank_rgba = compiled.geom_rgba[0][:3]  # the file's first geom is the crank's
+    mech = pinmech.load_mjcf(path)
+    np.testing.assert_allclose(colour_of(mech, "crank"), crank_rgba, atol=1e-7)  # float32 in MuJoCo
+    pages = _visual_colours(mech)
+    crank_joint = mech.model.frames[mech.links["crank"]].parentJoint
+    coupler_joint = mech.model.frames[mech.links["coupler"]].parentJoint
+    np.testing.assert_allclose(pages[crank_joint], crank_rgba, atol=1e-7)
+    np.testing.assert_allclose(colour_of(mech, "coupler"), PALETTE[coupler_joint - 1], atol=0)
+    np.testing.assert_allclose(pages[coupler_joint], PALETTE[coupler_joint - 1], atol=1e-7)

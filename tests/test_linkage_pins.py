@@ -105,3 +105,20 @@ def test_a_pin_is_accepted_in_a_sweep(tmp_path):
         theta = math.radians(float(next(v for k, v in row.items() if k.startswith("O2"))))
         ref = cf.four_bar(theta, 1.0, 0.0, 0.04, 0.12, 0.08, 0.10, branch=+1)
         np.testing.assert_allclose(float(row[x]) * scale, ref.B[0], atol=1e-9)  # CSV digits: ~1e-12 m
+
+
+@pytest.mark.parametrize("figure", ["--plot", "--paths"])
+def test_a_pin_named_only_on_the_command_line_is_drawn(tmp_path, figures, figure):
+    """`--points B` on a scene whose [report] does not list pin B (it ended in a KeyError
+    traceback): B is evaluated at every pose and drawn; its drawn path is Norton's B."""
+    path = tmp_path / "scene.toml"
+    path.write_text(f'linkage = "{LINKAGES / "four_bar.toml"}"\n[drivers.O2]\nangle = "0 deg"\nspeed = "1 rad/s"\n')
+    assert main(["sweep", str(path), "--steps", "9", figure, str(tmp_path / "f.png"), "--points", "B"]) == 0
+    ax = next(a for a in figures[-1].axes if any(line.get_label() == "path of B" for line in a.get_lines()))
+    (line,) = [x for x in ax.get_lines() if x.get_label() == "path of B"]
+    x, y = line.get_data()
+    scale = 1e-3 if "mm" in ax.get_xlabel() else 1.0
+    for k, theta in enumerate(np.radians(np.linspace(0.0, 360.0, 9))):
+        ref = cf.four_bar(theta, 1.0, 0.0, 0.04, 0.12, 0.08, 0.10, branch=+1)
+        # drawn coordinates are the solved ones (loops closed to 1e-13 of 0.1 m)
+        np.testing.assert_allclose([x[k] * scale, y[k] * scale], ref.B[:2], atol=1e-9)

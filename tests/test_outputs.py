@@ -283,3 +283,19 @@ def test_build_writes_files_as_every_other_output_does(tmp_path, models_dir):
     assert stat.S_IMODE(fresh.stat().st_mode) == 0o644
     assert stat.S_IMODE(kept.stat().st_mode) == 0o640
     assert "<robot" in kept.read_text()
+
+
+def test_a_figure_refused_at_the_end_names_the_users_file_not_its_temporary(tmp_path, capsys):
+    """`--paths` with no point to trace is refused when the figure is drawn: the message
+    named the hidden temporary file (.p.png.XXXX.tmp.png), not p.png."""
+    pytest.importorskip("matplotlib", reason='needs pip install "pinmech[plot]"')
+    from pinmech.cli import main
+
+    scene = tmp_path / "arm.toml"
+    scene.write_text(f'linkage = "{Path(__file__).resolve().parents[1] / "models/linkages/four_bar.toml"}"\n'
+                     '[drivers.O2]\nangle = "0 deg"\nspeed = "1 rad/s"\n[report]\npoints = []\n')
+    target = tmp_path / "p.png"
+    code = main(["sweep", str(scene), "--steps", "5", "--paths", str(target)])
+    err = capsys.readouterr().err
+    assert code != 0 and f"nothing to draw in {target}" in err and ".tmp" not in err, err
+    assert not target.exists()

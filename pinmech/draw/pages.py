@@ -67,6 +67,7 @@ def mechanism_visuals(mechanism) -> tuple[pin.GeometryModel, list[str]]:
     URDF, a drawn linkage's generated URDF, an MJCF file), links without visuals
     sketched, and the meshes left out (outside the model's package)."""
     from pinmech.draw.sketch import sketch_visuals
+    from pinmech.model.file_colours import UNCOLOURED
 
     path = mechanism.urdf_path or mechanism.source
     skipped: list[str] = []
@@ -74,20 +75,22 @@ def mechanism_visuals(mechanism) -> tuple[pin.GeometryModel, list[str]]:
         from pinmech.model.mjcf import mjcf_visuals
 
         visuals = mjcf_visuals(path, mechanism.model)
+        _paint_uncoloured(mechanism, visuals, lambda obj: tuple(obj.meshColor[:3]) == UNCOLOURED)
     else:
         visuals, skipped = package_visuals(path, mechanism.model)
         _paint_uncoloured(mechanism, visuals)
     return sketch_visuals(mechanism, visuals), skipped
 
 
-def _paint_uncoloured(mechanism, visuals: pin.GeometryModel) -> None:
-    """A URDF visual without a material takes its link's colour (pinmech.model.display), as the
-    curves and polygons draw that link; a visual with one keeps the file's colour."""
+def _paint_uncoloured(mechanism, visuals: pin.GeometryModel, uncoloured=lambda obj: not obj.overrideMaterial) -> None:
+    """A visual its file does not colour (a URDF visual without a material, an MJCF geom
+    without rgba or material) takes its link's colour (pinmech.model.display), as the curves and
+    polygons draw that link; a visual the file colours keeps the file's colour."""
     from pinmech.model.display import joint_colours
 
     colours = joint_colours(mechanism)
     for obj in visuals.geometryObjects:
-        if not obj.overrideMaterial:
+        if uncoloured(obj):
             obj.meshColor = np.array([*colours[obj.parentJoint], 1.0])
             obj.overrideMaterial = True
 

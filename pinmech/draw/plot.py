@@ -93,6 +93,7 @@ class SweepPlot:
         named = [n for n in self.points or () if sweep.mechanism.model.existFrame(n)]  # a drawn linkage's pins
         _check_names(sweep, "point", self.points, [*sweep.mechanism.points, *named],
                      "--points" if points else "[sweep] points")
+        sweep.need_points(n for n in named if n not in sweep.mechanism.points)  # evaluated at every pose
         self.every = max(1, math.ceil(total / max_points)) if total else 1
         self.last = total - 1 if total else None  # drawn whatever every is: a turn ends where it ends
         self.normal = sweep.mechanism.plane_normal
@@ -312,9 +313,10 @@ class SweepPlot:
 
     def _draw_paths(self, ax) -> None:
         """The paths, the mechanism at the scene's pose, ghost outlines at the limit
-        positions and the timing marks asked for."""
+        positions and folds, and the timing marks asked for."""
         ghosts = [(q, label) for label, _, q in self.design.limits()]
-        self.paths.draw(ax, self.mark_q, self._travel(), backwards=self._backwards(), ghosts=ghosts,
+        folds = [q for _, q in self.design.design.fold_poses()] if self.design.design.applicable else []
+        self.paths.draw(ax, self.mark_q, self._travel(), backwards=self._backwards(), ghosts=ghosts, folds=folds,
                         timing=self.timing)
 
     def _mark_least(self, ax, turn: bool) -> None:

@@ -54,10 +54,12 @@ class DesignTrace:
 
     def least(self) -> list[LeastAngle]:
         """Each dyad's least transmission angle, located between the poses around it by the
-        design summary's own search (`DesignSweep.angle_extremes`)."""
+        design summary's own search (`DesignSweep.angle_extremes`); none for an angle that
+        does not change (a slot through its lever's pivot: mu = 90 deg throughout)."""
         if not self.dyads or not self.design.count:
             return []
-        return [LeastAngle(x.name, x.low, x.low_at, x.refined) for x in self.design.angle_extremes()]
+        return [LeastAngle(x.name, x.low, x.low_at, x.refined) for x in self.design.angle_extremes()
+                if x.high - x.low > 1e-9 * 180.0]  # below: rounding about a constant
 
     def limits(self) -> list[tuple[str, float, np.ndarray]]:
         """(label, driver value [rad or m], closed q) of every output's limit position."""

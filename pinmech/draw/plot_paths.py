@@ -69,17 +69,21 @@ class PathRecorder:
         return {name: tuple(self.axes @ np.array(xyz)) for name, xyz in self.xyz.items()}
 
     def draw(self, ax, q: np.ndarray | None, travel: str, *, backwards: bool = False,
-             ghosts: list[tuple[np.ndarray, str]] = (), timing=None) -> None:
+             ghosts: list[tuple[np.ndarray, str]] = (), folds: list[np.ndarray] = (), timing=None) -> None:
         """Paths, the mechanism at q (if given) and arrows of travel, on matplotlib axes
         (3-D axes when the recorder is 3-D); `backwards`: the points move against the order
         they were recorded in (a driver turning at a negative speed), and the arrows say so;
-        `ghosts`: (q, label) of poses outlined thinly (limit positions); `timing`: a
+        `ghosts`: (q, label) of poses outlined thinly (limit positions); `folds`: q at the
+        driver's own limits, outlined dotted; `timing`: a
         `plot_timing.TimingMarks` whose marks are drawn on the paths."""
         if self.is_3d:
             return self._draw_3d(ax, q, travel, backwards)
         scale, unit = self._unit()
         for k, (ghost, label) in enumerate(ghosts):
             draw_ghost(ax, self.mechanism, ghost, self.axes, scale, "outlines: limit positions" if k == 0 else None)
+        for k, fold in enumerate(folds):
+            draw_ghost(ax, self.mechanism, fold, self.axes, scale, "outlines: folds (the driver's limits)" if k == 0
+                       else None, style=(0, (1, 1.5)), gid="fold")
         if q is not None:
             draw_linkage(ax, self.mechanism, q, self.axes, scale)
         for k, (name, (u, v)) in enumerate(self.uv.items()):
@@ -217,9 +221,9 @@ def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scal
 
 
 def draw_ghost(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scale: float = 1.0,
-               label: str | None = None) -> None:
+               label: str | None = None, style=(0, (3, 2)), gid: str = "ghost") -> None:
     """The mechanism at q outlined thinly (a limit position beside the drawn pose): each
-    moving link's bar or plate edge, dashed in its colour [m x scale]."""
+    moving link's bar or plate edge, dashed (`style`) in its colour [m x scale]."""
     data = mechanism.model.createData()
     pin.forwardKinematics(mechanism.model, data, q)
     colours = joint_colours(mechanism)
@@ -229,8 +233,8 @@ def draw_ghost(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scale:
             continue
         hull = _hull(uv) if link.is_plate and len(uv) >= 3 else np.empty((0, 2))
         ring = np.vstack([hull, hull[:1]]) if len(hull) >= 3 else uv[list(_farthest(uv))]
-        ax.plot(ring[:, 0], ring[:, 1], color=colours[link.joint], linewidth=1.0, linestyle=(0, (3, 2)),
-                alpha=0.55, zorder=1.5, gid="ghost", label=label)
+        ax.plot(ring[:, 0], ring[:, 1], color=colours[link.joint], linewidth=1.0, linestyle=style,
+                alpha=0.55, zorder=1.5, gid=gid, label=label)
         label = None
 
 

@@ -179,6 +179,7 @@ class Sweep:
     drivers: Drivers
     last_q: np.ndarray | None = None  # configuration of the last pose, None if it failed (drawings, return_gap)
     first_q: np.ndarray | None = None  # configuration of the first pose, None if it failed
+    extra_points: tuple[str, ...] = ()  # frames a figure draws beyond the reported points (need_points)
 
     @classmethod
     def from_scene(cls, scene: Scene, driver: str | None = None) -> Sweep:
@@ -256,6 +257,8 @@ class Sweep:
         elif predictor is False:
             start = "warm"
         points, links = report_lists(self.scene)
+        if self.extra_points:  # the reported points (None: every point), then the frames a figure draws
+            points = list(dict.fromkeys([*(self.mechanism.points if points is None else points), *self.extra_points]))
         coincident = coincident_points(self.scene)
         for chunk in self.chunks(values, start=start, batch=batch, interpolate=interpolate,
                                  through_folds=through_folds):
@@ -280,6 +283,11 @@ class Sweep:
                                              points=points, links=links, coincident=coincident)
                 yield SweepPose(index, value, motion, sol.accuracy(j), interpolated=bool(chunk.interpolated[j]),
                                 note=chunk.notes.get(j, ""))
+
+    def need_points(self, names) -> None:
+        """Evaluate these frames (a drawn linkage's pins, by name) at every pose as well, for a
+        figure that draws them though the scene does not report them."""
+        self.extra_points = tuple(dict.fromkeys([*self.extra_points, *names]))
 
     def _fold(self, exc: Exception) -> float | None:
         """The swept driver's value at the fold a DriverLimitError names [rad or m], else None."""

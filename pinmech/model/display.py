@@ -60,14 +60,18 @@ def display_names(mechanism: Mechanism) -> dict[str, str]:
 
 def joint_colours(mechanism: Mechanism) -> dict[int, tuple[float, float, float]]:
     """Pinocchio joint id (0: the ground) -> the colour of the link hanging on it: the
-    colour the model's URDF gives that link's visuals (pinmech.model.file_colours; a drawn
-    linkage's generated URDF too), else the palette's (the ground grey)."""
-    from pinmech.model.file_colours import urdf_link_colours
+    colour the model's file gives that link's visuals (pinmech.model.file_colours: a URDF's
+    materials, a drawn linkage's generated URDF's, an MJCF file's geom colours), else the
+    palette's (the ground grey)."""
+    from pinmech.model.file_colours import mjcf_joint_colours, urdf_link_colours
 
     out: dict[int, tuple[float, float, float]] = {0: GROUND_GREY}
     for k, joint in enumerate(range(1, mechanism.model.njoints)):
         out[joint] = PALETTE[k % len(PALETTE)]
     path = mechanism.urdf_path or mechanism.source
+    if str(path).endswith(".xml"):  # MJCF: the colour of each body's first coloured geom
+        out.update(mjcf_joint_colours(str(path), mechanism.model))
+        return out
     filed = urdf_link_colours(str(path)) if str(path).endswith(".urdf") else {}
     taken: set[int] = set()
     for frame in mechanism.model.frames:  # a joint's first coloured body (the link on it)

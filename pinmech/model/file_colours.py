@@ -1,7 +1,9 @@
-"""The colour a URDF gives each link's visuals: the first `<visual>` whose `<material>`
-has a `<color rgba>` or names a material defined at the top level with one. Read once per
-file (and again when the file changes); pinmech.model.display falls back to its palette for
-links the file does not colour."""
+"""The colour a model file gives each link's visuals. URDF: the first `<visual>` whose
+`<material>` has a `<color rgba>` or names a material defined at the top level with one.
+MJCF: the first geom of a moving body that its `rgba` or material colours, as Pinocchio's
+MJCF parser reads it (default classes included). Read once per file (and again when the
+file changes); pinmech.model.display falls back to its palette for links the file does not
+colour."""
 
 from __future__ import annotations
 
@@ -50,3 +52,30 @@ def _rgba(material: ET.Element) -> RGB | None:
     except ValueError:
         return None
     return (values[0], values[1], values[2]) if len(values) == 4 else None
+
+
+#: The colour Pinocchio's MJCF parser gives a geom that neither `rgba` nor a material colours.
+UNCOLOURED = (1.0, 1.0, 1.0)
+_MJCF_CACHE: dict[tuple[str, int, int], dict[int, RGB]] = {}
+
+
+def mjcf_joint_colours(path: str, model) -> dict[int, RGB]:
+    """Pinocchio joint id -> RGB in [0, 1] of the first geom the MJCF file colours on it
+    ({} for an unreadable file). `model`: the mechanism's model, built from that file."""
+    try:
+        stamp = os.stat(path).st_mtime_ns
+    except OSError:
+        return {}
+    key = (path, stamp, id(model))
+    if key not in _MJCF_CACHE:
+        from pinmech.model.mjcf import mjcf_visuals
+
+        out: dict[int, RGB] = {}
+        for obj in mjcf_visuals(path, model).geometryObjects:
+            rgb = (float(obj.meshColor[0]), float(obj.meshColor[1]), float(obj.meshColor[2]))
+            if obj.parentJoint not in out and rgb != UNCOLOURED:
+                out[obj.parentJoint] = rgb
+        _MJCF_CACHE.clear()  # one file at a time is what a run draws
+        _MJCF_CACHE[key] = out
+    return dict(_MJCF_CACHE[key])
+

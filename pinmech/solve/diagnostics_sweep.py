@@ -87,6 +87,8 @@ class DesignSweep:
         self._previous: float | None = None  # the last solved pose's driver value
         self._step: float | None = None  # the driver's last step between solved poses [rad or m]
         self._folds: list[float] = []
+        self._fold_from: list[tuple[float, np.ndarray, float]] = []  # (fold, closed q, its driver value)
+        self._previous_q: np.ndarray | None = None
         self.advantages = [_Extreme() for _ in self.outputs]
         self.previous: list[tuple | None] = [None] * len(self.outputs)
         self.brackets: list[list[tuple]] = [[] for _ in self.outputs]
@@ -105,7 +107,7 @@ class DesignSweep:
         if self.applicable:
             self._fold(pose)
         if self.applicable and pose.motion is None:
-            self._previous = None
+            self._previous, self._previous_q = None, None
         if self.applicable and pose.motion is not None:
             q = self._q(pose.motion)
             v, _, _ = self.solver.rates(q, self.unit, np.zeros(len(self.unit)), closed=not pose.interpolated)
@@ -131,10 +133,14 @@ class DesignSweep:
         point p with p - x0 + p - x1 = the step (x0, x1 the driver values either side)."""
         if pose.fold is not None and not any(abs(pose.fold - x) <= 1e-12 for x in self._folds):
             self._folds.append(pose.fold)
+            if self._previous_q is not None:
+                self._fold_from.append((pose.fold, self._previous_q, self._previous))
         if "crossed a fold" not in pose.note:
             return
         if self._previous is not None and self._step is not None and pose.motion is not None:
             self._folds.append(0.5 * (self._previous + pose.value + self._step))
+            if self._previous_q is not None:
+                self._fold_from.append((self._folds[-1], self._previous_q, self._previous))
         self._step = None if self._step is None else -self._step
 
     def _record(self, pose, q: np.ndarray, rates: list[float], out: dict) -> None:
@@ -145,7 +151,7 @@ class DesignSweep:
             pressure.add(phi, pose.value, q, self._previous)
         if self._previous is not None and "crossed a fold" not in pose.note:
             self._step = pose.value - self._previous
-        self._previous = pose.value
+        self._previous, self._previous_q = pose.value, q
         for i, (stat, value) in enumerate(zip(self.advantages, out["advantage"])):
             if math.isfinite(value):
                 stat.add(abs(value), pose.value)
@@ -255,6 +261,20 @@ class DesignSweep:
         (DriverLimitError) or, with `--through-folds`, where the driver turned back."""
         return list(self._folds)
 
+    def fold_poses(self) -> list[tuple[float, np.ndarray]]:
+        """(driver value [rad or m], closed q) at each fold, followed from the last pose
+        before it; where the step onto the fold itself does not close (the loop's Jacobian
+        is singular there), the nearest of 1e-12 .. 1e-6 of the step short of it."""
+        out = []
+        for fold, q0, x0 in self._fold_from:
+            for short in (0.0, 1e-12, 1e-9, 1e-6):
+                try:
+                    out.append((fold, self.finder.pose(q0, x0, fold - short * (fold - x0))))
+                    break
+                except PinmechError:
+                    continue
+        return out
+
     def summary(self, span: float | None = None) -> list[str]:
         """Lines for the end of a sweep; `span`: the driver's travel [rad] when it was one
         whole turn (then the time ratio of each output with two limit positions)."""
@@ -266,7 +286,7 @@ class DesignSweep:
                  for x in loop_classes(self.linkage)]
         fmt = self._driver
         for d, x in zip(self.dyads, self.angle_extremes()):
-            what = "transmission angle (acute)" if d.kind == "pin" else "90 deg - pressure angle"
+            what = "transmission angle (acute)" if d.kind == "pin" else "transmission angle (90 deg - pressure angle)"
             where = "located between" if x.refined else "over"
             lines.append(f"design: {d.name(self.linkage)}: {what} from {x.low:.6g} deg at {fmt(x.low_at)} to "
                          f"{x.high:.6g} deg at {fmt(x.high_at)}; pressure angle up to {x.pressure:.6g} deg at "

@@ -19,6 +19,12 @@ force on the output and its velocity):
 - slider dyad: phi is the acute angle between the coupler's line and the slide, and its
   transmission angle mu = 90 deg - phi (the angle between the coupler and the slide's
   normal, the "output link" of a slider being of infinite length along that normal).
+- slot dyad (the inverted slider-crank, Norton §4.7, and the crank and slotted lever): a
+  block on the input side's pin P slides in a slot of an output pivoted at O. Without
+  friction the block pushes the output normal to the slot, and the output's point at P
+  moves normal to OP: phi is the angle between those two normals, i.e. the acute angle
+  between the slot and OP (sin phi = e / |OP|, e the slot's offset from O), and mu =
+  90 deg - phi as for any dyad. A slot through the pivot transmits at mu = 90 deg always.
 """
 
 from __future__ import annotations
@@ -37,7 +43,8 @@ class Dyad:
     """A coupler and its output link.
 
     Attributes:
-        kind: "pin" (the output turns about a ground pivot) or "slide" (a block on the ground).
+        kind: "pin" (the output turns about a ground pivot), "slide" (a block on the
+            ground) or "slot" (the coupler is a block sliding in a slot of a pivoted output).
         coupler, output: link indices of the linkage.
         joint: the pin B between them; near: the coupler's pin A towards the input;
         ground: the output's pin O to the ground, or its slide on the ground.
@@ -126,6 +133,8 @@ def find_dyads(linkage: PlanarLinkage, drivers: list[str]) -> list[Dyad]:
     dist = distances(linkage, inputs)
     out = []
     for joint in linkage.pairs:
+        if joint.kind == "slide" and 0 not in joint.links:
+            out += _slot_dyads(linkage, joint, inputs, dist)
         if joint.kind != "pin" or 0 in joint.links:
             continue
         for coupler, output in (joint.links, joint.links[::-1]):
@@ -136,6 +145,20 @@ def find_dyads(linkage: PlanarLinkage, drivers: list[str]) -> list[Dyad]:
             if ground is not None and near is not None:
                 kind = "pin" if ground.kind == "pin" else "slide"
                 out.append(Dyad(kind, coupler, output, joint, near, ground, near.other(coupler)))
+    return out
+
+
+def _slot_dyads(linkage: PlanarLinkage, joint: Pair, inputs: list[int], dist: dict[int, int]) -> list[Dyad]:
+    """The slot dyad of a slide between two moving links: a block (not an input) pinned
+    towards the input, sliding on an output farther from it that is pivoted on the ground."""
+    out = []
+    for block, output in (joint.links, joint.links[::-1]):
+        if block in inputs or dist.get(output, -1) <= dist.get(block, 10**9):
+            continue
+        pivots = [p for other, p in linkage.neighbours(output) if other == 0]
+        near = _near_pin(linkage, block, joint, dist)
+        if len(pivots) == 1 and pivots[0].kind == "pin" and near is not None:
+            out.append(Dyad("slot", block, output, joint, near, pivots[0], near.other(block)))
     return out
 
 
@@ -166,8 +189,10 @@ def _end(pair: Pair, link: int) -> np.ndarray:
 
 def dyad_angles(linkage: PlanarLinkage, dyad: Dyad) -> DyadAngles:
     """The dyad's angles at the pose `linkage.place` was last given."""
-    B = linkage.point(dyad.coupler, _end(dyad.joint, dyad.coupler))
     A = linkage.point(dyad.coupler, _end(dyad.near, dyad.coupler))
+    if dyad.kind == "slot":
+        return _slot_angles(linkage, dyad, A)
+    B = linkage.point(dyad.coupler, _end(dyad.joint, dyad.coupler))
     rod = A - B
     if dyad.kind == "pin":
         O = linkage.point(0, _end(dyad.ground, 0))
@@ -176,6 +201,14 @@ def dyad_angles(linkage: PlanarLinkage, dyad: Dyad) -> DyadAngles:
         return DyadAngles(mu, acute, 90.0 - acute)
     u = linkage.direction(dyad.ground.links[0], dyad.ground.axis)
     phi = _angle(rod, u)
+    phi = min(phi, 180.0 - phi)
+    return DyadAngles(90.0 - phi, 90.0 - phi, phi)
+
+
+def _slot_angles(linkage: PlanarLinkage, dyad: Dyad, P: np.ndarray) -> DyadAngles:
+    """A slot dyad's angles with the block's pin at P: phi between the slot and OP."""
+    O = linkage.point(0, _end(dyad.ground, 0))
+    phi = _angle(linkage.direction(dyad.joint.links[0], dyad.joint.axis), P - O)
     phi = min(phi, 180.0 - phi)
     return DyadAngles(90.0 - phi, 90.0 - phi, phi)
 
@@ -204,7 +237,10 @@ def output_position(linkage: PlanarLinkage, output: Output | Dyad) -> float:
 
 def toggle(linkage: PlanarLinkage, dyad: Dyad, tol: float = 1e-6) -> str:
     """"extended" or "folded" when the driving link's pivot, A and B are in line (within
-    `tol` of the sine of their angle), else "": the toggle of the driving link and the coupler."""
+    `tol` of the sine of their angle), else "": the toggle of the driving link and the coupler
+    (a slot dyad's block has no line of its own to fall in line with: always "")."""
+    if dyad.kind == "slot":
+        return ""
     pivot = [p for other, p in linkage.neighbours(dyad.driving) if other == 0 and p.kind == "pin"]
     if len(pivot) != 1:
         return ""
