@@ -24,6 +24,7 @@ import numpy as np
 
 from pinmech.exceptions import FrameNotFound, PinmechError
 from pinmech.display import colour_of, display_names, hex_colour
+from pinmech.plot_centrodes import CentrodeTrace
 from pinmech.plot_curves import BRANCH_STYLES, angles as _angles, branch_pieces, driver_axis as _driver_axis
 from pinmech.plot_curves import draw_markers, legend_beside, length_unit, nearest as _nearest, spike_limits
 from pinmech.plot_design import DesignTrace, mark_least
@@ -69,6 +70,7 @@ class SweepPlot:
         plane: the world plane ("xy", "yz", "zx") a spatial mechanism's paths are
             projected on (None: the mechanism's own plane, or xy), or "3d": a 3-D view.
         timing: marks on the paths every `timing` of the driver [rad or m] (None: none).
+        centrodes: a link whose fixed and moving centrodes the paths panel draws (None: none).
 
     Lengths are drawn in one unit a figure, mm or m from the mechanism's size
     (`plot_curves.length_unit`); a planar linkage's figure has a panel of transmission
@@ -77,7 +79,7 @@ class SweepPlot:
 
     def __init__(self, sweep: Sweep, *, links: list[str] | None = None, points: list[str] | None = None,
                  total: int | None = None, max_points: int = MAX_POINTS, angles: str = "continuous",
-                 plane: str | None = None, timing: float | None = None) -> None:
+                 plane: str | None = None, timing: float | None = None, centrodes: str | None = None) -> None:
         _pyplot()  # fail early, before the sweep runs, when matplotlib is missing
         if angles not in ANGLE_STYLES:
             raise PinmechError(f"angles must be one of {', '.join(ANGLE_STYLES)}, got {angles!r}")
@@ -86,6 +88,7 @@ class SweepPlot:
         self.length = length_unit(sweep.mechanism.length_scale)  # (scale from m, unit): one a figure
         self.paths = PathRecorder(sweep.mechanism, plane, length=self.length)
         self.design, self.timing_step, self.timing = DesignTrace(sweep), timing, None
+        self.centrodes = None if centrodes is None else CentrodeTrace(self.design.design, centrodes)
         self._mus: list[float] = []
         self.mark_q = None  # configuration of the pose nearest the scene's (drawn under the paths)
         self.links, self.points = links or chosen.get("links"), points or chosen.get("points")
@@ -119,6 +122,8 @@ class SweepPlot:
         self._mus = self.design.add(pose, q)  # every pose: the least angle is looked for among them all
         if self.timing is not None:
             self.timing.add(pose.value, q)
+        if self.centrodes is not None:
+            self.centrodes.add(q)
         if pose.motion is None:
             self.failed.append(self._x(pose.value))
             if self.series:
@@ -318,6 +323,9 @@ class SweepPlot:
         folds = [q for _, q in self.design.design.fold_poses()] if self.design.design.applicable else []
         self.paths.draw(ax, self.mark_q, self._travel(), backwards=self._backwards(), ghosts=ghosts, folds=folds,
                         timing=self.timing)
+        if self.centrodes is not None and not self.paths.is_3d:
+            self.centrodes.draw(ax, self.paths.axes, self.paths._unit()[0], self.mark_q)
+            legend_beside(ax)
 
     def _mark_least(self, ax, turn: bool) -> None:
         """The least transmission angle of each dyad, refined between the poses, on its panel."""
