@@ -315,7 +315,12 @@ class Mechanism:
         try:
             return self.joints[name]
         except KeyError:
-            raise FrameNotFound("joint", name, list(self.joints), path=self.source) from None
+            raise FrameNotFound("joint", name, list(self.joints), path=self.source, cuts=self.cut_names) from None
+
+    @property
+    def cut_names(self) -> tuple[str, ...]:
+        """Names of the loop cuts (`<constraint>`s, a drawn loop's closing pins)."""
+        return tuple(c.name for c in self.closures)
 
     def driver_index(self, name: str) -> int:
         """Velocity index of a joint that can be driven (one degree of freedom).

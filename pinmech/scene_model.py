@@ -44,9 +44,23 @@ def load_mechanism(scene: Scene) -> Mechanism:
         locked[name] = scene.quantity(value, _kind(types, name), "lock", name)
     if "move" in scene.raw:
         locked.update(_locked_by_move(scene, types, locked))
-    mechanism = loader.load(locked)
+    try:
+        mechanism = loader.load(locked)
+    except FrameNotFound as exc:
+        if exc.kind != "joint to lock":
+            raise
+        cuts = tuple(set(types) - set(exc.known))  # a drawn loop's closing pins; a URDF's <constraint>s:
+        cuts += _constraint_names(path) if kind in ("urdf", "robot") else ()
+        raise FrameNotFound("joint (in [lock])", exc.name, exc.known, path=str(scene.path), cuts=cuts) from None
     add_scene_points(scene, mechanism)
     return mechanism
+
+
+def _constraint_names(path: Path) -> tuple[str, ...]:
+    """Names of a URDF's `<constraint>` loop cuts, read from the XML."""
+    from pinmech.mechanism import read_xml
+
+    return tuple(c.get("name") for c in read_xml(Path(path), "robot", "URDF").findall("constraint"))
 
 
 @dataclass(frozen=True)
@@ -104,7 +118,8 @@ def _locked_by_move(scene: Scene, types: dict[str, str], locked: dict[str, float
 def _scene_joint(scene: Scene, mechanism: Mechanism, name: str, key: str):
     """A joint the scene names, or FrameNotFound naming the scene file and key."""
     if name not in mechanism.joints:
-        raise FrameNotFound(f"joint (in [{key}])", name, list(mechanism.joints), path=str(scene.path))
+        raise FrameNotFound(f"joint (in [{key}])", name, list(mechanism.joints), path=str(scene.path),
+                            cuts=mechanism.cut_names)
     return mechanism.joints[name]
 
 

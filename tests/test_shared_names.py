@@ -88,3 +88,24 @@ def test_timing_marks_of_a_site_named_like_its_body_and_joint(tmp_path, figures)
     assert angles == list(range(0, 360, 30))
     np.testing.assert_allclose(np.column_stack(marks.get_data()), _site(np.array(angles)), rtol=0,
                                atol=PLACE_TOL_MM)
+
+
+@pytest.mark.parametrize("model, section, name", [
+    ('linkage = "{root}/models/linkages/watt.toml"', "drivers", "D"),   # a drawn loop's closing pin
+    ('linkage = "{root}/models/linkages/watt.toml"', "lock", "B"),
+    ('urdf = "{root}/models/four_bar.urdf"', "lock", "B"),              # a <constraint>
+    ('urdf = "{root}/models/four_bar.urdf"', "drivers", "B"),
+])
+def test_a_loop_cut_named_as_a_joint_is_called_a_cut_in_the_scene(tmp_path, capsys, model, section, name):
+    """Driving or locking a loop's cut said "unknown joint" (a [lock] blamed the generated or
+    bundled model file): the scene's key is named, and the name is called a loop cut."""
+    root = Path(__file__).resolve().parents[1]
+    scene = tmp_path / "cut.toml"
+    value = 'angle = "30 deg"' if section == "drivers" else ''
+    body = f'[drivers.O2]\nangle = "30 deg"\n[lock]\n{name} = "3 deg"\n' if section == "lock" else \
+        f'[drivers.{name}]\n{value}\n'
+    scene.write_text(model.format(root=root) + "\n" + body)
+    assert main(["solve", str(scene)]) == 4
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and err.startswith(f"pinmech: error: {scene}")
+    assert f"[{section}]) '{name}' is a loop cut" in err, err
