@@ -134,13 +134,23 @@ def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
     names = list(rows)
     if len(names) != mechanism.mobility:
         raise MobilityError(f"{scene.path}, drivers: {mechanism.source} has mobility {mechanism.mobility} "
-                            f"({mechanism.model.nv} joint freedoms, {mechanism.rank_report().rank} independent "
-                            f"closure equations): drive that many joints; the scene drives {len(names)} "
+                            f"({mechanism.model.nv} joint freedoms{_held_note(scene, mechanism)}, "
+                            f"{mechanism.rank_report().rank} independent closure equations): "
+                            f"{'drive that many joints' if mechanism.mobility else 'it cannot move'}; "
+                            f"the scene drives {len(names)} "
                             f"({', '.join(names) or 'none'}){_still_free(mechanism, names)}"
                             f"{_motors_note(scene, mechanism, table)}",
                             mobility=mechanism.mobility, drivers=len(names))
     arr = np.array(list(rows.values()), dtype=float).reshape(-1, 3)
     return Drivers(tuple(names), arr[:, 0].copy(), arr[:, 1].copy(), arr[:, 2].copy())
+
+
+def _held_note(scene: Scene, mechanism: Mechanism) -> str:
+    """" once [lock] holds O4" where the scene's locks took freedoms away (else "")."""
+    if not mechanism.locked:
+        return ""
+    by = "[lock] and move" if "move" in scene.raw else "[lock]"
+    return f" once {by} holds {', '.join(mechanism.locked)}"
 
 
 def _lock_lines(mechanism: Mechanism, names: list[str]) -> str:

@@ -109,3 +109,15 @@ def test_a_loop_cut_named_as_a_joint_is_called_a_cut_in_the_scene(tmp_path, caps
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and err.startswith(f"pinmech: error: {scene}")
     assert f"[{section}]) '{name}' is a loop cut" in err, err
+
+
+def test_a_mobility_error_says_which_locks_took_the_freedoms(tmp_path, capsys):
+    """The Watt six-bar (mobility 1) with O4 held by [lock] cannot move: the message said
+    "mobility 0 (4 joint freedoms ...): drive that many joints", silent on the lock."""
+    root = Path(__file__).resolve().parents[1]
+    scene = tmp_path / "held.toml"
+    scene.write_text(f'linkage = "{root}/models/linkages/watt.toml"\n[drivers.O2]\nangle = "30 deg"\n'
+                     '[lock]\nO4 = "20 deg"\n')
+    assert main(["solve", str(scene)]) == 5
+    err = capsys.readouterr().err
+    assert "once [lock] holds O4" in err and "it cannot move" in err, err
