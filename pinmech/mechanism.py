@@ -301,10 +301,23 @@ class Mechanism:
         """Fix a named point on a link, at `xyz` [m] in the link's frame; its frame id.
 
         Call before creating solvers: a `pin.Data` made earlier lacks the new frame.
+
+        Raises:
+            ModelError: a name that is no text or is already a point or link's (Pinocchio
+                would hand back the old point's frame), or xyz not 3 finite numbers.
+            FrameNotFound: an unknown link.
         """
+        if not isinstance(name, str) or not name:
+            raise ModelError(f"a point's name must be a non-empty str, got {name!r:.80}", path=self.source)
+        if not isinstance(link, str) or link not in self.links:
+            raise FrameNotFound("link (of a point)", str(link), list(self.links), path=self.source)
+        if name in self.points or name in self.links:
+            raise ModelError(f"the model already has a {'point' if name in self.points else 'link'} called "
+                             f"'{name}': name the point otherwise", path=self.source)
+        offset = float_array(xyz, f"the coordinates of point '{name}'", (3,), self.source)
         body_id = self.links[link]
         body = self.model.frames[body_id]
-        frame = pin.Frame(name, body.parentJoint, body_id, body.placement * pin.SE3(np.eye(3), np.asarray(xyz, float)),
+        frame = pin.Frame(name, body.parentJoint, body_id, body.placement * pin.SE3(np.eye(3), offset),
                           pin.FrameType.OP_FRAME)
         self.points[name] = self.model.addFrame(frame, False)
         return self.points[name]
