@@ -325,6 +325,8 @@ class Mechanism:
     # ---------------------------------------------------------------- look-ups
     def joint(self, name: str) -> JointInfo:
         """The joint called `name`; FrameNotFound lists the known ones otherwise."""
+        if not isinstance(name, str):
+            raise FrameNotFound("joint", f"{name!r:.40}", list(self.joints), path=self.source)
         try:
             return self.joints[name]
         except KeyError:
@@ -349,6 +351,9 @@ class Mechanism:
 
     def frame_id(self, name: str) -> int:
         """Frame id of a point, a link, or any other frame of the model, by name."""
+        if not isinstance(name, str):
+            raise FrameNotFound("point or frame", f"{name!r:.40}", list(self.points) + list(self.links),
+                                path=self.source)
         if name in self.points:
             return self.points[name]
         if name in self.links:
@@ -712,9 +717,19 @@ def _check_locked(locked: dict[str, float], source: str) -> None:
     if not isinstance(locked, dict):
         raise ModelError(f"locked must be a dict of joint name -> value (rad or m), got {locked!r:.60}", path=source)
     for name, value in locked.items():
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+        if not isinstance(name, str):
+            raise ModelError(f"locked must name joints (str), got the key {name!r:.40}", path=source)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(_as_float(value)):
             raise ModelError(f"locked joint '{name}' must be held at a finite number (rad or m), got {value!r:.40}",
                              path=source)
+
+
+def _as_float(value: int | float) -> float:
+    """value as a float; an int beyond float64 as infinity (refused as not finite)."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf
 
 
 def _lock_joints(model: pin.Model, locked: dict[str, float], source: str) -> pin.Model:

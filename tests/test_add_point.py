@@ -14,6 +14,7 @@ import pinocchio as pin
 import pytest
 from closed_form import four_bar
 
+import pinmech
 from pinmech import FrameNotFound, LoopSolver, Mechanism, ModelError
 from tests.conftest import MODELS
 
@@ -59,3 +60,20 @@ def test_a_point_on_the_rocker_is_where_the_closed_form_puts_it():
     fb = four_bar(np.radians([30.0]), 0.0, 0.0, 0.04, 0.12, 0.08, 0.10)
     expected = [0.10 + 0.02 * math.cos(fb.theta4[0]), 0.02 * math.sin(fb.theta4[0]), 0.0]
     np.testing.assert_allclose(data.oMf[fid].translation, expected, rtol=0, atol=PLACE_TOL_M)
+
+
+@pytest.mark.parametrize("call", [
+    lambda m: Mechanism.from_urdf(MODELS / "four_bar.urdf", locked={"O2": 10**400}),   # OverflowError
+    lambda m: Mechanism.from_urdf(MODELS / "four_bar.urdf", locked={3: 0.1}),          # ArgumentError
+    lambda m: m.joint(["O2"]),                                                         # TypeError: unhashable
+    lambda m: m.frame_id({"P": 1}),
+    lambda m: pinmech.ForceSolver(m, 0.5),                                             # TypeError: not iterable
+    lambda m: pinmech.RateSolver(m, "P"),                                              # AttributeError
+    lambda m: pinmech.RateSolver(m, [1, 2]),
+])
+def test_hostile_arguments_end_in_a_named_error(call):
+    """Only a PinmechError with a message leaves pinmech (README, Errors and exit codes)."""
+    mech = Mechanism.from_urdf(MODELS / "four_bar.urdf")
+    with pytest.raises(pinmech.PinmechError) as caught:
+        call(mech)
+    assert str(caught.value).strip()
