@@ -53,7 +53,10 @@ class FrameNotFound(SceneError):
                              f"follows the loop and cannot be driven, held or set; name a joint of the tree "
                              f"({listed})", path=path)
         else:
-            super().__init__(f"unknown {kind} '{name}' (the model has: {listed})", path=path)
+            split = [k for k in known if k.startswith(f"{name}_")]
+            hint = (f"; did you mean {' or '.join(split)}? (a drawn pin joining several links is one joint per "
+                    "link after the first, named PIN_LINK)" if split and "joint" in kind else "")
+            super().__init__(f"unknown {kind} '{name}'{hint} (the model has: {listed})", path=path)
         self.kind = kind
         self.name = name
         self.known = known

@@ -121,3 +121,15 @@ def test_a_mobility_error_says_which_locks_took_the_freedoms(tmp_path, capsys):
     assert main(["solve", str(scene)]) == 5
     err = capsys.readouterr().err
     assert "once [lock] holds O4" in err and "it cannot move" in err, err
+
+
+def test_a_pin_of_three_links_named_as_drawn_points_to_its_joints(tmp_path, capsys):
+    """Jansen's pin A joins three links, so the model has A_lower and A_upper: `[guess] A`
+    said only "unknown joint 'A'", leaving the newcomer to guess the split."""
+    root = Path(__file__).resolve().parents[1]
+    scene = tmp_path / "jansen.toml"
+    scene.write_text(f'linkage = "{root}/models/linkages/jansen.toml"\n[drivers.O]\nangle = "60 deg"\n'
+                     '[guess]\nA = "10 deg"\n')
+    assert main(["solve", str(scene)]) == 4
+    err = capsys.readouterr().err
+    assert "did you mean A_lower or A_upper?" in err, err
