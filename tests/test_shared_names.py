@@ -133,3 +133,13 @@ def test_a_pin_of_three_links_named_as_drawn_points_to_its_joints(tmp_path, caps
     assert main(["solve", str(scene)]) == 4
     err = capsys.readouterr().err
     assert "did you mean A_lower or A_upper?" in err, err
+
+
+@pytest.mark.parametrize("value", ['["+", "-"]', "{ a = 1 }"])
+def test_an_assembly_sign_that_is_a_list_or_table_is_a_scene_error(tmp_path, capsys, value):
+    """`[assembly] B = ["+", "-"]` raised TypeError (unhashable) out of pinmech."""
+    root = Path(__file__).resolve().parents[1]
+    scene = tmp_path / "asm.toml"
+    scene.write_text(f'urdf = "{root}/models/four_bar.urdf"\n[drivers.O2]\nangle = "30 deg"\n[assembly]\nB = {value}\n')
+    assert main(["solve", str(scene)]) == 4
+    assert "use one of" in capsys.readouterr().err
