@@ -36,6 +36,11 @@ if TYPE_CHECKING:
 MAX_POINTS = 20_000
 #: The panel of Norton's transmission angles (acute, 90 deg best) of a planar linkage's dyads.
 TRANSMISSION = "transmission angle, μ [deg]"
+
+
+def _mu(name: str) -> str:
+    """The transmission panel's key of a dyad (its joint may also be a slider drawn elsewhere)."""
+    return f"μ {name}"
 ANGLE_STYLES = ("continuous", "wrapped")
 
 
@@ -168,8 +173,8 @@ class SweepPlot:
         self.colours.update({n: hex_colour(colour_of(mech, s.child)) for n, s in motion.sliders.items()})
         for dyad, name in zip(self.design.dyads, self.design.names):  # a dyad in its output's colour
             coupler, output = (self.design.design.linkage.names[k] for k in (dyad.coupler, dyad.output))
-            self.colours[name] = hex_colour(colour_of(mech, output)) if output in mech.links else "#111111"
-            self.names[name] = f"{self.names.get(name, name)} ({coupler}-{output})"
+            self.colours[_mu(name)] = hex_colour(colour_of(mech, output)) if output in mech.links else "#111111"
+            self.names[_mu(name)] = f"{self.names.get(name, name)} ({coupler}-{output})"
         if self.timing_step is not None and self.points:
             from pinmech.plot_timing import TimingMarks
 
@@ -187,7 +192,7 @@ class SweepPlot:
         panels["angular velocity, ω [rad/s]" if planar else "angular speed, |ω| [rad/s]"] = self.links
         panels["angular acceleration, α [rad/s²]" if planar else "angular acceleration, |α| [rad/s²]"] = self.links
         if self.design.dyads:
-            panels[TRANSMISSION] = self.design.names
+            panels[TRANSMISSION] = [_mu(n) for n in self.design.names]
         if self.sliders:
             panels["position along its guide, s [m]"] = self.sliders
             panels["velocity along its guide, v_rel [m/s]"] = self.sliders
@@ -331,7 +336,7 @@ class SweepPlot:
         """The least transmission angle of each dyad, refined between the poses, on its panel."""
         for least in self.design.least():
             x = self._x(least.at) % 360.0 if turn else self._x(least.at)
-            mark_least(ax, least, x, self.colours.get(least.name, "k"), self.names.get(least.name, least.name),
+            mark_least(ax, least, x, self.colours.get(_mu(least.name), "k"), self.names.get(_mu(least.name), least.name),
                        "°" if self.sweep.is_angular else f" {self.length[1]}")
         legend_beside(ax)
 
@@ -371,12 +376,15 @@ class SweepPlot:
         largest = max((float(np.nanmax(np.abs(y))) for y in curves.values() if np.any(np.isfinite(y))), default=0.0)
         flat = max(1e-9 * largest, 1e-12)  # changes below this are rounding (1e-12: noise about an exact 0)
         constants, drawn, branch = [], [], np.array(self.branch)[order]
+        is_flat = {name: bool(y[np.isfinite(y)].size) and np.ptp(y[np.isfinite(y)]) <= flat for name, y in curves.items()}
+        every_flat = all(is_flat.values())  # an empty panel says less than its flat lines
         for name, y in curves.items():
-            finite = y[np.isfinite(y)]
-            if finite.size and np.ptp(finite) <= flat:
-                constants.append(f"{self.names.get(name, name)}: {symbol} = {finite[0]:.6g} {dim.rstrip(']')} "
-                                 "(constant, not drawn)")
-                continue
+            if is_flat[name]:
+                value = y[np.isfinite(y)][0]
+                constants.append(f"{self.names.get(name, name)}: {symbol} = {value:.6g} {dim.rstrip(']')} "
+                                 + ("(constant)" if every_flat else "(constant, not drawn)"))
+                if not every_flat:
+                    continue
             drawn.append(y)
             self._curve(ax, name, x, y, branch)
             if mark_x is not None:
