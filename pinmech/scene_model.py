@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from pinmech.arguments import instance_of
 from pinmech.branches import parse_assembly
 from pinmech.exceptions import FrameNotFound, MobilityError, ModelError, PinmechError, SceneError
 from pinmech.mechanism import Mechanism, urdf_joint_types, urdf_mimic_leaders
@@ -33,6 +34,7 @@ class Drivers:
 
 def load_mechanism(scene: Scene) -> Mechanism:
     """The scene's model (URDF, linkage, MJCF) as a Mechanism, `[lock]` joints locked out."""
+    instance_of(scene, Scene, "load_mechanism's scene")
     kind = scene.model_kind
     path = scene.urdf if kind in ("urdf", "robot") else scene.model_file(kind)
     if not path.is_file():
