@@ -98,3 +98,13 @@ def names(value: Any, what: str) -> tuple[str, ...]:
     if isinstance(value, (list, tuple)) and all(isinstance(n, str) for n in value):
         return tuple(value)
     raise ModelError(f"{what} must be a list of joint names (strings), got {value!r:.60}")
+
+
+def instance_of(value: Any, kind: type, what: str) -> Any:
+    """`value` if it is a `kind`; else a ModelError naming `what` and what it got (a
+    `pinmech.Scene` given as a path string, an Analysis as a dict)."""
+    if isinstance(value, kind):
+        return value
+    raise ModelError(f"{what} must be a pinmech.{kind.__name__}, got {type(value).__name__} {value!r:.60}"
+                     + (f" (load it first: pinmech.{kind.__name__}.load(...))" if kind.__name__ == "Scene" else ""))
+

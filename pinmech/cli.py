@@ -121,6 +121,9 @@ def _sweep_parser(sub) -> None:
     sweep.add_argument("--timing-marks", dest="timing_marks", nargs="?", const="30 deg", metavar="STEP",
                        help="mark the paths every STEP of the driver (default 30 deg; a slide's driver: a "
                             "length, e.g. '10 mm'), each mark solved at that driver value")
+    sweep.add_argument("--centrodes", metavar="LINK",
+                       help="draw LINK's fixed centrode (its instant centre's path in the plane) and moving "
+                            "centrode (seen from LINK, drawn on it at the scene's pose) on the paths")
     sweep.add_argument("--angles", choices=("continuous", "wrapped"), default="continuous",
                        help="link angles in the figure: continuous (default, no jump at 180 deg) or wrapped "
                        "to (-180, 180] deg")
@@ -539,7 +542,7 @@ def _sweep_sinks(args: argparse.Namespace, sweep, steps: int, figure: Path | Non
         from pinmech.draw.plot import SweepPlot
 
         recorder = SweepPlot(sweep, links=args.links, points=args.points, total=steps, angles=args.angles,
-                             plane=args.path_plane, timing=args.timing_step)
+                             plane=args.path_plane, timing=args.timing_step, centrodes=args.centrodes)
         if figure is not None:
             sinks.plot(recorder, figure)
         if args.paths_path:

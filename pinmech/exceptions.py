@@ -46,9 +46,17 @@ class UnitError(SceneError):
 class FrameNotFound(SceneError):
     """A joint, link, point or frame name is not in the model."""
 
-    def __init__(self, kind: str, name: str, known: list[str], *, path: str | None = None):
+    def __init__(self, kind: str, name: str, known: list[str], *, path: str | None = None, cuts: tuple = ()):
         listed = ", ".join(known[:20]) + (", ..." if len(known) > 20 else "")
-        super().__init__(f"unknown {kind} '{name}' (the model has: {listed})", path=path)
+        if name in cuts:  # a joint of the user's file, but the loop's cut: say so, not "unknown"
+            super().__init__(f"{kind} '{name}' is a loop cut (the joint that closes a loop): its coordinate "
+                             f"follows the loop and cannot be driven, held or set; name a joint of the tree "
+                             f"({listed})", path=path)
+        else:
+            split = [k for k in known if k.startswith(f"{name}_")]
+            hint = (f"; did you mean {' or '.join(split)}? (a drawn pin joining several links is one joint per "
+                    "link after the first, named PIN_LINK)" if split and "joint" in kind else "")
+            super().__init__(f"unknown {kind} '{name}'{hint} (the model has: {listed})", path=path)
         self.kind = kind
         self.name = name
         self.known = known

@@ -71,3 +71,15 @@ def test_only_named_errors_leave_the_api(call, h):
         CALLS[call](h)
     except pinmech.PinmechError as exc:
         assert str(exc), f"{call}({h!r}): {type(exc).__name__} without a message"
+
+
+@pytest.mark.parametrize("call", ["analyse", "load_mechanism", "to_text", "to_json", "to_dict",
+                                  "velocity_polygon", "acceleration_polygon", "Sweep.from_scene"])
+@pytest.mark.parametrize("value", ["models/scenes/r_rtr.toml", None, 3, {"drivers": {}}])
+def test_a_scene_or_analysis_of_another_type_is_a_named_error(call, value):
+    """A path string where a pinmech.Scene is wanted (or a dict where an Analysis is) ended
+    in AttributeError ("'str' object has no attribute 'raw'"): one ModelError naming the
+    argument and what it got."""
+    target = pinmech.Sweep.from_scene if call == "Sweep.from_scene" else getattr(pinmech, call)
+    with pytest.raises(pinmech.ModelError, match=r"must be a pinmech\.(Scene|Analysis), got"):
+        target(value)

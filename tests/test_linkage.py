@@ -526,15 +526,15 @@ def test_spatial_errors(tmp_path):
 
 
 def test_a_planar_linkage_written_in_3d_moves_as_the_planar_one(tmp_path):
-    """The four-bar with z coordinates and z axes given: spatial writer, same motion."""
+    """The four-bar with a z = 0 coordinate written out: the planar linkage it draws (it was
+    made spatial, its angles counted from the drawing: tests/test_linkage_plane_written_3d.py)."""
     path = tmp_path / "fb3.toml"
     path.write_text(BASE.replace('O2 = ["0 mm", "0 mm"]', 'O2 = ["0 mm", "0 mm", "0 mm"]'))
     mech = load_linkage(path)
     motion = follow(mech, "O2", path_to(0.0, [1.0]), omega=2.0, links=["rocker"])[-1]
     ref = cf.four_bar(1.0, 2.0, 0.0, 0.04, 0.12, 0.08, 0.10, branch=+1)
-    theta4_drawn = cf.four_bar(0.0, 0.0, 0.0, 0.04, 0.12, 0.08, 0.10, branch=+1).theta4
-    # spatial frames are world-aligned at the drawing: the rocker turned by theta4 - theta4(0)
-    angle_close(motion.links["rocker"].angle, ref.theta4 - theta4_drawn, 1, "theta4")
+    # a planar linkage's frame x runs from the link's first point to its next: the rocker at theta4
+    angle_close(motion.links["rocker"].angle, ref.theta4, 1, "theta4")
     assert motion.links["rocker"].angular_velocity[2] == pytest.approx(ref.omega4, abs=1e-9)
 
 

@@ -36,6 +36,8 @@ def drawn(tmp_path: Path, x: str, params: str = 'a = "30 mm", b = "12 mm"') -> P
     ("-a*2", -2 * A_MM),
     ("2*(a - b)", 2 * (A_MM - B_MM)),
     ("a/4*2", A_MM / 4 * 2),               # left to right
+    ("-(-a)", A_MM),                       # a sign before parentheses: one sign each, as the grammar has it
+    ("a - (-b)", A_MM + B_MM),
     ("15 mm", 15.0),
 ])
 def test_an_expression_reads_as_arithmetic_says(tmp_path, text, expected_mm):
@@ -47,7 +49,6 @@ def test_an_expression_reads_as_arithmetic_says(tmp_path, text, expected_mm):
     ("+-a", "two signs"),
     ("--a", "two signs"),
     ("-+a", "two signs"),
-    ("-(-a)", "two signs"),
     ("a - -b", "a sign right after"),
     ("a + -b", "a sign right after"),
     ("a**2", "'**'"),

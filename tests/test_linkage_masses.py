@@ -212,6 +212,9 @@ def test_a_spatial_linkage_states_the_whole_tensor(tmp_path):
     base = slider_crank(tmp_path).read_text().replace('O = ["0 mm", "0 mm"]', 'O = ["0 mm", "0 mm", "0 mm"]')
     path = tmp_path / "spatial.toml"
     path.write_text(base + '[masses]\nrod = { mass = "1 kg", at = "G3", izz = "1e-4 kg*m^2" }\n')
+    assert not parse_linkage(path).spatial  # z = 0 written out and a planar izz: the planar linkage
+    lifted = base.replace('O = ["0 mm", "0 mm", "0 mm"]', 'O = ["0 mm", "0 mm", "0 mm"]\nQ = ["0 mm", "0 mm", "5 mm"]')
+    path.write_text(lifted + '[masses]\nrod = { mass = "1 kg", at = "G3", izz = "1e-4 kg*m^2" }\n')
     with pytest.raises(ModelError, match=r"\[masses\] rod: give exactly at, inertia, mass"):
         parse_linkage(path)
     tensor = '["1e-4 kg*m^2", "1e-4 kg*m^2", "3e-4 kg*m^2", "0 kg*m^2", "0 kg*m^2", "0 kg*m^2"]'

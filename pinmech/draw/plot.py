@@ -24,6 +24,7 @@ import numpy as np
 
 from pinmech.exceptions import FrameNotFound, PinmechError
 from pinmech.model.display import colour_of, display_names, hex_colour
+from pinmech.draw.plot_centrodes import CentrodeTrace
 from pinmech.draw.plot_curves import BRANCH_STYLES, angles as _angles, branch_pieces, driver_axis as _driver_axis
 from pinmech.draw.plot_curves import draw_markers, legend_beside, length_unit, nearest as _nearest, spike_limits
 from pinmech.draw.plot_design import DesignTrace, mark_least
@@ -35,6 +36,11 @@ if TYPE_CHECKING:
 MAX_POINTS = 20_000
 #: The panel of Norton's transmission angles (acute, 90 deg best) of a planar linkage's dyads.
 TRANSMISSION = "transmission angle, μ [deg]"
+
+
+def _mu(name: str) -> str:
+    """The transmission panel's key of a dyad (its joint may also be a slider drawn elsewhere)."""
+    return f"μ {name}"
 ANGLE_STYLES = ("continuous", "wrapped")
 
 
@@ -69,6 +75,7 @@ class SweepPlot:
         plane: the world plane ("xy", "yz", "zx") a spatial mechanism's paths are
             projected on (None: the mechanism's own plane, or xy), or "3d": a 3-D view.
         timing: marks on the paths every `timing` of the driver [rad or m] (None: none).
+        centrodes: a link whose fixed and moving centrodes the paths panel draws (None: none).
 
     Lengths are drawn in one unit a figure, mm or m from the mechanism's size
     (`plot_curves.length_unit`); a planar linkage's figure has a panel of transmission
@@ -77,7 +84,7 @@ class SweepPlot:
 
     def __init__(self, sweep: Sweep, *, links: list[str] | None = None, points: list[str] | None = None,
                  total: int | None = None, max_points: int = MAX_POINTS, angles: str = "continuous",
-                 plane: str | None = None, timing: float | None = None) -> None:
+                 plane: str | None = None, timing: float | None = None, centrodes: str | None = None) -> None:
         _pyplot()  # fail early, before the sweep runs, when matplotlib is missing
         if angles not in ANGLE_STYLES:
             raise PinmechError(f"angles must be one of {', '.join(ANGLE_STYLES)}, got {angles!r}")
@@ -86,6 +93,7 @@ class SweepPlot:
         self.length = length_unit(sweep.mechanism.length_scale)  # (scale from m, unit): one a figure
         self.paths = PathRecorder(sweep.mechanism, plane, length=self.length)
         self.design, self.timing_step, self.timing = DesignTrace(sweep), timing, None
+        self.centrodes = None if centrodes is None else CentrodeTrace(self.design.design, centrodes)
         self._mus: list[float] = []
         self.mark_q = None  # configuration of the pose nearest the scene's (drawn under the paths)
         self.links, self.points = links or chosen.get("links"), points or chosen.get("points")
@@ -119,6 +127,8 @@ class SweepPlot:
         self._mus = self.design.add(pose, q)  # every pose: the least angle is looked for among them all
         if self.timing is not None:
             self.timing.add(pose.value, q)
+        if self.centrodes is not None:
+            self.centrodes.add(q)
         if pose.motion is None:
             self.failed.append(self._x(pose.value))
             if self.series:
@@ -163,8 +173,8 @@ class SweepPlot:
         self.colours.update({n: hex_colour(colour_of(mech, s.child)) for n, s in motion.sliders.items()})
         for dyad, name in zip(self.design.dyads, self.design.names):  # a dyad in its output's colour
             coupler, output = (self.design.design.linkage.names[k] for k in (dyad.coupler, dyad.output))
-            self.colours[name] = hex_colour(colour_of(mech, output)) if output in mech.links else "#111111"
-            self.names[name] = f"{self.names.get(name, name)} ({coupler}-{output})"
+            self.colours[_mu(name)] = hex_colour(colour_of(mech, output)) if output in mech.links else "#111111"
+            self.names[_mu(name)] = f"{self.names.get(name, name)} ({coupler}-{output})"
         if self.timing_step is not None and self.points:
             from pinmech.draw.plot_timing import TimingMarks
 
@@ -182,7 +192,7 @@ class SweepPlot:
         panels["angular velocity, ω [rad/s]" if planar else "angular speed, |ω| [rad/s]"] = self.links
         panels["angular acceleration, α [rad/s²]" if planar else "angular acceleration, |α| [rad/s²]"] = self.links
         if self.design.dyads:
-            panels[TRANSMISSION] = self.design.names
+            panels[TRANSMISSION] = [_mu(n) for n in self.design.names]
         if self.sliders:
             panels["position along its guide, s [m]"] = self.sliders
             panels["velocity along its guide, v_rel [m/s]"] = self.sliders
@@ -318,12 +328,15 @@ class SweepPlot:
         folds = [q for _, q in self.design.design.fold_poses()] if self.design.design.applicable else []
         self.paths.draw(ax, self.mark_q, self._travel(), backwards=self._backwards(), ghosts=ghosts, folds=folds,
                         timing=self.timing)
+        if self.centrodes is not None and not self.paths.is_3d:
+            self.centrodes.draw(ax, self.paths.axes, self.paths._unit()[0], self.mark_q)
+            legend_beside(ax)
 
     def _mark_least(self, ax, turn: bool) -> None:
         """The least transmission angle of each dyad, refined between the poses, on its panel."""
         for least in self.design.least():
             x = self._x(least.at) % 360.0 if turn else self._x(least.at)
-            mark_least(ax, least, x, self.colours.get(least.name, "k"), self.names.get(least.name, least.name),
+            mark_least(ax, least, x, self.colours.get(_mu(least.name), "k"), self.names.get(_mu(least.name), least.name),
                        "°" if self.sweep.is_angular else f" {self.length[1]}")
         legend_beside(ax)
 
@@ -363,12 +376,15 @@ class SweepPlot:
         largest = max((float(np.nanmax(np.abs(y))) for y in curves.values() if np.any(np.isfinite(y))), default=0.0)
         flat = max(1e-9 * largest, 1e-12)  # changes below this are rounding (1e-12: noise about an exact 0)
         constants, drawn, branch = [], [], np.array(self.branch)[order]
+        is_flat = {name: bool(y[np.isfinite(y)].size) and np.ptp(y[np.isfinite(y)]) <= flat for name, y in curves.items()}
+        every_flat = all(is_flat.values())  # an empty panel says less than its flat lines
         for name, y in curves.items():
-            finite = y[np.isfinite(y)]
-            if finite.size and np.ptp(finite) <= flat:
-                constants.append(f"{self.names.get(name, name)}: {symbol} = {finite[0]:.6g} {dim.rstrip(']')} "
-                                 "(constant, not drawn)")
-                continue
+            if is_flat[name]:
+                value = y[np.isfinite(y)][0]
+                constants.append(f"{self.names.get(name, name)}: {symbol} = {value:.6g} {dim.rstrip(']')} "
+                                 + ("(constant)" if every_flat else "(constant, not drawn)"))
+                if not every_flat:
+                    continue
             drawn.append(y)
             self._curve(ax, name, x, y, branch)
             if mark_x is not None:

@@ -28,7 +28,7 @@ class TimingMarks:
     def __init__(self, sweep, points: list[str], step: float) -> None:
         self.sweep, self.points, self.step = sweep, list(points), float(step)
         model = sweep.mechanism.model
-        self.frames = {p: model.getFrameId(p) for p in self.points}
+        self.frames = {p: sweep.mechanism.frame_id(p) for p in self.points}  # by name and kind (sites first)
         self.data = model.createData()
         self.k = list(sweep.drivers.names).index(sweep.driver)
         #: driver value [rad or m] -> point -> world position [m]

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from pinmech.arguments import instance_of
 from pinmech.model.display import colour_of, display_names, hex_colour
 from pinmech.draw.inputs import DrawError
 from pinmech.model.link_nodes import pin_links, sketch_links, world_nodes
@@ -96,11 +97,13 @@ class Polygon:
 
 def velocity_polygon(analysis: Analysis) -> Polygon:
     """The velocity polygon of a solved planar pose."""
+    instance_of(analysis, Analysis, "velocity_polygon's analysis")
     return _polygon(analysis, "velocity")
 
 
 def acceleration_polygon(analysis: Analysis) -> Polygon:
     """The acceleration polygon of a solved planar pose (normal, tangential, Coriolis parts)."""
+    instance_of(analysis, Analysis, "acceleration_polygon's analysis")
     return _polygon(analysis, "acceleration")
 
 

@@ -8,6 +8,7 @@ This is the one function the CLI's `solve` and a user's script share:
 
 from __future__ import annotations
 
+from pinmech.arguments import instance_of
 from pinmech.exceptions import SceneError
 from pinmech.solve.motion import evaluate_motion
 from pinmech.io.analysis_result import Analysis
@@ -31,6 +32,7 @@ def analyse(scene: Scene, *, forces: bool = False, static: bool = False, minimum
     Forces (driver efforts, reactions) are computed when asked (`forces`, `static`) or
     when the scene has a `[forces]`, `[gravity]` or `[[load]]` table (forces_scene.py).
     """
+    instance_of(scene, Scene, "analyse's scene")
     if "task" in scene.raw:
         if forces or static or wants_forces(scene):
             raise SceneError("forces are computed for driven mechanisms ([drivers]), not for [[task]] scenes",

@@ -94,7 +94,8 @@ def scene_pose(scene: Scene, mechanism: Mechanism) -> tuple[np.ndarray, list[str
         if name in mechanism.locked:
             continue
         if name not in mechanism.joints:
-            raise FrameNotFound("joint (in [pose])", name, list(mechanism.joints), path=str(scene.path))
+            raise FrameNotFound("joint (in [pose])", name, list(mechanism.joints), path=str(scene.path),
+                                cuts=mechanism.cut_names)
         if name in mechanism.mimics:  # set by its leader; checked below
             followers[name] = scene.joint_quantity(value, mechanism.mimics[name].kind, 0, "pose", name)
             continue

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from pinmech.arguments import instance_of
 from pinmech.solve.limits import limit_violations
 from pinmech.solve.motion import Motion
 from pinmech.io.analysis_result import Analysis
@@ -61,6 +62,7 @@ def motion_dict(motion: Motion) -> dict[str, Any]:
 
 def to_dict(analysis: Analysis) -> dict[str, Any]:
     """One JSON-ready object for a solved scene (SI units, vectors [x, y, z] in the world frame)."""
+    instance_of(analysis, Analysis, "to_dict's analysis")
     out: dict[str, Any] = {
         "title": analysis.scene.title,
         "scene": str(analysis.scene.path),
@@ -126,6 +128,7 @@ def _pinned(analysis: Analysis) -> bool:
 
 def to_json(analysis: Analysis) -> str:
     """`to_dict` as indented JSON text (non-finite numbers become null)."""
+    instance_of(analysis, Analysis, "to_json's analysis")
     import json  # here: a text report does not need it
 
     return json.dumps(_finite(to_dict(analysis)), indent=2)
@@ -183,6 +186,7 @@ class _Text:
 
 def to_text(analysis: Analysis) -> str:
     """A readable report in the textbook's order: positions, angles, link rates, points, sliders."""
+    instance_of(analysis, Analysis, "to_text's analysis")
     m = analysis.motion
     t = _Text(analysis)
     drivers = ", ".join(f"{n} = {_angle_or_length(analysis, n, q)}" for n, q in zip(analysis.drivers.names, analysis.drivers.q))

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from pinmech.arguments import instance_of
 from pinmech.solve.branches import parse_assembly
 from pinmech.exceptions import FrameNotFound, MobilityError, ModelError, PinmechError, SceneError
 from pinmech.model.mechanism import Mechanism, urdf_joint_types, urdf_mimic_leaders
@@ -33,6 +34,7 @@ class Drivers:
 
 def load_mechanism(scene: Scene) -> Mechanism:
     """The scene's model (URDF, linkage, MJCF) as a Mechanism, `[lock]` joints locked out."""
+    instance_of(scene, Scene, "load_mechanism's scene")
     kind = scene.model_kind
     path = scene.urdf if kind in ("urdf", "robot") else scene.model_file(kind)
     if not path.is_file():
@@ -44,9 +46,23 @@ def load_mechanism(scene: Scene) -> Mechanism:
         locked[name] = scene.quantity(value, _kind(types, name), "lock", name)
     if "move" in scene.raw:
         locked.update(_locked_by_move(scene, types, locked))
-    mechanism = loader.load(locked)
+    try:
+        mechanism = loader.load(locked)
+    except FrameNotFound as exc:
+        if exc.kind != "joint to lock":
+            raise
+        cuts = tuple(set(types) - set(exc.known))  # a drawn loop's closing pins; a URDF's <constraint>s:
+        cuts += _constraint_names(path) if kind in ("urdf", "robot") else ()
+        raise FrameNotFound("joint (in [lock])", exc.name, exc.known, path=str(scene.path), cuts=cuts) from None
     add_scene_points(scene, mechanism)
     return mechanism
+
+
+def _constraint_names(path: Path) -> tuple[str, ...]:
+    """Names of a URDF's `<constraint>` loop cuts, read from the XML."""
+    from pinmech.model.mechanism import read_xml
+
+    return tuple(c.get("name") for c in read_xml(Path(path), "robot", "URDF").findall("constraint"))
 
 
 @dataclass(frozen=True)
@@ -104,7 +120,8 @@ def _locked_by_move(scene: Scene, types: dict[str, str], locked: dict[str, float
 def _scene_joint(scene: Scene, mechanism: Mechanism, name: str, key: str):
     """A joint the scene names, or FrameNotFound naming the scene file and key."""
     if name not in mechanism.joints:
-        raise FrameNotFound(f"joint (in [{key}])", name, list(mechanism.joints), path=str(scene.path))
+        raise FrameNotFound(f"joint (in [{key}])", name, list(mechanism.joints), path=str(scene.path),
+                            cuts=mechanism.cut_names)
     return mechanism.joints[name]
 
 
@@ -119,13 +136,23 @@ def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
     names = list(rows)
     if len(names) != mechanism.mobility:
         raise MobilityError(f"{scene.path}, drivers: {mechanism.source} has mobility {mechanism.mobility} "
-                            f"({mechanism.model.nv} joint freedoms, {mechanism.rank_report().rank} independent "
-                            f"closure equations): drive that many joints; the scene drives {len(names)} "
+                            f"({mechanism.model.nv} joint freedoms{_held_note(scene, mechanism)}, "
+                            f"{mechanism.rank_report().rank} independent closure equations): "
+                            f"{'drive that many joints' if mechanism.mobility else 'it cannot move'}; "
+                            f"the scene drives {len(names)} "
                             f"({', '.join(names) or 'none'}){_still_free(mechanism, names)}"
                             f"{_motors_note(scene, mechanism, table)}",
                             mobility=mechanism.mobility, drivers=len(names))
     arr = np.array(list(rows.values()), dtype=float).reshape(-1, 3)
     return Drivers(tuple(names), arr[:, 0].copy(), arr[:, 1].copy(), arr[:, 2].copy())
+
+
+def _held_note(scene: Scene, mechanism: Mechanism) -> str:
+    """" once [lock] holds O4" where the scene's locks took freedoms away (else "")."""
+    if not mechanism.locked:
+        return ""
+    by = "[lock] and move" if "move" in scene.raw else "[lock]"
+    return f" once {by} holds {', '.join(mechanism.locked)}"
 
 
 def _lock_lines(mechanism: Mechanism, names: list[str]) -> str:

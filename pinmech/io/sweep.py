@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from pinmech.arguments import real_number
+from pinmech.arguments import instance_of, real_number
 from pinmech.exceptions import DriverLimitError, ModelError, SceneError, SweepError
 from pinmech.model.mechanism import Mechanism
 from pinmech.solve.motion import Motion, evaluate_motion
@@ -187,6 +187,7 @@ class Sweep:
             SceneError: a scene without drivers (a task scene is followed in time by
                 `pinmech path`), or a driver that is not one of the scene's.
         """
+        instance_of(scene, Scene, "Sweep.from_scene's scene")
         sweep_options(scene)
         if "task" in scene.raw:
             raise SceneError("has no [drivers] to sweep; a task scene ([[task]]) is followed in time: "

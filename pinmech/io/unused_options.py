@@ -21,13 +21,14 @@ DRIVER_SWEEP = {
     "cold_start": "--cold-start", "no_batch": "--no-batch", "interpolate": "--interpolate", "tol": "--tol",
     "max_iterations": "--max-iterations", "through_folds": "--through-folds", "forces": "--forces",
     "static": "--static", "minimum_norm": "--minimum-norm", "flywheel": "--flywheel",
-    "torque_plot": "--torque-plot", "timing_marks": "--timing-marks",
+    "torque_plot": "--torque-plot", "timing_marks": "--timing-marks", "centrodes": "--centrodes",
 }
 #: Options only a task followed in time reads.
 TASK = {"duration": "--duration", "step": "--step", "scheme": "--scheme", "gain": "--gain"}
 #: Settings of the sweep figure (`--plot`) alone, and of both it and the paths figure (`--paths`).
 PLOT_SETTINGS = {"links": "--links", "angles": "--angles"}
-PATH_SETTINGS = {"points": "--points", "path_plane": "--path-plane", "timing_marks": "--timing-marks"}
+PATH_SETTINGS = {"points": "--points", "path_plane": "--path-plane", "timing_marks": "--timing-marks",
+                 "centrodes": "--centrodes"}
 _DEFAULTS = {"angles": "continuous"}
 
 

@@ -137,7 +137,9 @@ def _masses(linkage: Linkage, reader: _Reader, table: Any) -> None:
     links = {n: v for n, v in linkage.links.items() if n not in linkage.hidden}
     linkage.masses = parse_masses(table, links, linkage.points, linkage.spatial, reader.length, linkage.source)
     for link, stated in linkage.masses.items():
-        if stated.centre.size == 3 and not linkage.spatial:
+        if stated.centre.size == 3 and not linkage.spatial and stated.centre[2] == 0.0:
+            linkage.masses[link] = LinkMass(stated.mass, stated.centre[:2], stated.inertia)  # in the plane
+        elif stated.centre.size == 3 and not linkage.spatial:
             raise ModelError("a planar linkage's centre of mass is [x, y]", path=linkage.source,
                              element=f"[masses] {link}")
         if linkage.spatial and stated.centre.size == 2:
@@ -290,6 +292,19 @@ def _spatial(linkage: Linkage, raw: dict[str, Any], source: str) -> None:
         if name not in linkage.points:
             raise ModelError(f"'{name}' is not a joint of [joints]", path=source, element="balls")
     linkage.balls = set(balls)
+    if _drawn_in_plane(linkage, raw):  # z = 0 and axes +z written out: the planar linkage it draws
+        linkage.spatial, linkage.axes = False, {}
+        linkage.points = {n: p[:2] for n, p in linkage.points.items()}
+
+
+def _drawn_in_plane(linkage: Linkage, raw: dict[str, Any]) -> bool:
+    """Every point at z = 0, every axis +z, no ball and no spatial inertia: a planar linkage
+    written in 3-D, read as one (else its driver angles would count from the drawing, not
+    from world x, because a third "0 mm" or a default axis was written out)."""
+    masses = raw.get("masses")
+    spatial_mass = isinstance(masses, dict) and any(isinstance(m, dict) and "inertia" in m for m in masses.values())
+    return (not linkage.balls and not spatial_mass and all(p[2] == 0.0 for p in linkage.points.values())
+            and all(a.tolist() == [0.0, 0.0, 1.0] for a in linkage.axes.values()))
 
 
 def _pins(linkage: Linkage) -> None:

@@ -6,11 +6,11 @@ numbers. The expression is read by Python's `ast` and only this grammar is evalu
 
     expr   := term (("+" | "-") term)*          both sides lengths
     term   := factor (("*" | "/") factor)*      at most one length in a product; divide by numbers only
-    factor := ["+" | "-"] atom                  one sign, never two ("--a", "+-a", "a - -b")
+    factor := ["+" | "-"] atom                  one sign, never two ("--a", "+-a", "a - -b"; "a - (-b)" has one)
     atom   := PARAM | NUMBER | "(" expr ")"
 
 Everything else is refused with a `ModelError` naming the file, the key and the text:
-`**`, implicit multiplication (`"2 a"` would be 2 years to pint: written with a parameter's
+`**`, implicit multiplication (`"2 a"` or `"2a"` would be 2 years to pint: written with a parameter's
 name as its unit it is ambiguous), unknown names, division by zero, a result that is not a
 length or not finite, or a magnitude beyond `units.MAX_MAGNITUDE`.
 """
@@ -21,6 +21,7 @@ import ast
 import keyword
 import math
 import re
+import warnings
 from typing import Any
 
 from pinmech.exceptions import ModelError, UnitError
@@ -29,6 +30,8 @@ from pinmech.units import MAX_MAGNITUDE, to_si
 #: Longer texts are not read as expressions (a guard on the parser's work and depth).
 MAX_TEXT = 200
 _BINARY = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/"}
+#: A number then a name, with or without a space between: "2 a", "3m", "1e3mm".
+_NUMBER_AND_NAME = re.compile(r"(?P<number>[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?)\s*(?P<name>[^\W\d]\w*)")
 
 
 class _Refused(Exception):
@@ -69,7 +72,7 @@ def length(value: Any, params: dict[str, float], source: str, where: str) -> flo
                              "holds parameters, plain numbers, + - * / and parentheses (put '1 mm' in [params])",
                              path=source, element=where) from None
     try:
-        result, is_length = _evaluate(tree.body, params)
+        result, is_length = _evaluate(tree.body, params, text.encode())
     except _Refused as exc:
         raise ModelError(f"{value!r}: {exc}", path=source, element=where) from None
     if not is_length:
@@ -86,7 +89,9 @@ def _parse(text: str) -> ast.Expression | None:
     if len(text) > MAX_TEXT:
         return None
     try:
-        return ast.parse(text, mode="eval")
+        with warnings.catch_warnings():  # "15mm": Python's SyntaxWarning, on stderr, is no message of ours
+            warnings.simplefilter("ignore", SyntaxWarning)
+            return ast.parse(text, mode="eval")
     except (SyntaxError, ValueError, RecursionError, MemoryError):
         return None
 
@@ -100,15 +105,18 @@ def _quantity(value: Any, source: str, where: str) -> float:
 
 def _refuse_unit_named_as_param(text: str, params: dict[str, float], source: str, where: str) -> None:
     """`"2 a"` with a parameter `a`: 2 years to pint, 2*a to a reader; neither is guessed."""
-    words = text.split()
+    glued = _NUMBER_AND_NAME.fullmatch(text)  # "2 a", and "3m" (3 metres to pint) beside a parameter m
+    words = [glued["number"], glued["name"]] if glued else text.split()
     if len(words) == 2 and words[1] in params:
-        raise ModelError(f"{text!r} is ambiguous: '{words[1]}' is a parameter and a unit; write "
-                         f"'{words[0]}*{words[1]}' for the parameter times {words[0]}, or the quantity with "
+        number, name = words
+        raise ModelError(f"{text!r} is ambiguous: '{name}' is a parameter and a unit; write "
+                         f"'{number}*{name}' for the parameter times {number}, or the quantity with "
                          "another spelling of its unit", path=source, element=where)
 
 
-def _evaluate(node: ast.AST, params: dict[str, float]) -> tuple[float, bool]:
-    """The value of a node and whether it is a length [m] (else a plain number)."""
+def _evaluate(node: ast.AST, params: dict[str, float], text: bytes) -> tuple[float, bool]:
+    """The value of a node of `text` (its UTF-8 bytes) and whether it is a length [m] (else a
+    plain number)."""
     if isinstance(node, ast.Name):
         if node.id not in params:
             known = ", ".join(params) or "none"
@@ -125,22 +133,28 @@ def _evaluate(node: ast.AST, params: dict[str, float]) -> tuple[float, bool]:
             raise _Refused(f"{number!r} is not a finite number")
         return number, False
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.UAdd, ast.USub)):
-        if isinstance(node.operand, ast.UnaryOp):
+        if isinstance(node.operand, ast.UnaryOp) and not _bracketed(node.operand, text):
             raise _Refused("two signs in a row: write one sign")
-        value, is_length = _evaluate(node.operand, params)
+        value, is_length = _evaluate(node.operand, params, text)
         return (-value if isinstance(node.op, ast.USub) else value), is_length
     if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
-        return _binary(node, params)
+        return _binary(node, params, text)
     if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow):
         raise _Refused("'**' (a power) is not a length: write products out")
     raise _Refused("only parameters, numbers, + - * / and parentheses are read")
 
 
-def _binary(node: ast.BinOp, params: dict[str, float]) -> tuple[float, bool]:
+def _bracketed(node: ast.AST, text: bytes) -> bool:
+    """Whether `node` of `text` opens right after a "(": `-(-a)` and `a - (-b)` hold one sign
+    each, `--a` and `a - -b` two in a row (ast drops the parentheses)."""
+    return text[: node.col_offset].rstrip().endswith(b"(")
+
+
+def _binary(node: ast.BinOp, params: dict[str, float], text: bytes) -> tuple[float, bool]:
     symbol = _BINARY[type(node.op)]
-    if symbol in "+-" and isinstance(node.right, ast.UnaryOp):
+    if symbol in "+-" and isinstance(node.right, ast.UnaryOp) and not _bracketed(node.right, text):
         raise _Refused(f"a sign right after '{symbol}': write one sign")
-    (a, a_len), (b, b_len) = _evaluate(node.left, params), _evaluate(node.right, params)
+    (a, a_len), (b, b_len) = _evaluate(node.left, params, text), _evaluate(node.right, params, text)
     if symbol in "+-":
         if a_len != b_len:
             raise _Refused(f"'{symbol}' between a length and a plain number: give both a unit or a parameter")

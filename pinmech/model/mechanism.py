@@ -301,10 +301,23 @@ class Mechanism:
         """Fix a named point on a link, at `xyz` [m] in the link's frame; its frame id.
 
         Call before creating solvers: a `pin.Data` made earlier lacks the new frame.
+
+        Raises:
+            ModelError: a name that is no text or is already a point or link's (Pinocchio
+                would hand back the old point's frame), or xyz not 3 finite numbers.
+            FrameNotFound: an unknown link.
         """
+        if not isinstance(name, str) or not name:
+            raise ModelError(f"a point's name must be a non-empty str, got {name!r:.80}", path=self.source)
+        if not isinstance(link, str) or link not in self.links:
+            raise FrameNotFound("link (of a point)", str(link), list(self.links), path=self.source)
+        if name in self.points or name in self.links:
+            raise ModelError(f"the model already has a {'point' if name in self.points else 'link'} called "
+                             f"'{name}': name the point otherwise", path=self.source)
+        offset = float_array(xyz, f"the coordinates of point '{name}'", (3,), self.source)
         body_id = self.links[link]
         body = self.model.frames[body_id]
-        frame = pin.Frame(name, body.parentJoint, body_id, body.placement * pin.SE3(np.eye(3), np.asarray(xyz, float)),
+        frame = pin.Frame(name, body.parentJoint, body_id, body.placement * pin.SE3(np.eye(3), offset),
                           pin.FrameType.OP_FRAME)
         self.points[name] = self.model.addFrame(frame, False)
         return self.points[name]
@@ -312,10 +325,17 @@ class Mechanism:
     # ---------------------------------------------------------------- look-ups
     def joint(self, name: str) -> JointInfo:
         """The joint called `name`; FrameNotFound lists the known ones otherwise."""
+        if not isinstance(name, str):
+            raise FrameNotFound("joint", f"{name!r:.40}", list(self.joints), path=self.source)
         try:
             return self.joints[name]
         except KeyError:
-            raise FrameNotFound("joint", name, list(self.joints), path=self.source) from None
+            raise FrameNotFound("joint", name, list(self.joints), path=self.source, cuts=self.cut_names) from None
+
+    @property
+    def cut_names(self) -> tuple[str, ...]:
+        """Names of the loop cuts (`<constraint>`s, a drawn loop's closing pins)."""
+        return tuple(c.name for c in self.closures)
 
     def driver_index(self, name: str) -> int:
         """Velocity index of a joint that can be driven (one degree of freedom).
@@ -331,6 +351,9 @@ class Mechanism:
 
     def frame_id(self, name: str) -> int:
         """Frame id of a point, a link, or any other frame of the model, by name."""
+        if not isinstance(name, str):
+            raise FrameNotFound("point or frame", f"{name!r:.40}", list(self.points) + list(self.links),
+                                path=self.source)
         if name in self.points:
             return self.points[name]
         if name in self.links:
@@ -694,9 +717,19 @@ def _check_locked(locked: dict[str, float], source: str) -> None:
     if not isinstance(locked, dict):
         raise ModelError(f"locked must be a dict of joint name -> value (rad or m), got {locked!r:.60}", path=source)
     for name, value in locked.items():
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+        if not isinstance(name, str):
+            raise ModelError(f"locked must name joints (str), got the key {name!r:.40}", path=source)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(_as_float(value)):
             raise ModelError(f"locked joint '{name}' must be held at a finite number (rad or m), got {value!r:.40}",
                              path=source)
+
+
+def _as_float(value: int | float) -> float:
+    """value as a float; an int beyond float64 as infinity (refused as not finite)."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf
 
 
 def _lock_joints(model: pin.Model, locked: dict[str, float], source: str) -> pin.Model:

@@ -173,7 +173,7 @@ def parse_assembly(asked: object, structure: AssemblyStructure) -> dict[str, int
         name = _block_name(written, structure.names)
         if name not in structure.names:
             raise ValueError(f"names no loop block '{name}' (blocks: {', '.join(structure.names) or 'none'})")
-        if word not in SIGN_WORDS:
+        if not isinstance(word, str) or word not in SIGN_WORDS:
             raise ValueError(f"{name} = {word!r}: use one of {', '.join(map(repr, SIGN_WORDS))}")
         out[name] = SIGN_WORDS[word]
     return out

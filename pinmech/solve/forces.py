@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from pinmech.arguments import float_array
+from pinmech.arguments import float_array, names
 from pinmech.model.closures import _cross
 from pinmech.exceptions import BalanceError, IndeterminateForcesError, ModelError, OptionError
 from pinmech.model.mechanism import Mechanism
@@ -220,7 +220,7 @@ class ForceSolver:
         self.model.gravity = pin.Motion(self.gravity, np.zeros(3))
         self.lock = threading.RLock()  # one Data: threads sharing the solver take turns
         self.data = self.model.createData()
-        self.drivers = tuple(drivers)
+        self.drivers = names(drivers, "drivers")
         self.loads = tuple(loads)
         for load in self.loads:  # NaN or misshapen loads would give NaN efforts in silence
             vectors = [np.asarray(x, dtype=float) for x in (load.force, load.torque)]

@@ -146,6 +146,8 @@ class RateSolver:
                  tol: float = DEFAULT_TOL) -> None:
         if method not in METHODS:
             raise TaskError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+        if not isinstance(tasks, (list, tuple)) or not all(isinstance(t, Task) for t in tasks):
+            raise TaskError(f"tasks must be a list of pinmech.Task, got {tasks!r:.80}")
         if not tasks:
             raise TaskError("no task given: add a [[task]] with frame, components, velocity, acceleration")
         low, high = DAMPING_RANGE
