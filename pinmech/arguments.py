@@ -7,6 +7,7 @@ argument is converted here and refused with the argument's name and what it was 
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 from typing import Any
@@ -24,6 +25,9 @@ def float_array(value: Any, name: str, shape: tuple[int | None, ...], source: st
     Raises:
         ModelError: naming `name`, the shape wanted and what was given (`source`: the model file).
     """
+    if (type(value) is np.ndarray and value.dtype == np.float64 and len(shape) == 1  # one pose's vector:
+            and value.shape == shape and all(map(math.isfinite, value.tolist()))):  # plain floats, no numpy calls
+        return value
     wrong = not_real(value)
     if wrong:
         raise ModelError(f"{name} must be real numbers (SI), got {wrong}: pinmech does not cast them", path=source)
