@@ -9,7 +9,7 @@ A parameter is one component (x, y or z) of a placement's translation [m]:
   side (the `<constraint>`'s `parent_origin` or `child_origin`): the frame's placement.
 
 A variant is the same mechanism with these placements written in place: the compiled
-core reads them at the next solve (changes/engine.md), nothing is rebuilt.
+core reads them at the next solve (CHANGELOG.md, round 3), nothing is rebuilt.
 """
 
 from __future__ import annotations
