@@ -48,7 +48,7 @@ def test_a_tolerance_study_counts_every_variant(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("edit, code, message", [
-    (("kind = \"tolerance\"", "kind = \"grid\""), 4, "kind: kind = 'grid' is not one of sensitivity, tolerance"),
+    (("kind = \"tolerance\"", "kind = \"workspace\""), 4, "kind: kind = 'workspace' is not one of sensitivity, tolerance, grid"),
     (("tolerance = \"0.1 mm\"\n", "tolerance = \"-0.1 mm\"\n"), 4, "params.crank.tolerance: tolerance = '-0.1 mm' must be a positive length"),
     (("joint = \"A\"", "joint = \"Q\""), 4, "unknown joint 'Q'"),
     (("points = [\"P\"]", "points = [\"nowhere\"]"), 4, "outputs.points: unknown point 'nowhere'"),

@@ -4,9 +4,9 @@
     result = pinmech.study("models/studies/four_bar_tolerance.toml", workers=2)
     print(result.summary())
 
-Kinds: "sensitivity" (exact dy/dp over the cycle, sensitivity.py) and "tolerance"
-(seeded Monte Carlo beside the linear estimate, tolerance.py), run in batches here or on
-Dask (cluster.py).
+Kinds: "sensitivity" (exact dy/dp over the cycle, sensitivity.py), "tolerance"
+(seeded Monte Carlo beside the linear estimate, tolerance.py) and "grid" (the outputs over
+a grid of parameter values, grid.py), run in batches here or on Dask (cluster.py).
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from pinmech.design.cluster import built, run_batches
+from pinmech.design.grid import grid_size
 from pinmech.design.sensitivity import cycle_sensitivity
 from pinmech.design.study_file import StudySpec, load_study
 from pinmech.design.tolerance import BatchResult, Spread, batches, spread
@@ -33,7 +34,8 @@ class StudyResult:
         nominal_p: the parameters' nominal values [m].
         nominal: (steps, n_out) outputs of the nominal; sensitivity: (steps, n_out, n_par) dy/dp.
         spread: the tolerance study's Spread (None for a sensitivity study).
-        batches: the tolerance study's variants, batch by batch (empty otherwise).
+        batches: a tolerance or grid study's variants (grid points), batch by batch (empty
+            for a sensitivity study).
     """
 
     spec: StudySpec
@@ -65,7 +67,7 @@ def study(path: str | Path | StudySpec, *, workers: int = 0, scheduler: str | No
         path: the study file (or a StudySpec already loaded).
         workers: 0 runs the variants in this process, n > 0 on a Dask LocalCluster of n
             processes; scheduler: a running Dask scheduler's address instead.
-        progress: called with (batches done, batches) during a tolerance study.
+        progress: called with (batches done, batches) during a tolerance or grid study.
 
     Raises:
         SceneError, FrameNotFound: a bad study file; the scene's and model's errors; the
@@ -85,7 +87,9 @@ def study(path: str | Path | StudySpec, *, workers: int = 0, scheduler: str | No
                   params=[p.name for p in spec.params], nominal_p=sm.nominal.copy(), nominal=y0, sensitivity=dy)
     if spec.kind == "sensitivity":
         return StudyResult(**common)
-    todo = batches(spec.samples, spec.batch)
+    todo = batches(grid_size(spec) if spec.kind == "grid" else spec.samples, spec.batch)
     tick = (lambda done: progress(done, len(todo))) if progress else None
     results = run_batches(spec, todo, workers=workers, scheduler=scheduler, progress=tick)
+    if spec.kind == "grid":
+        return StudyResult(**common, batches=tuple(results))
     return StudyResult(**common, spread=spread(sm, outputs, results), batches=tuple(results))

@@ -20,7 +20,7 @@ def _workers(text: str) -> int:
 
 def add_parser(sub) -> None:
     """The `study` subcommand's arguments."""
-    study = sub.add_parser("study", help="run a design study (sensitivity or tolerance) from a study file",
+    study = sub.add_parser("study", help="run a design study (sensitivity, tolerance or grid) from a study file",
                            description="Run a study file (models/studies/*.toml): exact sensitivities over the "
                            "cycle, or a seeded Monte Carlo tolerance study on Dask. Exit codes as `pinmech --help`.")
     study.add_argument("study_file", help="study file (TOML), e.g. models/studies/four_bar_tolerance.toml")
@@ -32,7 +32,8 @@ def add_parser(sub) -> None:
     study.add_argument("--out", default=None, metavar="PREFIX",
                        help="write PREFIX.csv, PREFIX.parquet (pyarrow) and PREFIX.json")
     study.add_argument("--plot", action="store_true",
-                       help="with --out: PREFIX_sensitivity.png, and PREFIX_histogram.png for a tolerance study")
+                       help="with --out: PREFIX_sensitivity.png, and PREFIX_histogram.png for a tolerance study, "
+                            "PREFIX_grid.png for a 1-D or 2-D grid study")
     study.add_argument("--json", action="store_true", help="print the JSON summary instead of the text one")
     study.set_defaults(func=cmd_study)
 
@@ -55,9 +56,11 @@ def cmd_study(args: argparse.Namespace) -> int:
     if args.out:
         written = write(result, args.out)
         if args.plot:
-            from pinmech.design.study_plot import sensitivity_bars, tolerance_histograms
+            from pinmech.design.study_plot import grid_figure, sensitivity_bars, tolerance_histograms
 
             written.append(sensitivity_bars(result, f"{args.out}_sensitivity.png"))
+            if result.spec.kind == "grid":
+                written.append(grid_figure(result, f"{args.out}_grid.png"))
             if result.spread is not None:
                 written.append(tolerance_histograms(result, f"{args.out}_histogram.png"))
         print("wrote " + ", ".join(str(p) for p in written), file=sys.stderr)

@@ -24,6 +24,12 @@
     points = ["P"]                       # world x, y, z of these points [m]
     links = ["rocker"]                   # angle of these links about the plane normal [rad]
 
+    # kind = "grid": 1 to 3 of the parameters over evenly spaced values (the others at nominal)
+    [grid.crank]
+    from = "20 mm"
+    to = "70 mm"
+    count = 11
+
 Every mistake is a SceneError naming the study file, the key and the value as written.
 """
 
@@ -40,11 +46,33 @@ from pinmech.units import to_si
 
 from pinmech.toml_file import read_toml
 
-KINDS = ("sensitivity", "tolerance")
-_TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs", "batch"}
+KINDS = ("sensitivity", "tolerance", "grid")
+_TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs", "batch", "grid"}
+_GRID_KEYS = {"from", "to", "count"}
+_GRID_MAX = 1_000_000  # grid points in all
 _PARAM_KEYS = {"joint", "cut", "side", "component", "nominal", "bounds", "tolerance", "k", "sigma", "distribution"}
 _OUTPUT_KEYS = {"points", "links"}
 _LIMITS = {"steps": (1, 100_000), "samples": (1, 10_000_000), "seed": (0, 2**63 - 1), "batch": (1, 1_000_000)}
+
+
+@dataclass(frozen=True)
+class GridAxis:
+    """One axis of a grid study: parameter `name` (index `param`) at `count` evenly spaced
+    values from `start` to `stop` [m], both ends included."""
+
+    name: str
+    param: int
+    start: float
+    stop: float
+    count: int
+
+    @property
+    def values(self) -> tuple[float, ...]:
+        """The axis's values [m]."""
+        if self.count == 1:
+            return (self.start,)
+        step = (self.stop - self.start) / (self.count - 1)
+        return tuple(self.start + i * step for i in range(self.count))
 
 
 @dataclass(frozen=True)
@@ -59,6 +87,7 @@ class StudySpec:
         batch: variants per batch (a Dask task); results do not depend on it.
         params: the parameters, in the file's order.
         points, links: the outputs (point positions, link angles).
+        grid: a grid study's axes (1 to 3), in the [grid] table's order; () otherwise.
     """
 
     path: Path
@@ -72,6 +101,7 @@ class StudySpec:
     params: tuple[Parameter, ...]
     points: tuple[str, ...]
     links: tuple[str, ...]
+    grid: tuple[GridAxis, ...] = ()
 
 
 def load_study(path: str | Path) -> StudySpec:
@@ -101,9 +131,46 @@ def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
         raise where.error("outputs", "name at least one output: points = [\"P\"] or links = [\"rocker\"]")
     counts = {k: where.whole(raw, k, default) for k, default in
               (("steps", 73), ("samples", 200), ("seed", 0), ("batch", 64))}
+    parsed = tuple(_parameter(name, table, where) for name, table in params.items())
     return StudySpec(path, str(raw.get("title", path.stem)), (path.parent / scene), kind, counts["steps"],
-                     counts["samples"], counts["seed"], counts["batch"],
-                     tuple(_parameter(name, table, where) for name, table in params.items()), points, links)
+                     counts["samples"], counts["seed"], counts["batch"], parsed, points, links,
+                     _grid(raw, kind, parsed, where))
+
+
+def _grid(raw: dict[str, Any], kind: str, params: tuple[Parameter, ...], where: _Where) -> tuple[GridAxis, ...]:
+    """The [grid] table's axes: given exactly when kind = "grid"."""
+    if kind != "grid":
+        if "grid" in raw:
+            raise where.error("grid", f"[grid] is for kind = \"grid\" (this study's kind is {kind!r})")
+        return ()
+    table = raw.get("grid")
+    if not isinstance(table, dict):
+        raise where.error("grid", "a grid study needs [grid.NAME] tables: from = \"30 mm\", to = \"60 mm\", count = 7")
+    names = [p.name for p in params]
+    if not 1 <= len(table) <= 3:
+        raise where.error("grid", f"give 1 to 3 [grid.NAME] tables, got {len(table)}")
+    axes = tuple(_axis(name, entry, names, where) for name, entry in table.items())
+    points = math.prod(a.count for a in axes)
+    if points > _GRID_MAX:
+        raise where.error("grid", f"{points} grid points is more than {_GRID_MAX}: lower the counts")
+    return axes
+
+
+def _axis(name: str, entry: Any, names: list[str], where: _Where) -> GridAxis:
+    key = f"grid.{name}"
+    if name not in names:
+        raise where.error(key, f"'{name}' is not a parameter (the [params] tables: {', '.join(names)})")
+    where.known(entry, _GRID_KEYS, key)
+    missing = sorted(_GRID_KEYS - set(entry))
+    if missing:
+        raise where.error(key, f"missing {', '.join(missing)}: give from = \"30 mm\", to = \"60 mm\", count = 7")
+    count = entry["count"]
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= _GRID_MAX:
+        raise where.error(f"{key}.count", f"count = {count!r} must be a whole number from 1 to {_GRID_MAX}")
+    start, stop = where.length(entry, "from", key), where.length(entry, "to", key)
+    if count > 1 and not start < stop:
+        raise where.error(key, f"from {entry['from']} is not below to {entry['to']} (count {count})")
+    return GridAxis(name, names.index(name), start, stop, count)
 
 
 def _parameter(name: str, table: Any, where: _Where) -> Parameter:

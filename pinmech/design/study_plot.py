@@ -74,3 +74,68 @@ def tolerance_histograms(result: StudyResult, path: str | Path) -> Path:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return Path(path)
+
+
+def grid_figure(result: StudyResult, path: str | Path) -> Path:
+    """One panel per output over a grid study: for 1-D its min and max over the cycle
+    against the parameter (failed points marked x on the axis); for 2-D a map of its range
+    over the cycle (max - min) with the failed cells hatched. 3-D grids have no figure."""
+    from pinmech.design.grid import cycle_range
+    from pinmech.exceptions import OptionRefused
+
+    axes_g = result.spec.grid
+    if len(axes_g) > 2:
+        raise OptionRefused(f"{result.spec.path}: a grid of {len(axes_g)} parameters has no figure (1-D or 2-D only); "
+                            "read the table", options=["--plot"])
+    plt = _pyplot()
+    _, y, causes = result.variants
+    lo, hi = cycle_range(y, result.kinds)
+    failed = np.array([bool(c) for c in causes])
+    n = len(result.outputs)
+    fig, axes = plt.subplots(1, n, figsize=(3.8 * n + 1, 3.6), squeeze=False)
+    for j, ax in enumerate(axes[0]):
+        scale, unit = _SCALE[result.kinds[j]]
+        if len(axes_g) == 1:
+            _grid_line(ax, axes_g[0], lo[:, j] * scale, hi[:, j] * scale, failed, unit)
+        else:
+            _grid_map(fig, ax, axes_g, (hi[:, j] - lo[:, j]) * scale, failed, unit)
+        ax.set_title(result.outputs[j])
+    fig.suptitle(f"{result.spec.title}: {len(causes)} points, {int(failed.sum())} failed (marked)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
+
+
+def _grid_line(ax, axis, lo: np.ndarray, hi: np.ndarray, failed: np.ndarray, unit: str) -> None:
+    x = np.asarray(axis.values) * 1e3
+    ax.plot(x, hi, "o-", color="tab:red", ms=3, label="max over the cycle")
+    ax.plot(x, lo, "o-", color="tab:blue", ms=3, label="min over the cycle")
+    if failed.any():
+        ax.plot(x[failed], np.zeros(int(failed.sum())), "kx", transform=ax.get_xaxis_transform(), clip_on=False,
+                label="failed (see table)")
+    ax.set_xlabel(f"{axis.name} [mm]")
+    ax.set_ylabel(f"[{unit}]")
+    ax.legend(fontsize=7)
+
+
+def _grid_map(fig, ax, axes_g, value: np.ndarray, failed: np.ndarray, unit: str) -> None:
+    shape = (axes_g[0].count, axes_g[1].count)
+    x, y = (np.asarray(a.values) * 1e3 for a in axes_g)
+    mesh = ax.pcolormesh(y, x, np.ma.masked_array(value.reshape(shape), failed.reshape(shape)), shading="nearest")
+    fig.colorbar(mesh, ax=ax, label=f"max - min over the cycle [{unit}]")
+    from matplotlib.patches import Rectangle
+
+    hx, hy = (_half(c) for c in (y, x))
+    for i, k in zip(*np.nonzero(failed.reshape(shape))):
+        ax.add_patch(Rectangle((y[k] - hx, x[i] - hy), 2 * hx, 2 * hy, facecolor="0.92", edgecolor="0.45",
+                               hatch="xx", lw=0.0, label="failed (see table)" if not ax.patches else None))
+    if failed.any():
+        ax.legend(fontsize=7, loc="lower right")
+    ax.set_xlabel(f"{axes_g[1].name} [mm]")
+    ax.set_ylabel(f"{axes_g[0].name} [mm]")
+
+
+def _half(centres: np.ndarray) -> float:
+    """Half a cell's width around evenly spaced centres (a single centre: 0.5)."""
+    return float(centres[1] - centres[0]) / 2 if len(centres) > 1 else 0.5

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from pinmech.design.grid import cycle_range, failures
 from pinmech.design.study import StudyResult
 from pinmech.design.tolerance import PERCENTILES, deviation
 
@@ -46,10 +47,20 @@ def summary(result: StudyResult) -> dict:
                                                         s.percentiles[i, :, j].max() * scale)
                                       for i, q in enumerate(PERCENTILES)})
         out["outputs"][name] = entry
+    if spec.kind == "grid":
+        out.update(_grid_summary(result))
     if result.spread is not None:
         out.update(samples=spec.samples, seed=spec.seed, solved=result.spread.solved,
                    failures=dict(result.spread.failures))
     return out
+
+
+def _grid_summary(result: StudyResult) -> dict:
+    """A grid study's axes [mm], its points that solved, and the failures by cause."""
+    _, _, causes = result.variants
+    return {"grid": {a.name: {"from_mm": a.start * 1e3, "to_mm": a.stop * 1e3, "count": a.count}
+                     for a in result.spec.grid},
+            "points": len(causes), "solved": sum(not c for c in causes), "failures": failures(causes)}
 
 
 def _finite(x: float) -> float | None:
@@ -76,12 +87,19 @@ def text(result: StudyResult) -> str:
                 for v in (e["sigma_max"], e["sigma_linear_max"], e["worst"], e["worst_linear"])))
         failed = ", ".join(f"{c}: {n}" for c, n in s["failures"].items()) or "none"
         lines.append(f"solved {s['solved']} of {s['samples']} variants; failed: {failed}")
+    if "points" in s:
+        axes = " x ".join(f"{n} {g['from_mm']:.6g}..{g['to_mm']:.6g} mm ({g['count']})" for n, g in s["grid"].items())
+        failed = ", ".join(f"{c}: {n}" for c, n in s["failures"].items()) or "none"
+        lines.append(f"grid {axes}: solved {s['solved']} of {s['points']} points; failed: {failed}")
     return "\n".join(lines)
 
 
 def table(result: StudyResult) -> dict[str, list]:
-    """The study's table as columns: one row a pose and output (sensitivity), or one row
-    a variant (tolerance: its parameters, its cause, its largest deviation of each output)."""
+    """The study's table as columns: one row a pose and output (sensitivity), one row a
+    variant (tolerance: its parameters, its cause, its largest deviation of each output), or
+    one row a grid point (grid: its parameters, its cause, each output's min and max)."""
+    if result.spec.kind == "grid":
+        return grid_table(result)
     if result.spread is None:
         rows: dict[str, list] = {f"{result.driver} [deg]": [], "output": [], "unit": [], "value": []}
         rows.update({f"d/d {p} [per mm]": [] for p in result.params})
@@ -102,6 +120,21 @@ def table(result: StudyResult) -> dict[str, list]:
     for j, name in enumerate(result.outputs):
         scale, unit = _unit(result.kinds[j])
         rows[f"max |d {name}| [{unit}]"] = (dev[:, j] * scale).tolist()
+    return rows
+
+
+def grid_table(result: StudyResult) -> dict[str, list]:
+    """One row a grid point: its index, parameters [mm], cause ("" if it solved) and each
+    output's min and max over the cycle (NaN where the point failed; angles unwrapped)."""
+    p, y, causes = result.variants
+    rows: dict[str, list] = {"point": list(range(len(causes)))}
+    rows.update({f"{name} [mm]": (p[:, k] * 1e3).tolist() for k, name in enumerate(result.params)})
+    rows["cause"] = list(causes)
+    lo, hi = cycle_range(y, result.kinds)
+    for j, name in enumerate(result.outputs):
+        scale, unit = _unit(result.kinds[j])
+        rows[f"min {name} [{unit}]"] = (lo[:, j] * scale).tolist()
+        rows[f"max {name} [{unit}]"] = (hi[:, j] * scale).tolist()
     return rows
 
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pinmech.design.grid import grid_points
 from pinmech.design.sensitivity import StudyOutputs, cycle_sensitivity
 from pinmech.design.study_variant import StudyMechanism
 
@@ -53,8 +54,9 @@ def draw(sm: StudyMechanism, batch: Batch) -> np.ndarray:
 
 
 def run_batch(sm: StudyMechanism, outputs: StudyOutputs, batch: Batch) -> BatchResult:
-    """Solve the batch's variants over the cycle (the model is left at the nominal)."""
-    p = draw(sm, batch)
+    """Solve the batch's variants over the cycle (the model is left at the nominal): drawn
+    for a tolerance study, the grid's points for a grid study."""
+    p = grid_points(sm.spec, sm.nominal, batch.start, batch.count) if sm.spec.kind == "grid" else draw(sm, batch)
     y = np.full((batch.count, len(sm.values), len(outputs.names)), np.nan)
     causes = []
     try:

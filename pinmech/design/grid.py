@@ -1,0 +1,56 @@
+"""Grid studies: the outputs over every point of a grid of 1 to 3 parameters' values.
+
+Grid point i is the i-th of the axes' values in row-major order (the last axis fastest);
+the parameters off the grid keep their nominal values. No randomness: a batch holds the
+points start .. start + count - 1, so the results do not depend on the batching or on the
+number of Dask workers. A point that fails keeps its cause (study_variant.CAUSES) and NaN
+outputs: it is counted and marked in the table, never dropped.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from pinmech.design.study_file import StudySpec
+
+
+def grid_size(spec: StudySpec) -> int:
+    """How many grid points the study has."""
+    return math.prod(axis.count for axis in spec.grid)
+
+
+def grid_points(spec: StudySpec, nominal: np.ndarray, start: int, count: int) -> np.ndarray:
+    """Grid points start .. start + count - 1 as parameter values (count, n_par) [m]."""
+    shape = tuple(axis.count for axis in spec.grid)
+    index = np.unravel_index(np.arange(start, start + count), shape)
+    p = np.tile(np.asarray(nominal, dtype=float), (count, 1))
+    for axis, i in zip(spec.grid, index):
+        p[:, axis.param] = np.asarray(axis.values)[i]
+    return p
+
+
+def cycle_range(y: np.ndarray, kinds: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Each output's min and max over the cycle (N, n_out) [m, rad] from y (N, steps, n_out).
+
+    An angle is unwrapped along the cycle first, so that a link turning through +-180 deg
+    is not read as a jump of 360 deg. Failed points (NaN rows) stay NaN.
+    """
+    y = np.array(y, dtype=float)
+    angles = [j for j, k in enumerate(kinds) if k == "angle"]
+    ok = ~np.isnan(y).any(axis=(1, 2))
+    if angles and ok.any():
+        y[np.ix_(ok, np.arange(y.shape[1]), angles)] = np.unwrap(y[np.ix_(ok, np.arange(y.shape[1]), angles)], axis=1)
+    lo, hi = np.full(y.shape[::2], np.nan), np.full(y.shape[::2], np.nan)
+    lo[ok], hi[ok] = y[ok].min(axis=1), y[ok].max(axis=1)
+    return lo, hi
+
+
+def failures(causes: list[str]) -> dict[str, int]:
+    """Cause -> how many grid points failed so."""
+    counted: dict[str, int] = {}
+    for cause in causes:
+        if cause:
+            counted[cause] = counted.get(cause, 0) + 1
+    return counted
