@@ -84,11 +84,44 @@ def test_rocker_swing_at_its_extreme_positions():
     assert np.all(hi[:, 0] - lo[:, 0] <= swing + 1e-9)
 
 
+def test_least_transmission_angle_matches_the_law_of_cosines(crank_grid):
+    """Norton's mu (ABO4, acute form) is extreme where |AO4| is: with the crank along the
+    ground (theta2 = 0, 180 deg, both among the 73 poses from 60 deg in 5 deg steps),
+    |AO4| = d - a, d + a and cos mu = (b^2 + c^2 - |AO4|^2) / (2 b c). Each point's own
+    lengths: a linkage left at the nominal's pins would give one value for all."""
+    p, _, causes = crank_grid.variants
+    mu = crank_grid.transmission
+    ok = np.array([not c for c in causes])
+    a = p[ok, 0]
+    ends = [np.degrees(np.arccos((B**2 + C**2 - e**2) / (2 * B * C))) for e in (D - a, D + a)]
+    least = np.minimum(np.minimum(ends[0], 180 - ends[0]), np.minimum(ends[1], 180 - ends[1]))
+    # 1e-6 deg: the loops close to ~1e-10 m (~1e-7 deg on 80 mm links).
+    np.testing.assert_allclose(np.degrees(mu[ok]), least, rtol=0, atol=1e-6)
+    assert np.isnan(mu[~ok]).all()
+    np.testing.assert_allclose(grid_table(crank_grid)["least transmission angle [deg]"][0], least[0], atol=1e-6)
+
+
+def test_least_transmission_angle_over_a_ground_grid_uses_each_points_pivot():
+    """As above over the ground length d (a = 40 mm): the transmission angle reads the
+    ground pivot O4, so a linkage built once at the nominal would give d = 100 mm throughout."""
+    raw = _crank_grid(85, 155, 8)
+    raw["params"] = {"ground": {"joint": "O4", "component": "x"}}
+    raw["grid"] = {"ground": {"from": "85 mm", "to": "155 mm", "count": 8}}
+    res = study(parse_study(raw, STUDIES / "inline.toml"))
+    p, _, causes = res.variants
+    assert not any(causes)  # Grashof: 40 + max(120, d) <= 80 + min(120, d) for 80 <= d <= 160 mm
+    a, d = 0.040, p[:, 0]
+    ends = [np.degrees(np.arccos((B**2 + C**2 - e**2) / (2 * B * C))) for e in (d - a, d + a)]
+    least = np.minimum(np.minimum(ends[0], 180 - ends[0]), np.minimum(ends[1], 180 - ends[1]))
+    np.testing.assert_allclose(np.degrees(res.transmission), least, rtol=0, atol=1e-6)  # 1e-6 deg as above
+
+
 def test_grid_results_do_not_depend_on_the_batching(crank_grid):
     other = study(parse_study(_crank_grid(11, 91, 17, batch=3), STUDIES / "inline.toml"))
     for x, z in zip(crank_grid.variants[:2], other.variants[:2]):
         np.testing.assert_array_equal(x, z)
     assert crank_grid.variants[2] == other.variants[2]
+    np.testing.assert_array_equal(crank_grid.transmission, other.transmission)
 
 
 def test_bundled_grid_study_parses():
@@ -102,6 +135,9 @@ def test_bundled_grid_study_parses():
     ({"grid": {"crank": {"from": "50 mm", "to": "20 mm", "count": 3}}}, "grid.crank"),
     ({"grid": {"crank": {"from": "20 mm", "to": "50 mm"}}}, "grid.crank"),
     ({"grid": {"crank": {"from": "20 mm", "to": "50 mm", "count": 0}}}, "grid.crank.count"),
+    ({"grid": {"crank": {"from": "20 mm", "to": "50 mm", "count": 1}}}, "grid.crank"),
+    ({"grid": {"crank": {"from": "20 mm", "to": "50 mm", "count": 3, "step": 1}}}, "grid.crank"),
+    ({"grid": {c: {"from": "20 mm", "to": "50 mm", "count": 2} for c in "abcd"}}, "grid"),
     ({"grid": {}}, "grid"),
     ({"kind": "tolerance"}, "grid"),
 ])
@@ -120,3 +156,4 @@ def test_a_local_dask_cluster_gives_the_serial_grid(crank_grid):
     for x, z in zip(crank_grid.variants[:2], on_dask.variants[:2]):
         np.testing.assert_array_equal(x, z)
     assert crank_grid.variants[2] == on_dask.variants[2]
+    np.testing.assert_array_equal(crank_grid.transmission, on_dask.transmission)

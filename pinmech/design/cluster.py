@@ -47,6 +47,10 @@ def built(spec: StudySpec) -> tuple:
 def solve_batch(spec: StudySpec, batch: Batch) -> BatchResult:
     """One batch, on the mechanism this process built (a Dask task)."""
     sm, outputs = built(spec)
+    if spec.kind == "grid":
+        from pinmech.design.grid import run_grid_batch
+
+        return run_grid_batch(sm, outputs, batch)
     return run_batch(sm, outputs, batch)
 
 

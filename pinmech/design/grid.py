@@ -4,7 +4,8 @@ Grid point i is the i-th of the axes' values in row-major order (the last axis f
 the parameters off the grid keep their nominal values. No randomness: a batch holds the
 points start .. start + count - 1, so the results do not depend on the batching or on the
 number of Dask workers. A point that fails keeps its cause (study_variant.CAUSES) and NaN
-outputs: it is counted and marked in the table, never dropped.
+outputs: it is counted and marked in the table, never dropped. For a planar linkage with
+dyads, each point also carries its least transmission angle over the cycle.
 """
 
 from __future__ import annotations
@@ -13,7 +14,11 @@ import math
 
 import numpy as np
 
+from pinmech.design.grid_transmission import has_dyads, least_transmission
+from pinmech.design.sensitivity import StudyOutputs
 from pinmech.design.study_file import StudySpec
+from pinmech.design.study_variant import StudyMechanism
+from pinmech.design.tolerance import Batch, BatchResult, solve_variants
 
 
 def grid_size(spec: StudySpec) -> int:
@@ -29,6 +34,15 @@ def grid_points(spec: StudySpec, nominal: np.ndarray, start: int, count: int) ->
     for axis, i in zip(spec.grid, index):
         p[:, axis.param] = np.asarray(axis.values)[i]
     return p
+
+
+def run_grid_batch(sm: StudyMechanism, outputs: StudyOutputs, batch: Batch) -> BatchResult:
+    """Solve the batch's grid points over the cycle, with each one's least transmission
+    angle [rad] as the result's `extra` (None where the mechanism has no dyad)."""
+    p = grid_points(sm.spec, sm.nominal, batch.start, batch.count)
+    drivers = list(sm.sweep.drivers.names)
+    mu = (lambda q: least_transmission(sm.mechanism, drivers, q)) if has_dyads(sm.mechanism, drivers) else None
+    return solve_variants(sm, outputs, batch, p, mu)
 
 
 def cycle_range(y: np.ndarray, kinds: list[str]) -> tuple[np.ndarray, np.ndarray]:

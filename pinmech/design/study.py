@@ -58,6 +58,14 @@ class StudyResult:
         return (np.concatenate([b.p for b in self.batches]), np.concatenate([b.y for b in self.batches]),
                 [c for b in self.batches for c in b.causes])
 
+    @property
+    def transmission(self) -> np.ndarray | None:
+        """A grid study's least transmission angle over the cycle at each point (N,) [rad]
+        (NaN where the point failed); None for other studies and mechanisms without a dyad."""
+        if not self.batches or any(b.extra is None for b in self.batches):
+            return None
+        return np.concatenate([b.extra for b in self.batches])
+
 
 def study(path: str | Path | StudySpec, *, workers: int = 0, scheduler: str | None = None,
           progress: Callable[[int, int], None] | None = None) -> StudyResult:

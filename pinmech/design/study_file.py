@@ -170,6 +170,8 @@ def _axis(name: str, entry: Any, names: list[str], where: _Where) -> GridAxis:
     start, stop = where.length(entry, "from", key), where.length(entry, "to", key)
     if count > 1 and not start < stop:
         raise where.error(key, f"from {entry['from']} is not below to {entry['to']} (count {count})")
+    if count == 1 and start != stop:
+        raise where.error(key, f"count = 1 is the one value from = {entry['from']}: give to = from, or a count above 1")
     return GridAxis(name, names.index(name), start, stop, count)
 
 

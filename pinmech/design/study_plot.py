@@ -79,8 +79,8 @@ def tolerance_histograms(result: StudyResult, path: str | Path) -> Path:
 def grid_figure(result: StudyResult, path: str | Path) -> Path:
     """One panel per output over a grid study: for 1-D its min and max over the cycle
     against the parameter (failed points marked x on the axis); for 2-D a map of its range
-    over the cycle (max - min) with the failed cells hatched. 3-D grids have no figure."""
-    from pinmech.design.grid import cycle_range
+    over the cycle (max - min) with the failed cells hatched; and a panel of the least
+    transmission angle where the mechanism has one. 3-D grids have no figure."""
     from pinmech.exceptions import OptionRefused
 
     axes_g = result.spec.grid
@@ -88,29 +88,44 @@ def grid_figure(result: StudyResult, path: str | Path) -> Path:
         raise OptionRefused(f"{result.spec.path}: a grid of {len(axes_g)} parameters has no figure (1-D or 2-D only); "
                             "read the table", options=["--plot"])
     plt = _pyplot()
-    _, y, causes = result.variants
-    lo, hi = cycle_range(y, result.kinds)
-    failed = np.array([bool(c) for c in causes])
-    n = len(result.outputs)
-    fig, axes = plt.subplots(1, n, figsize=(3.8 * n + 1, 3.6), squeeze=False)
-    for j, ax in enumerate(axes[0]):
-        scale, unit = _SCALE[result.kinds[j]]
+    panels = _grid_panels(result)
+    failed = np.array([bool(c) for c in result.variants[2]])
+    fig, axes = plt.subplots(1, len(panels), figsize=(3.8 * len(panels) + 1, 3.6), squeeze=False)
+    for (title, unit, lo, hi), ax in zip(panels, axes[0]):
         if len(axes_g) == 1:
-            _grid_line(ax, axes_g[0], lo[:, j] * scale, hi[:, j] * scale, failed, unit)
+            _grid_line(ax, axes_g[0], lo, hi, failed, unit)
         else:
-            _grid_map(fig, ax, axes_g, (hi[:, j] - lo[:, j]) * scale, failed, unit)
-        ax.set_title(result.outputs[j])
-    fig.suptitle(f"{result.spec.title}: {len(causes)} points, {int(failed.sum())} failed (marked)")
+            _grid_map(fig, ax, axes_g, hi - lo if hi is not lo else lo, failed,
+                      f"max - min over the cycle [{unit}]" if hi is not lo else f"least over the cycle [{unit}]")
+        ax.set_title(title)
+    fig.suptitle(f"{result.spec.title}: {len(failed)} points, {int(failed.sum())} failed (marked)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return Path(path)
 
 
+def _grid_panels(result: StudyResult) -> list[tuple[str, str, np.ndarray, np.ndarray]]:
+    """(title, unit, min, max) of each output over the cycle at each point, in the users'
+    units; the least transmission angle's panel has min and max the same array."""
+    from pinmech.design.grid import cycle_range
+
+    lo, hi = cycle_range(result.variants[1], result.kinds)
+    panels = []
+    for j, name in enumerate(result.outputs):
+        scale, unit = _SCALE[result.kinds[j]]
+        panels.append((name, unit, lo[:, j] * scale, hi[:, j] * scale))
+    if result.transmission is not None:
+        mu = np.degrees(result.transmission)
+        panels.append(("least transmission angle", "deg", mu, mu))
+    return panels
+
+
 def _grid_line(ax, axis, lo: np.ndarray, hi: np.ndarray, failed: np.ndarray, unit: str) -> None:
     x = np.asarray(axis.values) * 1e3
-    ax.plot(x, hi, "o-", color="tab:red", ms=3, label="max over the cycle")
-    ax.plot(x, lo, "o-", color="tab:blue", ms=3, label="min over the cycle")
+    if hi is not lo:
+        ax.plot(x, hi, "o-", color="tab:red", ms=3, label="max over the cycle")
+    ax.plot(x, lo, "o-", color="tab:blue", ms=3, label="min over the cycle" if hi is not lo else "least over the cycle")
     if failed.any():
         ax.plot(x[failed], np.zeros(int(failed.sum())), "kx", transform=ax.get_xaxis_transform(), clip_on=False,
                 label="failed (see table)")
@@ -119,11 +134,11 @@ def _grid_line(ax, axis, lo: np.ndarray, hi: np.ndarray, failed: np.ndarray, uni
     ax.legend(fontsize=7)
 
 
-def _grid_map(fig, ax, axes_g, value: np.ndarray, failed: np.ndarray, unit: str) -> None:
+def _grid_map(fig, ax, axes_g, value: np.ndarray, failed: np.ndarray, label: str) -> None:
     shape = (axes_g[0].count, axes_g[1].count)
     x, y = (np.asarray(a.values) * 1e3 for a in axes_g)
     mesh = ax.pcolormesh(y, x, np.ma.masked_array(value.reshape(shape), failed.reshape(shape)), shading="nearest")
-    fig.colorbar(mesh, ax=ax, label=f"max - min over the cycle [{unit}]")
+    fig.colorbar(mesh, ax=ax, label=label)
     from matplotlib.patches import Rectangle
 
     hx, hy = (_half(c) for c in (y, x))

@@ -58,9 +58,13 @@ def summary(result: StudyResult) -> dict:
 def _grid_summary(result: StudyResult) -> dict:
     """A grid study's axes [mm], its points that solved, and the failures by cause."""
     _, _, causes = result.variants
-    return {"grid": {a.name: {"from_mm": a.start * 1e3, "to_mm": a.stop * 1e3, "count": a.count}
-                     for a in result.spec.grid},
-            "points": len(causes), "solved": sum(not c for c in causes), "failures": failures(causes)}
+    out = {"grid": {a.name: {"from_mm": a.start * 1e3, "to_mm": a.stop * 1e3, "count": a.count}
+                    for a in result.spec.grid},
+           "points": len(causes), "solved": sum(not c for c in causes), "failures": failures(causes)}
+    mu = result.transmission
+    if mu is not None and not np.isnan(mu).all():
+        out["least_transmission_angle_deg"] = float(np.degrees(np.nanmin(mu)))
+    return out
 
 
 def _finite(x: float) -> float | None:
@@ -91,13 +95,16 @@ def text(result: StudyResult) -> str:
         axes = " x ".join(f"{n} {g['from_mm']:.6g}..{g['to_mm']:.6g} mm ({g['count']})" for n, g in s["grid"].items())
         failed = ", ".join(f"{c}: {n}" for c, n in s["failures"].items()) or "none"
         lines.append(f"grid {axes}: solved {s['solved']} of {s['points']} points; failed: {failed}")
+        if "least_transmission_angle_deg" in s:
+            lines.append(f"least transmission angle over the grid: {s['least_transmission_angle_deg']:.4g} deg")
     return "\n".join(lines)
 
 
 def table(result: StudyResult) -> dict[str, list]:
     """The study's table as columns: one row a pose and output (sensitivity), one row a
     variant (tolerance: its parameters, its cause, its largest deviation of each output), or
-    one row a grid point (grid: its parameters, its cause, each output's min and max)."""
+    one row a grid point (grid: its parameters, its cause, each output's min and max, its
+    least transmission angle)."""
     if result.spec.kind == "grid":
         return grid_table(result)
     if result.spread is None:
@@ -125,7 +132,8 @@ def table(result: StudyResult) -> dict[str, list]:
 
 def grid_table(result: StudyResult) -> dict[str, list]:
     """One row a grid point: its index, parameters [mm], cause ("" if it solved) and each
-    output's min and max over the cycle (NaN where the point failed; angles unwrapped)."""
+    output's min and max over the cycle (NaN where the point failed; angles unwrapped), and
+    the least transmission angle over the cycle for a planar linkage with dyads."""
     p, y, causes = result.variants
     rows: dict[str, list] = {"point": list(range(len(causes)))}
     rows.update({f"{name} [mm]": (p[:, k] * 1e3).tolist() for k, name in enumerate(result.params)})
@@ -135,6 +143,8 @@ def grid_table(result: StudyResult) -> dict[str, list]:
         scale, unit = _unit(result.kinds[j])
         rows[f"min {name} [{unit}]"] = (lo[:, j] * scale).tolist()
         rows[f"max {name} [{unit}]"] = (hi[:, j] * scale).tolist()
+    if result.transmission is not None:
+        rows["least transmission angle [deg]"] = np.degrees(result.transmission).tolist()
     return rows
 
 

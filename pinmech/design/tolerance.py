@@ -10,11 +10,11 @@ Every variant that fails is kept with its cause (study_variant.CAUSES).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from pinmech.design.grid import grid_points
 from pinmech.design.sensitivity import StudyOutputs, cycle_sensitivity
 from pinmech.design.study_variant import StudyMechanism
 
@@ -33,12 +33,14 @@ class Batch:
 @dataclass(frozen=True)
 class BatchResult:
     """The variants of a batch: parameters p (count, n_par) [m], outputs y (count, steps,
-    n_out) [m, rad] (NaN rows where a variant failed), and each failure's cause ("" if none)."""
+    n_out) [m, rad] (NaN rows where a variant failed), and each failure's cause ("" if none);
+    extra: one more number a variant (a grid study's least transmission angle [rad]) or None."""
 
     batch: Batch
     p: np.ndarray
     y: np.ndarray
     causes: tuple[str, ...]
+    extra: np.ndarray | None = None
 
 
 def batches(samples: int, size: int) -> list[Batch]:
@@ -54,10 +56,17 @@ def draw(sm: StudyMechanism, batch: Batch) -> np.ndarray:
 
 
 def run_batch(sm: StudyMechanism, outputs: StudyOutputs, batch: Batch) -> BatchResult:
-    """Solve the batch's variants over the cycle (the model is left at the nominal): drawn
-    for a tolerance study, the grid's points for a grid study."""
-    p = grid_points(sm.spec, sm.nominal, batch.start, batch.count) if sm.spec.kind == "grid" else draw(sm, batch)
+    """Solve the batch's drawn variants over the cycle (the model is left at the nominal)."""
+    return solve_variants(sm, outputs, batch, draw(sm, batch))
+
+
+def solve_variants(sm: StudyMechanism, outputs: StudyOutputs, batch: Batch, p: np.ndarray,
+                   at_variant: Callable[[np.ndarray], float] | None = None) -> BatchResult:
+    """Solve the variants p (count, n_par) [m] over the cycle (the model is left at the
+    nominal). `at_variant(q)`, if given, is called on each solved variant's poses while its
+    values are still written in the model; its numbers are the result's `extra` (NaN: failed)."""
     y = np.full((batch.count, len(sm.values), len(outputs.names)), np.nan)
+    extra = np.full(batch.count, np.nan) if at_variant else None
     causes = []
     try:
         for i, pi in enumerate(p):
@@ -65,9 +74,11 @@ def run_batch(sm: StudyMechanism, outputs: StudyOutputs, batch: Batch) -> BatchR
             causes.append(cycle.cause)
             if not cycle.cause:
                 y[i] = [outputs.values(sm.at(q)) for q in cycle.q]
+                if at_variant:
+                    extra[i] = at_variant(cycle.q)
     finally:
         sm.write(sm.nominal)
-    return BatchResult(batch, p, y, tuple(causes))
+    return BatchResult(batch, p, y, tuple(causes), extra)
 
 
 @dataclass(frozen=True)
