@@ -157,3 +157,21 @@ def test_a_local_dask_cluster_gives_the_serial_grid(crank_grid):
         np.testing.assert_array_equal(x, z)
     assert crank_grid.variants[2] == on_dask.variants[2]
     np.testing.assert_array_equal(crank_grid.transmission, on_dask.transmission)
+
+
+def test_a_three_parameter_grid_has_a_table_but_its_figure_is_refused_by_name(tmp_path):
+    from pinmech.design.study_plot import grid_figure
+    from pinmech.exceptions import OptionRefused
+
+    raw = _crank_grid(30, 40, 2)
+    raw["params"].update(ground={"joint": "O4", "component": "x"},
+                         coupler={"cut": "B", "side": "parent", "component": "x"})
+    raw["grid"].update(ground={"from": "100 mm", "to": "100 mm", "count": 1},
+                       coupler={"from": "118 mm", "to": "122 mm", "count": 2})
+    res = study(parse_study(raw, STUDIES / "inline.toml"))
+    assert len(grid_table(res)["point"]) == 4
+    # row-major, the last axis fastest; exact: the values are from + i (to - from) / (count - 1)
+    np.testing.assert_allclose(res.variants[0] * 1e3, [[30, 100, 118], [30, 100, 122], [40, 100, 118], [40, 100, 122]],
+                               rtol=1e-12)
+    with pytest.raises(OptionRefused, match="3 parameters"):
+        grid_figure(res, tmp_path / "g.png")
