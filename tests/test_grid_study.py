@@ -11,7 +11,6 @@ ground d = 100 mm) checked against two independent references:
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import closed_form

@@ -56,25 +56,6 @@ def _site(theta_deg: np.ndarray) -> np.ndarray:
     return 1000 * np.column_stack([fb.A[:, 0] + c * SITE[0] - s * SITE[1], fb.A[:, 1] + s * SITE[0] + c * SITE[1]])
 
 
-@pytest.fixture
-def figures(monkeypatch):
-    """The figures pinmech saves, kept open to be read."""
-    import pinmech.draw.plot
-
-    kept = []
-
-    def keep(plt, fig, path):
-        kept.append(fig)
-        return path
-
-    monkeypatch.setattr(pinmech.draw.plot, "_save", keep)
-    yield kept
-    import matplotlib.pyplot as plt
-
-    for fig in kept:
-        plt.close(fig)
-
-
 def test_timing_marks_of_a_site_named_like_its_body_and_joint(tmp_path, figures):
     """`--timing-marks` on the site 'coupler' (also a body and a joint): marks at the
     closed-form site every 30 deg (it raised Pinocchio's "Several frames match")."""

@@ -38,10 +38,7 @@ def sensitivity_bars(result: StudyResult, path: str | Path) -> Path:
         ax.set_title(result.outputs[j])
         ax.set_xlabel(f"max |d/dp| over the cycle [{unit}/mm]")
     fig.suptitle(f"{result.spec.title}: sensitivities over one turn of {result.driver}")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    return _save(plt, fig, path)
 
 
 def tolerance_histograms(result: StudyResult, path: str | Path) -> Path:
@@ -70,10 +67,7 @@ def tolerance_histograms(result: StudyResult, path: str | Path) -> Path:
         ax.legend(fontsize=7)
     failed = len(causes) - int(ok.sum())
     fig.suptitle(f"{result.spec.title}: {len(causes)} variants, {failed} failed (counted by cause)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    return _save(plt, fig, path)
 
 
 def grid_figure(result: StudyResult, path: str | Path) -> Path:
@@ -99,10 +93,7 @@ def grid_figure(result: StudyResult, path: str | Path) -> Path:
                       f"max - min over the cycle [{unit}]" if hi is not lo else f"least over the cycle [{unit}]")
         ax.set_title(title)
     fig.suptitle(f"{result.spec.title}: {len(failed)} points, {int(failed.sum())} failed (marked)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    return _save(plt, fig, path)
 
 
 def _grid_panels(result: StudyResult) -> list[tuple[str, str, np.ndarray, np.ndarray]]:
@@ -154,3 +145,12 @@ def _grid_map(fig, ax, axes_g, value: np.ndarray, failed: np.ndarray, label: str
 def _half(centres: np.ndarray) -> float:
     """Half a cell's width around evenly spaced centres (a single centre: 0.5)."""
     return float(centres[1] - centres[0]) / 2 if len(centres) > 1 else 0.5
+
+
+def _save(plt, fig, path: str | Path) -> Path:
+    """Lay the figure out, write it (format from the suffix) and close it."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
+
