@@ -118,5 +118,5 @@ def test_a_study_file_names_what_the_model_lacks():
         _study("four_bar.toml", {"x": {"cut": "Z", "component": "x"}}, ["P"])
     with pytest.raises(SceneError, match=r"outputs.links: unknown link 'bogus'"):
         StudyOutputs(_study("four_bar.toml", {"x": {"joint": "A", "component": "x"}}, ["P"], ["bogus"]))
-    with pytest.raises(SceneError, match=r"params.x.tolerance: '0.1' .*"):
-        _study("four_bar.toml", {"x": {"joint": "A", "component": "x", "tolerance": "0.1"}}, ["P"])
+    with pytest.raises(SceneError, match=r"params.x.nominal: '0.1' .*"):
+        _study("four_bar.toml", {"x": {"joint": "A", "component": "x", "nominal": "0.1"}}, ["P"])

@@ -53,6 +53,10 @@ _GRID_MAX = 1_000_000  # grid points in all
 _PARAM_KEYS = {"joint", "cut", "side", "component", "nominal", "bounds", "tolerance", "k", "sigma", "distribution"}
 _OUTPUT_KEYS = {"points", "links"}
 _LIMITS = {"steps": (1, 100_000), "samples": (1, 10_000_000), "seed": (0, 2**63 - 1), "batch": (1, 1_000_000)}
+#: Keys only some kinds use: any other kind refuses them (a key read by nobody would be a
+#: silent no-op). Top-level keys, then [params.NAME] keys.
+_TOP_USED_BY = {"samples": ("tolerance",), "seed": ("tolerance",), "batch": ("tolerance", "grid")}
+_PARAM_USED_BY = {k: ("tolerance",) for k in ("tolerance", "sigma", "k", "distribution")}
 
 
 @dataclass(frozen=True)
@@ -118,6 +122,7 @@ def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
     kind = raw.get("kind", "sensitivity")
     if kind not in KINDS:
         raise where.error("kind", f"kind = {kind!r} is not one of {', '.join(KINDS)}")
+    _refuse_unused(raw, kind, where)
     scene = raw.get("scene")
     if not isinstance(scene, str):
         raise where.error("scene", f"scene = {scene!r}: give the scene file, e.g. \"../scenes/four_bar.toml\"")
@@ -135,6 +140,20 @@ def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
     return StudySpec(path, str(raw.get("title", path.stem)), (path.parent / scene), kind, counts["steps"],
                      counts["samples"], counts["seed"], counts["batch"], parsed, points, links,
                      _grid(raw, kind, parsed, where))
+
+
+def _refuse_unused(raw: dict[str, Any], kind: str, where: _Where) -> None:
+    """A SceneError for the first key this kind does not use (samples on a grid study, a
+    parameter's sigma on a sensitivity study...), naming the kinds that use it."""
+    unused = [(k, k, kinds) for k, kinds in _TOP_USED_BY.items() if k in raw and kind not in kinds]
+    params = raw.get("params")
+    for name, table in (params.items() if isinstance(params, dict) else ()):
+        unused += [(k, f"params.{name}.{k}", kinds) for k, kinds in _PARAM_USED_BY.items()
+                   if isinstance(table, dict) and k in table and kind not in kinds]
+    if unused:
+        key, where_key, kinds = unused[0]
+        used = " or ".join(f"kind = \"{k}\"" for k in kinds)
+        raise where.error(where_key, f"{key} is for {used}; a {kind} study would not use it: remove it")
 
 
 def _grid(raw: dict[str, Any], kind: str, params: tuple[Parameter, ...], where: _Where) -> tuple[GridAxis, ...]:
