@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 
 from pinmech.exceptions import FrameNotFound, SceneError
-from pinmech.design.sensitivity import StudyOutputs, cycle_sensitivity
+from pinmech.design.sensitivity import cycle_sensitivity
+from pinmech.design.study_outputs import StudyOutputs
 from pinmech.design.study_file import load_study, parse_study
 from pinmech.design.study_variant import StudyMechanism
 from pinmech.design.tolerance import deviation
@@ -41,7 +42,7 @@ def _resolved_differences(sm: StudyMechanism, outputs: StudyOutputs, h: float) -
             p[k] += sign * h
             cycle = sm.cycle(p)  # leaves p in the model: the outputs are read on that variant
             assert not cycle.cause, cycle.detail
-            ys.append(np.array([outputs.values(sm.at(q)) for q in cycle.q]))
+            ys.append(outputs.cycle(cycle.q, cycle.v, cycle.a))
         columns.append(deviation(ys[0], ys[1], outputs.kinds) / (2 * h))  # angles: across +-pi too
     sm.write(sm.nominal)
     return np.stack(columns, axis=-1)
@@ -58,7 +59,7 @@ def test_four_bar_sensitivities_are_the_law_of_cosines_differentiated():
     outputs = StudyOutputs(sm)
     assert outputs.names == ["P.x", "P.y", "rocker.angle"]
     cycle = sm.cycle(sm.nominal)
-    y, dy = cycle_sensitivity(sm, outputs, cycle.q)
+    y, dy = cycle_sensitivity(sm, outputs, cycle)
     theta2, h = cycle.values, 1e-7
 
     def closed(a, b, c, d):
@@ -105,7 +106,7 @@ def test_sensitivities_are_central_differences_of_resolved_variants(scene, param
     outputs = StudyOutputs(sm)
     cycle = sm.cycle(sm.nominal)
     assert not cycle.cause, cycle.detail
-    _, dy = cycle_sensitivity(sm, outputs, cycle.q)
+    _, dy = cycle_sensitivity(sm, outputs, cycle)
     expected = _resolved_differences(sm, outputs, 1e-6)
     np.testing.assert_allclose(dy, expected, rtol=1e-6, atol=1e-6)
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import closed_form
 import numpy as np
 
-from pinmech.design.sensitivity import StudyOutputs
+from pinmech.design.study_outputs import StudyOutputs
 from pinmech.design.study_file import load_study, parse_study
 from pinmech.design.study_variant import StudyMechanism
 from pinmech.design.tolerance import batches, deviation, run_batch, spread

@@ -36,7 +36,7 @@ def require_dask():
 def built(spec: StudySpec) -> tuple:
     """This process's (StudyMechanism, StudyOutputs) of the study, built on first use."""
     if spec not in _BUILT:
-        from pinmech.design.sensitivity import StudyOutputs
+        from pinmech.design.study_outputs import StudyOutputs
         from pinmech.design.study_variant import StudyMechanism
 
         sm = StudyMechanism(spec)

@@ -91,7 +91,7 @@ def study(path: str | Path | StudySpec, *, workers: int = 0, scheduler: str | No
 
         raise SweepError(f"{spec.path}: the nominal fails over the cycle ({cycle.cause}): {cycle.detail}",
                          driver=sm.sweep.driver, value=float("nan"), cause=cycle.error) from cycle.error
-    y0, dy = cycle_sensitivity(sm, outputs, cycle.q)
+    y0, dy = cycle_sensitivity(sm, outputs, cycle)
     common = dict(spec=spec, driver=sm.sweep.driver, values=sm.values, outputs=outputs.names, kinds=outputs.kinds,
                   params=[p.name for p in spec.params], nominal_p=sm.nominal.copy(), nominal=y0, sensitivity=dy)
     if spec.kind == "sensitivity":

@@ -11,7 +11,8 @@ import numpy as np
 from pinmech.design.study import StudyResult
 from pinmech.design.tolerance import deviation
 
-_SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg")}
+_SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "speed": (1e3, "mm/s"),
+          "angular speed": (180 / math.pi, "deg/s"), "angular acceleration": (180 / math.pi, "deg/s^2")}
 
 
 def _pyplot():
