@@ -73,12 +73,9 @@ def output_sensitivity(sm: StudyMechanism, outputs: StudyOutputs, q: np.ndarray,
     dq = configuration_sensitivity(sm, data)
     rows = [Y_q @ dq + Y_p]
     if outputs.sliders or outputs.omega:
-        dv, rates = velocity_sensitivity(sm, q, v, dq)
+        dv, dV = velocity_sensitivity(sm, q, v, dq, outputs.omega)
         rows += [dv[[iv for _, iv in outputs.sliders]]]
-        rows += [link_omega_sensitivity(rates, f, outputs.normal, dq, dv)[None] for f in outputs.omega]
-    if outputs.alpha:
-        raise SceneError("the sensitivity of an angular acceleration is not computed: study omega, or alpha in a "
-                         "grid study", path=str(sm.spec.path), key="outputs.alpha")
+        rows += [link_omega_sensitivity(sm, f, outputs.normal, dV[i], dv)[None] for i, f in enumerate(outputs.omega)]
     return np.vstack(rows)
 
 

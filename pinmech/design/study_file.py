@@ -25,7 +25,6 @@
     links = ["rocker"]                   # angle of these links about the plane normal [rad]
     sliders = ["slide"]                  # a prismatic joint's s [m] and s_dot [m/s]
     omega = ["rocker"]                   # angular speed about the plane normal [rad/s]
-    alpha = ["rocker"]                   # angular acceleration [rad/s^2] (tolerance, grid)
 
     # kind = "grid": 1 to 3 of the parameters over evenly spaced values (the others at nominal)
     [grid.crank]
@@ -54,7 +53,7 @@ _TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs
 _GRID_KEYS = {"from", "to", "count"}
 _GRID_MAX = 1_000_000  # grid points in all
 _PARAM_KEYS = {"joint", "cut", "side", "component", "nominal", "bounds", "tolerance", "k", "sigma", "distribution"}
-_OUTPUT_KEYS = {"points", "links", "sliders", "omega", "alpha"}
+_OUTPUT_KEYS = {"points", "links", "sliders", "omega"}
 _LIMITS = {"steps": (1, 100_000), "samples": (1, 10_000_000), "seed": (0, 2**63 - 1), "batch": (1, 1_000_000)}
 #: Keys only some kinds use: any other kind refuses them (a key read by nobody would be a
 #: silent no-op). Top-level keys, then [params.NAME] keys.
@@ -94,8 +93,7 @@ class StudySpec:
         batch: variants per batch (a Dask task); results do not depend on it.
         params: the parameters, in the file's order.
         points, links: the outputs (point positions, link angles).
-        sliders, omega, alpha: prismatic joints (s and s_dot), links' angular speeds and
-            accelerations (study_outputs.py).
+        sliders, omega: prismatic joints (s and s_dot), links' angular speeds (study_outputs.py).
         grid: a grid study's axes (1 to 3), in the [grid] table's order; () otherwise.
     """
 
@@ -113,7 +111,6 @@ class StudySpec:
     grid: tuple[GridAxis, ...] = ()
     sliders: tuple[str, ...] = ()
     omega: tuple[str, ...] = ()
-    alpha: tuple[str, ...] = ()
 
 
 def load_study(path: str | Path) -> StudySpec:
@@ -147,7 +144,7 @@ def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
     parsed = tuple(_parameter(name, table, where) for name, table in params.items())
     return StudySpec(path, str(raw.get("title", path.stem)), (path.parent / scene), kind, counts["steps"],
                      counts["samples"], counts["seed"], counts["batch"], parsed, named["points"],
-                     named["links"], _grid(raw, kind, parsed, where), named["sliders"], named["omega"], named["alpha"])
+                     named["links"], _grid(raw, kind, parsed, where), named["sliders"], named["omega"])
 
 
 def _refuse_unused(raw: dict[str, Any], kind: str, where: _Where) -> None:
