@@ -128,4 +128,4 @@ def _cut_rows(sm, cut, rates: _FrameRates, S: np.ndarray, place, u: np.ndarray, 
 def _written_in(sm, place) -> int:
     """The joint whose body carries what a parameter moves (the parent joint for a joint
     origin, the frame's joint for a cut frame)."""
-    return sm.model.parents[place.joint] if place.frame < 0 else place.joint
+    return place.written_in

@@ -52,7 +52,8 @@ KINDS = ("sensitivity", "tolerance", "grid")
 _TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs", "batch", "grid"}
 _GRID_KEYS = {"from", "to", "count"}
 _GRID_MAX = 1_000_000  # grid points in all
-_PARAM_KEYS = {"joint", "cut", "side", "component", "nominal", "bounds", "tolerance", "k", "sigma", "distribution"}
+_TARGETS = ("joint", "cut", "point", "body")
+_PARAM_KEYS = {"joint", "cut", "point", "body", "side", "component", "nominal", "bounds", "tolerance", "k", "sigma", "distribution"}
 _OUTPUT_KEYS = {"points", "links", "sliders", "omega"}
 _LIMITS = {"steps": (1, 100_000), "samples": (1, 10_000_000), "seed": (0, 2**63 - 1), "batch": (1, 1_000_000)}
 #: Keys only some kinds use: any other kind refuses them (a key read by nobody would be a
@@ -204,14 +205,18 @@ def _parameter(name: str, table: Any, where: _Where) -> Parameter:
     if not isinstance(table, dict):
         raise where.error(key, "must be a table (joint = \"A\", component = \"x\", tolerance = \"0.1 mm\")")
     where.known(table, _PARAM_KEYS, key)
-    if ("joint" in table) == ("cut" in table):
-        raise where.error(key, "give one of joint = \"NAME\" (its origin) or cut = \"NAME\" (a cut frame's origin)")
-    target = "joint" if "joint" in table else "cut"
+    given = [t for t in _TARGETS if t in table]
+    if len(given) != 1:
+        raise where.error(key, "give one of joint = \"NAME\" (its origin), cut = \"NAME\" (a cut frame's origin), "
+                          "point = \"NAME\" (a named point) or body = \"NAME\" (an MJCF body's pos)")
+    target = given[0]
+    if not isinstance(table[target], str):
+        raise where.error(f"{key}.{target}", f"{target} = {table[target]!r} must be a name")
     side = table.get("side", "parent" if target == "cut" else "")
     if target == "cut" and side not in ("parent", "child"):
         raise where.error(f"{key}.side", f"side = {side!r} must be \"parent\" or \"child\"")
-    if target == "joint" and "side" in table:
-        raise where.error(f"{key}.side", "side is for a cut's frames; a joint has one origin")
+    if target != "cut" and "side" in table:
+        raise where.error(f"{key}.side", f"side is for a cut's frames; a {target} has one origin")
     component = table.get("component")
     if component not in AXES:
         raise where.error(f"{key}.component", f"component = {component!r} must be \"x\", \"y\" or \"z\"")

@@ -27,7 +27,7 @@ from pinmech.io.scene import Scene
 from pinmech.design.study_file import StudySpec
 from pinmech.design.study_params import Placement, placements, subtrees
 from pinmech.design.variant_core import CoreCycle
-from pinmech.io.sweep import Sweep
+from pinmech.io.sweep import Sweep, sweep_options
 
 CAUSES = ("cannot assemble", "other assembly", "fold within the range", "changes assembly", "singular pose",
           "outside bounds")
@@ -57,7 +57,8 @@ class StudyMechanism:
 
     def __init__(self, spec: StudySpec) -> None:
         self.spec = spec
-        self.sweep = Sweep.from_scene(Scene.load(spec.scene))
+        scene = Scene.load(spec.scene)
+        self.sweep = Sweep.from_scene(scene)
         self.mechanism, self.solver = self.sweep.mechanism, self.sweep.solver
         self.model = self.mechanism.model
         self.placements: list[Placement] = placements(self.mechanism, spec.params, str(spec.path))
@@ -69,7 +70,7 @@ class StudyMechanism:
         if outside:
             raise SceneError(f"the nominal {outside}", path=str(spec.path), key="params")
         self.subtree = subtrees(self.model)
-        self.values = np.asarray(self.sweep.default_values(spec.steps), dtype=float)
+        self.values = _cycle_values(scene, self.sweep, spec.steps)
         self.solver.refresh()
         scene_ref = self.solver.reference  # the scene's (scene_solver), closed again for the nominal
         self.reference = self.solver.set_reference(scene_ref.driver_q, scene_ref.q)
@@ -123,6 +124,18 @@ class StudyMechanism:
         pin.computeJointJacobians(self.model, self.data, q)
         pin.updateFramePlacements(self.model, self.data)
         return self.data
+
+
+def _cycle_values(scene: Scene, sweep: Sweep, steps: int) -> np.ndarray:
+    """The study's driver values [rad or m]: `steps` evenly spaced over the scene's
+    [sweep] from .. to where it gives them (a five-bar's motor cannot turn fully), else
+    over one turn of the driver from its scene value, both ends included."""
+    options = sweep_options(scene)
+    kind = "angle" if sweep.is_angular else "length"
+    start = scene.quantity(options["from"], kind, "sweep", "from") if "from" in options else sweep.start
+    span = sweep.default_values(2)[1] - sweep.start
+    stop = scene.quantity(options["to"], kind, "sweep", "to") if "to" in options else start + span
+    return np.linspace(start, stop, steps) if steps > 1 else np.array([start])
 
 
 def _cause(exc: PinmechError) -> str:
