@@ -25,7 +25,7 @@ def test_a_sensitivity_study_writes_its_table_summary_and_figure(tmp_path, capsy
     out = capsys.readouterr().out
     assert "largest |dy/dp| over the cycle" in out
     rows = list(csv.DictReader((prefix.with_suffix(".csv")).open()))
-    assert len(rows) == 73 * 3
+    assert len(rows) == 73 * 4  # P.x, P.y, rocker.angle, rocker.omega at each pose
     pq = pytest.importorskip("pyarrow.parquet")
     parquet = pq.read_table(prefix.with_suffix(".parquet")).to_pydict()
     np.testing.assert_array_equal(parquet["d/d crank [per mm]"], [float(r["d/d crank [per mm]"]) for r in rows])

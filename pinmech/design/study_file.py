@@ -3,7 +3,7 @@
     title = "Four-bar: how the tolerances move the rocker"
     scene = "../scenes/four_bar.toml"   # the mechanism, its drivers and assembly
     kind = "tolerance"                   # or "sensitivity"
-    steps = 73                           # poses over one turn of the scene's first driver
+    steps = 73                           # poses over the scene's [sweep] from..to, else one turn of its first driver
     samples = 400                        # tolerance: Monte Carlo variants
     seed = 2025                          # tolerance: the random stream's seed
 
@@ -19,6 +19,10 @@
     component = "x"
     sigma = "0.02 mm"
     bounds = ["119.9 mm", "120.1 mm"]
+
+    [params.P_x]                         # a named point's place on its link (a scene's [points],
+    point = "P"                          # a URDF fixed link, an MJCF site, a robot.yaml loop frame)
+    component = "x"                      # (or body = "coupler": an MJCF body's pos)
 
     [outputs]
     points = ["P"]                       # world x, y, z of these points [m]
@@ -89,7 +93,8 @@ class StudySpec:
     Attributes:
         path: the study file; scene: the scene file it names.
         kind: "sensitivity" or "tolerance".
-        steps: poses over one turn of the scene's first driver, both ends included.
+        steps: poses over the scene's [sweep] from .. to, else one turn of its first driver,
+            both ends included.
         samples, seed: Monte Carlo variants and the seed of their random stream.
         batch: variants per batch (a Dask task); results do not depend on it.
         params: the parameters, in the file's order.

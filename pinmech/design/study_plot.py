@@ -38,7 +38,7 @@ def sensitivity_bars(result: StudyResult, path: str | Path) -> Path:
         ax.invert_yaxis()
         ax.set_title(result.outputs[j])
         ax.set_xlabel(f"max |d/dp| over the cycle [{unit}/mm]")
-    fig.suptitle(f"{result.spec.title}: sensitivities over one turn of {result.driver}")
+    fig.suptitle(f"{result.spec.title}: sensitivities over the cycle of {result.driver}")
     return _save(plt, fig, path)
 
 
