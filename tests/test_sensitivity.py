@@ -54,20 +54,22 @@ def test_four_bar_sensitivities_are_the_law_of_cosines_differentiated():
     of the closed form (law of cosines, circle intersection) in a, b, c, d. Step h = 1e-7 m
     (1e-6 of the 0.1 m loop): truncation h^2 |y'''| ~ 1e-12, rounding 1e-16 / 1e-6 ~ 1e-10
     rad/m; the IFT derivative carries the closure tolerance times the condition number
-    (< 1e-10). Tolerance 1e-7 (rad/m or m/m) against values of order 10."""
+    (< 1e-10). Tolerance 1e-7 (rad/m or m/m) against values of order 10. The rocker's
+    omega4 at 120 rpm (Norton's formula, closed_form.four_bar): its d/dp of order 600
+    rad/s/m carries omega2 = 12.6 rad/s times those errors: tolerance 2e-6 rad/s/m."""
     sm = StudyMechanism(load_study(STUDIES / "four_bar_sensitivity.toml"))
     outputs = StudyOutputs(sm)
-    assert outputs.names == ["P.x", "P.y", "rocker.angle"]
+    assert outputs.names == ["P.x", "P.y", "rocker.angle", "rocker.omega"]
     cycle = sm.cycle(sm.nominal)
     y, dy = cycle_sensitivity(sm, outputs, cycle)
     theta2, h = cycle.values, 1e-7
 
     def closed(a, b, c, d):
-        fb = closed_form.four_bar(theta2, 0.0, 0.0, a, b, c, d, +1)
+        fb = closed_form.four_bar(theta2, 4 * np.pi, 0.0, a, b, c, d, +1)  # 120 rpm
         A = a * np.stack([np.cos(theta2), np.sin(theta2)], axis=-1)
         c3, s3 = np.cos(fb.theta3), np.sin(fb.theta3)
         P = A + np.stack([0.06 * c3 - 0.03 * s3, 0.06 * s3 + 0.03 * c3], axis=-1)
-        return np.column_stack([P, np.unwrap(fb.theta4)])
+        return np.column_stack([P, np.unwrap(fb.theta4), fb.omega4])
 
     nominal = np.array([0.04, 0.12, 0.08, 0.10])  # a, b, c, d
     np.testing.assert_allclose(y[:, :2], closed(*nominal)[:, :2], rtol=0, atol=1e-12)  # the same assembly
@@ -76,7 +78,8 @@ def test_four_bar_sensitivities_are_the_law_of_cosines_differentiated():
         step = np.zeros(4)
         step[order[param.name]] = h
         expected = (closed(*(nominal + step)) - closed(*(nominal - step))) / (2 * h)
-        np.testing.assert_allclose(dy[:, :, k], expected, rtol=0, atol=1e-7, err_msg=param.name)
+        np.testing.assert_allclose(dy[:, :3, k], expected[:, :3], rtol=0, atol=1e-7, err_msg=param.name)
+        np.testing.assert_allclose(dy[:, 3, k], expected[:, 3], rtol=0, atol=2e-6, err_msg=param.name)
 
 
 @pytest.mark.parametrize("scene, params, points, links", [
@@ -201,3 +204,41 @@ def test_mjcf_robot_yaml_and_scene_point_parameters_are_central_differences(tmp_
     assert np.abs(expected).max(axis=(0, 1)).min() > 1e-3  # every parameter moves some output
     for j, name in enumerate(out.names):
         np.testing.assert_allclose(dy[:, j], expected[:, j], rtol=0, atol=1e-6 * scale[j] + 1e-9, err_msg=name)
+
+
+def test_transmission_angle_is_the_law_of_cosines_and_its_sensitivity_central_differences():
+    """The four-bar's transmission angle mu at B (between the coupler B->A and the rocker
+    B->O4) equals the law of cosines, cos mu = (b^2 + c^2 - |A O4|^2) / (2 b c), to 1e-12
+    rad (the closure tolerance); d mu / dp for the four lengths equals central differences
+    of re-solved variants (h = 1e-6 m, tolerance 1e-6 of the largest |d mu/dp| ~ 15 rad/m,
+    as for the other outputs: truncation ~ (h/L)^2, rounding ~ 1e-13 L / h). The slider-
+    crank's (mu = 90 deg - the rod's angle to the slide) is checked the same way."""
+    params = {"crank": {"joint": "A", "component": "x"}, "ground": {"joint": "O4", "component": "x"},
+              "coupler": {"cut": "B", "side": "parent", "component": "x"},
+              "rocker": {"cut": "B", "side": "child", "component": "x"}}
+    raw = {"scene": "../scenes/four_bar.toml", "kind": "sensitivity", "steps": 25, "params": params,
+           "outputs": {"transmission": ["B"]}}
+    sm = StudyMechanism(parse_study(raw, STUDIES / "inline.toml"))
+    out = StudyOutputs(sm)
+    cycle = sm.cycle(sm.nominal)
+    y, dy = cycle_sensitivity(sm, out, cycle)
+    a, b, c, d = 0.04, 0.12, 0.08, 0.10
+    L2 = a * a + d * d - 2 * a * d * np.cos(cycle.values)
+    np.testing.assert_allclose(y[:, 0], np.arccos((b * b + c * c - L2) / (2 * b * c)), rtol=0, atol=1e-12)
+    expected = _resolved_differences(sm, out, 1e-6)
+    np.testing.assert_allclose(dy, expected, rtol=0, atol=1e-6 * np.abs(expected).max())
+    raw = {"scene": "../scenes/slider_crank.toml", "kind": "sensitivity", "steps": 25,
+           "params": {"offset": {"joint": "slide", "component": "y"}, "rod": {"cut": "B", "component": "x"},
+                      "crank": {"joint": "A", "component": "x"}}, "outputs": {"transmission": ["B"]}}
+    sm = StudyMechanism(parse_study(raw, STUDIES / "inline.toml"))
+    out = StudyOutputs(sm)
+    _, dy = cycle_sensitivity(sm, out, sm.cycle(sm.nominal))
+    expected = _resolved_differences(sm, out, 1e-6)
+    np.testing.assert_allclose(dy, expected, rtol=0, atol=1e-6 * np.abs(expected).max())
+
+
+def test_a_transmission_angle_names_a_dyad():
+    raw = {"scene": "../scenes/four_bar.toml", "kind": "sensitivity", "steps": 5,
+           "params": {"crank": {"joint": "A", "component": "x"}}, "outputs": {"transmission": ["A"]}}
+    with pytest.raises(SceneError, match=r"inline.toml, outputs.transmission: 'A' is not the middle pin .*: B\)"):
+        StudyOutputs(StudyMechanism(parse_study(raw, STUDIES / "inline.toml")))

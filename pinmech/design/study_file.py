@@ -29,6 +29,7 @@
     links = ["rocker"]                   # angle of these links about the plane normal [rad]
     sliders = ["slide"]                  # a prismatic joint's s [m] and s_dot [m/s]
     omega = ["rocker"]                   # angular speed about the plane normal [rad/s]
+    transmission = ["B"]                 # the transmission angle of the dyad with middle pin B [rad]
 
     # kind = "grid": 1 to 3 of the parameters over evenly spaced values (the others at nominal)
     [grid.crank]
@@ -58,7 +59,7 @@ _GRID_KEYS = {"from", "to", "count"}
 _GRID_MAX = 1_000_000  # grid points in all
 _TARGETS = ("joint", "cut", "point", "body")
 _PARAM_KEYS = {"joint", "cut", "point", "body", "side", "component", "nominal", "bounds", "tolerance", "k", "sigma", "distribution"}
-_OUTPUT_KEYS = {"points", "links", "sliders", "omega"}
+_OUTPUT_KEYS = {"points", "links", "sliders", "omega", "transmission"}
 _LIMITS = {"steps": (1, 100_000), "samples": (1, 10_000_000), "seed": (0, 2**63 - 1), "batch": (1, 1_000_000)}
 #: Keys only some kinds use: any other kind refuses them (a key read by nobody would be a
 #: silent no-op). Top-level keys, then [params.NAME] keys.
@@ -100,6 +101,7 @@ class StudySpec:
         params: the parameters, in the file's order.
         points, links: the outputs (point positions, link angles).
         sliders, omega: prismatic joints (s and s_dot), links' angular speeds (study_outputs.py).
+        transmission: dyads by their middle pin, for their transmission angle.
         grid: a grid study's axes (1 to 3), in the [grid] table's order; () otherwise.
     """
 
@@ -117,6 +119,7 @@ class StudySpec:
     grid: tuple[GridAxis, ...] = ()
     sliders: tuple[str, ...] = ()
     omega: tuple[str, ...] = ()
+    transmission: tuple[str, ...] = ()
 
 
 def load_study(path: str | Path) -> StudySpec:
@@ -150,7 +153,8 @@ def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
     parsed = tuple(_parameter(name, table, where) for name, table in params.items())
     return StudySpec(path, str(raw.get("title", path.stem)), (path.parent / scene), kind, counts["steps"],
                      counts["samples"], counts["seed"], counts["batch"], parsed, named["points"],
-                     named["links"], _grid(raw, kind, parsed, where), named["sliders"], named["omega"])
+                     named["links"], _grid(raw, kind, parsed, where), named["sliders"], named["omega"],
+                     named["transmission"])
 
 
 def _refuse_unused(raw: dict[str, Any], kind: str, where: _Where) -> None:

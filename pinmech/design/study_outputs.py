@@ -7,6 +7,8 @@ Outputs, in this order (`[outputs]` of the study file):
     links = ["rocker"]    rocker.angle: its x axis about the plane normal [rad]
     sliders = ["slide"]   slide.s: a prismatic joint's coordinate [m]
     sliders (again)       slide.s_dot: its speed [m/s]
+    transmission = ["B"]  B.mu: the transmission angle of the dyad whose middle pin is B [rad]
+                          (study_transmission.py)
     omega = ["rocker"]    rocker.omega: angular speed about the plane normal [rad/s]
 
 Speeds are those of the scene's driver speed. (A link's angular acceleration is not an
@@ -19,6 +21,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import SceneError
+from pinmech.design.study_transmission import dyad_pins, transmission_row, transmission_values
 from pinmech.solve.core import CompiledModel
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -49,25 +52,29 @@ class StudyOutputs:
         self.points = [mech.frame_id(_checked_point(mech, name, spec)) for name in spec.points]
         self.links = [mech.links[name] for name in spec.links]
         self.omega = [mech.links[name] for name in spec.omega]
+        self.dyads = (dyad_pins(mech, list(sm.solver.drivers), spec.transmission, str(spec.path))
+                      if spec.transmission else [])
         self.axes = _plane_axes(self.normal)
         self.names = ([f"{n}.{'xyz'[k]}" for n in spec.points for k in self.axes] + [f"{n}.angle" for n in spec.links]
-                      + [f"{n}.s" for n in spec.sliders] + [f"{n}.s_dot" for n in spec.sliders]
+                      + [f"{n}.mu" for n in spec.transmission] + [f"{n}.s" for n in spec.sliders] + [f"{n}.s_dot" for n in spec.sliders]
                       + [f"{n}.omega" for n in spec.omega])
         self.kinds = (["length"] * (len(spec.points) * len(self.axes)) + ["angle"] * len(spec.links)
+                      + ["angle"] * len(spec.transmission)
                       + ["length"] * len(spec.sliders) + ["speed"] * len(spec.sliders)
                       + ["angular speed"] * len(spec.omega))
-        self.n_pose = len(self.points) * len(self.axes) + len(self.links) + len(self.sliders)
+        self.n_pose = len(self.points) * len(self.axes) + len(self.links) + len(self.dyads) + len(self.sliders)
         if self.normal is not None:
             e1 = np.eye(3)[int(np.argmin(np.abs(self.normal)))]
             e1 = e1 - self.normal * (self.normal @ e1)
             self.e1 = e1 / np.linalg.norm(e1)
             self.e2 = np.cross(self.normal, self.e1)
-        frames = self.points + self.links + self.omega
+        self.pins = sorted({f for d in self.dyads for f in (d.near, d.joint, d.ground) if f >= 0})
+        frames = self.points + self.links + self.omega + self.pins
         compiled = CompiledModel(sm.model, frames)
         self._core = compiled.kinematics(sm.model)  # reads the variant's placements at each call
         self._frames = list(range(len(compiled.frame_ids)))
         self._index = {key: [compiled.frames[f] for f in fs] for key, fs in
-                       (("points", self.points), ("links", self.links), ("omega", self.omega))}
+                       (("points", self.points), ("links", self.links), ("omega", self.omega), ("pins", self.pins))}
 
     def cycle(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         """The outputs (steps, n_out) at the poses q with rates v, a (steps, nq / nv) of the
@@ -81,6 +88,8 @@ class StudyOutputs:
             columns += [P[:, i, k] for i in at["points"] for k in self.axes]
             x_axes = R[:, at["links"]][..., [0, 3, 6]]  # each link's x axis (rotation's first column), world
             columns += list(np.arctan2(x_axes @ self.e2, x_axes @ self.e1).T) if at["links"] else []
+            x = {f: P[:, i] for f, i in zip(self.pins, at["pins"])}
+            columns += [transmission_values(d, x, self.e1, self.e2) for d in self.dyads]
         columns += [q[:, iq] for iq, _ in self.sliders] + [v[:, iv] for _, iv in self.sliders]
         if self._frames:
             columns += list((W[:, at["omega"]] @ self.normal).T) if at["omega"] else []
@@ -102,6 +111,14 @@ class StudyOutputs:
             J = pin.getFrameJacobian(model, data, f, _LWA).reshape(6, -1)
             rows_q.append(self.normal @ J[3:])
             rows_p.append(np.zeros(n_par))
+        if self.dyads:
+            x = {f: data.oMf[f].translation for f in self.pins}
+            J = {f: pin.getFrameJacobian(model, data, f, _LWA).reshape(6, -1)[:3] for f in self.pins}
+            direct = {f: np.array([place.direction(data) if place.moves_frame(f, sm.subtree) else np.zeros(3)
+                                   for place in sm.placements]).reshape(-1, 3).T for f in self.pins}
+            for d in self.dyads:
+                rows_q.append(transmission_row(d, x, J, self.e1, self.e2))
+                rows_p.append(transmission_row(d, x, direct, self.e1, self.e2))
         for _, iv in self.sliders:
             rows_q.append(np.eye(model.nv)[iv])
             rows_p.append(np.zeros(n_par))
