@@ -257,9 +257,15 @@ def _distribution(table: dict, key: str, where: _Where) -> tuple[str, float]:
         raise where.error(f"{key}.distribution", f"distribution = {distribution!r} is not one of "
                           f"{', '.join(DISTRIBUTIONS)}")
     if distribution == "fixed":
+        spread = [k for k in ("sigma", "tolerance", "k") if k in table]
+        if spread:
+            raise where.error(f"{key}.{spread[0]}", f"a fixed parameter has no spread: remove {spread[0]}, or give "
+                              "distribution = \"normal\" or \"uniform\"")
         return distribution, 0.0
     if "sigma" in table and ("tolerance" in table or distribution == "uniform"):
         raise where.error(f"{key}.sigma", "give sigma (normal) or tolerance (+-, normal at k sigma, or uniform)")
+    if "sigma" in table and "k" in table:
+        raise where.error(f"{key}.k", "k (tolerance at k sigma) goes with tolerance; sigma is the standard deviation")
     if "sigma" in table:
         return distribution, where.positive(table, "sigma", key)
     if "tolerance" not in table:
