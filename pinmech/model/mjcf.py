@@ -50,7 +50,9 @@ from pinmech.model.mjcf_composite import place_composites_as_mujoco
 from pinmech.model.mjcf_limits import mjcf_limits
 from pinmech.model.mjcf_frames import (angles_in_radians, fromto_sites, hoist_to_moving_bodies, orientations_as_quaternions,
                                  sites_on)
-from pinmech.model.mechanism import Mechanism, pinocchio_build, read_xml
+from pinmech.model.mechanism import Mechanism
+from pinmech.model.pinocchio_build import pinocchio_build
+from pinmech.model.urdf_xml import read_xml
 from pinmech.user_cache import cached_text
 
 _CLOSE_TOL = 1e-9  # [m] gap of a connect at qpos0 read as open (parsers print 6-9 digits)
