@@ -33,10 +33,11 @@ from pinmech.model.frame_names import frame_named, frames_of_kind
 from pinmech.model.inertia_check import model_inertia_caveats, urdf_inertia_caveats
 from pinmech.model.joint_info import JointInfo, _body_frame, _joint_infos, _named_points, _tree_joint_links
 from pinmech.model.loop_size import SIZE_RANGE, _length_scale, _translational
-from pinmech.model.pinocchio_build import MAX_DOF, _build_model, _check_locked, _check_size, _lock_joints, pinocchio_build
+from pinmech.model.pinocchio_build import (MAX_DOF, _build_model, _check_locked, _check_size, _lock_joints,
+                                          pinocchio_build)
 from pinmech.model.urdf_joints import JointLimit, MimicJoint, joint_limits, mimic_joints, with_followers
-from pinmech.model.urdf_xml import (_check_urdf_spelling, _joint_links, _link_names, _parse_constraint, _parse_xml, _point_links,
-                                    read_xml, urdf_joint_types, urdf_mimic_leaders)
+from pinmech.model.urdf_xml import (_check_urdf_spelling, _joint_links, _link_names, _parse_constraint, _parse_xml,
+                                    _point_links, read_xml, urdf_joint_types, urdf_mimic_leaders)
 
 #: names kept importable from here (they lived in this module)
 __all__ = ["MAX_DOF", "SIZE_RANGE", "STRUCTURAL_RANK_TOL", "UNIT_NORM_TOL", "JointInfo", "Mechanism",
