@@ -129,6 +129,15 @@ def linkage_from_spec(spec: LinkageSpec, source: str = "<linkage>") -> Linkage:
     return linkage
 
 
+def linkage_params(spec: LinkageSpec, source: str = "<linkage>") -> dict[str, float]:
+    """The spec's parameters as lengths [m], in the order written (a study's named dimensions).
+
+    Raises:
+        ModelError: a parameter that is no length (naming `[params] NAME`).
+    """
+    return dict(_Reader(source, spec.params).params)
+
+
 def _masses(linkage: Linkage, reader: _Reader, spec: LinkageSpec) -> None:
     """`[masses]`: the links' masses as stated (`pinmech.model.linkage_masses`), none invented."""
     linkage.masses = parse_masses(spec.masses, linkage.points, linkage.spatial, reader.length, linkage.source)
