@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from pinmech.exceptions import ModelError, UnitError
-from pinmech.model.linkage_spec import MassSpec
+from pinmech.model.linkage_entries import MassSpec
 from pinmech.units import to_si
 
 _PLANAR_KEYS = {"mass", "at", "izz"}

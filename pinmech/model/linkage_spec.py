@@ -24,87 +24,23 @@ Attributes of `LinkageSpec` (the file's keys; every table in the order written):
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Union
+from typing import Any, Union
 
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, StrictFloat, StrictInt, StrictStr, Tag
-from pydantic import ValidationError, ValidationInfo, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, StrictStr, ValidationError, ValidationInfo, field_validator
+from pydantic import model_validator
 
 from pinmech.directions import unit_vector, written
 from pinmech.exceptions import ModelError
+from pinmech.model.linkage_entries import (TABLES as _TABLES, Compass, Joint, MassSpec, Polar, Slider, Slot, Written,
+                                           as_model_error as _as_model_error)
 from pinmech.model.linkage_expr import check_param_name
 
 GROUND = "ground"
-#: A quantity as the file writes it: "40 mm", "crank", "2*a + b", "30 deg", or a number.
-Written = Union[StrictStr, StrictInt, StrictFloat]
-_TABLES = ("params", "joints", "links", "sliders", "slots", "colors", "axes", "masses")
 _KEYS = {"title", "ground", "balls", *_TABLES}
 
 
 def _source(info: ValidationInfo) -> str:
     return (info.context or {}).get("source", "<linkage>")
-
-
-class _Entry(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
-
-
-class Polar(_Entry):
-    """`{from = "O", length = "m", angle = "30 deg"}`: at `length` from a joint, `angle` from x."""
-
-    base: StrictStr = Field(alias="from")
-    length: Written
-    angle: Written
-
-
-class Compass(_Entry):
-    """`{from = ["A", "B"], lengths = [|A..|, |B..|], side = "left"}`: left or right of A -> B."""
-
-    bases: tuple[StrictStr, StrictStr] = Field(alias="from")
-    lengths: tuple[Written, Written]
-    side: StrictStr
-
-
-class Slider(_Entry):
-    """`{block = LINK, on = LINK, at = JOINT, along = ANGLE or [P, Q]}`: a prismatic pair."""
-
-    block: Union[StrictStr, None] = None
-    on: Union[StrictStr, None] = None
-    at: Union[StrictStr, None] = None
-    along: Union[Written, tuple[StrictStr, ...], None] = None
-
-
-class Slot(_Entry):
-    """`{pin = LINK, slot = LINK, along = ANGLE or [P, Q]}`: the pin of the key's name in a slot."""
-
-    pin: Union[StrictStr, None] = None
-    slot: Union[StrictStr, None] = None
-    along: Union[Written, tuple[StrictStr, ...], None] = None
-
-
-class MassSpec(_Entry):
-    """`{mass, at, izz}` (planar) or `{mass, at, inertia = [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]}`."""
-
-    mass: Union[Written, None] = None
-    at: Union[StrictStr, tuple[Written, ...], None] = None
-    izz: Union[Written, None] = None
-    inertia: Union[tuple[Written, ...], None] = None
-
-
-Coordinates = tuple[Written, ...]
-
-
-def _joint_kind(entry: Any) -> str:
-    """Which form a `[joints]` entry takes (its shape is checked before: `_joint`)."""
-    if isinstance(entry, (Polar, Compass)):
-        return type(entry).__name__
-    if isinstance(entry, dict):
-        return "Polar" if isinstance(entry.get("from"), str) else "Compass"
-    return "coordinates"
-
-
-#: A joint's place at the drawn pose: coordinates as written, or a construction.
-Joint = Annotated[Union[Annotated[Coordinates, Tag("coordinates")], Annotated[Polar, Tag("Polar")],
-                        Annotated[Compass, Tag("Compass")]], Discriminator(_joint_kind)]
 
 
 class LinkageSpec(BaseModel):
@@ -283,35 +219,6 @@ def linkage_spec(raw: dict[str, Any], source: str = "<linkage>") -> LinkageSpec:
         return LinkageSpec.model_validate(raw, context={"source": source})
     except ValidationError as exc:
         raise _as_model_error(exc, source) from None
-
-
-#: pydantic's error types, said as pinmech says them
-_SAID = {"string_type": "must be text", "tuple_type": "must be a list", "dict_type": "must be a table",
-         "float_type": "must be a number", "float_parsing": "must be a number", "finite_number": "must be finite"}
-
-
-def _as_model_error(exc: ValidationError, source: str) -> ModelError:
-    """pydantic's first error as one line: `[table] name`, the key in it, what was wrong."""
-    error = exc.errors(include_url=False)[0]
-    raw = [str(part) for part in error["loc"]]
-    union = any(part in ("str", "int", "float") for part in raw)
-    loc = [part for part in raw if part not in ("str", "int", "float", "coordinates", "Polar", "Compass")
-           and not part.startswith(("tuple[", "function-"))]
-    if loc and loc[0] in _TABLES and len(loc) > 1:
-        element, inner = f"[{loc[0]}] {loc[1]}", loc[2:]
-        if loc[0] == "joints" and len(inner) == 1 and inner[0] in "012":
-            inner = ["xyz"[int(inner[0])]]
-    else:
-        element, inner = (loc[0] if loc else None), loc[1:]
-    key = f"{' '.join(inner)}: " if inner else ""
-    message = _SAID.get(error["type"], error["msg"])
-    if union:
-        message = 'must be a quantity as text ("40 mm", "30 deg") or a number'
-        if inner and inner[0] == "at":
-            message = "the centre of mass is a joint's name or [x, y] (or [x, y, z]) with units"
-    got = error.get("input")
-    shown = "" if isinstance(got, dict) else f", got {got!r:.60}"
-    return ModelError(f"{key}{message}{shown}", path=source, element=element)
 
 
 def _check_references(spec: LinkageSpec, source: str) -> None:

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import re
 
-from pinmech.model.linkage_spec import Compass, LinkageSpec, MassSpec, Polar, Slider, Slot
+from pinmech.model.linkage_entries import Compass, MassSpec, Polar, Slider, Slot
+from pinmech.model.linkage_spec import LinkageSpec
 
 _BARE = re.compile(r"[A-Za-z0-9_-]+")
 
