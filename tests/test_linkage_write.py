@@ -136,3 +136,22 @@ def test_a_value_of_the_wrong_type_is_one_line_naming_the_file_and_the_key(tmp_p
     assert message.startswith(f"{path}, ") and "\n" not in message, message
     for word in words:
         assert word in message, message
+
+
+def test_a_spec_built_in_code_is_validated_and_draws_as_the_file_does():
+    """The four-bar built from Python objects, as a synthesis would: the same drawn pose as
+    the bundled file (the same texts read the same way: exact), and a name no joint has is
+    refused as in a file."""
+    from pinmech.model.linkage_entries import Compass
+
+    built = LinkageSpec(
+        title="Four-bar linkage, drawn", ground=("O2", "O4"), params={"crank": "40 mm"},
+        joints={"O2": ("0 mm", "0 mm"), "O4": ("100 mm", "0 mm"), "A": ("crank", "0 mm"),
+                "B": Compass(bases=("A", "O4"), lengths=("120 mm", "80 mm"), side="left"), "P": ("100 mm", "30 mm")},
+        links={"crank": ("O2", "A"), "coupler": ("A", "B", "P"), "rocker": ("O4", "B")})
+    spec, source = read_linkage_spec(LINKAGES / "four_bar.toml")
+    assert built == spec
+    for name, at in linkage_from_spec(spec, source).points.items():
+        np.testing.assert_array_equal(linkage_from_spec(built).points[name], at)
+    with pytest.raises(ModelError, match=r"\[links\] rocker: names joint 'Q', which \[joints\] does not give"):
+        LinkageSpec(joints=built.joints, links={**built.links, "rocker": ("O4", "Q")})

@@ -4,7 +4,7 @@ masses as written, and pydantic's errors said as one line naming the file and th
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Union
+from typing import Annotated, Any, Literal, Union
 
 from pydantic import BaseModel, ConfigDict, Discriminator, Field, StrictFloat, StrictInt, StrictStr, Tag
 from pydantic import ValidationError
@@ -34,7 +34,7 @@ class Compass(_Entry):
 
     bases: tuple[StrictStr, StrictStr] = Field(alias="from")
     lengths: tuple[Written, Written]
-    side: StrictStr
+    side: Literal["left", "right"]
 
 
 class Slider(_Entry):

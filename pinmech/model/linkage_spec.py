@@ -9,17 +9,6 @@ drawn pose is constructed, in `pinmech.model.linkage.linkage_from_spec`, the one
 written quantity is read; nothing below reads TOML keys. `linkage_toml` writes a spec back
 (`pinmech.model.linkage_write`), so a program (a study, a synthesis) can change `params` or
 joints and write or load the result.
-
-Attributes of `LinkageSpec` (the file's keys; every table in the order written):
-    title: the linkage's title (None: the file's stem).
-    ground: the joints on the ground.
-    params: parameter name -> a length as written; coordinates may use them.
-    joints: joint name -> `[x, y]` / `[x, y, z]` as written, or a `Polar` or `Compass`
-        construction from joints above it.
-    links: link name -> the joints it carries, in order.
-    sliders, slots: name -> `Slider` / `Slot`.
-    axes: joint -> its pin's axis (three numbers); balls: joints that are ball joints.
-    masses: link -> `MassSpec`; colors: link -> a colour (kept, not read).
 """
 
 from __future__ import annotations
@@ -44,7 +33,22 @@ def _source(info: ValidationInfo) -> str:
 
 
 class LinkageSpec(BaseModel):
-    """A drawn linkage as its file writes it, validated (see the module's docstring)."""
+    """A drawn linkage as its file writes it, validated: build one with `read_linkage_spec`
+    (a file), `linkage_spec` (TOML's tables) or `LinkageSpec(...)` in code; draw it with
+    `linkage_from_spec`, write it with `linkage_toml`. Frozen: `with_params` makes a changed
+    copy (validated again), as does `linkage_spec(changed tables)`.
+
+    Attributes (the file's keys; every table in the order written):
+        title: the linkage's title (None: the file's stem).
+        ground: the joints on the ground.
+        params: parameter name -> a length as written; coordinates may use them.
+        joints: joint name -> `[x, y]` / `[x, y, z]` as written, or a `Polar` or `Compass`
+            construction from joints above it.
+        links: link name -> the joints it carries, in order.
+        sliders, slots: name -> `Slider` / `Slot`.
+        axes: joint -> its pin's axis (three numbers); balls: joints that are ball joints.
+        masses: link -> `MassSpec`; colors: link -> a colour (kept, not read).
+    """
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
@@ -105,7 +109,7 @@ class LinkageSpec(BaseModel):
     def _axis_shapes(cls, value: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
         for name, axis in value.items():
             where = f"[axes] {name}"
-            if (not isinstance(axis, list) or len(axis) != 3
+            if (not isinstance(axis, (list, tuple)) or len(axis) != 3
                     or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in axis)):
                 raise ModelError(f"an axis is three numbers, e.g. [0, 0, 1], got {axis!r}", path=_source(info),
                                  element=where)
@@ -119,6 +123,8 @@ class LinkageSpec(BaseModel):
     def _entry_keys(cls, value: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
         shape = _SHAPES[info.field_name]
         for name, spec in value.items():
+            if isinstance(spec, BaseModel):  # an entry built in code, typed already
+                continue
             if not isinstance(spec, dict) or not set(spec) <= set(shape[0]):
                 raise ModelError(shape[1], path=_source(info), element=f"[{info.field_name}] {name}")
         return value
@@ -158,7 +164,7 @@ _SHAPES = {
 
 
 def _names(value: Any, where: str, source: str) -> list[str]:
-    if not isinstance(value, list) or not all(isinstance(n, str) for n in value):
+    if not isinstance(value, (list, tuple)) or not all(isinstance(n, str) for n in value):
         raise ModelError(f"must be a list of joint names, e.g. [\"A\", \"B\"], got {value!r}", path=source,
                          element=where)
     if len(set(value)) != len(value):
@@ -168,7 +174,9 @@ def _names(value: Any, where: str, source: str) -> list[str]:
 
 def _joint(spec: Any, where: str, source: str) -> Any:
     """A joint's entry checked for shape: coordinates, or a polar or compass construction."""
-    if isinstance(spec, list):
+    if isinstance(spec, (Polar, Compass)):  # built in code, typed already
+        return spec
+    if isinstance(spec, (list, tuple)):
         if len(spec) not in (2, 3):
             raise ModelError(f"give coordinates [x, y] (or [x, y, z]) with units, got {spec!r}", path=source,
                              element=where)
@@ -177,7 +185,7 @@ def _joint(spec: Any, where: str, source: str) -> Any:
         raise ModelError(f"give [x, y] with units or a construction table, got {spec!r}", path=source, element=where)
     origin = spec.get("from")
     bases = [origin] if isinstance(origin, str) else origin
-    if not isinstance(bases, list) or not all(isinstance(b, str) for b in bases):
+    if not isinstance(bases, (list, tuple)) or not all(isinstance(b, str) for b in bases):
         raise ModelError("a construction needs from = \"JOINT\" (with length, angle) or from = [\"A\", \"B\"] "
                          "(with lengths, side)", path=source, element=where)
     if isinstance(origin, str):
@@ -187,7 +195,7 @@ def _joint(spec: Any, where: str, source: str) -> Any:
     if len(bases) != 2 or set(spec) != {"from", "lengths", "side"}:
         raise ModelError("a compass construction has exactly from = [\"A\", \"B\"], lengths = [|A..|, |B..|], "
                          "side = \"left\" or \"right\" (of the line A -> B)", path=source, element=where)
-    if not isinstance(spec["lengths"], list) or len(spec["lengths"]) != 2:
+    if not isinstance(spec["lengths"], (list, tuple)) or len(spec["lengths"]) != 2:
         raise ModelError(f"lengths must be two lengths, got {spec['lengths']!r}", path=source, element=where)
     if spec["side"] not in ("left", "right"):
         raise ModelError(f"side must be \"left\" or \"right\", got {spec['side']!r}", path=source, element=where)
