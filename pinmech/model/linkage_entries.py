@@ -12,7 +12,7 @@ from pydantic import ValidationError
 from pinmech.exceptions import ModelError
 
 #: A quantity as the file writes it: "40 mm", "crank", "2*a + b", "30 deg", or a number.
-Written = Union[StrictStr, StrictInt, StrictFloat]
+Written = StrictStr | StrictInt | StrictFloat
 #: the file's tables (the other keys: title, ground, balls)
 TABLES = ("params", "joints", "links", "sliders", "slots", "colors", "axes", "masses")
 
@@ -40,27 +40,27 @@ class Compass(_Entry):
 class Slider(_Entry):
     """`{block = LINK, on = LINK, at = JOINT, along = ANGLE or [P, Q]}`: a prismatic pair."""
 
-    block: Union[StrictStr, None] = None
-    on: Union[StrictStr, None] = None
-    at: Union[StrictStr, None] = None
-    along: Union[Written, tuple[StrictStr, ...], None] = None
+    block: StrictStr | None = None
+    on: StrictStr | None = None
+    at: StrictStr | None = None
+    along: Written | tuple[StrictStr, ...] | None = None
 
 
 class Slot(_Entry):
     """`{pin = LINK, slot = LINK, along = ANGLE or [P, Q]}`: the pin of the key's name in a slot."""
 
-    pin: Union[StrictStr, None] = None
-    slot: Union[StrictStr, None] = None
-    along: Union[Written, tuple[StrictStr, ...], None] = None
+    pin: StrictStr | None = None
+    slot: StrictStr | None = None
+    along: Written | tuple[StrictStr, ...] | None = None
 
 
 class MassSpec(_Entry):
     """`{mass, at, izz}` (planar) or `{mass, at, inertia = [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]}`."""
 
-    mass: Union[Written, None] = None
-    at: Union[StrictStr, tuple[Written, ...], None] = None
-    izz: Union[Written, None] = None
-    inertia: Union[tuple[Written, ...], None] = None
+    mass: Written | None = None
+    at: StrictStr | tuple[Written, ...] | None = None
+    izz: Written | None = None
+    inertia: tuple[Written, ...] | None = None
 
 
 Coordinates = tuple[Written, ...]

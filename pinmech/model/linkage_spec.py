@@ -13,7 +13,7 @@ joints and write or load the result.
 
 from __future__ import annotations
 
-from typing import Any, Union
+from typing import Any
 
 from pydantic import BaseModel, ConfigDict, StrictStr, ValidationError, ValidationInfo, field_validator
 from pydantic import model_validator
@@ -52,7 +52,7 @@ class LinkageSpec(BaseModel):
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
-    title: Union[StrictStr, None] = None
+    title: StrictStr | None = None
     ground: tuple[StrictStr, ...] = ()
     params: dict[str, Written] = {}
     joints: dict[str, Joint] = {}
