@@ -3,6 +3,8 @@ plane of a planar mechanism: found once, on seeded sample configurations."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pinocchio as pin
 
@@ -99,3 +101,13 @@ def _plane_normal(model: pin.Model, columns: np.ndarray, length_scale: float) ->
     if np.linalg.norm(normal @ lin) > STRUCTURAL_RANK_TOL * max(np.linalg.norm(lin), 1e-300):
         return None
     return normal
+
+
+def close_loops(mech: Any, closures: list[Closure]) -> None:
+    """Give a Mechanism its closures, with their sizes, independent rows and the motion plane."""
+    from pinmech.model.loop_size import _length_scale
+
+    mech.closures = closures
+    mech.length_scale = _length_scale(mech.model, closures, mech.source)
+    _reduce_rows(mech.model, closures, mech.velocity_scale())
+    mech.plane_normal = _plane_normal(mech.model, mech.velocity_scale(), mech.length_scale)

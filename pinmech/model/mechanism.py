@@ -24,20 +24,18 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from pinmech.arguments import file_path, float_array
+from pinmech.arguments import float_array
 from pinmech.exceptions import FrameNotFound, ModelError
-from pinmech.model.closure_rows import STRUCTURAL_RANK_TOL, _make_closure, _plane_normal, _reduce_rows
+from pinmech.model.closure_rows import STRUCTURAL_RANK_TOL, close_loops
 from pinmech.model.closures import Closure
 from pinmech.model.configuration_check import UNIT_NORM_TOL, checked_configuration, unit_parts
 from pinmech.model.frame_names import frame_named, frames_of_kind
-from pinmech.model.inertia_check import model_inertia_caveats, urdf_inertia_caveats
-from pinmech.model.joint_info import JointInfo, _body_frame, _joint_infos, _named_points, _tree_joint_links
-from pinmech.model.loop_size import SIZE_RANGE, _length_scale, _translational
-from pinmech.model.pinocchio_build import (MAX_DOF, _build_model, _check_locked, _check_size, _lock_joints,
-                                          pinocchio_build)
-from pinmech.model.urdf_joints import JointLimit, MimicJoint, joint_limits, mimic_joints, with_followers
-from pinmech.model.urdf_xml import (_check_urdf_spelling, _joint_links, _link_names, _parse_constraint, _parse_xml,
-                                    _point_links, read_xml, urdf_joint_types, urdf_mimic_leaders)
+from pinmech.model.inertia_check import model_inertia_caveats
+from pinmech.model.joint_info import JointInfo, _joint_infos, _named_points, _tree_joint_links
+from pinmech.model.loop_size import SIZE_RANGE, _translational
+from pinmech.model.pinocchio_build import MAX_DOF, pinocchio_build
+from pinmech.model.urdf_joints import JointLimit, MimicJoint
+from pinmech.model.urdf_xml import read_xml, urdf_joint_types, urdf_mimic_leaders
 
 #: names kept importable from here (they lived in this module)
 __all__ = ["MAX_DOF", "SIZE_RANGE", "STRUCTURAL_RANK_TOL", "UNIT_NORM_TOL", "JointInfo", "Mechanism",
@@ -127,53 +125,9 @@ class Mechanism:
             ModelError: malformed XML or URDF, or a malformed `<constraint>`.
             FrameNotFound: a locked joint that is not in the model.
         """
-        path = file_path(path, "the URDF")
-        source = str(path)
-        root = _parse_xml(path)
-        _check_urdf_spelling(root, source)
-        _check_locked(locked or {}, source)
-        mimics = mimic_joints(root, source)
-        full = _build_model(source, root_joint, mimic=bool(mimics))
-        locked = with_followers(dict(locked or {}), mimics, source)
-        model = _lock_joints(full, locked, source)
-        _check_size(model, source)
-        if model.nv == 0:
-            held = f" once {', '.join(locked)} are locked" if locked else ""
-            raise ModelError(f"no joint of the model moves{held}: nothing to solve", path=source)
-        links_xml = _link_names(root)
-        point_names = _point_links(root)
-        joint_links = _joint_links(root)
-        cuts = [_parse_constraint(c, model, links_xml, source) for c in root.findall("constraint")]
-        names = [c.name for c in cuts]
-        for name in names:
-            if names.count(name) > 1:
-                raise ModelError("two <constraint> elements share this name", path=source,
-                                 element=f"<constraint name=\"{name}\">")
-        mech = cls(
-            model=model,
-            closures=[],
-            joints=_joint_infos(model, joint_links, source),
-            links={n: _body_frame(model, n) for n in links_xml if n not in point_names and model.existBodyName(n)},
-            points={n: _body_frame(model, n) for n in point_names if model.existBodyName(n)},
-            length_scale=1.0,
-            plane_normal=None,
-            source=source,
-            locked=dict(locked or {}),
-            mimics={n: m for n, m in mimics.items() if n not in (locked or {})},
-            force_caveats=tuple(urdf_inertia_caveats(root, source)),
-        )
-        mech.limits = {n: lu for n, lu in joint_limits(root, source).items() if n in mech.joints or n in mech.locked}
-        mech.closures = [_make_closure(model, c) for c in cuts]
-        mech.length_scale = _length_scale(model, mech.closures, source)
-        _reduce_rows(model, mech.closures, mech.velocity_scale())
-        mech.plane_normal = _plane_normal(model, mech.velocity_scale(), mech.length_scale)
-        if reference:
-            q = pin.neutral(model)
-            for name, value in reference.items():
-                if name in mech.joints:
-                    mech.set_coordinate(q, name, value)
-            mech.reference = q
-        return mech
+        from pinmech.model.urdf_load import mechanism_from_urdf
+
+        return mechanism_from_urdf(cls, path, locked=locked, root_joint=root_joint, reference=reference)
 
     @classmethod
     def from_model(
@@ -224,10 +178,7 @@ class Mechanism:
                    points=_named_points(model, points, source), length_scale=1.0, plane_normal=None,
                    source=source, urdf_path=urdf_path, locked=dict(locked or {}),
                    force_caveats=tuple(model_inertia_caveats(model)))
-        mech.closures = [anchor_closure(model, cut, 1.0) for cut in cuts]  # each loop's size: below
-        mech.length_scale = _length_scale(model, mech.closures, source)
-        _reduce_rows(model, mech.closures, mech.velocity_scale())
-        mech.plane_normal = _plane_normal(model, mech.velocity_scale(), mech.length_scale)
+        close_loops(mech, [anchor_closure(model, cut, 1.0) for cut in cuts])  # each loop's size: there
         if reference is not None:
             mech.reference = np.array(reference, dtype=float)
             if mech.reference.shape != (model.nq,):
