@@ -15,7 +15,9 @@ at all: J_p = rows6 @ [R_P^T (u_C - u_P); 0].
 
 An output y(q, p) (a point's world position, a link's angle in the plane, a slider's
 coordinate) then has dy/dp = J_y dq/dp + dy/dp|_q, the last term u where the parameter
-moves the point's frame; speeds (a slider's, a link's omega): rate_sensitivity.py.
+moves the point's frame; speeds (a slider's, a link's omega): rate_sensitivity.py; a
+link's angular acceleration: central differences of re-solved variants
+(variant_differences.py).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from pinmech.exceptions import SceneError, SingularPoseError
 from pinmech.design.rate_sensitivity import link_omega_sensitivity, velocity_sensitivity
 from pinmech.design.study_outputs import StudyOutputs
 from pinmech.design.study_variant import StudyMechanism, VariantCycle
+from pinmech.design.variant_differences import central_differences
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -84,4 +87,6 @@ def cycle_sensitivity(sm: StudyMechanism, outputs: StudyOutputs, cycle: VariantC
     cycle of the variant now written in the model."""
     y = outputs.cycle(cycle.q, cycle.v, cycle.a)
     dy = np.array([output_sensitivity(sm, outputs, qi, vi) for qi, vi in zip(cycle.q, cycle.v)])
+    if outputs.n_exact < len(outputs.names):  # angular accelerations: central differences
+        dy = np.concatenate((dy, central_differences(sm, outputs, slice(outputs.n_exact, None))), axis=1)
     return y, dy

@@ -10,9 +10,10 @@ Outputs, in this order (`[outputs]` of the study file):
     transmission = ["B"]  B.mu: the transmission angle of the dyad whose middle pin is B [rad]
                           (study_transmission.py)
     omega = ["rocker"]    rocker.omega: angular speed about the plane normal [rad/s]
+    alpha = ["rocker"]    rocker.alpha: angular acceleration about the plane normal [rad/s^2]
+                          (its sensitivity: variant_differences.py)
 
-Speeds are those of the scene's driver speed. (A link's angular acceleration is not an
-output yet: its exact sensitivity needs the derivative of the acceleration drift.)
+Speeds and accelerations are those of the scene's driver speed and acceleration.
 """
 
 from __future__ import annotations
@@ -31,15 +32,17 @@ class StudyOutputs:
     """A study's outputs on a StudyMechanism `sm`.
 
     Attributes:
-        names: "P.x", "rocker.angle", "slide.s", "slide.s_dot", "rocker.omega".
-        kinds: "length", "angle", "speed", "angular speed", each.
+        names: "P.x", "rocker.angle", "slide.s", "slide.s_dot", "rocker.omega", "rocker.alpha".
+        kinds: "length", "angle", "speed", "angular speed", "angular acceleration", each.
         n_pose: how many outputs (the first ones) depend on q alone.
+        n_exact: how many outputs (the first ones) have an exact sensitivity; the others'
+            are central differences of re-solved variants (variant_differences.py).
     """
 
     def __init__(self, sm) -> None:
         mech, spec = sm.mechanism, sm.spec
         self.sm, self.normal = sm, mech.plane_normal
-        planar = [("links", spec.links), ("omega", spec.omega)]
+        planar = [("links", spec.links), ("omega", spec.omega), ("alpha", spec.alpha)]
         for key, names in planar:
             if names and self.normal is None:
                 raise SceneError("link angles and their rates are outputs of planar mechanisms; name points instead",
@@ -52,16 +55,18 @@ class StudyOutputs:
         self.points = [mech.frame_id(_checked_point(mech, name, spec)) for name in spec.points]
         self.links = [mech.links[name] for name in spec.links]
         self.omega = [mech.links[name] for name in spec.omega]
+        self.alpha = [mech.links[name] for name in spec.alpha]
         self.dyads = (dyad_pins(mech, list(sm.solver.drivers), spec.transmission, str(spec.path))
                       if spec.transmission else [])
         self.axes = _plane_axes(self.normal)
         self.names = ([f"{n}.{'xyz'[k]}" for n in spec.points for k in self.axes] + [f"{n}.angle" for n in spec.links]
                       + [f"{n}.mu" for n in spec.transmission] + [f"{n}.s" for n in spec.sliders] + [f"{n}.s_dot" for n in spec.sliders]
-                      + [f"{n}.omega" for n in spec.omega])
+                      + [f"{n}.omega" for n in spec.omega] + [f"{n}.alpha" for n in spec.alpha])
         self.kinds = (["length"] * (len(spec.points) * len(self.axes)) + ["angle"] * len(spec.links)
                       + ["angle"] * len(spec.transmission)
                       + ["length"] * len(spec.sliders) + ["speed"] * len(spec.sliders)
-                      + ["angular speed"] * len(spec.omega))
+                      + ["angular speed"] * len(spec.omega) + ["angular acceleration"] * len(spec.alpha))
+        self.n_exact = len(self.names) - len(spec.alpha)  # the last ones: by central differences
         self.n_pose = len(self.points) * len(self.axes) + len(self.links) + len(self.dyads) + len(self.sliders)
         if self.normal is not None:
             e1 = np.eye(3)[int(np.argmin(np.abs(self.normal)))]
@@ -69,12 +74,13 @@ class StudyOutputs:
             self.e1 = e1 / np.linalg.norm(e1)
             self.e2 = np.cross(self.normal, self.e1)
         self.pins = sorted({f for d in self.dyads for f in (d.near, d.joint, d.ground) if f >= 0})
-        frames = self.points + self.links + self.omega + self.pins
+        frames = self.points + self.links + self.omega + self.alpha + self.pins
         compiled = CompiledModel(sm.model, frames)
         self._core = compiled.kinematics(sm.model)  # reads the variant's placements at each call
         self._frames = list(range(len(compiled.frame_ids)))
         self._index = {key: [compiled.frames[f] for f in fs] for key, fs in
-                       (("points", self.points), ("links", self.links), ("omega", self.omega), ("pins", self.pins))}
+                       (("points", self.points), ("links", self.links), ("omega", self.omega), ("alpha", self.alpha),
+                                                                  ("pins", self.pins))}
 
     def cycle(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         """The outputs (steps, n_out) at the poses q with rates v, a (steps, nq / nv) of the
@@ -82,7 +88,7 @@ class StudyOutputs:
         q, v, a = (np.ascontiguousarray(x, dtype=float).reshape(len(q), -1) for x in (q, v, a))
         n, columns = len(q), []
         if self._frames:
-            P, R, _, W, _, _ = (x.reshape(n, len(self._frames), -1)
+            P, R, _, W, _, alpha = (x.reshape(n, len(self._frames), -1)
                                 for x in self._core.frame_motion(q, v, a, self._frames))
             at = self._index
             columns += [P[:, i, k] for i in at["points"] for k in self.axes]
@@ -93,6 +99,7 @@ class StudyOutputs:
         columns += [q[:, iq] for iq, _ in self.sliders] + [v[:, iv] for _, iv in self.sliders]
         if self._frames:
             columns += list((W[:, at["omega"]] @ self.normal).T) if at["omega"] else []
+            columns += list((alpha[:, at["alpha"]] @ self.normal).T) if at["alpha"] else []
         return np.column_stack(columns) if columns else np.zeros((len(q), 0))
 
     def jacobians(self, data: pin.Data) -> tuple[np.ndarray, np.ndarray]:
