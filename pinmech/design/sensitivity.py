@@ -28,6 +28,7 @@ import pinocchio as pin
 from pinmech.exceptions import SceneError, SingularPoseError
 from pinmech.design.rate_sensitivity import link_omega_sensitivity, velocity_sensitivity
 from pinmech.design.study_outputs import StudyOutputs
+from pinmech.design.study_stroke import stroke_sensitivity
 from pinmech.design.study_variant import StudyMechanism, VariantCycle
 from pinmech.design.variant_differences import central_differences
 
@@ -87,6 +88,10 @@ def cycle_sensitivity(sm: StudyMechanism, outputs: StudyOutputs, cycle: VariantC
     cycle of the variant now written in the model."""
     y = outputs.cycle(cycle.q, cycle.v, cycle.a)
     dy = np.array([output_sensitivity(sm, outputs, qi, vi) for qi, vi in zip(cycle.q, cycle.v)])
+    if outputs.strokes:  # the envelope theorem at each stroke's extremes (study_stroke.py)
+        rows = [stroke_sensitivity(sm, s, *s.extremes(cycle.q)[1::2],
+                                   lambda q: configuration_sensitivity(sm, sm.at(q))) for s in outputs.strokes]
+        dy = np.concatenate((dy, np.broadcast_to(np.array(rows)[None], (len(dy), *np.shape(rows)))), axis=1)
     if outputs.n_exact < len(outputs.names):  # angular accelerations: central differences
         dy = np.concatenate((dy, central_differences(sm, outputs, slice(outputs.n_exact, None))), axis=1)
     return y, dy

@@ -10,6 +10,8 @@ Outputs, in this order (`[outputs]` of the study file):
     transmission = ["B"]  B.mu: the transmission angle of the dyad whose middle pin is B [rad]
                           (study_transmission.py)
     omega = ["rocker"]    rocker.omega: angular speed about the plane normal [rad/s]
+    strokes = ["slide"]   slide.stroke: max - min of s over the cycle [m], the same at every
+                          pose (study_stroke.py)
     alpha = ["rocker"]    rocker.alpha: angular acceleration about the plane normal [rad/s^2]
                           (its sensitivity: variant_differences.py)
 
@@ -22,6 +24,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import SceneError
+from pinmech.design.study_stroke import Stroke
 from pinmech.design.study_transmission import dyad_pins, transmission_row, transmission_values
 from pinmech.solve.core import CompiledModel
 
@@ -32,7 +35,8 @@ class StudyOutputs:
     """A study's outputs on a StudyMechanism `sm`.
 
     Attributes:
-        names: "P.x", "rocker.angle", "slide.s", "slide.s_dot", "rocker.omega", "rocker.alpha".
+        names: "P.x", "rocker.angle", "slide.s", "slide.s_dot", "rocker.omega", "slide.stroke",
+            "rocker.alpha".
         kinds: "length", "angle", "speed", "angular speed", "angular acceleration", each.
         n_pose: how many outputs (the first ones) depend on q alone.
         n_exact: how many outputs (the first ones) have an exact sensitivity; the others'
@@ -52,6 +56,7 @@ class StudyOutputs:
                     raise SceneError(f"unknown link '{name}' (the model has: {', '.join(mech.links)})",
                                      path=str(spec.path), key=f"outputs.{key}")
         self.sliders = [_slider(mech, name, spec) for name in spec.sliders]
+        self.strokes = [Stroke(sm, name, *_slider(mech, name, spec, "outputs.strokes")) for name in spec.strokes]
         self.points = [mech.frame_id(_checked_point(mech, name, spec)) for name in spec.points]
         self.links = [mech.links[name] for name in spec.links]
         self.omega = [mech.links[name] for name in spec.omega]
@@ -61,11 +66,13 @@ class StudyOutputs:
         self.axes = _plane_axes(self.normal)
         self.names = ([f"{n}.{'xyz'[k]}" for n in spec.points for k in self.axes] + [f"{n}.angle" for n in spec.links]
                       + [f"{n}.mu" for n in spec.transmission] + [f"{n}.s" for n in spec.sliders] + [f"{n}.s_dot" for n in spec.sliders]
-                      + [f"{n}.omega" for n in spec.omega] + [f"{n}.alpha" for n in spec.alpha])
+                      + [f"{n}.omega" for n in spec.omega] + [f"{n}.stroke" for n in spec.strokes]
+                      + [f"{n}.alpha" for n in spec.alpha])
         self.kinds = (["length"] * (len(spec.points) * len(self.axes)) + ["angle"] * len(spec.links)
                       + ["angle"] * len(spec.transmission)
                       + ["length"] * len(spec.sliders) + ["speed"] * len(spec.sliders)
-                      + ["angular speed"] * len(spec.omega) + ["angular acceleration"] * len(spec.alpha))
+                      + ["angular speed"] * len(spec.omega) + ["length"] * len(spec.strokes)
+                      + ["angular acceleration"] * len(spec.alpha))
         self.n_exact = len(self.names) - len(spec.alpha)  # the last ones: by central differences
         self.n_pose = len(self.points) * len(self.axes) + len(self.links) + len(self.dyads) + len(self.sliders)
         if self.normal is not None:
@@ -99,6 +106,10 @@ class StudyOutputs:
         columns += [q[:, iq] for iq, _ in self.sliders] + [v[:, iv] for _, iv in self.sliders]
         if self._frames:
             columns += list((W[:, at["omega"]] @ self.normal).T) if at["omega"] else []
+        for stroke in self.strokes:
+            top, _, low, _ = stroke.extremes(q)
+            columns.append(np.full(n, top - low))
+        if self._frames:
             columns += list((alpha[:, at["alpha"]] @ self.normal).T) if at["alpha"] else []
         return np.column_stack(columns) if columns else np.zeros((len(q), 0))
 
@@ -132,13 +143,13 @@ class StudyOutputs:
         return np.array(rows_q).reshape(-1, model.nv), np.array(rows_p).reshape(-1, n_par)
 
 
-def _slider(mech, name: str, spec) -> tuple[int, int]:
-    """(idx_q, idx_v) of a prismatic joint named in outputs.sliders."""
+def _slider(mech, name: str, spec, key: str = "outputs.sliders") -> tuple[int, int]:
+    """(idx_q, idx_v) of a prismatic joint named in outputs.sliders (or `key`)."""
     joint = mech.joints.get(name)
     if joint is None or joint.kind != "prismatic":
         sliders = [n for n, j in mech.joints.items() if j.kind == "prismatic"]
         raise SceneError(f"'{name}' is not a prismatic joint of the model (its sliders: "
-                         f"{', '.join(sliders) or 'none'})", path=str(spec.path), key="outputs.sliders")
+                         f"{', '.join(sliders) or 'none'})", path=str(spec.path), key=key)
     return joint.idx_q, joint.idx_v
 
 
