@@ -16,8 +16,8 @@ at all: J_p = rows6 @ [R_P^T (u_C - u_P); 0].
 An output y(q, p) (a point's world position, a link's angle in the plane, a slider's
 coordinate) then has dy/dp = J_y dq/dp + dy/dp|_q, the last term u where the parameter
 moves the point's frame; speeds (a slider's, a link's omega): rate_sensitivity.py; a
-link's angular acceleration: central differences of re-solved variants
-(variant_differences.py).
+link's angular acceleration and a driver's torque: central differences of re-solved
+variants (variant_differences.py).
 """
 
 from __future__ import annotations
@@ -92,6 +92,6 @@ def cycle_sensitivity(sm: StudyMechanism, outputs: StudyOutputs, cycle: VariantC
         rows = [stroke_sensitivity(sm, s, *s.extremes(cycle.q)[1::2],
                                    lambda q: configuration_sensitivity(sm, sm.at(q))) for s in outputs.strokes]
         dy = np.concatenate((dy, np.broadcast_to(np.array(rows)[None], (len(dy), *np.shape(rows)))), axis=1)
-    if outputs.n_exact < len(outputs.names):  # angular accelerations: central differences
+    if outputs.n_exact < len(outputs.names):  # angular accelerations, torques: central differences
         dy = np.concatenate((dy, central_differences(sm, outputs, slice(outputs.n_exact, None))), axis=1)
     return y, dy

@@ -32,6 +32,7 @@
     transmission = ["B"]                 # the transmission angle of the dyad with middle pin B [rad]
     alpha = ["rocker"]                   # angular acceleration about the plane normal [rad/s^2]
     strokes = ["slide"]                  # a prismatic joint's max - min of s over the cycle [m]
+    torque = ["O2"]                      # a driver's torque [N m] or force [N] (the scene's masses, loads)
 
     # kind = "grid": 1 to 3 of the parameters over evenly spaced values (the others at nominal)
     [grid.crank]
@@ -61,7 +62,7 @@ _GRID_KEYS = {"from", "to", "count"}
 _GRID_MAX = 1_000_000  # grid points in all
 _TARGETS = ("joint", "cut", "point", "body")
 _PARAM_KEYS = {"joint", "cut", "point", "body", "side", "component", "nominal", "bounds", "tolerance", "k", "sigma", "distribution"}
-_OUTPUT_KEYS = {"points", "links", "sliders", "omega", "transmission", "alpha", "strokes"}
+_OUTPUT_KEYS = {"points", "links", "sliders", "omega", "transmission", "alpha", "strokes", "torque"}
 _LIMITS = {"steps": (1, 100_000), "samples": (1, 10_000_000), "seed": (0, 2**63 - 1), "batch": (1, 1_000_000)}
 #: Keys only some kinds use: any other kind refuses them (a key read by nobody would be a
 #: silent no-op). Top-level keys, then [params.NAME] keys.
@@ -105,6 +106,7 @@ class StudySpec:
         sliders, omega: prismatic joints (s and s_dot), links' angular speeds (study_outputs.py).
         transmission: dyads by their middle pin, for their transmission angle.
         alpha: links' angular accelerations; strokes: prismatic joints' max - min of s.
+        torque: drivers whose torque (force) the scene's masses and loads need.
         grid: a grid study's axes (1 to 3), in the [grid] table's order; () otherwise.
     """
 
@@ -125,6 +127,7 @@ class StudySpec:
     transmission: tuple[str, ...] = ()
     alpha: tuple[str, ...] = ()
     strokes: tuple[str, ...] = ()
+    torque: tuple[str, ...] = ()
 
 
 def load_study(path: str | Path) -> StudySpec:
@@ -159,7 +162,8 @@ def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
     return StudySpec(path, str(raw.get("title", path.stem)), (path.parent / scene), kind, counts["steps"],
                      counts["samples"], counts["seed"], counts["batch"], parsed, named["points"],
                      named["links"], _grid(raw, kind, parsed, where), named["sliders"], named["omega"],
-                     named["transmission"], named["alpha"], named["strokes"])
+                     named["transmission"], named["alpha"], named["strokes"],
+                     named["torque"])
 
 
 def _refuse_unused(raw: dict[str, Any], kind: str, where: _Where) -> None:

@@ -14,6 +14,9 @@ Outputs, in this order (`[outputs]` of the study file):
                           pose (study_stroke.py)
     alpha = ["rocker"]    rocker.alpha: angular acceleration about the plane normal [rad/s^2]
                           (its sensitivity: variant_differences.py)
+    torque = ["O2"]       O2.torque: the driver's torque [N m] (a prismatic one's force [N])
+                          from the scene's masses and loads (study_torque.py; its
+                          sensitivity: variant_differences.py)
 
 Speeds and accelerations are those of the scene's driver speed and acceleration.
 """
@@ -25,6 +28,7 @@ import pinocchio as pin
 
 from pinmech.exceptions import SceneError
 from pinmech.design.study_stroke import Stroke
+from pinmech.design.study_torque import DriverTorques
 from pinmech.design.study_transmission import dyad_pins, transmission_row, transmission_values
 from pinmech.solve.core import CompiledModel
 
@@ -36,8 +40,9 @@ class StudyOutputs:
 
     Attributes:
         names: "P.x", "rocker.angle", "slide.s", "slide.s_dot", "rocker.omega", "slide.stroke",
-            "rocker.alpha".
-        kinds: "length", "angle", "speed", "angular speed", "angular acceleration", each.
+            "rocker.alpha", "O2.torque".
+        kinds: "length", "angle", "speed", "angular speed", "angular acceleration", "torque"
+            (or "force"), each.
         n_pose: how many outputs (the first ones) depend on q alone.
         n_exact: how many outputs (the first ones) have an exact sensitivity; the others'
             are central differences of re-solved variants (variant_differences.py).
@@ -56,6 +61,7 @@ class StudyOutputs:
                     raise SceneError(f"unknown link '{name}' (the model has: {', '.join(mech.links)})",
                                      path=str(spec.path), key=f"outputs.{key}")
         self.sliders = [_slider(mech, name, spec) for name in spec.sliders]
+        self.torques = DriverTorques(sm, spec.torque)
         self.strokes = [Stroke(sm, name, *_slider(mech, name, spec, "outputs.strokes")) for name in spec.strokes]
         self.points = [mech.frame_id(_checked_point(mech, name, spec)) for name in spec.points]
         self.links = [mech.links[name] for name in spec.links]
@@ -67,13 +73,13 @@ class StudyOutputs:
         self.names = ([f"{n}.{'xyz'[k]}" for n in spec.points for k in self.axes] + [f"{n}.angle" for n in spec.links]
                       + [f"{n}.mu" for n in spec.transmission] + [f"{n}.s" for n in spec.sliders] + [f"{n}.s_dot" for n in spec.sliders]
                       + [f"{n}.omega" for n in spec.omega] + [f"{n}.stroke" for n in spec.strokes]
-                      + [f"{n}.alpha" for n in spec.alpha])
+                      + [f"{n}.alpha" for n in spec.alpha] + self.torques.names)
         self.kinds = (["length"] * (len(spec.points) * len(self.axes)) + ["angle"] * len(spec.links)
                       + ["angle"] * len(spec.transmission)
                       + ["length"] * len(spec.sliders) + ["speed"] * len(spec.sliders)
                       + ["angular speed"] * len(spec.omega) + ["length"] * len(spec.strokes)
-                      + ["angular acceleration"] * len(spec.alpha))
-        self.n_exact = len(self.names) - len(spec.alpha)  # the last ones: by central differences
+                      + ["angular acceleration"] * len(spec.alpha) + self.torques.kinds)
+        self.n_exact = len(self.names) - len(spec.alpha) - len(spec.torque)  # the last: central differences
         self.n_pose = len(self.points) * len(self.axes) + len(self.links) + len(self.dyads) + len(self.sliders)
         if self.normal is not None:
             e1 = np.eye(3)[int(np.argmin(np.abs(self.normal)))]
@@ -111,6 +117,7 @@ class StudyOutputs:
             columns.append(np.full(n, top - low))
         if self._frames:
             columns += list((alpha[:, at["alpha"]] @ self.normal).T) if at["alpha"] else []
+        columns += list(self.torques.values(q, v, a).T)
         return np.column_stack(columns) if columns else np.zeros((len(q), 0))
 
     def jacobians(self, data: pin.Data) -> tuple[np.ndarray, np.ndarray]:

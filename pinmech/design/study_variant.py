@@ -57,7 +57,7 @@ class StudyMechanism:
 
     def __init__(self, spec: StudySpec) -> None:
         self.spec = spec
-        scene = Scene.load(spec.scene)
+        self.scene = scene = Scene.load(spec.scene)
         self.sweep = Sweep.from_scene(scene)
         self.mechanism, self.solver = self.sweep.mechanism, self.sweep.solver
         self.model = self.mechanism.model
