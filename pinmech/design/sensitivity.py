@@ -15,7 +15,8 @@ at all: J_p = rows6 @ [R_P^T (u_C - u_P); 0].
 
 An output y(q, p) (a point's world position, a link's angle in the plane, a slider's
 coordinate) then has dy/dp = J_y dq/dp + dy/dp|_q, the last term u where the parameter
-moves the point's frame; speeds (a slider's, a link's omega): rate_sensitivity.py; a
+moves the point's frame (for a drawn linkage's param, J_p and dy/dp|_q are central
+differences of the drawing at fixed q, drawn_params.py); speeds (a slider's, a link's omega): rate_sensitivity.py; a
 link's angular acceleration and a driver's torque: central differences of re-solved
 variants (variant_differences.py).
 """
@@ -40,6 +41,9 @@ def parameter_jacobian(sm: StudyMechanism, data: pin.Data) -> np.ndarray:
     (`data` at q with frame placements up to date)."""
     columns = []
     for place in sm.placements:
+        if place.drawn:  # the drawing's central differences at fixed q (drawn_params.py)
+            columns.append(place.column(lambda: _closure_residual(sm, sm.q_at)))
+            continue
         u = place.direction(data)
         rows = []
         for c in sm.mechanism.closures:
@@ -49,6 +53,14 @@ def parameter_jacobian(sm: StudyMechanism, data: pin.Data) -> np.ndarray:
             rows.append(c._rows6 @ d6)
         columns.append(np.concatenate(rows))
     return np.array(columns).T
+
+
+def _closure_residual(sm: StudyMechanism, q: np.ndarray) -> np.ndarray:
+    """The closure residual (rows,) at q with the placements now in the model (own Data)."""
+    if not hasattr(sm, "_fd_data"):
+        sm._fd_data = sm.model.createData()
+    pin.framesForwardKinematics(sm.model, sm._fd_data, q)
+    return np.concatenate([c.residual(sm._fd_data) for c in sm.mechanism.closures])
 
 
 def configuration_sensitivity(sm: StudyMechanism, data: pin.Data) -> np.ndarray:
@@ -74,6 +86,9 @@ def output_sensitivity(sm: StudyMechanism, outputs: StudyOutputs, q: np.ndarray,
     per m] (rate outputs: rate_sensitivity.py)."""
     data = sm.at(q)
     Y_q, Y_p = outputs.jacobians(data)
+    for k, place in enumerate(sm.placements):
+        if place.drawn:  # the drawing's central differences at fixed q (drawn_params.py)
+            Y_p[:, k] = place.column(lambda: outputs.pose_values(q))
     dq = configuration_sensitivity(sm, data)
     rows = [Y_q @ dq + Y_p]
     if outputs.sliders or outputs.omega:

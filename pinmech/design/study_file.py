@@ -60,8 +60,8 @@ KINDS = ("sensitivity", "tolerance", "grid")
 _TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs", "batch", "grid"}
 _GRID_KEYS = {"from", "to", "count"}
 _GRID_MAX = 1_000_000  # grid points in all
-_TARGETS = ("joint", "cut", "point", "body")
-_PARAM_KEYS = {"joint", "cut", "point", "body", "side", "component", "nominal", "bounds", "tolerance", "k", "sigma", "distribution"}
+_TARGETS = ("joint", "cut", "point", "body", "param")
+_PARAM_KEYS = {"joint", "cut", "point", "body", "param", "side", "component", "nominal", "bounds", "tolerance", "k", "sigma", "distribution"}
 _OUTPUT_KEYS = {"points", "links", "sliders", "omega", "transmission", "alpha", "strokes", "torque"}
 _LIMITS = {"steps": (1, 100_000), "samples": (1, 10_000_000), "seed": (0, 2**63 - 1), "batch": (1, 1_000_000)}
 #: Keys only some kinds use: any other kind refuses them (a key read by nobody would be a
@@ -226,7 +226,8 @@ def _parameter(name: str, table: Any, where: _Where) -> Parameter:
     given = [t for t in _TARGETS if t in table]
     if len(given) != 1:
         raise where.error(key, "give one of joint = \"NAME\" (its origin), cut = \"NAME\" (a cut frame's origin), "
-                          "point = \"NAME\" (a named point) or body = \"NAME\" (an MJCF body's pos)")
+                          "point = \"NAME\" (a named point), body = \"NAME\" (an MJCF body's pos) or param = \"NAME\" "
+                          "(a drawn linkage's [params] entry)")
     target = given[0]
     if not isinstance(table[target], str):
         raise where.error(f"{key}.{target}", f"{target} = {table[target]!r} must be a name")
@@ -235,7 +236,9 @@ def _parameter(name: str, table: Any, where: _Where) -> Parameter:
         raise where.error(f"{key}.side", f"side = {side!r} must be \"parent\" or \"child\"")
     if target != "cut" and "side" in table:
         raise where.error(f"{key}.side", f"side is for a cut's frames; a {target} has one origin")
-    component = table.get("component")
+    component = table.get("component", "x" if target == "param" else None)
+    if target == "param" and "component" in table:
+        raise where.error(f"{key}.component", "a drawn linkage's param is a length of its own: it has no component")
     if component not in AXES:
         raise where.error(f"{key}.component", f"component = {component!r} must be \"x\", \"y\" or \"z\"")
     nominal = where.length(table, "nominal", key) if "nominal" in table else None

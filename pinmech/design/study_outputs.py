@@ -99,17 +99,13 @@ class StudyOutputs:
         """The outputs (steps, n_out) at the poses q with rates v, a (steps, nq / nv) of the
         variant now written in the model [m, rad, m/s, rad/s, rad/s^2]."""
         q, v, a = (np.ascontiguousarray(x, dtype=float).reshape(len(q), -1) for x in (q, v, a))
-        n, columns = len(q), []
+        n, P, R = len(q), None, None
         if self._frames:
             P, R, _, W, _, alpha = (x.reshape(n, len(self._frames), -1)
-                                for x in self._core.frame_motion(q, v, a, self._frames))
+                                    for x in self._core.frame_motion(q, v, a, self._frames))
             at = self._index
-            columns += [P[:, i, k] for i in at["points"] for k in self.axes]
-            x_axes = R[:, at["links"]][..., [0, 3, 6]]  # each link's x axis (rotation's first column), world
-            columns += list(np.arctan2(x_axes @ self.e2, x_axes @ self.e1).T) if at["links"] else []
-            x = {f: P[:, i] for f, i in zip(self.pins, at["pins"])}
-            columns += [transmission_values(d, x, self.e1, self.e2) for d in self.dyads]
-        columns += [q[:, iq] for iq, _ in self.sliders] + [v[:, iv] for _, iv in self.sliders]
+        columns = self._pose_columns(q, P, R)
+        columns += [v[:, iv] for _, iv in self.sliders]
         if self._frames:
             columns += list((W[:, at["omega"]] @ self.normal).T) if at["omega"] else []
         for stroke in self.strokes:
@@ -119,6 +115,28 @@ class StudyOutputs:
             columns += list((alpha[:, at["alpha"]] @ self.normal).T) if at["alpha"] else []
         columns += list(self.torques.values(q, v, a).T)
         return np.column_stack(columns) if columns else np.zeros((len(q), 0))
+
+    def pose_values(self, q: np.ndarray) -> np.ndarray:
+        """The pose outputs (the first n_pose) at one pose q (nq,) [m, rad]."""
+        q = np.ascontiguousarray(q, dtype=float).reshape(1, -1)
+        if not self._frames:
+            return np.array(self._pose_columns(q, None, None)).reshape(-1)
+        zero = np.zeros((1, self.sm.model.nv))
+        P, R = (x.reshape(1, len(self._frames), -1) for x in self._core.frame_motion(q, zero, zero, self._frames)[:2])
+        return np.array(self._pose_columns(q, P, R)).reshape(-1)
+
+    def _pose_columns(self, q: np.ndarray, P: np.ndarray | None, R: np.ndarray | None) -> list[np.ndarray]:
+        """Points, link angles, transmission angles, sliders' s at the poses q (n, nq), from
+        the frames' positions P (n, F, 3) and rotations R (n, F, 9)."""
+        columns = []
+        if P is not None:
+            at = self._index
+            columns += [P[:, i, k] for i in at["points"] for k in self.axes]
+            x_axes = R[:, at["links"]][..., [0, 3, 6]]  # each link's x axis (rotation's first column), world
+            columns += list(np.arctan2(x_axes @ self.e2, x_axes @ self.e1).T) if at["links"] else []
+            x = {f: P[:, i] for f, i in zip(self.pins, at["pins"])}
+            columns += [transmission_values(d, x, self.e1, self.e2) for d in self.dyads]
+        return columns + [q[:, iq] for iq, _ in self.sliders]
 
     def jacobians(self, data: pin.Data) -> tuple[np.ndarray, np.ndarray]:
         """The pose outputs' (dy/dq on the tangent space (n_pose, nv), dy/dp at fixed q

@@ -61,7 +61,7 @@ class StudyMechanism:
         self.sweep = Sweep.from_scene(scene)
         self.mechanism, self.solver = self.sweep.mechanism, self.sweep.solver
         self.model = self.mechanism.model
-        self.placements: list[Placement] = placements(self.mechanism, spec.params, str(spec.path))
+        self.placements: list[Placement] = placements(self.mechanism, spec.params, str(spec.path), scene)
         for p, place in zip(spec.params, self.placements):
             if p.nominal is not None:
                 place.write(p.nominal)
@@ -70,6 +70,10 @@ class StudyMechanism:
         if outside:
             raise SceneError(f"the nominal {outside}", path=str(spec.path), key="params")
         self.subtree = subtrees(self.model)
+        if any(place.drawn for place in self.placements) and (spec.sliders or spec.omega):
+            raise SceneError("the speed outputs (sliders' s_dot, omega) have no sensitivity to a drawn linkage's "
+                             "params yet: name strokes, points or links instead, or alpha", path=str(spec.path),
+                             key="outputs")
         self.values = _cycle_values(scene, self.sweep, spec.steps)
         self.solver.refresh()
         scene_ref = self.solver.reference  # the scene's (scene_solver), closed again for the nominal
@@ -120,7 +124,8 @@ class StudyMechanism:
         return VariantCycle(self.values, np.vstack(rows), v=np.vstack(v), a=np.vstack(a))
 
     def at(self, q: np.ndarray) -> pin.Data:
-        """self.data with joint Jacobians and every frame placement at q."""
+        """self.data with joint Jacobians and every frame placement at q (kept as self.q_at)."""
+        self.q_at = np.array(q, dtype=float)
         pin.computeJointJacobians(self.model, self.data, q)
         pin.updateFramePlacements(self.model, self.data)
         return self.data
