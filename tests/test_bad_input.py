@@ -390,7 +390,7 @@ def test_the_installed_command_prints_one_line(tmp_path):
 
 
 def test_every_error_class_has_its_exit_code_documented():
-    """cli.py's docstring, `pinmech --help` and the README's table list the exit code of every
+    """The pinmech.cli package's docstring, `pinmech --help` and the README's table list the exit code of every
     error class (PinmechError and all its subclasses, DrawError of the drawing layer too)."""
     import pinmech.draw  # noqa: F401  (its DrawError)
     from pinmech import cli
