@@ -7,7 +7,17 @@ from __future__ import annotations
 import argparse
 
 from pinmech import __version__
-from pinmech.cli import animate, build, check, forces, path, polygon, report, snapshot, solve, sweep, view
+from pinmech.cli.animate import add_parser as add_animate_parser
+from pinmech.cli.build import add_parser as add_build_parser
+from pinmech.cli.check import add_parser as add_check_parser
+from pinmech.cli.forces import add_parser as add_forces_parser
+from pinmech.cli.path import add_parser as add_path_parser
+from pinmech.cli.polygon import add_parser as add_polygon_parser
+from pinmech.cli.report import add_parser as add_report_parser
+from pinmech.cli.snapshot import add_parser as add_snapshot_parser
+from pinmech.cli.solve import add_parser as add_solve_parser
+from pinmech.cli.sweep import add_parser as add_sweep_parser
+from pinmech.cli.view import add_parser as add_view_parser
 from pinmech.design.study_cli import add_parser as add_study_parser
 
 
@@ -33,16 +43,16 @@ def build_parser(command: str | None = None, *, parser_class: type[argparse.Argu
 
 #: Each subcommand's parser, in the order `pinmech --help` lists them.
 SUBCOMMANDS = {
-    "solve": solve.add_parser,
-    "forces": forces.add_parser,
-    "sweep": sweep.add_parser,
-    "path": path.add_parser,
-    "snapshot": snapshot.add_parser,
-    "animate": animate.add_parser,
-    "polygon": polygon.add_parser,
-    "report": report.add_parser,
-    "view": view.add_parser,
-    "build": build.add_parser,
-    "check": check.add_parser,
+    "solve": add_solve_parser,
+    "forces": add_forces_parser,
+    "sweep": add_sweep_parser,
+    "path": add_path_parser,
+    "snapshot": add_snapshot_parser,
+    "animate": add_animate_parser,
+    "polygon": add_polygon_parser,
+    "report": add_report_parser,
+    "view": add_view_parser,
+    "build": add_build_parser,
+    "check": add_check_parser,
     "study": add_study_parser,
 }
