@@ -49,7 +49,7 @@ def cmd_animate(args: argparse.Namespace) -> int:
                            f"got {args.steps}")
     if not args.fps > 0:
         raise PinmechError(f"--fps must be positive, got {args.fps}")
-    if "task" in scene.raw:
+    if scene.is_task:
         frames = task_frames(scene, given_text(args.duration, "--duration"), args.steps)
     else:
         frames = driver_frames(scene, given_text(args.start, "--from"), given_text(args.stop, "--to"), args.steps,
@@ -87,7 +87,7 @@ def _check_animation(args: argparse.Namespace, scene) -> None:
         from pinmech.draw.animation_export import check_mp4
 
         check_mp4(args.mp4)
-    task = "task" in scene.raw
+    task = scene.is_task
     wrong = ["--from"] * bool(task and args.start) + ["--to"] * bool(task and args.stop)
     wrong += ["--duration"] * bool(not task and args.duration)
     if wrong:

@@ -36,7 +36,7 @@ def inputs_of(scene, hand: str | None = None) -> dict[str, Path]:
     sidecar (robot.yaml) and a hand file."""
     out = {"the scene file": scene.path, _MODEL_FILES.get(getattr(scene, "model_kind", ""), "the model file"):
            _urdf_path(scene)}
-    if "sidecar" in scene.raw:
+    if scene.file.sidecar is not None:
         out["the sidecar (robot.yaml)"] = scene.model_file("sidecar")
     if hand:
         out["the hand file"] = Path(hand)

@@ -42,7 +42,7 @@ def follow_task(args: argparse.Namespace, scene) -> int:
     from pinmech.io.sweep import sweep_options
     from pinmech.io.tables import PathCsv
 
-    if "task" not in scene.raw:
+    if not scene.is_task:
         raise PinmechError(f"{scene.path}: no [[task]] to follow; a scene with [drivers] is swept: "
                            "pinmech sweep SCENE")
     figure = check_outputs(args, scene)

@@ -73,13 +73,12 @@ def scene_from_args(args: argparse.Namespace):
         given_text(value, f"--{key}")
     if any(shortcuts.values()):
         scene = Scene.load(args.scene)
-        drivers = list(scene.section("drivers"))
+        drivers = list(scene.file.drivers)
         if len(drivers) != 1:
             raise PinmechError(f"--angle/--speed/--acceleration need a single driver; {args.scene} has "
                                f"{len(drivers)}: use --set drivers.NAME.angle=...")
         name = drivers[0]
-        spec = scene.section("drivers")[name]
-        keys = {"angle": "position" if "position" in spec else "angle",
-                "speed": "velocity" if "velocity" in spec else "speed", "acceleration": "acceleration"}
+        spec = scene.file.drivers[name]
+        keys = {"angle": spec.key_of(0), "speed": spec.key_of(1), "acceleration": "acceleration"}
         overrides += [f'drivers.{name}.{keys[k]}="{v}"' for k, v in shortcuts.items() if v]
     return Scene.load(args.scene, overrides)

@@ -114,8 +114,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from pinmech.io.unused_options import refuse_sweep_options
 
     scene = scene_from_args(args)
-    refuse_sweep_options(args, str(scene.path), task="task" in scene.raw)
-    if "task" in scene.raw:
+    refuse_sweep_options(args, str(scene.path), task=scene.is_task)
+    if scene.is_task:
         return follow_task(args, scene)
     figure = check_outputs(args, scene)
     options = sweep_options(scene)  # the scene's values checked there, naming the file and key

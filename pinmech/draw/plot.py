@@ -88,7 +88,7 @@ class SweepPlot:
         _pyplot()  # fail early, before the sweep runs, when matplotlib is missing
         if angles not in ANGLE_STYLES:
             raise PinmechError(f"angles must be one of {', '.join(ANGLE_STYLES)}, got {angles!r}")
-        chosen = sweep.scene.section("sweep")
+        chosen = sweep.scene.file.sweep
         self.sweep, self.angles = sweep, angles
         self.length = length_unit(sweep.mechanism.length_scale)  # (scale from m, unit): one a figure
         self.paths = PathRecorder(sweep.mechanism, plane, length=self.length)
@@ -96,7 +96,7 @@ class SweepPlot:
         self.centrodes = None if centrodes is None else CentrodeTrace(self.design.design, centrodes)
         self._mus: list[float] = []
         self.mark_q = None  # configuration of the pose nearest the scene's (drawn under the paths)
-        self.links, self.points = links or chosen.get("links"), points or chosen.get("points")
+        self.links, self.points = links or chosen.links, points or chosen.points
         _check_names(sweep, "link", self.links, sweep.mechanism.links, "--links" if links else "[sweep] links")
         named = [n for n in self.points or () if sweep.mechanism.model.existFrame(n)]  # a drawn linkage's pins
         _check_names(sweep, "point", self.points, [*sweep.mechanism.points, *named],
@@ -358,8 +358,8 @@ class SweepPlot:
         unit = "deg" if self.sweep.is_angular else self.length[1]
         if self._speed() == 0:
             return f"arrows: travel as {self.sweep.driver} {'grows' if self._increasing() else 'falls'} [{unit}]"
-        spec = self.sweep.scene.section("drivers").get(self.sweep.driver, {})
-        speed = spec.get("speed", spec.get("velocity", f"{self._speed():.4g}"))
+        spec = self.sweep.scene.file.drivers.get(self.sweep.driver)
+        speed = spec.rate if spec is not None and spec.rate is not None else f"{self._speed():.4g}"
         return f"arrows: the motion, {self.sweep.driver} at {speed}"
 
     def _panel(self, ax, title: str, series: dict[str, array], x: np.ndarray, order: np.ndarray,
@@ -421,13 +421,14 @@ class SweepPlot:
 
     def _title(self, marked: bool, mark_x: float, unit: str) -> str:
         sweep = self.sweep
-        spec = sweep.scene.section("drivers").get(sweep.driver, {})
+        spec = sweep.scene.file.drivers.get(sweep.driver)
         rate = "speed" if sweep.is_angular else "velocity"
-        speed = spec.get("speed", spec.get("velocity", "0"))  # as the scene writes them; absent: 0
+        speed = spec.rate if spec is not None and spec.rate is not None else "0"  # as the scene writes it; absent: 0
+        acceleration = spec.acceleration if spec is not None and spec.acceleration is not None else "0"
         note = f"dashed: the scene's pose, {mark_x:.4g} {unit}" if marked else ""
         if self.failed:
             note += ("; " if note else "") + f"{len(self.failed)} pose(s) failed (red x)"
-        driven = f"driver {sweep.driver} at {rate} {speed}, acceleration {spec.get('acceleration', '0')}"
+        driven = f"driver {sweep.driver} at {rate} {speed}, acceleration {acceleration}"
         return f"{sweep.scene.title}: {driven}" + (f"\n({note})" if note else "")
 
     def _summary(self, mark_x: float, unit: str) -> str:
