@@ -65,14 +65,25 @@ class Scene:
         tables = copy.deepcopy(written)
         for item in overrides or []:
             _override(tables, item, path)
-        file = SceneFile.read(tables, path)
+        scene = cls.from_tables(tables, path)
         if not overrides:
-            return cls(path, file, file.drivers)
+            return scene
         try:
             as_written = SceneFile.read(dict(tables, drivers=written.get("drivers", {})), path)
         except PinmechError:
-            return cls(path, file, None)
-        return cls(path, file, as_written.drivers)
+            return cls(path, scene.file, None)
+        return cls(path, scene.file, as_written.drivers)
+
+    @classmethod
+    def from_tables(cls, tables: dict[str, Any], path: str | Path) -> Scene:
+        """A scene from its TOML tables as read (relative paths from `path`'s folder).
+
+        Raises:
+            SceneError: as `load`, naming `path` and the key.
+        """
+        path = Path(path)
+        file = SceneFile.read(tables, path)
+        return cls(path, file, file.drivers)
 
     # -------------------------------------------------------------- accessors
     @property

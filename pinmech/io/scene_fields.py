@@ -11,7 +11,7 @@ from typing import Any, ClassVar, NamedTuple
 from pydantic import BaseModel, ConfigDict, model_validator
 
 from pinmech.exceptions import SceneError, UnitError
-from pinmech.units import to_si
+from pinmech.units import JOINT_KINDS, to_si
 
 
 class Refused(ValueError):
@@ -47,13 +47,23 @@ def positive_quantity(value: Any, kind: str, what: str) -> Quantity:
     return q
 
 
-def written_value(value: Any) -> Any:
-    """A value whose kind (angle or length) the model decides: a string or a finite number,
-    converted once the joint is known (`Scene.joint_quantity`)."""
+def written_value(value: Any, order: int = 0) -> Any:
+    """A joint's coordinate (order 0), rate (1) or acceleration (2) as written: a quantity
+    of a revolute or of a prismatic joint's kind (which one, the model decides: it is
+    converted once the joint is known, `Scene.joint_quantity`)."""
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
         raise Refused(f"must be a quantity such as \"30 deg\" or \"12 mm\", got {value!r}", error=UnitError)
     if isinstance(value, float) and not math.isfinite(value):
         raise Refused(f"{value!r} is not a finite number", error=UnitError)
+    revolute, prismatic = (JOINT_KINDS[kind][order] for kind in ("revolute", "prismatic"))
+    try:
+        to_si(value, revolute)
+    except SceneError as exc:
+        try:
+            to_si(value, prismatic)
+        except SceneError:
+            said = prismatic.replace("_", " ")
+            raise Refused(f"{exc}; nor is it a {said}, as a prismatic joint's would be", error=type(exc)) from None
     return value
 
 

@@ -34,8 +34,8 @@ class DriverSpec(Table):
 
     @field_validator("*", mode="before")
     @classmethod
-    def _written(cls, value: Any) -> Any:
-        return value if value is None else written_value(value)
+    def _written(cls, value: Any, info) -> Any:
+        return value if value is None else written_value(value, DRIVER_KEYS[info.field_name])
 
     @model_validator(mode="after")
     def _one_per_order(self) -> DriverSpec:

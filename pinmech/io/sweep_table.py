@@ -23,7 +23,7 @@ from typing import Any
 
 from pydantic import Field, field_validator, model_validator
 
-from pinmech.io.scene_fields import Refused, Table, names, positive_quantity
+from pinmech.io.scene_fields import Refused, Table, names, positive_quantity, written_value
 
 #: The `[sweep]` keys and their types.
 SWEEP_KEYS = {"links": list, "points": list, "steps": int, "from": str, "to": str, "start": str,
@@ -94,6 +94,11 @@ class SweepSpec(Table):
         if not 0 <= value < math.inf:
             raise Refused(f"must be a number from 0 (open loop) up, in 1/s, got {value!r}")
         return value
+
+    @field_validator("first", "last")
+    @classmethod
+    def _driver_value(cls, value: str) -> str:
+        return written_value(value)
 
     @field_validator("duration", "step")
     @classmethod
