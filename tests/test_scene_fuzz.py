@@ -22,6 +22,7 @@ from hypothesis import strategies as st
 
 from pinmech.exceptions import PinmechError, SceneError
 from pinmech.io.analysis import analyse
+from pinmech.io.check import hand_file
 from pinmech.io.scene import KNOWN_KEYS, Scene
 from pinmech.io.sweep import Sweep
 
@@ -31,7 +32,7 @@ BUNDLED = sorted(p for p in SCENES.glob("*.toml") if not p.name.endswith(".hand.
 QUICK = [SCENES / n for n in ("r_rtr.toml", "slider_crank_dynamic.toml", "four_bar.toml", "planar_arm.toml",
                                "four_bar_drawn.toml")]
 #: Keys that appear somewhere in a scene, to write where they do not belong.
-KEY_NAMES = sorted(KNOWN_KEYS | {"angle", "position", "speed", "velocity", "acceleration", "at", "link", "points",
+KEY_NAMES = sorted(KNOWN_KEYS | {"value", "label", "quantity", "hand", "unit", "kind", "source", "scene","angle", "position", "speed", "velocity", "acceleration", "at", "link", "points",
                                  "links", "limits", "tol", "max_iterations", "max_condition", "method", "damping",
                                  "steps", "from", "to", "start", "batch", "interpolate", "duration", "step",
                                  "scheme", "gain", "massless", "static", "minimum_norm", "flywheel", "direction",
@@ -137,6 +138,20 @@ def test_a_wrong_scene_is_swept_or_refused_by_a_named_error(case):
         sweep = Sweep.from_scene(Scene.from_tables(tables, path))
         for _ in sweep.poses(sweep.default_values(5)):
             pass
+    except PinmechError as exc:
+        _said_well(exc, path)
+
+
+HANDS = sorted(SCENES.glob("*.hand.toml"))
+
+
+@settings(max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(mutated(HANDS))
+def test_a_wrong_hand_file_is_read_or_refused_by_a_named_error(case):
+    """The same for hand-value files: read into HandValues, or one named error."""
+    path, tables = case
+    try:
+        hand_file(tables, path)
     except PinmechError as exc:
         _said_well(exc, path)
 
