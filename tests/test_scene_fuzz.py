@@ -58,27 +58,14 @@ def _tables(path: Path) -> dict[str, Any]:
     return tomllib.loads(path.read_text(encoding="utf-8"))
 
 
-def _paths(node: Any, prefix: tuple = ()) -> list[tuple]:
-    """Every place in the tables a value sits (keys of tables, indices of arrays)."""
-    out = [prefix] if prefix else []
-    if isinstance(node, dict):
-        for key, value in node.items():
-            out += _paths(value, prefix + (key,))
-    elif isinstance(node, list):
-        for i, value in enumerate(node):
-            out += _paths(value, prefix + (i,))
-    return out
-
-
-def _tables_of(node: Any, prefix: tuple = ()) -> list[tuple]:
-    """Every table (where a new key can go), the top level included."""
-    out = [prefix] if isinstance(node, dict) else []
-    if isinstance(node, dict):
-        for key, value in node.items():
-            out += _tables_of(value, prefix + (key,))
-    elif isinstance(node, list):
-        for i, value in enumerate(node):
-            out += _tables_of(value, prefix + (i,))
+def _places(node: Any, prefix: tuple = (), *, tables: bool = False) -> list[tuple]:
+    """Every place in the tables a value sits (keys of tables, indices of arrays), or with
+    `tables` every table (where a new key can go), the top level included."""
+    here = isinstance(node, dict) if tables else bool(prefix)
+    out = [prefix] if here else []
+    items = node.items() if isinstance(node, dict) else enumerate(node) if isinstance(node, list) else ()
+    for key, value in items:
+        out += _places(value, prefix + (key,), tables=tables)
     return out
 
 
@@ -89,9 +76,9 @@ def mutated(draw, scenes: list[Path]) -> tuple[Path, dict[str, Any]]:
     tables = copy.deepcopy(_tables(path))
     for _ in range(draw(st.integers(1, 3))):
         if draw(st.booleans()):
-            where = draw(st.sampled_from(_paths(tables)))
+            where = draw(st.sampled_from(_places(tables)))
         else:
-            where = draw(st.sampled_from(_tables_of(tables))) + (draw(st.sampled_from(KEY_NAMES)),)
+            where = draw(st.sampled_from(_places(tables, tables=True))) + (draw(st.sampled_from(KEY_NAMES)),)
         node = tables
         for part in where[:-1]:
             node = node[part]

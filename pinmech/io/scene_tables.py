@@ -13,13 +13,10 @@ from typing import Any, ClassVar
 from pydantic import field_validator, model_validator
 
 from pinmech.io.scene_fields import Quantity, Refused, Table, names, positive_number, quantity, written_value
+from pinmech.solve.loops import SOLVER_RANGES  # the accepted [solver] values, the solver's own
 
 #: A driver's keys and the order of the derivative each gives (0 coordinate, 1 rate, 2 acceleration).
 DRIVER_KEYS = {"angle": 0, "position": 0, "speed": 1, "velocity": 1, "acceleration": 2}
-#: Accepted `[solver]` values. A closure tolerance (relative to the mechanism's size)
-#: below 1e-16 is tighter than rounding allows; above 1e-3 a "closed" loop is visibly
-#: open. A singular limit below 1 would refuse every pose.
-SOLVER_RANGES = {"tol": (1e-16, 1e-3), "max_iterations": (1, 1000), "max_condition": (1.0, float("inf"))}
 
 
 class DriverSpec(Table):

@@ -70,22 +70,15 @@ class SweepSpec(Table):
     def _names(cls, value: Any) -> list[str] | None:
         return names(value)
 
-    @field_validator("start")
+    @field_validator("start", "scheme")
     @classmethod
-    def _start(cls, value: str) -> str:
+    def _one_of(cls, value: str, info) -> str:
         from pinmech.solve.cycle import STARTS
-
-        if value not in STARTS:
-            raise Refused(f"must be one of {', '.join(STARTS)}, got {value!r}")
-        return value
-
-    @field_validator("scheme")
-    @classmethod
-    def _scheme(cls, value: str) -> str:
         from pinmech.solve.path import SCHEMES  # here: sweeping needs no path integration
 
-        if value not in SCHEMES:
-            raise Refused(f"must be one of {', '.join(SCHEMES)}, got {value!r}")
+        choices = STARTS if info.field_name == "start" else SCHEMES
+        if value not in choices:
+            raise Refused(f"must be one of {', '.join(choices)}, got {value!r}")
         return value
 
     @field_validator("gain")
