@@ -95,19 +95,17 @@ def table_of(value: Any, what: str) -> dict[str, Any]:
 class Table(BaseModel):
     """A scene table: strict types, frozen, every key it does not know refused by name.
 
-    Subclasses set `unknown_hint` for their own wording of the known keys, and
-    `what` (the table's name in messages)."""
+    Subclasses set `unknown_hint` for their own wording of the known keys."""
 
     model_config = ConfigDict(extra="forbid", strict=True, frozen=True, populate_by_name=True,
                               arbitrary_types_allowed=True)
-    what: ClassVar[str] = "table"
     unknown_hint: ClassVar[str | None] = None
 
     @model_validator(mode="before")
     @classmethod
     def _known_keys(cls, data: Any) -> Any:
         if not isinstance(data, dict):
-            raise Refused(f"[{cls.what}] must be a table, got {data!r}")
+            raise Refused(f"must be a table, got {data!r}")
         known = [f.alias or name for name, f in cls.model_fields.items()]
         unknown = sorted(set(data) - set(known))
         if unknown:
