@@ -1,0 +1,86 @@
+"""Sphinx configuration of pinmech's documentation site.
+
+Sphinx with MyST (Markdown) and the furo theme, as the Python side of the field documents
+itself (Pinocchio's Python bindings, pink, qpsolvers): autodoc reads pinmech's own docstrings
+for the API reference, sphinx-argparse reads the CLI's argparse parser, and the pages stay
+Markdown files that the tests run (tests/test_docs_examples.py). Built offline with warnings
+as errors (tests/test_docs_build.py): no intersphinx, nitpicky references.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+project = "pinmech"
+author = "pinmech's authors"
+copyright = "pinmech's authors, BSD-3-Clause"  # noqa: A001
+
+extensions = [
+    "myst_parser",
+    "sphinx.ext.autodoc",
+    "sphinx.ext.napoleon",
+    "sphinxarg.ext",
+]
+
+source_suffix = {".md": "markdown"}
+root_doc = "index"
+exclude_patterns = ["_build", "_generated/*.txt", "Thumbs.db", ".DS_Store"]
+
+myst_enable_extensions = ["colon_fence", "deflist"]
+myst_heading_anchors = 3
+
+nitpicky = True
+# Names of other packages in signatures and docstrings (numpy, Pinocchio, the standard
+# library): intersphinx is off (the build is offline), so they cannot resolve.
+nitpick_ignore_regex = [
+    (r"py:.*", r"(np|numpy|pin|pinocchio|pint|pathlib|collections|typing|argparse|dask|"
+               r"distributed|matplotlib|pandas|pyarrow|scipy|os|io|concurrent)\b.*"),
+    (r"py:.*", r"(Path|Sequence|Mapping|Iterable|Iterator|Callable|Any|ndarray|NDArray|"
+               r"ArrayLike|Literal|Self|IO|TextIO|Figure|Axes|Model|Data)"),
+    # Types of pinmech's modules that the public API returns but does not export by name.
+    (r"py:.*", r"pinmech\.(model|solve|io|design|draw)\..*"),
+    (r"py:class", r"(int|float|str|bool|bytes|dict|list|tuple|set|frozenset|object|None|type|"
+                  r"Exception|KeyboardInterrupt|ImportError|ValueError|optional)"),
+]
+
+autodoc_typehints = "description"
+autodoc_typehints_description_target = "documented"
+autodoc_member_order = "bysource"
+autodoc_default_options = {"undoc-members": False}
+napoleon_google_docstring = True
+napoleon_numpy_docstring = False
+napoleon_use_ivar = True  # a dataclass's "Attributes:" as fields, not a second description
+napoleon_use_rtype = False  # "Returns: The solved poses: ..." is prose, not a type
+
+
+def _plain_text(app, what, name, obj, options, lines) -> None:
+    """Docstrings are written for `help()` in Markdown's habits: `|F|` is a magnitude, not
+    an RST substitution; `code` is code, not RST's interpreted text; and a property's
+    "The URDF file: ..." is a sentence, not napoleon's "type: description"."""
+    for i, line in enumerate(lines):
+        line = line.replace("|", "\\|")
+        lines[i] = _CODE.sub(lambda m: f"``{m.group(1)}``" + ("\\ " if m.group(2) else ""), line)
+    if what in ("property", "attribute", "data") and lines and ":" in lines[0]:
+        # U+A789 (a letter that looks like a colon): napoleon then reads no type here
+        lines[0] = lines[0].replace(":", "\ua789", 1)
+
+
+_CODE = re.compile(r"(?<![`:])`([^`]+)`(?!`)(?=([A-Za-z0-9])?)")
+
+
+def setup(app) -> None:
+    app.connect("autodoc-process-docstring", _plain_text, priority=400)  # before napoleon's
+
+html_theme = "furo"
+html_title = "pinmech"
+html_static_path: list[str] = []
+html_show_sourcelink = False
+
+# A glob toctree entry for the pages other work adds (docs/studies*.md, docs/synthesis*.md):
+# until such a page exists, its pattern matches nothing, and that is not an error.
+suppress_warnings = ["toc.empty_glob"]
