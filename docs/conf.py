@@ -15,6 +15,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).parent / "_ext"))  # cli_parser: the CLI reference
 
 project = "pinmech"
 author = "pinmech's authors"
@@ -29,7 +30,7 @@ extensions = [
 
 source_suffix = {".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "_generated/*.txt", "Thumbs.db", ".DS_Store"]
+exclude_patterns = ["_build", "_generated", "Thumbs.db", ".DS_Store"]
 
 myst_enable_extensions = ["colon_fence", "deflist"]
 myst_heading_anchors = 3
@@ -73,14 +74,27 @@ def _plain_text(app, what, name, obj, options, lines) -> None:
 _CODE = re.compile(r"(?<![`:])`([^`]+)`(?!`)(?=([A-Za-z0-9])?)")
 
 
+#: Pages other work adds at the top of docs/ (a study kind, synthesis), listed in the home
+#: page's "Design studies and synthesis" toctree when they exist: a pattern that matches no
+#: page yet lists nothing (a glob toctree would warn, and warnings are errors here).
+OPTIONAL_PAGES = ("studies*.md", "synthesis*.md")
+
+
+def _optional_pages(app, docname: str, source: list[str]) -> None:
+    """The home page's toctree of optional pages, written out from the files present."""
+    if docname != "index":
+        return
+    here = Path(app.srcdir)
+    pages = sorted({p.stem for pattern in OPTIONAL_PAGES for p in here.glob(pattern)})
+    block = "\n".join(pages)
+    source[0] = source[0].replace("<!-- optional pages -->", block)
+
+
 def setup(app) -> None:
     app.connect("autodoc-process-docstring", _plain_text, priority=400)  # before napoleon's
+    app.connect("source-read", _optional_pages)
 
 html_theme = "furo"
 html_title = "pinmech"
 html_static_path: list[str] = []
 html_show_sourcelink = False
-
-# A glob toctree entry for the pages other work adds (docs/studies*.md, docs/synthesis*.md):
-# until such a page exists, its pattern matches nothing, and that is not an error.
-suppress_warnings = ["toc.empty_glob"]

@@ -5,7 +5,8 @@
 
 Each output is `$ pinmech ...` then what pinmech printed (stdout, then stderr), run from a
 scratch folder holding a link to models/ (so files the command writes land there), with
-the exit code a line of its own when it is not 0. The docs include these files (MyST
+the exit code a line of its own when it is not 0, and paths as seen from the
+repository's root (not this machine's folders). The docs include these files (MyST
 `literalinclude`); README.md's output blocks follow a marker line `<!-- output: NAME -->`
 and are rewritten from the same files. docs/_generated/exit_codes.md is the exit-code table,
 from the error classes in pinmech/exceptions.py. tests/test_docs_examples.py checks that all
@@ -63,7 +64,9 @@ def run(command: str) -> str:
         os.symlink(ROOT / "models", Path(scratch) / "models")
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             code = main(argv[1:])
-    text = f"$ {command}\n{out.getvalue()}{err.getvalue()}"
+        text = f"$ {command}\n{out.getvalue()}{err.getvalue()}"
+        for folder in (str(ROOT), os.path.realpath(scratch), scratch):  # as from the repository's root
+            text = text.replace(folder + os.sep, "")
     if code:
         text += f"(exit {code})\n"
     return text.rstrip() + "\n"

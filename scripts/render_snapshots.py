@@ -1,4 +1,4 @@
-"""Regenerate the README's pictures of the bundled mechanisms: each pose drawn by
+"""Regenerate the pictures of the docs (and the README) of the bundled mechanisms: each pose drawn by
 `pinmech.draw` as an offline meshcat page, then photographed by headless chromium, the same
 route as the browser tests (tests/browser.py).
 
@@ -18,6 +18,9 @@ route as the browser tests (tests/browser.py).
   `polygon_a_r_rtr.png`, `polygon_a_four_bar.png`: `pinmech polygon`;
   `docs/images/report_r_rtr_page1.png`: the first page of `pinmech report`, printed to PDF by
   chromium (poppler's `pdftoppm` makes the picture).
+- `docs/images/study_four_bar_histogram.png`, `study_four_bar_sensitivity.png`,
+  `study_four_bar_grid.png`: `pinmech study --out --plot` of models/studies/four_bar_tolerance.toml
+  and four_bar_grid.toml.
 
 Poses and rates of the first two come from the independent closed forms in
 scripts/closed_form.py; the models are built from the URDF files directly. The others run
@@ -185,6 +188,21 @@ def figure_pictures(tmp: Path) -> None:
              str(IMAGES / "torque_slider_crank.png"), "--csv", str(tmp / "t.csv")])
     pinmech(["path", str(scenes / "planar_arm.toml"), "--csv", str(tmp / "arm.csv"),
              "--plot", str(IMAGES / "path_planar_arm.png")])
+    study_pictures(tmp)
+
+
+def study_pictures(tmp: Path) -> None:
+    """The design studies' figures (`pinmech study --out --plot`, in this process): the
+    four-bar's tolerance histograms and sensitivity bars, and its 2-D grid map."""
+    import shutil
+
+    from pinmech.cli import main as pinmech
+
+    studies = MODELS / "studies"
+    for study, figures in (("four_bar_tolerance", ("histogram", "sensitivity")), ("four_bar_grid", ("grid",))):
+        pinmech(["study", str(studies / f"{study}.toml"), "--workers", "0", "--out", str(tmp / study), "--plot"])
+        for figure in figures:
+            shutil.copyfile(tmp / f"{study}_{figure}.png", IMAGES / f"study_four_bar_{figure}.png")
 
 
 def _svg_pixels(svg: Path) -> tuple[int, int]:
