@@ -66,10 +66,47 @@ def _plain_text(app, what, name, obj, options, lines) -> None:
     for i, line in enumerate(lines):
         line = line.replace("|", "\\|")
         lines[i] = _CODE.sub(lambda m: f"``{m.group(1)}``" + ("\\ " if m.group(2) else ""), line)
+    _literal_blocks(lines)
+    if what == "module":
+        _module_examples(lines)
     if what in ("property", "attribute", "data") and lines and ":" in lines[0]:
         # U+A789 (a letter that looks like a colon): napoleon then reads no type here
         lines[0] = lines[0].replace(":", "\ua789", 1)
 
+
+def _literal_blocks(lines: list[str]) -> None:
+    """A sentence ending in ":" over an indented block (an example, a file's text) shows the
+    block as code, as `help()` does: RST's "::" (napoleon's section titles are left alone)."""
+    out: list[str] = []
+    for i, line in enumerate(lines):
+        out.append(line)
+        text = line.rstrip()
+        if not text.endswith(":") or text.endswith("::") or text.strip()[:-1].lower() in _SECTIONS:
+            continue
+        following = next((n for n in lines[i + 1:] if n.strip()), "")
+        if len(following) - len(following.lstrip()) > len(line) - len(line.lstrip()):
+            out[-1] = text + ":"
+            if i + 1 < len(lines) and lines[i + 1].strip():
+                out.append("")
+    lines[:] = out
+
+
+def _module_examples(lines: list[str]) -> None:
+    """A module's docstring shows its file formats as indented blocks after a blank line:
+    code, as `help()` shows them (RST's lone "::" paragraph before each)."""
+    out: list[str] = []
+    for i, line in enumerate(lines):
+        starts = (line.startswith(" ") and line.strip() and i > 1 and not lines[i - 1].strip()
+                  and not lines[i - 2].startswith(" ") and not lines[i - 2].rstrip().endswith("::"))
+        if starts:
+            out += ["::", ""]
+        out.append(line)
+    lines[:] = out
+
+
+_SECTIONS = {"args", "arguments", "attributes", "example", "examples", "keyword args", "methods",
+             "note", "notes", "other parameters", "parameters", "raises", "returns", "return",
+             "see also", "todo", "warning", "warnings", "warns", "yields", "yield", "references"}
 
 _CODE = re.compile(r"(?<![`:])`([^`]+)`(?!`)(?=([A-Za-z0-9])?)")
 
@@ -93,6 +130,9 @@ def _optional_pages(app, docname: str, source: list[str]) -> None:
 def setup(app) -> None:
     app.connect("autodoc-process-docstring", _plain_text, priority=400)  # before napoleon's
     app.connect("source-read", _optional_pages)
+
+# Commands and options in prose stay as typed: no "--set" turned into an en dash.
+smartquotes = False
 
 html_theme = "furo"
 html_title = "pinmech"

@@ -2,7 +2,7 @@
 
 A scene keeps quantities as the user wrote them ("30 deg", "-50 rpm", "150 mm") and
 converts them to SI only once the model is known (a driver's unit depends on its joint
-type). See the README section "Scene files" for the format.
+type). See the docs page docs/reference/scene.md for the format.
 """
 
 from __future__ import annotations

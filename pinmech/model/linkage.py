@@ -4,8 +4,8 @@ Mechanism people think in joint coordinates on a drawing. A linkage file gives e
 joint's world coordinates at one drawn pose, the links and the joints and points each
 carries, sliders and pin-in-slot joints one line each; this module picks a spanning tree
 (breadth first from the ground), turns every other joint into one loop cut, and writes a
-URDF whose reference configuration is the drawn pose. See the README section
-"Linkages as drawn" for the format; `parse_linkage` reads and validates it once,
+URDF whose reference configuration is the drawn pose. See the docs page
+docs/howto/linkage_toml.md for the format; `parse_linkage` reads and validates it once,
 `pinmech.model.linkage_urdf` writes the URDF text, `load_linkage` makes the Mechanism.
 
 Conventions of the generated URDF (all in the plane z = 0, axes along z):
