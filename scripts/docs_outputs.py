@@ -9,7 +9,8 @@ the exit code a line of its own when it is not 0, and paths as seen from the
 repository's root (not this machine's folders). The docs include these files (MyST
 `literalinclude`); README.md's output blocks follow a marker line `<!-- output: NAME -->`
 and are rewritten from the same files. docs/_generated/exit_codes.md is the exit-code table,
-from the error classes in pinmech/exceptions.py. tests/test_docs_examples.py checks that all
+from the error classes in pinmech/exceptions.py; docs/_generated/singular_accuracy.md what
+scripts/singular_accuracy.py prints (the same at every run). tests/test_docs_examples.py checks that all
 of it is what the code prints now.
 """
 
@@ -49,6 +50,11 @@ COMMANDS: dict[str, str] = {
     "four_bar_tolerance": "pinmech study models/studies/four_bar_tolerance.toml --workers 0",
 }
 
+#: name -> a script of scripts/ whose printed Markdown (a deterministic table) a page includes.
+SCRIPTS: dict[str, str] = {
+    "singular_accuracy": "singular_accuracy.py",
+}
+
 #: README.md's shortened example: these lines of r_rtr_solve (a tutorial shows it whole).
 README_EXCERPTS = {"r_rtr_solve_excerpt": ("r_rtr_solve", 22)}
 
@@ -80,6 +86,21 @@ def _cwd(path: Path):
         yield
     finally:
         os.chdir(before)
+
+
+def script_output(script: str) -> str:
+    """What `python scripts/SCRIPT` prints (run in this process, as its `__main__`)."""
+    import runpy
+
+    out = io.StringIO()
+    saved = sys.argv
+    sys.argv = [str(ROOT / "scripts" / script)]
+    try:
+        with contextlib.redirect_stdout(out):
+            runpy.run_path(str(ROOT / "scripts" / script), run_name="__main__")
+    finally:
+        sys.argv = saved
+    return out.getvalue().rstrip() + "\n"
 
 
 def exit_code_table() -> str:
@@ -114,6 +135,8 @@ def expected() -> dict[Path, str]:
         lines = files[GENERATED / f"{source}.txt"].splitlines()[:count]
         files[GENERATED / f"{name}.txt"] = "\n".join(lines) + "\n...\n"
     files[GENERATED / "exit_codes.md"] = exit_code_table()
+    for name, script in SCRIPTS.items():
+        files[GENERATED / f"{name}.md"] = script_output(script)
     return files
 
 
