@@ -229,3 +229,12 @@ def test_every_page_is_reached_and_every_include_exists() -> None:
         text = page.read_text(encoding="utf-8")
         for target in re.findall(r"```\{(?:literalinclude|include)\} (\S+)", text):
             assert (page.parent / target).resolve().exists(), f"{page.relative_to(ROOT)}: {target}"
+
+
+def test_the_scene_reference_lists_every_key_a_scene_may_have() -> None:
+    """docs/reference/scene.md's key table holds the keys the scene reader knows, no more."""
+    from pinmech.io.scene import KNOWN_KEYS
+
+    text = (ROOT / "docs" / "reference" / "scene.md").read_text(encoding="utf-8")
+    listed = set(re.findall(r"^\| `\[{0,2}(\w+)(?:\.\w+)?\]{0,2}` \|", text, re.M))
+    assert listed == KNOWN_KEYS
