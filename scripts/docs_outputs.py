@@ -48,6 +48,13 @@ COMMANDS: dict[str, str] = {
     "crank_shaper_sweep": "pinmech sweep models/scenes/crank_shaper.toml --json lines.jsonl",
     "four_bar_sensitivity": "pinmech study models/studies/four_bar_sensitivity.toml --workers 0",
     "four_bar_tolerance": "pinmech study models/studies/four_bar_tolerance.toml --workers 0",
+    "r_rtr_solve_json": "pinmech solve models/scenes/r_rtr.toml --json",
+}
+
+#: name -> a sweep whose CSV header (the first line it prints) a page lists, one column a line.
+COLUMNS: dict[str, str] = {
+    "r_rtr_csv_columns": "pinmech sweep models/scenes/r_rtr.toml --steps 2",
+    "slider_crank_csv_columns": "pinmech sweep models/scenes/slider_crank_dynamic.toml --steps 2",
 }
 
 #: name -> a script of scripts/ whose printed Markdown (a deterministic table) a page includes.
@@ -131,6 +138,9 @@ def exit_code_table() -> str:
 def expected() -> dict[Path, str]:
     """Every generated file and the text it must hold now."""
     files = {GENERATED / f"{name}.txt": run(command) for name, command in COMMANDS.items()}
+    for name, command in COLUMNS.items():
+        header = run(command).splitlines()[1]
+        files[GENERATED / f"{name}.txt"] = f"$ {command} | head -1\n" + "\n".join(header.split(",")) + "\n"
     for name, (source, count) in README_EXCERPTS.items():
         lines = files[GENERATED / f"{source}.txt"].splitlines()[:count]
         files[GENERATED / f"{name}.txt"] = "\n".join(lines) + "\n...\n"
