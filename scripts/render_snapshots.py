@@ -12,7 +12,8 @@ route as the browser tests (tests/browser.py).
   `<visual>` taken out (a user's model), and `docs/images/jansen_leg.png`, a model written
   without any: their links sketched from their joints and points.
 - `docs/images/sweep_r_rtr.png`, `sweep_four_bar.png`, `docs/images/paths_four_bar.png`
-  (with `--timing-marks`), `paths_jansen_leg.png`: `pinmech sweep --plot` and `--paths`;
+  (with `--timing-marks`), `paths_jansen_leg.png`, `paths_four_bar_drawn.png` (the drawn
+  four-bar): `pinmech sweep --plot` and `--paths`;
   `docs/images/animate_four_bar.gif` and `.png`: `pinmech animate --gif`, and its page with
   the slider moved to frame 30; `docs/images/path_planar_arm.png`: `pinmech path --plot`; `docs/images/torque_slider_crank.png`: `--torque-plot`; `docs/images/polygon_v_r_rtr.png`,
   `polygon_a_r_rtr.png`, `polygon_a_four_bar.png`: `pinmech polygon`;
@@ -182,6 +183,8 @@ def figure_pictures(tmp: Path) -> None:
              "--csv", str(tmp / "f.csv")])
     pinmech(["sweep", str(scenes / "four_bar.toml"), "--paths", str(IMAGES / "paths_four_bar.png"), "--timing-marks"])
     pinmech(["sweep", str(scenes / "jansen_leg.toml"), "--paths", str(IMAGES / "paths_jansen_leg.png")])
+    pinmech(["sweep", str(scenes / "four_bar_drawn.toml"), "--steps", "73", "--csv", str(tmp / "d.csv"),
+             "--paths", str(IMAGES / "paths_four_bar_drawn.png")])  # the drawn-linkage tutorial's
     pinmech(["animate", str(scenes / "four_bar.toml"), "--steps", "37", "--fps", "12",
              "--gif", str(IMAGES / "animate_four_bar.gif")])
     pinmech(["sweep", str(scenes / "slider_crank_dynamic.toml"), "--torque-plot",
