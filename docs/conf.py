@@ -113,18 +113,21 @@ _CODE = re.compile(r"(?<![`:])`([^`]+)`(?!`)(?=([A-Za-z0-9])?)")
 
 #: Pages other work adds at the top of docs/ (a study kind, synthesis), listed in the home
 #: page's "Design studies and synthesis" toctree when they exist: a pattern that matches no
-#: page yet lists nothing (a glob toctree would warn, and warnings are errors here).
-OPTIONAL_PAGES = ("studies*.md", "synthesis*.md")
+#: page yet lists nothing (a glob toctree would warn, and warnings are errors here). Any
+#: other page at the top of docs/ that the home page does not list goes under "More".
+OPTIONAL_PAGES = ("studies*.md", "synthesis*.md", "workspace*.md")
 
 
 def _optional_pages(app, docname: str, source: list[str]) -> None:
-    """The home page's toctree of optional pages, written out from the files present."""
+    """The home page's toctrees of optional pages, written out from the files present."""
     if docname != "index":
         return
     here = Path(app.srcdir)
-    pages = sorted({p.stem for pattern in OPTIONAL_PAGES for p in here.glob(pattern)})
-    block = "\n".join(pages)
-    source[0] = source[0].replace("<!-- optional pages -->", block)
+    design = sorted({p.stem for pattern in OPTIONAL_PAGES for p in here.glob(pattern)})
+    listed = set(re.findall(r"^([\w/]+)$", source[0], re.M))
+    others = sorted(p.stem for p in here.glob("*.md") if p.stem not in listed | set(design) | {"index"})
+    source[0] = source[0].replace("<!-- optional pages -->", "\n".join(design))
+    source[0] = source[0].replace("<!-- other pages -->", "\n".join(others))
 
 
 def setup(app) -> None:

@@ -240,3 +240,18 @@ def test_the_scene_reference_lists_every_key_a_scene_may_have() -> None:
     text = (ROOT / "docs" / "reference" / "scene.md").read_text(encoding="utf-8")
     listed = set(re.findall(r"^\| `\[{0,2}(\w+)(?:\.\w+)?\]{0,2}` \|", text, re.M))
     assert listed == KNOWN_KEYS
+
+
+def test_the_readme_links_reach_files_and_anchors() -> None:
+    """Every relative link of README.md names a file of the repository (a page of docs/, an
+    image), and an in-page link a heading of the README (GitHub's anchor of it)."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    anchors = {re.sub(r"[^\w\- ]", "", h.strip().lower()).replace(" ", "-")
+               for h in re.findall(r"^#+ (.*)$", text, re.M)}
+    for target in re.findall(r"\]\(([^)\s]+)\)", text):
+        if re.match(r"\w+://", target):
+            continue
+        if target.startswith("#"):
+            assert target[1:] in anchors, target
+        else:
+            assert (ROOT / target.split("#")[0]).exists(), target
