@@ -62,8 +62,9 @@ SCRIPTS: dict[str, str] = {
     "singular_accuracy": "singular_accuracy.py",
 }
 
-#: README.md's shortened example: these lines of r_rtr_solve (a tutorial shows it whole).
-README_EXCERPTS = {"r_rtr_solve_excerpt": ("r_rtr_solve", 22)}
+#: README.md's shortened example: of r_rtr_solve (a tutorial shows it whole), its first
+#: lines (the command, title, model, drivers), then these sections, whole.
+README_EXCERPTS = {"r_rtr_solve_excerpt": ("r_rtr_solve", 4, ("Positions", "Velocities of points"))}
 
 
 def run(command: str) -> str:
@@ -110,6 +111,17 @@ def script_output(script: str) -> str:
     return out.getvalue().rstrip() + "\n"
 
 
+def excerpt(text: str, head: int, sections: tuple[str, ...]) -> str:
+    """The first `head` lines of a report, then each named section (up to its blank line)."""
+    lines = text.splitlines()
+    out = lines[:head]
+    for title in sections:
+        start = lines.index(title)
+        end = lines.index("", start) if "" in lines[start:] else len(lines)
+        out += ["", *lines[start:end]]
+    return "\n".join(out) + "\n...\n"
+
+
 def exit_code_table() -> str:
     """The exit code of every error class, from pinmech/exceptions.py (Markdown table)."""
     import pinmech.draw  # noqa: F401  (registers DrawError)
@@ -141,9 +153,8 @@ def expected() -> dict[Path, str]:
     for name, command in COLUMNS.items():
         header = run(command).splitlines()[1]
         files[GENERATED / f"{name}.txt"] = f"$ {command} | head -1\n" + "\n".join(header.split(",")) + "\n"
-    for name, (source, count) in README_EXCERPTS.items():
-        lines = files[GENERATED / f"{source}.txt"].splitlines()[:count]
-        files[GENERATED / f"{name}.txt"] = "\n".join(lines) + "\n...\n"
+    for name, (source, head, sections) in README_EXCERPTS.items():
+        files[GENERATED / f"{name}.txt"] = excerpt(files[GENERATED / f"{source}.txt"], head, sections)
     files[GENERATED / "exit_codes.md"] = exit_code_table()
     for name, script in SCRIPTS.items():
         files[GENERATED / f"{name}.md"] = script_output(script)
