@@ -14,7 +14,8 @@ A list of values goes with a vector path; a component (.x, .y, .z, .norm) takes 
 unit must measure the quantity's own kind (a declared `kind`, needed for a joint's q, v
 and a, must agree with it), and any key but these is refused as a typo.
 
-A printed value is an interval: "0.386" means [0.3855, 0.3865]. Verdicts:
+A printed value is an interval: "0.386" means [0.3855, 0.3865]. Verdicts::
+
     ok        within half a unit of the last printed digit: correctly rounded;
     rounding  within `slack` units: truncated, or carried rounding of the hand work's
               own rounded intermediate values; right at the printed precision;

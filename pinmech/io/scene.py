@@ -4,7 +4,7 @@
 validates every table once (scene_file.py): what it returns holds typed tables
 (`scene.file.drivers`, `scene.file.sweep`, ...), never raw TOML. Quantities whose unit the
 model decides (a driver's angle or position) are kept as written and converted once the
-joint is known (`joint_quantity`). See the README section "Scene files" for the format.
+joint is known (`joint_quantity`). See docs/reference/scene.md for the format.
 """
 
 from __future__ import annotations

@@ -134,7 +134,9 @@ class Sweep:
 
     @classmethod
     def from_scene(cls, scene: Scene, driver: str | None = None) -> Sweep:
-        """Raises:
+        """The sweep of a scene's driver (its only one unless `driver` names one).
+
+        Raises:
             SceneError: a scene without drivers (a task scene is followed in time by
                 `pinmech path`), or a driver that is not one of the scene's.
         """
