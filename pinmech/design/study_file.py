@@ -24,6 +24,9 @@
     point = "P"                          # a URDF fixed link, an MJCF site, a robot.yaml loop frame)
     component = "x"                      # (or body = "coupler": an MJCF body's pos)
 
+    [params.crank_drawn]                 # a drawn linkage's [params] entry (a scene with linkage = ...):
+    param = "crank"                      # the linkage is redrawn for each variant; no component
+
     [outputs]
     points = ["P"]                       # world x, y, z of these points [m]
     links = ["rocker"]                   # angle of these links about the plane normal [rad]
