@@ -35,6 +35,13 @@ def _theta4(theta2: np.ndarray, a: float) -> np.ndarray:
     return np.unwrap(closed_form.four_bar(theta2, 0.0, 0.0, a, 0.12, 0.08, 0.10, +1).theta4)
 
 
+def _omega4(theta2: np.ndarray, a: float) -> np.ndarray:
+    """The rocker's angular speed [rad/s] at 120 rpm: Norton's omega4 = a w2 sin(th2 - th3)
+    / (c sin(th4 - th3)), the positions from the law of cosines."""
+    fb = closed_form.four_bar(theta2, 0.0, 0.0, a, 0.12, 0.08, 0.10, +1)
+    return a * 4 * np.pi * np.sin(theta2 - fb.theta3) / (0.08 * np.sin(fb.theta4 - fb.theta3))
+
+
 def test_crank_param_moves_the_rocker_as_nortons_closed_form():
     """param = "crank" (40 mm) of the drawn four-bar: the rocker angle at 25 poses of a turn
     is theta4 of the law of cosines (tolerance 1e-12 rad: both exact to the closure
@@ -43,8 +50,10 @@ def test_crank_param_moves_the_rocker_as_nortons_closed_form():
     the closed form. Reference step 1e-7 m: truncation (1e-7 / 0.04)^2 ~ 6e-12 relative,
     rounding 1e-16 / 1e-7 ~ 1e-9 rad/m. The study's drawing step 1e-6 m: truncation ~ 6e-10
     relative, rounding 1e-16 * 0.1 / 1e-6 ~ 1e-11; |d theta4 / da| ~ 23 rad/m: tolerance
-    1e-7 rad/m (measured 3e-9)."""
-    sm = _drawn({"crank": {"param": "crank"}}, {"links": ["rocker"]})
+    1e-7 rad/m (measured 3e-9). The rocker's omega4 at 120 rpm and its d/d(crank) against
+    Norton's omega4 formula: the same errors times omega2 = 12.6 rad/s; tolerance 1e-6 of
+    the largest |d omega4 / da| (~600 rad/s/m)."""
+    sm = _drawn({"crank": {"param": "crank"}}, {"links": ["rocker"], "omega": ["rocker"]})
     out = StudyOutputs(sm)
     assert sm.nominal.tolist() == [0.04]
     cycle = sm.cycle(sm.nominal)
@@ -54,6 +63,9 @@ def test_crank_param_moves_the_rocker_as_nortons_closed_form():
     slope = (_theta4(cycle.values, 0.04 + h) - _theta4(cycle.values, 0.04 - h)) / (2 * h)
     assert np.abs(slope).max() > 1.0
     np.testing.assert_allclose(dy[:, 0, 0], slope, rtol=0, atol=1e-7)
+    np.testing.assert_allclose(y[:, 1], _omega4(cycle.values, 0.04), rtol=0, atol=1e-10)
+    slope = (_omega4(cycle.values, 0.04 + h) - _omega4(cycle.values, 0.04 - h)) / (2 * h)
+    np.testing.assert_allclose(dy[:, 1, 0], slope, rtol=0, atol=1e-6 * np.abs(slope).max())  # ~600 rad/s/m
     variant = sm.cycle(np.array([0.045]))
     assert not variant.cause, variant.detail
     y45 = out.cycle(variant.q, variant.v, variant.a)
@@ -63,12 +75,13 @@ def test_crank_param_moves_the_rocker_as_nortons_closed_form():
 
 def test_drawn_params_sensitivities_are_central_differences_of_resolved_variants():
     """The crank and a derived length at once (the coupler point P, the rocker and the
-    transmission angle at B): dy/dp equals central differences of variants redrawn and
+    transmission angle at B, the rocker's and the coupler's omega at 120 rpm): dy/dp equals central differences of variants redrawn and
     re-solved over the cycle at p +- 1e-6 m (truncation (h/L)^2 ~ 1e-9, the closure
     tolerance over h ~ 1e-8; tolerance 1e-6 of the largest |dy/dp|); the rocker's alpha,
     by central differences of re-solved variants, comes along."""
     sm = _drawn({"crank": {"param": "crank"}}, {"points": ["P"], "links": ["rocker", "coupler"],
-                                                "transmission": ["B"], "alpha": ["rocker"]})
+                                                "transmission": ["B"], "omega": ["rocker", "coupler"],
+                                                "alpha": ["rocker"]})
     out = StudyOutputs(sm)
     cycle = sm.cycle(sm.nominal)
     _, dy = cycle_sensitivity(sm, out, cycle)
@@ -91,5 +104,3 @@ def test_a_drawn_param_is_named_and_refused_where_it_does_not_apply():
         _drawn({"x": {"param": "crank", "component": "x"}}, {"links": ["rocker"]}, steps=3)
     with pytest.raises(SceneError, match=r"drawn linkage's \[params\]; this scene's model is given by 'urdf'"):
         _drawn({"x": {"param": "crank"}}, {"links": ["rocker"]}, scene="four_bar.toml", steps=3)
-    with pytest.raises(SceneError, match=r"outputs: the speed outputs .* no sensitivity to a drawn linkage's params"):
-        _drawn({"x": {"param": "crank"}}, {"omega": ["rocker"]}, steps=3)

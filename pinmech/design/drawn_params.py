@@ -8,7 +8,8 @@ name; frames the scene adds, such as its own [points], keep theirs in their link
 
 The exact sensitivity needs the drawing's derivative: the placements at p +- STEP (the
 drawing is a closed-form construction, smooth away from a compass that cannot close) are
-kept, and the closure residual's and the pose outputs' derivatives at fixed q are their
+kept, and the closure residual's and the pose outputs' derivatives at fixed q (and the
+velocity rows' and frames' velocities at fixed q and v, rate_sensitivity.py) are their
 central differences over those two drawings; sensitivity.py composes them exactly with the
 implicit-function theorem. Truncation (STEP / L)^2 ~ 1e-10 of a 0.1 m linkage, rounding
 1e-16 L / STEP ~ 1e-11: far below the 1e-7 the tests hold them to.
@@ -91,6 +92,7 @@ class DrawnPlacement:
     read, write), with the drawing's central differences for the exact sensitivity."""
 
     drawn = True
+    written_in = 0  # no translation of its own (rate_sensitivity.py reads it, with u = 0)
 
     def __init__(self, drawing: Drawing, name: str, where: str) -> None:
         if name not in drawing.values:

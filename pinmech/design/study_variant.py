@@ -70,10 +70,6 @@ class StudyMechanism:
         if outside:
             raise SceneError(f"the nominal {outside}", path=str(spec.path), key="params")
         self.subtree = subtrees(self.model)
-        if any(place.drawn for place in self.placements) and (spec.sliders or spec.omega):
-            raise SceneError("the speed outputs (sliders' s_dot, omega) have no sensitivity to a drawn linkage's "
-                             "params yet: name strokes, points or links instead, or alpha", path=str(spec.path),
-                             key="outputs")
         self.values = _cycle_values(scene, self.sweep, spec.steps)
         self.solver.refresh()
         scene_ref = self.solver.reference  # the scene's (scene_solver), closed again for the nominal
