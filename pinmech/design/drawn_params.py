@@ -13,9 +13,14 @@ velocity rows' and frames' velocities at fixed q and v, rate_sensitivity.py) are
 central differences over those two drawings; sensitivity.py composes them exactly with the
 implicit-function theorem. Truncation (STEP / L)^2 ~ 1e-10 of a 0.1 m linkage, rounding
 1e-16 L / STEP ~ 1e-11: far below the 1e-7 the tests hold them to.
+
+Each redrawing writes its URDF through the user's cache folder (linkage_model.py); a
+variant's is removed once loaded, the scene's own is kept.
 """
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -29,7 +34,7 @@ class Drawing:
     """A scene's drawn linkage bound to the study's model: its params' values [m] and the
     placements each set of values draws."""
 
-    def __init__(self, scene, model: pin.Model, where: str) -> None:
+    def __init__(self, scene, mechanism, where: str) -> None:
         from pinmech.model.linkage_expr import length
         from pinmech.model.linkage_spec import read_linkage_spec
 
@@ -37,7 +42,7 @@ class Drawing:
             raise SceneError(f"param = names a drawn linkage's [params]; this scene's model is given by "
                              f"'{scene.model_kind}'", path=where, key="params")
         self.spec, self.source = read_linkage_spec(scene.model_file("linkage"))
-        self.model = model
+        self.model, self.urdf_path = mechanism.model, getattr(mechanism, "urdf_path", None)
         self.values: dict[str, float] = {}
         for name, value in self.spec.params.items():  # in the order written: expressions use earlier ones
             self.values[name] = length(value, self.values, self.source, f"[params] {name}")
@@ -71,7 +76,10 @@ class Drawing:
 
         changed = {n: v for n, v in values.items() if v != self.values.get(n)} or values
         try:
-            drawn = linkage_mechanism(linkage_from_spec(self.spec.with_params(**changed), self.source)).model
+            mech = linkage_mechanism(linkage_from_spec(self.spec.with_params(**changed), self.source))
+            drawn = mech.model
+            if mech.urdf_path != self.urdf_path:  # a variant's URDF: not left in the user's cache folder
+                Path(mech.urdf_path).unlink(missing_ok=True)
         except ModelError as exc:
             shown = ", ".join(f"{n} = {v * 1e3:.6g} mm" for n, v in changed.items())
             raise ModelError(f"the linkage cannot be drawn with {shown}: {exc}", path=self.source) from exc

@@ -152,7 +152,7 @@ def placements(mechanism, params: tuple[Parameter, ...], path: str, scene=None) 
         if p.target == "param":
             from pinmech.design.drawn_params import Drawing, DrawnPlacement
 
-            drawing = drawing or Drawing(scene, mechanism.model, where)
+            drawing = drawing or Drawing(scene, mechanism, where)
             out.append(DrawnPlacement(drawing, p.element, where))
         else:
             out.append(_placement(mechanism, p, where))
