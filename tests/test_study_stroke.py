@@ -71,3 +71,22 @@ def test_stroke_and_its_sensitivity_are_the_closed_form(offset_mm):
 def test_a_stroke_names_a_prismatic_joint():
     with pytest.raises(SceneError, match=r"outputs.strokes: 'rod' is not a prismatic joint"):
         StudyOutputs(_slider_crank(10.0, steps=3, outputs={"strokes": ["rod"]}))
+
+
+def test_every_tolerance_variants_stroke_is_the_closed_form_at_its_own_lengths():
+    """A tolerance study (20 variants, sigma 0.5 mm on r, l and e): each variant's stroke
+    equals sqrt((l+r)^2-e^2) - sqrt((l-r)^2-e^2) at its own sampled lengths (tolerance
+    1e-13 m: the closure tolerance; the extremes located to the solver's precision)."""
+    from pinmech.design.study import study
+
+    raw = {"scene": "../scenes/slider_crank.toml", "kind": "tolerance", "steps": 70, "samples": 20, "seed": 7,
+           "batch": 10, "outputs": {"strokes": ["slide"]},
+           "params": {"crank": {"joint": "A", "component": "x", "sigma": "0.5 mm"},
+                      "rod": {"cut": "B", "side": "parent", "component": "x", "sigma": "0.5 mm"},
+                      "offset": {"joint": "slide", "component": "y", "sigma": "0.5 mm"}}}
+    result = study(parse_study(raw, STUDIES / "inline.toml"), workers=0)
+    p, y, causes = result.variants
+    assert causes == [""] * 20
+    expected = [closed_stroke(r, l, e)[0] for r, l, e in p]
+    np.testing.assert_allclose(y[:, :, 0], np.broadcast_to(np.array(expected)[:, None], y.shape[:2]), rtol=0,
+                               atol=1e-13)
