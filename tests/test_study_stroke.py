@@ -90,3 +90,18 @@ def test_every_tolerance_variants_stroke_is_the_closed_form_at_its_own_lengths()
     expected = [closed_stroke(r, l, e)[0] for r, l, e in p]
     np.testing.assert_allclose(y[:, :, 0], np.broadcast_to(np.array(expected)[:, None], y.shape[:2]), rtol=0,
                                atol=1e-13)
+
+
+def test_the_golden_section_fallback_locates_the_same_stroke(monkeypatch):
+    """Where the secant from the poses leaves their bracket, golden section narrows it
+    first (forced here): the same stroke and derivatives as the closed form (tolerances as
+    above)."""
+    from pinmech.design.study_stroke import Stroke
+
+    monkeypatch.setattr(Stroke, "_from_poses", lambda self, q, i, lo, hi: (None, q[i]))
+    sm = _slider_crank(10.0)
+    outputs = StudyOutputs(sm)
+    y, dy = cycle_sensitivity(sm, outputs, sm.cycle(sm.nominal))
+    stroke, slopes = closed_stroke(R, L, 0.01)
+    np.testing.assert_allclose(y[:, 0], stroke, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(dy[:, 0], np.broadcast_to(slopes, (len(y), 3)), rtol=0, atol=1e-12)

@@ -1,10 +1,11 @@
 """A slider's stroke as a study output: max - min of its coordinate s over the cycle,
 the extremes located between the poses, and its exact sensitivity by the envelope theorem.
 
-Over the poses the largest and least s bracket the extremes; each is refined by golden
-section (extremum.golden_minimum) over the driver between the poses on either side to
-1e-5, then by the secant method on ds/dtheta = 0 (ds/dtheta by the implicit-function
-theorem at each pose), every trial pose closed by the loop solver's Newton. The secant
+Over the poses the largest and least s bracket the extremes; each is located by the
+secant method on ds/dtheta = 0 (ds/dtheta by the implicit-function theorem at each pose)
+from the pose and its neighbour across the sign change, every trial pose closed by the
+loop solver's Newton; where the secant leaves the poses' bracket, golden section
+(extremum.golden_minimum) narrows it to 1e-5 first. The secant
 locates the extreme to the solver's precision (golden section alone cannot: s is flat
 there, so its noise hides the extreme's place to ~sqrt(1e-15 / s'') ~ 1e-7 rad, which
 would leave d(s)/dp off by d2s/(dtheta dp) times that).
@@ -31,7 +32,7 @@ from pinmech.extremum import golden_minimum
 
 COARSE = 1e-5  # [rad or m] of the driver: the golden section's bracket, then the secant's first step
 TOL = 1e-13  # [rad or m] of the driver: the secant stops at steps below this
-_SECANT_STEPS = 12  # it needs 3 or 4 from COARSE
+_SECANT_STEPS = 12  # it needs 5 to 7 from the poses, 3 or 4 from COARSE
 
 
 class Stroke:
@@ -69,9 +70,11 @@ class Stroke:
         hi = values[i + 1] if i < n - 1 else (values[1] + span if self.whole_turn else values[-1])
         guess = q[i]
         try:
-            x = golden_minimum(lambda t: sign * float(self._close(guess, t)[self.iq]), min(lo, hi), max(lo, hi),
-                               COARSE)
-            x, q_x = self._secant(guess, x)
+            x, q_x = self._from_poses(q, i, lo, hi)
+            if x is None:  # the secant from the poses left them: golden section first
+                x = golden_minimum(lambda t: sign * float(self._close(guess, t)[self.iq]), min(lo, hi), max(lo, hi),
+                                   COARSE)
+                x, q_x = self._secant(x - COARSE, self._close(guess, x - COARSE), x, self._close(guess, x))
         except PinmechError as exc:
             raise SweepError(f"{self.sm.spec.path}: outputs.strokes: the extreme of '{self.name}' near the driver at "
                              f"{values[i]:.6g} does not close between the poses ({exc})",
@@ -80,12 +83,23 @@ class Stroke:
             return float(q_x[self.iq]), q_x
         return float(q[i, self.iq]), q[i]
 
-    def _secant(self, guess: np.ndarray, x: float) -> tuple[float, np.ndarray]:
-        """The root of ds/dtheta near x by the secant method (ds/dtheta from the closure's
-        implicit-function theorem at each closed pose)."""
-        q1 = self._close(guess, x)
-        x0, g0 = x - COARSE, self._slope(self._close(guess, x - COARSE))
-        x1, g1 = x, self._slope(q1)
+    def _from_poses(self, q: np.ndarray, i: int, lo: float, hi: float) -> tuple[float | None, np.ndarray]:
+        """The secant on ds/dtheta = 0 from pose i and its neighbour across the sign change
+        of ds/dtheta; (None, q[i]) where it leaves [lo, hi]."""
+        values, n = self.sm.values, len(self.sm.values)
+        g = self._slope(q[i])
+        side = -1 if g * (self._slope(q[i - 1]) if i > 0 else self._slope(q[-2])) < 0 else +1
+        j = i + side
+        if j < 0 or j >= n:  # beyond an end of a whole turn: the pose a turn away
+            j = j % (n - 1)
+        x_j = lo if side < 0 else hi
+        x, q_x = self._secant(x_j, q[j], values[i], q[i])
+        return (x, q_x) if min(lo, hi) <= x <= max(lo, hi) else (None, q[i])
+
+    def _secant(self, x0: float, q0: np.ndarray, x1: float, q1: np.ndarray) -> tuple[float, np.ndarray]:
+        """The root of ds/dtheta by the secant method from two closed poses (ds/dtheta from
+        the closure's implicit-function theorem at each), each new pose closed from the last."""
+        g0, g1 = self._slope(q0), self._slope(q1)
         for _ in range(_SECANT_STEPS):
             if g1 == g0 or abs(x1 - x0) < TOL:
                 break
