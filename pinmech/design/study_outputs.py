@@ -10,10 +10,10 @@ Outputs, in this order (`[outputs]` of the study file):
     transmission = ["B"]  B.mu: the transmission angle of the dyad whose middle pin is B [rad]
                           (study_transmission.py)
     omega = ["rocker"]    rocker.omega: angular speed about the plane normal [rad/s]
+    alpha = ["rocker"]    rocker.alpha: angular acceleration about the plane normal [rad/s^2]
+                          (its sensitivity: accel_sensitivity.py)
     strokes = ["slide"]   slide.stroke: max - min of s over the cycle [m], the same at every
                           pose (study_stroke.py)
-    alpha = ["rocker"]    rocker.alpha: angular acceleration about the plane normal [rad/s^2]
-                          (its sensitivity: variant_differences.py)
     torque = ["O2"]       O2.torque: the driver's torque [N m] (a prismatic one's force [N])
                           from the scene's masses and loads (study_torque.py; its
                           sensitivity: variant_differences.py)
@@ -40,12 +40,11 @@ class StudyOutputs:
 
     Attributes:
         names: "P.x", "rocker.angle", "slide.s", "slide.s_dot", "rocker.omega", "slide.stroke",
-            "rocker.alpha", "O2.torque".
+            "rocker.alpha", "O2.torque" (in this order).
         kinds: "length", "angle", "speed", "angular speed", "angular acceleration", "torque"
             (or "force"), each.
         n_pose: how many outputs (the first ones) depend on q alone.
-        n_exact: how many outputs (the first ones) have an exact sensitivity; the others'
-            are central differences of re-solved variants (variant_differences.py).
+        alpha_at, strokes_at, torque_at: where those outputs sit in `names` (slices).
     """
 
     def __init__(self, sm) -> None:
@@ -72,14 +71,17 @@ class StudyOutputs:
         self.axes = _plane_axes(self.normal)
         self.names = ([f"{n}.{'xyz'[k]}" for n in spec.points for k in self.axes] + [f"{n}.angle" for n in spec.links]
                       + [f"{n}.mu" for n in spec.transmission] + [f"{n}.s" for n in spec.sliders] + [f"{n}.s_dot" for n in spec.sliders]
-                      + [f"{n}.omega" for n in spec.omega] + [f"{n}.stroke" for n in spec.strokes]
-                      + [f"{n}.alpha" for n in spec.alpha] + self.torques.names)
+                      + [f"{n}.omega" for n in spec.omega] + [f"{n}.alpha" for n in spec.alpha]
+                      + [f"{n}.stroke" for n in spec.strokes] + self.torques.names)
         self.kinds = (["length"] * (len(spec.points) * len(self.axes)) + ["angle"] * len(spec.links)
                       + ["angle"] * len(spec.transmission)
                       + ["length"] * len(spec.sliders) + ["speed"] * len(spec.sliders)
-                      + ["angular speed"] * len(spec.omega) + ["length"] * len(spec.strokes)
-                      + ["angular acceleration"] * len(spec.alpha) + self.torques.kinds)
-        self.n_exact = len(self.names) - len(spec.alpha) - len(spec.torque)  # the last: central differences
+                      + ["angular speed"] * len(spec.omega) + ["angular acceleration"] * len(spec.alpha)
+                      + ["length"] * len(spec.strokes) + self.torques.kinds)
+        end = len(self.names)
+        self.torque_at = slice(end - len(spec.torque), end)
+        self.strokes_at = slice(self.torque_at.start - len(spec.strokes), self.torque_at.start)
+        self.alpha_at = slice(self.strokes_at.start - len(spec.alpha), self.strokes_at.start)
         self.n_pose = len(self.points) * len(self.axes) + len(self.links) + len(self.dyads) + len(self.sliders)
         if self.normal is not None:
             e1 = np.eye(3)[int(np.argmin(np.abs(self.normal)))]
@@ -108,11 +110,11 @@ class StudyOutputs:
         columns += [v[:, iv] for _, iv in self.sliders]
         if self._frames:
             columns += list((W[:, at["omega"]] @ self.normal).T) if at["omega"] else []
+        if self._frames:
+            columns += list((alpha[:, at["alpha"]] @ self.normal).T) if at["alpha"] else []
         for stroke in self.strokes:
             top, _, low, _ = stroke.extremes(q)
             columns.append(np.full(n, top - low))
-        if self._frames:
-            columns += list((alpha[:, at["alpha"]] @ self.normal).T) if at["alpha"] else []
         columns += list(self.torques.values(q, v, a).T)
         return np.column_stack(columns) if columns else np.zeros((len(q), 0))
 

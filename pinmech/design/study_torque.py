@@ -4,8 +4,8 @@ inverse-dynamics path (solve/forces.py's ForceSolver, which checks each pose's p
 balance), on the variant now written in the model.
 
 Its sensitivity is by central differences of re-solved variants (variant_differences.py):
-the exact one would need the derivative of the inverse dynamics along dq/dp, dv/dp and
-da/dp, and da/dp is not derived (a link's alpha has the same gap).
+the exact one would differentiate the inverse dynamics along dq/dp, dv/dp and da/dp
+(accel_sensitivity.py has the last), not done yet.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Sensitivities by central differences of re-solved variants, for the outputs whose exact
-derivative is not derived: a link's angular acceleration (its exact sensitivity needs the
-derivative of the acceleration drift J_dot v, a second derivative of the closure).
+derivative is not derived: a driver's torque, and a link's angular acceleration with
+respect to a drawn linkage's param (accel_sensitivity.py serves the other parameters).
 
     dy/dp_k = (y(p + h e_k) - y(p - h e_k)) / 2h,    h = STEP [m]
 
@@ -9,7 +9,8 @@ assembly (StudyMechanism.cycle, the same path as every variant of a study), its 
 read as the study reads them. The error is the truncation h^2/6 |d3y/dp3| plus the
 solve's error over h: for a four-bar of 0.1 m links, |d3y/dp3| ~ |dy/dp| / (0.1 m)^2 gives
 2e-9 of |dy/dp|, and the closure tolerance (1e-13 of the loop) over 2h about 1e-9 of it;
-measured against Norton's closed form: 2e-7 of the largest |dy/dp| (tests/test_study_alpha.py).
+measured on alpha against Norton's closed form: 2e-7 of the largest |dy/dp|; on the
+torque against Norton's hand Newton-Euler: within 1e-6 (tests/test_study_torque.py).
 A variant at p +- h that does not solve is a SweepError naming the parameter, never a
 silently one-sided difference.
 """
