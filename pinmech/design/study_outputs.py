@@ -39,8 +39,8 @@ class StudyOutputs:
     """A study's outputs on a StudyMechanism `sm`.
 
     Attributes:
-        names: "P.x", "rocker.angle", "slide.s", "slide.s_dot", "rocker.omega", "slide.stroke",
-            "rocker.alpha", "O2.torque" (in this order).
+        names: "P.x", "rocker.angle", "B.mu", "slide.s", "slide.s_dot", "rocker.omega",
+            "rocker.alpha", "slide.stroke", "O2.torque" (in this order).
         kinds: "length", "angle", "speed", "angular speed", "angular acceleration", "torque"
             (or "force"), each.
         n_pose: how many outputs (the first ones) depend on q alone.
