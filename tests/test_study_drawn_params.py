@@ -52,8 +52,11 @@ def test_crank_param_moves_the_rocker_as_nortons_closed_form():
     relative, rounding 1e-16 * 0.1 / 1e-6 ~ 1e-11; |d theta4 / da| ~ 23 rad/m: tolerance
     1e-7 rad/m (measured 3e-9). The rocker's omega4 at 120 rpm and its d/d(crank) against
     Norton's omega4 formula: the same errors times omega2 = 12.6 rad/s; tolerance 1e-6 of
-    the largest |d omega4 / da| (~600 rad/s/m)."""
-    sm = _drawn({"crank": {"param": "crank"}}, {"links": ["rocker"], "omega": ["rocker"]})
+    the largest |d omega4 / da| (~600 rad/s/m). The rocker's alpha4 (closed_form.four_bar,
+    Norton's acceleration loop projected) and its d/d(crank), exact here too (the drawing's
+    central differences at fixed q, v, a composed with the acceleration closure): 1e-6 of
+    the largest (~2e4 rad/s^2/m)."""
+    sm = _drawn({"crank": {"param": "crank"}}, {"links": ["rocker"], "omega": ["rocker"], "alpha": ["rocker"]})
     out = StudyOutputs(sm)
     assert sm.nominal.tolist() == [0.04]
     cycle = sm.cycle(sm.nominal)
@@ -66,6 +69,10 @@ def test_crank_param_moves_the_rocker_as_nortons_closed_form():
     np.testing.assert_allclose(y[:, 1], _omega4(cycle.values, 0.04), rtol=0, atol=1e-10)
     slope = (_omega4(cycle.values, 0.04 + h) - _omega4(cycle.values, 0.04 - h)) / (2 * h)
     np.testing.assert_allclose(dy[:, 1, 0], slope, rtol=0, atol=1e-6 * np.abs(slope).max())  # ~600 rad/s/m
+    alpha4 = lambda a: closed_form.four_bar(cycle.values, 4 * np.pi, 0.0, a, 0.12, 0.08, 0.10, +1).alpha4  # noqa: E731
+    np.testing.assert_allclose(y[:, 2], alpha4(0.04), rtol=0, atol=1e-8)
+    slope = (alpha4(0.04 + h) - alpha4(0.04 - h)) / (2 * h)
+    np.testing.assert_allclose(dy[:, 2, 0], slope, rtol=0, atol=1e-6 * np.abs(slope).max())  # ~2e4 rad/s^2/m
     variant = sm.cycle(np.array([0.045]))
     assert not variant.cause, variant.detail
     y45 = out.cycle(variant.q, variant.v, variant.a)
@@ -77,8 +84,8 @@ def test_drawn_params_sensitivities_are_central_differences_of_resolved_variants
     """The crank and a derived length at once (the coupler point P, the rocker and the
     transmission angle at B, the rocker's and the coupler's omega at 120 rpm): dy/dp equals central differences of variants redrawn and
     re-solved over the cycle at p +- 1e-6 m (truncation (h/L)^2 ~ 1e-9, the closure
-    tolerance over h ~ 1e-8; tolerance 1e-6 of the largest |dy/dp|); the rocker's alpha,
-    by central differences of re-solved variants, comes along."""
+    tolerance over h ~ 1e-8; tolerance 1e-6 of the largest |dy/dp|), the rocker's alpha
+    included."""
     sm = _drawn({"crank": {"param": "crank"}}, {"points": ["P"], "links": ["rocker", "coupler"],
                                                 "transmission": ["B"], "omega": ["rocker", "coupler"],
                                                 "alpha": ["rocker"]})

@@ -24,8 +24,9 @@ w_b, acceleration alpha_b). At fixed a, each frame's quantities change by
 and differentiating A term by term (d(R_P^T y) = R_P^T (dy - d(theta_P) x y)) gives
 dA/dp_k at fixed a; then J_dep da_dep/dp_k = -dA/dp_k. A link's angular acceleration
 alpha_f moves by n . ((d alpha_f at fixed a) + J_f,ang da/dp_k). A drawn linkage's param
-(drawn_params.py), which turns frames, is not served here: its alpha keeps the central
-differences of re-solved variants (variant_differences.py).
+(drawn_params.py) translates nothing by u but turns and moves the placements themselves:
+A and alpha_f gain the drawing's own change at fixed (q, v, a), their central differences
+over the drawings at p +- STEP.
 """
 
 from __future__ import annotations
@@ -106,10 +107,47 @@ def acceleration_sensitivity(sm, q: np.ndarray, v: np.ndarray, a: np.ndarray, dq
         dA[:, k] = np.concatenate([_cut_rows(c, fr, S, w, moved, carrier) for c in mech.closures])
         for i, f in enumerate(frames):
             d_alpha[i, :, k] = fr.change(f, S, w, np.zeros(3), carrier)[5]
+        if place.drawn:  # the drawing's own change at fixed q, v, a: its central differences
+            dA[:, k] += place.column(lambda: _rows_now(sm, q, v, a, frames)[0])
+            d_alpha[:, :, k] += place.column(lambda: _rows_now(sm, q, v, a, frames)[1])
     da = np.zeros((model.nv, n_par))
     da[dep] = -np.linalg.solve(J[:, dep], dA)
     normal = mech.plane_normal
     return np.array([normal @ (d_alpha[i] + fr(f)[6][3:] @ da) for i, f in enumerate(frames)]).reshape(-1, n_par)
+
+
+def _rows_now(sm, q: np.ndarray, v: np.ndarray, a: np.ndarray, frames: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """The acceleration rows A (rows,) and the frames' angular accelerations (F, 3) at
+    (q, v, a) with the placements now in the model (a Data of its own)."""
+    if not hasattr(sm, "_acc_now"):
+        sm._acc_now = sm.model.createData()
+    model, data = sm.model, sm._acc_now
+    pin.forwardKinematics(model, data, q, v, a)
+    pin.updateFramePlacements(model, data)
+
+    def motion(f: int) -> tuple:
+        M = data.oMf[f]
+        V, A = pin.getFrameVelocity(model, data, f, _LWA), pin.getFrameAcceleration(model, data, f, _LWA)
+        return M.translation, M.rotation, V.linear, V.angular, A.linear + _cross(V.angular, V.linear), A.angular
+
+    rows = [_rows(c, motion(c.parent_frame), motion(c.child_frame)) for c in sm.mechanism.closures]
+    return np.concatenate(rows), np.array([motion(f)[5] for f in frames]).reshape(-1, 3)
+
+
+def _rows(cut, P: tuple, C: tuple) -> np.ndarray:
+    """A cut's acceleration rows from its frames' (x, R, v, w, acc, alpha) (the module's A)."""
+    lin, ang = _inner(P, C)
+    return cut._rows6 @ np.concatenate((P[1].T @ lin, P[1].T @ ang))
+
+
+def _inner(P: tuple, C: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """The brackets of A (world axes): acc_C - acc_P - alpha_P x delta - w_P x (v_C - v_P)
+    - w_P x a_, and alpha_C - alpha_P - w_P x b."""
+    x_P, _, v_P, w_P, acc_P, al_P = P
+    x_C, _, v_C, w_C, acc_C, al_C = C
+    delta, rel = x_C - x_P, v_C - v_P
+    lin = acc_C - acc_P - _cross(al_P, delta) - _cross(w_P, rel) - _cross(w_P, rel - _cross(w_P, delta))
+    return lin, al_C - al_P - _cross(w_P, w_C - w_P)
 
 
 def _cut_rows(cut, fr: _Frames, S, w, moved, carrier) -> np.ndarray:
@@ -124,10 +162,9 @@ def _cut_rows(cut, fr: _Frames, S, w, moved, carrier) -> np.ndarray:
     a_ = rel - _cross(w_P, delta)
     da_ = d_rel - _cross(dw_P, delta) - _cross(w_P, d_delta)
     b, db = w_C - w_P, dw_C - dw_P
-    lin = acc_C - acc_P - _cross(al_P, delta) - _cross(w_P, rel) - _cross(w_P, a_)
+    lin, ang = _inner(fr(P)[:6], fr(C)[:6])
     d_lin = (dacc_C - dacc_P - _cross(dal_P, delta) - _cross(al_P, d_delta) - _cross(dw_P, rel)
              - _cross(w_P, d_rel) - _cross(dw_P, a_) - _cross(w_P, da_))
-    ang = al_C - al_P - _cross(w_P, b)
     d_ang = dal_C - dal_P - _cross(dw_P, b) - _cross(w_P, db)
     R_T = R_P.T
     return cut._rows6 @ np.concatenate((R_T @ (d_lin - _cross(dth_P, lin)), R_T @ (d_ang - _cross(dth_P, ang))))

@@ -18,8 +18,7 @@ coordinate) then has dy/dp = J_y dq/dp + dy/dp|_q, the last term u where the par
 moves the point's frame (for a drawn linkage's param, J_p and dy/dp|_q are central
 differences of the drawing at fixed q, drawn_params.py); speeds (a slider's, a link's
 omega): rate_sensitivity.py; a link's angular acceleration: accel_sensitivity.py; a
-driver's torque (and alpha for a drawn param): central differences of re-solved variants
-(variant_differences.py).
+driver's torque: central differences of re-solved variants (variant_differences.py).
 """
 
 from __future__ import annotations
@@ -107,21 +106,17 @@ def output_sensitivity(sm: StudyMechanism, outputs: StudyOutputs, q: np.ndarray,
 
 def cycle_sensitivity(sm: StudyMechanism, outputs: StudyOutputs, cycle: VariantCycle) -> tuple[np.ndarray, np.ndarray]:
     """The outputs (steps, n_out) and dy/dp (steps, n_out, n_par) at each pose of a solved
-    cycle of the variant now written in the model. Exact but for the driver torques, and
-    the alphas where a parameter is a drawn linkage's: central differences of re-solved
-    variants (variant_differences.py)."""
+    cycle of the variant now written in the model. Exact but for the driver torques:
+    central differences of re-solved variants (variant_differences.py)."""
     y = outputs.cycle(cycle.q, cycle.v, cycle.a)
     dy = np.zeros((*y.shape, len(sm.placements)))
-    exact_alpha = not any(place.drawn for place in sm.placements)
-    head = outputs.strokes_at.start if exact_alpha else outputs.alpha_at.start
+    head = outputs.strokes_at.start
     if head:
-        dy[:, :head] = [output_sensitivity(sm, outputs, qi, vi, ai if exact_alpha else None)
-                        for qi, vi, ai in zip(cycle.q, cycle.v, cycle.a)]
+        dy[:, :head] = [output_sensitivity(sm, outputs, qi, vi, ai) for qi, vi, ai in zip(cycle.q, cycle.v, cycle.a)]
     if outputs.strokes:  # the envelope theorem at each stroke's extremes (study_stroke.py)
         dy[:, outputs.strokes_at] = [stroke_sensitivity(sm, s, *s.extremes(cycle.q)[1::2],
                                                         lambda q: configuration_sensitivity(sm, sm.at(q)))
                                      for s in outputs.strokes]
-    for at in ([] if exact_alpha else [outputs.alpha_at]) + [outputs.torque_at]:
-        if at.stop > at.start:
-            dy[:, at] = central_differences(sm, outputs, at)
+    if outputs.torque_at.stop > outputs.torque_at.start:
+        dy[:, outputs.torque_at] = central_differences(sm, outputs, outputs.torque_at)
     return y, dy
