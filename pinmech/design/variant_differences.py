@@ -1,6 +1,6 @@
 """Sensitivities by central differences of re-solved variants, for the outputs whose exact
-derivative is not derived: a driver's torque, and a link's angular acceleration with
-respect to a drawn linkage's param (accel_sensitivity.py serves the other parameters).
+derivative is not derived: a driver's torque (a link's angular acceleration has its
+exact one, accel_sensitivity.py).
 
     dy/dp_k = (y(p + h e_k) - y(p - h e_k)) / 2h,    h = STEP [m]
 
@@ -9,8 +9,8 @@ assembly (StudyMechanism.cycle, the same path as every variant of a study), its 
 read as the study reads them. The error is the truncation h^2/6 |d3y/dp3| plus the
 solve's error over h: for a four-bar of 0.1 m links, |d3y/dp3| ~ |dy/dp| / (0.1 m)^2 gives
 2e-9 of |dy/dp|, and the closure tolerance (1e-13 of the loop) over 2h about 1e-9 of it;
-measured on alpha against Norton's closed form: 2e-7 of the largest |dy/dp|; on the
-torque against Norton's hand Newton-Euler: within 1e-6 (tests/test_study_torque.py).
+measured on the torque against Norton's hand Newton-Euler: within 1e-6 of the largest
+|dy/dp| (tests/test_study_torque.py).
 A variant at p +- h that does not solve is a SweepError naming the parameter, never a
 silently one-sided difference.
 """
