@@ -20,7 +20,7 @@ def _workers(text: str) -> int:
 
 def add_parser(sub) -> None:
     """The `study` subcommand's arguments."""
-    study = sub.add_parser("study", help="run a design study (sensitivity, tolerance or grid) from a study file",
+    study = sub.add_parser("study", help="run a design study (sensitivity, tolerance, grid or workspace) from a study file",
                            description="Run a study file (models/studies/*.toml): exact sensitivities over the "
                            "cycle, or a seeded Monte Carlo tolerance study on Dask. Exit codes as `pinmech --help`.")
     study.add_argument("study_file", help="study file (TOML), e.g. models/studies/four_bar_tolerance.toml")
@@ -33,7 +33,7 @@ def add_parser(sub) -> None:
                        help="write PREFIX.csv, PREFIX.parquet (pyarrow) and PREFIX.json")
     study.add_argument("--plot", action="store_true",
                        help="with --out: PREFIX_sensitivity.png, and PREFIX_histogram.png for a tolerance study, "
-                            "PREFIX_grid.png for a 1-D or 2-D grid study")
+                            "PREFIX_grid.png for a 1-D or 2-D grid study, PREFIX_workspace.png for a workspace study")
     study.add_argument("--json", action="store_true", help="print the JSON summary instead of the text one")
     study.set_defaults(func=cmd_study)
 
@@ -52,6 +52,8 @@ def cmd_study(args: argparse.Namespace) -> int:
     scheduler = scheduler_address(args.scheduler)
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
     result = study(args.study_file, workers=workers, scheduler=scheduler)
+    if result.spec.kind == "workspace":
+        return _workspace_output(result, args)
     print(json.dumps(summary(result), indent=2) if args.json else text(result))
     if args.out:
         written = write(result, args.out)
@@ -63,5 +65,22 @@ def cmd_study(args: argparse.Namespace) -> int:
                 written.append(grid_figure(result, f"{args.out}_grid.png"))
             if result.spread is not None:
                 written.append(tolerance_histograms(result, f"{args.out}_histogram.png"))
+        print("wrote " + ", ".join(str(p) for p in written), file=sys.stderr)
+    return 0
+
+
+def _workspace_output(result, args: argparse.Namespace) -> int:
+    """A workspace study's summary, table, JSON and map."""
+    import json
+
+    from pinmech.design.workspace_report import summary, text, write
+
+    print(json.dumps(summary(result), indent=2) if args.json else text(result))
+    if args.out:
+        written = write(result, args.out)
+        if args.plot:
+            from pinmech.design.workspace_plot import workspace_figure
+
+            written.append(workspace_figure(result, f"{args.out}_workspace.png"))
         print("wrote " + ", ".join(str(p) for p in written), file=sys.stderr)
     return 0

@@ -36,8 +36,9 @@ _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 TOL = 1e-10  # Newton's convergence on the dimensionless residual (closure rows / loop size, end rows / L)
 _ITERATIONS = 60
 _STALL = 8  # Newton gives up when |F| has not halved over this many steps (it converges in ~5 from a seed)
-_SAMPLES_FULL = 24  # seed poses an unbounded revolute joint (15 deg apart)
-_SAMPLES_HALF = 9  # a bounded passive revolute joint, reference +- 90 deg (one parametrisation of a bar)
+_SAMPLES_FULL = 20  # seed poses over a full turn (18 deg apart): the motor and the first passive joint
+_SAMPLES_HALF = 9  # a further hinge (a universal joint's second), reference +- 90 deg: the bar directions
+# (a, b) and (a + pi, pi - b) of a universal joint are one pose, so half a turn of b covers them once
 
 
 @dataclass(frozen=True)
@@ -92,7 +93,7 @@ class WorkspaceMechanism:
     def _seed_table(self, leg: Leg) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The leg's sampled poses: angles (S, n), cut frame (S, 3) and end point (S, 3)
         positions [m], mode signs (S,)."""
-        grids = [self._samples(j, first=(k == 0)) for k, j in enumerate(leg.joints)]
+        grids = [self._samples(j, full=(k <= 1)) for k, j in enumerate(leg.joints)]
         theta = np.array(list(product(*grids)))
         tips, ends, signs = (np.zeros((len(theta), 3)), np.zeros((len(theta), 3)), np.zeros(len(theta)))
         q = self.q0.copy()
@@ -103,9 +104,9 @@ class WorkspaceMechanism:
             signs[s] = np.sign(mode_sign(self.mechanism, self.data, leg))
         return theta, tips, ends, signs
 
-    def _samples(self, jid: int, first: bool) -> np.ndarray:
+    def _samples(self, jid: int, full: bool) -> np.ndarray:
         joint = self.model.joints[jid]
-        if joint.nq == 2 or first:
+        if joint.nq == 2 or full:
             return np.linspace(-np.pi, np.pi, _SAMPLES_FULL, endpoint=False)
         ref = angles(self.model, self.q0, (jid,))[0]
         return ref + np.linspace(-np.pi / 2, np.pi / 2, _SAMPLES_HALF)
