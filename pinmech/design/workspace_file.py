@@ -24,6 +24,7 @@ from typing import Any
 
 from pinmech.design.study_file import GridAxis, _Where
 from pinmech.exceptions import SceneError
+from pinmech.toml_file import read_toml
 from pinmech.units import to_si
 
 _TOP = {"title", "scene", "kind", "batch", "workspace"}
@@ -62,6 +63,12 @@ class WorkspaceSpec:
     def size(self) -> int:
         """Grid points in all."""
         return math.prod(a.count for a in self.axes)
+
+
+def load_workspace(path: str | Path) -> WorkspaceSpec:
+    """Read and check a workspace study file. Raises SceneError naming the file and the key."""
+    path = Path(path)
+    return parse_workspace(read_toml(path, "study", SceneError), path)
 
 
 def parse_workspace(raw: dict[str, Any], path: Path) -> WorkspaceSpec:

@@ -35,7 +35,7 @@ from pinmech.io.scene_model import load_mechanism, scene_drivers
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 TOL = 1e-10  # Newton's convergence on the dimensionless residual (closure rows / loop size, end rows / L)
 _ITERATIONS = 60
-_STALL = 8  # Newton gives up when |F| has not halved over this many steps (it converges in ~5 from a seed)
+_STALL = 20  # Newton gives up when |F| has not halved over this many steps (a leg near its fold takes ~15)
 _SAMPLES_FULL = 20  # seed poses over a full turn (18 deg apart): the motor and the first passive joint
 _SAMPLES_HALF = 9  # a further hinge (a universal joint's second), reference +- 90 deg: the bar directions
 # (a, b) and (a + pi, pi - b) of a universal joint are one pose, so half a turn of b covers them once
@@ -111,8 +111,10 @@ class WorkspaceMechanism:
         ref = angles(self.model, self.q0, (jid,))[0]
         return ref + np.linspace(-np.pi / 2, np.pi / 2, _SAMPLES_HALF)
 
-    def _seed(self, x: np.ndarray, signs: tuple[float, ...]) -> np.ndarray:
-        """A start for Newton: the platform placed on x, each leg's nearest sample of its sign."""
+    def _seed(self, x: np.ndarray, signs: tuple[float, ...]) -> np.ndarray | None:
+        """A start for Newton: the platform placed on x, then each leg in turn from its
+        nearest sample of its sign to its own target by a leg-local Newton; None if a leg
+        cannot reach its target in its mode."""
         q = self.q0.copy()
         if self.end_leg is None:
             self._place_platform(q, x)
@@ -120,15 +122,48 @@ class WorkspaceMechanism:
                 [i for i in range(len(self.legs)) if i != self.end_leg]
         for i in order:
             leg, (theta, tips, ends, sample_signs) = self.legs[i], self.seeds[i]
-            ok = sample_signs == signs[i]
             if i == self.end_leg:
-                gap = np.linalg.norm(ends[:, self.rows] - x, axis=1)
+                frame, rows, target, gap = self.end, self.rows, x, np.linalg.norm(ends[:, self.rows] - x, axis=1)
             else:
                 self._kinematics(q)
-                gap = np.linalg.norm(tips - self.data.oMf[leg.partner].translation, axis=1)
-            gap[~ok] = np.inf
+                target = self.data.oMf[leg.partner].translation.copy()
+                frame, rows, gap = leg.frame, np.arange(3), np.linalg.norm(tips - target, axis=1)
+            gap[sample_signs != signs[i]] = np.inf
             set_angles(self.model, q, leg.joints, theta[int(np.argmin(gap))])
+            if not self._leg_newton(q, leg, frame, rows, target, signs[i]):
+                return None
         return q
+
+    def _leg_newton(self, q: np.ndarray, leg: Leg, frame: int, rows: np.ndarray, target: np.ndarray,
+                    sign: float) -> bool:
+        """Move the leg's joints in q (in place) until `frame`'s coordinates `rows` reach
+        target [m], keeping the leg's mode sign: Gauss-Newton (a planar leg's third row is
+        identically met) with a line search; False if it does not get there."""
+        def error(qq: np.ndarray) -> tuple[np.ndarray, bool]:
+            self._kinematics(qq)
+            kept = np.sign(mode_sign(self.mechanism, self.data, leg)) == sign
+            return (self.data.oMf[frame].translation[rows] - target) / self.length, kept
+
+        e, kept = error(q)
+        history = [float(np.linalg.norm(e))]
+        for _ in range(_ITERATIONS):
+            if not kept or (len(history) > _STALL and history[-1] > 0.5 * history[-1 - _STALL]):
+                return False
+            if history[-1] < TOL:
+                return True
+            jac = pin.getFrameJacobian(self.model, self.data, frame, _LWA)[:3][rows][:, leg.cols] / self.length
+            step = np.zeros(self.model.nv)
+            step[leg.cols] = np.linalg.lstsq(jac, -e, rcond=None)[0]
+            for alpha in 0.5 ** np.arange(12):
+                trial = pin.integrate(self.model, q, alpha * step)
+                e2, kept = error(trial)
+                if kept and np.linalg.norm(e2) < history[-1]:
+                    break
+            else:
+                return False
+            q[:], e = trial, e2
+            history.append(float(np.linalg.norm(e)))
+        return False
 
     def _place_platform(self, q: np.ndarray, x: np.ndarray) -> None:
         cols = np.array([self.model.joints[j].idx_v for j in self.platform])
@@ -169,6 +204,8 @@ class WorkspaceMechanism:
         """q reaching end point coordinates x [m] in working mode `mode`, or None."""
         signs = tuple(1.0 if s == "+" else -1.0 for s in mode)
         q = self._seed(x, signs)
+        if q is None:
+            return None
         F, dF, kept = self._residual(q, x, signs)
         if not kept:
             return None
