@@ -109,6 +109,14 @@ def mode_sign(mechanism, data: pin.Data, leg: Leg) -> float:
     return float(m @ n) / norm if norm > 0 else 0.0
 
 
+def passive_conditioning(mechanism, data: pin.Data, leg: Leg) -> float:
+    """sigma_min / sigma_max of the leg's passive columns (1 for a single column): near 0 the
+    passive joints' coordinates are singular themselves (a universal joint's bar along its
+    second hinge), where the mode sign means nothing."""
+    sigma = np.linalg.svd(_tip_rows(mechanism, data, leg)[:, 1:], compute_uv=False)
+    return float(sigma[-1] / sigma[0]) if sigma[0] > 0 else 0.0
+
+
 def _tip_rows(mechanism, data: pin.Data, leg: Leg) -> np.ndarray:
     """(rows, leg joints): the leg's tip motion (linear / loop size, angular) in the cut's rows."""
     c = mechanism.closures[leg.closure]

@@ -27,7 +27,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.design.workspace_file import WorkspaceSpec
-from pinmech.design.workspace_legs import Leg, angles, find_legs, mode_sign, set_angles
+from pinmech.design.workspace_legs import Leg, angles, find_legs, mode_sign, passive_conditioning, set_angles
 from pinmech.exceptions import WorkspaceError
 from pinmech.io.scene import Scene
 from pinmech.io.scene_model import load_mechanism, scene_drivers
@@ -39,6 +39,8 @@ _STALL = 20  # Newton gives up when |F| has not halved over this many steps (a l
 _SAMPLES_FULL = 20  # seed poses over a full turn (18 deg apart): the motor and the first passive joint
 _SAMPLES_HALF = 9  # a further hinge (a universal joint's second), reference +- 90 deg: the bar directions
 # (a, b) and (a + pi, pi - b) of a universal joint are one pose, so half a turn of b covers them once
+_SEED_CONDITIONING = 0.2  # seeds this far from a leg's fold (|m . n| / |m|) and from a gimbal lock of its
+# passive joints (their columns' sigma_min / sigma_max): a seed on either has no meaningful mode
 
 
 @dataclass(frozen=True)
@@ -101,7 +103,10 @@ class WorkspaceMechanism:
             set_angles(self.model, q, leg.joints, t)
             self._kinematics(q)
             tips[s], ends[s] = self.data.oMf[leg.frame].translation, self.data.oMf[self.end].translation
-            signs[s] = np.sign(mode_sign(self.mechanism, self.data, leg))
+            sign = mode_sign(self.mechanism, self.data, leg)
+            conditioning = passive_conditioning(self.mechanism, self.data, leg)
+            usable = abs(sign) > _SEED_CONDITIONING and conditioning > _SEED_CONDITIONING
+            signs[s] = np.sign(sign) if usable else 0.0
         return theta, tips, ends, signs
 
     def _samples(self, jid: int, full: bool) -> np.ndarray:
