@@ -43,7 +43,7 @@ def workspace_figure(result: WorkspaceResult, path: str | Path) -> Path:
             ax.plot(pts[:, 0], pts[:, 1], ".", color=colour, markersize=2.5, label=name)
         m = result.measures[mode]
         scale = u ** len(result.coords)
-        ax.set_title(f"mode {mode}{label}: {result.kind} {m.value / scale:.4g} +- {m.bound / scale:.2g} "
+        ax.set_title(f"mode {mode}{label}: {result.kind} {_number(m.value / scale)} +- {_number(m.bound / scale)} "
                      f"{unit}^{len(result.coords)}", fontsize=8)
         ax.set_aspect("equal")
         ax.set_xlabel(f"x [{unit}]")
@@ -56,6 +56,11 @@ def workspace_figure(result: WorkspaceResult, path: str | Path) -> Path:
     return Path(path)
 
 
+def _number(x: float) -> str:
+    """A measure for a title: whole above 100 (35775), else 3 significant digits."""
+    return f"{x:.0f}" if abs(x) >= 100 else f"{x:.3g}"
+
+
 def _planes(result: WorkspaceResult) -> list[tuple[str, tuple, object]]:
     """(title suffix, grid index, locus filter) of each panel: the plane, or z slices."""
     if len(result.coords) == 2:
@@ -64,7 +69,7 @@ def _planes(result: WorkspaceResult) -> list[tuple[str, tuple, object]]:
     reached = result.reached.any(axis=(0, 1, 3))
     levels = np.flatnonzero(reached)
     picks = np.unique(levels[np.linspace(0, len(levels) - 1, min(_SLICES, len(levels))).round().astype(int)])
-    half = (z[1] - z[0]) / 2
+    tiny = 1e-9 * (z[-1] - z[0])
     u, unit = result.spec.unit_si, result.spec.unit
     return [(f", z = {z[i] / u:.4g} {unit}", (slice(None), slice(None), i),
-             lambda pts, zi=z[i]: np.abs(pts[:, 2] - zi) <= half + 1e-12) for i in picks]
+             lambda pts, zi=z[i]: np.abs(pts[:, 2] - zi) <= tiny) for i in picks]  # the slice's own edges

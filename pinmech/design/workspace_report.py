@@ -51,16 +51,23 @@ def text(result: WorkspaceResult) -> str:
     lines = [f"{s['title']} (workspace of '{s['point']}', motors {', '.join(s['motors'])})",
              f"grid {grid} {s['unit']}; characteristic length L = {s['characteristic_length']:.6g} {s['unit']} "
              f"(kappa of the Jacobian over L); loci within {s['locus_bound']:.3g} {s['unit']}",
-             f"{'mode':<8}{s['measure'] + ' [' + s['measure_unit'] + ']':>22}{'assembly +':>20}{'assembly -':>20}"
+             f"{'mode':<8}{s['measure'] + ' [' + s['measure_unit'] + ']':>26}{'assembly +':>26}{'assembly -':>26}"
              f"{'kappa min':>11}{'median':>9}"]
     for mode, e in s["working_modes"].items():
-        parts = [f"{e[s['measure']]:.5g} +- {e['bound']:.2g}"] + [
-            f"{a[s['measure']]:.5g} +- {a['bound']:.2g}" for a in e["assembly_modes"].values()]
+        parts = [_pm(e[s["measure"]], e["bound"])] + [_pm(a[s["measure"]], a["bound"])
+                                                     for a in e["assembly_modes"].values()]
         kappa = "".join(f"{v:>11.4g}" if v is not None else f"{'-':>11}" for v in (e["kappa_least"],)) + (
             f"{e['kappa_median']:>9.4g}" if e["kappa_median"] is not None else f"{'-':>9}")
-        lines.append(f"{mode:<8}{parts[0]:>22}{parts[1]:>20}{parts[2]:>20}{kappa}"
+        lines.append(f"{mode:<8}{parts[0]:>26}{parts[1]:>26}{parts[2]:>26}{kappa}"
                      + ("  (reaches the grid's edge: the workspace may go on beyond it)" if e["reaches_grid_edge"] else ""))
     return "\n".join(lines)
+
+
+def _pm(value: float, bound: float) -> str:
+    """"35775 +- 9900": whole numbers above 100, else 4 significant digits."""
+    if abs(value) >= 100:
+        return f"{value:.0f} +- {bound:.0f}"
+    return f"{value:.4g} +- {bound:.2g}"
 
 
 def table(result: WorkspaceResult) -> dict[str, list]:

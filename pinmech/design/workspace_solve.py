@@ -35,6 +35,7 @@ from pinmech.io.scene_model import load_mechanism, scene_drivers
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 TOL = 1e-10  # Newton's convergence on the dimensionless residual (closure rows / loop size, end rows / L)
 _ITERATIONS = 60
+_HALVINGS = 9  # line-search steps 1 .. 1/256 of Newton's
 _STALL = 20  # Newton gives up when |F| has not halved over this many steps (a leg near its fold takes ~15)
 _SAMPLES_FULL = 20  # seed poses over a full turn (18 deg apart): the motor and the first passive joint
 _SAMPLES_HALF = 9  # a further hinge (a universal joint's second), reference +- 90 deg: the bar directions
@@ -159,7 +160,7 @@ class WorkspaceMechanism:
             jac = pin.getFrameJacobian(self.model, self.data, frame, _LWA)[:3][rows][:, leg.cols] / self.length
             step = np.zeros(self.model.nv)
             step[leg.cols] = np.linalg.lstsq(jac, -e, rcond=None)[0]
-            for alpha in 0.5 ** np.arange(12):
+            for alpha in 0.5 ** np.arange(_HALVINGS):
                 trial = pin.integrate(self.model, q, alpha * step)
                 e2, kept = error(trial)
                 if kept and np.linalg.norm(e2) < history[-1]:
@@ -168,6 +169,8 @@ class WorkspaceMechanism:
                 return False
             q[:], e = trial, e2
             history.append(float(np.linalg.norm(e)))
+            if alpha == 1.0 and history[-1] > 0.99 * history[-2]:
+                return False  # a full step that no longer gains: the nearest the leg gets, short of the target
         return False
 
     def _place_platform(self, q: np.ndarray, x: np.ndarray) -> None:
@@ -224,7 +227,7 @@ class WorkspaceMechanism:
                 step = np.linalg.solve(dF, -F)
             except np.linalg.LinAlgError:
                 step = np.linalg.lstsq(dF, -F, rcond=None)[0]
-            for alpha in 0.5 ** np.arange(12):
+            for alpha in 0.5 ** np.arange(_HALVINGS):
                 trial = pin.integrate(self.model, q, alpha * step)
                 F2, dF2, kept = self._residual(trial, x, signs)
                 if kept and np.linalg.norm(F2) < np.linalg.norm(F):  # Newton's step descends |F|^2
