@@ -333,12 +333,3 @@ class MissingTool(PinmechError):
         self.tool = tool
         self.option = option
 
-
-class WorkspaceError(PinmechError):
-    """A workspace study cannot be made: the mechanism is not parallel, or no grid point is reachable."""
-
-    exit_code = 2
-
-    def __init__(self, message: str, *, path: str | None = None):
-        super().__init__(f"{path}: {message}" if path else message)
-        self.path = path

@@ -23,7 +23,7 @@ import pinmech
 from pinmech.cli import main
 from pinmech.design.workspace_batch import built
 from pinmech.design.workspace_file import WorkspaceSpec, load_workspace
-from pinmech.exceptions import FrameNotFound, SceneError, WorkspaceError
+from pinmech.exceptions import FrameNotFound, SceneError
 
 SCENES = Path(__file__).resolve().parents[1] / "models" / "scenes"
 
@@ -336,9 +336,9 @@ def test_cli_writes_the_table_summary_and_map(tmp_path, capsys):
 def test_a_mechanism_that_is_not_parallel_is_refused(tmp_path, capsys):
     body = '[workspace]\npoint = "P"\nx = { from = "0 mm", to = "1 mm", count = 2 }\ny = { from = "0 mm", to = "1 mm", count = 2 }\n'
     path = _study_file(tmp_path, "four_bar.toml", body)
-    with pytest.raises(WorkspaceError, match="parallel mechanism of 2 or 3 motors.*driven by 1"):
+    with pytest.raises(SceneError, match="scene: a workspace study needs a parallel mechanism of 2 or 3 motors.*driven by 1"):
         pinmech.study(path)
-    assert main(["study", str(path), "--workers", "0"]) == WorkspaceError.exit_code
+    assert main(["study", str(path), "--workers", "0"]) == SceneError.exit_code
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and str(path) in err[0]
 
@@ -346,7 +346,7 @@ def test_a_mechanism_that_is_not_parallel_is_refused(tmp_path, capsys):
 def test_a_grid_that_reaches_no_point_is_refused(tmp_path):
     path = _five_bar(tmp_path, '{ from = "300 mm", to = "400 mm", count = 3 }', '{ from = "0 mm", to = "100 mm", count = 3 }',
                      'modes = ["+-"]')
-    with pytest.raises(WorkspaceError, match=r"no grid point is reachable.*x 300 to 400 mm"):
+    with pytest.raises(SceneError, match=r"workspace: no grid point is reachable.*x 300 to 400 mm"):
         pinmech.study(path)
 
 
@@ -365,7 +365,7 @@ def test_modes_of_the_wrong_length_and_axes_of_the_wrong_number_are_named(tmp_pa
         pinmech.study(path)
     body = ('[workspace]\npoint = "closedloop1_A"\nx = { from = "0 mm", to = "1 mm", count = 2 }\n'
             'y = { from = "0 mm", to = "1 mm", count = 2 }\nz = { from = "0 mm", to = "1 mm", count = 2 }\n')
-    with pytest.raises(WorkspaceError, match="2 motors need 2 grid axes"):
+    with pytest.raises(SceneError, match="workspace: 2 motors need 2 grid axes"):
         pinmech.study(_study_file(tmp_path, "five_bar.toml", body))
 
 

@@ -85,8 +85,8 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
     Raises:
         SceneError, FrameNotFound: a bad study file; the scene's and model's errors; the
         nominal's own (a LoopClosureError where the nominal does not assemble, a
-        SweepError where its cycle fails); WorkspaceError: a workspace study of a mechanism
-        that is not parallel, or of a grid reaching no point. ImportError naming `pinmech[study]` without Dask.
+        SweepError where its cycle fails); for a workspace study, a mechanism that is not
+        parallel or a grid reaching no point is a SceneError. ImportError naming `pinmech[study]` without Dask.
     """
     spec = path if isinstance(path, (StudySpec, WorkspaceSpec)) else _load(Path(path))
     if spec.kind == "workspace":

@@ -22,7 +22,7 @@ from pinmech.design.tolerance import batches
 from pinmech.design.workspace_batch import FIELDS, WorkspaceBatch, built
 from pinmech.design.workspace_file import WorkspaceSpec
 from pinmech.design.workspace_maps import Measure, boundary_edges, distances, measure, sign_change_edges
-from pinmech.exceptions import WorkspaceError
+from pinmech.exceptions import SceneError
 
 
 @dataclass(frozen=True)
@@ -75,8 +75,9 @@ def run_workspace(spec: WorkspaceSpec, *, workers: int = 0, scheduler: str | Non
     """Solve the study's grid (here, or on Dask) and read its maps.
 
     Raises:
-        WorkspaceError: the mechanism is not parallel, or no grid point is reached in any mode.
-        SceneError, FrameNotFound: the study file's or the scene's mistakes (an unknown point).
+        SceneError: the study file's or the scene's mistakes, a mechanism that is not parallel
+            (key "scene"), a grid where no point is reached in any mode (key "workspace");
+            FrameNotFound: an unknown end point.
     """
     wm = built(spec)  # here first: the file's and the mechanism's errors before any worker starts
     todo = batches(spec.size, spec.batch)
@@ -88,8 +89,8 @@ def run_workspace(spec: WorkspaceSpec, *, workers: int = 0, scheduler: str | Non
     if not reached.any():
         span = ", ".join(f"{a.name} {a.start / spec.unit_si:g} to {a.stop / spec.unit_si:g} {spec.unit}"
                          for a in spec.axes)
-        raise WorkspaceError(f"no grid point is reachable in working modes {', '.join(modes)}: the grid "
-                             f"({span}) misses the workspace of '{spec.point}'", path=str(spec.path))
+        raise SceneError(f"no grid point is reachable in working modes {', '.join(modes)}: the grid "
+                         f"({span}) misses the workspace of '{spec.point}'", path=str(spec.path), key="workspace")
     values = {f: np.concatenate([b.values[f] for b in results]).reshape(*shape, len(modes)) for f in FIELDS}
     motor_q = np.concatenate([b.motors for b in results]).reshape(*shape, len(modes), len(wm.legs))
     coords = [np.asarray(a.values) for a in spec.axes]

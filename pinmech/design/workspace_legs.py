@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from pinmech.exceptions import WorkspaceError
+from pinmech.exceptions import SceneError
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -46,20 +46,25 @@ class Leg:
     elbow: int
 
 
+def _refused(message: str, path: str) -> SceneError:
+    """The study file's scene is not a parallel mechanism a workspace study can map."""
+    return SceneError(message, path=path, key="scene")
+
+
 def find_legs(mechanism, motors: tuple[str, ...], where: str) -> tuple[Leg, ...]:
-    """The legs of `motors`, or a WorkspaceError saying why the mechanism is not parallel."""
+    """The legs of `motors`, or a SceneError (key "scene") saying why the mechanism is not parallel."""
     model = mechanism.model
     if len(motors) < 2:
-        raise WorkspaceError(f"a workspace study needs a parallel mechanism of 2 or 3 motors, one a leg; "
+        raise _refused(f"a workspace study needs a parallel mechanism of 2 or 3 motors, one a leg; "
                              f"{mechanism.source} is driven by {len(motors)} ({', '.join(motors) or 'none'})",
                              path=where)
     offsets = np.cumsum([0] + [c.rows for c in mechanism.closures])
     legs = tuple(_leg(mechanism, name, offsets, where) for name in motors)
     owned = [j for leg in legs for j in leg.joints]
     if len(owned) != len(set(owned)):
-        raise WorkspaceError("the motors' legs share joints: not a parallel mechanism of one motor a leg", path=where)
+        raise _refused("the motors' legs share joints: not a parallel mechanism of one motor a leg", path=where)
     if any(model.joints[j].nv != 1 for j in owned):
-        raise WorkspaceError("a leg has a joint of several freedoms: give one-freedom joints", path=where)
+        raise _refused("a leg has a joint of several freedoms: give one-freedom joints", path=where)
     return legs
 
 
@@ -67,7 +72,7 @@ def _leg(mechanism, motor: str, offsets: np.ndarray, where: str) -> Leg:
     model = mechanism.model
     jid = model.getJointId(motor)
     if model.parents[jid] != 0:
-        raise WorkspaceError(f"motor '{motor}' does not hang from the base (its parent joint is "
+        raise _refused(f"motor '{motor}' does not hang from the base (its parent joint is "
                              f"'{model.names[model.parents[jid]]}'): not a leg of a parallel mechanism", path=where)
     joints = [jid] + [j for j in range(jid + 1, model.njoints) if _below(model, j, jid)]
     cuts = []
@@ -77,7 +82,7 @@ def _leg(mechanism, motor: str, offsets: np.ndarray, where: str) -> Leg:
                 cuts.append((k, frame, partner))
     rows = np.concatenate([np.arange(offsets[k], offsets[k + 1]) for k, *_ in cuts]) if cuts else np.zeros(0, int)
     if len(cuts) != 1 or len(rows) != len(joints):
-        raise WorkspaceError(f"motor '{motor}''s leg ({len(joints)} joints) meets {len(cuts)} loop cuts with "
+        raise _refused(f"motor '{motor}''s leg ({len(joints)} joints) meets {len(cuts)} loop cuts with "
                              f"{len(rows)} rows: a workspace study needs one cut a leg, as many rows as joints",
                              path=where)
     k, frame, partner = cuts[0]

@@ -28,7 +28,7 @@ import pinocchio as pin
 
 from pinmech.design.workspace_file import WorkspaceSpec
 from pinmech.design.workspace_legs import Leg, angles, find_legs, mode_sign, passive_conditioning, set_angles
-from pinmech.exceptions import WorkspaceError
+from pinmech.exceptions import SceneError
 from pinmech.io.scene import Scene
 from pinmech.io.scene_model import load_mechanism, scene_drivers
 
@@ -70,9 +70,9 @@ class WorkspaceMechanism:
         self.motors = tuple(scene_drivers(scene, m).names)
         self.legs = find_legs(m, self.motors, where)
         if len(spec.axes) != len(self.legs):
-            raise WorkspaceError(f"{len(self.legs)} motors need {len(self.legs)} grid axes "
-                                 f"({'x, y' if len(self.legs) == 2 else 'x, y, z'}); the file gives "
-                                 f"{len(spec.axes)}", path=where)
+            raise SceneError(f"{len(self.legs)} motors need {len(self.legs)} grid axes "
+                             f"({'x, y' if len(self.legs) == 2 else 'x, y, z'}); the file gives {len(spec.axes)}",
+                             path=where, key="workspace")
         self.end = m.frame_id(spec.point)
         self.rows = np.array([a.param for a in spec.axes])
         self.length = spec.length or m.length_scale
@@ -87,8 +87,8 @@ class WorkspaceMechanism:
         self.prismatic_motor = np.array([self.model.joints[leg.joints[0]].shortname().startswith("JointModelP")
                                          for leg in self.legs])
         if self.end_leg is None and len(self.platform) != len(spec.axes):
-            raise WorkspaceError(f"the end point '{spec.point}' is on neither a motor's leg nor a platform of "
-                                 f"{len(spec.axes)} joints", path=where)
+            raise SceneError(f"the end point '{spec.point}' is on neither a motor's leg nor a platform of "
+                             f"{len(spec.axes)} joints", path=where, key="workspace.point")
         self.seeds = [self._seed_table(leg) for leg in self.legs]
         self.modes = resolve_modes(spec, len(self.legs))
 
@@ -267,8 +267,6 @@ def resolve_modes(spec: WorkspaceSpec, legs: int) -> tuple[str, ...]:
         return tuple("".join(s) for s in product("+-", repeat=legs))
     bad = [m for m in spec.modes if len(m) != legs]
     if bad:
-        from pinmech.exceptions import SceneError
-
         raise SceneError(f"working mode {bad[0]!r} has {len(bad[0])} signs; the mechanism has {legs} legs "
                          f"(one sign a leg, in the motors' order)", path=str(spec.path), key="workspace.modes")
     return spec.modes
