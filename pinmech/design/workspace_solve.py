@@ -169,8 +169,8 @@ class WorkspaceMechanism:
                 return False
             q[:], e = trial, e2
             history.append(float(np.linalg.norm(e)))
-            if alpha == 1.0 and history[-1] > 0.99 * history[-2]:
-                return False  # a full step that no longer gains: the nearest the leg gets, short of the target
+            if np.max(np.abs(step)) < 1e-4 and history[-1] > 0.99 * history[-2]:
+                return False  # steps of < 1e-4 rad that no longer gain: the nearest the leg gets, short of it
         return False
 
     def _place_platform(self, q: np.ndarray, x: np.ndarray) -> None:
