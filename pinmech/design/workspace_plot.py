@@ -22,7 +22,7 @@ def workspace_figure(result: WorkspaceResult, path: str | Path) -> Path:
 
     planes = _planes(result)
     modes = result.modes
-    panels = [(k, plane) for k in range(len(modes)) for plane in planes]
+    panels = [(k, plane, col) for k in range(len(modes)) for col, plane in enumerate(planes)]
     ncols = len(planes) if len(planes) > 1 else min(2, len(modes))
     nrows = -(-len(panels) // ncols)
     fig, axs = plt.subplots(nrows, ncols, figsize=(3.8 * ncols + 1.4, 3.6 * nrows + 0.6), squeeze=False,
@@ -33,7 +33,7 @@ def workspace_figure(result: WorkspaceResult, path: str | Path) -> Path:
     norm = LogNorm(vmin=max(1.0, float(finite.min())), vmax=max(2.0, float(np.percentile(finite, 98))))
     u, unit = result.spec.unit_si, result.spec.unit
     image = None
-    for ax, (k, (label, index, near)) in zip(axs.flat, panels):
+    for ax, (k, (label, index, near), col) in zip(axs.flat, panels):
         mode = modes[k]
         kappa = np.where(result.reached[..., k], result.values["kappa"][..., k], np.nan)[index]
         x, y = result.coords[0] / u, result.coords[1] / u
@@ -43,8 +43,9 @@ def workspace_figure(result: WorkspaceResult, path: str | Path) -> Path:
             ax.plot(pts[:, 0], pts[:, 1], ".", color=colour, markersize=2.5, label=name)
         m = result.measures[mode]
         scale = u ** len(result.coords)
-        ax.set_title(f"mode {mode}{label}: {result.kind} {_number(m.value / scale)} +- {_number(m.bound / scale)} "
-                     f"{unit}^{len(result.coords)}", fontsize=8)
+        measure = (f"\n{result.kind} {_number(m.value / scale)} +- {_number(m.bound / scale)} {unit}^{len(result.coords)}"
+                   if col == 0 else "")
+        ax.set_title(f"mode {mode}{label}{measure}", fontsize=8)
         ax.set_aspect("equal")
         ax.set_xlabel(f"x [{unit}]")
         ax.set_ylabel(f"y [{unit}]")
