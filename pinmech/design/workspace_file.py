@@ -106,7 +106,8 @@ def _axis(name: str, entry: Any, where: _Where) -> GridAxis:
     where.known(entry, _AXIS_KEYS, key)
     missing = sorted(_AXIS_KEYS - set(entry))
     if missing:
-        raise where.error(key, f"missing {', '.join(missing)}: give {{ from = \"-100 mm\", to = \"100 mm\", count = 51 }}")
+        example = '{ from = "-100 mm", to = "100 mm", count = 51 }'
+        raise where.error(key, f"missing {', '.join(missing)}: give {example}")
     count = entry["count"]
     if isinstance(count, bool) or not isinstance(count, int) or not 2 <= count <= 10_000:
         raise where.error(f"{key}.count", f"count = {count!r} must be a whole number from 2 to 10000")

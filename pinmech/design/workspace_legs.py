@@ -21,6 +21,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import SceneError
+from pinmech.model.mechanism import Mechanism
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -51,7 +52,7 @@ def _refused(message: str, path: str) -> SceneError:
     return SceneError(message, path=path, key="scene")
 
 
-def find_legs(mechanism, motors: tuple[str, ...], where: str) -> tuple[Leg, ...]:
+def find_legs(mechanism: Mechanism, motors: tuple[str, ...], where: str) -> tuple[Leg, ...]:
     """The legs of `motors`, or a SceneError (key "scene") saying why the mechanism is not parallel."""
     model = mechanism.model
     if len(motors) < 2:
@@ -68,7 +69,7 @@ def find_legs(mechanism, motors: tuple[str, ...], where: str) -> tuple[Leg, ...]
     return legs
 
 
-def _leg(mechanism, motor: str, offsets: np.ndarray, where: str) -> Leg:
+def _leg(mechanism: Mechanism, motor: str, offsets: np.ndarray, where: str) -> Leg:
     model = mechanism.model
     jid = model.getJointId(motor)
     if model.parents[jid] != 0:
@@ -98,7 +99,7 @@ def _below(model: pin.Model, j: int, ancestor: int) -> bool:
     return False
 
 
-def mode_sign(mechanism, data: pin.Data, leg: Leg) -> float:
+def mode_sign(mechanism: Mechanism, data: pin.Data, leg: Leg) -> float:
     """m . n of the leg at the pose in `data` (joint Jacobians and frames placed): its sign
     is the working mode, 0 a type I singularity of the leg. The leg's block is its tip's own
     motion (not the cut's relative motion, which mixes in the other side's while the loop is
@@ -114,7 +115,7 @@ def mode_sign(mechanism, data: pin.Data, leg: Leg) -> float:
     return float(m @ n) / norm if norm > 0 else 0.0
 
 
-def passive_conditioning(mechanism, data: pin.Data, leg: Leg) -> float:
+def passive_conditioning(mechanism: Mechanism, data: pin.Data, leg: Leg) -> float:
     """sigma_min / sigma_max of the leg's passive columns (1 for a single column): near 0 the
     passive joints' coordinates are singular themselves (a universal joint's bar along its
     second hinge), where the mode sign means nothing."""
@@ -122,7 +123,7 @@ def passive_conditioning(mechanism, data: pin.Data, leg: Leg) -> float:
     return float(sigma[-1] / sigma[0]) if sigma[0] > 0 else 0.0
 
 
-def _tip_rows(mechanism, data: pin.Data, leg: Leg) -> np.ndarray:
+def _tip_rows(mechanism: Mechanism, data: pin.Data, leg: Leg) -> np.ndarray:
     """(rows, leg joints): the leg's tip motion (linear / loop size, angular) in the cut's rows."""
     c = mechanism.closures[leg.closure]
     jac = pin.getFrameJacobian(mechanism.model, data, leg.frame, _LWA)[:, leg.cols]
@@ -130,7 +131,7 @@ def _tip_rows(mechanism, data: pin.Data, leg: Leg) -> np.ndarray:
     return c.basis @ c.selected @ np.vstack([R_T @ jac[:3] / c.length_scale, R_T @ jac[3:]])
 
 
-def _bar_rows(mechanism, data: pin.Data, leg: Leg) -> np.ndarray:
+def _bar_rows(mechanism: Mechanism, data: pin.Data, leg: Leg) -> np.ndarray:
     """The leg's last bar (first passive joint -> tip) as the cut's rows see a tip motion."""
     c = mechanism.closures[leg.closure]
     bar = data.oMf[leg.frame].translation - data.oMi[leg.elbow].translation

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.design.study_plot import _pyplot, _save
+from pinmech.design.study_plot import _pyplot
 from pinmech.design.workspace import WorkspaceResult
 
 _SLICES = 4
@@ -43,7 +43,8 @@ def workspace_figure(result: WorkspaceResult, path: str | Path) -> Path:
             ax.plot(pts[:, 0], pts[:, 1], ".", color=colour, markersize=2.5, label=name)
         m = result.measures[mode]
         scale = u ** len(result.coords)
-        measure = (f"\n{result.kind} {_number(m.value / scale)} +- {_number(m.bound / scale)} {unit}^{len(result.coords)}"
+        power = len(result.coords)
+        measure = (f"\n{result.kind} {_number(m.value / scale)} +- {_number(m.bound / scale)} {unit}^{power}"
                    if col == 0 else "")
         ax.set_title(f"mode {mode}{label}{measure}", fontsize=8)
         ax.set_aspect("equal")

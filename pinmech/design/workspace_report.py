@@ -58,8 +58,8 @@ def text(result: WorkspaceResult) -> str:
                                                      for a in e["assembly_modes"].values()]
         kappa = "".join(f"{v:>11.4g}" if v is not None else f"{'-':>11}" for v in (e["kappa_least"],)) + (
             f"{e['kappa_median']:>9.4g}" if e["kappa_median"] is not None else f"{'-':>9}")
-        lines.append(f"{mode:<8}{parts[0]:>26}{parts[1]:>26}{parts[2]:>26}{kappa}"
-                     + ("  (reaches the grid's edge: the workspace may go on beyond it)" if e["reaches_grid_edge"] else ""))
+        edge = "  (reaches the grid's edge: the workspace may go on beyond it)" if e["reaches_grid_edge"] else ""
+        lines.append(f"{mode:<8}{parts[0]:>26}{parts[1]:>26}{parts[2]:>26}{kappa}{edge}")
     return "\n".join(lines)
 
 
