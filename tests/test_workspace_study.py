@@ -227,6 +227,29 @@ def test_five_bar_kappa_is_that_of_the_closed_form_jacobian(tmp_path):
         np.testing.assert_allclose(wm.solve(p, mode).kappa, expected, rtol=1e-6)
 
 
+def test_five_bar_determinants_are_the_closed_form_sines(tmp_path):
+    """det K (type I) goes as sin(elbow 1) sin(elbow 2), each leg's det being l1 l2 sin(elbow);
+    det Phi_p (type II) as the sine between the distal links, cross(P - B1, P - B2). The rows'
+    scales are constant, so ratios between points equal the closed forms' ratios (to 1e-8:
+    Newton's residual of 1e-10 moves the sines by about that)."""
+    wm = built(load_workspace(_five_bar(tmp_path, '{ from = "0 mm", to = "1 mm", count = 2 }',
+                                        '{ from = "0 mm", to = "1 mm", count = 2 }')))
+
+    def sines(p: np.ndarray, mode: str) -> tuple[float, float]:
+        b = [elbow(p, i, 1.0 if s == "+" else -1.0) for i, s in enumerate(mode)]
+        elbows = [cross2(b[i] - A[i], p - b[i]) / (L1 * L2) for i in range(2)]
+        return elbows[0] * elbows[1], collinearity(p, mode)
+    reference = np.array([0.05, 0.09])
+    for mode in ("+-", "++", "--"):
+        s0 = wm.solve(reference, mode)
+        k0, c0 = sines(reference, mode)
+        for p in (np.array([0.02, -0.07]), np.array([0.11, 0.05]), np.array([-0.02, 0.08]), np.array([0.1, 0.0305])):
+            s = wm.solve(p, mode)
+            k, c = sines(p, mode)
+            np.testing.assert_allclose(s.det1 / s0.det1, k / k0, rtol=1e-8, err_msg=mode)
+            np.testing.assert_allclose(s.det2 / s0.det2, c / c0, rtol=1e-8, err_msg=mode)
+
+
 # ------------------------------------------------------------------ Delta: Clavel's closed form
 def delta_roots(p: np.ndarray, leg: int) -> list[tuple[float, float]] | None:
     """Arm i's angles a (from the base plane, positive downwards) whose forearm reaches the
