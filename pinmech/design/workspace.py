@@ -72,7 +72,8 @@ class WorkspaceResult:
 
 def run_workspace(spec: WorkspaceSpec, *, workers: int = 0, scheduler: str | None = None,
                   progress: Callable[[int, int], None] | None = None) -> WorkspaceResult:
-    """Solve the study's grid (here, or on Dask) and read its maps.
+    """Solve the study's grid (here, or on Dask) and read its maps; `progress` is called with
+    (grid points done, grid points) as each batch finishes.
 
     Raises:
         SceneError: the study file's or the scene's mistakes, a mechanism that is not parallel
@@ -81,8 +82,14 @@ def run_workspace(spec: WorkspaceSpec, *, workers: int = 0, scheduler: str | Non
     """
     wm = built(spec)  # here first: the file's and the mechanism's errors before any worker starts
     todo = batches(spec.size, spec.batch)
-    tick = (lambda done: progress(done, len(todo))) if progress else None
-    results: list[WorkspaceBatch] = run_batches(spec, todo, workers=workers, scheduler=scheduler, progress=tick)
+    done = [0]
+
+    def tick(batch) -> None:
+        done[0] += batch.count
+        progress(done[0], spec.size)
+
+    results: list[WorkspaceBatch] = run_batches(spec, todo, workers=workers, scheduler=scheduler,
+                                                progress=tick if progress else None)
     shape = tuple(a.count for a in spec.axes)
     modes = wm.modes
     reached = np.concatenate([b.reached for b in results]).reshape(*shape, len(modes))
