@@ -85,11 +85,10 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
 
     Raises:
         SceneError: a bad study file (FrameNotFound: a name the model lacks); the scene's
-            and model's errors.
+            and model's errors; for a workspace study, a mechanism that is not parallel
+            (key "scene") or a grid reaching no point (key "workspace").
         LoopClosureError: the nominal does not assemble.
         SweepError: the nominal's cycle fails.
-        For a workspace study, a mechanism that is not parallel or a grid reaching no point
-        is a SceneError (keys "scene", "workspace").
         ImportError: naming `pinmech[study]`, without Dask.
     """
     spec = path if isinstance(path, (StudySpec, WorkspaceSpec)) else _load(Path(path))
