@@ -10,19 +10,12 @@
 
 namespace pinmech {
 
-namespace {
-
-// Steps between two looks at Python's signal handlers in a long loop run without the GIL.
-constexpr long SIGNAL_EVERY = 4096;
-
 // Run Python's signal handlers (Ctrl-C, SIGTERM: pinmech's raise Interrupted) from a loop
 // that released the GIL, and leave the loop with the exception they raised.
 void check_signals() {
   nb::gil_scoped_acquire acquire;
   if (PyErr_CheckSignals() != 0) throw nb::python_error();
 }
-
-}  // namespace
 
 // ---------------------------------------------------------------- the corrector
 // LoopSolver.correct(strict=True): full Newton steps, each at least halving the

@@ -594,15 +594,7 @@ class LoopSolver:
         J_dep, J_drv = J[:, self._dep], J[:, self._drv]
         condition, sigma_min = _condition(J_dep * self._dep_scale)
         if condition > (self.max_condition if limit is None else limit):
-            raise SingularPoseError(
-                f"{self.mechanism.source}: the loop constraint Jacobian is singular at "
-                f"{self.describe_drivers(self._driver_values(q))} "
-                f"(condition number {condition:.3g} > {self.max_condition:.3g}, smallest singular "
-                f"value {sigma_min:.3g}): the dependent joints' rates are undefined",
-                condition=condition,
-                sigma_min=sigma_min,
-                partial=q,
-            )
+            raise self._singular_error(q, condition, sigma_min)
         v = np.zeros(self.model.nv)
         v[self._drv] = driver_v
         a = np.zeros(self.model.nv)
@@ -617,6 +609,17 @@ class LoopSolver:
         if condition <= self.max_condition and not math.isfinite(sum(v.tolist()) + sum(a.tolist())):
             raise self._overflow(q, driver_v, driver_a)  # a regular pose: the driver rates are too large
         return v, a, condition, sigma_min, _max_abs(J @ v), _max_abs(J @ a + drift), signs
+
+    def _singular_error(self, q: np.ndarray, condition: float, sigma_min: float) -> SingularPoseError:
+        """The error for a pose whose dependent-joint Jacobian is conditioned worse than
+        max_condition: the drivers' values, the condition number and the smallest
+        singular value."""
+        return SingularPoseError(
+            f"{self.mechanism.source}: the loop constraint Jacobian is singular at "
+            f"{self.describe_drivers(self._driver_values(q))} "
+            f"(condition number {condition:.3g} > {self.max_condition:.3g}, smallest singular "
+            f"value {sigma_min:.3g}): the dependent joints' rates are undefined",
+            condition=float(condition), sigma_min=float(sigma_min), partial=q)
 
     def _overflow(self, q: np.ndarray, driver_v, driver_a) -> RateOverflowError:
         return RateOverflowError(
