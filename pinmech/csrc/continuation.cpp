@@ -59,7 +59,7 @@ bool Core::correct(VectorXd& q, const VectorXd& drivers, int max_iterations, dou
 // ---------------------------------------------------------------- nodes and steps
 // Path.node at a closed q whose placements and Jacobians are in data_: the path
 // derivatives at driver velocity d, the condition number and the signature.
-void Core::node_at(Node& node, const VectorXd& d) {
+void Core::node_at(Node& node, const VectorXd& d, const VectorXd* a_drv) {
   // One factorization of the dimensionless J_dep (columns times dep_scale_) serves the
   // condition number and both solves; a dependent rate is dep_scale_ times its unknown.
   jacobian_into(false);
@@ -85,6 +85,10 @@ void Core::node_at(Node& node, const VectorXd& d) {
   for (size_t i = 0; i < dep_v_.size(); ++i) v(dep_v_[i]) = dep_scale_(Index(i)) * dstep_(Index(i));
   drift_into(node.q, v, drift_);
   rhs_ = -drift_;
+  if (a_drv != nullptr) {
+    for (size_t i = 0; i < drv_v_.size(); ++i) a(drv_v_[i]) = (*a_drv)(Index(i));
+    rhs_.noalias() -= J_ * a;  // driver columns only: a is zero elsewhere yet
+  }
   square_.solve(rhs_, dstep_);
   for (size_t i = 0; i < dep_v_.size(); ++i) a(dep_v_[i]) = dep_scale_(Index(i)) * dstep_(Index(i));
   rhs_.noalias() = J_ * v;

@@ -184,7 +184,8 @@ class Core {
 
   // ------------------------------------------------------------ continuation.cpp
   bool correct(VectorXd& q, const VectorXd& drivers, int max_iterations, double& residual_left);
-  void node_at(Node& node, const VectorXd& d);
+  // a_drv: the drivers' accelerations (zero where null: path derivatives)
+  void node_at(Node& node, const VectorXd& d, const VectorXd* a_drv = nullptr);
   int step(const Node& from, double p, const VectorXd& x0, const VectorXd& d, double unit, Node& out, bool& change);
   nb::tuple follow(double p0, const VectorXd& q0, const VectorXd& d1, const VectorXd& d2, const std::vector<int>& signs0,
                    double condition0, const VectorXd& x0, const VectorXd& d, double unit, const VectorXd& targets,
@@ -195,6 +196,8 @@ class Core {
   // LoopSolver.close and correct(strict=False): Newton steps kept where they lower the
   // residual, else a minimum-norm least-squares step halved until it does; the polish.
   bool close(VectorXd& q, const VectorXd& drivers, int max_iterations, bool polish_within, double& residual_left);
+  // LoopSolver._rates: v, a at a closed q from the drivers' v and a, with the accuracy.
+  nb::tuple rates_at(const VectorXd& q, const VectorXd& v_drv, const VectorXd& a_drv);
   nb::tuple close_py(VectorXd q, const VectorXd& drivers, int max_iterations, bool polish_within);
   // Path.follow from a node to p_target: regular steps, and where they shrink below
   // PIVOT_BELOW the curve with a dependent joint as parameter (folds, landing).

@@ -70,6 +70,7 @@ NB_MODULE(_core, m) {
       .def("close", &Core::close_py, nb::arg("q"), nb::arg("drivers"), nb::arg("max_iterations"),
            nb::arg("polish_within") = true)
       .def("follow_path", &Core::follow_path_py)
+      .def("rates_at", &Core::rates_at)
       .def("follow", &Core::follow)
       .def("node", &Core::node)
       .def("rates", &Core::rates)

@@ -95,6 +95,20 @@ nb::tuple Core::close_py(VectorXd q, const VectorXd& drivers, int max_iterations
   return nb::make_tuple(q, ok, residual, iterations_);
 }
 
+nb::tuple Core::rates_at(const VectorXd& q, const VectorXd& v_drv, const VectorXd& a_drv) {
+  check_structure();
+  if (q.size() != model_.nq || v_drv.size() != Index(drv_v_.size()) || a_drv.size() != v_drv.size())
+    throw std::invalid_argument("q or the drivers' rates of the wrong size");
+  if (Index(dep_v_.size()) != rows_) throw std::invalid_argument("the dependent Jacobian must be square");
+  Node out;
+  out.q = q;
+  residual_into(q, r_);
+  out.residual = std::max(max_abs(r_), full_residual());
+  node_at(out, v_drv, &a_drv);
+  return nb::make_tuple(out.d1, out.d2, out.signs, out.condition, out.sigma_min, out.velocity_residual,
+                        out.acceleration_residual, out.residual);
+}
+
 // ---------------------------------------------------------------- Path.follow
 void Core::follow_path(Node node, double p_target, PathSpec& path, PathResult& out) {
   const double unit = path.unit;

@@ -48,7 +48,8 @@ from pinmech.exceptions import (
 )
 from pinmech.solve.hermite import interpolate_poses
 from pinmech.solve.results import Accuracy, LoopSolution
-from pinmech.solve.batch import BatchSolution, BatchSolver, difference_many
+from pinmech.solve.batch import BatchSolution, BatchSolver
+from pinmech.solve.manifold import difference_many
 from pinmech.solve.loops import LoopSolver
 
 STARTS = ("predictor", "warm", "cold")

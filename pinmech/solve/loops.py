@@ -1,10 +1,12 @@
 """Close the loops: q, v and a of the dependent joints from the drivers.
 
-Position: Gauss-Newton on the closure residual from frame placements, with a
-backtracking safeguard. Velocity: the constraint Jacobian built from frame Jacobians,
+Position: Newton on the closure residual from frame placements, with a least-squares
+and backtracking safeguard. Velocity: the constraint Jacobian built from frame Jacobians,
 J_dep v_dep = -J_drv v_drv. Acceleration: the same Jacobian and the drift term from
-classical frame accelerations, J_dep a_dep = -J_drv a_drv - Jdot v.
-Nothing here knows which mechanism it solves.
+classical frame accelerations, J_dep a_dep = -J_drv a_drv - Jdot v. Each is computed by
+the compiled core (pinmech/csrc), on the user's own pin.Model; this is its Python face:
+assemblies, references, arguments and named errors. Nothing here knows which mechanism
+it solves.
 """
 
 from __future__ import annotations
@@ -22,9 +24,8 @@ import pinocchio as pin
 from pinmech.arguments import float_array, names, not_real
 from pinmech.solve.assembly_check import check_guessed_pose
 from pinmech.solve.branches import AssemblyStructure
-from pinmech.model.closures import CutEvaluator
 from pinmech.solve.continuation import Path, Route
-from pinmech.solve.core import core_for
+from pinmech.solve.core import _core, core_for
 from pinmech.exceptions import (
     AssemblyError,
     LoopClosureError,
@@ -38,11 +39,11 @@ from pinmech.model.mechanism import Mechanism
 from pinmech.solve.results import Accuracy, LoopSolution
 
 #: Default closure tolerance (dimensionless: metres per metre of mechanism, or radians).
-DEFAULT_TOL = 1e-13
+DEFAULT_TOL = _core.DEFAULT_TOL
 #: A closure residual below this (relative to the size) is rounding, not a loop out of reach.
 ROUNDING_LEVEL = 1e-14
 #: Largest Newton step of one joint [rad, or mechanism sizes for a prismatic joint].
-MAX_STEP = 1.0
+MAX_STEP = _core.MAX_NEWTON_STEP
 #: Default largest condition number accepted before a pose is called singular. Near a
 #: singularity accelerations lose accuracy like eps x condition^3 (tests/test_singular.py),
 #: so 1e4 keeps every acceleration pinmech gives to about 1e-3 relative or better.
@@ -50,7 +51,7 @@ DEFAULT_MAX_CONDITION = 1e4
 #: With the default tolerance or a tighter one, a pose that ends between this residual and
 #: the tolerance gets one more Newton step: it costs one kinematics pass and lands at
 #: rounding level, so results do not depend on how close the guess happened to be.
-POLISH = 1e-15
+POLISH = _core.POLISH
 #: The ranges of the solver's options, for the Python API as for a scene's [solver] table.
 SOLVER_RANGES = {"tol": (1e-16, 1e-3), "max_iterations": (1, 1000), "max_condition": (1.0, math.inf)}
 
@@ -156,46 +157,6 @@ def _max_abs(x: np.ndarray) -> float:
     return float(np.max(np.abs(x)))
 
 
-def _solve_square(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """A x = b for a small square A: closed forms up to 2x2 (a microsecond, where
-    np.linalg.solve costs three), LU above. NaN where A is exactly singular."""
-    n = A.shape[0]
-    if n == 1:
-        a = float(A[0, 0])
-        return np.array((float(b[0]) / a,)) if a != 0.0 else np.full(1, np.nan)
-    if n == 2:
-        (a, c), (d, e) = A.tolist()
-        f, g = b.tolist()
-        det = a * e - c * d
-        if det == 0.0:
-            return np.full(2, np.nan)
-        return np.array(((e * f - c * g) / det, (a * g - d * f) / det))
-    try:
-        return np.linalg.solve(A, b)
-    except np.linalg.LinAlgError:
-        return np.full(n, np.nan)
-
-
-def _condition(A: np.ndarray) -> tuple[float, float]:
-    """2-norm condition number and smallest singular value of a square A: closed forms up
-    to 2x2 (sigma_max = |(a+e, c-d)|/2 + |(a-e, c+d)|/2, a sum without cancellation, and
-    sigma_max sigma_min = |det A|), SVD above."""
-    n = A.shape[0]
-    if n == 0:
-        return 1.0, 1.0
-    if n == 1:
-        s = abs(float(A[0, 0]))
-        return (1.0 if s > 0 else math.inf), s
-    if n == 2:
-        (a, c), (d, e) = A.tolist()
-        s_max = 0.5 * (math.hypot(a + e, c - d) + math.hypot(a - e, c + d))
-        det = abs(a * e - c * d)
-        s_min = det / s_max if s_max > 0 else 0.0
-        return (s_max * s_max / det if det > 0 else math.inf), s_min
-    sigma = np.linalg.svd(A, compute_uv=False)
-    return (float(sigma[0] / sigma[-1]) if sigma[-1] > 0 else math.inf), float(sigma[-1])
-
-
 def _index(indices: np.ndarray) -> slice | np.ndarray:
     """A slice when the indices are contiguous (a view, cheaper than fancy indexing)."""
     if len(indices) and np.array_equal(indices, np.arange(indices[0], indices[-1] + 1)):
@@ -279,12 +240,15 @@ class LoopSolver:
         self._check_mobility()
         self._drv, self._dep = _index(self._drv_v), _index(self._dep_v)
         self._drv_q = [(mechanism.joint(n).idx_q, mechanism.joint(n).kind == "continuous") for n in self.drivers]
-        self._cuts = [CutEvaluator(c, self.model) for c in mechanism.closures]
-        self._step = np.zeros(self.model.nv)
+        self._cuts = list(mechanism.closures)  # the loops (their rows: the compiled core's)
+        for c in self._cuts:  # what the core's rows are built from stays as it is
+            c.__dict__["_in_use"] = True
+        self._ground = [c.parent_frame for c in mechanism.closures
+                        if self.model.frames[c.parent_frame].parentJoint == 0]
+        self._ground_at = [self.model.frames[f].placement.copy() for f in self._ground]
         self._dep_scale = mechanism.velocity_scale()[self._dep_v]  # dimensionless columns
         self._v_scale_inv = 1.0 / mechanism.velocity_scale()
         self.dep_is_scalar = [self._one_coordinate(int(v)) for v in self._dep_v]
-        self._zero_a = np.zeros(self.model.nv)
         self.structure = AssemblyStructure(self.model, mechanism.closures, self._dep_v, mechanism.plane_normal)
         self.reference: Reference | None = None
         self.iterations = 0  # Newton iterations of the last `correct`
@@ -322,9 +286,12 @@ class LoopSolver:
         """Read again the placements of ground cut frames, which the user may have moved in
         the model since the last call (the hot path folds them into its row matrices); the
         reference pose, closed for the old placement, is then closed again from itself."""
-        moved = [cut.refresh() for cut in self._cuts]
+        now = [self.model.frames[f].placement for f in self._ground]  # by index: frames may be added
+        moved = any(a != b for a, b in zip(now, self._ground_at))
+        if moved:
+            self._ground_at = [m.copy() for m in now]
         ref = self.reference
-        if any(moved) and ref is not None:
+        if moved and ref is not None:
             q, _, _ = self.close(ref.q, ref.driver_q)
             signs = self._rates(q, np.zeros(len(self.drivers)), np.zeros(len(self.drivers)))[-1]
             self.reference = Reference(ref.driver_q, q, signs, ref.keep)
@@ -370,36 +337,19 @@ class LoopSolver:
 
     # ------------------------------------------------------------------ pieces
     def _residual(self, q: np.ndarray) -> np.ndarray:
-        """Independent closure rows at q; leaves joint placements, Jacobians and the cut
-        frames' placements in self.data."""
-        pin.computeJointJacobians(self.model, self.data, q)
-        cuts = self._cuts
-        if len(cuts) == 1:
-            cuts[0].place(self.data)
-            return cuts[0].residual()
-        for cut in cuts:
-            cut.place(self.data)
-        return np.concatenate([c.residual() for c in cuts]) if cuts else np.zeros(0)
+        """Independent closure rows at q (dimensionless), from the compiled core."""
+        compiled = core_for(self)
+        return compiled.residual(q) if compiled is not None else np.zeros(0)
 
     def _full_residual(self) -> float:
-        return max((c.full_residual() for c in self._cuts), default=0.0)
+        """Largest error over every selected row at the q of the last `_residual`."""
+        compiled = core_for(self)
+        return compiled.full_residual() if compiled is not None else 0.0
 
-    def _stack(self, rows: list[np.ndarray]) -> np.ndarray:
-        if len(rows) == 1:
-            return rows[0]
-        return np.vstack(rows) if rows else np.zeros((0, self.model.nv))
-
-    def _jacobian(self) -> np.ndarray:
-        return self._stack([c.jacobian(self.data) for c in self._cuts])
-
-    def _residual_jacobian(self) -> np.ndarray:
-        return self._stack([c.newton_jacobian(self.data) for c in self._cuts])
-
-    def _drift(self) -> np.ndarray:
-        cuts = self._cuts
-        if len(cuts) == 1:
-            return cuts[0].drift(self.data)
-        return np.concatenate([c.drift(self.data) for c in cuts]) if cuts else np.zeros(0)
+    def _place(self, q: np.ndarray) -> None:
+        """self.data at q: joint placements, joint Jacobians and every frame placement."""
+        pin.computeJointJacobians(self.model, self.data, q)
+        pin.updateFramePlacements(self.model, self.data)
 
     def set_drivers(self, q: np.ndarray, driver_q: Sequence[float]) -> np.ndarray:
         """A copy of q with the drivers' coordinates written in."""
@@ -425,23 +375,13 @@ class LoopSolver:
                 residual that stops decreasing).
         """
         q = self.set_drivers(q_guess, driver_q)
-        r = self._residual(q)
-        norm = _max_abs(r)
-        iterations = 0
-        while norm > self._tol and iterations < self._max_iterations:
-            J_dep = self._residual_jacobian()[:, self._dep]
-            q, r, norm, ok = self._newton_update(q, J_dep, r, norm)
-            iterations += 1
-            if not ok:
-                break
-        if POLISH < norm <= self._tol <= DEFAULT_TOL and iterations < self._max_iterations:
-            J_dep = self._residual_jacobian()[:, self._dep]
-            q, r, norm, _ = self._newton_update(q, J_dep, r, norm)  # kept only if it helps
-            iterations += 1
-        full = self._full_residual()
-        if not is_closed(norm, full, self._tol):
-            self._raise_not_closed(q, max(norm, full), iterations, driver_q)
-        return q, iterations, max(norm, full)
+        compiled = core_for(self)
+        if compiled is None:  # an open chain: the drivers are the pose
+            return q, 0, 0.0
+        q, ok, residual, iterations = compiled.close(q, np.asarray(driver_q, dtype=float), self._max_iterations, True)
+        if not ok:
+            self._raise_not_closed(q, residual, iterations, driver_q)
+        return q, iterations, residual
 
     def correct(self, q_guess: np.ndarray, driver_q: np.ndarray, *, max_iterations: int,
                 strict: bool = True) -> tuple[np.ndarray, float | None]:
@@ -452,37 +392,18 @@ class LoopSolver:
         that does not contract is not close to one root); else as `close`, with the
         least-squares and backtracking safeguard."""
         q = self.set_drivers(q_guess, driver_q)
-        r = self._residual(q)
-        norm = _max_abs(r)
-        self.iterations, self.moved = 0, 0.0
-        for _ in range(max_iterations):
-            if norm <= self._tol:
-                break
-            J_dep = self._residual_jacobian()[:, self._dep]
-            self.iterations += 1
-            if strict:
-                step = _solve_square(J_dep, -r) if J_dep.shape[0] == J_dep.shape[1] else np.full(1, np.nan)
-                if not math.isfinite(sum(step.tolist())):
-                    return q, None
-                q_new = self._move(q, step)
-                r_new = self._residual(q_new)
-                new_norm = _max_abs(r_new)
-                if new_norm > 0.5 * norm and new_norm > self._tol:
-                    self._residual(q)
-                    return q, None
-                q, r, norm = q_new, r_new, new_norm
-            else:
-                q, r, norm, ok = self._newton_update(q, J_dep, r, norm)
-                if not ok:
-                    return q, None
-        if POLISH < norm <= self._tol <= DEFAULT_TOL:
-            J_dep = self._residual_jacobian()[:, self._dep]
-            q, r, norm, _ = self._newton_update(q, J_dep, r, norm)
-            self.iterations += 1
-        full = self._full_residual()
-        if not is_closed(norm, full, self._tol):
-            return q, None
-        return q, max(norm, full)
+        compiled = core_for(self)
+        if compiled is None:
+            self.iterations, self.moved = 0, 0.0
+            return q, 0.0
+        x = np.asarray(driver_q, dtype=float)
+        if strict:
+            q, residual = compiled.correct(q, x, max_iterations)
+        else:
+            q, ok, residual, _ = compiled.close(q, x, max_iterations, False)
+            residual = residual if ok else None
+        self.iterations, self.moved = compiled.iterations, compiled.moved
+        return q, residual
 
     def scaled_norm(self, dv: np.ndarray) -> float:
         """Largest |component| of a velocity-space vector, prismatic parts in mechanism
@@ -492,48 +413,6 @@ class LoopSolver:
     def describe_drivers(self, values: Sequence[float]) -> str:
         """Driver values as a user reads them: angles in degrees, lengths in metres."""
         return describe_joint_values(self.mechanism, self.drivers, values)
-
-    def _newton_update(self, q: np.ndarray, J_dep: np.ndarray, r: np.ndarray,
-                       norm: float) -> tuple[np.ndarray, np.ndarray, float, bool]:
-        """A full Newton step when it lowers the residual (the usual case near a solution);
-        else a minimum-norm least-squares step, halved until the residual decreases."""
-        if J_dep.shape[0] == J_dep.shape[1]:
-            step = _solve_square(J_dep, -r)
-            if math.isfinite(sum(step.tolist())):
-                trial = self._move(q, step)
-                r_trial = self._residual(trial)
-                trial_norm = _max_abs(r_trial)
-                if trial_norm < norm:
-                    return trial, r_trial, trial_norm, True
-                self._residual(q)
-        step = np.linalg.lstsq(J_dep, -r, rcond=None)[0]
-        return self._line_search(q, step, norm)
-
-    def _move(self, q: np.ndarray, step: np.ndarray) -> np.ndarray:
-        """q moved by a step of the dependent joints, shortened to at most MAX_STEP.
-
-        From a guess where the Jacobian is singular a solve returns steps of 1e16 rad,
-        after which no step can move those joints (a unit in the last place of 1e16 is 2).
-        """
-        size = float(np.max(np.abs(step / self._dep_scale), initial=0.0))  # rad, or sizes of the mechanism
-        if size > MAX_STEP:
-            step = step * (MAX_STEP / size)
-        self.moved += min(size, MAX_STEP)
-        self._step[:] = 0.0
-        self._step[self._dep_v] = step
-        return pin.integrate(self.model, q, self._step)
-
-    def _line_search(self, q: np.ndarray, step: np.ndarray, norm: float) -> tuple[np.ndarray, np.ndarray, float, bool]:
-        """Backtracking: halve the Newton step until the residual decreases."""
-        alpha = 1.0
-        for _ in range(30):
-            trial = self._move(q, alpha * step)
-            r = self._residual(trial)
-            trial_norm = _max_abs(r)
-            if trial_norm < norm:
-                return trial, r, trial_norm, True
-            alpha *= 0.5
-        return q, self._residual(q), norm, False  # data back at q
 
     def _raise_not_closed(self, q: np.ndarray, norm: float, iterations: int, driver_q: Sequence[float]) -> None:
         drivers = self.describe_drivers(driver_q)
@@ -561,8 +440,7 @@ class LoopSolver:
         q's closure residual (dimensionless, as `Accuracy.residual`).
 
         Args:
-            at_q: the solver's data already holds q's placements and Jacobians (as `close`
-                leaves them), so they are not computed again.
+            at_q: q is the solver's own (closed by it): not checked again.
             closed: refuse a q whose loops are open beyond `tol` (False: an interpolated
                 pose, whose error the caller states; the residual is still measured).
 
@@ -573,14 +451,9 @@ class LoopSolver:
         """
         if not at_q:  # a user's q: checked (shape, finite, real, unit norms), never cast
             q = self.mechanism.checked_q(q)
-        if at_q:
-            for cut in self._cuts:
-                cut.place(self.data)
-            rows = np.concatenate([c.residual() for c in self._cuts]) if self._cuts else np.zeros(0)
-        else:
-            rows = self._residual(q)
-        independent, full = _max_abs(rows), self._full_residual()
+        independent, full = _max_abs(self._residual(q)), self._full_residual()
         if closed and not is_closed(independent, full, self._tol):
+            self._place(q)
             raise open_loops_error(self.mechanism, self.data, q, max(independent, full), self._tol,
                                    f"rates at {self.describe_drivers(self._driver_values(q))}")
         v, a, *numbers, _ = self._rates(q, driver_v, driver_a)
@@ -588,27 +461,21 @@ class LoopSolver:
 
     def _rates(self, q: np.ndarray, driver_v, driver_a, limit: float | None = None) -> tuple:
         """v, a, condition, sigma_min, velocity and acceleration residuals, and the assembly
-        signature (data at q). A condition number over `limit` (default: max_condition)
-        is a SingularPoseError."""
-        J = self._jacobian()
-        J_dep, J_drv = J[:, self._dep], J[:, self._drv]
-        condition, sigma_min = _condition(J_dep * self._dep_scale)
+        signature at a closed q, from the compiled core. A condition number over `limit`
+        (default: max_condition) is a SingularPoseError."""
+        v = np.zeros(self.model.nv)
+        a = np.zeros(self.model.nv)
+        compiled = core_for(self)
+        if compiled is None:  # an open chain: every joint is a driver
+            v[self._drv], a[self._drv] = driver_v, driver_a
+            return v, a, 1.0, 1.0, 0.0, 0.0, ()
+        v, a, signs, condition, sigma_min, v_res, a_res, _ = compiled.rates_at(
+            q, np.asarray(driver_v, dtype=float), np.asarray(driver_a, dtype=float))
         if condition > (self.max_condition if limit is None else limit):
             raise self._singular_error(q, condition, sigma_min)
-        v = np.zeros(self.model.nv)
-        v[self._drv] = driver_v
-        a = np.zeros(self.model.nv)
-        a[self._drv] = driver_a
-        if not J.size:
-            return v, a, condition, sigma_min, 0.0, 0.0, ()
-        signs = self.structure.signs(J_dep)
-        v[self._dep] = _solve_square(J_dep, -(J_drv @ v[self._drv]))
-        pin.forwardKinematics(self.model, self.data, q, v, self._zero_a)
-        drift = self._drift()
-        a[self._dep] = _solve_square(J_dep, -(J_drv @ a[self._drv]) - drift)
         if condition <= self.max_condition and not math.isfinite(sum(v.tolist()) + sum(a.tolist())):
             raise self._overflow(q, driver_v, driver_a)  # a regular pose: the driver rates are too large
-        return v, a, condition, sigma_min, _max_abs(J @ v), _max_abs(J @ a + drift), signs
+        return v, a, condition, sigma_min, v_res, a_res, tuple(signs)
 
     def _singular_error(self, q: np.ndarray, condition: float, sigma_min: float) -> SingularPoseError:
         """The error for a pose whose dependent-joint Jacobian is conditioned worse than
@@ -656,6 +523,7 @@ class LoopSolver:
         if isinstance(assembly, Mapping):
             wrong = [n for n, s in zip(self.structure.names, signs) if n in assembly and assembly[n] != s]
             if wrong:
+                self._place(q)
                 found = self.structure.assembly(signs, self.data)
                 raise AssemblyError(
                     f"{self.mechanism.source}: at {self.describe_drivers(dq)} the guess closes on assembly "
@@ -769,6 +637,7 @@ class LoopSolver:
                   route: Route | None) -> LoopSolution:
         """Rates at a closed q (data at q), the assembly checked against the reference."""
         v, a, *numbers, signs = self._rates(q, dv, da)
+        self._place(q)
         ref = self.reference
         if ref is not None and ref.keep and signs != ref.signs and not (route and (route.folds or route.change_points)):
             expected, found = self.structure.assembly(ref.signs), self.structure.assembly(signs, self.data)
