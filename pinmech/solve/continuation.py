@@ -129,25 +129,22 @@ class Path:
 
     # ------------------------------------------------------------------ nodes
     def node(self, p: float, q: np.ndarray, *, at_q: bool = False, residual: float | None = None) -> Node:
-        """The path derivatives and signature at a closed q (numerically regular). With
-        `at_q` the solver's data already holds q's placements and Jacobians, and
-        `residual` is the closure residual measured there."""
+        """The path derivatives and signature at a closed q (numerically regular), from
+        the compiled core. With `at_q`, `residual` is the closure residual measured at q
+        (by the corrector that closed it)."""
         solver = self.solver
         compiled = core_for(solver)
-        if compiled is not None:  # the same numbers from the compiled core (tests/test_core.py)
-            d1, d2, signs, condition, sigma_min, v_res, a_res, res = compiled.node(q, self.d)
-            if math.isfinite(sum(d1.tolist()) + sum(d2.tolist())):  # else the Python path names the overflow
-                signs = tuple(signs)
-                if not condition <= SINGULAR_NODE or 0 in signs:
-                    raise self._singular(q, condition, sigma_min)
-                return Node(p, q, d1, d2, signs, condition, sigma_min, v_res, a_res,
-                            res if not at_q or residual is None else residual)
-        if not at_q or residual is None:
-            residual = max(max(map(abs, solver._residual(q).tolist()), default=0.0), solver._full_residual())
-        d1, d2, condition, sigma_min, v_res, a_res, signs = solver._rates(q, self.d, self.zero, limit=math.inf)
+        if compiled is None:  # an open chain: the drivers are the pose
+            d1, d2, condition, sigma_min, v_res, a_res, signs = solver._rates(q, self.d, self.zero)
+            return Node(p, q, d1, d2, signs, condition, sigma_min, v_res, a_res, 0.0)
+        d1, d2, signs, condition, sigma_min, v_res, a_res, res = compiled.node(q, self.d)
+        signs = tuple(signs)
         if not condition <= SINGULAR_NODE or 0 in signs:
             raise self._singular(q, condition, sigma_min)
-        return Node(p, q, d1, d2, signs, condition, sigma_min, v_res, a_res, residual)
+        if not math.isfinite(sum(d1.tolist()) + sum(d2.tolist())):  # a regular pose: rates too large
+            raise solver._overflow(q, self.d, self.zero)
+        return Node(p, q, d1, d2, signs, condition, sigma_min, v_res, a_res,
+                    res if not at_q or residual is None else residual)
 
     def _singular(self, q: np.ndarray, condition: float, sigma_min: float) -> _Singular:
         solver = self.solver

@@ -9,11 +9,8 @@ How each pose is found is the user's accuracy choice (README, "Speed and accurac
     start="warm": from the previous pose as it is (O(dx) off: more Newton iterations).
     start="cold": every pose from the same guess (the scene's): slowest, and where two
         assembly branches are close it may land on the other one.
-    batch=True (default, with the predictor, on dense ranges): every 64th pose is
-        solved as above; the poses between are guessed by quintic Hermite interpolation
-        in (q, q', q'') of their solved neighbours, every 8th first, then the rest, and
-        closed and rated together by `BatchSolver` (every pose still meets the
-        tolerance, with its accuracy measured).
+    batch: accepted for compatibility; the compiled core follows every pose with the
+        predictor (the range mode of the one engine, pinmech/csrc).
     interpolate=n: solve every n-th pose exactly (as above) and interpolate the poses
         between (quintic Hermite); their accuracy is measured at the points of each
         interval where the interpolation error peaks: there the poses are also solved
@@ -55,11 +52,6 @@ from pinmech.solve.loops import LoopSolver
 STARTS = ("predictor", "warm", "cold")
 #: Poses per chunk: what is held in memory at once.
 CHUNK = 4096
-#: Batched refinement: exact poses every LEVELS[0]-th, then every LEVELS[1]-th, ...,
-#: used when the driver moves less than MAX_SPAN (rad, or lengths of the mechanism)
-#: between the poses of the first level.
-LEVELS = (64, 8, 1)
-MAX_SPAN = 0.12
 #: Where the error of a quintic Hermite interpolant peaks within its interval (to
 #: leading order, s^3 (1 - s)^3 and its derivatives): the middle for positions and
 #: accelerations, (1 - 1/sqrt 5) / 2 for velocities (and its mirror image, as large).
@@ -182,12 +174,8 @@ class _Cycle:
         if interpolate > 1 and (start != "predictor" or not self.alone):
             raise PinmechError("interpolating a sweep needs the predictor start and the other drivers at "
                                "rest (zero speed and acceleration): their motion is not the swept driver's path")
-        batch = batch and self.alone
         self.start, self.interpolate = start, int(interpolate)
-        # the batched levels serve the Python path only: the compiled core follows every pose
-        self.batch = (BatchSolver(solver) if batch and start == "predictor" and solver._cuts
-                      and core_for(solver) is None else None)
-        self.measurer = (self.batch or BatchSolver(solver)) if interpolate > 1 and solver._cuts else None
+        self.measurer = BatchSolver(solver) if interpolate > 1 and solver._cuts else None
         self.guess = None if guess is None else np.asarray(guess, dtype=float)
         self.ref: Node | None = None  # the last pose solved: p is the swept value, d1 and d2 its path derivatives
         self.unit_v = np.zeros_like(self.v_drv)
@@ -198,7 +186,7 @@ class _Cycle:
         self.path = Path(solver, x0, self.unit_v, through_folds=through_folds)  # p = the swept value
         self.mirror = (1.0, 0.0)  # p = a x + b: past each fold crossed, values are mirrored at it
         self.notes: dict[int, str] = {}
-        self._index, self._iterations, self._batching = 0, 0, False
+        self._index, self._iterations, self._sweeping = 0, 0, False
         self.span_scale = float(solver.mechanism.velocity_scale()[solver.mechanism.joint(driver).idx_v])  # 1: a turn
 
     # ------------------------------------------------------------------ chunks
@@ -228,7 +216,7 @@ class _Cycle:
         try:
             if self.interpolate > 1:
                 return self._interpolated(index, xs)
-            q, d1, d2, acc = self._exact(xs, self._levels(xs))
+            q, d1, d2, acc = self._exact(xs)
             return self._actual(index, xs, q, d1, d2, acc, np.zeros(len(xs), dtype=bool))
         except _Fallback:  # near trouble: pose by pose, each failure named
             self.ref = ref
@@ -255,17 +243,6 @@ class _Cycle:
         self.q_drv[k] = self.ref.p
         return self._actual(index, xs, q, d1, d2, acc, np.zeros(len(xs), dtype=bool))
 
-    def _levels(self, xs: np.ndarray) -> tuple[int, ...]:
-        """The batched levels this chunk's spacing allows (LEVELS, MAX_SPAN)."""
-        if self.batch is None or len(xs) < 2:
-            return (1,)
-        steps = np.abs(np.diff(np.concatenate(([self.ref.p], xs))))
-        step = float(steps.max()) / self.span_scale
-        for first in range(len(LEVELS) - 1):
-            if LEVELS[first] * step <= MAX_SPAN:
-                return LEVELS[first:]
-        return (1,)
-
     def _sequential(self, index: int, xs: np.ndarray) -> RangeChunk:
         """Pose after pose through `LoopSolver.solve`; a failing pose is kept as an error."""
         rows, errors, values = [], {}, xs.copy()
@@ -279,51 +256,27 @@ class _Cycle:
                 rows.append(None)
         return RangeChunk(index, values, _stack(rows, self.solver), np.zeros(len(xs), dtype=bool), errors)
 
-    def _exact(self, xs: np.ndarray, levels: tuple[int, ...]):
-        """Every pose exact, in path-derivative terms: q, q', q'' and accuracy arrays.
-
-        The poses of the first level one by one from the predictor, the others batched
-        from Hermite guesses between the poses of the level before (see LEVELS).
-        """
+    def _exact(self, xs: np.ndarray):
+        """Every pose exact, in path-derivative terms: q, q', q'' and accuracy arrays,
+        followed by the compiled core (an open chain's poses one by one: the drivers are
+        the pose)."""
         compiled = core_for(self.solver)
         if compiled is not None:
             return self._compiled(compiled, xs)
         n, nq, nv = len(xs), self.solver.model.nq, self.solver.model.nv
-        ref = self.ref
-        q, d1, d2 = np.empty((n + 1, nq)), np.empty((n + 1, nv)), np.empty((n + 1, nv))
-        q[0], d1[0], d2[0] = ref.q, ref.d1, ref.d2  # slot 0: the pose before the chunk
-        x = np.concatenate(([ref.p], xs))
-        acc = _accuracy_arrays(n + 1)
-        solved = np.zeros(n + 1, dtype=bool)
-        solved[0] = True
-        self._batching = True
-        try:
-            for j in sorted(set(range(levels[0], n + 1, levels[0])) | {n}):
-                self._solve_level(x, j, q, d1, d2, acc, solved)
-        finally:
-            self._batching = False
-        for stride in levels[1:]:
-            targets = np.array([j for j in range(stride, n + 1, stride) if not solved[j]], dtype=int)
-            if not targets.size:
-                continue
-            guesses = self._hermite(x, q, d1, d2, solved, targets)[0]
-            count = len(targets)
-            out = self.batch.try_solve(guesses, self._drivers(x[targets]), np.tile(self.unit_v, (count, 1)),
-                                       np.tile(self.zero, (count, 1)), _on_path=True)
-            if out is None or (ref.signs and np.any(out.signs != np.array(ref.signs))):
-                raise _Fallback
-            q[targets], d1[targets], d2[targets] = out.q, out.v, out.a
-            for name in _ACCURACY:
-                acc[name][targets] = getattr(out, name)
-            solved[targets] = True
-        self.ref = Node(float(x[n]), q[n].copy(), d1[n].copy(), d2[n].copy(), self.ref.signs, acc["condition"][n],
-                        acc["sigma_min"][n])
-        return q[1:], d1[1:], d2[1:], {k: v[1:] for k, v in acc.items()}
+        q, d1, d2 = np.empty((n, nq)), np.empty((n, nv)), np.empty((n, nv))
+        acc = _accuracy_arrays(n)
+        for j, x in enumerate(xs):
+            sol = self._solve(x, actual=False, fail=_Fallback)
+            q[j], d1[j], d2[j] = sol.q, sol.v, sol.a
+            _store(acc, j, sol.accuracy)
+        return q, d1, d2, acc
 
     def _compiled(self, compiled, xs: np.ndarray):
         """Every pose exact, as `_exact`, followed by the compiled core (core.py) from the
         last pose; a pose it hands back (a change point, a fold, a singular or too
-        ill-conditioned pose) is taken by the Python path, then the core goes on."""
+        ill-conditioned pose) is taken by `_solve` (the core's whole path follow, which names
+        what it met), then the core's sweep goes on."""
         n, solver, path = len(xs), self.solver, self.path
         q, d1, d2 = np.empty((n, solver.model.nq)), np.empty((n, solver.model.nv)), np.empty((n, solver.model.nv))
         acc = _accuracy_arrays(n)
@@ -345,30 +298,22 @@ class _Cycle:
                 self.ref = Node(float(xs[j + done - 1]), Q[-1].copy(), D1[-1].copy(), D2[-1].copy(), ref.signs,
                                 float(last[2]), float(last[3]), float(last[4]), float(last[5]), float(last[0]))
                 j += done
-            if j < n:  # the Python path names what the core met
-                self._batching = True
+            if j < n:  # `_solve` names what the sweep met (the core's Path.follow)
+                self._sweeping = True
                 try:
                     sol = self._solve(xs[j], actual=False, fail=_Fallback)
                 finally:
-                    self._batching = False
+                    self._sweeping = False
                 q[j], d1[j], d2[j] = sol.q, sol.v, sol.a
                 _store(acc, j, sol.accuracy)
                 j += 1
         return q, d1, d2, acc
 
-    def _solve_level(self, x: np.ndarray, j: int, q: np.ndarray, d1: np.ndarray, d2: np.ndarray,
-                     acc: dict[str, np.ndarray], solved: np.ndarray) -> None:
-        """Slot j solved exactly (path derivatives), or _Fallback."""
-        sol = self._solve(x[j], actual=False, fail=_Fallback)
-        q[j], d1[j], d2[j] = sol.q, sol.v, sol.a
-        _store(acc, j, sol.accuracy)
-        solved[j] = True
-
     def _interpolated(self, index: int, xs: np.ndarray) -> RangeChunk:
         """Exact poses every n-th (batched when dense), Hermite between, accuracy measured."""
         n, ref = len(xs), self.ref
         exact_at = np.array(sorted(set(range(self.interpolate - 1, n, self.interpolate)) | {n - 1}), dtype=int)
-        qe, d1e, d2e, acc_e = self._exact(xs[exact_at], self._levels(xs[exact_at]))
+        qe, d1e, d2e, acc_e = self._exact(xs[exact_at])
         nq, nv = qe.shape[1], d1e.shape[1]
         q, d1, d2 = np.empty((n + 1, nq)), np.empty((n + 1, nv)), np.empty((n + 1, nv))
         acc = _accuracy_arrays(n + 1)
@@ -490,9 +435,9 @@ class _Cycle:
 
     def _note(self, route: Route) -> None:
         """Record what a step passed: change points, and folds crossed (values mirrored).
-        The batched levels hand such a step back to the pose-by-pose path, which names
+        The core's sweep hands such a step back to the pose-by-pose path, which names
         the pose."""
-        if (route.change_points or route.folds) and self._batching:
+        if (route.change_points or route.folds) and self._sweeping:
             raise _Fallback
         solver, index = self.solver, self._index
         for x in route.change_points:

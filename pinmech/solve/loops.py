@@ -608,18 +608,7 @@ class LoopSolver:
                 return self.set_drivers(self.follow(q0, x0, rest, route), x1)
             return self.follow(q_turn, once, x1, route)
         path = Path(self, x0, x1 - x0, through_folds=through_folds)
-        start = path.node(0.0, q0)
-        compiled = core_for(self)
-        if compiled is not None:  # regular steps all the way: the compiled core; else the Python path
-            done, _, Q, _, _, numbers = compiled.follow(
-                0.0, start.q, start.d1, start.d2, list(start.signs), start.condition, path.x0, path.d, path.unit,
-                np.ones(1), math.inf)
-            if done:
-                route.steps += int(numbers[0, 6])
-                route.iterations += int(numbers[0, 1])
-                return Q[0]
-        node = path.follow(start, 1.0, route)
-        return node.q
+        return path.follow(path.node(0.0, q0), 1.0, route).q
 
     def turn_gap(self, q0: np.ndarray, q1: np.ndarray) -> float:
         """Largest joint difference between two poses, angles modulo a turn [rad], slides
