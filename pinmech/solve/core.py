@@ -128,7 +128,7 @@ def compile_loops(model: pin.Model, closures: list, v_scale: np.ndarray, *, extr
     """
     compiled = CompiledModel(model, [f for c in closures for f in (c.parent_frame, c.child_frame)]
                              + list(extra_frames))
-    for c in closures:  # what the core copies stays as it is (as CutEvaluator does)
+    for c in closures:  # what the core copies stays as it is
         c.__dict__["_in_use"] = True
     rows6 = [np.ascontiguousarray(c._rows6, dtype=float) for c in closures]
     full = [np.ascontiguousarray(c.selected * c._scale(), dtype=float) for c in closures]
