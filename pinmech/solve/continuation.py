@@ -28,7 +28,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-import pinocchio as pin
 
 from pinmech.solve.core import _core, core_for
 from pinmech.exceptions import AssemblyError, DriverLimitError, PinmechError, SingularPoseError

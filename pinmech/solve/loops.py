@@ -11,181 +11,43 @@ it solves.
 
 from __future__ import annotations
 
-import functools
 import math
 import threading
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
-from typing import Any, TypeVar
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pinocchio as pin
 
-from pinmech.arguments import float_array, names, not_real
+from pinmech.arguments import float_array, names
 from pinmech.solve.assembly_check import check_guessed_pose
 from pinmech.solve.branches import AssemblyStructure
 from pinmech.solve.continuation import Path, Route
-from pinmech.solve.core import _core, core_for
-from pinmech.exceptions import (
-    AssemblyError,
-    LoopClosureError,
-    MobilityError,
-    OptionError,
-    RateOverflowError,
-    SingularPoseError,
-    UnitError,
-)
+from pinmech.solve.core import core_for
+from pinmech.exceptions import AssemblyError, RateOverflowError, SingularPoseError
 from pinmech.model.mechanism import Mechanism
+from pinmech.solve.closure_check import (  # noqa: F401  (importers of these names from here)
+    ROUNDING_LEVEL,
+    describe_joint_values,
+    is_closed,
+    max_abs,
+    not_closed_error,
+    open_loops_error,
+)
+from pinmech.solve.driver_values import check_mobility, index_view, one_coordinate, ordered_values, turn_remainder
 from pinmech.solve.results import Accuracy, LoopSolution
+from pinmech.solve.solver_options import (  # noqa: F401  (names users and other modules import from here)
+    DEFAULT_MAX_CONDITION,
+    DEFAULT_TOL,
+    MAX_STEP,
+    POLISH,
+    SOLVER_RANGES,
+    Reference,
+    SolverOptions,
+    checked_option,
+    serialized,
+)
 
-#: Default closure tolerance (dimensionless: metres per metre of mechanism, or radians).
-DEFAULT_TOL = _core.DEFAULT_TOL
-#: A closure residual below this (relative to the size) is rounding, not a loop out of reach.
-ROUNDING_LEVEL = 1e-14
-#: Largest Newton step of one joint [rad, or mechanism sizes for a prismatic joint].
-MAX_STEP = _core.MAX_NEWTON_STEP
-#: Default largest condition number accepted before a pose is called singular. Near a
-#: singularity accelerations lose accuracy like eps x condition^3 (tests/test_singular.py),
-#: so 1e4 keeps every acceleration pinmech gives to about 1e-3 relative or better.
-DEFAULT_MAX_CONDITION = 1e4
-#: With the default tolerance or a tighter one, a pose that ends between this residual and
-#: the tolerance gets one more Newton step: it costs one kinematics pass and lands at
-#: rounding level, so results do not depend on how close the guess happened to be.
-POLISH = _core.POLISH
-#: The ranges of the solver's options, for the Python API as for a scene's [solver] table.
-SOLVER_RANGES = {"tol": (1e-16, 1e-3), "max_iterations": (1, 1000), "max_condition": (1.0, math.inf)}
-
-_Method = TypeVar("_Method", bound=Callable[..., Any])
-
-
-def serialized(method: _Method) -> _Method:
-    """A solver method that holds the solver's lock: threads sharing one solver take turns
-    (its Pinocchio `Data` and buffers hold one pose at a time), the same thread re-enters.
-    It first reads again what the user may have changed in the model (`refresh`, where
-    the solver has one)."""
-    @functools.wraps(method)
-    def locked(self, *args, **kwargs):
-        if self.lock._is_owned():  # called from within the solver: held and refreshed already
-            return method(self, *args, **kwargs)
-        with self.lock:
-            refresh = getattr(self, "refresh", None)
-            if refresh is not None:
-                refresh()
-            return method(self, *args, **kwargs)
-    return locked  # type: ignore[return-value]
-
-
-def checked_option(name: str, value: Any) -> float | int:
-    """A solver option within `SOLVER_RANGES` (a number, not NaN; max_iterations whole).
-
-    Raises:
-        OptionError: naming the option, the value and the range.
-    """
-    low, high = SOLVER_RANGES[name]
-    whole = name == "max_iterations"
-    try:
-        number = float(value) if isinstance(value, (int, float, np.number)) and not isinstance(value, bool) else math.nan
-    except OverflowError:  # an int beyond float64
-        number = math.inf
-    ok = low <= number <= high and (not whole or number == int(number))  # NaN is in no range
-    if not ok:
-        kind = "a whole number" if whole else "a number"
-        raise OptionError(f"{name} = {value!r} must be {kind} in [{low:g}, {high:g}]", option=name, value=value)
-    return int(number) if whole else number
-
-
-def _turn_remainder(x0: float, x1: float) -> float:
-    """x1 - x0 less its whole turns [rad], with the sign of x1 - x0: the rest of the way
-    once the turns repeat. The angles are reduced by sin and cos, whose argument
-    reduction is exact: x1 - x0 itself, rounded to the spacing of x1, lost the pose
-    (0.06 rad at 1e15 rad, and the loop was left open by 0.03 of its size)."""
-    reduced = math.remainder(math.atan2(math.sin(x1), math.cos(x1)) - math.atan2(math.sin(x0), math.cos(x0)),
-                             2 * math.pi)
-    if reduced * (x1 - x0) < 0:
-        reduced += math.copysign(2 * math.pi, x1 - x0)
-    return reduced
-
-
-def describe_joint_values(mechanism: Mechanism, names: Sequence[str], values: Sequence[float]) -> str:
-    """One-dof joints' values as a user reads them in an error: angles in degrees, lengths
-    in metres ("O2 = 90 deg, slide = 0.15 m")."""
-    out = []
-    for name, value in zip(names, values):
-        if mechanism.joint(name).is_angular:
-            out.append(f"{name} = {math.degrees(value):.10g} deg")
-        else:
-            out.append(f"{name} = {value:.10g} m")
-    return ", ".join(out)
-
-
-def is_closed(independent, full, tol: float):
-    """Whether a pose's loops are closed: its independent closure rows within `tol`, and
-    every selected row (the ones reduced away as out of the plane too) within ten times
-    max(tol, 1e-12), as `LoopSolver.close` accepts them (all dimensionless: lengths in
-    loop sizes, angles in rad). Floats give a bool, arrays of poses an array of them."""
-    return (independent <= tol) & (full <= max(tol, 1e-12) * 10)
-
-
-def open_loops_error(mechanism: Mechanism, data: pin.Data, q: np.ndarray, residual: float, tol: float,
-                     where: str) -> LoopClosureError:
-    """The error for rates asked at a pose whose loops are open: each open loop's gap
-    between its cut frames [m] and the misalignment of its axes [deg], the residual
-    relative to the loop's size, and the tolerance. `data` holds q's joint placements."""
-    pin.updateFramePlacements(mechanism.model, data)
-    said = []
-    for c in mechanism.closures:
-        if is_closed(float(np.max(np.abs(c.residual(data)), initial=0.0)),
-                     float(np.max(np.abs(c.full_residual(data)), initial=0.0)), tol):
-            continue
-        r6, rows = c.residual6(data), c.selected
-        gap = float(np.linalg.norm(rows[:, :3] @ r6[:3]))  # the distance its rows constrain [m]
-        turn = float(np.linalg.norm(rows[:, 3:] @ r6[3:]))  # rad, or the sine of the axes' angle
-        angle = math.degrees(math.asin(min(turn, 1.0)) if c.cut_type == "revolute" else turn)
-        said.append(f"loop {c.name}'s cut frames are {gap:.3g} m apart ({gap / c.length_scale:.3g} of its size, "
-                    f"{c.length_scale:.3g} m)" + (f", axes {angle:.3g} deg apart" if rows[:, 3:].any() else ""))
-    return LoopClosureError(
-        f"{mechanism.source}: {where}: the loops are open: {'; '.join(said)} (largest closure row "
-        f"{residual:.3g}, tolerance {tol:g}, both of the loop's size); rates hold only where the loops "
-        "are closed: close them first (LoopSolver.solve or close) and pass that q",
-        residual=float(residual), iterations=0, partial=q)
-
-
-def _max_abs(x: np.ndarray) -> float:
-    """Largest |x_i| (0 when empty); plain Python below 9 entries, where numpy's call costs more."""
-    if x.size < 9:
-        return max(map(abs, x.tolist()), default=0.0)
-    return float(np.max(np.abs(x)))
-
-
-def _index(indices: np.ndarray) -> slice | np.ndarray:
-    """A slice when the indices are contiguous (a view, cheaper than fancy indexing)."""
-    if len(indices) and np.array_equal(indices, np.arange(indices[0], indices[-1] + 1)):
-        return slice(int(indices[0]), int(indices[-1]) + 1)
-    return indices
-
-
-@dataclass(frozen=True)
-class Reference:
-    """The pose that names the assembly: the drivers' values [rad or m], the closed q,
-    its assembly signature, whether other poses must keep it (False: "any"), and the
-    Newton iterations that closed it from its guess."""
-
-    driver_q: np.ndarray
-    q: np.ndarray
-    signs: tuple[int, ...]
-    keep: bool = True
-    iterations: int = 0
-
-    def __post_init__(self) -> None:
-        """The arrays are read-only copies: the solver goes on from them, so a write into
-        the ones the API returns must not change its reference."""
-        for name in ("driver_q", "q"):
-            array = np.array(getattr(self, name), dtype=float)
-            array.flags.writeable = False
-            object.__setattr__(self, name, array)
-
-
-class LoopSolver:
+class LoopSolver(SolverOptions):
     """Solves one mechanism pose after pose, keeping Pinocchio `Data` and buffers alive.
 
     Assemblies: `set_reference` closes the loops once at given driver values from a
@@ -237,8 +99,8 @@ class LoopSolver:
         dependent = np.ones(self.model.nv, dtype=bool)  # not np.setdiff1d: it imports numpy.ma (11 ms)
         dependent[self._drv_v] = False
         self._dep_v = np.flatnonzero(dependent)
-        self._check_mobility()
-        self._drv, self._dep = _index(self._drv_v), _index(self._dep_v)
+        check_mobility(mechanism, self.drivers)
+        self._drv, self._dep = index_view(self._drv_v), index_view(self._dep_v)
         self._drv_q = [(mechanism.joint(n).idx_q, mechanism.joint(n).kind == "continuous") for n in self.drivers]
         self._cuts = list(mechanism.closures)  # the loops (their rows: the compiled core's)
         for c in self._cuts:  # what the core's rows are built from stays as it is
@@ -254,37 +116,9 @@ class LoopSolver:
         self.iterations = 0  # Newton iterations of the last `correct`
         self.moved = 0.0  # sum of the scaled sizes of its steps: a bound on how far it moved q
 
-    # ------------------------------------------------------------------ options
-    @property
-    def tol(self) -> float:
-        """Closure tolerance (dimensionless, of each loop's size), in SOLVER_RANGES."""
-        return self._tol
-
-    @tol.setter
-    def tol(self, value: float) -> None:
-        self._tol = checked_option("tol", value)
-
-    @property
-    def max_iterations(self) -> int:
-        """Newton iteration cap, in SOLVER_RANGES."""
-        return self._max_iterations
-
-    @max_iterations.setter
-    def max_iterations(self, value: int) -> None:
-        self._max_iterations = checked_option("max_iterations", value)
-
-    @property
-    def max_condition(self) -> float:
-        """Largest condition number accepted before a pose is singular, in SOLVER_RANGES."""
-        return self._max_condition
-
-    @max_condition.setter
-    def max_condition(self, value: float) -> None:
-        self._max_condition = checked_option("max_condition", value)
-
     def refresh(self) -> None:
         """Read again the placements of ground cut frames, which the user may have moved in
-        the model since the last call (the hot path folds them into its row matrices); the
+        the model since the last call (the core reads the model at every call): the
         reference pose, closed for the old placement, is then closed again from itself."""
         now = [self.model.frames[f].placement for f in self._ground]  # by index: frames may be added
         moved = any(a != b for a, b in zip(now, self._ground_at))
@@ -297,43 +131,7 @@ class LoopSolver:
             self.reference = Reference(ref.driver_q, q, signs, ref.keep)
 
     def _one_coordinate(self, v: int) -> bool:
-        """Velocity index v moves one coordinate alone: a one-freedom joint, or a one-freedom
-        joint inside a composite (MJCF's several hinges in one body), which the
-        continuation can hold fixed as its curve's parameter."""
-        for joint in self.model.joints[1:]:
-            if joint.idx_v <= v < joint.idx_v + joint.nv:
-                if joint.nv == 1:
-                    return True
-                if joint.shortname() != "JointModelComposite":
-                    return False
-                offset = joint.idx_v
-                for part in joint.extract().joints:
-                    if offset <= v < offset + part.nv:
-                        return part.nv == 1
-                    offset += part.nv
-        return False
-
-    def _joint_nv(self, v: int) -> int:
-        for joint in self.model.joints[1:]:
-            if joint.idx_v <= v < joint.idx_v + joint.nv:
-                return joint.nv
-        return 0
-
-    # ------------------------------------------------------------------ set-up
-    def _check_mobility(self) -> None:
-        if len(set(self.drivers)) != len(self.drivers):
-            raise MobilityError(f"a joint is driven twice: {', '.join(self.drivers)}",
-                                mobility=self.mechanism.mobility, drivers=len(self.drivers))
-        mobility = self.mechanism.mobility
-        if mobility != len(self.drivers):
-            rows = self.mechanism.constraint_rows
-            raise MobilityError(
-                f"{self.mechanism.source}: the mechanism has {self.model.nv} joint freedoms and "
-                f"{rows} independent closure equations, so mobility {mobility}; "
-                f"{len(self.drivers)} driver(s) given ({', '.join(self.drivers) or 'none'})",
-                mobility=mobility,
-                drivers=len(self.drivers),
-            )
+        return one_coordinate(self.model, v)
 
     # ------------------------------------------------------------------ pieces
     def _residual(self, q: np.ndarray) -> np.ndarray:
@@ -408,30 +206,15 @@ class LoopSolver:
     def scaled_norm(self, dv: np.ndarray) -> float:
         """Largest |component| of a velocity-space vector, prismatic parts in mechanism
         sizes (dimensionless)."""
-        return _max_abs(dv * self._v_scale_inv)
+        return max_abs(dv * self._v_scale_inv)
 
     def describe_drivers(self, values: Sequence[float]) -> str:
         """Driver values as a user reads them: angles in degrees, lengths in metres."""
         return describe_joint_values(self.mechanism, self.drivers, values)
 
     def _raise_not_closed(self, q: np.ndarray, norm: float, iterations: int, driver_q: Sequence[float]) -> None:
-        drivers = self.describe_drivers(driver_q)
-        names = ", ".join(c.name for c in self.mechanism.closures)
-        solved = float(np.max(np.abs(self._residual(q)), initial=0.0))  # the rows Newton solves
-        if norm <= ROUNDING_LEVEL:
-            why = f"that is rounding level: the tolerance {self.tol:g} is tighter than floating point allows"
-        elif solved <= self.tol:
-            why = ("the rows dropped as out of the mechanism's plane do not close: the two sides of the cut "
-                   "are not in one plane (check the z of the origins and the axes)")
-        else:
-            why = "the pose is out of reach for these dimensions, or the guess is on no branch"
-        raise LoopClosureError(
-            f"{self.mechanism.source}: loop(s) {names} cannot be closed at {drivers} "
-            f"(residual {norm:.3g} of the loop's size after {iterations} Newton iterations): {why}",
-            residual=float(norm),
-            iterations=iterations,
-            partial=q,
-        )
+        solved = max_abs(self._residual(q))  # the rows Newton solves
+        raise not_closed_error(self.mechanism, q, norm, solved, self.tol, iterations, self.describe_drivers(driver_q))
 
     @serialized
     def rates(self, q: np.ndarray, driver_v: Sequence[float], driver_a: Sequence[float], *,
@@ -451,7 +234,7 @@ class LoopSolver:
         """
         if not at_q:  # a user's q: checked (shape, finite, real, unit norms), never cast
             q = self.mechanism.checked_q(q)
-        independent, full = _max_abs(self._residual(q)), self._full_residual()
+        independent, full = max_abs(self._residual(q)), self._full_residual()
         if closed and not is_closed(independent, full, self._tol):
             self._place(q)
             raise open_loops_error(self.mechanism, self.data, q, max(independent, full), self._tol,
@@ -567,7 +350,7 @@ class LoopSolver:
         if guess is None and ref is not None and ref.keep:
             route = Route(tuple(ref.driver_q.tolist()))
             q = self.follow(ref.q, ref.driver_q, dq, route)
-            residual = max(_max_abs(self._residual(q)), self._full_residual())
+            residual = max(max_abs(self._residual(q)), self._full_residual())
             iterations = route.iterations if route.steps else ref.iterations  # the reference itself: its Newton
             return self._solution(q, dv, da, residual, iterations, route)
         if guess is None and ref is not None:  # assembly "any": Newton from the reference pose
@@ -604,7 +387,7 @@ class LoopSolver:
             q_turn = self.follow(q0, x0, once, route)
             if self.turn_gap(q0, q_turn) <= max(1e3 * self.tol, 1e-10):
                 rest = x0.copy()
-                rest[k] += _turn_remainder(float(x0[k]), float(x1[k]))
+                rest[k] += turn_remainder(float(x0[k]), float(x1[k]))
                 return self.set_drivers(self.follow(q0, x0, rest, route), x1)
             return self.follow(q_turn, once, x1, route)
         path = Path(self, x0, x1 - x0, through_folds=through_folds)
@@ -647,29 +430,4 @@ class LoopSolver:
         return float_array(guess, "guess", (self.model.nq,), self.mechanism.source)
 
     def _ordered(self, values: Sequence[float] | Mapping[str, float] | None) -> np.ndarray:
-        if (type(values) is np.ndarray and values.shape == (len(self.drivers),) and values.dtype == float
-                and math.isfinite(sum(values.tolist()))):
-            return values  # already in order (a sweep's arrays: no conversion)
-        if values is None:
-            return np.zeros(len(self.drivers))
-        if isinstance(values, Mapping):
-            unknown = set(values) - set(self.drivers)
-            if unknown:
-                raise MobilityError(f"{', '.join(sorted(unknown))} is not a driver ({', '.join(self.drivers)})",
-                                    mobility=self.mechanism.mobility, drivers=len(self.drivers))
-            values = [values.get(n, 0.0) for n in self.drivers]
-        wrong = not_real(values)
-        if wrong:
-            hint = ": convert quantities first, e.g. pinmech.to_si('30 deg', 'angle')" if wrong == "text" else ""
-            raise UnitError(f"driver values of {', '.join(self.drivers)} must be real numbers in SI (rad or m), "
-                            f"got {wrong}, which pinmech does not cast{hint}")
-        try:
-            out = np.asarray(values, dtype=float).reshape(-1)
-        except (TypeError, ValueError, OverflowError):
-            raise UnitError(f"driver values of {', '.join(self.drivers)} must be numbers in SI (rad or m), "
-                            f"got {values!r:.80}: convert quantities first, e.g. pinmech.to_si('30 deg', "
-                            f"'angle')") from None
-        if out.shape != (len(self.drivers),) or not math.isfinite(sum(out.tolist())):
-            raise MobilityError(f"expected {len(self.drivers)} finite driver value(s), got {values!r}",
-                                mobility=self.mechanism.mobility, drivers=len(self.drivers))
-        return out
+        return ordered_values(values, self.drivers, self.mechanism.mobility)
