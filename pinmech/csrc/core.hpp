@@ -1,19 +1,20 @@
-// pinmech's compiled core: a sweep of one driver followed pose by pose, in C++ on
-// Pinocchio, on the user's own pin.Model (taken by reference from Python: model_ref.cpp).
-//
-// It computes what pinmech/solve_loops.py (closure rows, corrector, rates) and
-// pinmech/continuation.py (predictor, trust region, tangent turn, assembly signature)
-// compute, with the same rules and constants, for the regular steps of a sweep: where a
-// step needs anything more (a signature change, a pivot below PIVOT_BELOW, a singular or
-// overflowing pose, a pose worse conditioned than max_condition) it stops and hands the
-// pose back to the Python path, which names what happened. pinmech/core.py builds it from
-// a LoopSolver; tests/test_core.py checks every number against the closed forms and
-// finite differences.
+// pinmech's compiled core, the one engine: the closure rows, Newton (`close`, `correct`),
+// the predictor-corrector continuation with every assembly rule (trust region, tangent
+// turn, signature, change points, the curve on a joint parameter through folds, landing)
+// and the rate solves, in C++ on Pinocchio, on the user's own pin.Model (taken by
+// reference from Python: model_ref.cpp). Pose (`close`, `rates_at`, `follow_path`), range
+// (`follow`) and batch (BatchSolver's calls) are its modes. Python (pinmech/solve/) orders
+// the calls and names what the core reports (a status and the numbers): where the range
+// mode meets a change point, a fold, a pose worse conditioned than max_condition or
+// overflowing rates, it stops and the pose-by-pose `follow_path` names and notes it.
+// pinmech/solve/core.py builds it from a LoopSolver; tests/test_core.py checks it against
+// closed forms, SVDs and finite differences.
 //
 // One translation unit per concern, so that a change recompiles little and the compile
 // stays within modest memory: condition.cpp (condition numbers), closure.cpp (the model,
 // closure rows, their Jacobians and drift, assembly blocks), continuation.cpp (corrector,
-// predictor-corrector steps, sweeps), rates.cpp (rate problems, frames along a sweep),
+// predictor-corrector steps, sweeps), pivot.cpp (Newton with least squares, the whole
+// path follow: folds, landing, change points), rates.cpp (rate problems, frames along a sweep),
 // model_ref.cpp (the pin.Model from Python), module.cpp (the Python bindings). Pinocchio's
 // algorithms come compiled from libpinocchio_default (PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION),
 // the library the installed `pin` loads: the same version, pinned in pyproject.toml.
@@ -76,7 +77,7 @@ void check_signals();
 
 enum CutType { REVOLUTE, PRISMATIC, SPHERICAL_CUT, FIXED };
 
-// Why a sweep stopped before its last pose (the Python path then takes that pose).
+// Why a sweep stopped before its last pose (the pose-by-pose follow then takes that pose).
 enum Stop { DONE = 0, NEEDS_PIVOT = 1, SIGNATURE_CHANGED = 2, CONDITION = 3, NOT_FINITE = 4 };
 
 // The pin.Model inside a Python object made by the installed `pin` (model_ref.cpp), or
@@ -221,6 +222,9 @@ class Core {
   // Diagonal blocks the dependent solves go through (0: the whole matrix at once).
   int solve_blocks() const { return int(square_.blocks()); }
   double moved() const { return moved_; }
+  // The dependent velocity indices of one-coordinate joints, the pivots a path's curve
+  // may take through a fold (LoopSolver.dep_is_scalar), for the range mode's `follow`.
+  void set_pivots(const std::vector<int>& scalar);
   // Throws (a ValueError in Python) where the model's joints or frames changed.
   void check_structure() const;
 
@@ -274,6 +278,8 @@ class Core {
   double tol_;
   int iterations_ = 0;
   double moved_ = 0.0;
+  std::vector<int> pivots_;
+  long attempts_ = 0;  // steps tried since the last look at Python's signal handlers
 };
 
 }  // namespace pinmech

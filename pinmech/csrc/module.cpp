@@ -71,6 +71,7 @@ NB_MODULE(_core, m) {
            nb::arg("polish_within") = true)
       .def("follow_path", &Core::follow_path_py)
       .def("rates_at", &Core::rates_at)
+      .def("set_pivots", &Core::set_pivots)
       .def("follow", &Core::follow)
       .def("node", &Core::node)
       .def("rates", &Core::rates)

@@ -114,10 +114,9 @@ void Core::follow_path(Node node, double p_target, PathSpec& path, PathResult& o
   const double unit = path.unit;
   double h = std::copysign(std::min(std::abs(p_target - node.p), MAX_STEP / unit), p_target - node.p);
   int why = 0;
-  long attempts = 0;
   Node next;
   while (node.p != p_target) {
-    if (++attempts % SIGNAL_EVERY == 0) check_signals();
+    if (++attempts_ % SIGNAL_EVERY == 0) check_signals();
     const double remaining = p_target - node.p;
     h = std::copysign(std::min(std::abs(h), std::abs(remaining)), remaining);
     bool change = false;
@@ -174,7 +173,7 @@ bool Core::pivot_follow(const Node& node, double p_target, PathSpec& path, int w
   curve_start(node, sense, path, state);
   bool folded = false;
   for (long i = 0; i < MAX_PIVOT_STEPS; ++i) {
-    if ((i + 1) % SIGNAL_EVERY == 0) check_signals();
+    if (++attempts_ % SIGNAL_EVERY == 0) check_signals();
     if (!advance(state, path, next)) return stuck(node, why, out);
     if (next.dp() * state.dp() <= 0) {  // the driver turned back: a fold in between
       locate_fold(state, next, path, fold);

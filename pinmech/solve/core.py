@@ -112,9 +112,11 @@ def _build(solver) -> _core.Core | None:
     closures = solver.mechanism.closures
     if not closures or solver.model.nv == 0:
         return None
-    return compile_loops(solver.model, closures, solver.mechanism.velocity_scale(), tol=solver.tol,
+    core = compile_loops(solver.model, closures, solver.mechanism.velocity_scale(), tol=solver.tol,
                          drv_v=solver._drv_v, dep_v=solver._dep_v, drv_q=solver._drv_q,
                          blocks=solver.structure.blocks, source=str(solver.mechanism.source))[0]
+    core.set_pivots([int(v) for v, ok in zip(solver._dep_v, solver.dep_is_scalar) if ok])
+    return core
 
 
 def compile_loops(model: pin.Model, closures: list, v_scale: np.ndarray, *, extra_frames: list[int] = (),
