@@ -202,7 +202,7 @@ class Core {
   nb::tuple close_py(VectorXd q, const VectorXd& drivers, int max_iterations, bool polish_within);
   // Path.follow from a node to p_target: regular steps, and where they shrink below
   // PIVOT_BELOW the curve with a dependent joint as parameter (folds, landing).
-  void follow_path(Node node, double p_target, PathSpec& path, PathResult& out);
+  void follow_path(Node& node, double p_target, PathSpec& path, PathResult& out);  // node: worked on in place
   nb::tuple follow_path_py(double p0, const VectorXd& q0, const VectorXd& d1, const VectorXd& d2,
                            const std::vector<int>& signs0, double condition0, const VectorXd& x0, const VectorXd& d,
                            double unit, double p_target, bool through_folds, const std::vector<int>& scalar);
@@ -279,6 +279,7 @@ class Core {
   int iterations_ = 0;
   double moved_ = 0.0;
   std::vector<int> pivots_;
+  Node next_;  // follow_path's step buffer
   long attempts_ = 0;  // steps tried since the last look at Python's signal handlers
 };
 

@@ -110,11 +110,11 @@ nb::tuple Core::rates_at(const VectorXd& q, const VectorXd& v_drv, const VectorX
 }
 
 // ---------------------------------------------------------------- Path.follow
-void Core::follow_path(Node node, double p_target, PathSpec& path, PathResult& out) {
+void Core::follow_path(Node& node, double p_target, PathSpec& path, PathResult& out) {
   const double unit = path.unit;
   double h = std::copysign(std::min(std::abs(p_target - node.p), MAX_STEP / unit), p_target - node.p);
   int why = 0;
-  Node next;
+  Node& next = next_;  // a buffer kept across calls: a regular pose allocates nothing
   while (node.p != p_target) {
     if (++attempts_ % SIGNAL_EVERY == 0) check_signals();
     const double remaining = p_target - node.p;
@@ -145,7 +145,7 @@ void Core::follow_path(Node node, double p_target, PathSpec& path, PathResult& o
     h = p_target - node.p;
   }
   out.status = PATH_DONE;
-  out.node = node;
+  std::swap(out.node, node);
   out.p_target = p_target;
 }
 
