@@ -25,6 +25,7 @@ from pinmech.counts import checked_count
 from pinmech.exceptions import PinmechError, SceneError
 from pinmech.interrupts import SIGNALS
 from pinmech.design.study_cli import add_parser as add_study_parser
+from pinmech.design.synthesis_cli import add_parser as add_synth_parser
 
 if TYPE_CHECKING:
     from pinmech.outputs import Outputs
@@ -261,6 +262,7 @@ _SUBCOMMANDS = {
     "build": _build_parser,
     "check": _check_parser,
     "study": add_study_parser,
+    "synth": add_synth_parser,
 }
 
 

@@ -151,8 +151,9 @@ def _evolved(spec: SynthesisSpec, mapper: PopulationMap, assembly: float) -> tup
 
     de = opt.differential_evolution(objective, search_bounds(spec), seed=spec.seed, popsize=spec.population,
                                     maxiter=spec.generations, workers=mapper, updating="deferred", polish=False,
-                                    init="sobol", tol=0.0, atol=0.0, mutation=(0.5, 1.0), recombination=0.9,
+                                    init="sobol", tol=0.0, atol=-1.0, mutation=(0.5, 1.0), recombination=0.9,
                                     strategy=_STRATEGY, callback=_stopper(spec, assembly))
+    # atol < 0: never "converged" (a population all rejected is flat, not converged)
     order = np.argsort(de.population_energies, kind="stable")
     return de.population[order], de.population_energies[order], int(de.nit)
 

@@ -1,0 +1,127 @@
+"""A synthesised four-bar written as a drawn linkage (models/linkages/*.toml) with a scene
+that sweeps its crank through the targets, and checked by the engine: the scene solved by
+continuation from the first target's pose, the coupler point read at every target.
+
+(The drawn-linkage writer is this module's own until the typed drawn linkage has one: the
+two should become one.)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from pinmech.design.synthesis_fourbar import pose
+from pinmech.design.synthesis_search import Linkage
+
+_STEP = math.radians(1.0)  # the engine's sweep: at most this crank step between poses
+
+
+def _mm(v: float) -> str:
+    return f"\"{v * 1e3:.15g} mm\""
+
+
+def _deg(v: float) -> str:
+    return f"\"{math.degrees(v):.15g} deg\""
+
+
+def linkage_toml(lk: Linkage, title: str, source: str) -> str:
+    """The drawn linkage's TOML text: joints at the first target's pose (crank at theta_1)."""
+    p = pose(lk.z[None], np.array([lk.s]), lk.theta[:1][None])
+    A, P = p.A[0, 0], p.P[0, 0]
+    z = lk.z
+    side = "left" if lk.s > 0 else "right"
+    return "\n".join([
+        f"# Synthesised by `pinmech synth {source}`: the coupler point P through the targets.",
+        f"# Drawn at the first target's pose (crank O2 at {math.degrees(lk.theta[0]):.6g} deg from x).",
+        f"title = \"{title}\"",
+        "ground = [\"O2\", \"O4\"]",
+        "",
+        "[joints]",
+        f"O2 = [{_mm(z[0])}, {_mm(z[1])}]",
+        f"O4 = [{_mm(z[2])}, {_mm(z[3])}]",
+        f"A = [{_mm(A[0])}, {_mm(A[1])}]",
+        f"B = {{ from = [\"A\", \"O4\"], lengths = [{_mm(z[5])}, {_mm(z[6])}], side = \"{side}\" }}",
+        f"P = [{_mm(P[0])}, {_mm(P[1])}]",
+        "",
+        "[links]",
+        "crank = [\"O2\", \"A\"]",
+        "coupler = [\"A\", \"B\", \"P\"]",
+        "rocker = [\"O4\", \"B\"]",
+        "",
+    ])
+
+
+def motion_values(lk: Linkage) -> np.ndarray:
+    """The crank's angles at the targets [rad], unwrapped along the motion (one way)."""
+    steps = np.mod(lk.way * np.diff(lk.theta), 2 * math.pi)
+    return lk.theta[0] + lk.way * np.concatenate(([0.0], np.cumsum(steps)))
+
+
+def scene_toml(lk: Linkage, linkage_file: str, title: str) -> str:
+    """A scene of the linkage: the crank O2 driven from the first target's angle, its
+    sweep over the motion to the last target."""
+    values = motion_values(lk)
+    steps = int(math.ceil(abs(values[-1] - values[0]) / _STEP)) + 1
+    return "\n".join([
+        "# The synthesised linkage swept through its targets:",
+        "#   pinmech sweep THIS_FILE --plot fig.png",
+        f"title = \"{title}\"",
+        f"linkage = \"{linkage_file}\"",
+        "",
+        "[drivers.O2]",
+        f"angle = {_deg(values[0])}",
+        "",
+        "[sweep]",
+        f"from = {_deg(values[0])}",
+        f"to = {_deg(values[-1])}",
+        f"steps = {steps}",
+        "points = [\"P\"]",
+        "",
+        "[report]",
+        "points = [\"P\"]",
+        "",
+    ])
+
+
+def write_linkage(lk: Linkage, prefix: str | Path, title: str, source: str) -> tuple[Path, Path]:
+    """PREFIX.toml (the drawn linkage) and PREFIX_scene.toml (its sweep); their paths."""
+    prefix = Path(prefix)
+    linkage, scene = prefix.with_name(prefix.name + ".toml"), prefix.with_name(prefix.name + "_scene.toml")
+    linkage.write_text(linkage_toml(lk, title, source), encoding="utf-8")
+    scene.write_text(scene_toml(lk, linkage.name, title), encoding="utf-8")
+    return linkage, scene
+
+
+@dataclass(frozen=True)
+class EngineCheck:
+    """The engine's coupler point at each target's crank angle [m], solved by continuation
+    from the first target's pose on the drawn assembly, and its distance to the targets [m]."""
+
+    points: np.ndarray
+    errors: np.ndarray
+
+
+def engine_check(scene_file: str | Path, lk: Linkage, targets: np.ndarray) -> EngineCheck:
+    """Solve the written scene through the motion with the engine (pinmech sweep's path),
+    poses at most _STEP apart, and read P at the targets.
+
+    Raises:
+        SweepError: the engine could not follow the motion (a fold, no closure).
+    """
+    from pinmech.io.scene import Scene
+    from pinmech.io.sweep import Sweep
+
+    values = motion_values(lk)
+    dense = [values[0]]
+    for a, b in zip(values[:-1], values[1:]):
+        n = int(math.ceil(abs(b - a) / _STEP))
+        dense += list(np.linspace(a, b, n + 1)[1:])
+    at = {int(np.argmin(np.abs(np.asarray(dense) - v))) for v in values}
+    sweep = Sweep.from_scene(Scene.load(scene_file))
+    points = [p.motion.points["P"].position[:2] for p in sweep.poses(np.asarray(dense)) if p.index in at]
+    P = np.array(points)
+    return EngineCheck(P, np.linalg.norm(P - targets, axis=1))
