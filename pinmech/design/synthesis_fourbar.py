@@ -118,7 +118,7 @@ def point_jacobian(z: np.ndarray, s: float, theta: np.ndarray) -> tuple[np.ndarr
     G_z[:, :, 2:4] = -np.eye(2)
     G_z[:, :, 4], G_z[:, :, 5], G_z[:, :, 6] = et, e3, -e4
     G_t = r2 * dt
-    inv = np.linalg.inv(G_phi)
+    inv = np.linalg.inv(G_phi)  # LinAlgError at a fold (coupler and rocker in line)
     dphi3_z = -(inv @ G_z)[:, 0, :]  # (m, 9)
     dphi3_t = -(inv @ G_t[..., None])[:, 0, 0]  # (m,)
     dP_dphi3 = pu * d3 + pv * (d3 @ perp.T)  # d/dphi3 of R(phi3)(along, across)

@@ -8,7 +8,8 @@ The crank turns from the first target's angle to the last's, one way, on one ass
   between the first and the last target: the crank cannot carry the linkage through it;
 - **order** ("targets out of order"): the crank angles of the targets do not progress
   one way (each step within one turn, all of them within one turn);
-- "does not close" at a target, "transmission angle" below the least asked, "Grashof
+- "does not close" at a target, "transmission angle" below the least asked (never below
+  MIN_TRANSMISSION: a dead point), "Grashof
   class" other than the one asked, "link ratio" above the one asked.
 """
 
@@ -26,6 +27,9 @@ from pinmech.solve.grashof import four_bar_class
 CAUSES = ("does not close", "targets out of order", "fold within the motion", "Grashof class", "link ratio",
           "transmission angle")
 _TWO_PI = 2 * math.pi
+#: The least transmission angle ever accepted [rad], whatever the file asks: at 0 the
+#: linkage is at a dead point (a fold), where the crank cannot drive it nor the engine solve it.
+MIN_TRANSMISSION = math.radians(1.0)
 
 
 def progress(theta: np.ndarray, direction: str) -> tuple[np.ndarray, np.ndarray]:
@@ -78,7 +82,7 @@ def causes(spec: SynthesisSpec, z: np.ndarray, s: np.ndarray, theta: np.ndarray)
     for i in range(len(z)):
         out.append("does not close" if not closes[i] else "targets out of order" if way[i] == 0
                    else "fold within the motion" if crosses[i] else _shape(spec, z[i])
-                   or ("transmission angle" if quality[i] < spec.transmission else ""))
+                   or ("transmission angle" if quality[i] < max(spec.transmission, MIN_TRANSMISSION) else ""))
     return out
 
 

@@ -202,7 +202,8 @@ def _refined(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage | None:
 
     def residual(v: np.ndarray) -> np.ndarray:
         zz, th = unpack(v)
-        return ((pose(zz[None], np.array([s0]), th[None]).P[0] - spec.targets) / S).ravel()
+        r = ((pose(zz[None], np.array([s0]), th[None]).P[0] - spec.targets) / S).ravel()
+        return np.where(np.isfinite(r), r, 1.0)  # where the dyad does not close: a step refused
 
     def jacobian(v: np.ndarray) -> np.ndarray:
         zz, th = unpack(v)
@@ -216,10 +217,13 @@ def _refined(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage | None:
     lower = np.concatenate((spec.lower, np.full(len(v0) - 9, -np.inf)))
     upper = np.concatenate((spec.upper, np.full(len(v0) - 9, np.inf)))
     candidates = []
-    if np.all(np.isfinite(residual(v0))):
-        fit = opt.least_squares(residual, np.clip(v0, lower, upper), jac=jacobian, bounds=(lower, upper),
-                                method="trf", x_scale="jac", ftol=1e-15, xtol=1e-15, gtol=1e-15, max_nfev=400)
+    try:
+        with np.errstate(all="ignore"):
+            fit = opt.least_squares(residual, np.clip(v0, lower, upper), jac=jacobian, bounds=(lower, upper),
+                                    method="trf", x_scale="jac", ftol=1e-15, xtol=1e-15, gtol=1e-15, max_nfev=400)
         candidates.append(fit.x)
+    except (np.linalg.LinAlgError, ValueError):  # a fold or an open dyad on the way: keep x
+        pass
     candidates.append(v0)
     for v in candidates:
         lk = _linkage(spec, *unpack(v), s0)
