@@ -68,7 +68,8 @@ _LAZY = {
     "pinmech.design.study": ("StudyResult", "study"),
     "pinmech.design.study_file": ("StudySpec", "load_study"),
     "pinmech.design.synthesis_file": ("SynthesisSpec", "load_synthesis"),
-    "pinmech.design.synthesis_search": ("Linkage", "SynthesisResult", "synthesise"),
+    "pinmech.design.synthesis_result": ("Linkage", "SynthesisResult"),
+    "pinmech.design.synthesis_search": ("synthesise",),
     "pinmech.io.sweep": ("Sweep", "SweepPose"),
     "pinmech.units": ("to_si",),
 }

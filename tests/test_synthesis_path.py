@@ -15,7 +15,7 @@ from pinmech.design.synthesis_file import SynthesisSpec
 from pinmech.design.synthesis_fourbar import folds, point_jacobian, pose
 from pinmech.design.synthesis_linkage import engine_check, write_linkage
 from pinmech.design.synthesis_motion import CAUSES
-from pinmech.design.synthesis_objective import evaluate
+from pinmech.design.synthesis_objective import evaluate_path as evaluate
 from pinmech.design.synthesis_search import synthesise
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -56,9 +56,10 @@ def cmd_synth(args: argparse.Namespace) -> int:
             files = write_linkage(lk, f"{args.out}_{i}", f"{spec.title}: linkage {i}", str(spec.path))
             check = engine_check(files[1], lk, spec.targets)
             entry["files"] = [str(p) for p in files]
-            entry["engine_errors_mm"] = [float(e) * 1e3 for e in check.errors]
+            scale, unit = (1e3, "mm") if lk.task == "path" else (180 / 3.141592653589793, "deg")
+            entry[f"engine_errors_{unit}"] = [float(e) * scale for e in check.errors]
             lines.append(f"linkage {i}: {files[0]}; the engine (pinmech sweep of {files[1]}) meets the targets "
-                         f"within {check.errors.max() * 1e3:.3g} mm")
+                         f"within {check.errors.max() * scale:.3g} {unit}")
             written += files
         json_path = f"{args.out}.json"
         with open(json_path, "w", encoding="utf-8") as f:

@@ -41,12 +41,13 @@ from pinmech.exceptions import SceneError
 from pinmech.toml_file import read_toml
 from pinmech.units import to_si
 
-TASKS = ("path",)
+TASKS = ("path", "function")
 TOPOLOGIES = ("four-bar",)
 CLASSES = ("any", "grashof", "crank-rocker", "double-crank", "double-rocker", "triple rocker")
 DIRECTIONS = ("ccw", "cw", "either")
 _TOP = {"title", "task", "topology", "targets", "timing", "seed", "population", "generations", "keep",
-        "bounds", "constraints"}
+        "bounds", "constraints", "pairs", "ground"}
+_ONLY = {"targets": "path", "timing": "path", "pairs": "function", "ground": "function"}
 _BOUNDS = ("O2", "O4", "crank", "coupler", "rocker", "point")
 _CONSTRAINTS = {"grashof", "transmission", "ratio", "direction"}
 _LIMITS = {"seed": (0, 2**32 - 1), "population": (5, 1000), "generations": (1, 100_000), "keep": (1, 20)}
@@ -57,11 +58,14 @@ class SynthesisSpec:
     """A validated synthesis file (SI: m, rad).
 
     Attributes:
-        targets: (N, 2) the coupler point's targets in the order of the motion [m].
+        targets: (N, 2) the coupler point's targets in the order of the motion [m]; for a
+            function, the pairs (crank turn, rocker turn) from the first pair [rad].
         timing: (N,) the crank's turn from the first target to each [rad], or None
             (then the crank angles are free, their order checked).
         lower, upper: (9,) bounds of (O2x, O2y, O4x, O4y, crank, coupler, rocker, along,
-            across) [m] (synthesis_fourbar.NAMES).
+            across) [m] (synthesis_fourbar.NAMES); for a function (3,) of crank, coupler,
+            rocker [m].
+        ground: a function generator's ground O2 -> O4 along x [m] (0 for a path).
         grashof: the Grashof class asked ("any": none).
         transmission: the least transmission angle allowed over the motion [rad].
         ratio: the longest link over the shortest, at most.
@@ -77,6 +81,7 @@ class SynthesisSpec:
     lower: np.ndarray
     upper: np.ndarray
     grashof: str = "any"
+    ground: float = 0.0
     transmission: float = 0.0
     ratio: float = math.inf
     direction: str = "either"
@@ -101,9 +106,18 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
     w.known(raw, _TOP, "")
     task = w.choice(raw, "task", TASKS, None)
     topology = w.choice(raw, "topology", TOPOLOGIES, "four-bar")
-    targets = _targets(raw, w)
-    timing = _timing(raw, w, len(targets)) if "timing" in raw else None
-    lower, upper = _bounds(raw, w)
+    for key, only in _ONLY.items():
+        if key in raw and task != only:
+            raise w.error(key, f"{key} is for task = \"{only}\" (this file's task is {task!r})")
+    if task == "function":
+        targets, timing = _pairs(raw, w), None
+        lower, upper = _bounds(raw, w, ("crank", "coupler", "rocker"))
+        ground = w.positive_length(raw, "ground")
+    else:
+        targets = _targets(raw, w)
+        timing = _timing(raw, w, len(targets)) if "timing" in raw else None
+        lower, upper = _bounds(raw, w, _BOUNDS)
+        ground = 0.0
     c = raw.get("constraints", {})
     w.known(c, _CONSTRAINTS, "constraints")
     transmission = w.quantity(c, "transmission", "angle", "constraints") if "transmission" in c else 0.0
@@ -114,7 +128,7 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
         raise w.error("constraints.ratio", f"ratio = {ratio!r} must be a number above 1 (longest / shortest link)")
     counts = {k: w.whole(raw, k, d) for k, d in (("seed", 0), ("population", 20), ("generations", 400), ("keep", 3))}
     return SynthesisSpec(path, str(raw.get("title", path.stem)), task, topology, targets, timing, lower, upper,
-                         w.choice(c, "grashof", CLASSES, "any", "constraints"), transmission, float(ratio),
+                         w.choice(c, "grashof", CLASSES, "any", "constraints"), ground, transmission, float(ratio),
                          w.choice(c, "direction", DIRECTIONS, "either", "constraints"), **counts)
 
 
@@ -135,6 +149,25 @@ def _targets(raw: dict[str, Any], w: _Where) -> np.ndarray:
     return out
 
 
+def _pairs(raw: dict[str, Any], w: _Where) -> np.ndarray:
+    value = raw.get("pairs")
+    if not isinstance(value, list) or len(value) < 3:
+        raise w.error("pairs", "give at least 3 pairs [crank turn, rocker turn] from the first, e.g. "
+                      "[[\"0 deg\", \"0 deg\"], [\"30 deg\", \"12 deg\"], ...]")
+    rows = []
+    for i, t in enumerate(value):
+        if not isinstance(t, list) or len(t) != 2:
+            raise w.error(f"pairs[{i}]", f"{t!r} must be [crank turn, rocker turn] with units")
+        rows.append([to_si(x, "angle", where=f"{w.path}, pairs[{i}]") for x in t])
+    out = np.array(rows)
+    if np.any(out[0] != 0):
+        raise w.error("pairs[0]", "the first pair is the start: [\"0 deg\", \"0 deg\"]")
+    step = np.diff(out[:, 0])
+    if not (np.all(step > 0) or np.all(step < 0)) or abs(out[-1, 0]) >= 2 * math.pi:
+        raise w.error("pairs", "the crank turns must grow (ccw) or fall (cw) strictly, within one turn")
+    return out
+
+
 def _timing(raw: dict[str, Any], w: _Where, n: int) -> np.ndarray:
     value = raw["timing"]
     if not isinstance(value, list) or len(value) != n:
@@ -147,15 +180,17 @@ def _timing(raw: dict[str, Any], w: _Where, n: int) -> np.ndarray:
     return t
 
 
-def _bounds(raw: dict[str, Any], w: _Where) -> tuple[np.ndarray, np.ndarray]:
+def _bounds(raw: dict[str, Any], w: _Where, names: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
     table = raw.get("bounds")
-    w.known(table, set(_BOUNDS), "bounds")
-    missing = [k for k in _BOUNDS if k not in table]
+    w.known(table, set(names), "bounds")
+    missing = [k for k in names if k not in table]
     if missing:
         raise w.error("bounds", f"missing {', '.join(missing)}: every parameter needs [lower, upper]")
     pairs = []
     for name, axes in (("O2", ("x", "y")), ("O4", ("x", "y")), ("crank", ()), ("coupler", ()), ("rocker", ()),
                        ("point", ("along", "across"))):
+        if name not in names:
+            continue
         entry = table[name]
         if axes:
             w.known(entry, set(axes), f"bounds.{name}")
@@ -195,6 +230,14 @@ class _Where:
         low, high = _LIMITS[key]
         if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
             raise self.error(key, f"{key} = {value!r} must be a whole number from {low} to {high}")
+        return value
+
+    def positive_length(self, raw: dict, key: str) -> float:
+        if key not in raw:
+            raise self.error(key, f"give {key} = \"100 mm\" (the ground O2 -> O4)")
+        value = to_si(raw[key], "length", where=f"{self.path}, {key}")
+        if not value > 0:
+            raise self.error(key, f"{key} = {raw[key]!r} must be a positive length")
         return value
 
     def quantity(self, table: dict, name: str, kind: str, under: str) -> float:

@@ -129,3 +129,31 @@ def point_jacobian(z: np.ndarray, s: float, theta: np.ndarray) -> tuple[np.ndarr
     dP_z += dP_dphi3[:, :, None] * dphi3_z[:, None, :]
     dP_t = r2 * dt + dP_dphi3 * dphi3_t[:, None]
     return P, dP_z, dP_t
+
+
+def rocker_jacobian(z: np.ndarray, s: float, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The rocker's angle phi4 (direction O4 -> B) at crank angles theta (m,) of one
+    linkage z (9,), and its exact derivatives from the same loop equation as
+    `point_jacobian`: dphi = -G_phi^-1 (G_z dz + G_theta dtheta), second row.
+
+    Returns:
+        phi4 (m,) [rad], dphi4/dz (m, 9) [rad/m], dphi4/dtheta (m,) [rad/rad].
+    """
+    z = np.asarray(z, dtype=float)
+    theta = np.asarray(theta, dtype=float)
+    p = pose(z[None], np.array([s]), theta[None])
+    A, B = p.A[0], p.B[0]
+    r2, r3, r4 = z[4:7]
+    e3, e4 = (B - A) / r3, (B - z[2:4]) / r4
+    perp = np.array([[0.0, -1.0], [1.0, 0.0]])
+    d3, d4 = e3 @ perp.T, e4 @ perp.T
+    m = len(theta)
+    et = np.stack((np.cos(theta), np.sin(theta)), -1)
+    G_phi = np.stack((r3 * d3, -r4 * d4), -1)
+    G_z = np.zeros((m, 2, 9))
+    G_z[:, :, 0:2] = np.eye(2)
+    G_z[:, :, 2:4] = -np.eye(2)
+    G_z[:, :, 4], G_z[:, :, 5], G_z[:, :, 6] = et, e3, -e4
+    G_t = r2 * (et @ perp.T)
+    inv = np.linalg.inv(G_phi)  # LinAlgError at a fold
+    return (np.arctan2(e4[:, 1], e4[:, 0]), -(inv @ G_z)[:, 1, :], -(inv @ G_t[..., None])[:, 1, 0])

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from pinmech.design.synthesis_fourbar import pose
-from pinmech.design.synthesis_search import Linkage
+from pinmech.design.synthesis_result import Linkage
 
 _STEP = math.radians(1.0)  # the engine's sweep: at most this crank step between poses
 
@@ -34,8 +34,10 @@ def linkage_toml(lk: Linkage, title: str, source: str) -> str:
     A, P = p.A[0, 0], p.P[0, 0]
     z = lk.z
     side = "left" if lk.s > 0 else "right"
+    path = lk.task == "path"
+    what = "the coupler point P through the targets" if path else "the rocker's turns as the function asks"
     return "\n".join([
-        f"# Synthesised by `pinmech synth {source}`: the coupler point P through the targets.",
+        f"# Synthesised by `pinmech synth {source}`: {what}.",
         f"# Drawn at the first target's pose (crank O2 at {math.degrees(lk.theta[0]):.6g} deg from x).",
         f"title = \"{title}\"",
         "ground = [\"O2\", \"O4\"]",
@@ -45,11 +47,11 @@ def linkage_toml(lk: Linkage, title: str, source: str) -> str:
         f"O4 = [{_mm(z[2])}, {_mm(z[3])}]",
         f"A = [{_mm(A[0])}, {_mm(A[1])}]",
         f"B = {{ from = [\"A\", \"O4\"], lengths = [{_mm(z[5])}, {_mm(z[6])}], side = \"{side}\" }}",
-        f"P = [{_mm(P[0])}, {_mm(P[1])}]",
+        *([f"P = [{_mm(P[0])}, {_mm(P[1])}]"] if path else []),
         "",
         "[links]",
         "crank = [\"O2\", \"A\"]",
-        "coupler = [\"A\", \"B\", \"P\"]",
+        "coupler = [\"A\", \"B\", \"P\"]" if path else "coupler = [\"A\", \"B\"]",
         "rocker = [\"O4\", \"B\"]",
         "",
     ])
@@ -66,6 +68,7 @@ def scene_toml(lk: Linkage, linkage_file: str, title: str) -> str:
     sweep over the motion to the last target."""
     values = motion_values(lk)
     steps = int(math.ceil(abs(values[-1] - values[0]) / _STEP)) + 1
+    shown = "points = [\"P\"]" if lk.task == "path" else "links = [\"rocker\"]"
     return "\n".join([
         "# The synthesised linkage swept through its targets:",
         "#   pinmech sweep THIS_FILE --plot fig.png",
@@ -79,10 +82,10 @@ def scene_toml(lk: Linkage, linkage_file: str, title: str) -> str:
         f"from = {_deg(values[0])}",
         f"to = {_deg(values[-1])}",
         f"steps = {steps}",
-        "points = [\"P\"]",
+        shown,
         "",
         "[report]",
-        "points = [\"P\"]",
+        shown,
         "",
     ])
 
@@ -98,8 +101,9 @@ def write_linkage(lk: Linkage, prefix: str | Path, title: str, source: str) -> t
 
 @dataclass(frozen=True)
 class EngineCheck:
-    """The engine's coupler point at each target's crank angle [m], solved by continuation
-    from the first target's pose on the drawn assembly, and its distance to the targets [m]."""
+    """The engine's coupler point at each target's crank angle [m] (a function: the rocker's
+    angle [rad]), solved by continuation from the first target's pose on the drawn assembly,
+    and its distance to the targets [m] (the angle errors [rad])."""
 
     points: np.ndarray
     errors: np.ndarray
@@ -122,6 +126,10 @@ def engine_check(scene_file: str | Path, lk: Linkage, targets: np.ndarray) -> En
         dense += list(np.linspace(a, b, n + 1)[1:])
     at = {int(np.argmin(np.abs(np.asarray(dense) - v))) for v in values}
     sweep = Sweep.from_scene(Scene.load(scene_file))
-    points = [p.motion.points["P"].position[:2] for p in sweep.poses(np.asarray(dense)) if p.index in at]
-    P = np.array(points)
-    return EngineCheck(P, np.linalg.norm(P - targets, axis=1))
+    poses = [p.motion for p in sweep.poses(np.asarray(dense)) if p.index in at]
+    if lk.task == "path":
+        P = np.array([m.points["P"].position[:2] for m in poses])
+        return EngineCheck(P, np.linalg.norm(P - targets, axis=1))
+    phi = np.array([m.links["rocker"].angle for m in poses])
+    wanted = lk.phi0 + targets[:, 1]  # the rocker's angles asked: its start plus the pairs' turns
+    return EngineCheck(phi, np.abs(np.mod(phi - wanted + math.pi, 2 * math.pi) - math.pi))

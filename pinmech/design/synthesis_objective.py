@@ -46,7 +46,7 @@ def split(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return x[:, :9], theta0
 
 
-def search_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
+def path_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
     """The bounds of a search row: the file's, and with timing theta0."""
     timed = [(-math.pi, math.pi)] if spec.timing is not None else []
     return [*zip(spec.lower.tolist(), spec.upper.tolist()), *timed]
@@ -76,7 +76,7 @@ def nearest_angles(z: np.ndarray, s: np.ndarray, targets: np.ndarray) -> np.ndar
     return np.where(found, theta, np.nan)
 
 
-def evaluate(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchValues:
+def evaluate_path(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchValues:
     """The objective of search rows x (n, 9 or 10) on one assembly (+1 or -1), row by row
     (the same numbers however the rows are split into batches)."""
     z, theta0 = split(np.atleast_2d(np.asarray(x, dtype=float)))

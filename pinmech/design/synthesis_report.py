@@ -11,7 +11,7 @@ import numpy as np
 
 from pinmech.design.synthesis_fourbar import NAMES, pose
 from pinmech.design.synthesis_linkage import motion_values
-from pinmech.design.synthesis_search import Linkage, SynthesisResult
+from pinmech.design.synthesis_result import Linkage, SynthesisResult
 
 DEFECTS = {
     "branch": "none: every pose on one assembly (B {side} of A -> O4), by construction",
@@ -29,8 +29,9 @@ def linkage_summary(lk: Linkage) -> dict:
         "assembly": side,
         "grashof": lk.grashof,
         "crank_deg": [round(math.degrees(v), 6) for v in motion_values(lk)],
-        "errors_mm": [float(e) * 1e3 for e in lk.errors],
-        "max_error_relative": float(np.max(lk.errors) / lk.size),
+        **({"errors_mm": [float(e) * 1e3 for e in lk.errors], "max_error_relative": float(np.max(lk.errors) / lk.size)}
+           if lk.task == "path" else
+           {"errors_deg": [math.degrees(float(e)) for e in lk.errors], "rocker_start_deg": math.degrees(lk.phi0)}),
         "transmission_deg": [round(math.degrees(v), 3) for v in lk.transmission],
         "defects": {k: v.format(side=side, way=way) for k, v in DEFECTS.items()},
     }
@@ -66,13 +67,20 @@ def text(result: SynthesisResult) -> str:
             f"ground {lk['ground_mm']:.6g}, crank {d['crank']:.6g}, coupler {d['coupler']:.6g}, "
             f"rocker {d['rocker']:.6g} mm, P at {d['along']:.6g} along and {d['across']:.6g} across A->B; "
             f"{lk['grashof']}, assembly {lk['assembly']}",
-            f"  error at each target [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
-            f"(max {lk['max_error_relative']:.3g} of its size)",
+            _errors(lk),
             f"  crank at the targets [deg]: {', '.join(f'{v:.6g}' for v in lk['crank_deg'])}",
             f"  transmission angle over the motion: {lk['transmission_deg'][0]:.4g} .. {lk['transmission_deg'][1]:.4g} deg",
         ]
         lines += [f"  {k} defect: {v}" for k, v in lk["defects"].items()]
     return "\n".join(lines)
+
+
+def _errors(lk: dict) -> str:
+    if "errors_mm" in lk:
+        return (f"  error at each target [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
+                f"(max {lk['max_error_relative']:.3g} of its size)")
+    return (f"  rocker angle error at each pair [deg]: {', '.join(f'{e:.3g}' for e in lk['errors_deg'])} "
+            f"(rocker at {lk['rocker_start_deg']:.6g} deg at the first pair)")
 
 
 def _pyplot():
@@ -89,6 +97,8 @@ def _pyplot():
 def figure(result: SynthesisResult, path: str | Path) -> Path:
     """One panel per linkage: the targets, the coupler curve over the motion (solid) and
     the rest of its turn on the same assembly (dotted), the linkage at the first target."""
+    if result.spec.task == "function":
+        return function_figure(result, path)
     plt = _pyplot()
     n = max(len(result.linkages), 1)
     fig, axes = plt.subplots(1, n, figsize=(4.6 * n + 0.6, 4.6), squeeze=False)
@@ -119,6 +129,33 @@ def figure(result: SynthesisResult, path: str | Path) -> Path:
     if result.linkages:
         axes[0][0].legend(fontsize=7, loc="best")
     fig.suptitle(result.spec.title)
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def function_figure(result: SynthesisResult, path: str | Path) -> Path:
+    """The rocker's turn against the crank's over the motion for each linkage, and the pairs."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    pairs = np.degrees(result.spec.targets)
+    for i, lk in enumerate(result.linkages, start=1):
+        values = motion_values(lk)
+        crank = np.linspace(values[0], values[-1], 300)
+        B = pose(lk.z[None], np.array([lk.s]), crank[None]).B[0]
+        phi = np.unwrap(np.arctan2(B[:, 1], B[:, 0] - lk.z[2]))
+        turn = np.degrees(phi - lk.phi0)
+        turn -= 360 * np.round((turn[0]) / 360)
+        ax.plot(np.degrees(crank - crank[0]), turn, lw=1.5,
+                label=f"linkage {i}: max error {math.degrees(np.max(lk.errors)):.2g} deg")
+    ax.plot(pairs[:, 0], pairs[:, 1], "x", color="tab:red", ms=8, mew=2, label="pairs asked")
+    ax.set_xlabel("crank turn from the first pair [deg]")
+    ax.set_ylabel("rocker turn [deg]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(result.spec.title)
     fig.tight_layout()
     path = Path(path)
     fig.savefig(path, dpi=110)
