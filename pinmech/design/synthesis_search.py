@@ -23,6 +23,8 @@ _EXTRA = 'pip install "pinmech[study]"'
 _CLOSE = 3e-2  # from a best relative rms target error below this, every 10th generation tries a refinement ...
 _MET = 1e-10  # ... and DE stops when the refined best meets every target within this share of its size
 _STRATEGY = "rand1bin"
+_STALL = 100  # generations without a 1 % better best: DE restarts with the next seed
+_RESTART = 7919  # a restart's seed: the file's + this times the restart's number
 _DISTINCT = 0.02  # two linkages whose parameters differ by less than this share of the bounds are one
 
 
@@ -75,15 +77,18 @@ def synthesise(spec: SynthesisSpec, *, workers: int = 0, scheduler: str | None =
 
 def _run(spec: SynthesisSpec, mapper: PopulationMap) -> SynthesisResult:
     """DE on each assembly in turn (the second only if the first found no linkage meeting
-    the targets within _MET), the best distinct refined, best first."""
+    the targets within _MET), restarted with the next seed of the stream when it stalls
+    until the assembly's generations are spent; the best distinct refined, best first."""
     found: list[Linkage] = []
     generations = 0
     for assembly in (1.0, -1.0):
         mapper.assembly = assembly
-        rows, energies, nit = _evolved(spec, mapper, assembly)
-        generations += nit
-        starts = _distinct(spec, rows, energies, 3 * spec.keep) + _classical(spec, assembly, 3 * spec.keep)
-        found += [lk for lk in (refined(spec, assembly, x) for x in starts) if lk is not None]
+        left, restart = spec.generations, 0
+        while left > 0 and not any(lk.meets(_MET) for lk in found):
+            rows, energies, nit = _evolved(spec, mapper, assembly, spec.seed + _RESTART * restart, left)
+            generations, left, restart = generations + nit, left - nit, restart + 1
+            starts = _distinct(spec, rows, energies, 3 * spec.keep) + _classical(spec, assembly, 3 * spec.keep)
+            found += [lk for lk in (refined(spec, assembly, x) for x in starts) if lk is not None]
         if any(lk.meets(_MET) for lk in found):
             break
     found.sort(key=lambda lk: float(np.sum(lk.errors**2)))
@@ -94,16 +99,17 @@ def _run(spec: SynthesisSpec, mapper: PopulationMap) -> SynthesisResult:
     return SynthesisResult(spec, kept[:spec.keep], mapper.rejected, mapper.evaluations, generations)
 
 
-def _evolved(spec: SynthesisSpec, mapper: PopulationMap, assembly: float) -> tuple[np.ndarray, np.ndarray, int]:
+def _evolved(spec: SynthesisSpec, mapper: PopulationMap, assembly: float, seed: int,
+             generations: int) -> tuple[np.ndarray, np.ndarray, int]:
     """DE's final population on one assembly, best first, its objective values and the
-    generations it ran."""
+    generations it ran (at most `generations`; fewer once it meets the targets or stalls)."""
     opt = _scipy_optimize()
 
     def objective(x: np.ndarray) -> float:  # what the map stands for; never called itself
         return float(evaluate(spec, assembly, x[None]).values[0])
 
-    de = opt.differential_evolution(objective, search_bounds(spec), seed=spec.seed, popsize=spec.population,
-                                    maxiter=spec.generations, workers=mapper, updating="deferred", polish=False,
+    de = opt.differential_evolution(objective, search_bounds(spec), seed=seed, popsize=spec.population,
+                                    maxiter=generations, workers=mapper, updating="deferred", polish=False,
                                     init="sobol", tol=0.0, atol=-1.0, mutation=(0.5, 1.0), recombination=0.9,
                                     strategy=_STRATEGY, callback=_stopper(spec, assembly))
     # atol < 0: never "converged" (a population all rejected is flat, not converged)
@@ -113,11 +119,18 @@ def _evolved(spec: SynthesisSpec, mapper: PopulationMap, assembly: float) -> tup
 
 def _stopper(spec: SynthesisSpec, assembly: float):
     """DE's callback: True (stop) once the best so far refines to a linkage that meets
-    every target within _MET of its size (tried every 10th generation from _CLOSE on)."""
+    every target within _MET of its size (tried every 10th generation from _CLOSE on), or
+    once the best has not fallen by 1 % in _STALL generations (a restart does better)."""
     count = iter(range(10**9))
+    best = [np.inf, 0]  # the best objective that was 1 % below the one before, and its generation
 
     def callback(intermediate_result) -> bool:
-        if next(count) % 10 or intermediate_result.fun > _CLOSE**2 * len(spec.targets):
+        k = next(count)
+        if intermediate_result.fun < 0.99 * best[0]:
+            best[:] = [intermediate_result.fun, k]
+        if k - best[1] >= _STALL:
+            return True
+        if k % 10 or intermediate_result.fun > _CLOSE**2 * len(spec.targets):
             return False
         lk = refined(spec, assembly, intermediate_result.x)
         return lk is not None and lk.meets(_MET)
