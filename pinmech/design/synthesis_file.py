@@ -25,6 +25,16 @@
     ratio = 6                         # longest / shortest link at most
     direction = "either"              # the crank's turn: "ccw", "cw" or "either"
 
+A function-generation task (the rocker's turns a function of the crank's):
+
+    task = "function"
+    ground = "100 mm"                 # O2 at (0, 0), O4 at (ground, 0)
+    pairs = [["0 deg", "0 deg"], ["10.9 deg", "21.2 deg"], ...]   # [crank turn, rocker turn]
+    [bounds]
+    crank = ["20 mm", "300 mm"]
+    coupler = ["20 mm", "300 mm"]
+    rocker = ["20 mm", "300 mm"]
+
 Every mistake is a SceneError naming the synthesis file and the key.
 """
 
