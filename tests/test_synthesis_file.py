@@ -80,3 +80,25 @@ def test_the_example_writes_linkages_the_engine_reproduces(tmp_path, capsys):
     assert max(abs(a - b) for a, b in zip(best["errors_mm"], best["engine_errors_mm"])) < 1e-9
     assert (tmp_path / "fbp.png").stat().st_size > 10_000
     assert main(["solve", best["files"][1]]) == 0
+
+
+FUNCTION = ROOT / "models" / "synthesis" / "four_bar_function.toml"
+
+
+@pytest.mark.parametrize("old, new, key", [
+    ('ground = "100 mm"', 'ground = "-100 mm"', "ground"),
+    ('ground = "100 mm"', '', "ground"),
+    ('["0.0000 deg", "0.0000 deg"],', '["1 deg", "0 deg"],', "pairs[0]"),
+    ('["10.8981 deg", "21.1930 deg"]', '["10.8981 mm", "21.1930 deg"]', "pairs[1]"),
+    ('["28.5317 deg", "49.5074 deg"]', '["5 deg", "49.5074 deg"]', "pairs"),
+    ('ground = "100 mm"', 'ground = "100 mm"\ntargets = [["0 mm", "0 mm"]]', "targets"),
+    ('coupler = ["20 mm", "300 mm"]', 'coupler = ["20 mm", "300 mm"]\npoint = ["0 mm", "1 mm"]', "bounds.point"),
+])
+def test_a_bad_function_file_is_one_line_naming_file_and_key(tmp_path, capsys, old, new, key):
+    text = FUNCTION.read_text(encoding="utf-8")
+    assert old in text
+    path = tmp_path / "bad.toml"
+    path.write_text(text.replace(old, new, 1), encoding="utf-8")
+    assert main(["synth", str(path)]) == 4
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and str(path) in err and re.search(rf"[ ,]{re.escape(key)}[:,. ]", err), err
