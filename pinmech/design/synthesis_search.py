@@ -12,10 +12,11 @@ in the same arithmetic and gathered in order, and DE updates it once per generat
 from __future__ import annotations
 
 from collections import Counter
+from pathlib import Path
 
 import numpy as np
 
-from pinmech.design.synthesis_file import SynthesisSpec
+from pinmech.design.synthesis_file import SynthesisSpec, load_synthesis
 from pinmech.design.synthesis_result import Linkage, SynthesisResult
 from pinmech.design.synthesis_tasks import classical_rows, evaluate, refined, search_bounds
 
@@ -54,13 +55,16 @@ class PopulationMap:
         return values
 
 
-def synthesise(spec: SynthesisSpec, *, workers: int = 0, scheduler: str | None = None) -> SynthesisResult:
+def synthesise(spec: SynthesisSpec | str | Path, *, workers: int = 0, scheduler: str | None = None) -> SynthesisResult:
     """The best distinct linkages (up to spec.keep) that meet the targets without defects.
 
     Args:
+        spec: a synthesis file's spec, or the file (read with load_synthesis).
         workers: 0 evaluates in this process; n > 0 on a LocalCluster of n worker
             processes (unless a scheduler address is given).
     """
+    if not isinstance(spec, SynthesisSpec):
+        spec = load_synthesis(spec)
     if scheduler is None and workers == 0:
         return _run(spec, PopulationMap(spec))
     from pinmech.design.cluster import require_dask
