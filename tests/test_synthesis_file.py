@@ -93,6 +93,7 @@ FUNCTION = ROOT / "models" / "synthesis" / "four_bar_function.toml"
     ('["28.5317 deg", "49.5074 deg"]', '["5 deg", "49.5074 deg"]', "pairs"),
     ('ground = "100 mm"', 'ground = "100 mm"\ntargets = [["0 mm", "0 mm"]]', "targets"),
     ('coupler = ["20 mm", "300 mm"]', 'coupler = ["20 mm", "300 mm"]\npoint = ["0 mm", "1 mm"]', "bounds.point"),
+    ('ratio = 6', 'ratio = 6\ndirection = "cw"', "constraints.direction"),
 ])
 def test_a_bad_function_file_is_one_line_naming_file_and_key(tmp_path, capsys, old, new, key):
     text = FUNCTION.read_text(encoding="utf-8")

@@ -136,10 +136,15 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
     ratio = c.get("ratio", math.inf)
     if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not ratio > 1:
         raise w.error("constraints.ratio", f"ratio = {ratio!r} must be a number above 1 (longest / shortest link)")
+    direction = w.choice(c, "direction", DIRECTIONS, "either", "constraints")
+    turns = timing if timing is not None else targets[:, 0] if task == "function" else None
+    if turns is not None and direction != "either" and (turns[-1] > 0) != (direction == "ccw"):
+        raise w.error("constraints.direction", f"direction = {direction!r}, but the crank's turns given go "
+                      f"{'ccw' if turns[-1] > 0 else 'cw'}")
     counts = {k: w.whole(raw, k, d) for k, d in (("seed", 0), ("population", 20), ("generations", 400), ("keep", 3))}
     return SynthesisSpec(path, str(raw.get("title", path.stem)), task, topology, targets, timing, lower, upper,
                          w.choice(c, "grashof", CLASSES, "any", "constraints"), ground, transmission, float(ratio),
-                         w.choice(c, "direction", DIRECTIONS, "either", "constraints"), **counts)
+                         direction, **counts)
 
 
 def _targets(raw: dict[str, Any], w: _Where) -> np.ndarray:
