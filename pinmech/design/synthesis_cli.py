@@ -54,12 +54,16 @@ def cmd_synth(args: argparse.Namespace) -> int:
     if args.out:
         for i, (lk, entry) in enumerate(zip(result.linkages, report["linkages"]), start=1):
             files = write_linkage(lk, f"{args.out}_{i}", f"{spec.title}: linkage {i}", str(spec.path))
-            check = engine_check(files[1], lk, spec.targets)
+            check = engine_check(files[1], lk, spec.targets, spec.angles)
             entry["files"] = [str(p) for p in files]
-            scale, unit = (1e3, "mm") if lk.task == "path" else (180 / 3.141592653589793, "deg")
+            scale, unit = (1e3, "mm") if lk.task != "function" else (180 / 3.141592653589793, "deg")
             entry[f"engine_errors_{unit}"] = [float(e) * scale for e in check.errors]
+            also = ""
+            if check.angle_errors is not None:
+                entry["engine_angle_errors_deg"] = [float(e) * 180 / 3.141592653589793 for e in check.angle_errors]
+                also = f" and {max(entry['engine_angle_errors_deg']):.3g} deg"
             lines.append(f"linkage {i}: {files[0]}; the engine (pinmech sweep of {files[1]}) meets the targets "
-                         f"within {check.errors.max() * scale:.3g} {unit}")
+                         f"within {check.errors.max() * scale:.3g} {unit}{also}")
             written += files
         json_path = f"{args.out}.json"
         with open(json_path, "w", encoding="utf-8") as f:

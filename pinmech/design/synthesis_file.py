@@ -35,6 +35,11 @@ A function-generation task (the rocker's turns a function of the crank's):
     coupler = ["20 mm", "300 mm"]
     rocker = ["20 mm", "300 mm"]
 
+A motion-generation task (the coupler through poses): `task = "motion"`, `poses =
+[["x", "y", "angle"], ...]` (the coupler point's place and the coupler's angle) instead
+of `targets`, the path's bounds (the angle between the poses' angles and the bar A -> B
+is searched as well).
+
 Every mistake is a SceneError naming the synthesis file and the key.
 """
 
@@ -51,13 +56,13 @@ from pinmech.exceptions import SceneError
 from pinmech.toml_file import read_toml
 from pinmech.units import to_si
 
-TASKS = ("path", "function")
+TASKS = ("path", "function", "motion")
 TOPOLOGIES = ("four-bar",)
 CLASSES = ("any", "grashof", "crank-rocker", "double-crank", "double-rocker", "triple rocker")
 DIRECTIONS = ("ccw", "cw", "either")
 _TOP = {"title", "task", "topology", "targets", "timing", "seed", "population", "generations", "keep",
-        "bounds", "constraints", "pairs", "ground"}
-_ONLY = {"targets": "path", "timing": "path", "pairs": "function", "ground": "function"}
+        "bounds", "constraints", "pairs", "ground", "poses"}
+_ONLY = {"targets": "path", "timing": "path", "pairs": "function", "ground": "function", "poses": "motion"}
 _BOUNDS = ("O2", "O4", "crank", "coupler", "rocker", "point")
 _CONSTRAINTS = {"grashof", "transmission", "ratio", "direction"}
 _LIMITS = {"seed": (0, 2**32 - 1), "population": (5, 1000), "generations": (1, 100_000), "keep": (1, 20)}
@@ -76,6 +81,8 @@ class SynthesisSpec:
             across) [m] (synthesis_fourbar.NAMES); for a function (3,) of crank, coupler,
             rocker [m].
         ground: a function generator's ground O2 -> O4 along x [m] (0 for a path).
+        angles: (N,) the coupler's angles at the poses of a motion task [rad] (its
+            positions are `targets`), else None.
         grashof: the Grashof class asked ("any": none).
         transmission: the least transmission angle allowed over the motion [rad].
         ratio: the longest link over the shortest, at most.
@@ -99,6 +106,7 @@ class SynthesisSpec:
     population: int = 20
     generations: int = 400
     keep: int = 3
+    angles: np.ndarray | None = None
 
     def __hash__(self) -> int:
         return hash((self.path, self.title, self.targets.tobytes(), self.seed))
@@ -124,7 +132,7 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
         lower, upper = _bounds(raw, w, ("crank", "coupler", "rocker"))
         ground = w.positive_length(raw, "ground")
     else:
-        targets = _targets(raw, w)
+        targets = _targets(raw, w, "poses" if task == "motion" else "targets")
         timing = _timing(raw, w, len(targets)) if "timing" in raw else None
         lower, upper = _bounds(raw, w, _BOUNDS)
         ground = 0.0
@@ -142,25 +150,32 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
         raise w.error("constraints.direction", f"direction = {direction!r}, but the crank's turns given go "
                       f"{'ccw' if turns[-1] > 0 else 'cw'}")
     counts = {k: w.whole(raw, k, d) for k, d in (("seed", 0), ("population", 20), ("generations", 400), ("keep", 3))}
+    angles = None
+    if task == "motion":
+        targets, angles = targets[:, :2].copy(), targets[:, 2].copy()
     return SynthesisSpec(path, str(raw.get("title", path.stem)), task, topology, targets, timing, lower, upper,
                          w.choice(c, "grashof", CLASSES, "any", "constraints"), ground, transmission, float(ratio),
-                         direction, **counts)
+                         direction, angles=angles, **counts)
 
 
-def _targets(raw: dict[str, Any], w: _Where) -> np.ndarray:
-    value = raw.get("targets")
+def _targets(raw: dict[str, Any], w: _Where, key: str = "targets") -> np.ndarray:
+    """Path targets [x, y] [m], or motion poses [x, y, angle] [m, m, rad] (key "poses")."""
+    value = raw.get(key)
+    width, example = (3, '["120 mm", "35 mm", "30 deg"]') if key == "poses" else (2, '["120 mm", "35 mm"]')
     if not isinstance(value, list) or len(value) < 3:
-        raise w.error("targets", "give at least 3 targets, [[\"120 mm\", \"35 mm\"], ...], in the order of the motion")
+        raise w.error(key, f"give at least 3 {key}, [{example}, ...], in the order of the motion")
     rows = []
     for i, t in enumerate(value):
-        if not isinstance(t, list) or len(t) != 2:
-            raise w.error(f"targets[{i}]", f"{t!r} must be [x, y] with units, e.g. [\"120 mm\", \"35 mm\"]")
-        rows.append([to_si(x, "length", where=f"{w.path}, targets[{i}]") for x in t])
+        if not isinstance(t, list) or len(t) != width:
+            raise w.error(f"{key}[{i}]", f"{t!r} must be {'[x, y, angle]' if width == 3 else '[x, y]'} with units, "
+                          f"e.g. {example}")
+        kinds = ("length", "length", "angle")[:width]
+        rows.append([to_si(x, kind, where=f"{w.path}, {key}[{i}]") for x, kind in zip(t, kinds)])
     out = np.array(rows)
-    gaps = np.linalg.norm(np.diff(out, axis=0), axis=1)
+    gaps = np.linalg.norm(np.diff(out[:, :2], axis=0), axis=1)
     if np.any(gaps == 0):
         i = int(np.argmin(gaps))
-        raise w.error(f"targets[{i + 1}]", f"target {i + 1} repeats target {i}")
+        raise w.error(f"{key}[{i + 1}]", f"{key}[{i + 1}] is at {key}[{i}]'s place")
     return out
 
 

@@ -133,11 +133,18 @@ def point_jacobian(z: np.ndarray, s: float, theta: np.ndarray) -> tuple[np.ndarr
 
 def rocker_jacobian(z: np.ndarray, s: float, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The rocker's angle phi4 (direction O4 -> B) at crank angles theta (m,) of one
-    linkage z (9,), and its exact derivatives from the same loop equation as
-    `point_jacobian`: dphi = -G_phi^-1 (G_z dz + G_theta dtheta), second row.
+    linkage z (9,), and its exact derivatives: `link_angle_jacobian` of the rocker."""
+    return link_angle_jacobian(z, s, theta, 1)
+
+
+def link_angle_jacobian(z: np.ndarray, s: float, theta: np.ndarray,
+                        link: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The coupler's (link 0: direction A -> B) or the rocker's (link 1: O4 -> B) angle at
+    crank angles theta (m,) of one linkage z (9,), and its exact derivatives from the loop
+    equation of `point_jacobian`: dphi = -G_phi^-1 (G_z dz + G_theta dtheta), row `link`.
 
     Returns:
-        phi4 (m,) [rad], dphi4/dz (m, 9) [rad/m], dphi4/dtheta (m,) [rad/rad].
+        phi (m,) [rad], dphi/dz (m, 9) [rad/m], dphi/dtheta (m,) [rad/rad].
     """
     z = np.asarray(z, dtype=float)
     theta = np.asarray(theta, dtype=float)
@@ -156,4 +163,5 @@ def rocker_jacobian(z: np.ndarray, s: float, theta: np.ndarray) -> tuple[np.ndar
     G_z[:, :, 4], G_z[:, :, 5], G_z[:, :, 6] = et, e3, -e4
     G_t = r2 * (et @ perp.T)
     inv = np.linalg.inv(G_phi)  # LinAlgError at a fold
-    return (np.arctan2(e4[:, 1], e4[:, 0]), -(inv @ G_z)[:, 1, :], -(inv @ G_t[..., None])[:, 1, 0])
+    e = (e3, e4)[link]
+    return (np.arctan2(e[:, 1], e[:, 0]), -(inv @ G_z)[:, link, :], -(inv @ G_t[..., None])[:, link, 0])

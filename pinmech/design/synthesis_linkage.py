@@ -34,8 +34,9 @@ def linkage_toml(lk: Linkage, title: str, source: str) -> str:
     A, P = p.A[0, 0], p.P[0, 0]
     z = lk.z
     side = "left" if lk.s > 0 else "right"
-    path = lk.task == "path"
-    what = "the coupler point P through the targets" if path else "the rocker's turns as the function asks"
+    path = lk.task != "function"
+    what = {"path": "the coupler point P through the targets", "motion": "the coupler through the poses",
+            "function": "the rocker's turns as the function asks"}[lk.task]
     return "\n".join([
         f"# Synthesised by `pinmech synth {source}`: {what}.",
         f"# Drawn at the first target's pose (crank O2 at {math.degrees(lk.theta[0]):.6g} deg from x).",
@@ -68,7 +69,8 @@ def scene_toml(lk: Linkage, linkage_file: str, title: str) -> str:
     sweep over the motion to the last target."""
     values = motion_values(lk)
     steps = int(math.ceil(abs(values[-1] - values[0]) / _STEP)) + 1
-    shown = "points = [\"P\"]" if lk.task == "path" else "links = [\"rocker\"]"
+    shown = {"path": "points = [\"P\"]", "motion": "points = [\"P\"]\nlinks = [\"coupler\"]",
+             "function": "links = [\"rocker\"]"}[lk.task]
     return "\n".join([
         "# The synthesised linkage swept through its targets:",
         "#   pinmech sweep THIS_FILE --plot fig.png",
@@ -107,9 +109,11 @@ class EngineCheck:
 
     points: np.ndarray
     errors: np.ndarray
+    angle_errors: np.ndarray | None = None  # a motion's coupler angles against the poses' [rad]
 
 
-def engine_check(scene_file: str | Path, lk: Linkage, targets: np.ndarray) -> EngineCheck:
+def engine_check(scene_file: str | Path, lk: Linkage, targets: np.ndarray,
+                 angles: np.ndarray | None = None) -> EngineCheck:
     """Solve the written scene through the motion with the engine (pinmech sweep's path),
     poses at most _STEP apart, and read P at the targets.
 
@@ -127,9 +131,12 @@ def engine_check(scene_file: str | Path, lk: Linkage, targets: np.ndarray) -> En
     at = {int(np.argmin(np.abs(np.asarray(dense) - v))) for v in values}
     sweep = Sweep.from_scene(Scene.load(scene_file))
     poses = [p.motion for p in sweep.poses(np.asarray(dense)) if p.index in at]
-    if lk.task == "path":
+    if lk.task != "function":
         P = np.array([m.points["P"].position[:2] for m in poses])
-        return EngineCheck(P, np.linalg.norm(P - targets, axis=1))
+        if lk.task == "path":
+            return EngineCheck(P, np.linalg.norm(P - targets, axis=1))
+        turn = np.array([m.links["coupler"].angle for m in poses]) + lk.phi0 - angles
+        return EngineCheck(P, np.linalg.norm(P - targets, axis=1), np.abs(np.mod(turn + math.pi, 2 * math.pi) - math.pi))
     phi = np.array([m.links["rocker"].angle for m in poses])
     wanted = lk.phi0 + targets[:, 1]  # the rocker's angles asked: its start plus the pairs' turns
     return EngineCheck(phi, np.abs(np.mod(phi - wanted + math.pi, 2 * math.pi) - math.pi))

@@ -30,8 +30,10 @@ def linkage_summary(lk: Linkage) -> dict:
         "grashof": lk.grashof,
         "crank_deg": [round(math.degrees(v), 6) for v in motion_values(lk)],
         **({"errors_mm": [float(e) * 1e3 for e in lk.errors], "max_error_relative": float(np.max(lk.errors) / lk.size)}
-           if lk.task == "path" else
+           if lk.task != "function" else
            {"errors_deg": [math.degrees(float(e)) for e in lk.errors], "rocker_start_deg": math.degrees(lk.phi0)}),
+        **({"angle_errors_deg": [math.degrees(float(e)) for e in lk.angle_errors],
+            "offset_deg": math.degrees(lk.phi0)} if lk.angle_errors is not None else {}),
         "transmission_deg": [round(math.degrees(v), 3) for v in lk.transmission],
         "defects": {k: v.format(side=side, way=way) for k, v in DEFECTS.items()},
     }
@@ -76,6 +78,11 @@ def text(result: SynthesisResult) -> str:
 
 
 def _errors(lk: dict) -> str:
+    if "angle_errors_deg" in lk:
+        return (f"  error at each pose [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
+                f"(max {lk['max_error_relative']:.3g} of its size); [deg]: "
+                f"{', '.join(f'{e:.3g}' for e in lk['angle_errors_deg'])} (the poses' angle is A->B's + "
+                f"{lk['offset_deg']:.6g} deg)")
     if "errors_mm" in lk:
         return (f"  error at each target [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
                 f"(max {lk['max_error_relative']:.3g} of its size)")
@@ -117,6 +124,15 @@ def figure(result: SynthesisResult, path: str | Path) -> Path:
         ax.fill(*np.array([A, B, P]).T, color="tab:orange", alpha=0.3)
         ax.plot(*np.array([O2, O4]).T, "^", color="k", ms=8)
         ax.plot(T[:, 0], T[:, 1], "x", color="tab:red", ms=8, mew=2, label="targets")
+        if result.spec.angles is not None:  # the poses' angles, and the coupler's at each pose
+            L = 0.15 * float(np.ptp(T, axis=0).max())
+            a = result.spec.angles
+            ax.quiver(T[:, 0], T[:, 1], np.cos(a), np.sin(a), color="tab:red", angles="xy", scale_units="xy",
+                      scale=1 / L, width=0.006, label="pose angles")
+            q = pose(lk.z[None], s, lk.theta[None])
+            c = np.arctan2(q.B[0, :, 1] - q.A[0, :, 1], q.B[0, :, 0] - q.A[0, :, 0]) + lk.phi0
+            ax.quiver(q.P[0, :, 0] * 1e3, q.P[0, :, 1] * 1e3, np.cos(c), np.sin(c), color="tab:blue",
+                      angles="xy", scale_units="xy", scale=1 / L, width=0.003, label="coupler at the poses")
         for k, t in enumerate(T, start=1):
             ax.annotate(str(k), t, textcoords="offset points", xytext=(4, 4), fontsize=8, color="tab:red")
         ax.set_aspect("equal")

@@ -25,8 +25,10 @@ class Linkage:
             each pair [rad] (function).
         transmission: the least and greatest transmission angle over the motion [rad].
         grashof: its Grashof class.
-        task: "path" or "function".
-        phi0: a function generator's rocker angle asked at the first pair [rad].
+        task: "path", "function" or "motion".
+        phi0: a function generator's rocker angle asked at the first pair, or a motion
+            generator's angle from the bar A -> B to the poses' line [rad].
+        angle_errors: a motion generator's coupler angle error at each pose [rad].
     """
 
     z: np.ndarray
@@ -38,6 +40,7 @@ class Linkage:
     grashof: str
     task: str = "path"
     phi0: float = 0.0
+    angle_errors: np.ndarray | None = None
 
     @property
     def size(self) -> float:
@@ -45,10 +48,13 @@ class Linkage:
         return float(max(math.hypot(self.z[2] - self.z[0], self.z[3] - self.z[1]), *self.z[4:7]))
 
     def meets(self, relative: float) -> bool:
-        """Whether every target is met within `relative` of the linkage's size (path), or
-        every output angle within `relative` rad (function)."""
-        scale = self.size if self.task == "path" else 1.0
-        return bool(np.max(self.errors) <= relative * scale)
+        """Whether every target is met within `relative` of the linkage's size (path; a
+        motion's angles within `relative` rad too), or every output angle within `relative`
+        rad (function)."""
+        if self.task == "function":
+            return bool(np.max(self.errors) <= relative)
+        angles = self.angle_errors if self.angle_errors is not None else np.zeros(1)
+        return bool(np.max(self.errors) <= relative * self.size and np.max(angles) <= relative)
 
 
 @dataclass

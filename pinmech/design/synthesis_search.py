@@ -166,7 +166,7 @@ def _distinct(spec: SynthesisSpec, rows: np.ndarray, energies: np.ndarray, count
 def _bounded(spec: SynthesisSpec, lk: Linkage) -> np.ndarray:
     """The linkage's parameters that the file bounds (all 9 for a path; crank, coupler,
     rocker for a function)."""
-    return lk.z if spec.task == "path" else lk.z[4:7]
+    return lk.z[4:7] if spec.task == "function" else lk.z
 
 
 def _far(spec: SynthesisSpec, a: np.ndarray, b: np.ndarray) -> bool:

@@ -1,6 +1,6 @@
 """Each synthesis task's search rows: their bounds, their batch objective, the refinement
 of one row and the classical starting rows (path: synthesis_objective and
-synthesis_path; function: synthesis_function)."""
+synthesis_path; function: synthesis_function; motion: synthesis_poses)."""
 
 from __future__ import annotations
 
@@ -10,22 +10,23 @@ from pinmech.design.synthesis_file import SynthesisSpec
 from pinmech.design.synthesis_function import evaluate_function, freudenstein_rows, function_bounds, refined_function
 from pinmech.design.synthesis_objective import BatchValues, evaluate_path, path_bounds
 from pinmech.design.synthesis_path import refined_path
+from pinmech.design.synthesis_poses import evaluate_poses, poses_bounds, refined_poses
 from pinmech.design.synthesis_result import Linkage
 
 
 def search_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
     """The bounds of the task's search rows."""
-    return function_bounds(spec) if spec.task == "function" else path_bounds(spec)
+    return {"function": function_bounds, "motion": poses_bounds}.get(spec.task, path_bounds)(spec)
 
 
 def evaluate(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchValues:
     """The task's objective of rows x on one assembly (a Dask task)."""
-    return evaluate_function(spec, assembly, x) if spec.task == "function" else evaluate_path(spec, assembly, x)
+    return {"function": evaluate_function, "motion": evaluate_poses}.get(spec.task, evaluate_path)(spec, assembly, x)
 
 
 def refined(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Linkage | None:
     """Row x refined with the exact Jacobian, checked for defects (None: it has one)."""
-    return refined_function(spec, assembly, x) if spec.task == "function" else refined_path(spec, assembly, x)
+    return {"function": refined_function, "motion": refined_poses}.get(spec.task, refined_path)(spec, assembly, x)
 
 
 def classical_rows(spec: SynthesisSpec) -> np.ndarray:
