@@ -332,20 +332,3 @@ class MissingTool(PinmechError):
         super().__init__(message)
         self.tool = tool
         self.option = option
-
-
-class SynthesisError(PinmechError):
-    """A synthesis found no linkage that meets its targets without a defect and within its
-    constraints (`pinmech synth`): the candidates rejected, by cause, are in the message.
-
-    Attributes:
-        path: the synthesis file.
-        rejected: cause -> the number of candidates rejected for it.
-    """
-
-    exit_code = 15
-
-    def __init__(self, message: str, *, path: str | None = None, rejected: dict | None = None):
-        super().__init__(f"{path}: {message}" if path else message)
-        self.path = path
-        self.rejected = dict(rejected or {})
