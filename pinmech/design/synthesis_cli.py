@@ -4,7 +4,6 @@ linkages found written as drawn linkages with their scenes and checked by the en
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 
 from pinmech.design.study_cli import _workers
@@ -33,6 +32,8 @@ def add_parser(sub) -> None:
 
 def cmd_synth(args: argparse.Namespace) -> int:
     """Run the synthesis; print its report; write the linkages, scenes, JSON and figure."""
+    import json
+
     from pinmech.design.synthesis_file import load_synthesis
     from pinmech.design.synthesis_linkage import engine_check, write_linkage
     from pinmech.design.synthesis_report import figure, summary, text
