@@ -2,8 +2,7 @@
 that sweeps its crank through the targets, and checked by the engine: the scene solved by
 continuation from the first target's pose, the coupler point read at every target.
 
-(The drawn-linkage writer is this module's own until the typed drawn linkage has one: the
-two should become one.)
+The drawn linkage is written by the drawn linkage's own writer (model/linkage_write.py).
 """
 
 from __future__ import annotations
@@ -21,7 +20,7 @@ _STEP = math.radians(1.0)  # the engine's sweep: at most this crank step between
 
 
 def _mm(v: float) -> str:
-    return f"\"{v * 1e3:.15g} mm\""
+    return f"{v * 1e3:.15g} mm"
 
 
 def _deg(v: float) -> str:
@@ -29,33 +28,26 @@ def _deg(v: float) -> str:
 
 
 def linkage_toml(lk: Linkage, title: str, source: str) -> str:
-    """The drawn linkage's TOML text: joints at the first target's pose (crank at theta_1)."""
+    """The drawn linkage's TOML text (model.linkage_write): joints at the first target's
+    pose (crank at theta_1)."""
+    from pinmech.model.linkage_spec import linkage_spec
+    from pinmech.model.linkage_write import linkage_toml as written
+
     p = pose(lk.z[None], np.array([lk.s]), lk.theta[:1][None])
     A, P = p.A[0, 0], p.P[0, 0]
     z = lk.z
-    side = "left" if lk.s > 0 else "right"
     path = lk.task != "function"
     what = {"path": "the coupler point P through the targets", "motion": "the coupler through the poses",
             "function": "the rocker's turns as the function asks"}[lk.task]
-    return "\n".join([
-        f"# Synthesised by `pinmech synth {source}`: {what}.",
-        f"# Drawn at the first target's pose (crank O2 at {math.degrees(lk.theta[0]):.6g} deg from x).",
-        f"title = \"{title}\"",
-        "ground = [\"O2\", \"O4\"]",
-        "",
-        "[joints]",
-        f"O2 = [{_mm(z[0])}, {_mm(z[1])}]",
-        f"O4 = [{_mm(z[2])}, {_mm(z[3])}]",
-        f"A = [{_mm(A[0])}, {_mm(A[1])}]",
-        f"B = {{ from = [\"A\", \"O4\"], lengths = [{_mm(z[5])}, {_mm(z[6])}], side = \"{side}\" }}",
-        *([f"P = [{_mm(P[0])}, {_mm(P[1])}]"] if path else []),
-        "",
-        "[links]",
-        "crank = [\"O2\", \"A\"]",
-        "coupler = [\"A\", \"B\", \"P\"]" if path else "coupler = [\"A\", \"B\"]",
-        "rocker = [\"O4\", \"B\"]",
-        "",
-    ])
+    joints = {"O2": [_mm(z[0]), _mm(z[1])], "O4": [_mm(z[2]), _mm(z[3])], "A": [_mm(A[0]), _mm(A[1])],
+              "B": {"from": ["A", "O4"], "lengths": [_mm(z[5]), _mm(z[6])], "side": "left" if lk.s > 0 else "right"}}
+    if path:
+        joints["P"] = [_mm(P[0]), _mm(P[1])]
+    raw = {"title": title, "ground": ["O2", "O4"], "joints": joints,
+           "links": {"crank": ["O2", "A"], "coupler": ["A", "B", "P"] if path else ["A", "B"], "rocker": ["O4", "B"]}}
+    header = (f"Synthesised by `pinmech synth {source}`: {what}.\n"
+              f"Drawn at the first target's pose (crank O2 at {math.degrees(lk.theta[0]):.6g} deg from x).")
+    return written(linkage_spec(raw, source), header)
 
 
 def motion_values(lk: Linkage) -> np.ndarray:
