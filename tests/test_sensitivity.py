@@ -41,7 +41,7 @@ def _resolved_differences(sm: StudyMechanism, outputs: StudyOutputs, h: float) -
             p[k] += sign * h
             cycle = sm.cycle(p)  # leaves p in the model: the outputs are read on that variant
             assert not cycle.cause, cycle.detail
-            ys.append(np.array([outputs.values(sm.at(q)) for q in cycle.q]))
+            ys.append(outputs.values(cycle.q))
         columns.append(deviation(ys[0], ys[1], outputs.kinds) / (2 * h))  # angles: across +-pi too
     sm.write(sm.nominal)
     return np.stack(columns, axis=-1)

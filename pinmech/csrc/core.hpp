@@ -70,6 +70,28 @@ enum Stop { DONE = 0, NEEDS_PIVOT = 1, SIGNATURE_CHANGED = 2, CONDITION = 3, NOT
 // The pin.Model inside a Python object made by the installed `pin` (model_ref.cpp), or
 // nullptr where the object is no pin.Model.
 pin::Model* borrow_model(PyObject* obj);
+// The pin.Data inside a Python object made by the installed `pin`, or nullptr.
+pin::Data* borrow_data(PyObject* obj);
+
+// ------------------------------------------------------------ kinematics.cpp
+// A row per frame, then per joint: position (3) [m], rotation (9, row-major), velocity
+// (3) [m/s], angular velocity (3) [rad/s], classical acceleration (3) [m/s^2], angular
+// acceleration (3) [rad/s^2], world axes (LOCAL_WORLD_ALIGNED).
+constexpr int KINEMATICS_COLUMNS = 24;
+// Pinocchio's forward kinematics at (q, v, a) in `data`, then a row per frame and joint
+// asked written at `out` (ids checked by the caller).
+void pose_kinematics(const pin::Model& model, pin::Data& data, const Eigen::Ref<const VectorXd>& q,
+                     const Eigen::Ref<const VectorXd>& v, const Eigen::Ref<const VectorXd>& a,
+                     const Eigen::Ref<const Eigen::VectorXi>& frames, const Eigen::Ref<const Eigen::VectorXi>& joints,
+                     double* out);
+// One pose on the user's model and data: (frames + joints, KINEMATICS_COLUMNS).
+RowMatrix frames_at(nb::object model, nb::object data, const Eigen::Ref<const VectorXd>& q,
+                    const Eigen::Ref<const VectorXd>& v, const Eigen::Ref<const VectorXd>& a,
+                    const Eigen::Ref<const Eigen::VectorXi>& frames, const Eigen::Ref<const Eigen::VectorXi>& joints);
+// N poses: (N, frames * KINEMATICS_COLUMNS).
+RowMatrix frames_along(nb::object model, nb::object data, const Eigen::Ref<const RowMatrix>& Q,
+                       const Eigen::Ref<const RowMatrix>& V, const Eigen::Ref<const RowMatrix>& A,
+                       const Eigen::Ref<const Eigen::VectorXi>& frames);
 
 // A column of data.J (Pinocchio's joint Jacobians, nvExtended columns: a mimic joint has
 // its own, already times its scaling) and the velocity column it adds to (a mimic
@@ -145,11 +167,18 @@ class Core {
   nb::tuple node(const VectorXd& q, const VectorXd& d);
 
   // ------------------------------------------------------------ rates.cpp
-  nb::tuple rates(const Eigen::Ref<const RowMatrix>& Q, const std::vector<int>& task_frames,
-                  const std::vector<std::vector<int>>& task_rows, const std::vector<int>& task_local,
-                  const VectorXd& x_dot, const VectorXd& x_ddot, const VectorXd& row_scale, double max_condition);
-  nb::tuple frame_motion(const Eigen::Ref<const RowMatrix>& Q, const Eigen::Ref<const RowMatrix>& V,
-                         const Eigen::Ref<const RowMatrix>& A, const std::vector<int>& frames);
+  // The task rows RateSolver.solve stacks under the closure rows: frames (indices into
+  // this core's frames), the components (0-5: x y z wx wy wz) of each, and whether each is
+  // read in the frame's own axes.
+  void set_task(const std::vector<int>& task_frames, const std::vector<std::vector<int>>& task_rows,
+                const std::vector<int>& task_local);
+  // The stacked Jacobian (closure rows, then task rows) at q, not made dimensionless.
+  MatrixXd stacked_jacobian(const Eigen::Ref<const VectorXd>& q);
+  // RateSolver.solve at every row of Q (see rates.cpp).
+  nb::tuple rates(const Eigen::Ref<const RowMatrix>& Q, const Eigen::Ref<const VectorXd>& x_dot,
+                  const Eigen::Ref<const VectorXd>& x_ddot, const Eigen::Ref<const VectorXd>& row_scale,
+                  const Eigen::Ref<const VectorXd>& v_scale, int method, double damping, double max_condition,
+                  int structural_rank);
   RowMatrix pinocchio_passes(const Eigen::Ref<const RowMatrix>& Q, const Eigen::Ref<const RowMatrix>& V,
                              int jacobians);
 
@@ -171,6 +200,8 @@ class Core {
   void move_into(const VectorXd& q, const VectorXd& step, VectorXd& out);
   void polish(VectorXd& q, VectorXd& r, double& norm);
   double turn_between(const Node& a, const Node& b, double unit) const;
+  void task_jacobian_into(const VectorXd& q, MatrixXd& J);
+  void task_drift_into(const VectorXd& q, const VectorXd& v, VectorXd& drift);
 
   nb::object model_object_;  // the Python pin.Model: alive as long as this core
   const pin::Model& model_;
@@ -196,6 +227,12 @@ class Core {
   double tol_;
   int iterations_ = 0;
   double moved_ = 0.0;
+  // the rate task (set_task)
+  std::vector<pin::FrameIndex> task_frames_;
+  std::vector<std::vector<int>> task_rows_;
+  std::vector<int> task_local_;
+  Index task_size_ = 0;
+  Matrix6Xd task_J_;
 };
 
 }  // namespace pinmech

@@ -35,6 +35,10 @@ NB_MODULE(_core, m) {
         return condition_of(A, A.rows() > 0 && lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0, work);
       },
       "2-norm condition number and smallest singular value of a square A, as the core computes them");
+  m.attr("KINEMATICS_COLUMNS") = KINEMATICS_COLUMNS;
+  m.def("frames_at", &frames_at,
+        "forwardKinematics(q, v, a) in the user's data, then a row per frame and joint asked (kinematics.cpp)");
+  m.def("frames_along", &frames_along, "frames_at at every row of Q, V, A: (N, frames * KINEMATICS_COLUMNS)");
   nb::class_<Core>(m, "Core")
       .def(nb::init<nb::object, const std::vector<int>&, const std::vector<int>&, const std::vector<int>&,
                     const std::vector<int>&, const Eigen::Ref<const RowMatrix>&, const Eigen::Ref<const RowMatrix>&,
@@ -66,6 +70,7 @@ NB_MODULE(_core, m) {
       .def("follow", &Core::follow)
       .def("node", &Core::node)
       .def("rates", &Core::rates)
-      .def("frame_motion", &Core::frame_motion)
+      .def("set_task", &Core::set_task)
+      .def("stacked_jacobian", &Core::stacked_jacobian)
       .def("pinocchio_passes", &Core::pinocchio_passes);
 }

@@ -24,6 +24,7 @@ import pinocchio as pin
 
 from pinmech.exceptions import SceneError, SingularPoseError
 from pinmech.design.study_variant import StudyMechanism
+from pinmech.solve.core import _core
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -57,14 +58,18 @@ class StudyOutputs:
             self.e1 = e1 / np.linalg.norm(e1)
             self.e2 = np.cross(self.normal, self.e1)
 
-    def values(self, data: pin.Data) -> np.ndarray:
-        """The outputs at the pose of `data` (frame placements up to date) [m, rad]."""
-        pos = [data.oMf[f].translation[k] for f in self.points for k in self.axes]
-        ang = []
-        for f in self.links:
-            x = data.oMf[f].rotation[:, 0]
-            ang.append(np.arctan2(x @ self.e2, x @ self.e1))
-        return np.array(pos + ang, dtype=float)
+    def values(self, q: np.ndarray) -> np.ndarray:
+        """The outputs (N, n_out) at the poses q (N, nq) [m, rad]: the frames' placements
+        from one compiled call for every pose (csrc/kinematics.cpp, at zero rates)."""
+        q = np.ascontiguousarray(q, dtype=float)
+        frames = np.array(self.points + self.links, dtype=np.int32)
+        zero = np.zeros((len(q), self.sm.model.nv))
+        rows = _core.frames_along(self.sm.model, self.sm.data, q, zero, zero, frames)
+        rows = rows.reshape(len(q), len(frames), _core.KINEMATICS_COLUMNS)
+        pos = rows[:, : len(self.points), 0:3][:, :, list(self.axes)].reshape(len(q), -1)
+        x = rows[:, len(self.points):, 3:12:3]  # each link's x axis: the rotation's first column
+        ang = np.arctan2(x @ self.e2, x @ self.e1) if self.links else np.zeros((len(q), 0))
+        return np.concatenate((pos, ang), axis=1)
 
     def jacobians(self, data: pin.Data) -> tuple[np.ndarray, np.ndarray]:
         """(dy/dq on the tangent space (n_out, nv), dy/dp at fixed q (n_out, n_par))."""
@@ -126,7 +131,7 @@ def output_sensitivity(sm: StudyMechanism, outputs: StudyOutputs, q: np.ndarray)
 
 def cycle_sensitivity(sm: StudyMechanism, outputs: StudyOutputs, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The outputs (steps, n_out) and dy/dp (steps, n_out, n_par) at each pose of a cycle."""
-    y = np.array([outputs.values(sm.at(qi)) for qi in q])
+    y = outputs.values(q)
     dy = np.array([output_sensitivity(sm, outputs, qi) for qi in q])
     return y, dy
 

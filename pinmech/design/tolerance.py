@@ -73,7 +73,7 @@ def solve_variants(sm: StudyMechanism, outputs: StudyOutputs, batch: Batch, p: n
             cycle = sm.cycle(pi)
             causes.append(cycle.cause)
             if not cycle.cause:
-                y[i] = [outputs.values(sm.at(q)) for q in cycle.q]
+                y[i] = outputs.values(cycle.q)
                 if at_variant:
                     extra[i] = at_variant(cycle.q)
     finally:
