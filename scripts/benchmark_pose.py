@@ -13,7 +13,11 @@ Rows:
   pose), one nanobind call that does nothing but return (`Core.nq`), building one frozen
   dataclass of four fields, and `Mechanism.checked_q` on one pose.
 
-    python scripts/benchmark_pose.py [--rounds 7]
+With `--before DIR` (a checkout of an earlier pinmech, e.g. `git archive d3dde90`), that
+checkout's `solve/motion.py` and `solve/rates.py` are loaded beside this one's (on this
+compiled core) and timed in the same rounds: a before/after ratio under one machine load.
+
+    python scripts/benchmark_pose.py [--rounds 7] [--before DIR]
 """
 
 from __future__ import annotations
@@ -39,6 +43,37 @@ def _p1():
     return pinmech, sweep.mechanism, sweep.solver.data, s.q[0], s.v[0], s.a[0]
 
 
+def _module_from(path: Path, name: str):
+    """The Python module at `path`, loaded under `name` (its imports from this pinmech)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module  # dataclasses look their module up there
+    spec.loader.exec_module(module)
+    return module
+
+
+def before_rows(root: Path) -> dict[str, Timed]:
+    """evaluate_motion and RateSolver.solve as the checkout at `root` computes them."""
+    motion = _module_from(root / "pinmech" / "solve" / "motion.py", "_before_motion")
+    rates = _module_from(root / "pinmech" / "solve" / "rates.py", "_before_rates")
+    pinmech, mechanism, data, q, v, a = _p1()
+    run_many, _, _ = peers.pinmech_p2(*peers.p2_angles(360), many=True)
+    cells = {type(c.cell_contents).__name__: c.cell_contents for c in run_many.__closure__}
+    solver = cells["RateSolver"]
+    old = rates.RateSolver(solver.mechanism, [rates.Task(t.frame, t.components, t.velocity, t.acceleration)
+                                              for t in solver.tasks])
+    q2 = cells["ndarray"][3]
+
+    def motion_read():
+        m = motion.evaluate_motion(mechanism, data, q, v, a, points=["D"], links=["link3"])
+        return peers._pinmech_p1_row(m)
+
+    return {"before: evaluate_motion (link3, D), P1 outputs read": Timed(motion_read),
+            "before: RateSolver.solve (P2 pose)": Timed(lambda: old.solve(q2))}
+
+
 def rows() -> dict[str, Timed]:
     from pinmech.solve.core import _core
     from pinmech.solve.motion import PointMotion
@@ -48,9 +83,11 @@ def rows() -> dict[str, Timed]:
     cells = {type(c.cell_contents).__name__: c.cell_contents for c in run_many.__closure__}
     solver, Q = cells["RateSolver"], cells["ndarray"]
     q2 = Q[3]
-    core, row_scale, v_scale = solver._compiled()
+    core = solver._compiled()
+    Q1, out = Q[3:4].copy(), np.empty((1, core.rate_columns))
     plan_motion = pinmech.evaluate_motion(mechanism, data, q, v, a, points=["D"], links=["link3"])
     plan = plan_motion._plan
+    rows_out = np.empty((plan.rows, _core.KINEMATICS_COLUMNS))
     x = np.zeros(3)
 
     def motion_read():
@@ -68,10 +105,9 @@ def rows() -> dict[str, Timed]:
         "evaluate_motion (every point and link), all read": Timed(motion_all),
         "RateSolver.solve (P2 pose)": Timed(lambda: solver.solve(q2)),
         "floor: _core.frames_at alone (R-RTR, link3 and D)": Timed(
-            lambda: _core.frames_at(mechanism.model, data, q, v, a, plan.frames, plan.joints)),
+            lambda: _core.frames_at(mechanism.model, data, q, v, a, plan.frames, plan.joints, rows_out)),
         "floor: Core.rates on one pose alone (P2)": Timed(
-            lambda: core.rates(Q[3:4], solver.x_dot, solver.x_ddot, row_scale, v_scale, 0, 1e-3,
-                               solver.max_condition, -1)),
+            lambda: core.rates(Q1, solver.x_dot, solver.x_ddot, -1, out)),
         "floor: one nanobind call (Core.nq)": Timed(lambda: core.nq),
         "floor: a frozen dataclass of four fields": Timed(lambda: PointMotion(x, x, x, "l")),
         "floor: Mechanism.checked_q (one pose)": Timed(lambda: mechanism.checked_q(q)),
@@ -82,8 +118,11 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=7)
     parser.add_argument("--calls", type=int, default=2000, help="calls in one timed sample")
+    parser.add_argument("--before", type=Path, help="an earlier checkout to time beside this one")
     args = parser.parse_args(argv)
     timed = rows()
+    if args.before:
+        timed.update(before_rows(args.before))
     for t in timed.values():
         t.calls = args.calls
         t.run()

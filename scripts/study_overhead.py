@@ -4,10 +4,11 @@ The bundled four-bar tolerance study (models/studies/four_bar_tolerance.toml) wi
 `--steps` poses over the crank's turn and `--samples` variants, run in this process
 through `design/tolerance.py`'s per-variant loop (`solve_variants`: write the variant's
 dimensions into the model, re-read them, close the reference pose, sweep the cycle, read
-the outputs at every pose). The time inside `Sweep.chunks` (the per-pose solve: the
-compiled continuation, every pose's q, v, a) is measured around each chunk with
-time.perf_counter; everything else is "outside". Reported: total, inside, outside and the
-outside fraction, and a cProfile of the outside's largest items with `--profile`.
+the outputs at every pose). Two shares are measured with time.perf_counter: the time inside
+`Sweep.chunks` (the sweep's whole Python face: set-up of each cycle, then the compiled
+continuation giving every pose's q, v, a), and within it the time inside the compiled core's
+own calls (`Core.follow` and `Core.node`: the per-pose solve proper). Reported: total, both
+shares and what lies outside each, and with `--profile` a cProfile of one batch.
 
     python scripts/study_overhead.py --samples 10000 --steps 360
 """
@@ -28,6 +29,26 @@ from pinmech.design.study_file import load_study  # noqa: E402
 from pinmech.design.sensitivity import StudyOutputs  # noqa: E402
 from pinmech.design.study_variant import StudyMechanism  # noqa: E402
 from pinmech.design.tolerance import batches, run_batch  # noqa: E402
+
+
+class _TimedCore:
+    """The compiled core's sweep calls with their time added up [s] (wrapped on the class)."""
+
+    def __init__(self) -> None:
+        from pinmech.solve.core import _core
+
+        self.seconds, self.core = 0.0, _core.Core
+        for name in ("follow", "node"):
+            setattr(self.core, name, self._timed(getattr(self.core, name)))
+
+    def _timed(self, method):
+        def timed(core, *args):
+            t0 = time.perf_counter()
+            try:
+                return method(core, *args)
+            finally:
+                self.seconds += time.perf_counter() - t0
+        return timed
 
 
 class _TimedChunks:
@@ -61,6 +82,7 @@ def main(argv: list[str] | None = None) -> None:
     outputs = StudyOutputs(sm)
     timed = _TimedChunks(sm.sweep.chunks)
     sm.sweep.chunks = timed
+    compiled = _TimedCore()
     todo = batches(spec.samples, spec.batch)
     t0 = time.perf_counter()
     results = [run_batch(sm, outputs, b) for b in todo]
@@ -68,8 +90,11 @@ def main(argv: list[str] | None = None) -> None:
     solved = sum(not c for r in results for c in r.causes)
     poses = spec.samples * spec.steps
     print(f"{spec.samples} variants x {spec.steps} poses ({solved} solved): total {total:.3g} s "
-          f"({total / poses * 1e6:.3g} us a variant-pose); per-pose solve (Sweep.chunks) {timed.seconds:.3g} s; "
-          f"outside it {total - timed.seconds:.3g} s = {(total - timed.seconds) / total:.1%} of the time")
+          f"({total / poses * 1e6:.3g} us a variant-pose)\n"
+          f"- inside Sweep.chunks {timed.seconds:.3g} s; outside it {total - timed.seconds:.3g} s = "
+          f"{(total - timed.seconds) / total:.1%} of the time\n"
+          f"- inside the compiled core's sweep calls (Core.follow, Core.node) {compiled.seconds:.3g} s; outside "
+          f"them {total - compiled.seconds:.3g} s = {(total - compiled.seconds) / total:.1%} of the time")
     if args.profile:
         profile = cProfile.Profile()
         profile.runcall(run_batch, sm, outputs, todo[0])

@@ -16,7 +16,7 @@ namespace {
 
 // The pin.Model and pin.Data inside two Python objects, or a TypeError; the Data must be
 // one of that model's (as many joints and frames) or a ValueError.
-std::pair<const pin::Model*, pin::Data*> borrowed_pair(const nb::object& model, const nb::object& data) {
+std::pair<const pin::Model*, pin::Data*> borrowed_pair(nb::handle model, nb::handle data) {
   const pin::Model* m = borrow_model(model.ptr());
   pin::Data* d = borrow_data(data.ptr());
   if (m == nullptr || d == nullptr)
@@ -26,14 +26,13 @@ std::pair<const pin::Model*, pin::Data*> borrowed_pair(const nb::object& model, 
   return {m, d};
 }
 
-void check_ids(const Eigen::Ref<const Eigen::VectorXi>& ids, Index bound, const char* what) {
-  for (Index k = 0; k < ids.size(); ++k)
-    if (ids(k) < 0 || ids(k) >= bound)
-      throw std::invalid_argument(std::string(what) + " id " + std::to_string(ids(k)) + " not in the model");
+void check_ids(const Buffer& ids, Index bound, const char* what) {
+  for (Py_ssize_t k = 0; k < ids.size(); ++k)
+    if (ids.ints()[k] < 0 || ids.ints()[k] >= bound)
+      throw std::invalid_argument(std::string(what) + " id " + std::to_string(ids.ints()[k]) + " not in the model");
 }
 
-void put_row(double* row, const pin::SE3& M, const pin::Motion& vel, const pin::Motion& acc,
-             const Vector3d& alpha) {
+void put_row(double* row, const pin::SE3& M, const pin::Motion& vel, const pin::Motion& acc) {
   using Map3 = Eigen::Map<Vector3d>;
   Map3 position(row), velocity(row + 12), omega(row + 15), acceleration(row + 18), angular(row + 21);
   Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> rotation(row + 3);
@@ -42,61 +41,57 @@ void put_row(double* row, const pin::SE3& M, const pin::Motion& vel, const pin::
   velocity = vel.linear();
   omega = vel.angular();
   acceleration = acc.linear();
-  angular = alpha;
+  angular = acc.angular();  // the same in the classical and the spatial convention
 }
 
 }  // namespace
 
-void pose_kinematics(const pin::Model& model, pin::Data& data, const Eigen::Ref<const VectorXd>& q,
-                     const Eigen::Ref<const VectorXd>& v, const Eigen::Ref<const VectorXd>& a,
-                     const Eigen::Ref<const Eigen::VectorXi>& frames, const Eigen::Ref<const Eigen::VectorXi>& joints,
-                     double* out) {
-  pin::forwardKinematics(model, data, q, v, a);
-  for (Index k = 0; k < frames.size(); ++k, out += KINEMATICS_COLUMNS) {
-    const pin::FrameIndex f = pin::FrameIndex(frames(k));
+void pose_kinematics(const pin::Model& model, pin::Data& data, const double* q, const double* v, const double* a,
+                     const int* frames, Index nframes, const int* joints, Index njoints, double* out) {
+  using CMap = Eigen::Map<const VectorXd>;
+  pin::forwardKinematics(model, data, CMap(q, model.nq), CMap(v, model.nv), CMap(a, model.nv));
+  for (Index k = 0; k < nframes; ++k, out += KINEMATICS_COLUMNS) {
+    const pin::FrameIndex f = pin::FrameIndex(frames[k]);
     const pin::SE3& M = pin::updateFramePlacement(model, data, f);
-    const pin::Motion vel = pin::getFrameVelocity(model, data, f, pin::LOCAL_WORLD_ALIGNED);
-    const pin::Motion acc = pin::getFrameClassicalAcceleration(model, data, f, pin::LOCAL_WORLD_ALIGNED);
-    put_row(out, M, vel, acc, acc.angular());  // angular: the same in both conventions
+    put_row(out, M, pin::getFrameVelocity(model, data, f, pin::LOCAL_WORLD_ALIGNED),
+            pin::getFrameClassicalAcceleration(model, data, f, pin::LOCAL_WORLD_ALIGNED));
   }
-  for (Index k = 0; k < joints.size(); ++k, out += KINEMATICS_COLUMNS) {
-    const pin::JointIndex j = pin::JointIndex(joints(k));
-    const pin::Motion vel = pin::getVelocity(model, data, j, pin::LOCAL_WORLD_ALIGNED);
-    const pin::Motion acc = pin::getClassicalAcceleration(model, data, j, pin::LOCAL_WORLD_ALIGNED);
-    put_row(out, data.oMi[j], vel, acc, acc.angular());
+  for (Index k = 0; k < njoints; ++k, out += KINEMATICS_COLUMNS) {
+    const pin::JointIndex j = pin::JointIndex(joints[k]);
+    put_row(out, data.oMi[j], pin::getVelocity(model, data, j, pin::LOCAL_WORLD_ALIGNED),
+            pin::getClassicalAcceleration(model, data, j, pin::LOCAL_WORLD_ALIGNED));
   }
 }
 
-RowMatrix frames_at(nb::object model_object, nb::object data_object, const Eigen::Ref<const VectorXd>& q,
-                    const Eigen::Ref<const VectorXd>& v, const Eigen::Ref<const VectorXd>& a,
-                    const Eigen::Ref<const Eigen::VectorXi>& frames, const Eigen::Ref<const Eigen::VectorXi>& joints) {
+void frames_at(nb::handle model_object, nb::handle data_object, nb::handle q, nb::handle v, nb::handle a,
+               nb::handle frames, nb::handle joints, nb::handle out) {
   const auto [model, data] = borrowed_pair(model_object, data_object);
-  if (q.size() != model->nq || v.size() != model->nv || a.size() != model->nv)
-    throw std::invalid_argument("frames_at: q, v, a of the wrong sizes");
-  check_ids(frames, Index(model->frames.size()), "frame");
-  check_ids(joints, Index(model->njoints), "joint");
-  RowMatrix out(frames.size() + joints.size(), KINEMATICS_COLUMNS);
-  pose_kinematics(*model, *data, q, v, a, frames, joints, out.data());
-  return out;
+  const Buffer bq(q, 'd', model->nq, false, "q"), bv(v, 'd', model->nv, false, "v"), ba(a, 'd', model->nv, false, "a");
+  const Buffer bf(frames, 'i', -1, false, "frames"), bj(joints, 'i', -1, false, "joints");
+  check_ids(bf, Index(model->frames.size()), "frame");
+  check_ids(bj, Index(model->njoints), "joint");
+  const Buffer bout(out, 'd', (bf.size() + bj.size()) * KINEMATICS_COLUMNS, true, "out");
+  pose_kinematics(*model, *data, bq.doubles(), bv.doubles(), ba.doubles(), bf.ints(), bf.size(), bj.ints(), bj.size(),
+                  bout.doubles());
 }
 
-RowMatrix frames_along(nb::object model_object, nb::object data_object, const Eigen::Ref<const RowMatrix>& Q,
-                       const Eigen::Ref<const RowMatrix>& V, const Eigen::Ref<const RowMatrix>& A,
-                       const Eigen::Ref<const Eigen::VectorXi>& frames) {
+void frames_along(nb::handle model_object, nb::handle data_object, nb::handle Q, nb::handle V, nb::handle A,
+                  nb::handle frames, nb::handle out) {
   const auto [model, data] = borrowed_pair(model_object, data_object);
-  const Index n = Q.rows();
-  if (Q.cols() != model->nq || V.cols() != model->nv || A.cols() != model->nv || V.rows() != n || A.rows() != n)
-    throw std::invalid_argument("frames_along: q, v and a of the wrong shapes");
-  check_ids(frames, Index(model->frames.size()), "frame");
-  const Eigen::VectorXi no_joints(0);
-  RowMatrix out(n, frames.size() * KINEMATICS_COLUMNS);
+  const Buffer bq(Q, 'd', -1, false, "q");
+  if (model->nq == 0 || bq.size() % model->nq != 0) throw std::invalid_argument("q: rows of nq numbers needed");
+  const Index n = bq.size() / model->nq;
+  const Buffer bv(V, 'd', n * model->nv, false, "v"), ba(A, 'd', n * model->nv, false, "a");
+  const Buffer bf(frames, 'i', -1, false, "frames");
+  check_ids(bf, Index(model->frames.size()), "frame");
+  const Index width = bf.size() * KINEMATICS_COLUMNS;
+  const Buffer bout(out, 'd', n * width, true, "out");
   {
     nb::gil_scoped_release release;
     for (Index i = 0; i < n; ++i)
-      pose_kinematics(*model, *data, Q.row(i).transpose(), V.row(i).transpose(), A.row(i).transpose(), frames,
-                      no_joints, out.row(i).data());
+      pose_kinematics(*model, *data, bq.doubles() + i * model->nq, bv.doubles() + i * model->nv,
+                      ba.doubles() + i * model->nv, bf.ints(), bf.size(), nullptr, 0, bout.doubles() + i * width);
   }
-  return out;
 }
 
 }  // namespace pinmech

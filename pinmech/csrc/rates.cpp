@@ -149,20 +149,41 @@ MatrixXd Core::stacked_jacobian(const Eigen::Ref<const VectorXd>& q) {
   return J;
 }
 
-nb::tuple Core::rates(const Eigen::Ref<const RowMatrix>& Q, const Eigen::Ref<const VectorXd>& x_dot,
-                      const Eigen::Ref<const VectorXd>& x_ddot, const Eigen::Ref<const VectorXd>& row_scale,
-                      const Eigen::Ref<const VectorXd>& v_scale, int method, double damping, double max_condition,
-                      int structural_rank) {
+void Core::set_rate_options(const VectorXd& row_scale, const VectorXd& v_scale, int method, double damping,
+                            double max_condition) {
+  if (row_scale.size() != rows_ + task_size_ || v_scale.size() != model_.nv || method < 0 || method > 2)
+    throw std::invalid_argument("set_rate_options: scales of the wrong sizes, or an unknown method");
+  rate_row_scale_ = row_scale;
+  rate_v_scale_ = v_scale;
+  rate_method_ = method;
+  rate_damping_ = damping;
+  rate_max_condition_ = max_condition;
+}
+
+void Core::rates(nb::handle Q_object, nb::handle x_dot_object, nb::handle x_ddot_object, int structural_rank,
+                 nb::handle out_object) {
   check_structure();
-  const Index n = Q.rows(), nv = model_.nv, m_task = task_size_, m = rows_ + m_task;
-  if (Q.cols() != model_.nq || x_dot.size() != m_task || x_ddot.size() != m_task || row_scale.size() != m ||
-      v_scale.size() != nv || m_task == 0)
-    throw std::invalid_argument("rates: no task set, or arrays of the wrong sizes");
-  RowMatrix V = RowMatrix::Constant(n, nv, NAN), A = RowMatrix::Constant(n, nv, NAN);
-  // condition, sigma_min, closure v and a residuals, status, q's closure residuals
-  // (independent rows, full rows: LoopSolver's is_closed reads both), rank, method used
-  RowMatrix numbers = RowMatrix::Constant(n, 9, NAN);
-  RowMatrix achieved_v = RowMatrix::Constant(n, m_task, NAN), achieved_a = RowMatrix::Constant(n, m_task, NAN);
+  const Index nv = model_.nv, m_task = task_size_, m = rows_ + m_task;
+  if (m_task == 0 || rate_row_scale_.size() != m || rate_v_scale_.size() != nv)
+    throw std::invalid_argument("rates: no task or no options set (set_task, set_rate_options)");
+  const Buffer bq(Q_object, 'd', -1, false, "q");
+  if (model_.nq == 0 || bq.size() % model_.nq != 0) throw std::invalid_argument("q: rows of nq numbers needed");
+  const Index n = bq.size() / model_.nq, width = rate_columns();
+  const Buffer bxd(x_dot_object, 'd', m_task, false, "x_dot"), bxdd(x_ddot_object, 'd', m_task, false, "x_ddot");
+  const Buffer bout(out_object, 'd', n * width, true, "out");
+  const Eigen::Map<const RowMatrix> Q(bq.doubles(), n, model_.nq);
+  const Eigen::Map<const VectorXd> x_dot(bxd.doubles(), m_task), x_ddot(bxdd.doubles(), m_task);
+  Eigen::Map<RowMatrix> out(bout.doubles(), n, width);
+  out.setConstant(NAN);
+  auto V = out.leftCols(nv);
+  auto A = out.middleCols(nv, nv);
+  auto numbers = out.middleCols(2 * nv, RATE_NUMBERS);
+  auto achieved_v = out.middleCols(2 * nv + RATE_NUMBERS, m_task);
+  auto achieved_a = out.rightCols(m_task);
+  const VectorXd& row_scale = rate_row_scale_;
+  const VectorXd& v_scale = rate_v_scale_;
+  const int method = rate_method_;
+  const double damping = rate_damping_, max_condition = rate_max_condition_;
   {
     nb::gil_scoped_release release;
     RateWork w(m, nv, model_.nq);
@@ -253,7 +274,6 @@ nb::tuple Core::rates(const Eigen::Ref<const RowMatrix>& Q, const Eigen::Ref<con
       numbers(i, 8) = used;
     }
   }
-  return nb::make_tuple(V, A, numbers, achieved_v, achieved_a);
 }
 
 // ---------------------------------------------------------------- Pinocchio's share

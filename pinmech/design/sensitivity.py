@@ -64,8 +64,8 @@ class StudyOutputs:
         q = np.ascontiguousarray(q, dtype=float)
         frames = np.array(self.points + self.links, dtype=np.int32)
         zero = np.zeros((len(q), self.sm.model.nv))
-        rows = _core.frames_along(self.sm.model, self.sm.data, q, zero, zero, frames)
-        rows = rows.reshape(len(q), len(frames), _core.KINEMATICS_COLUMNS)
+        rows = np.empty((len(q), len(frames), _core.KINEMATICS_COLUMNS))
+        _core.frames_along(self.sm.model, self.sm.data, q, zero, zero, frames, rows)
         pos = rows[:, : len(self.points), 0:3][:, :, list(self.axes)].reshape(len(q), -1)
         x = rows[:, len(self.points):, 3:12:3]  # each link's x axis: the rotation's first column
         ang = np.arctan2(x @ self.e2, x @ self.e1) if self.links else np.zeros((len(q), 0))

@@ -57,7 +57,6 @@ DEFAULT_TOL = _core.DEFAULT_TOL
 #: PINMECH_CORE=0 in the environment solves everything by the Python path (tests compare
 #: the two; a user can rule the core out when in doubt).
 ENABLED = os.environ.get("PINMECH_CORE", "1") != "0"
-_NO_ROWS = np.zeros((0, 3))
 
 
 class ModelShape:
@@ -86,11 +85,6 @@ class CompiledModel:
     def __init__(self, model: pin.Model, frame_ids: list[int]) -> None:
         self.frames = {int(fid): i for i, fid in enumerate(dict.fromkeys(int(f) for f in frame_ids))}
         self.frame_ids = list(self.frames)
-
-    def kinematics(self, model: pin.Model) -> _core.Core:
-        """A core of the model with these frames and no loops (for `Core.frame_motion`)."""
-        return _core.Core(model, self.frame_ids, [], [], [], _NO_ROWS, _NO_ROWS, [], [], [], [], [], [],
-                          np.ones(model.nv), [], [], DEFAULT_TOL)
 
 
 def core_for(solver) -> _core.Core | None:

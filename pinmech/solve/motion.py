@@ -99,6 +99,21 @@ class CoincidentPoint:
     link: str
 
 
+class _built:
+    """A Motion's dict, built on first reading and kept in the instance (functools'
+    cached_property takes a lock on every first read in Python 3.11: microseconds here)."""
+
+    def __init__(self, build) -> None:
+        self.build, self.name = build, build.__name__
+        self.__doc__ = build.__doc__
+
+    def __get__(self, motion, owner=None):
+        if motion is None:
+            return self
+        value = motion.__dict__[self.name] = self.build(motion)
+        return value
+
+
 class Motion:
     """Everything a report shows about one solved pose: `joints`, `links`, `points` and
     `sliders`, dicts by name of JointMotion, LinkMotion, PointMotion and SliderMotion. The
@@ -109,22 +124,22 @@ class Motion:
         self._mechanism, self._plan, self._rows = mechanism, plan, rows
         self._q, self._v, self._a = q, v, a
 
-    @functools.cached_property
+    @_built
     def joints(self) -> dict[str, JointMotion]:
         return _joint_motions(self._mechanism, self._q, self._v, self._a)
 
-    @functools.cached_property
+    @_built
     def links(self) -> dict[str, LinkMotion]:
         rows, normal = self._rows, self._mechanism.plane_normal
         return {name: _link_motion(rows[r], normal) for name, r in self._plan.links}
 
-    @functools.cached_property
+    @_built
     def points(self) -> dict[str, PointMotion]:
         rows = self._rows
         return {name: _point(rows[r], link) if at is None else _coincident(rows[at], rows[r], link)
                 for name, r, at, link in self._plan.points}
 
-    @functools.cached_property
+    @_built
     def sliders(self) -> dict[str, SliderMotion]:
         rows, q, v, a = self._rows, self._q, self._v, self._a
         out = {}
@@ -177,9 +192,12 @@ def evaluate_motion(
     v, a = float_array(v, "v", (nv,), mechanism.source), float_array(a, "a", (nv,), mechanism.source)
     plan = _plan(mechanism, None if points is None else tuple(points), tuple(coincident),
                  None if links is None else tuple(links))
+    if not (q.flags.c_contiguous and v.flags.c_contiguous and a.flags.c_contiguous):  # the core reads them so
+        q, v, a = np.ascontiguousarray(q), np.ascontiguousarray(v), np.ascontiguousarray(a)
+    rows = np.empty((plan.rows, _core.KINEMATICS_COLUMNS))
     try:
-        rows = _core.frames_at(mechanism.model, data, q, v, a, plan.frames, plan.joints)
-    except (TypeError, ValueError):
+        _core.frames_at(mechanism.model, data, q, v, a, plan.frames, plan.joints, rows)
+    except (TypeError, ValueError):  # no pin.Data, or one of another model (the core checks both)
         raise ModelError("data must be a pin.Data of the mechanism's model (mechanism.model.createData())",
                          path=mechanism.source) from None
     return Motion(mechanism, plan, rows, q.tolist(), v.tolist(), a.tolist())
@@ -193,6 +211,7 @@ class _Plan:
 
     frames: np.ndarray  # Pinocchio frame ids (int32)
     joints: np.ndarray  # Pinocchio joint ids (int32), rows after the frames'
+    rows: int  # frames and joints
     links: tuple[tuple[str, int], ...]  # name, row
     points: tuple[tuple[str, int, int | None, str], ...]  # name, row, the link's row if coincident, link
     sliders: tuple[tuple[str, str, tuple], ...]  # name, "joint" or "cut", what _slider / _cut_slider read
@@ -250,7 +269,7 @@ def _build_plan(mechanism: Mechanism, points: tuple[str, ...] | None, coincident
             parent = mechanism.model.parents[j.id]
             tree.append((name, "joint", (j, joint_row(j.id), joint_row(parent) if parent else None)))
     return _Plan(np.array(list(frames), dtype=np.int32), np.array(list(joints), dtype=np.int32),
-                 tuple(link_rows), tuple((n, *r) for n, r in point_rows.items()), tuple(tree + cuts))
+                 len(frames) + len(joints), tuple(link_rows), tuple((n, *r) for n, r in point_rows.items()), tuple(tree + cuts))
 
 
 def _point_plan(mechanism: Mechanism, point, frame, link_frame) -> tuple[int, int | None, str]:
@@ -324,9 +343,8 @@ def _point(row: np.ndarray, link: str) -> PointMotion:
 
 def _link_motion(row: np.ndarray, normal: np.ndarray | None) -> LinkMotion:
     """A link's frame from its row of the core's answer."""
-    rotation = row[3:12].reshape(3, 3)
-    angle, axis = _plane_angle(rotation, normal)
-    return LinkMotion(rotation=rotation, angular_velocity=row[15:18], angular_acceleration=row[21:24],
+    angle, axis = _plane_angle(row[3:12].tolist(), normal)
+    return LinkMotion(rotation=row[3:12].reshape(3, 3), angular_velocity=row[15:18], angular_acceleration=row[21:24],
                       angle=angle, angle_axis=axis)
 
 
@@ -336,18 +354,23 @@ def _link_motion(row: np.ndarray, normal: np.ndarray | None) -> LinkMotion:
 _IN_PLANE = 0.5
 
 
-def _plane_angle(rotation: np.ndarray, normal: np.ndarray | None) -> tuple[float | None, str]:
+def _plane_angle(rotation: list[float], normal: np.ndarray | None) -> tuple[float | None, str]:
     """Angle about the plane normal of the link's x axis (else y, else z: the first that
     lies within 60 deg of the plane), from the world x axis projected on the plane; and
-    which axis was measured."""
+    which axis was measured. `rotation`: the link's rotation, 9 floats row by row (plain
+    floats: a pose's few products cost less than numpy's calls)."""
     if normal is None:
         return None, "x"
-    ref = _plane_reference(*normal.tolist())
+    n = normal.tolist()
+    ref = _plane_reference(*n).tolist()
     for k, name in enumerate("xyz"):
-        axis = rotation[:, k]
-        in_plane = axis - normal * float(normal @ axis)
-        if math.hypot(*in_plane.tolist()) >= _IN_PLANE or name == "z":
-            return math.atan2(float(normal @ _cross(ref, in_plane)), float(ref @ in_plane)), name
+        axis = rotation[k::3]  # column k
+        along = n[0] * axis[0] + n[1] * axis[1] + n[2] * axis[2]
+        p = [axis[i] - n[i] * along for i in range(3)]
+        if math.hypot(*p) >= _IN_PLANE or name == "z":
+            c = (ref[1] * p[2] - ref[2] * p[1], ref[2] * p[0] - ref[0] * p[2], ref[0] * p[1] - ref[1] * p[0])
+            return math.atan2(n[0] * c[0] + n[1] * c[1] + n[2] * c[2],
+                              ref[0] * p[0] + ref[1] * p[1] + ref[2] * p[2]), name
     raise AssertionError("unreachable")  # pragma: no cover
 
 

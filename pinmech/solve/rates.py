@@ -36,6 +36,7 @@ from pinmech.arguments import not_real
 from pinmech.exceptions import ModelError, SingularPoseError, TaskError
 from pinmech.model.mechanism import Mechanism
 from pinmech.solve import core
+from pinmech.solve.core import _core
 from pinmech.solve.results import RateSolution
 from pinmech.solve.loops import (
     DEFAULT_MAX_CONDITION,
@@ -235,19 +236,20 @@ class RateSolver:
     def _rates(self, q: np.ndarray, x_dot: np.ndarray, x_ddot: np.ndarray) -> tuple[np.ndarray, ...]:
         """The compiled rate solve at every row of q (csrc/rates.cpp): v, a, numbers (per
         pose: condition, sigma_min, closure velocity and acceleration residuals, status,
-        q's independent and full closure residuals, rank, method code), achieved rows. Poses
-        that look singular are solved again with the task's structural rank."""
-        core, row_scale, v_scale = self._compiled()
-        asked = _ASKED[self.method]
-        rank = self._generic[0] if self._generic is not None else -1
-        out = core.rates(q, x_dot, x_ddot, row_scale, v_scale, asked, self.damping, self.max_condition, rank)
-        again = np.flatnonzero(out[2][:, 4] == _NEEDS_RANK)
-        if again.size:  # only poses that look singular pay for the structural rank
-            more = core.rates(q[again], x_dot, x_ddot, row_scale, v_scale, asked, self.damping,
-                              self.max_condition, self._structural_rank()[0])
-            for whole, part in zip(out, more):
-                whole[again] = part
-        return out
+        q's independent and full closure residuals, rank, method code), achieved rows
+        (views of one array). Poses that look singular are solved again with the task's
+        structural rank."""
+        core = self._compiled()
+        out = np.empty((len(q), core.rate_columns))
+        core.rates(q, x_dot, x_ddot, self._generic[0] if self._generic is not None else -1, out)
+        nv, m = self.model.nv, x_dot.size
+        first = 2 * nv + _core.RATE_NUMBERS
+        if _NEEDS_RANK in out[:, 2 * nv + 4].tolist():  # only poses that look singular pay for the structural rank
+            again = np.flatnonzero(out[:, 2 * nv + 4] == _NEEDS_RANK)
+            more = np.empty((again.size, out.shape[1]))
+            core.rates(np.ascontiguousarray(q[again]), x_dot, x_ddot, self._structural_rank()[0], more)
+            out[again] = more
+        return out[:, :nv], out[:, nv:2 * nv], out[:, 2 * nv:first], out[:, first:first + m], out[:, first + m:]
 
     def _checked(self, q: np.ndarray, numbers: np.ndarray) -> list[float]:
         """One pose's numbers as floats, or its error: open loops first (how far, in m and
@@ -270,13 +272,15 @@ class RateSolver:
         return values
 
     def _compiled(self):
-        """The core with this solver's loops and task (built once per model tree: it reads
-        placements changed in the model), and the row and column scales it solves with.
+        """The core with this solver's loops, task and options (built once per model tree:
+        it reads placements changed in the model; the scales, which a model changed in place
+        changes, and the options are read afresh).
 
         Raises:
             ModelError: the core reads a cut otherwise than its closure rows state."""
         cached = self.__dict__.get("_core")
-        scales = (self.mechanism.length_scale, *(c.length_scale for c in self.mechanism.closures))
+        options = (self.mechanism.length_scale, *(c.length_scale for c in self.mechanism.closures), self.method,
+                   self.damping, self.max_condition)
         if cached is None or cached[0].model is not self.model or not cached[0].same_structure:
             built = core.compile_loops(self.model, self.mechanism.closures, self.mechanism.velocity_scale(),
                                        extra_frames=self.frames)
@@ -287,12 +291,13 @@ class RateSolver:
             compiled, rebuilt = built
             compiled.set_task([rebuilt.frames[f] for f in self.frames], [[int(k) for k in t.rows] for t in self.tasks],
                               [int(t.reference == "local") for t in self.tasks])
-            cached = (compiled, None, None)
-        if cached[1] != scales:  # the sizes a model changed in place has (read afresh)
+            cached = (compiled, None)
+        if cached[1] != options:
             rows, columns = self._scales(self._closure_rows)
-            cached = (cached[0], scales, (rows, columns))
+            cached[0].set_rate_options(rows, columns, _ASKED[self.method], self.damping, self.max_condition)
+            cached = (cached[0], options)
         self.__dict__["_core"] = cached
-        return cached[0], *cached[2]
+        return cached[0]
 
     @property
     def _closure_rows(self) -> int:
@@ -305,7 +310,7 @@ class RateSolver:
         if wrong:
             raise ModelError(f"{name} must be real numbers (SI), got {wrong}: pinmech does not cast them",
                              path=self.mechanism.source)
-        values = np.asarray(given, dtype=float)
+        values = np.ascontiguousarray(given, dtype=float)
         if values.shape != default.shape or not np.all(np.isfinite(values)):
             raise TaskError(f"{name} needs {default.size} finite values (rows {', '.join(self.row_names)}), "
                             f"got {given!r}")
@@ -329,13 +334,13 @@ class RateSolver:
         rows before them: a deficiency no pose can cure. Computed once, and only when a
         pose looks singular, so well-posed tasks never pay for it."""
         if self._generic is None:
-            core = self._compiled()[0]
+            compiled = self._compiled()
             n_c = self._closure_rows
             rng = np.random.default_rng(20261122)
             best = None
             for _ in range(_SAMPLES):
                 q = pin.integrate(self.model, pin.neutral(self.model), rng.normal(size=self.model.nv))
-                Jd = self._dimensionless(core.stacked_jacobian(q), n_c)
+                Jd = self._dimensionless(compiled.stacked_jacobian(q), n_c)
                 r = _rank(Jd)
                 if best is None or r > best[0]:
                     best = (r, Jd)

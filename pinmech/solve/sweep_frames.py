@@ -62,8 +62,8 @@ def frame_paths(mechanism: Mechanism, names: Sequence[str], q: np.ndarray, v: np
                          f"{q.shape}, {v.shape}, {a.shape}", path=mechanism.source)
     data, lock = _data_for(mechanism)
     with lock:  # one Data per mechanism: threads sharing it take turns
-        rows = _core.frames_along(model, data, q, v, a, np.array(fids, dtype=np.int32))
-    rows = rows.reshape(n, len(fids), _core.KINEMATICS_COLUMNS)
+        rows = np.empty((n, len(fids), _core.KINEMATICS_COLUMNS))
+        _core.frames_along(model, data, q, v, a, np.array(fids, dtype=np.int32), rows)
     return FramePaths(names, rows[..., 0:3], rows[..., 3:12].reshape(n, len(fids), 3, 3), rows[..., 12:15],
                       rows[..., 15:18], rows[..., 18:21], rows[..., 21:24])
 
