@@ -492,7 +492,7 @@ class Mechanism:
             return m.multiplier * self.coordinate(q, m.leader) + m.offset
         j = self.joint(name)
         if j.kind == "continuous":
-            return float(np.arctan2(q[j.idx_q + 1], q[j.idx_q]))
+            return math.atan2(q[j.idx_q + 1], q[j.idx_q])  # libm's atan2, as numpy's for one pair
         return float(q[j.idx_q])
 
 

@@ -130,8 +130,8 @@ class Motion:
 
     @_built
     def links(self) -> dict[str, LinkMotion]:
-        rows, normal = self._rows, self._mechanism.plane_normal
-        return {name: _link_motion(rows[r], normal) for name, r in self._plan.links}
+        rows, plane = self._rows, self._plan.plane
+        return {name: _link_motion(rows[r], plane) for name, r in self._plan.links}
 
     @_built
     def points(self) -> dict[str, PointMotion]:
@@ -212,6 +212,7 @@ class _Plan:
     frames: np.ndarray  # Pinocchio frame ids (int32)
     joints: np.ndarray  # Pinocchio joint ids (int32), rows after the frames'
     rows: int  # frames and joints
+    plane: tuple[list[float], list[float]] | None  # the plane's normal and reference direction (see _plane_angle)
     links: tuple[tuple[str, int], ...]  # name, row
     points: tuple[tuple[str, int, int | None, str], ...]  # name, row, the link's row if coincident, link
     sliders: tuple[tuple[str, str, tuple], ...]  # name, "joint" or "cut", what _slider / _cut_slider read
@@ -269,7 +270,7 @@ def _build_plan(mechanism: Mechanism, points: tuple[str, ...] | None, coincident
             parent = mechanism.model.parents[j.id]
             tree.append((name, "joint", (j, joint_row(j.id), joint_row(parent) if parent else None)))
     return _Plan(np.array(list(frames), dtype=np.int32), np.array(list(joints), dtype=np.int32),
-                 len(frames) + len(joints), tuple(link_rows), tuple((n, *r) for n, r in point_rows.items()), tuple(tree + cuts))
+                 len(frames) + len(joints), _plane(mechanism.plane_normal), tuple(link_rows), tuple((n, *r) for n, r in point_rows.items()), tuple(tree + cuts))
 
 
 def _point_plan(mechanism: Mechanism, point, frame, link_frame) -> tuple[int, int | None, str]:
@@ -341,11 +342,17 @@ def _point(row: np.ndarray, link: str) -> PointMotion:
     return PointMotion(position=row[0:3], velocity=row[12:15], acceleration=row[18:21], link=link)
 
 
-def _link_motion(row: np.ndarray, normal: np.ndarray | None) -> LinkMotion:
+def _link_motion(row: np.ndarray, plane: tuple[list[float], list[float]] | None) -> LinkMotion:
     """A link's frame from its row of the core's answer."""
-    angle, axis = _plane_angle(row[3:12].tolist(), normal)
-    return LinkMotion(rotation=row[3:12].reshape(3, 3), angular_velocity=row[15:18], angular_acceleration=row[21:24],
-                      angle=angle, angle_axis=axis)
+    angle, axis = _plane_angle(row[3:12].tolist(), plane)
+    return LinkMotion(rotation=row[3:12].reshape(3, 3), angular_velocity=row[15:18],
+                      angular_acceleration=row[21:24], angle=angle, angle_axis=axis)
+
+
+def _plane(normal: np.ndarray | None) -> tuple[list[float], list[float]] | None:
+    """A planar mechanism's plane normal and the world x axis projected on the plane
+    (`_plane_reference`), as floats; None for a spatial mechanism."""
+    return None if normal is None else (normal.tolist(), _plane_reference(*normal.tolist()).tolist())
 
 
 #: A link axis is measured in the plane when its projection on the plane is at least this
@@ -354,23 +361,22 @@ def _link_motion(row: np.ndarray, normal: np.ndarray | None) -> LinkMotion:
 _IN_PLANE = 0.5
 
 
-def _plane_angle(rotation: list[float], normal: np.ndarray | None) -> tuple[float | None, str]:
+def _plane_angle(rotation: list[float], plane: tuple[list[float], list[float]] | None) -> tuple[float | None, str]:
     """Angle about the plane normal of the link's x axis (else y, else z: the first that
     lies within 60 deg of the plane), from the world x axis projected on the plane; and
-    which axis was measured. `rotation`: the link's rotation, 9 floats row by row (plain
-    floats: a pose's few products cost less than numpy's calls)."""
-    if normal is None:
+    which axis was measured. `rotation`: the link's rotation, 9 floats row by row; `plane`:
+    the normal and the reference direction (`_plane`), None for a spatial mechanism. Plain
+    floats: a pose's few products cost less than numpy's calls."""
+    if plane is None:
         return None, "x"
-    n = normal.tolist()
-    ref = _plane_reference(*n).tolist()
+    n, ref = plane
     for k, name in enumerate("xyz"):
         axis = rotation[k::3]  # column k
         along = n[0] * axis[0] + n[1] * axis[1] + n[2] * axis[2]
-        p = [axis[i] - n[i] * along for i in range(3)]
-        if math.hypot(*p) >= _IN_PLANE or name == "z":
-            c = (ref[1] * p[2] - ref[2] * p[1], ref[2] * p[0] - ref[0] * p[2], ref[0] * p[1] - ref[1] * p[0])
-            return math.atan2(n[0] * c[0] + n[1] * c[1] + n[2] * c[2],
-                              ref[0] * p[0] + ref[1] * p[1] + ref[2] * p[2]), name
+        p0, p1, p2 = axis[0] - n[0] * along, axis[1] - n[1] * along, axis[2] - n[2] * along
+        if math.hypot(p0, p1, p2) >= _IN_PLANE or name == "z":
+            c = (ref[1] * p2 - ref[2] * p1, ref[2] * p0 - ref[0] * p2, ref[0] * p1 - ref[1] * p0)
+            return math.atan2(n[0] * c[0] + n[1] * c[1] + n[2] * c[2], ref[0] * p0 + ref[1] * p1 + ref[2] * p2), name
     raise AssertionError("unreachable")  # pragma: no cover
 
 
