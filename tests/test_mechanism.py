@@ -206,9 +206,9 @@ def test_a_chain_of_2000_links_is_refused_in_one_line_before_allocating(tmp_path
 
 
 def test_locking_brings_a_long_chain_within_the_limit(tmp_path, monkeypatch):
-    import pinmech.model.mechanism
+    import pinmech.model.pinocchio_build
 
-    monkeypatch.setattr(pinmech.model.mechanism, "MAX_DOF", 20)
+    monkeypatch.setattr(pinmech.model.pinocchio_build, "MAX_DOF", 20)
     urdf = _chain(tmp_path, 25)
     with pytest.raises(ModelError, match="keeps 25 degrees of freedom"):
         Mechanism.from_urdf(urdf)

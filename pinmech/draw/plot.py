@@ -25,10 +25,11 @@ import numpy as np
 from pinmech.exceptions import FrameNotFound, PinmechError
 from pinmech.model.display import colour_of, display_names, hex_colour
 from pinmech.draw.plot_centrodes import CentrodeTrace
-from pinmech.draw.plot_curves import BRANCH_STYLES, angles as _angles, branch_pieces, driver_axis as _driver_axis
-from pinmech.draw.plot_curves import draw_markers, legend_beside, length_unit, nearest as _nearest, spike_limits
+from pinmech.draw.plot_curves import driver_axis as _driver_axis
+from pinmech.draw.plot_curves import draw_markers, legend_beside, length_unit
 from pinmech.draw.plot_design import DesignTrace, mark_least
 from pinmech.draw.plot_paths import PathRecorder
+from pinmech.draw.sweep_panels import SweepPanels
 
 if TYPE_CHECKING:
     from pinmech.io.sweep import Sweep, SweepPose
@@ -62,7 +63,7 @@ def _check_names(sweep: Sweep, what: str, names: list[str] | None, known, where:
             raise FrameNotFound(f"{what} (in {where})", name, list(known), path=str(sweep.scene.path))
 
 
-class SweepPlot:
+class SweepPlot(SweepPanels):
     """Records a sweep's plotted quantities pose by pose, then draws them (`save`).
 
     Args:
@@ -361,83 +362,6 @@ class SweepPlot:
         spec = self.sweep.scene.section("drivers").get(self.sweep.driver, {})
         speed = spec.get("speed", spec.get("velocity", f"{self._speed():.4g}"))
         return f"arrows: the motion, {self.sweep.driver} at {speed}"
-
-    def _panel(self, ax, title: str, series: dict[str, array], x: np.ndarray, order: np.ndarray,
-               mark_x: float | None) -> None:
-        """One quantity against the driver: a curve per name in its link's colour (one line
-        style a branch), constant ones said in the legend, a fold's spike clipped."""
-        quantity, label = title.split(", ")
-        symbol, dim = label.split(" [")
-        scale, dim = self._length_dim(dim.rstrip("]"))
-        label, dim = f"{symbol} [{dim}]", dim + "]"
-        angle = title.startswith("angle")
-        curves = {name: _angles(np.array(v)[order], self.angles) if angle else scale * np.array(v)[order]
-                  for name, v in series.items()}
-        largest = max((float(np.nanmax(np.abs(y))) for y in curves.values() if np.any(np.isfinite(y))), default=0.0)
-        flat = max(1e-9 * largest, 1e-12)  # changes below this are rounding (1e-12: noise about an exact 0)
-        constants, drawn, branch = [], [], np.array(self.branch)[order]
-        is_flat = {name: bool(y[np.isfinite(y)].size) and np.ptp(y[np.isfinite(y)]) <= flat for name, y in curves.items()}
-        every_flat = all(is_flat.values())  # an empty panel says less than its flat lines
-        for name, y in curves.items():
-            if is_flat[name]:
-                value = y[np.isfinite(y)][0]
-                constants.append(f"{self.names.get(name, name)}: {symbol} = {value:.6g} {dim.rstrip(']')} "
-                                 + ("(constant)" if every_flat else "(constant, not drawn)"))
-                if not every_flat:
-                    continue
-            drawn.append(y)
-            self._curve(ax, name, x, y, branch)
-            if mark_x is not None:
-                at = _nearest(x, y, mark_x, scale * self.mark[1][title][name])
-                ax.plot([mark_x], [at], "o", color=self.colours.get(name, "k"), markersize=5)
-        for text in constants:  # in the legend, not in a box over the curves
-            ax.plot([], [], " ", label=text)
-        clipped = spike_limits(drawn)
-        if clipped is not None:
-            ax.set_ylim(clipped[0], clipped[1])
-            quantity += f" (clipped: reaches {clipped[2]:.3g} at a fold)"
-        if mark_x is not None:
-            ax.axvline(mark_x, color="0.35", linestyle="--", linewidth=1)
-        name = self.names.get(next(iter(series)), next(iter(series)))
-        ax.set_title(f"{name}: {quantity}" if len(series) == 1 else quantity, fontsize=10)
-        ax.set_ylabel(label + (f", {self.angles}" if angle else ""))
-        ax.grid(True, alpha=0.35)
-        legend_beside(ax)
-
-    def _length_dim(self, dim: str) -> tuple[float, str]:
-        """(factor, unit) a quantity in SI `dim` is drawn in: the figure's length unit for
-        lengths, speeds and accelerations ("m/s" -> "mm/s"), else as it is."""
-        if dim in ("m", "m/s", "m/s²"):
-            return self.length[0], self.length[1] + dim[1:]
-        return 1.0, dim
-
-    def _curve(self, ax, name: str, x: np.ndarray, y: np.ndarray, branch: np.ndarray) -> None:
-        """One name's curve, in its link's colour, one line style for each branch."""
-        colour = self.colours.get(name, "k")
-        for b, mask in branch_pieces(branch):
-            label = self.names.get(name, name) + (f", assembly {b + 1}" if self._folded else "")
-            ax.plot(x, np.where(mask, y, np.nan), linewidth=1.6, color=colour,
-                    linestyle=BRANCH_STYLES[b % len(BRANCH_STYLES)], label=label)
-
-    def _title(self, marked: bool, mark_x: float, unit: str) -> str:
-        sweep = self.sweep
-        spec = sweep.scene.section("drivers").get(sweep.driver, {})
-        rate = "speed" if sweep.is_angular else "velocity"
-        speed = spec.get("speed", spec.get("velocity", "0"))  # as the scene writes them; absent: 0
-        note = f"dashed: the scene's pose, {mark_x:.4g} {unit}" if marked else ""
-        if self.failed:
-            note += ("; " if note else "") + f"{len(self.failed)} pose(s) failed (red x)"
-        driven = f"driver {sweep.driver} at {rate} {speed}, acceleration {spec.get('acceleration', '0')}"
-        return f"{sweep.scene.title}: {driven}" + (f"\n({note})" if note else "")
-
-    def _summary(self, mark_x: float, unit: str) -> str:
-        lines = [f"At the scene's pose, {self.sweep.driver} = {mark_x:.4g} {unit}:", ""]
-        for title, values in self.mark[1].items():
-            symbol, dim = title.split(", ")[1].split(" [")
-            scale, dim = self._length_dim(dim.rstrip("]"))
-            for name, value in values.items():
-                lines.append(f"  {self.names.get(name, name) + ' ' + symbol:<18} {scale * value: .5g} {dim}")
-        return "\n".join(lines)
 
 
 def plot_sweep(sweep: Sweep, poses: Iterable[SweepPose], path: str | Path, *,

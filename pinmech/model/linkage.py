@@ -2,11 +2,13 @@
 
 Mechanism people think in joint coordinates on a drawing. A linkage file gives every
 joint's world coordinates at one drawn pose, the links and the joints and points each
-carries, sliders and pin-in-slot joints one line each; this module picks a spanning tree
-(breadth first from the ground), turns every other joint into one loop cut, and writes a
-URDF whose reference configuration is the drawn pose. See the README section
-"Linkages as drawn" for the format; `parse_linkage` reads and validates it once,
-`pinmech.model.linkage_urdf` writes the URDF text, `load_linkage` makes the Mechanism.
+carries, sliders and pin-in-slot joints one line each. `pinmech.model.linkage_spec` reads
+and validates the file once into a `LinkageSpec`; this module turns a spec into the
+`Linkage` graph at the drawn pose (lengths and angles in SI, constructions drawn, pins
+split into pairs); `pinmech.model.linkage_urdf` picks a spanning tree (breadth first from
+the ground), turns every other joint into one loop cut and writes the URDF, whose
+reference configuration is the drawn pose; `load_linkage` makes the Mechanism. See the
+README section "Linkages as drawn" for the format.
 
 Conventions of the generated URDF (all in the plane z = 0, axes along z):
   * every link's frame sits on its parent joint, its x axis from the first point the link
@@ -25,17 +27,13 @@ from typing import Any
 
 import numpy as np
 
-from pinmech.arguments import file_path
-from pinmech.directions import unit_vector, written
 from pinmech.exceptions import ModelError, UnitError
-from pinmech.model.linkage_expr import check_param_name, length
+from pinmech.model.linkage_expr import length
 from pinmech.model.linkage_masses import LinkMass, parse_masses
+from pinmech.directions import unit_vector
+from pinmech.model.linkage_spec import GROUND, Compass, LinkageSpec, Polar, Slot, read_linkage_spec
 from pinmech.units import to_si
 
-from pinmech.toml_file import read_toml
-
-GROUND = "ground"
-_KEYS = {"title", "ground", "params", "joints", "links", "sliders", "slots", "colors", "axes", "balls", "masses"}
 
 @dataclass(frozen=True)
 class Edge:
@@ -91,51 +89,58 @@ class Linkage:
 
 # ------------------------------------------------------------------------- reading
 def parse_linkage(path: str | Path) -> Linkage:
-    """Read a linkage file: values with units, names checked, the drawn pose constructed.
+    """Read a linkage file: validated once (`read_linkage_spec`), then drawn (`linkage_from_spec`).
 
     Raises:
         ModelError: a missing file, malformed TOML, an unknown key or name, a value without
             units, a construction that cannot be drawn (circles that do not meet).
     """
-    path = file_path(path, "the linkage file")
-    source = str(path)
-    raw = read_toml(path, "linkage", ModelError)
-    unknown = set(raw) - _KEYS
-    if unknown:
-        raise ModelError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_KEYS))}",
-                         path=source)
-    reader = _Reader(source, _table(raw, "params", source))
-    points = reader.points(_table(raw, "joints", source))
-    ground = _names(raw.get("ground", []), "ground", source)
-    links = {GROUND: list(ground)}
-    for name, value in _table(raw, "links", source).items():
-        if name == GROUND:
-            raise ModelError("the ground is listed by ground = [...], not as a link", path=source,
-                             element="[links] ground")
-        links[name] = _names(value, f"[links] {name}", source)
-    for link, names in links.items():
-        for name in names:
-            if name not in points:
-                raise ModelError(f"names joint '{name}', which [joints] does not give", path=source,
-                                 element=f"[links] {link}" if link != GROUND else "ground")
-    if len(links) < 2:
-        raise ModelError("no link: list the moving links under [links]", path=source)
-    linkage = Linkage(source, str(raw.get("title", path.stem)), points, links, [], {})
-    _spatial(linkage, raw, source)
+    spec, source = read_linkage_spec(path)
+    return linkage_from_spec(spec, source)
+
+
+def linkage_from_spec(spec: LinkageSpec, source: str = "<linkage>") -> Linkage:
+    """The linkage a spec draws: lengths and angles in SI, the drawn pose constructed.
+
+    Args:
+        spec: a validated linkage (`read_linkage_spec`, `linkage_spec`, or built in code).
+        source: the file's name for messages (its stem is the default title).
+
+    Raises:
+        ModelError: a quantity without units or of the wrong kind, a construction that
+            cannot be drawn, names that clash in the URDF it would write.
+    """
+    reader = _Reader(source, spec.params)
+    points = reader.points(spec.joints)
+    links = {GROUND: list(spec.ground), **{name: list(names) for name, names in spec.links.items()}}
+    title = spec.title if spec.title is not None else Path(source).stem
+    linkage = Linkage(source, title, points, links, [], {})
+    _spatial(linkage, spec)
     _pins(linkage)
-    for name, spec in _table(raw, "sliders", source).items():
-        _slider(linkage, reader, name, spec)
-    for name, spec in _table(raw, "slots", source).items():
-        _slot(linkage, reader, name, spec)
+    for name, slider in spec.sliders.items():
+        edge = Edge(name, "prismatic", (slider.on, slider.block), linkage.points[slider.at],
+                    _direction(linkage, reader, slider.along, linkage.points[slider.at], f"[sliders] {name}"))
+        linkage.edges.append(edge)
+        linkage.blocks[slider.block] = edge
+    for name, slot in spec.slots.items():
+        _slot(linkage, reader, name, slot)
     _check_names(linkage)
-    _masses(linkage, reader, raw.get("masses", {}))
+    _masses(linkage, reader, spec)
     return linkage
 
 
-def _masses(linkage: Linkage, reader: _Reader, table: Any) -> None:
+def linkage_params(spec: LinkageSpec, source: str = "<linkage>") -> dict[str, float]:
+    """The spec's parameters as lengths [m], in the order written (a study's named dimensions).
+
+    Raises:
+        ModelError: a parameter that is no length (naming `[params] NAME`).
+    """
+    return dict(_Reader(source, spec.params).params)
+
+
+def _masses(linkage: Linkage, reader: _Reader, spec: LinkageSpec) -> None:
     """`[masses]`: the links' masses as stated (`pinmech.model.linkage_masses`), none invented."""
-    links = {n: v for n, v in linkage.links.items() if n not in linkage.hidden}
-    linkage.masses = parse_masses(table, links, linkage.points, linkage.spatial, reader.length, linkage.source)
+    linkage.masses = parse_masses(spec.masses, linkage.points, linkage.spatial, reader.length, linkage.source)
     for link, stated in linkage.masses.items():
         if stated.centre.size == 3 and not linkage.spatial and stated.centre[2] == 0.0:
             linkage.masses[link] = LinkMass(stated.mass, stated.centre[:2], stated.inertia)  # in the plane
@@ -146,22 +151,6 @@ def _masses(linkage: Linkage, reader: _Reader, table: Any) -> None:
             linkage.masses[link] = LinkMass(stated.mass, np.append(stated.centre, 0.0), stated.inertia)
 
 
-def _table(raw: dict[str, Any], key: str, source: str) -> dict[str, Any]:
-    value = raw.get(key, {})
-    if not isinstance(value, dict):
-        raise ModelError(f"[{key}] must be a table", path=source, element=key)
-    return value
-
-
-def _names(value: Any, where: str, source: str) -> list[str]:
-    if not isinstance(value, list) or not all(isinstance(n, str) for n in value):
-        raise ModelError(f"must be a list of joint names, e.g. [\"A\", \"B\"], got {value!r}", path=source,
-                         element=where)
-    if len(set(value)) != len(value):
-        raise ModelError(f"lists a joint twice: {value}", path=source, element=where)
-    return list(value)
-
-
 class _Reader:
     """Lengths and angles of one file: quantities with units, or names of `[params]`."""
 
@@ -169,7 +158,6 @@ class _Reader:
         self.source = source
         self.params: dict[str, float] = {}
         for name, value in params.items():  # in the order written: a parameter may use earlier ones
-            check_param_name(name, source)
             self.params[name] = self.length(value, f"[params] {name}")
 
     def length(self, value: Any, where: str) -> float:
@@ -177,64 +165,30 @@ class _Reader:
         (see `pinmech.model.linkage_expr`)."""
         return length(value, self.params, self.source, where)
 
-    def _quantity(self, value: Any, kind: str, where: str) -> float:
+    def angle(self, value: Any, where: str) -> float:
+        """An angle [rad]: "30 deg"."""
         try:
-            return to_si(value, kind, where=where)
+            return to_si(value, "angle", where=where)
         except UnitError as exc:
             raise ModelError(str(exc), path=self.source) from exc
 
-    def angle(self, value: Any, where: str) -> float:
-        return self._quantity(value, "angle", where)
-
-    def points(self, table: dict[str, Any]) -> dict[str, np.ndarray]:
+    def points(self, joints: dict[str, tuple | Polar | Compass]) -> dict[str, np.ndarray]:
         """World positions of `[joints]`, in the order written (constructions use earlier ones)."""
         out: dict[str, np.ndarray] = {}
-        for name, spec in table.items():
+        for name, spec in joints.items():
             where = f"[joints] {name}"
-            if isinstance(spec, list):
-                if len(spec) not in (2, 3):
-                    raise ModelError(f"give coordinates [x, y] (or [x, y, z]) with units, got {spec!r}",
-                                     path=self.source, element=where)
-                out[name] = np.array([self.length(v, f"{where} {c}") for v, c in zip(spec, "xyz")])
-            elif isinstance(spec, dict):
-                out[name] = self._construction(name, spec, out, where)
+            if isinstance(spec, Polar):
+                r, phi = self.length(spec.length, f"{where} length"), self.angle(spec.angle, f"{where} angle")
+                base = out[spec.base]  # in 3-D: in the plane z = the base's z (the angle from x, seen from +z)
+                out[name] = base + r * np.array([math.cos(phi), math.sin(phi), 0.0][: base.size])
+            elif isinstance(spec, Compass):
+                r1, r2 = (self.length(v, f"{where} lengths") for v in spec.lengths)
+                a, b = _level(out[spec.bases[0]], out[spec.bases[1]], list(spec.bases), self.source, where)
+                point = _compass(a[:2], b[:2], r1, r2, spec.side == "left", f"{self.source}, {where}")
+                out[name] = np.append(point, a[2]) if a.size == 3 else point
             else:
-                raise ModelError(f"give [x, y] with units or a construction table, got {spec!r}",
-                                 path=self.source, element=where)
+                out[name] = np.array([self.length(v, f"{where} {c}") for v, c in zip(spec, "xyz")])
         return out
-
-    def _construction(self, name: str, spec: dict[str, Any], known: dict[str, np.ndarray], where: str) -> np.ndarray:
-        """`{from = "O", length = "m", angle = "30 deg"}` or `{from = ["A", "B"], lengths = [..], side = ..}`."""
-        origin = spec.get("from")
-        bases = [origin] if isinstance(origin, str) else origin
-        if not isinstance(bases, list) or not all(isinstance(b, str) for b in bases):
-            raise ModelError("a construction needs from = \"JOINT\" (with length, angle) or from = [\"A\", \"B\"] "
-                             "(with lengths, side)", path=self.source, element=where)
-        for base in bases:
-            if base not in known:
-                raise ModelError(f"from names '{base}', which is not given above it", path=self.source,
-                                 element=where)
-        if len(bases) == 1:
-            if set(spec) != {"from", "length", "angle"}:
-                raise ModelError("a polar construction has exactly from, length, angle", path=self.source,
-                                 element=where)
-            r, phi = self.length(spec["length"], f"{where} length"), self.angle(spec["angle"], f"{where} angle")
-            base = known[bases[0]]  # in 3-D: in the plane z = the base's z (the angle from x, seen from +z)
-            return base + r * np.array([math.cos(phi), math.sin(phi), 0.0][: base.size])
-        if len(bases) != 2 or set(spec) != {"from", "lengths", "side"}:
-            raise ModelError("a compass construction has exactly from = [\"A\", \"B\"], lengths = [|A..|, |B..|], "
-                             "side = \"left\" or \"right\" (of the line A -> B)", path=self.source, element=where)
-        lengths = spec["lengths"]
-        if not isinstance(lengths, list) or len(lengths) != 2:
-            raise ModelError(f"lengths must be two lengths, got {lengths!r}", path=self.source, element=where)
-        if spec["side"] not in ("left", "right"):
-            raise ModelError(f"side must be \"left\" or \"right\", got {spec['side']!r}", path=self.source,
-                             element=where)
-        r1, r2 = (self.length(v, f"{where} lengths") for v in lengths)
-        a, b = _level(known[bases[0]], known[bases[1]], bases, self.source, where)
-        point = _compass(a[:2], b[:2], r1, r2, spec["side"] == "left", f"{self.source}, {where}")
-        return np.append(point, a[2]) if a.size == 3 else point
-
 
 def _level(a: np.ndarray, b: np.ndarray, names: list[str], source: str, where: str) -> tuple[np.ndarray, np.ndarray]:
     """The two bases of a compass construction, both 2-D or both 3-D at one z [m]: left and
@@ -266,43 +220,28 @@ def _compass(a: np.ndarray, b: np.ndarray, r1: float, r2: float, left: bool, whe
     return a + along * u + (across if left else -across) * normal
 
 
-def _spatial(linkage: Linkage, raw: dict[str, Any], source: str) -> None:
+def _spatial(linkage: Linkage, spec: LinkageSpec) -> None:
     """3-D coordinates, `[axes]` or `balls`: a spatial linkage (2-D entries lie in z = 0)."""
-    axes = _table(raw, "axes", source)
-    balls = _names(raw.get("balls", []), "balls", source)
-    linkage.spatial = bool(axes or balls or any(p.size == 3 for p in linkage.points.values()))
+    linkage.spatial = bool(spec.axes or spec.balls or any(p.size == 3 for p in linkage.points.values()))
     if not linkage.spatial:
         return
     linkage.points = {n: np.append(p, 0.0) if p.size == 2 else p for n, p in linkage.points.items()}
     z = np.array([0.0, 0.0, 1.0])
     for name in linkage.points:
         linkage.axes[name] = z
-    for name, value in axes.items():
-        where = f"[axes] {name}"
-        if name not in linkage.points:
-            raise ModelError(f"'{name}' is not a joint of [joints]", path=source, element=where)
-        if (not isinstance(value, list) or len(value) != 3
-                or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
-            raise ModelError(f"an axis is three numbers, e.g. [0, 0, 1], got {value!r}", path=source, element=where)
-        axis = unit_vector(value)
-        if axis is None:
-            raise ModelError(f"{written(value)} is not a direction (zero or not finite)", path=source, element=where)
-        linkage.axes[name] = axis
-    for name in balls:
-        if name not in linkage.points:
-            raise ModelError(f"'{name}' is not a joint of [joints]", path=source, element="balls")
-    linkage.balls = set(balls)
-    if _drawn_in_plane(linkage, raw):  # z = 0 and axes +z written out: the planar linkage it draws
+    for name, value in spec.axes.items():
+        linkage.axes[name] = unit_vector(value)
+    linkage.balls = set(spec.balls)
+    if _drawn_in_plane(linkage, spec):  # z = 0 and axes +z written out: the planar linkage it draws
         linkage.spatial, linkage.axes = False, {}
         linkage.points = {n: p[:2] for n, p in linkage.points.items()}
 
 
-def _drawn_in_plane(linkage: Linkage, raw: dict[str, Any]) -> bool:
+def _drawn_in_plane(linkage: Linkage, spec: LinkageSpec) -> bool:
     """Every point at z = 0, every axis +z, no ball and no spatial inertia: a planar linkage
     written in 3-D, read as one (else its driver angles would count from the drawing, not
     from world x, because a third "0 mm" or a default axis was written out)."""
-    masses = raw.get("masses")
-    spatial_mass = isinstance(masses, dict) and any(isinstance(m, dict) and "inertia" in m for m in masses.values())
+    spatial_mass = any(m.inertia is not None for m in spec.masses.values())
     return (not linkage.balls and not spatial_mass and all(p[2] == 0.0 for p in linkage.points.values())
             and all(a.tolist() == [0.0, 0.0, 1.0] for a in linkage.axes.values()))
 
@@ -324,77 +263,30 @@ def _pins(linkage: Linkage) -> None:
                                       axis=linkage.axes.get(name) if linkage.spatial else None))
 
 
-def _link(linkage: Linkage, value: Any, key: str, where: str) -> str:
-    if not isinstance(value, str) or value not in linkage.links:
-        known = ", ".join(linkage.links)
-        raise ModelError(f"{key} = {value!r} names no link (links: {known})", path=linkage.source, element=where)
-    return value
-
-
-def _direction(linkage: Linkage, reader: _Reader, spec: dict[str, Any], at: np.ndarray, where: str) -> np.ndarray:
+def _direction(linkage: Linkage, reader: _Reader, along: Any, at: np.ndarray, where: str) -> np.ndarray:
     """`along = "30 deg"` or `along = ["A", "B"]`: a unit direction in the world [-]."""
-    along = spec.get("along")
-    if along is None:
-        raise ModelError("has no line: give along = \"ANGLE\" or along = [\"P\", \"Q\"]", path=linkage.source,
-                         element=where)
-    if isinstance(along, list):
-        if len(along) != 2 or not all(isinstance(n, str) and n in linkage.points for n in along):
-            raise ModelError(f"along = {along!r} must name two joints of [joints]", path=linkage.source,
-                             element=where)
+    if isinstance(along, tuple):
         vector = linkage.points[along[1]] - linkage.points[along[0]]
         if np.linalg.norm(vector) < 1e-12 * max(1.0, float(np.linalg.norm(at))):
-            raise ModelError(f"along = {along!r}: the two joints coincide, so they give no direction",
+            raise ModelError(f"along = {list(along)!r}: the two joints coincide, so they give no direction",
                              path=linkage.source, element=where)
         return vector / np.linalg.norm(vector)
     phi = reader.angle(along, f"{where} along")
     return np.array([math.cos(phi), math.sin(phi), 0.0][: at.size])
 
 
-def _slider(linkage: Linkage, reader: _Reader, name: str, spec: Any) -> None:
-    """`S = {block = "piston", on = "ground", at = "B", along = "0 deg"}`: a prismatic pair."""
-    where = f"[sliders] {name}"
-    if not isinstance(spec, dict) or not set(spec) <= {"block", "on", "at", "along"}:
-        raise ModelError("a slider is {block = LINK, on = LINK, at = JOINT, along = ANGLE or [P, Q]}",
-                         path=linkage.source, element=where)
-    block = _link(linkage, spec.get("block"), "block", where)
-    on = _link(linkage, spec.get("on"), "on", where)
-    if block == on:
-        raise ModelError(f"block and on are the same link '{block}'", path=linkage.source, element=where)
-    at = spec.get("at")
-    if at not in linkage.links[block]:
-        raise ModelError(f"at = {at!r} must be a joint the block '{block}' lists", path=linkage.source,
-                         element=where)
-    edge = Edge(name, "prismatic", (on, block), linkage.points[at],
-                _direction(linkage, reader, spec, linkage.points[at], where))
-    linkage.edges.append(edge)
-    linkage.blocks[block] = edge
-
-
-def _slot(linkage: Linkage, reader: _Reader, name: str, spec: Any) -> None:
+def _slot(linkage: Linkage, reader: _Reader, name: str, slot: Slot) -> None:
     """`A = {pin = "crank", slot = "rocker", along = ["O4", "A"]}`: a pin sliding in a slot."""
     where = f"[slots] {name}"
-    if not isinstance(spec, dict) or not set(spec) <= {"pin", "slot", "along"}:
-        raise ModelError("a pin-in-slot joint is {pin = LINK, slot = LINK, along = ANGLE or [P, Q]}",
-                         path=linkage.source, element=where)
     if linkage.spatial:
         raise ModelError("pin-in-slot joints are planar only: in a spatial linkage, give the block as a link "
                          "with a slider and a pin", path=linkage.source, element=where)
-    pin_link = _link(linkage, spec.get("pin"), "pin", where)
-    slot_link = _link(linkage, spec.get("slot"), "slot", where)
-    if name not in linkage.points:
-        raise ModelError(f"the slot's pin '{name}' is not given in [joints]", path=linkage.source, element=where)
-    if name not in linkage.links[pin_link]:
-        raise ModelError(f"the pin '{name}' must be listed by its link '{pin_link}'", path=linkage.source,
-                         element=where)
     at = linkage.points[name]
     block = f"{name}_block"
-    if block in linkage.links:  # it was replaced by the block, in silence
-        raise ModelError(f"link '{block}' has the name pinmech gives slot {name}'s block (a hidden link): rename "
-                         "the link", path=linkage.source, element=f"[links] {block}")
     linkage.links[block] = [name]
     linkage.hidden.add(block)
-    linkage.edges.append(Edge(f"{name}_pin", "revolute", (pin_link, block), at))
-    edge = Edge(f"{name}_slide", "prismatic", (slot_link, block), at, _direction(linkage, reader, spec, at, where))
+    linkage.edges.append(Edge(f"{name}_pin", "revolute", (slot.pin, block), at))
+    edge = Edge(f"{name}_slide", "prismatic", (slot.slot, block), at, _direction(linkage, reader, slot.along, at, where))
     linkage.edges.append(edge)
     linkage.blocks[block] = edge
     linkage.point_links.pop(name, None)

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from pinmech.exceptions import ModelError, UnitError
+from pinmech.model.linkage_entries import MassSpec
 from pinmech.units import to_si
 
 _PLANAR_KEYS = {"mass", "at", "izz"}
@@ -43,32 +44,27 @@ class LinkMass:
     inertia: np.ndarray
 
 
-def parse_masses(table: Any, links: dict[str, list[str]], points: dict[str, np.ndarray], spatial: bool,
-                 length, source: str) -> dict[str, LinkMass]:
-    """The `[masses]` table: link -> LinkMass.
+def parse_masses(masses: dict[str, MassSpec], points: dict[str, np.ndarray], spatial: bool, length,
+                 source: str) -> dict[str, LinkMass]:
+    """The `[masses]` table (its links and names checked by `LinkageSpec`): link -> LinkMass.
 
     Args:
         length: the file's reader of lengths, (value, where) -> [m].
 
     Raises:
-        ModelError: a table or key that is not as above, a link of no such name (or the
-            ground), a unit of the wrong kind, a mass that is not positive, a tensor that
-            is not a physical inertia.
+        ModelError: izz in a spatial linkage or inertia in a planar one, a key missing, a
+            unit of the wrong kind, a mass that is not positive, a tensor that is not a
+            physical inertia.
     """
-    if not isinstance(table, dict):
-        raise ModelError("[masses] must be a table of links", path=source, element="masses")
     out = {}
-    for link, spec in table.items():
+    for link, spec in masses.items():
         where = f"[masses] {link}"
-        if link not in links or link == "ground":
-            known = ", ".join(n for n in links if n != "ground")
-            raise ModelError(f"names no moving link (links: {known})", path=source, element=where)
         keys = _SPATIAL_KEYS if spatial else _PLANAR_KEYS
-        if not isinstance(spec, dict) or set(spec) != keys:
+        if {key for key in _SPATIAL_KEYS | _PLANAR_KEYS if getattr(spec, key) is not None} != keys:
             example = ('{ mass = "0.4 kg", at = "G", inertia = ["1e-4 kg*m^2", ...6 values] }' if spatial
                        else '{ mass = "0.4 kg", at = "G", izz = "2e-4 kg*m^2" }')
             raise ModelError(f"give exactly {', '.join(sorted(keys))}: {example}", path=source, element=where)
-        out[link] = LinkMass(_mass(spec["mass"], source, where), _centre(spec["at"], points, length, where, source),
+        out[link] = LinkMass(_mass(spec.mass, source, where), _centre(spec.at, points, length, where),
                              _inertia(spec, spatial, source, where))
     return out
 
@@ -88,28 +84,23 @@ def _mass(value: Any, source: str, where: str) -> float:
     return mass
 
 
-def _centre(value: Any, points: dict[str, np.ndarray], length, where: str, source: str) -> np.ndarray:
+def _centre(value: str | tuple, points: dict[str, np.ndarray], length, where: str) -> np.ndarray:
+    """A joint's position (a name, checked by the spec) or [x, y] / [x, y, z] as written [m]."""
     if isinstance(value, str):
-        if value not in points:
-            raise ModelError(f"at = {value!r} is not a joint of [joints] (give its name or coordinates)",
-                             path=source, element=where)
         return points[value]
-    if not isinstance(value, list) or len(value) not in (2, 3):
-        raise ModelError(f"at = {value!r}: the centre of mass is a joint's name or [x, y] (or [x, y, z]) "
-                         "with units", path=source, element=where)
     return np.array([length(v, f"{where} at {c}") for v, c in zip(value, "xyz")])
 
 
-def _inertia(spec: dict[str, Any], spatial: bool, source: str, where: str) -> np.ndarray:
+def _inertia(spec: MassSpec, spatial: bool, source: str, where: str) -> np.ndarray:
     """About the centre of mass, world axes [kg m^2]; physical (symmetric, eigenvalues >= 0
     and each at most the sum of the other two)."""
     if not spatial:
-        izz = _quantity(spec["izz"], "moment_of_inertia", source, f"{where} izz")
+        izz = _quantity(spec.izz, "moment_of_inertia", source, f"{where} izz")
         if izz < 0:
-            raise ModelError(f"izz = {spec['izz']!r} is negative", path=source, element=where)
+            raise ModelError(f"izz = {spec.izz!r} is negative", path=source, element=where)
         return np.diag([izz / 2, izz / 2, izz])
-    values = spec["inertia"]
-    if not isinstance(values, list) or len(values) != 6:
+    values = list(spec.inertia)
+    if len(values) != 6:
         raise ModelError(f"inertia = {values!r}: give [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] about the centre of mass, "
                          "world axes at the drawn pose, each with units", path=source, element=where)
     xx, yy, zz, xy, xz, yz = (_quantity(v, "moment_of_inertia", source, f"{where} inertia") for v in values)

@@ -47,10 +47,24 @@ def load_linkage(path: str | Path, *, locked: dict[str, float] | None = None):
     Raises:
         ModelError: anything wrong in the file (one line naming the file and the key).
     """
+    return linkage_mechanism(parse_linkage(path), locked=locked)
+
+
+def linkage_mechanism(linkage: Linkage, *, locked: dict[str, float] | None = None):
+    """A drawn linkage (`linkage_from_spec`, `parse_linkage`) as a Mechanism, its reference
+    configuration the drawn pose and its pins named points.
+
+    Args:
+        linkage: the linkage, drawn in SI.
+        locked: joints to lock, name -> value [rad or m] (as `Mechanism.from_urdf`).
+
+    Raises:
+        ModelError: a URDF pinmech generated that Pinocchio refuses (named as such), a
+            locked joint the linkage lacks.
+    """
     from pinmech.model.linkage_urdf import linkage_urdf
     from pinmech.model.mechanism import Mechanism
 
-    linkage = parse_linkage(path)
     text, reference = linkage_urdf(linkage)
     urdf = _cached_urdf(text)
 
@@ -59,8 +73,9 @@ def load_linkage(path: str | Path, *, locked: dict[str, float] | None = None):
             mech = Mechanism.from_urdf(urdf, locked=held, reference=reference)
         except ModelError as exc:  # pinmech's own URDF refused: say so, never "the user's file is no URDF"
             said = str(exc).replace(f"{urdf}: ", "").replace(str(urdf), "it")
-            raise ModelError(f"the URDF pinmech generated from it ({urdf}) is refused: {said}", path=str(path)) from exc
-        mech.source, mech.urdf_path = str(path), str(urdf)
+            raise ModelError(f"the URDF pinmech generated from it ({urdf}) is refused: {said}",
+                             path=linkage.source) from exc
+        mech.source, mech.urdf_path = linkage.source, str(urdf)
         mech.mass_source = "mass under the linkage's [masses]"
         mech.massless_links = tuple(n for n in mech.links if n not in linkage.links or n in linkage.hidden)
         mech.limits = {}  # a drawing states no limits: the URDF's slide <limit> is a formality

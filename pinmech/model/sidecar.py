@@ -24,7 +24,9 @@ import pinocchio as pin
 from pinmech.exceptions import ModelError
 from pinmech.model.frame_names import frame_named, reduced_model
 from pinmech.model.inertia_check import urdf_inertia_caveats
-from pinmech.model.mechanism import Mechanism, _build_model, _parse_xml, _point_links
+from pinmech.model.mechanism import Mechanism
+from pinmech.model.pinocchio_build import _build_model
+from pinmech.model.urdf_xml import _parse_xml, _point_links
 from pinmech.model.urdf_joints import joint_limits, mimic_joints, with_followers
 
 _KEYS = {"closed_loop", "type", "name_mot", "joint_name", "joint_type"}

@@ -1,0 +1,314 @@
+"""A drawn-linkage file as one typed, validated object: `LinkageSpec` (pydantic v2).
+
+The file is read once (`read_linkage_spec`) into a `LinkageSpec` holding what it writes, as
+it writes it: quantities stay the user's text (`"40 mm"`, `"2*a + b"`, `"30 deg"`), names
+stay names. Validation checks every entry's shape and every name it refers to (a link's
+joints, a construction's bases, a slider's links...), each failure one `ModelError` naming
+the file and the key (`[links] coupler`). Lengths and angles become SI numbers, and the
+drawn pose is constructed, in `pinmech.model.linkage.linkage_from_spec`, the one place a
+written quantity is read; nothing below reads TOML keys. `linkage_toml` writes a spec back
+(`pinmech.model.linkage_write`), so a program (a study, a synthesis) can change `params` or
+joints and write or load the result.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, StrictStr, ValidationError, ValidationInfo, field_validator
+from pydantic import model_validator
+
+from pinmech.directions import unit_vector, written
+from pinmech.exceptions import ModelError
+from pinmech.model.linkage_entries import (TABLES as _TABLES, Compass, Joint, MassSpec, Polar, Slider, Slot, Written,
+                                           as_model_error as _as_model_error)
+from pinmech.model.linkage_expr import check_param_name
+
+GROUND = "ground"
+_KEYS = {"title", "ground", "balls", *_TABLES}
+
+
+def _source(info: ValidationInfo) -> str:
+    return (info.context or {}).get("source", "<linkage>")
+
+
+class LinkageSpec(BaseModel):
+    """A drawn linkage as its file writes it, validated: build one with `read_linkage_spec`
+    (a file), `linkage_spec` (TOML's tables) or `LinkageSpec(...)` in code; draw it with
+    `linkage_from_spec`, write it with `linkage_toml`. Frozen: `with_params` makes a changed
+    copy (validated again), as does `linkage_spec(changed tables)`.
+
+    Attributes (the file's keys; every table in the order written):
+        title: the linkage's title (None: the file's stem).
+        ground: the joints on the ground.
+        params: parameter name -> a length as written; coordinates may use them.
+        joints: joint name -> `[x, y]` / `[x, y, z]` as written, or a `Polar` or `Compass`
+            construction from joints above it.
+        links: link name -> the joints it carries, in order.
+        sliders, slots: name -> `Slider` / `Slot`.
+        axes: joint -> its pin's axis (three numbers); balls: joints that are ball joints.
+        masses: link -> `MassSpec`; colors: link -> a colour (kept, not read).
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    title: StrictStr | None = None
+    ground: tuple[StrictStr, ...] = ()
+    params: dict[str, Written] = {}
+    joints: dict[str, Joint] = {}
+    links: dict[str, tuple[StrictStr, ...]] = {}
+    sliders: dict[str, Slider] = {}
+    slots: dict[str, Slot] = {}
+    colors: dict[str, StrictStr] = {}
+    axes: dict[str, tuple[float, float, float]] = {}
+    balls: tuple[StrictStr, ...] = ()
+    masses: dict[str, MassSpec] = {}
+
+    @model_validator(mode="before")
+    @classmethod
+    def _known_keys(cls, raw: Any, info: ValidationInfo) -> Any:
+        if not isinstance(raw, dict):
+            raise ModelError("a linkage file is a table of keys", path=_source(info))
+        unknown = set(raw) - _KEYS
+        if unknown:
+            raise ModelError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_KEYS))}",
+                             path=_source(info))
+        for key in _TABLES:
+            if not isinstance(raw.get(key, {}), dict):
+                raise ModelError(f"[{key}] must be a table", path=_source(info), element=key)
+        return raw
+
+    @field_validator("params", mode="before")
+    @classmethod
+    def _param_names(cls, value: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
+        for name in value:
+            check_param_name(name, _source(info))
+        return value
+
+    @field_validator("ground", "balls", mode="before")
+    @classmethod
+    def _name_list(cls, value: Any, info: ValidationInfo) -> list[str]:
+        return _names(value, info.field_name, _source(info))
+
+    @field_validator("links", mode="before")
+    @classmethod
+    def _link_lists(cls, value: dict[str, Any], info: ValidationInfo) -> dict[str, list[str]]:
+        for name in value:
+            if name == GROUND:
+                raise ModelError("the ground is listed by ground = [...], not as a link", path=_source(info),
+                                 element="[links] ground")
+        return {name: _names(names, f"[links] {name}", _source(info)) for name, names in value.items()}
+
+    @field_validator("joints", mode="before")
+    @classmethod
+    def _joint_shapes(cls, value: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
+        return {name: _joint(spec, f"[joints] {name}", _source(info)) for name, spec in value.items()}
+
+    @field_validator("axes", mode="before")
+    @classmethod
+    def _axis_shapes(cls, value: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
+        for name, axis in value.items():
+            where = f"[axes] {name}"
+            if (not isinstance(axis, (list, tuple)) or len(axis) != 3
+                    or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in axis)):
+                raise ModelError(f"an axis is three numbers, e.g. [0, 0, 1], got {axis!r}", path=_source(info),
+                                 element=where)
+            if unit_vector(axis) is None:
+                raise ModelError(f"{written(axis)} is not a direction (zero or not finite)", path=_source(info),
+                                 element=where)
+        return value
+
+    @field_validator("sliders", "slots", "masses", mode="before")
+    @classmethod
+    def _entry_keys(cls, value: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
+        shape = _SHAPES[info.field_name]
+        for name, spec in value.items():
+            if isinstance(spec, BaseModel):  # an entry built in code, typed already
+                continue
+            if not isinstance(spec, dict) or not set(spec) <= set(shape[0]):
+                raise ModelError(shape[1], path=_source(info), element=f"[{info.field_name}] {name}")
+        return value
+
+    @model_validator(mode="after")
+    def _references(self, info: ValidationInfo) -> LinkageSpec:
+        _check_references(self, _source(info))
+        return self
+
+    # ------------------------------------------------------------------ for programs
+    @property
+    def pins(self) -> tuple[str, ...]:
+        """Joints on two or more links (the ground counting as one): the pins, in order."""
+        count = {name: sum(name in names for names in (self.ground, *self.links.values())) for name in self.joints}
+        return tuple(name for name, n in count.items() if n >= 2)
+
+    def with_params(self, **lengths_m: float) -> LinkageSpec:
+        """This linkage with parameters set to lengths [m] (written "<value> m"), validated again.
+
+        Raises:
+            ModelError: a name that is not one of `params`.
+        """
+        for name in lengths_m:
+            if name not in self.params:
+                raise ModelError(f"'{name}' is not a parameter (params: {', '.join(self.params) or 'none'})",
+                                 element="[params]")
+        params = {**self.params, **{n: f"{float(v)!r} m" for n, v in lengths_m.items()}}
+        return linkage_spec({**self.model_dump(mode="json", by_alias=True, exclude_defaults=True), "params": params})
+
+
+_SHAPES = {
+    "sliders": (("block", "on", "at", "along"), "a slider is {block = LINK, on = LINK, at = JOINT, along = ANGLE or [P, Q]}"),
+    "slots": (("pin", "slot", "along"), "a pin-in-slot joint is {pin = LINK, slot = LINK, along = ANGLE or [P, Q]}"),
+    "masses": (("mass", "at", "izz", "inertia"), "give mass, at and izz (planar) or inertia (spatial): "
+               '{ mass = "0.4 kg", at = "G", izz = "2e-4 kg*m^2" }'),
+}
+
+
+def _names(value: Any, where: str, source: str) -> list[str]:
+    if not isinstance(value, (list, tuple)) or not all(isinstance(n, str) for n in value):
+        raise ModelError(f"must be a list of joint names, e.g. [\"A\", \"B\"], got {value!r}", path=source,
+                         element=where)
+    if len(set(value)) != len(value):
+        raise ModelError(f"lists a joint twice: {value}", path=source, element=where)
+    return list(value)
+
+
+def _joint(spec: Any, where: str, source: str) -> Any:
+    """A joint's entry checked for shape: coordinates, or a polar or compass construction."""
+    if isinstance(spec, (Polar, Compass)):  # built in code, typed already
+        return spec
+    if isinstance(spec, (list, tuple)):
+        if len(spec) not in (2, 3):
+            raise ModelError(f"give coordinates [x, y] (or [x, y, z]) with units, got {spec!r}", path=source,
+                             element=where)
+        return spec
+    if not isinstance(spec, dict):
+        raise ModelError(f"give [x, y] with units or a construction table, got {spec!r}", path=source, element=where)
+    origin = spec.get("from")
+    bases = [origin] if isinstance(origin, str) else origin
+    if not isinstance(bases, (list, tuple)) or not all(isinstance(b, str) for b in bases):
+        raise ModelError("a construction needs from = \"JOINT\" (with length, angle) or from = [\"A\", \"B\"] "
+                         "(with lengths, side)", path=source, element=where)
+    if isinstance(origin, str):
+        if set(spec) != {"from", "length", "angle"}:
+            raise ModelError("a polar construction has exactly from, length, angle", path=source, element=where)
+        return spec
+    if len(bases) != 2 or set(spec) != {"from", "lengths", "side"}:
+        raise ModelError("a compass construction has exactly from = [\"A\", \"B\"], lengths = [|A..|, |B..|], "
+                         "side = \"left\" or \"right\" (of the line A -> B)", path=source, element=where)
+    if not isinstance(spec["lengths"], (list, tuple)) or len(spec["lengths"]) != 2:
+        raise ModelError(f"lengths must be two lengths, got {spec['lengths']!r}", path=source, element=where)
+    if spec["side"] not in ("left", "right"):
+        raise ModelError(f"side must be \"left\" or \"right\", got {spec['side']!r}", path=source, element=where)
+    return spec
+
+
+def read_linkage_spec(path: Any) -> tuple[LinkageSpec, str]:
+    """Read and validate a linkage file: (its LinkageSpec, the file's name for messages).
+
+    Raises:
+        ModelError: a missing file, malformed TOML, or anything the spec refuses (one line
+            naming the file and the key).
+    """
+    from pinmech.arguments import file_path
+    from pinmech.toml_file import read_toml
+
+    path = file_path(path, "the linkage file")
+    source = str(path)
+    return linkage_spec(read_toml(path, "linkage", ModelError), source), source
+
+
+def linkage_spec(raw: dict[str, Any], source: str = "<linkage>") -> LinkageSpec:
+    """Validate the tables of a linkage file (as TOML reads them) into a LinkageSpec.
+
+    Raises:
+        ModelError: one line naming `source` and the first key in error.
+    """
+    try:
+        return LinkageSpec.model_validate(raw, context={"source": source})
+    except ValidationError as exc:
+        raise _as_model_error(exc, source) from None
+
+
+def _check_references(spec: LinkageSpec, source: str) -> None:
+    """Every name an entry uses is given where it must be (joints, links, earlier joints)."""
+    joints = list(spec.joints)
+    for name, entry in spec.joints.items():
+        bases = [entry.base] if isinstance(entry, Polar) else list(entry.bases) if isinstance(entry, Compass) else []
+        for base in bases:
+            if base not in joints[: joints.index(name)]:
+                raise ModelError(f"from names '{base}', which is not given above it", path=source,
+                                 element=f"[joints] {name}")
+    for link, names in {GROUND: spec.ground, **spec.links}.items():
+        for name in names:
+            if name not in spec.joints:
+                raise ModelError(f"names joint '{name}', which [joints] does not give", path=source,
+                                 element=f"[links] {link}" if link != GROUND else "ground")
+    if not spec.links:
+        raise ModelError("no link: list the moving links under [links]", path=source)
+    for where, names in ((f"[axes] {n}", [n]) for n in spec.axes):
+        _joints_given(names, spec, source, where)
+    _joints_given(list(spec.balls), spec, source, "balls")
+    links = [GROUND, *spec.links]
+    for name, slider in spec.sliders.items():
+        _check_slider(name, slider, spec, links, source)
+    for name, slot in spec.slots.items():
+        _check_slot(name, slot, spec, links, source)
+        links.append(f"{name}_block")
+    for link, mass in spec.masses.items():
+        _check_mass(link, mass, spec, source)
+
+
+def _joints_given(names: list[str], spec: LinkageSpec, source: str, where: str) -> None:
+    for name in names:
+        if name not in spec.joints:
+            raise ModelError(f"'{name}' is not a joint of [joints]", path=source, element=where)
+
+
+def _link(value: Any, links: list[str], key: str, source: str, where: str) -> str:
+    if not isinstance(value, str) or value not in links:
+        raise ModelError(f"{key} = {value!r} names no link (links: {', '.join(links)})", path=source, element=where)
+    return value
+
+
+def _check_along(along: Any, spec: LinkageSpec, source: str, where: str) -> None:
+    if along is None:
+        raise ModelError("has no line: give along = \"ANGLE\" or along = [\"P\", \"Q\"]", path=source, element=where)
+    if isinstance(along, tuple) and (len(along) != 2 or not all(n in spec.joints for n in along)):
+        raise ModelError(f"along = {list(along)!r} must name two joints of [joints]", path=source, element=where)
+
+
+def _check_slider(name: str, slider: Slider, spec: LinkageSpec, links: list[str], source: str) -> None:
+    where = f"[sliders] {name}"
+    block = _link(slider.block, links, "block", source, where)
+    on = _link(slider.on, links, "on", source, where)
+    if block == on:
+        raise ModelError(f"block and on are the same link '{block}'", path=source, element=where)
+    if slider.at not in ({GROUND: spec.ground, **spec.links}.get(block) or ()):
+        raise ModelError(f"at = {slider.at!r} must be a joint the block '{block}' lists", path=source, element=where)
+    _check_along(slider.along, spec, source, where)
+
+
+def _check_slot(name: str, slot: Slot, spec: LinkageSpec, links: list[str], source: str) -> None:
+    where = f"[slots] {name}"
+    pin_link = _link(slot.pin, links, "pin", source, where)
+    _link(slot.slot, links, "slot", source, where)
+    if name not in spec.joints:
+        raise ModelError(f"the slot's pin '{name}' is not given in [joints]", path=source, element=where)
+    if name not in ({GROUND: spec.ground, **spec.links}.get(pin_link) or ()):
+        raise ModelError(f"the pin '{name}' must be listed by its link '{pin_link}'", path=source, element=where)
+    if f"{name}_block" in spec.links:  # it would be replaced by the block, in silence
+        raise ModelError(f"link '{name}_block' has the name pinmech gives slot {name}'s block (a hidden link): "
+                         "rename the link", path=source, element=f"[links] {name}_block")
+    _check_along(slot.along, spec, source, where)
+
+
+def _check_mass(link: str, mass: MassSpec, spec: LinkageSpec, source: str) -> None:
+    where = f"[masses] {link}"
+    if link not in spec.links:
+        raise ModelError(f"names no moving link (links: {', '.join(spec.links)})", path=source, element=where)
+    if isinstance(mass.at, str) and mass.at not in spec.joints:
+        raise ModelError(f"at = {mass.at!r} is not a joint of [joints] (give its name or coordinates)",
+                         path=source, element=where)
+    if not isinstance(mass.at, (str, tuple)) or (isinstance(mass.at, tuple) and len(mass.at) not in (2, 3)):
+        raise ModelError(f"at = {mass.at!r}: the centre of mass is a joint's name or [x, y] (or [x, y, z]) "
+                         "with units", path=source, element=where)
