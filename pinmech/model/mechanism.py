@@ -16,6 +16,7 @@ rows). Named points are massless leaf links hung on fixed joints.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
