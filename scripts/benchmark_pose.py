@@ -85,8 +85,7 @@ def rows() -> dict[str, Timed]:
     q2 = Q[3]
     core = solver._compiled()
     Q1, out = Q[3:4].copy(), np.empty((1, core.rate_columns))
-    plan_motion = pinmech.evaluate_motion(mechanism, data, q, v, a, points=["D"], links=["link3"])
-    plan = plan_motion._plan
+    plan = pinmech.evaluate_motion(mechanism, data, q, v, a, points=["D"], links=["link3"])._plan
     rows_out = np.empty((plan.rows, _core.KINEMATICS_COLUMNS))
     x = np.zeros(3)
 

@@ -17,10 +17,11 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.arguments import float_array
-from pinmech.exceptions import FrameNotFound, ModelError
+from pinmech.exceptions import ModelError
 from pinmech.model.closures import _cross
 from pinmech.model.mechanism import Mechanism
 from pinmech.solve.core import _core
+from pinmech.solve.motion_plan import MotionPlan, motion_plan
 
 
 @dataclass(frozen=True)
@@ -119,7 +120,7 @@ class Motion:
     `sliders`, dicts by name of JointMotion, LinkMotion, PointMotion and SliderMotion. The
     numbers are computed when the pose is evaluated; each dict is built when first read."""
 
-    def __init__(self, mechanism: Mechanism, plan: _Plan, rows: np.ndarray, q: list[float], v: list[float],
+    def __init__(self, mechanism: Mechanism, plan: MotionPlan, rows: np.ndarray, q: list[float], v: list[float],
                  a: list[float]) -> None:
         self._mechanism, self._plan, self._rows = mechanism, plan, rows
         self._q, self._v, self._a = q, v, a
@@ -190,8 +191,8 @@ def evaluate_motion(
     q = mechanism.checked_q(q)
     nv = mechanism.model.nv
     v, a = float_array(v, "v", (nv,), mechanism.source), float_array(a, "a", (nv,), mechanism.source)
-    plan = _plan(mechanism, None if points is None else tuple(points), tuple(coincident),
-                 None if links is None else tuple(links))
+    plan = motion_plan(mechanism, None if points is None else tuple(points), tuple(coincident),
+                       None if links is None else tuple(links), _plane)
     if not (q.flags.c_contiguous and v.flags.c_contiguous and a.flags.c_contiguous):  # the core reads them so
         q, v, a = np.ascontiguousarray(q), np.ascontiguousarray(v), np.ascontiguousarray(a)
     rows = np.empty((plan.rows, _core.KINEMATICS_COLUMNS))
@@ -201,86 +202,6 @@ def evaluate_motion(
         raise ModelError("data must be a pin.Data of the mechanism's model (mechanism.model.createData())",
                          path=mechanism.source) from None
     return Motion(mechanism, plan, rows, q.tolist(), v.tolist(), a.tolist())
-
-
-@dataclass(frozen=True)
-class _Plan:
-    """What evaluate_motion reads for one choice of points, coincident points and links:
-    the frames and joints the core evaluates (rows of its answer, in order), and where each
-    output finds its rows. Depends on names only: built once per mechanism and choice."""
-
-    frames: np.ndarray  # Pinocchio frame ids (int32)
-    joints: np.ndarray  # Pinocchio joint ids (int32), rows after the frames'
-    rows: int  # frames and joints
-    plane: tuple[list[float], list[float]] | None  # the plane's normal and reference direction (see _plane_angle)
-    links: tuple[tuple[str, int], ...]  # name, row
-    points: tuple[tuple[str, int, int | None, str], ...]  # name, row, the link's row if coincident, link
-    sliders: tuple[tuple[str, str, tuple], ...]  # name, "joint" or "cut", what _slider / _cut_slider read
-
-
-def _plan(mechanism: Mechanism, points: tuple[str, ...] | None, coincident: tuple[CoincidentPoint, ...],
-          links: tuple[str, ...] | None) -> _Plan:
-    """The plan for these names, from the mechanism's cache (FrameNotFound for a name it lacks)."""
-    cache = mechanism.__dict__.setdefault("_motion_plans", {})
-    key = (points, coincident, links)
-    plan = cache.get(key)
-    if plan is None:
-        if len(cache) >= _PLANS:
-            cache.clear()
-        plan = cache[key] = _build_plan(mechanism, points, coincident, links)
-    return plan
-
-
-#: Plans kept per mechanism (a caller that asks ever new names rebuilds them).
-_PLANS = 64
-
-
-def _build_plan(mechanism: Mechanism, points: tuple[str, ...] | None, coincident: tuple[CoincidentPoint, ...],
-                links: tuple[str, ...] | None) -> _Plan:
-    frames: dict[int, int] = {}
-
-    def frame(fid: int) -> int:
-        return frames.setdefault(int(fid), len(frames))
-
-    def link_frame(name: str) -> int:
-        if name not in mechanism.links:
-            raise FrameNotFound("link", name, list(mechanism.links), path=mechanism.source)
-        return frame(mechanism.links[name])
-
-    link_rows = [(n, link_frame(n)) for n in (links if links is not None else _moving_links(mechanism))]
-    point_rows = {}
-    for name in points if points is not None else list(mechanism.points):
-        match = [c for c in coincident if c.name == name]
-        point_rows[name] = _point_plan(mechanism, match[0], frame, link_frame) if match else \
-            _point_plan(mechanism, name, frame, link_frame)
-    for c in coincident:
-        if c.name not in point_rows:
-            point_rows[c.name] = _point_plan(mechanism, c, frame, link_frame)
-    cuts = [(c.name, "cut", (c, frame(c.parent_frame), frame(c.child_frame))) for c in mechanism.closures
-            if c.cut_type == "prismatic" and not (c.name in mechanism.joints
-                                                  and mechanism.joints[c.name].kind == "prismatic")]
-    joints: dict[int, int] = {}
-
-    def joint_row(jid: int) -> int:  # joint rows follow the frame rows
-        return len(frames) + joints.setdefault(int(jid), len(joints))
-
-    tree = []
-    for name, j in mechanism.joints.items():
-        if j.kind == "prismatic":
-            parent = mechanism.model.parents[j.id]
-            tree.append((name, "joint", (j, joint_row(j.id), joint_row(parent) if parent else None)))
-    return _Plan(np.array(list(frames), dtype=np.int32), np.array(list(joints), dtype=np.int32),
-                 len(frames) + len(joints), _plane(mechanism.plane_normal), tuple(link_rows), tuple((n, *r) for n, r in point_rows.items()), tuple(tree + cuts))
-
-
-def _point_plan(mechanism: Mechanism, point, frame, link_frame) -> tuple[int, int | None, str]:
-    """A named point's row, None and its link; a coincident point's row (the point it sits
-    at), its link's row and its link."""
-    if isinstance(point, CoincidentPoint):
-        link = link_frame(point.link)
-        return frame(mechanism.frame_id(point.at)), link, point.link
-    fid = mechanism.frame_id(point)
-    return frame(fid), None, mechanism.link_of_frame(fid)
 
 
 def _cut_slider(closure, parent: np.ndarray, child: np.ndarray) -> SliderMotion:
@@ -330,11 +251,6 @@ def _multi_dof(mechanism: Mechanism, jid: int, q: list[float], v: list[float], a
     if kind == "planar":
         qj = np.array([qj[0], qj[1], math.atan2(qj[3], qj[2])])
     return JointMotion(qj, vj, aj, kind)
-
-
-def _moving_links(mechanism: Mechanism) -> list[str]:
-    model = mechanism.model
-    return [n for n, fid in mechanism.links.items() if model.frames[fid].parentJoint != 0]
 
 
 def _point(row: np.ndarray, link: str) -> PointMotion:
