@@ -26,7 +26,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from pinmech.design.study_file import load_study  # noqa: E402
-from pinmech.design.sensitivity import StudyOutputs  # noqa: E402
+from pinmech.design.study_outputs import StudyOutputs  # noqa: E402
 from pinmech.design.study_variant import StudyMechanism  # noqa: E402
 from pinmech.design.tolerance import batches, run_batch  # noqa: E402
 

@@ -174,3 +174,32 @@ def test_a_three_parameter_grid_has_a_table_but_its_figure_is_refused_by_name(tm
                                rtol=1e-12)
     with pytest.raises(OptionRefused, match="3 parameters"):
         grid_figure(res, tmp_path / "g.png")
+
+
+@pytest.mark.parametrize("kind, change, key", [
+    ("grid", {"params": {"crank": {"joint": "A", "component": "x", "sigma": "0.1 mm"}}}, "params.crank.sigma"),
+    ("grid", {"params": {"crank": {"joint": "A", "component": "x", "tolerance": "0.1 mm"}}},
+     "params.crank.tolerance"),
+    ("grid", {"params": {"crank": {"joint": "A", "component": "x", "distribution": "uniform"}}},
+     "params.crank.distribution"),
+    ("grid", {"samples": 100}, "samples"),
+    ("grid", {"seed": 7}, "seed"),
+    ("sensitivity", {"params": {"crank": {"joint": "A", "component": "x", "k": 2}}}, "params.crank.k"),
+    ("sensitivity", {"batch": 10}, "batch"),
+    ("tolerance", {"params": {"crank": {"joint": "A", "component": "x", "sigma": "0.1 mm", "k": 2}}},
+     "params.crank.k"),
+    ("tolerance", {"params": {"crank": {"joint": "A", "component": "x", "tolerance": "0.1 mm",
+                                        "distribution": "fixed"}}}, "params.crank.tolerance"),
+])
+def test_a_key_the_kind_would_ignore_is_refused_by_name(kind, change, key):
+    """Before: a grid study's sigma or samples were read by nobody, in silence, as were a
+    k beside sigma and a tolerance on a fixed parameter. Now each key that nothing would
+    read is a SceneError naming the file and the key."""
+    raw = {**_crank_grid(11, 91, 17), **change, "kind": kind}
+    if kind != "grid":
+        raw.pop("grid")
+        raw.pop("batch") if kind == "sensitivity" else None
+        raw.update(change)
+    with pytest.raises(SceneError) as err:
+        parse_study(raw, STUDIES / "inline.toml")
+    assert key in str(err.value) and "inline.toml" in str(err.value)

@@ -25,7 +25,7 @@ def test_a_sensitivity_study_writes_its_table_summary_and_figure(tmp_path, capsy
     out = capsys.readouterr().out
     assert "largest |dy/dp| over the cycle" in out
     rows = list(csv.DictReader((prefix.with_suffix(".csv")).open()))
-    assert len(rows) == 73 * 3
+    assert len(rows) == 73 * 4  # P.x, P.y, rocker.angle, rocker.omega at each pose
     pq = pytest.importorskip("pyarrow.parquet")
     parquet = pq.read_table(prefix.with_suffix(".parquet")).to_pydict()
     np.testing.assert_array_equal(parquet["d/d crank [per mm]"], [float(r["d/d crank [per mm]"]) for r in rows])
@@ -94,3 +94,36 @@ def test_a_nominal_that_fails_is_its_error_on_one_line(tmp_path, capsys):
     assert main(["study", str(file), "--workers", "0"]) == 4
     err = capsys.readouterr().err
     assert "params: the nominal params.a: 40 mm is outside 41 .. 42 mm" in err, err
+
+
+class _Terminal:
+    """A stand-in stderr that says it is a terminal and keeps what is written."""
+
+    def __init__(self) -> None:
+        self.text = ""
+
+    def isatty(self) -> bool:
+        return True
+
+    def write(self, s: str) -> int:
+        self.text += s
+        return len(s)
+
+    def flush(self) -> None:
+        pass
+
+
+@pytest.mark.parametrize("quiet", [False, True])
+def test_a_progress_bar_on_a_terminal_counts_the_variants_unless_quiet(tmp_path, monkeypatch, capsys, quiet):
+    """60 variants in 3 batches of 20: on a terminal the bar ends at 60/60 variants (tqdm's
+    own count, moved once a batch); with --quiet nothing is drawn."""
+    pytest.importorskip("tqdm")
+    file = tmp_path / "tol.toml"
+    text = (STUDIES / "four_bar_tolerance.toml").read_text().replace('scene = "../scenes/', f'scene = "{STUDIES.parent}/scenes/')
+    file.write_text(text.replace("samples = 2000", "samples = 60").replace("batch = 100", "batch = 20")
+                    .replace("steps = 73", "steps = 13"))
+    terminal = _Terminal()
+    monkeypatch.setattr(sys, "stderr", terminal)
+    assert main(["study", str(file), "--workers", "0"] + ["--quiet"] * quiet) == 0
+    assert ("60/60" in terminal.text) != quiet, terminal.text
+    assert "variant" in terminal.text or quiet

@@ -36,7 +36,7 @@ def require_dask():
 def built(spec: StudySpec) -> tuple:
     """This process's (StudyMechanism, StudyOutputs) of the study, built on first use."""
     if spec not in _BUILT:
-        from pinmech.design.sensitivity import StudyOutputs
+        from pinmech.design.study_outputs import StudyOutputs
         from pinmech.design.study_variant import StudyMechanism
 
         sm = StudyMechanism(spec)
@@ -55,7 +55,7 @@ def solve_batch(spec: StudySpec, batch: Batch) -> BatchResult:
 
 
 def run_batches(spec: StudySpec, batches: list[Batch], *, workers: int = 0, scheduler: str | None = None,
-                progress: Callable[[int], None] | None = None) -> list[BatchResult]:
+                progress: Callable[[Batch], None] | None = None) -> list[BatchResult]:
     """Every batch's result, in batch order.
 
     Args:
@@ -63,14 +63,14 @@ def run_batches(spec: StudySpec, batches: list[Batch], *, workers: int = 0, sche
             processes of one thread each (unless a scheduler is given).
         scheduler: a running scheduler's address ("tcp://127.0.0.1:8786"); the CLI takes
             it from --scheduler or $DASK_SCHEDULER_ADDRESS (`scheduler_address`).
-        progress: called with the number of batches done, as they finish.
+        progress: called with each batch as it finishes (on Dask: in the order they finish).
     """
     if scheduler is None and workers == 0:
         results = []
-        for i, batch in enumerate(batches):
+        for batch in batches:
             results.append(solve_batch(spec, batch))
             if progress:
-                progress(i + 1)
+                progress(batch)
         return results
     distributed = require_dask()
     if scheduler is not None:
@@ -90,8 +90,9 @@ def _gathered(client, spec: StudySpec, batches: list[Batch], progress, distribut
     futures = client.map(solve_batch, [spec] * len(batches), batches, pure=False)
     index = {f.key: i for i, f in enumerate(futures)}
     results: list[BatchResult | None] = [None] * len(batches)
-    for done, future in enumerate(distributed.as_completed(futures), start=1):
-        results[index[future.key]] = future.result()
+    for future in distributed.as_completed(futures):
+        i = index[future.key]
+        results[i] = future.result()
         if progress:
-            progress(done)
+            progress(batches[i])
     return results

@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from pinmech.design.grid_transmission import has_dyads, least_transmission
-from pinmech.design.sensitivity import StudyOutputs
+from pinmech.design.study_outputs import StudyOutputs
 from pinmech.design.study_file import StudySpec
 from pinmech.design.study_variant import StudyMechanism
 from pinmech.design.tolerance import Batch, BatchResult, solve_variants

@@ -21,7 +21,7 @@ from pinmech.design.cluster import built, run_batches
 from pinmech.design.grid import grid_size
 from pinmech.design.sensitivity import cycle_sensitivity
 from pinmech.design.study_file import StudySpec, load_study
-from pinmech.design.tolerance import BatchResult, Spread, batches, spread
+from pinmech.design.tolerance import Batch, BatchResult, Spread, batches, spread
 
 
 @dataclass(frozen=True)
@@ -75,7 +75,8 @@ def study(path: str | Path | StudySpec, *, workers: int = 0, scheduler: str | No
         path: the study file (or a StudySpec already loaded).
         workers: 0 runs the variants in this process, n > 0 on a Dask LocalCluster of n
             processes; scheduler: a running Dask scheduler's address instead.
-        progress: called with (batches done, batches) during a tolerance or grid study.
+        progress: called with (variants done, variants) as each batch of a tolerance or grid
+            study finishes.
 
     Raises:
         SceneError, FrameNotFound: a bad study file; the scene's and model's errors; the
@@ -90,14 +91,19 @@ def study(path: str | Path | StudySpec, *, workers: int = 0, scheduler: str | No
 
         raise SweepError(f"{spec.path}: the nominal fails over the cycle ({cycle.cause}): {cycle.detail}",
                          driver=sm.sweep.driver, value=float("nan"), cause=cycle.error) from cycle.error
-    y0, dy = cycle_sensitivity(sm, outputs, cycle.q)
+    y0, dy = cycle_sensitivity(sm, outputs, cycle)
     common = dict(spec=spec, driver=sm.sweep.driver, values=sm.values, outputs=outputs.names, kinds=outputs.kinds,
                   params=[p.name for p in spec.params], nominal_p=sm.nominal.copy(), nominal=y0, sensitivity=dy)
     if spec.kind == "sensitivity":
         return StudyResult(**common)
     todo = batches(grid_size(spec) if spec.kind == "grid" else spec.samples, spec.batch)
-    tick = (lambda done: progress(done, len(todo))) if progress else None
-    results = run_batches(spec, todo, workers=workers, scheduler=scheduler, progress=tick)
+    total, done = sum(b.count for b in todo), [0]
+
+    def tick(batch: Batch) -> None:
+        done[0] += batch.count
+        progress(done[0], total)
+
+    results = run_batches(spec, todo, workers=workers, scheduler=scheduler, progress=tick if progress else None)
     if spec.kind == "grid":
         return StudyResult(**common, batches=tuple(results))
     return StudyResult(**common, spread=spread(sm, outputs, results), batches=tuple(results))

@@ -18,6 +18,35 @@ def _workers(text: str) -> int:
     return value
 
 
+class ProgressBar:
+    """A tqdm bar of the variants done, moved as each batch finishes (on Dask too)."""
+
+    def __init__(self, tqdm) -> None:
+        self._tqdm, self._bar = tqdm, None
+
+    @classmethod
+    def on_terminal(cls, *, quiet: bool) -> ProgressBar | None:
+        """A bar when stderr is a terminal and not --quiet; None otherwise. Without tqdm,
+        one line naming the extra that brings it, and no bar."""
+        if quiet or not sys.stderr.isatty():
+            return None
+        try:
+            from tqdm import tqdm
+        except ImportError:
+            print('no progress bar: pip install "pinmech[progress]" (tqdm)', file=sys.stderr)
+            return None
+        return cls(tqdm)
+
+    def __call__(self, done: int, total: int) -> None:
+        if self._bar is None:
+            self._bar = self._tqdm(total=total, unit="variant", file=sys.stderr, mininterval=0.5)
+        self._bar.update(done - self._bar.n)
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+
+
 def add_parser(sub) -> None:
     """The `study` subcommand's arguments."""
     study = sub.add_parser("study", help="run a design study (sensitivity, tolerance or grid) from a study file",
@@ -35,6 +64,8 @@ def add_parser(sub) -> None:
                        help="with --out: PREFIX_sensitivity.png, and PREFIX_histogram.png for a tolerance study, "
                             "PREFIX_grid.png for a 1-D or 2-D grid study")
     study.add_argument("--json", action="store_true", help="print the JSON summary instead of the text one")
+    study.add_argument("--quiet", action="store_true",
+                       help="no progress bar (there is none either when stderr is not a terminal)")
     study.set_defaults(func=cmd_study)
 
 
@@ -51,7 +82,12 @@ def cmd_study(args: argparse.Namespace) -> int:
         raise OptionRefused("--plot writes PREFIX_*.png: give --out PREFIX too", options=["--plot"])
     scheduler = scheduler_address(args.scheduler)
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
-    result = study(args.study_file, workers=workers, scheduler=scheduler)
+    bar = ProgressBar.on_terminal(quiet=args.quiet)
+    try:
+        result = study(args.study_file, workers=workers, scheduler=scheduler, progress=bar)
+    finally:
+        if bar is not None:
+            bar.close()
     print(json.dumps(summary(result), indent=2) if args.json else text(result))
     if args.out:
         written = write(result, args.out)

@@ -3,7 +3,7 @@
     title = "Four-bar: how the tolerances move the rocker"
     scene = "../scenes/four_bar.toml"   # the mechanism, its drivers and assembly
     kind = "tolerance"                   # or "sensitivity"
-    steps = 73                           # poses over one turn of the scene's first driver
+    steps = 73                           # poses over the scene's [sweep] from..to, else one turn of its first driver
     samples = 400                        # tolerance: Monte Carlo variants
     seed = 2025                          # tolerance: the random stream's seed
 
@@ -20,9 +20,16 @@
     sigma = "0.02 mm"
     bounds = ["119.9 mm", "120.1 mm"]
 
+    [params.P_x]                         # a named point's place on its link (a scene's [points],
+    point = "P"                          # a URDF fixed link, an MJCF site, a robot.yaml loop frame)
+    component = "x"                      # (or body = "coupler": an MJCF body's pos)
+
     [outputs]
     points = ["P"]                       # world x, y, z of these points [m]
     links = ["rocker"]                   # angle of these links about the plane normal [rad]
+    sliders = ["slide"]                  # a prismatic joint's s [m] and s_dot [m/s]
+    omega = ["rocker"]                   # angular speed about the plane normal [rad/s]
+    transmission = ["B"]                 # the transmission angle of the dyad with middle pin B [rad]
 
     # kind = "grid": 1 to 3 of the parameters over evenly spaced values (the others at nominal)
     [grid.crank]
@@ -50,9 +57,14 @@ KINDS = ("sensitivity", "tolerance", "grid")
 _TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs", "batch", "grid"}
 _GRID_KEYS = {"from", "to", "count"}
 _GRID_MAX = 1_000_000  # grid points in all
-_PARAM_KEYS = {"joint", "cut", "side", "component", "nominal", "bounds", "tolerance", "k", "sigma", "distribution"}
-_OUTPUT_KEYS = {"points", "links"}
+_TARGETS = ("joint", "cut", "point", "body")
+_PARAM_KEYS = {"joint", "cut", "point", "body", "side", "component", "nominal", "bounds", "tolerance", "k", "sigma", "distribution"}
+_OUTPUT_KEYS = {"points", "links", "sliders", "omega", "transmission"}
 _LIMITS = {"steps": (1, 100_000), "samples": (1, 10_000_000), "seed": (0, 2**63 - 1), "batch": (1, 1_000_000)}
+#: Keys only some kinds use: any other kind refuses them (a key read by nobody would be a
+#: silent no-op). Top-level keys, then [params.NAME] keys.
+_TOP_USED_BY = {"samples": ("tolerance",), "seed": ("tolerance",), "batch": ("tolerance", "grid")}
+_PARAM_USED_BY = {k: ("tolerance",) for k in ("tolerance", "sigma", "k", "distribution")}
 
 
 @dataclass(frozen=True)
@@ -82,11 +94,14 @@ class StudySpec:
     Attributes:
         path: the study file; scene: the scene file it names.
         kind: "sensitivity" or "tolerance".
-        steps: poses over one turn of the scene's first driver, both ends included.
+        steps: poses over the scene's [sweep] from .. to, else one turn of its first driver,
+            both ends included.
         samples, seed: Monte Carlo variants and the seed of their random stream.
         batch: variants per batch (a Dask task); results do not depend on it.
         params: the parameters, in the file's order.
         points, links: the outputs (point positions, link angles).
+        sliders, omega: prismatic joints (s and s_dot), links' angular speeds (study_outputs.py).
+        transmission: dyads by their middle pin, for their transmission angle.
         grid: a grid study's axes (1 to 3), in the [grid] table's order; () otherwise.
     """
 
@@ -102,6 +117,9 @@ class StudySpec:
     points: tuple[str, ...]
     links: tuple[str, ...]
     grid: tuple[GridAxis, ...] = ()
+    sliders: tuple[str, ...] = ()
+    omega: tuple[str, ...] = ()
+    transmission: tuple[str, ...] = ()
 
 
 def load_study(path: str | Path) -> StudySpec:
@@ -118,6 +136,7 @@ def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
     kind = raw.get("kind", "sensitivity")
     if kind not in KINDS:
         raise where.error("kind", f"kind = {kind!r} is not one of {', '.join(KINDS)}")
+    _refuse_unused(raw, kind, where)
     scene = raw.get("scene")
     if not isinstance(scene, str):
         raise where.error("scene", f"scene = {scene!r}: give the scene file, e.g. \"../scenes/four_bar.toml\"")
@@ -126,15 +145,30 @@ def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
         raise where.error("params", "give at least one [params.NAME] table")
     outputs = raw.get("outputs", {})
     where.known(outputs, _OUTPUT_KEYS, "outputs")
-    points, links = (_names(outputs.get(k, []), where, f"outputs.{k}") for k in ("points", "links"))
-    if not points and not links:
+    named = {k: _names(outputs.get(k, []), where, f"outputs.{k}") for k in sorted(_OUTPUT_KEYS)}
+    if not any(named.values()):
         raise where.error("outputs", "name at least one output: points = [\"P\"] or links = [\"rocker\"]")
     counts = {k: where.whole(raw, k, default) for k, default in
               (("steps", 73), ("samples", 200), ("seed", 0), ("batch", 64))}
     parsed = tuple(_parameter(name, table, where) for name, table in params.items())
     return StudySpec(path, str(raw.get("title", path.stem)), (path.parent / scene), kind, counts["steps"],
-                     counts["samples"], counts["seed"], counts["batch"], parsed, points, links,
-                     _grid(raw, kind, parsed, where))
+                     counts["samples"], counts["seed"], counts["batch"], parsed, named["points"],
+                     named["links"], _grid(raw, kind, parsed, where), named["sliders"], named["omega"],
+                     named["transmission"])
+
+
+def _refuse_unused(raw: dict[str, Any], kind: str, where: _Where) -> None:
+    """A SceneError for the first key this kind does not use (samples on a grid study, a
+    parameter's sigma on a sensitivity study...), naming the kinds that use it."""
+    unused = [(k, k, kinds) for k, kinds in _TOP_USED_BY.items() if k in raw and kind not in kinds]
+    params = raw.get("params")
+    for name, table in (params.items() if isinstance(params, dict) else ()):
+        unused += [(k, f"params.{name}.{k}", kinds) for k, kinds in _PARAM_USED_BY.items()
+                   if isinstance(table, dict) and k in table and kind not in kinds]
+    if unused:
+        key, where_key, kinds = unused[0]
+        used = " or ".join(f"kind = \"{k}\"" for k in kinds)
+        raise where.error(where_key, f"{key} is for {used}; a {kind} study would not use it: remove it")
 
 
 def _grid(raw: dict[str, Any], kind: str, params: tuple[Parameter, ...], where: _Where) -> tuple[GridAxis, ...]:
@@ -180,14 +214,18 @@ def _parameter(name: str, table: Any, where: _Where) -> Parameter:
     if not isinstance(table, dict):
         raise where.error(key, "must be a table (joint = \"A\", component = \"x\", tolerance = \"0.1 mm\")")
     where.known(table, _PARAM_KEYS, key)
-    if ("joint" in table) == ("cut" in table):
-        raise where.error(key, "give one of joint = \"NAME\" (its origin) or cut = \"NAME\" (a cut frame's origin)")
-    target = "joint" if "joint" in table else "cut"
+    given = [t for t in _TARGETS if t in table]
+    if len(given) != 1:
+        raise where.error(key, "give one of joint = \"NAME\" (its origin), cut = \"NAME\" (a cut frame's origin), "
+                          "point = \"NAME\" (a named point) or body = \"NAME\" (an MJCF body's pos)")
+    target = given[0]
+    if not isinstance(table[target], str):
+        raise where.error(f"{key}.{target}", f"{target} = {table[target]!r} must be a name")
     side = table.get("side", "parent" if target == "cut" else "")
     if target == "cut" and side not in ("parent", "child"):
         raise where.error(f"{key}.side", f"side = {side!r} must be \"parent\" or \"child\"")
-    if target == "joint" and "side" in table:
-        raise where.error(f"{key}.side", "side is for a cut's frames; a joint has one origin")
+    if target != "cut" and "side" in table:
+        raise where.error(f"{key}.side", f"side is for a cut's frames; a {target} has one origin")
     component = table.get("component")
     if component not in AXES:
         raise where.error(f"{key}.component", f"component = {component!r} must be \"x\", \"y\" or \"z\"")
@@ -219,9 +257,15 @@ def _distribution(table: dict, key: str, where: _Where) -> tuple[str, float]:
         raise where.error(f"{key}.distribution", f"distribution = {distribution!r} is not one of "
                           f"{', '.join(DISTRIBUTIONS)}")
     if distribution == "fixed":
+        spread = [k for k in ("sigma", "tolerance", "k") if k in table]
+        if spread:
+            raise where.error(f"{key}.{spread[0]}", f"a fixed parameter has no spread: remove {spread[0]}, or give "
+                              "distribution = \"normal\" or \"uniform\"")
         return distribution, 0.0
     if "sigma" in table and ("tolerance" in table or distribution == "uniform"):
         raise where.error(f"{key}.sigma", "give sigma (normal) or tolerance (+-, normal at k sigma, or uniform)")
+    if "sigma" in table and "k" in table:
+        raise where.error(f"{key}.k", "k (tolerance at k sigma) goes with tolerance; sigma is the standard deviation")
     if "sigma" in table:
         return distribution, where.positive(table, "sigma", key)
     if "tolerance" not in table:

@@ -11,7 +11,8 @@ import numpy as np
 from pinmech.design.study import StudyResult
 from pinmech.design.tolerance import deviation
 
-_SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg")}
+_SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "speed": (1e3, "mm/s"),
+          "angular speed": (180 / math.pi, "deg/s"), "angular acceleration": (180 / math.pi, "deg/s^2")}
 
 
 def _pyplot():
@@ -37,7 +38,7 @@ def sensitivity_bars(result: StudyResult, path: str | Path) -> Path:
         ax.invert_yaxis()
         ax.set_title(result.outputs[j])
         ax.set_xlabel(f"max |d/dp| over the cycle [{unit}/mm]")
-    fig.suptitle(f"{result.spec.title}: sensitivities over one turn of {result.driver}")
+    fig.suptitle(f"{result.spec.title}: sensitivities over the cycle of {result.driver}")
     return _save(plt, fig, path)
 
 

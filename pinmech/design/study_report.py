@@ -16,7 +16,8 @@ from pinmech.design.grid import cycle_range, failures
 from pinmech.design.study import StudyResult
 from pinmech.design.tolerance import PERCENTILES, deviation
 
-_SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg")}
+_SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "speed": (1e3, "mm/s"),
+          "angular speed": (180 / math.pi, "deg/s"), "angular acceleration": (180 / math.pi, "deg/s^2")}
 
 
 def _unit(kind: str) -> tuple[float, str]:

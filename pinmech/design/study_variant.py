@@ -26,7 +26,8 @@ from pinmech.exceptions import (
 from pinmech.io.scene import Scene
 from pinmech.design.study_file import StudySpec
 from pinmech.design.study_params import Placement, placements, subtrees
-from pinmech.io.sweep import Sweep
+from pinmech.design.variant_core import CoreCycle
+from pinmech.io.sweep import Sweep, sweep_options
 
 CAUSES = ("cannot assemble", "other assembly", "fold within the range", "changes assembly", "singular pose",
           "outside bounds")
@@ -34,13 +35,16 @@ CAUSES = ("cannot assemble", "other assembly", "fold within the range", "changes
 
 @dataclass(frozen=True)
 class VariantCycle:
-    """A variant solved over the cycle: q at each pose (None where it failed) and the cause."""
+    """A variant solved over the cycle: q, v, a at each pose (None where it failed) and the
+    cause."""
 
     values: np.ndarray
     q: np.ndarray | None
     cause: str = ""
     detail: str = ""
     error: PinmechError | None = None  # the error behind the cause (None: outside bounds)
+    v: np.ndarray | None = None  # joint velocities [rad/s, m/s] at the scene's driver speed
+    a: np.ndarray | None = None  # joint accelerations [rad/s^2, m/s^2]
 
 
 class StudyMechanism:
@@ -53,7 +57,8 @@ class StudyMechanism:
 
     def __init__(self, spec: StudySpec) -> None:
         self.spec = spec
-        self.sweep = Sweep.from_scene(Scene.load(spec.scene))
+        scene = Scene.load(spec.scene)
+        self.sweep = Sweep.from_scene(scene)
         self.mechanism, self.solver = self.sweep.mechanism, self.sweep.solver
         self.model = self.mechanism.model
         self.placements: list[Placement] = placements(self.mechanism, spec.params, str(spec.path))
@@ -65,12 +70,15 @@ class StudyMechanism:
         if outside:
             raise SceneError(f"the nominal {outside}", path=str(spec.path), key="params")
         self.subtree = subtrees(self.model)
-        self.values = np.asarray(self.sweep.default_values(spec.steps), dtype=float)
+        self.values = _cycle_values(scene, self.sweep, spec.steps)
         self.solver.refresh()
         scene_ref = self.solver.reference  # the scene's (scene_solver), closed again for the nominal
         self.reference = self.solver.set_reference(scene_ref.driver_q, scene_ref.q)
         self.assembly = dict(zip(self.solver.structure.names, self.reference.signs))
         self.data = self.model.createData()  # outputs and sensitivities: not the solver's Data
+        self.lower = np.array([x.lower for x in spec.params])
+        self.upper = np.array([x.upper for x in spec.params])
+        self.core = CoreCycle(self.solver, self.sweep.drivers, self.sweep.driver, self.values, self.reference)
 
     def write(self, p: np.ndarray) -> None:
         """Write the parameter values p [m] into the model in place."""
@@ -78,12 +86,15 @@ class StudyMechanism:
             place.write(float(value))
 
     def cycle(self, p: np.ndarray) -> VariantCycle:
-        """The variant with parameters p [m] over the cycle; the model keeps p afterwards."""
-        lower = np.array([x.lower for x in self.spec.params])
-        upper = np.array([x.upper for x in self.spec.params])
-        if np.any(p < lower) or np.any(p > upper):
+        """The variant with parameters p [m] over the cycle; the model keeps p afterwards.
+        The compiled core follows it in one call (variant_core.py); where it hands the
+        variant back, the scene's sweep solves it and names what failed."""
+        if np.any(p < self.lower) or np.any(p > self.upper):
             return VariantCycle(self.values, None, "outside bounds", _outside(self.spec, p))
         self.write(p)
+        fast = self.core.follow()
+        if fast is not None:
+            return VariantCycle(self.values, fast[0], v=fast[1], a=fast[2])
         self.solver.refresh()
         try:
             self.solver.set_reference(self.reference.driver_q, self.reference.q, assembly=self.assembly)
@@ -94,7 +105,7 @@ class StudyMechanism:
         return self._swept()
 
     def _swept(self) -> VariantCycle:
-        rows = []
+        rows, v, a = [], [], []
         for chunk in self.sweep.chunks(self.values):
             if chunk.errors:
                 exc = next(iter(chunk.errors.values()))
@@ -104,13 +115,27 @@ class StudyMechanism:
                 return VariantCycle(self.values, None, "changes assembly", note,
                                     AssemblyError(note, expected=(), found=()))
             rows.append(chunk.solution.q)
-        return VariantCycle(self.values, np.vstack(rows))
+            v.append(chunk.solution.v)
+            a.append(chunk.solution.a)
+        return VariantCycle(self.values, np.vstack(rows), v=np.vstack(v), a=np.vstack(a))
 
     def at(self, q: np.ndarray) -> pin.Data:
         """self.data with joint Jacobians and every frame placement at q."""
         pin.computeJointJacobians(self.model, self.data, q)
         pin.updateFramePlacements(self.model, self.data)
         return self.data
+
+
+def _cycle_values(scene: Scene, sweep: Sweep, steps: int) -> np.ndarray:
+    """The study's driver values [rad or m]: `steps` evenly spaced over the scene's
+    [sweep] from .. to where it gives them (a five-bar's motor cannot turn fully), else
+    over one turn of the driver from its scene value, both ends included."""
+    options = sweep_options(scene)
+    kind = "angle" if sweep.is_angular else "length"
+    start = scene.quantity(options["from"], kind, "sweep", "from") if "from" in options else sweep.start
+    span = sweep.default_values(2)[1] - sweep.start
+    stop = scene.quantity(options["to"], kind, "sweep", "to") if "to" in options else start + span
+    return np.linspace(start, stop, steps) if steps > 1 else np.array([start])
 
 
 def _cause(exc: PinmechError) -> str:

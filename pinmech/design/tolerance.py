@@ -15,7 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pinmech.design.sensitivity import StudyOutputs, cycle_sensitivity
+from pinmech.design.sensitivity import cycle_sensitivity
+from pinmech.design.study_outputs import StudyOutputs
 from pinmech.design.study_variant import StudyMechanism
 
 PERCENTILES = (0.5, 50.0, 99.5)
@@ -73,7 +74,7 @@ def solve_variants(sm: StudyMechanism, outputs: StudyOutputs, batch: Batch, p: n
             cycle = sm.cycle(pi)
             causes.append(cycle.cause)
             if not cycle.cause:
-                y[i] = outputs.values(cycle.q)
+                y[i] = outputs.cycle(cycle.q, cycle.v, cycle.a)
                 if at_variant:
                     extra[i] = at_variant(cycle.q)
     finally:
@@ -111,7 +112,7 @@ class Spread:
 def spread(sm: StudyMechanism, outputs: StudyOutputs, results: list[BatchResult]) -> Spread:
     """Gather the batches (in order) into a Spread against the nominal's linear estimate."""
     nominal_cycle = sm.cycle(sm.nominal)
-    y0, dy = cycle_sensitivity(sm, outputs, nominal_cycle.q)
+    y0, dy = cycle_sensitivity(sm, outputs, nominal_cycle)
     y = np.concatenate([r.y for r in results])
     causes = [c for r in results for c in r.causes]
     ok = np.array([not c for c in causes], dtype=bool)

@@ -1,0 +1,131 @@
+"""Exact first-order sensitivities of speeds to the parameters: the implicit-function
+theorem on the velocity closure equations, after the configuration's (sensitivity.py).
+
+Each cut's velocity rows are G = rows6 [R_P^T (v_C - v_P - w_P x delta); R_P^T (w_C - w_P)]
+(`Closure.relative_jacobian6` times v), zero on every variant with the drivers' speeds
+held. Along a parameter p_k the pose moves by S_k = dq/dp_k and the frames it carries
+translate by u (study_params.Placement); with v held,
+
+    dG/dp_k = rows6 [R_P^T (da - w'_P x a); R_P^T (db - w'_P x b)],   a, b: the brackets above
+    da = dv_C - dv_P - dw_P x delta - w_P x d(delta),   d(delta) = (J_C - J_P)_lin S_k + u_C - u_P
+    dv_X = (dv_X/dq) S_k + w_body x u_X                  (the frame carried by its body's motion)
+    dw_X = (dw_X/dq) S_k,   w'_P = (J_P)_ang S_k          (a translation turns nothing)
+
+with (dv_X/dq) S from the world Jacobian's time variation at q_dot = S (_FrameRates). Then
+C_dep dv_dep/dp_k = -dG/dp_k (the driver's speed held), and an output's speed derivative
+follows: a slider's ds_dot/dp = dv/dp at its index; a link's d(omega)/dp =
+n . ((dw_f/dq) S_k + J_f,ang dv/dp_k).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from pinmech.model.closures import _cross
+
+_LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+
+class _FrameRates:
+    """Frames' world-aligned velocities at (q, v) and their change along a pose change S.
+
+    d(velocity)/dS comes from the world (spatial) Jacobian's time variation at q_dot = S,
+    which is the exact derivative of its columns (each joint's spatial axis moved by its
+    parent's motion): dV_s = dJ_s v; the velocity of the frame's origin x is then
+    d(v_s + w x x) = dv_s + dw x x + w x dx, dx = J_x,lin S.
+    """
+
+    def __init__(self, model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray) -> None:
+        self.model, self.data, self.q, self.v = model, data, q, v
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        self._at = {}  # frame -> (velocity (6,), Jacobian (6, nv)), world-aligned at the origin
+        self._S = None
+
+    def __call__(self, frame: int) -> tuple[np.ndarray, np.ndarray]:
+        """(velocity (6,) [linear; angular], Jacobian (6, nv)), world-aligned axes."""
+        if frame not in self._at:
+            J = pin.getFrameJacobian(self.model, self.data, frame, _LWA).reshape(6, -1)
+            self._at[frame] = (J @ self.v, J)
+        return self._at[frame]
+
+    def joint_omega(self, joint: int) -> np.ndarray:
+        """World angular velocity [rad/s] of a joint's body."""
+        return pin.getJointJacobian(self.model, self.data, joint, pin.WORLD).reshape(6, -1)[3:] @ self.v
+
+    def along(self, S: np.ndarray) -> None:
+        """Set the pose change S (nv,) that `change` differentiates along."""
+        for frame in list(self._at):
+            self(frame)
+        pin.computeJointJacobiansTimeVariation(self.model, self.data, self.q, S)
+        self._S = S
+
+    def change(self, frame: int) -> np.ndarray:
+        """d(velocity)/dS (6,) of a frame at fixed v, along the S of `along`."""
+        V, J = self(frame)
+        dVs = pin.getFrameJacobianTimeVariation(self.model, self.data, frame, pin.WORLD).reshape(6, -1) @ self.v
+        x = self.data.oMf[frame].translation
+        dv = dVs[:3] + _cross(dVs[3:], x) + _cross(V[3:], J[:3] @ self._S)
+        return np.concatenate((dv, dVs[3:]))
+
+
+def velocity_sensitivity(sm, q: np.ndarray, v: np.ndarray, dq_dp: np.ndarray,
+                         frames: list[int] = ()) -> tuple[np.ndarray, np.ndarray]:
+    """dv/dp (nv, n_par) at the closed pose q with joint velocities v [per s / m], the
+    drivers' speeds held; and d(velocity)/dp at fixed v of `frames` along each dq/dp_k
+    (len(frames), 6, n_par), for the outputs."""
+    model, mech, solver = sm.model, sm.mechanism, sm.solver
+    data = sm.data
+    rates = _FrameRates(model, data, q, v)
+    driven = {mech.driver_index(n) for n in solver.drivers}
+    dep = [i for i in range(model.nv) if i not in driven]
+    J = np.vstack([c.jacobian(model, data) for c in mech.closures])
+    carried = [rates.joint_omega(_written_in(sm, place)) for place in sm.placements]
+    n_par = len(sm.placements)
+    dG, dV = np.zeros((len(J), n_par)), np.zeros((len(frames), 6, n_par))
+    for k, place in enumerate(sm.placements):
+        u = place.direction(data)
+        rates.along(dq_dp[:, k])
+        dG[:, k] = np.concatenate([_cut_rows(sm, c, rates, dq_dp[:, k], place, u, carried[k])
+                                   for c in mech.closures])
+        for i, f in enumerate(frames):
+            dV[i, :, k] = rates.change(f)
+    dv = np.zeros((model.nv, n_par))
+    dv[dep] = -np.linalg.solve(J[:, dep], dG)
+    return dv, dV
+
+
+def link_omega_sensitivity(sm, frame: int, normal: np.ndarray, dV: np.ndarray, dv_dp: np.ndarray) -> np.ndarray:
+    """d(omega)/dp (n_par,) of a link frame's angular speed about the plane normal [rad/s/m]:
+    its change at fixed v (dV (6, n_par)) plus J_ang dv/dp."""
+    J = pin.getFrameJacobian(sm.model, sm.data, frame, _LWA).reshape(6, -1)
+    return normal @ (dV[3:] + J[3:] @ dv_dp)
+
+
+def _cut_rows(sm, cut, rates: _FrameRates, S: np.ndarray, place, u: np.ndarray, moved: np.ndarray) -> np.ndarray:
+    """dG/dp_k of one cut's velocity rows at fixed v (the module's formula); u: the world
+    direction the parameter moves what it moves, `moved`: the carrying body's angular velocity."""
+    data = sm.data
+    M_P, M_C = data.oMf[cut.parent_frame], data.oMf[cut.child_frame]
+    (V_P, JP), (V_C, JC) = rates(cut.parent_frame), rates(cut.child_frame)
+    u_P = u if place.moves_frame(cut.parent_frame, sm.subtree) else np.zeros(3)
+    u_C = u if place.moves_frame(cut.child_frame, sm.subtree) else np.zeros(3)
+    w_P, delta = V_P[3:], M_C.translation - M_P.translation
+    a = V_C[:3] - V_P[:3] - _cross(w_P, delta)
+    b = V_C[3:] - w_P
+    dV_P, dV_C = rates.change(cut.parent_frame), rates.change(cut.child_frame)
+    dv_P = dV_P[:3] + (_cross(moved, u_P) if u_P.any() else 0.0)
+    dv_C = dV_C[:3] + (_cross(moved, u_C) if u_C.any() else 0.0)
+    d_delta = (JC[:3] - JP[:3]) @ S + u_C - u_P
+    da = dv_C - dv_P - _cross(dV_P[3:], delta) - _cross(w_P, d_delta)
+    db = dV_C[3:] - dV_P[3:]
+    turn = JP[3:] @ S
+    R_T = M_P.rotation.T
+    return cut._rows6 @ np.concatenate((R_T @ (da - _cross(turn, a)), R_T @ (db - _cross(turn, b))))
+
+
+def _written_in(sm, place) -> int:
+    """The joint whose body carries what a parameter moves (the parent joint for a joint
+    origin, the frame's joint for a cut frame)."""
+    return place.written_in

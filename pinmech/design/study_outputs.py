@@ -1,0 +1,150 @@
+"""A study's outputs: their names and kinds, their values over a cycle (all poses in one
+call of the compiled core's `frames_along`), and their Jacobians at a pose.
+
+Outputs, in this order (`[outputs]` of the study file):
+
+    points = ["P"]        P.x, P.y (P.z for a spatial mechanism): world position [m]
+    links = ["rocker"]    rocker.angle: its x axis about the plane normal [rad]
+    sliders = ["slide"]   slide.s: a prismatic joint's coordinate [m]
+    sliders (again)       slide.s_dot: its speed [m/s]
+    transmission = ["B"]  B.mu: the transmission angle of the dyad whose middle pin is B [rad]
+                          (study_transmission.py)
+    omega = ["rocker"]    rocker.omega: angular speed about the plane normal [rad/s]
+
+Speeds are those of the scene's driver speed. (A link's angular acceleration is not an
+output yet: its exact sensitivity needs the derivative of the acceleration drift.)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from pinmech.exceptions import SceneError
+from pinmech.design.study_transmission import dyad_pins, transmission_row, transmission_values
+from pinmech.solve.core import _core
+
+_LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+
+class StudyOutputs:
+    """A study's outputs on a StudyMechanism `sm`.
+
+    Attributes:
+        names: "P.x", "rocker.angle", "slide.s", "slide.s_dot", "rocker.omega".
+        kinds: "length", "angle", "speed", "angular speed", each.
+        n_pose: how many outputs (the first ones) depend on q alone.
+    """
+
+    def __init__(self, sm) -> None:
+        mech, spec = sm.mechanism, sm.spec
+        self.sm, self.normal = sm, mech.plane_normal
+        planar = [("links", spec.links), ("omega", spec.omega)]
+        for key, names in planar:
+            if names and self.normal is None:
+                raise SceneError("link angles and their rates are outputs of planar mechanisms; name points instead",
+                                 path=str(spec.path), key=f"outputs.{key}")
+            for name in names:
+                if name not in mech.links:
+                    raise SceneError(f"unknown link '{name}' (the model has: {', '.join(mech.links)})",
+                                     path=str(spec.path), key=f"outputs.{key}")
+        self.sliders = [_slider(mech, name, spec) for name in spec.sliders]
+        self.points = [mech.frame_id(_checked_point(mech, name, spec)) for name in spec.points]
+        self.links = [mech.links[name] for name in spec.links]
+        self.omega = [mech.links[name] for name in spec.omega]
+        self.dyads = (dyad_pins(mech, list(sm.solver.drivers), spec.transmission, str(spec.path))
+                      if spec.transmission else [])
+        self.axes = _plane_axes(self.normal)
+        self.names = ([f"{n}.{'xyz'[k]}" for n in spec.points for k in self.axes] + [f"{n}.angle" for n in spec.links]
+                      + [f"{n}.mu" for n in spec.transmission] + [f"{n}.s" for n in spec.sliders] + [f"{n}.s_dot" for n in spec.sliders]
+                      + [f"{n}.omega" for n in spec.omega])
+        self.kinds = (["length"] * (len(spec.points) * len(self.axes)) + ["angle"] * len(spec.links)
+                      + ["angle"] * len(spec.transmission)
+                      + ["length"] * len(spec.sliders) + ["speed"] * len(spec.sliders)
+                      + ["angular speed"] * len(spec.omega))
+        self.n_pose = len(self.points) * len(self.axes) + len(self.links) + len(self.dyads) + len(self.sliders)
+        if self.normal is not None:
+            e1 = np.eye(3)[int(np.argmin(np.abs(self.normal)))]
+            e1 = e1 - self.normal * (self.normal @ e1)
+            self.e1 = e1 / np.linalg.norm(e1)
+            self.e2 = np.cross(self.normal, self.e1)
+        self.pins = sorted({f for d in self.dyads for f in (d.near, d.joint, d.ground) if f >= 0})
+        rows = {f: i for i, f in enumerate(dict.fromkeys(self.points + self.links + self.omega + self.pins))}
+        self._frames = np.array(list(rows), dtype=np.int32)  # read with the variant's placements at each call
+        self._data = sm.model.createData()
+        self._index = {key: [rows[f] for f in fs] for key, fs in
+                       (("points", self.points), ("links", self.links), ("omega", self.omega), ("pins", self.pins))}
+
+    def cycle(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """The outputs (steps, n_out) at the poses q with rates v, a (steps, nq / nv) of the
+        variant now written in the model [m, rad, m/s, rad/s, rad/s^2]."""
+        q, v, a = (np.ascontiguousarray(x, dtype=float).reshape(len(q), -1) for x in (q, v, a))
+        n, columns = len(q), []
+        if len(self._frames):
+            K = np.empty((n, len(self._frames), _core.KINEMATICS_COLUMNS))
+            _core.frames_along(self.sm.model, self._data, q, v, a, self._frames, K)
+            P, R, W = K[..., 0:3], K[..., 3:12], K[..., 15:18]
+            at = self._index
+            columns += [P[:, i, k] for i in at["points"] for k in self.axes]
+            x_axes = R[:, at["links"]][..., [0, 3, 6]]  # each link's x axis (rotation's first column), world
+            columns += list(np.arctan2(x_axes @ self.e2, x_axes @ self.e1).T) if at["links"] else []
+            x = {f: P[:, i] for f, i in zip(self.pins, at["pins"])}
+            columns += [transmission_values(d, x, self.e1, self.e2) for d in self.dyads]
+        columns += [q[:, iq] for iq, _ in self.sliders] + [v[:, iv] for _, iv in self.sliders]
+        if len(self._frames):
+            columns += list((W[:, at["omega"]] @ self.normal).T) if at["omega"] else []
+        return np.column_stack(columns) if columns else np.zeros((len(q), 0))
+
+    def jacobians(self, data: pin.Data) -> tuple[np.ndarray, np.ndarray]:
+        """The pose outputs' (dy/dq on the tangent space (n_pose, nv), dy/dp at fixed q
+        (n_pose, n_par)), `data` at q with joint Jacobians and frame placements."""
+        model, sm = self.sm.model, self.sm
+        n_par = len(sm.placements)
+        rows_q, rows_p = [], []
+        for f in self.points:
+            J = pin.getFrameJacobian(model, data, f, _LWA).reshape(6, -1)
+            direct = np.array([place.direction(data) if place.moves_frame(f, sm.subtree) else np.zeros(3)
+                               for place in sm.placements]).reshape(-1, 3).T
+            rows_q += [J[k] for k in self.axes]
+            rows_p += [direct[k] for k in self.axes]
+        for f in self.links:
+            J = pin.getFrameJacobian(model, data, f, _LWA).reshape(6, -1)
+            rows_q.append(self.normal @ J[3:])
+            rows_p.append(np.zeros(n_par))
+        if self.dyads:
+            x = {f: data.oMf[f].translation for f in self.pins}
+            J = {f: pin.getFrameJacobian(model, data, f, _LWA).reshape(6, -1)[:3] for f in self.pins}
+            direct = {f: np.array([place.direction(data) if place.moves_frame(f, sm.subtree) else np.zeros(3)
+                                   for place in sm.placements]).reshape(-1, 3).T for f in self.pins}
+            for d in self.dyads:
+                rows_q.append(transmission_row(d, x, J, self.e1, self.e2))
+                rows_p.append(transmission_row(d, x, direct, self.e1, self.e2))
+        for _, iv in self.sliders:
+            rows_q.append(np.eye(model.nv)[iv])
+            rows_p.append(np.zeros(n_par))
+        return np.array(rows_q).reshape(-1, model.nv), np.array(rows_p).reshape(-1, n_par)
+
+
+def _slider(mech, name: str, spec) -> tuple[int, int]:
+    """(idx_q, idx_v) of a prismatic joint named in outputs.sliders."""
+    joint = mech.joints.get(name)
+    if joint is None or joint.kind != "prismatic":
+        sliders = [n for n, j in mech.joints.items() if j.kind == "prismatic"]
+        raise SceneError(f"'{name}' is not a prismatic joint of the model (its sliders: "
+                         f"{', '.join(sliders) or 'none'})", path=str(spec.path), key="outputs.sliders")
+    return joint.idx_q, joint.idx_v
+
+
+def _plane_axes(normal: np.ndarray | None) -> tuple[int, ...]:
+    """World components reported for points: those in the plane when it is a coordinate plane."""
+    if normal is None:
+        return (0, 1, 2)
+    axis = int(np.argmax(np.abs(normal)))
+    return tuple(k for k in range(3) if k != axis) if abs(normal[axis]) > 1 - 1e-12 else (0, 1, 2)
+
+
+def _checked_point(mech, name: str, spec) -> str:
+    if name not in mech.points and name not in mech.links:
+        raise SceneError(f"unknown point '{name}' (the model has: {', '.join(mech.points)})", path=str(spec.path),
+                         key="outputs.points")
+    return name
