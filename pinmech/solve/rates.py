@@ -202,13 +202,16 @@ class RateSolver:
         q = self.mechanism.checked_q(q)
         x_dot = self._values(velocity, self.x_dot, "velocity")
         x_ddot = self._values(acceleration, self.x_ddot, "acceleration")
-        v, a, numbers, achieved_v, achieved_a = self._rates(q[None], x_dot, x_ddot)
-        condition, sigma_min, closure_v, closure_a, _, independent, full, rank, used = self._checked(q, numbers[0])
+        row = self._rates(q[None], x_dot, x_ddot)[0]
+        nv, m = self.model.nv, x_dot.size
+        first = 2 * nv + _core.RATE_NUMBERS
+        condition, sigma_min, closure_v, closure_a, _, independent, full, rank, used = self._checked(
+            q, row[2 * nv:first])
         return RateSolution(
-            v=v[0], a=a[0], method=_USED[int(used)], condition=condition, sigma_min=sigma_min,
-            nullspace_dim=self.model.nv - int(rank), rank=int(rank),
-            requested_velocity=x_dot.copy(), achieved_velocity=achieved_v[0],
-            requested_acceleration=x_ddot.copy(), achieved_acceleration=achieved_a[0],
+            v=row[:nv], a=row[nv:2 * nv], method=_USED[int(used)], condition=condition, sigma_min=sigma_min,
+            nullspace_dim=nv - int(rank), rank=int(rank),
+            requested_velocity=x_dot.copy(), achieved_velocity=row[first:first + m],
+            requested_acceleration=x_ddot.copy(), achieved_acceleration=row[first + m:],
             closure_velocity_residual=closure_v, closure_acceleration_residual=closure_a,
             closure_residual=max(independent, full),
         )
@@ -224,7 +227,11 @@ class RateSolver:
                 that has them.
         """
         q = np.ascontiguousarray(self.mechanism.checked_q(q, many=True))
-        v, a, numbers, achieved_v, achieved_a = self._rates(q, self.x_dot, self.x_ddot)
+        out = self._rates(q, self.x_dot, self.x_ddot)
+        nv, m = self.model.nv, self.x_dot.size
+        first = 2 * nv + _core.RATE_NUMBERS
+        v, a, numbers = out[:, :nv], out[:, nv:2 * nv], out[:, 2 * nv:first]
+        achieved_v, achieved_a = out[:, first:first + m], out[:, first + m:]
         condition, sigma_min, closure_v, closure_a, status, independent, full, _, used = numbers.T
         bad = (status != _SOLVED) | ~is_closed(independent, full, self.tol)
         for i in np.flatnonzero(bad)[:1]:  # the first pose that has an error raises it, named
@@ -233,23 +240,22 @@ class RateSolver:
         return RateBatch(v, a, methods, condition, sigma_min, achieved_v, achieved_a, closure_v, closure_a,
                          np.maximum(independent, full))
 
-    def _rates(self, q: np.ndarray, x_dot: np.ndarray, x_ddot: np.ndarray) -> tuple[np.ndarray, ...]:
-        """The compiled rate solve at every row of q (csrc/rates.cpp): v, a, numbers (per
-        pose: condition, sigma_min, closure velocity and acceleration residuals, status,
-        q's independent and full closure residuals, rank, method code), achieved rows
-        (views of one array). Poses that look singular are solved again with the task's
-        structural rank."""
+    def _rates(self, q: np.ndarray, x_dot: np.ndarray, x_ddot: np.ndarray) -> np.ndarray:
+        """The compiled rate solve at every row of q (csrc/rates.cpp), a row a pose: v, a
+        (nv each), RATE_NUMBERS numbers (condition, sigma_min, closure velocity and
+        acceleration residuals, status, q's independent and full closure residuals, rank,
+        method code), the achieved task rows' velocities and accelerations. Poses that look
+        singular are solved again with the task's structural rank."""
         core = self._compiled()
         out = np.empty((len(q), core.rate_columns))
         core.rates(q, x_dot, x_ddot, self._generic[0] if self._generic is not None else -1, out)
-        nv, m = self.model.nv, x_dot.size
-        first = 2 * nv + _core.RATE_NUMBERS
-        if _NEEDS_RANK in out[:, 2 * nv + 4].tolist():  # only poses that look singular pay for the structural rank
-            again = np.flatnonzero(out[:, 2 * nv + 4] == _NEEDS_RANK)
+        status = 2 * self.model.nv + 4
+        if _NEEDS_RANK in out[:, status].tolist():  # only poses that look singular pay for the structural rank
+            again = np.flatnonzero(out[:, status] == _NEEDS_RANK)
             more = np.empty((again.size, out.shape[1]))
             core.rates(np.ascontiguousarray(q[again]), x_dot, x_ddot, self._structural_rank()[0], more)
             out[again] = more
-        return out[:, :nv], out[:, nv:2 * nv], out[:, 2 * nv:first], out[:, first:first + m], out[:, first + m:]
+        return out
 
     def _checked(self, q: np.ndarray, numbers: np.ndarray) -> list[float]:
         """One pose's numbers as floats, or its error: open loops first (how far, in m and
@@ -279,8 +285,8 @@ class RateSolver:
         Raises:
             ModelError: the core reads a cut otherwise than its closure rows state."""
         cached = self.__dict__.get("_core")
-        options = (self.mechanism.length_scale, *(c.length_scale for c in self.mechanism.closures), self.method,
-                   self.damping, self.max_condition)
+        options = (self.mechanism.length_scale, self.method, self.damping, self.max_condition,
+                   *[c.length_scale for c in self.mechanism.closures])
         if cached is None or cached[0].model is not self.model or not cached[0].same_structure:
             built = core.compile_loops(self.model, self.mechanism.closures, self.mechanism.velocity_scale(),
                                        extra_frames=self.frames)
