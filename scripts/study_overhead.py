@@ -5,10 +5,9 @@ The bundled four-bar tolerance study (models/studies/four_bar_tolerance.toml) wi
 through `design/tolerance.py`'s per-variant loop (`solve_variants`: write the variant's
 dimensions into the model, re-read them, close the reference pose, sweep the cycle, read
 the outputs at every pose). Two shares are measured with time.perf_counter: the time inside
-`Sweep.chunks` (the sweep's whole Python face: set-up of each cycle, then the compiled
-continuation giving every pose's q, v, a), and within it the time inside the compiled core's
-own calls (`Core.follow` and `Core.node`: the per-pose solve proper). Reported: total, both
-shares and what lies outside each, and with `--profile` a cProfile of one batch.
+the compiled core's own sweep calls (`Core.follow` and `Core.node`: the per-pose solve proper), and those with the
+outputs' compiled kinematics over the cycle (`_core.frames_along`). Reported: total, each
+share and what lies outside it, and with `--profile` a cProfile of one batch.
 
     python scripts/study_overhead.py --samples 10000 --steps 360
 """
@@ -32,42 +31,25 @@ from pinmech.design.tolerance import batches, run_batch  # noqa: E402
 
 
 class _TimedCore:
-    """The compiled core's sweep calls with their time added up [s] (wrapped on the class)."""
+    """The compiled core's sweep calls (Core.follow, Core.node, wrapped on the class) and
+    its kinematics over a cycle (`frames_along`, the outputs' poses), their times added up [s]."""
 
     def __init__(self) -> None:
         from pinmech.solve.core import _core
 
-        self.seconds, self.core = 0.0, _core.Core
+        self.seconds, self.kinematics = 0.0, 0.0
         for name in ("follow", "node"):
-            setattr(self.core, name, self._timed(getattr(self.core, name)))
+            setattr(_core.Core, name, self._timed(getattr(_core.Core, name), "seconds"))
+        _core.frames_along = self._timed(_core.frames_along, "kinematics")
 
-    def _timed(self, method):
-        def timed(core, *args):
+    def _timed(self, method, total: str):
+        def timed(*args):
             t0 = time.perf_counter()
             try:
-                return method(core, *args)
+                return method(*args)
             finally:
-                self.seconds += time.perf_counter() - t0
+                setattr(self, total, getattr(self, total) + time.perf_counter() - t0)
         return timed
-
-
-class _TimedChunks:
-    """Sweep.chunks with the time spent producing each chunk added up [s]."""
-
-    def __init__(self, chunks) -> None:
-        self.chunks, self.seconds = chunks, 0.0
-
-    def __call__(self, *args, **kwargs):
-        it = self.chunks(*args, **kwargs)
-        while True:
-            t0 = time.perf_counter()
-            try:
-                chunk = next(it)
-            except StopIteration:
-                self.seconds += time.perf_counter() - t0
-                return
-            self.seconds += time.perf_counter() - t0
-            yield chunk
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -80,8 +62,6 @@ def main(argv: list[str] | None = None) -> None:
     spec = spec.__class__(**{**spec.__dict__, "samples": args.samples, "steps": args.steps})
     sm = StudyMechanism(spec)
     outputs = StudyOutputs(sm)
-    timed = _TimedChunks(sm.sweep.chunks)
-    sm.sweep.chunks = timed
     compiled = _TimedCore()
     todo = batches(spec.samples, spec.batch)
     t0 = time.perf_counter()
@@ -91,10 +71,11 @@ def main(argv: list[str] | None = None) -> None:
     poses = spec.samples * spec.steps
     print(f"{spec.samples} variants x {spec.steps} poses ({solved} solved): total {total:.3g} s "
           f"({total / poses * 1e6:.3g} us a variant-pose)\n"
-          f"- inside Sweep.chunks {timed.seconds:.3g} s; outside it {total - timed.seconds:.3g} s = "
-          f"{(total - timed.seconds) / total:.1%} of the time\n"
           f"- inside the compiled core's sweep calls (Core.follow, Core.node) {compiled.seconds:.3g} s; outside "
-          f"them {total - compiled.seconds:.3g} s = {(total - compiled.seconds) / total:.1%} of the time")
+          f"them {total - compiled.seconds:.3g} s = {(total - compiled.seconds) / total:.1%} of the time\n"
+          f"- inside those and the outputs' compiled kinematics (frames_along) {compiled.seconds + compiled.kinematics:.3g}"
+          f" s; outside every compiled per-pose call {total - compiled.seconds - compiled.kinematics:.3g} s = "
+          f"{(total - compiled.seconds - compiled.kinematics) / total:.1%} of the time")
     if args.profile:
         profile = cProfile.Profile()
         profile.runcall(run_batch, sm, outputs, todo[0])
