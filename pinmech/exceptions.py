@@ -221,7 +221,8 @@ class BalanceError(PinmechError):
     (a term the model computes one way and the check another). Never printed as an answer.
 
     Attributes:
-        power_residual, equation_residual: the two relative residuals.
+        power_residual: the power balance's relative residual.
+        equation_residual: the joint equations' relative residual.
         bound: what rounding allows at this condition number.
     """
 

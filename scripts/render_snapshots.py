@@ -1,4 +1,4 @@
-"""Regenerate the README's pictures of the bundled mechanisms: each pose drawn by
+"""Regenerate the pictures of the docs (and the README) of the bundled mechanisms: each pose drawn by
 `pinmech.draw` as an offline meshcat page, then photographed by headless chromium, the same
 route as the browser tests (tests/browser.py).
 
@@ -12,12 +12,16 @@ route as the browser tests (tests/browser.py).
   `<visual>` taken out (a user's model), and `docs/images/jansen_leg.png`, a model written
   without any: their links sketched from their joints and points.
 - `docs/images/sweep_r_rtr.png`, `sweep_four_bar.png`, `docs/images/paths_four_bar.png`
-  (with `--timing-marks`), `paths_jansen_leg.png`: `pinmech sweep --plot` and `--paths`;
+  (with `--timing-marks`), `paths_jansen_leg.png`, `paths_four_bar_drawn.png` (the drawn
+  four-bar): `pinmech sweep --plot` and `--paths`;
   `docs/images/animate_four_bar.gif` and `.png`: `pinmech animate --gif`, and its page with
   the slider moved to frame 30; `docs/images/path_planar_arm.png`: `pinmech path --plot`; `docs/images/torque_slider_crank.png`: `--torque-plot`; `docs/images/polygon_v_r_rtr.png`,
   `polygon_a_r_rtr.png`, `polygon_a_four_bar.png`: `pinmech polygon`;
   `docs/images/report_r_rtr_page1.png`: the first page of `pinmech report`, printed to PDF by
   chromium (poppler's `pdftoppm` makes the picture).
+- `docs/images/study_four_bar_histogram.png`, `study_four_bar_sensitivity.png`,
+  `study_four_bar_grid.png`: `pinmech study --out --plot` of models/studies/four_bar_tolerance.toml
+  and four_bar_grid.toml.
 
 Poses and rates of the first two come from the independent closed forms in
 scripts/closed_form.py; the models are built from the URDF files directly. The others run
@@ -179,12 +183,29 @@ def figure_pictures(tmp: Path) -> None:
              "--csv", str(tmp / "f.csv")])
     pinmech(["sweep", str(scenes / "four_bar.toml"), "--paths", str(IMAGES / "paths_four_bar.png"), "--timing-marks"])
     pinmech(["sweep", str(scenes / "jansen_leg.toml"), "--paths", str(IMAGES / "paths_jansen_leg.png")])
+    pinmech(["sweep", str(scenes / "four_bar_drawn.toml"), "--steps", "73", "--csv", str(tmp / "d.csv"),
+             "--paths", str(IMAGES / "paths_four_bar_drawn.png")])  # the drawn-linkage tutorial's
     pinmech(["animate", str(scenes / "four_bar.toml"), "--steps", "37", "--fps", "12",
              "--gif", str(IMAGES / "animate_four_bar.gif")])
     pinmech(["sweep", str(scenes / "slider_crank_dynamic.toml"), "--torque-plot",
              str(IMAGES / "torque_slider_crank.png"), "--csv", str(tmp / "t.csv")])
     pinmech(["path", str(scenes / "planar_arm.toml"), "--csv", str(tmp / "arm.csv"),
              "--plot", str(IMAGES / "path_planar_arm.png")])
+    study_pictures(tmp)
+
+
+def study_pictures(tmp: Path) -> None:
+    """The design studies' figures (`pinmech study --out --plot`, in this process): the
+    four-bar's tolerance histograms and sensitivity bars, and its 2-D grid map."""
+    import shutil
+
+    from pinmech.cli import main as pinmech
+
+    studies = MODELS / "studies"
+    for study, figures in (("four_bar_tolerance", ("histogram", "sensitivity")), ("four_bar_grid", ("grid",))):
+        pinmech(["study", str(studies / f"{study}.toml"), "--workers", "0", "--out", str(tmp / study), "--plot"])
+        for figure in figures:
+            shutil.copyfile(tmp / f"{study}_{figure}.png", IMAGES / f"study_four_bar_{figure}.png")
 
 
 def _svg_pixels(svg: Path) -> tuple[int, int]:

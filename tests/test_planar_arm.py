@@ -211,7 +211,7 @@ def test_singular_pose_from_the_command_line(capsys):
          "no joint of the model gives D.z at any pose"),
         # a scene's misspelling: exit 4 naming the key (it was 8, an inconsistent task)
         ('rates.method="pinv"', 4, "rates.method: must be one of exact, least_squares, damped"),
-        ('rates.lambda=0.1', 4, "unknown key(s) ['lambda']"),
+        ('rates.lambda=0.1', 4, "rates: unknown key(s) lambda; known: method, damping, max_condition"),
         ('pose.E="10 deg"', 4, "unknown joint (in [pose]) 'E'"),
         ('pose.A="10 mm"', 4, "pose.A: '10 mm' has no angle unit"),
     ],

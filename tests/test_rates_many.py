@@ -130,7 +130,7 @@ def test_local_axes_and_a_six_dof_arm_equal_solve(scenes_dir):
         np.testing.assert_allclose(batch.a[i], r.a, rtol=0, atol=1e-12 * (1 + np.abs(r.a).max()))
     analysis = pinmech.analyse(pinmech.Scene.load(scenes_dir / "ur5.toml"))
     mech = analysis.mechanism
-    tasks = [pinmech.Task(analysis.scene.raw["task"][0]["frame"], ("x", "y", "z", "wx", "wy", "wz"),
+    tasks = [pinmech.Task(analysis.scene.file.task[0].frame, ("x", "y", "z", "wx", "wy", "wz"),
                           np.array([0.1, -0.2, 0.05, 0.3, 0.0, -0.1]), np.array([0.0, 0.1, 0.0, 0.0, 0.2, 0.0]))]
     arm = pinmech.RateSolver(mech, tasks)
     rng = np.random.default_rng(3)

@@ -200,7 +200,7 @@ def test_every_bundled_planar_scene_makes_a_page(tmp_path, name):
     assert main(["report", str(SCENES / f"{name}.toml"), "-o", str(out), "--steps", "9"]) == 0
     page = out.read_text(encoding="utf-8")
     assert "<iframe" in page and "<table>" in page and "Velocity polygon" in page
-    assert ('<img alt="sweep"' in page) == ("task" not in Scene.load(SCENES / f"{name}.toml").raw)
+    assert ('<img alt="sweep"' in page) == (not Scene.load(SCENES / f"{name}.toml").is_task)
     assert not re.search(OFF_PAGE, html.unescape(page))
 
 

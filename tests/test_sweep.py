@@ -226,7 +226,7 @@ def test_the_progress_bar_shows_on_a_terminal_only(monkeypatch):
     """Piped (the tests), poses pass through untouched; on a terminal tqdm wraps them."""
     import sys
 
-    from pinmech.cli import _progress
+    from pinmech.cli.progress import progress as _progress
 
     items = iter(range(3))
     assert _progress(items, 3) is items

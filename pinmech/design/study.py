@@ -79,9 +79,11 @@ def study(path: str | Path | StudySpec, *, workers: int = 0, scheduler: str | No
             study finishes.
 
     Raises:
-        SceneError, FrameNotFound: a bad study file; the scene's and model's errors; the
-        nominal's own (a LoopClosureError where the nominal does not assemble, a
-        SweepError where its cycle fails). ImportError naming `pinmech[study]` without Dask.
+        SceneError: a bad study file (FrameNotFound: a name the model lacks); the scene's
+            and model's errors.
+        LoopClosureError: the nominal does not assemble.
+        SweepError: the nominal's cycle fails.
+        ImportError: naming `pinmech[study]`, without Dask.
     """
     spec = path if isinstance(path, StudySpec) else load_study(path)
     sm, outputs = built(spec)

@@ -122,7 +122,7 @@ def task_frames(scene: Scene, duration: str | None, steps: int) -> Frames:
         raise PinmechError(f"{scene.path}: say how long to follow the task: --duration '0.08 s' "
                            "(or [sweep] duration = \"0.08 s\")")
     total_time = scene.quantity(text, "time", "--duration")
-    step = scene.quantity(options.get("step", "1 ms"), "time", "[sweep] step")
+    step = scene.quantity(options.get("step", "1 ms"), "time", "sweep", "step")
     if not (total_time > 0 and 0 < step <= total_time):
         raise PinmechError(f"need 0 < step <= --duration, got step {step} s, duration {total_time} s")
     mechanism = load_mechanism(scene)

@@ -89,7 +89,7 @@ class SweepPlot(SweepPanels):
         _pyplot()  # fail early, before the sweep runs, when matplotlib is missing
         if angles not in ANGLE_STYLES:
             raise PinmechError(f"angles must be one of {', '.join(ANGLE_STYLES)}, got {angles!r}")
-        chosen = sweep.scene.section("sweep")
+        chosen = sweep.scene.file.sweep
         self.sweep, self.angles = sweep, angles
         self.length = length_unit(sweep.mechanism.length_scale)  # (scale from m, unit): one a figure
         self.paths = PathRecorder(sweep.mechanism, plane, length=self.length)
@@ -97,7 +97,7 @@ class SweepPlot(SweepPanels):
         self.centrodes = None if centrodes is None else CentrodeTrace(self.design.design, centrodes)
         self._mus: list[float] = []
         self.mark_q = None  # configuration of the pose nearest the scene's (drawn under the paths)
-        self.links, self.points = links or chosen.get("links"), points or chosen.get("points")
+        self.links, self.points = links or chosen.links, points or chosen.points
         _check_names(sweep, "link", self.links, sweep.mechanism.links, "--links" if links else "[sweep] links")
         named = [n for n in self.points or () if sweep.mechanism.model.existFrame(n)]  # a drawn linkage's pins
         _check_names(sweep, "point", self.points, [*sweep.mechanism.points, *named],
@@ -359,8 +359,8 @@ class SweepPlot(SweepPanels):
         unit = "deg" if self.sweep.is_angular else self.length[1]
         if self._speed() == 0:
             return f"arrows: travel as {self.sweep.driver} {'grows' if self._increasing() else 'falls'} [{unit}]"
-        spec = self.sweep.scene.section("drivers").get(self.sweep.driver, {})
-        speed = spec.get("speed", spec.get("velocity", f"{self._speed():.4g}"))
+        spec = self.sweep.scene.file.drivers.get(self.sweep.driver)
+        speed = spec.rate if spec is not None and spec.rate is not None else f"{self._speed():.4g}"
         return f"arrows: the motion, {self.sweep.driver} at {speed}"
 
 

@@ -243,6 +243,6 @@ def _sliding(places, shown, axes, labels, images, c, w: float, acc: bool) -> lis
 
 def _title(analysis: Analysis, quantity: str) -> str:
     scene = analysis.scene
-    spec = scene.section("drivers")
-    drivers = "; ".join(f"{n}: " + ", ".join(str(v) for v in spec[n].values()) for n in spec)
+    drivers = "; ".join(f"{n}: " + ", ".join(str(v) for _, _, v in spec.given())
+                        for n, spec in scene.file.drivers.items())
     return f"{quantity.capitalize()} polygon: {scene.title}" + (f" ({drivers})" if drivers else "")

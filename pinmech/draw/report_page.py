@@ -75,7 +75,7 @@ def _figures(analysis: Analysis, steps: int) -> list[tuple[str, str]]:
         out += [(svg, caption) for svg, caption in _polygons(analysis)]
     else:
         out.append((_interactive(analysis, None), _CAPTIONS["drawing"]))
-    if steps and "task" not in analysis.scene.raw:
+    if steps and not analysis.scene.is_task:
         out += _sweep(analysis, steps)
     return out
 

@@ -75,13 +75,14 @@ class SweepPanels:
 
     def _title(self, marked: bool, mark_x: float, unit: str) -> str:
         sweep = self.sweep
-        spec = sweep.scene.section("drivers").get(sweep.driver, {})
+        spec = sweep.scene.file.drivers.get(sweep.driver)
         rate = "speed" if sweep.is_angular else "velocity"
-        speed = spec.get("speed", spec.get("velocity", "0"))  # as the scene writes them; absent: 0
+        speed = spec.rate if spec is not None and spec.rate is not None else "0"  # as the scene writes it; absent: 0
+        acceleration = spec.acceleration if spec is not None and spec.acceleration is not None else "0"
         note = f"dashed: the scene's pose, {mark_x:.4g} {unit}" if marked else ""
         if self.failed:
             note += ("; " if note else "") + f"{len(self.failed)} pose(s) failed (red x)"
-        driven = f"driver {sweep.driver} at {rate} {speed}, acceleration {spec.get('acceleration', '0')}"
+        driven = f"driver {sweep.driver} at {rate} {speed}, acceleration {acceleration}"
         return f"{sweep.scene.title}: {driven}" + (f"\n({note})" if note else "")
 
     def _summary(self, mark_x: float, unit: str) -> str:

@@ -33,15 +33,13 @@ def analyse(scene: Scene, *, forces: bool = False, static: bool = False, minimum
     when the scene has a `[forces]`, `[gravity]` or `[[load]]` table (forces_scene.py).
     """
     instance_of(scene, Scene, "analyse's scene")
-    if "task" in scene.raw:
+    if scene.is_task:
         if forces or static or wants_forces(scene):
             raise SceneError("forces are computed for driven mechanisms ([drivers]), not for [[task]] scenes",
                              path=str(scene.path), key="forces")
         from pinmech.io.analysis_task import analyse_task
 
         return analyse_task(scene)
-    scene.solver_options()  # settings first: a bad one is named before the model is read
-    scene.assembly()
     mechanism = load_mechanism(scene)
     drivers = scene_drivers(scene, mechanism)
     check_scene_names(scene, mechanism)

@@ -33,48 +33,13 @@ from pinmech.io.scene_model import (
     report_lists,
     scene_guess,
 )
-from pinmech.solve.loops import DEFAULT_TOL, SOLVER_RANGES, LoopSolver
-from pinmech.solve.rates import COMPONENTS, DAMPING_RANGE, METHODS, RateSolver, Task
-
-_ORDER_KINDS = {True: ("angular_velocity", "angular_acceleration"), False: ("velocity", "acceleration")}
-
+from pinmech.solve.loops import DEFAULT_TOL, LoopSolver
+from pinmech.solve.rates import RateSolver, Task
 
 def scene_tasks(scene: Scene) -> list[Task]:
-    """The `[[task]]` entries, in SI units."""
-    entries = scene.raw["task"]
-    if not isinstance(entries, list) or not entries:
-        raise SceneError("task must be an array of tables: [[task]]", path=str(scene.path), key="task")
-    return [_task(scene, entry, i) for i, entry in enumerate(entries)]
-
-
-def _task(scene: Scene, entry: Any, i: int) -> Task:
-    where = f"task[{i}]"
-    if not isinstance(entry, dict):
-        raise SceneError("must be a table", path=str(scene.path), key=where)
-    unknown = set(entry) - {"frame", "components", "velocity", "acceleration", "reference"}
-    missing = {"frame", "components", "velocity"} - set(entry)
-    if unknown or missing:
-        raise SceneError(f"unknown keys {sorted(unknown)} / missing keys {sorted(missing)}; a task has frame, "
-                         "components, velocity, acceleration (optional) and reference (optional)",
-                         path=str(scene.path), key=where)
-    comps = entry["components"]
-    if not isinstance(comps, list) or not all(c in COMPONENTS for c in comps):
-        raise SceneError(f"components {comps!r} must be a list of {', '.join(COMPONENTS)}",
-                         path=str(scene.path), key=f"{where}.components")
-    values = {}
-    for order, key in enumerate(("velocity", "acceleration")):
-        given = entry.get(key, [0] * len(comps))
-        if not isinstance(given, list) or len(given) != len(comps):
-            raise SceneError(f"{key} needs one quantity per component ({len(comps)})",
-                             path=str(scene.path), key=f"{where}.{key}")
-        values[key] = np.array([
-            scene.quantity(x, _ORDER_KINDS[c.startswith("w")][order], where, key, c) for x, c in zip(given, comps)
-        ])
-    reference = entry.get("reference", "world")
-    if reference not in ("world", "local"):
-        raise SceneError(f"reference must be \"world\" or \"local\" (the frame's own axes), got {reference!r}",
-                         path=str(scene.path), key=f"{where}.reference")
-    return Task(str(entry["frame"]), tuple(comps), values["velocity"], values["acceleration"], reference)
+    """The `[[task]]` entries (validated when the scene was read), in SI units."""
+    return [Task(t.frame, t.components, np.array(t.velocity), np.array(t.acceleration), t.reference)
+            for t in scene.file.task or ()]
 
 
 def _check_frames(scene: Scene, mechanism: Mechanism, tasks: list[Task]) -> None:
@@ -90,7 +55,7 @@ def scene_pose(scene: Scene, mechanism: Mechanism) -> tuple[np.ndarray, list[str
     """Configuration from `[guess]` then `[pose]`; also the pose joints and their values (SI)."""
     q = scene_guess(scene, mechanism)
     names, values, followers = [], [], {}
-    for name, value in scene.section("pose").items():
+    for name, value in scene.file.pose.items():
         if name in mechanism.locked:
             continue
         if name not in mechanism.joints:
@@ -114,28 +79,6 @@ def scene_pose(scene: Scene, mechanism: Mechanism) -> tuple[np.ndarray, list[str
     return q, names, np.array(values)
 
 
-def _rate_options(scene: Scene) -> dict[str, Any]:
-    options = scene.section("rates")
-    unknown = set(options) - {"method", "damping", "max_condition"}
-    if unknown:
-        raise SceneError(f"unknown key(s) {sorted(unknown)}; known: method, damping, max_condition",
-                         path=str(scene.path), key="rates")
-    ranges = {"damping": DAMPING_RANGE, "max_condition": SOLVER_RANGES["max_condition"]}
-    for key, value in options.items():
-        number = key != "method"
-        if (number and (isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0)) or (
-                not number and not isinstance(value, str)):
-            raise SceneError(f"must be {'a positive number' if number else 'a string'}, got {value!r}",
-                             path=str(scene.path), key=f"rates.{key}")
-        if number and not ranges[key][0] <= value <= ranges[key][1]:
-            raise SceneError(f"rates.{key} = {value!r} is outside [{ranges[key][0]:g}, {ranges[key][1]:g}]",
-                             path=str(scene.path), key=f"rates.{key}")
-        if not number and value not in METHODS:  # a scene's misspelling, not an inconsistent task (8)
-            raise SceneError(f"must be one of {', '.join(METHODS)}, got {value!r}", path=str(scene.path),
-                             key="rates.method")
-    return dict(options)
-
-
 def analyse_task(scene: Scene) -> Analysis:
     """Set the pose (closing loops with the pose joints held), then solve the task's rates."""
     mechanism = load_mechanism(scene)
@@ -147,7 +90,7 @@ def analyse_task(scene: Scene) -> Analysis:
     tasks = scene_tasks(scene)
     _check_frames(scene, mechanism, tasks)
     check_scene_names(scene, mechanism)
-    rates = RateSolver(mechanism, tasks, **_rate_options(scene),
+    rates = RateSolver(mechanism, tasks, **scene.file.rates.options(),
                        tol=scene.solver_options().get("tol", DEFAULT_TOL))  # the q closed above, to this tol
     rs = rates.solve(q)
     accuracy = Accuracy(residual, iterations, rs.condition, rs.sigma_min,

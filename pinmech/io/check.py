@@ -14,7 +14,8 @@ A list of values goes with a vector path; a component (.x, .y, .z, .norm) takes 
 unit must measure the quantity's own kind (a declared `kind`, needed for a joint's q, v
 and a, must agree with it), and any key but these is refused as a typo.
 
-A printed value is an interval: "0.386" means [0.3855, 0.3865]. Verdicts:
+A printed value is an interval: "0.386" means [0.3855, 0.3865]. Verdicts::
+
     ok        within half a unit of the last printed digit: correctly rounded;
     rounding  within `slack` units: truncated, or carried rounding of the hand work's
               own rounded intermediate values; right at the printed precision;
@@ -23,7 +24,6 @@ A printed value is an interval: "0.386" means [0.3855, 0.3865]. Verdicts:
 
 from __future__ import annotations
 
-import difflib
 import math
 import re
 from dataclasses import dataclass
@@ -34,15 +34,13 @@ from typing import Any
 from pinmech.exceptions import SceneError, UnitError
 from pinmech.units import JOINT_KINDS, SI_UNITS, format_si, to_si
 
+from pinmech.io.hand_tables import HandEntry, HandTables
 from pinmech.toml_file import read_toml
 
 #: How many units of the last printed digit count as "rounding" rather than a mismatch,
 #: and the most a user may allow (more would call any value rounding).
 DEFAULT_SLACK = 2.0
 MAX_SLACK = 100.0
-#: The keys a hand file and each of its [[value]] tables may hold: any other is a typo.
-_FILE_KEYS = ("scene", "source", "value")
-_ENTRY_KEYS = ("label", "quantity", "hand", "unit", "kind")
 _COMPONENTS: dict[str, int | str] = {"x": 0, "y": 1, "z": 2, "norm": "norm"}
 _KINDS = {
     "position": "length",
@@ -127,47 +125,31 @@ def load_hand_file(path: str | Path) -> HandFile:
             a printed number, an unknown unit.
     """
     path = Path(path)
-    raw = read_toml(path, "hand-value", SceneError)
-    if not isinstance(raw.get("scene"), str):
-        raise SceneError("missing scene = \"scene.toml\"", path=str(path), key="scene")
-    _refuse_unknown_keys(raw, _FILE_KEYS, str(path), "")
-    entries = raw.get("value", [])
-    if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
-        raise SceneError("values must be tables: [[value]] with quantity, hand and unit", path=str(path), key="value")
-    if not entries:
-        raise SceneError("no [[value]] to check: a hand file lists at least one (quantity, hand, unit); "
-                         "an empty check would pass", path=str(path), key="value")
+    return hand_file(read_toml(path, "hand-value", SceneError), path)
+
+
+def hand_file(toml_tables: dict[str, Any], path: Path) -> HandFile:
+    """A hand file from its TOML tables as read (`path`: the file, for its scene and messages).
+
+    Raises:
+        SceneError: as `load_hand_file`.
+    """
+    tables = HandTables.read(toml_tables, path)
     values = []
-    for i, entry in enumerate(entries):
-        _refuse_unknown_keys(entry, _ENTRY_KEYS, str(path), f"value[{i}]")
+    for i, entry in enumerate(tables.value):
         values.extend(_hand_values(entry, f"value[{i}]", str(path)))
-    scene = (path.parent / raw["scene"]).resolve()
+    scene = (path.parent / tables.scene).resolve()
     if not scene.is_file():
-        raise SceneError(f"scene = {raw['scene']!r}: no such scene file ({scene})", path=str(path), key="scene")
-    return HandFile(path, scene, str(raw.get("source", "")), values)
+        raise SceneError(f"scene = {tables.scene!r}: no such scene file ({scene})", path=str(path), key="scene")
+    return HandFile(path, scene, tables.source, values)
 
 
-def _refuse_unknown_keys(table: dict[str, Any], known: tuple[str, ...], path: str, where: str) -> None:
-    """SceneError on a key that is not in `known` (a typo would otherwise check nothing),
-    suggesting the closest known key."""
-    for key in table:
-        if key not in known:
-            close = [f"[[{k}]]" if k == "value" else repr(k) for k in difflib.get_close_matches(key, known, n=1)]
-            hint = f" (did you mean {close[0]}?)" if close else ""
-            holds = "a [[value]] holds " + ", ".join(known) if where else "a hand file holds scene, source and [[value]]"
-            raise SceneError(f"unknown key {key!r}{hint}: {holds}", path=path, key=f"{where}.{key}" if where else key)
-
-
-def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue]:
-    for key in ("quantity", "hand", "unit"):
-        if key not in entry:
-            raise SceneError(f"missing {key}", path=path, key=where)
-    quantity = str(entry["quantity"])
-    hand = entry["hand"] if isinstance(entry["hand"], list) else [entry["hand"]]
-    if not 1 <= len(hand) <= 3:
-        raise SceneError(f"hand = {hand!r}: give one to three printed values", path=path, key=where)
+def _hand_values(entry: HandEntry, where: str, path: str) -> list[HandValue]:
+    """The printed values of one `[[value]]` (typed by hand_tables.py), checked against the
+    result's kinds: a path of the result, a unit of its kind, numbers as printed."""
+    quantity, hand = entry.quantity, list(entry.hand)
     base, component = _split_component(quantity)
-    declared = str(entry.get("kind", ""))
+    declared = entry.kind or ""
     if declared and declared not in SI_UNITS:
         raise SceneError(f"kind = {declared!r} is not one of {', '.join(SI_UNITS)}", path=path, key=where)
     if component == "norm" and len(hand) > 1:
@@ -178,17 +160,15 @@ def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue
     known, _ = _path_kind(base)
     if known == NUMBER:
         raise SceneError(f"{base!r} is a pure number of the solver (a sign, a count or a ratio, without unit), "
-                         f"not {_a(declared) if declared else 'a quantity'} with unit = {entry['unit']!r}: a hand "
+                         f"not {_a(declared) if declared else 'a quantity'} with unit = {entry.unit!r}: a hand "
                          "file checks lengths, angles, their rates, forces and torques", path=path, key=where)
     kind = known or declared
     if not kind:
         raise SceneError(f"cannot tell the kind of {base!r}: add kind = \"angle\" (or length, velocity, ...)",
                          path=path, key=where)
-    label = str(entry.get("label", quantity))
+    label = entry.label if entry.label is not None else quantity
     out = []
     for i, printed in enumerate(hand):
-        if not isinstance(printed, str):
-            raise SceneError(f"hand value {printed!r} must be a string as printed (e.g. \"0.386\")", path=path, key=where)
         try:
             exponent = Decimal(printed).as_tuple().exponent
             finite = math.isfinite(float(printed)) and isinstance(exponent, int) and -300 < exponent < 300
@@ -198,7 +178,7 @@ def _hand_values(entry: dict[str, Any], where: str, path: str) -> list[HandValue
             raise SceneError(f"hand value {printed!r} is not a finite number as printed", path=path, key=where)
         comp = component if component is not None else (i if len(hand) > 1 else None)
         suffix = "" if len(hand) == 1 else f" {'xyz'[i]}"
-        out.append(HandValue(label + suffix, base, comp, printed.strip(), str(entry["unit"]), kind, path, where))
+        out.append(HandValue(label + suffix, base, comp, printed.strip(), entry.unit, kind, path, where))
     unit = out[0].unit
     if not unit.strip() or re.search(r"^\s*[-+.\d]|,", unit):
         raise SceneError(f"unit = {unit!r} is not a unit (e.g. \"m/s\", \"deg\")", path=path, key=f"{where}.unit")

@@ -1,19 +1,6 @@
-"""A scene's `[forces]`, `[gravity]` and `[[load]]` tables, parsed once into typed settings.
-
-    [forces]                          # optional; any of these three tables turns forces on
-    massless = ["slider_pin"]         # links meant to have no mass (else: an error naming them)
-    static = false                    # true: zero speeds and accelerations (statics)
-    minimum_norm = false              # redundant loops: the smallest reactions, not an error
-    flywheel = "0.05 kg*m^2"          # sweeps: the coefficient of speed fluctuation with it
-
-    [gravity]                         # default: no gravity (kinematics-only scenes)
-    acceleration = "9.81 m/s^2"
-    direction = [0, -1, 0]            # world frame, any length
-
-    [[load]]                          # an external load, constant in the world frame
-    point = "B_pin"                   # a named point (or link = "piston": its frame origin)
-    force = ["-200 N", "0 N"]         # x, y (, z) with units
-    torque = "0.5 N*m"                # on the point's link; one value: about the plane normal
+"""A scene's force analysis: its `[forces]`, `[gravity]` and `[[load]]` tables (typed in
+force_tables.py) gathered into ForceSettings, the loads found in the model, the forces
+solved at a pose.
 """
 
 from __future__ import annotations
@@ -23,29 +10,13 @@ from typing import Any
 
 import numpy as np
 
-from pinmech.directions import unit_vector, written
 from pinmech.exceptions import FrameNotFound, SceneError
-from pinmech.solve.forces import ForceSolver, Load, advantage_unit, mechanical_advantage
-from pinmech.model.mechanism import Mechanism
+from pinmech.io.force_tables import ForcesSpec, LoadSpec
 from pinmech.io.scene import Scene
+from pinmech.model.mechanism import Mechanism
+from pinmech.solve.forces import ForceSolver, Load, advantage_unit, mechanical_advantage
 
-_FORCES_KEYS = {"massless", "static", "minimum_norm", "flywheel"}
-_LOAD_KEYS = {"name", "point", "link", "force", "torque"}
-
-
-@dataclass(frozen=True)
-class LoadSpec:
-    """A `[[load]]` entry in SI: where (a point or link name), force [N], torque [N m].
-
-    `torque_about_normal` is a single torque [N m] about the plane normal (None when the
-    torque was given as a vector)."""
-
-    name: str
-    at: str
-    key: str
-    force: np.ndarray
-    torque: np.ndarray
-    torque_about_normal: float | None
+__all__ = ["ForceSettings", "LoadSpec", "analyse_forces", "build_loads", "force_settings", "force_solver"]
 
 
 @dataclass(frozen=True)
@@ -61,102 +32,17 @@ class ForceSettings:
 
 
 def force_settings(scene: Scene) -> ForceSettings:
-    """The scene's force tables, checked (keys, types, units).
-
-    Raises:
-        SceneError: unknown keys, wrong types; UnitError: a quantity of the wrong kind
-            (a force given in N*m).
-    """
-    table = scene.section("forces")
-    where = str(scene.path)
-    unknown = set(table) - _FORCES_KEYS
-    if unknown:
-        raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_FORCES_KEYS))}",
-                         path=where, key="forces")
-    for key in ("static", "minimum_norm"):
-        if key in table and not isinstance(table[key], bool):
-            raise SceneError(f"must be true or false, got {table[key]!r}", path=where, key=f"forces.{key}")
-    flywheel = table.get("flywheel")
-    if flywheel is not None:
-        flywheel = scene.quantity(flywheel, "moment_of_inertia", "forces", "flywheel")
-        if not flywheel > 0:
-            raise SceneError(f"must be positive, got {table['flywheel']!r}", path=where, key="forces.flywheel")
+    """The scene's force tables (validated when the scene was read) as ForceSettings."""
+    tables = scene.file
+    forces = tables.forces or ForcesSpec()
     return ForceSettings(
-        gravity=_gravity(scene),
-        loads=tuple(_load(scene, i, entry) for i, entry in enumerate(_load_entries(scene))),
-        massless=tuple(scene.names("forces", "massless") or ()),
-        static=bool(table.get("static", False)),
-        minimum_norm=bool(table.get("minimum_norm", False)),
-        flywheel=flywheel,
+        gravity=np.zeros(3) if tables.gravity is None else tables.gravity.vector,
+        loads=tables.load or (),
+        massless=forces.massless,
+        static=forces.static,
+        minimum_norm=forces.minimum_norm,
+        flywheel=forces.flywheel,
     )
-
-
-def _gravity(scene: Scene) -> np.ndarray:
-    table = scene.section("gravity")
-    if not table:
-        return np.zeros(3)
-    where = str(scene.path)
-    unknown = set(table) - {"acceleration", "direction"}
-    if unknown or "acceleration" not in table or "direction" not in table:
-        raise SceneError("give acceleration = \"9.81 m/s^2\" and direction = [0, -1, 0] (world frame)",
-                         path=where, key="gravity")
-    size = scene.quantity(table["acceleration"], "acceleration", "gravity", "acceleration")
-    direction = unit_vector(_numbers(table["direction"], where, "gravity.direction"))
-    if direction is None:
-        raise SceneError(f"{written(table['direction'])} is not a direction (all zero)", path=where,
-                         key="gravity.direction")
-    return size * direction
-
-
-def _numbers(value: Any, where: str, key: str) -> np.ndarray:
-    ok = isinstance(value, list) and len(value) == 3 and all(
-        isinstance(x, (int, float)) and not isinstance(x, bool) for x in value)
-    if not ok or not np.all(np.isfinite(value)):
-        raise SceneError(f"must be three numbers [x, y, z], got {value!r}", path=where, key=key)
-    return np.array(value, dtype=float)
-
-
-def _load_entries(scene: Scene) -> list[dict[str, Any]]:
-    entries = scene.raw.get("load", [])
-    if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
-        raise SceneError("write each load as a [[load]] table", path=str(scene.path), key="load")
-    return entries
-
-
-def _load(scene: Scene, index: int, entry: dict[str, Any]) -> LoadSpec:
-    key = f"load[{index}]"
-    where = str(scene.path)
-    unknown = set(entry) - _LOAD_KEYS
-    if unknown:
-        raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_LOAD_KEYS))}",
-                         path=where, key=key)
-    places = [k for k in ("point", "link") if k in entry]
-    if len(places) != 1 or not isinstance(entry[places[0]], str):
-        raise SceneError("say where the load acts: point = \"NAME\" (a named point) or link = \"NAME\"",
-                         path=where, key=key)
-    if "force" not in entry and "torque" not in entry:
-        raise SceneError("give a force = [\"x N\", \"y N\"] and/or a torque = \"T N*m\"", path=where, key=key)
-    force = _vector(scene, entry.get("force", [0, 0, 0]), "force", key)
-    torque_value = entry.get("torque", [0, 0, 0])
-    about_normal = None
-    if isinstance(torque_value, (str, int, float)) and not isinstance(torque_value, bool):
-        about_normal = scene.quantity(torque_value, "torque", key, "torque")
-        torque = np.zeros(3)
-    else:
-        torque = _vector(scene, torque_value, "torque", key)
-    name = str(entry.get("name", entry[places[0]]))
-    return LoadSpec(name, entry[places[0]], places[0], force, torque, about_normal)
-
-
-def _vector(scene: Scene, value: Any, kind: str, key: str) -> np.ndarray:
-    """Two or three quantities with units ("-200 N", "0 N"), world frame, in SI."""
-    if not isinstance(value, list) or len(value) not in (2, 3):
-        raise SceneError(f"{kind} must be a list of 2 or 3 quantities, e.g. [\"-200 N\", \"0 N\"], got {value!r}",
-                         path=str(scene.path), key=f"{key}.{kind}")
-    out = np.zeros(3)
-    for i, item in enumerate(value):
-        out[i] = scene.quantity(item, kind, key, f"{kind}[{i}]")
-    return out
 
 
 def build_loads(settings: ForceSettings, mechanism: Mechanism, scene: Scene) -> list[Load]:
@@ -182,7 +68,7 @@ def build_loads(settings: ForceSettings, mechanism: Mechanism, scene: Scene) -> 
                 raise SceneError("torque = one value needs a planar mechanism; give [x, y, z] with units",
                                  path=str(scene.path), key=f"load {spec.name}")
             torque = spec.torque_about_normal * mechanism.plane_normal
-        loads.append(Load(spec.name, frame, spec.force, torque))
+        loads.append(Load(spec.name, frame, np.array(spec.force), np.array(torque)))
     return loads
 
 

@@ -123,7 +123,7 @@ def assembly_dict(analysis: Analysis) -> dict[str, Any]:
 
 
 def _pinned(analysis: Analysis) -> bool:
-    return bool(analysis.scene.section("guess")) or "assembly" in analysis.scene.raw
+    return bool(analysis.scene.file.guess) or analysis.scene.file.assembly is not None
 
 
 def to_json(analysis: Analysis) -> str:
@@ -279,7 +279,7 @@ def _assembly_lines(t: _Text, analysis: Analysis) -> None:
 
 def _closed_from(analysis: Analysis) -> str:
     """Where the loops of the scene's own pose were closed from."""
-    if analysis.scene.section("guess"):
+    if analysis.scene.file.guess:
         return "its [guess]"
     if analysis.mechanism.reference is not None:
         return "the pose as drawn (the model file's)"

@@ -85,7 +85,7 @@ def _sense(mech, data: pin.Data, joint, v: float) -> str:
 def loads(analysis: Analysis) -> list[str]:
     """Gravity and the scene's loads, or that the scene asks no forces."""
     scene = analysis.scene
-    if not any(scene.section(k) for k in ("forces", "gravity")) and "load" not in scene.raw:
+    if not scene.file.wants_forces:
         return ["none: a kinematic analysis (no [forces], [gravity] or [[load]] in the scene)"]
     from pinmech.io.forces_scene import force_settings
 
@@ -104,7 +104,7 @@ def assumptions(analysis: Analysis) -> list[str]:
     out = ["rigid links; ideal joints (no clearance, no friction, no elasticity)",
            "the drivers' speeds and accelerations as given, at this one pose",
            "angles and rates counter-clockwise positive about the plane's normal; vectors in the world frame, SI"]
-    if "load" in analysis.scene.raw or analysis.scene.section("gravity") or analysis.scene.section("forces"):
+    if analysis.scene.file.wants_forces:
         out.append("masses and inertias from the model (links listed massless in [forces] excepted)")
     return out
 

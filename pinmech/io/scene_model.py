@@ -19,6 +19,7 @@ from pinmech.exceptions import FrameNotFound, MobilityError, ModelError, Pinmech
 from pinmech.model.mechanism import Mechanism, urdf_joint_types, urdf_mimic_leaders
 from pinmech.solve.motion import CoincidentPoint
 from pinmech.io.scene import Scene
+from pinmech.io.scene_tables import DriverSpec
 from pinmech.solve.loops import LoopSolver
 
 
@@ -38,13 +39,13 @@ def load_mechanism(scene: Scene) -> Mechanism:
     kind = scene.model_kind
     path = scene.urdf if kind in ("urdf", "robot") else scene.model_file(kind)
     if not path.is_file():
-        raise ModelError(f"the scene's {kind} = \"{scene.raw[kind]}\" is not a file", path=str(scene.path))
+        raise ModelError(f"the scene's {kind} = \"{getattr(scene.file, kind)}\" is not a file", path=str(scene.path))
     loader = _model_loader(scene, kind, path)
     types = loader.joint_types()
     locked = {}
-    for name, value in scene.section("lock").items():
+    for name, value in scene.file.lock.items():
         locked[name] = scene.quantity(value, _kind(types, name), "lock", name)
-    if "move" in scene.raw:
+    if scene.file.move is not None:
         locked.update(_locked_by_move(scene, types, locked))
     try:
         mechanism = loader.load(locked)
@@ -82,7 +83,7 @@ def _model_loader(scene: Scene, kind: str, path) -> _Loader:
         from pinmech.model.mjcf import load_mjcf, mjcf_joint_types
 
         return _Loader(lambda: mjcf_joint_types(path), lambda locked: load_mjcf(path, locked=locked))
-    if "sidecar" in scene.raw:
+    if scene.file.sidecar is not None:
         from pinmech.model.sidecar import load_extended_urdf
 
         sidecar = scene.model_file("sidecar")
@@ -97,17 +98,12 @@ def _kind(types: dict[str, str], name: str) -> str:
 
 def _locked_by_move(scene: Scene, types: dict[str, str], locked: dict[str, float]) -> dict[str, float]:
     """`move = [...]`: every other one-dof joint is locked at its `[pose]` value (else 0)."""
-    move = scene.raw["move"]
-    if not isinstance(move, list) or not all(isinstance(n, str) for n in move):
-        raise SceneError("move must be a list of joint names", path=str(scene.path), key="move")
+    move = scene.file.move
     movable = [n for n, t in types.items() if t in ("revolute", "continuous", "prismatic")]
-    if not move:
-        raise SceneError("move = [] leaves no joint to move: name the joints the scene moves",
-                         path=str(scene.path), key="move")
     for name in move:
         if name not in movable:
             raise FrameNotFound("joint (in move)", name, movable, path=str(scene.path))
-    pose = scene.section("pose")
+    pose = scene.file.pose
     leaders = urdf_mimic_leaders(scene.urdf)  # a <mimic> follower goes with its leader, moved or locked
     return {
         name: scene.quantity(pose[name], _kind(types, name), "pose", name) if name in pose else 0.0
@@ -129,7 +125,7 @@ def scene_drivers(scene: Scene, mechanism: Mechanism) -> Drivers:
     """The `[drivers]` table in SI units, checked against the model's joints. A sidecar's
     motors (robot.yaml's name_mot) drive a scene whose file has no `[drivers]`, at the
     reference pose and at rest; a `--set` on some of them keeps the others so."""
-    table = scene.driver_table()
+    table = scene.file.drivers
     rows = _default_motors(scene, mechanism, table)
     for name, spec in table.items():
         rows[name] = _driver_row(scene, mechanism, name, spec)
@@ -151,7 +147,7 @@ def _held_note(scene: Scene, mechanism: Mechanism) -> str:
     """" once [lock] holds O4" where the scene's locks took freedoms away (else "")."""
     if not mechanism.locked:
         return ""
-    by = "[lock] and move" if "move" in scene.raw else "[lock]"
+    by = "[lock] and move" if scene.file.move is not None else "[lock]"
     return f" once {by} holds {', '.join(mechanism.locked)}"
 
 
@@ -167,10 +163,10 @@ def _lock_lines(mechanism: Mechanism, names: list[str]) -> str:
 
 
 def _file_has_drivers(scene: Scene) -> bool:
-    return bool((scene.raw if scene.base is None else scene.base).get("drivers"))
+    return bool(scene.file.drivers if scene.file_drivers is None else scene.file_drivers)
 
 
-def _default_motors(scene: Scene, mechanism: Mechanism, table: dict[str, Any]) -> dict[str, list[float]]:
+def _default_motors(scene: Scene, mechanism: Mechanism, table: dict[str, DriverSpec]) -> dict[str, list[float]]:
     """The sidecar's motors at the reference pose, at rest [rad or m], that drive besides
     the table: all of them when the scene file has no `[drivers]` and the table (from
     `--set`) names motors only; none otherwise."""
@@ -181,7 +177,7 @@ def _default_motors(scene: Scene, mechanism: Mechanism, table: dict[str, Any]) -
     return {name: [mechanism.coordinate(reference, name), 0.0, 0.0] for name in motors}
 
 
-def _driver_row(scene: Scene, mechanism: Mechanism, name: str, spec: dict[str, Any]) -> list[float]:
+def _driver_row(scene: Scene, mechanism: Mechanism, name: str, spec: DriverSpec) -> list[float]:
     """One `[drivers.NAME]` table as [q, v, a] in SI."""
     if name in mechanism.locked:
         raise SceneError(f"joint '{name}' is both driven and locked", path=str(scene.path), key=f"drivers.{name}")
@@ -191,15 +187,8 @@ def _driver_row(scene: Scene, mechanism: Mechanism, name: str, spec: dict[str, A
         raise SceneError(f"joint '{name}' follows '{leader}' (URDF <mimic>): drive {leader} instead",
                          path=str(scene.path), key=f"drivers.{name}")
     row = [0.0, 0.0, 0.0]
-    given = [False, False, False]
-    for key, value in spec.items():
-        order = Scene.driver_order(key)
-        if given[order]:
-            raise SceneError(f"{key} repeats another key of the same order", path=str(scene.path), key=f"drivers.{name}")
+    for key, order, value in spec.given():
         row[order] = scene.joint_quantity(value, joint.kind, order, "drivers", name, key)
-        given[order] = True
-    if not given[0]:
-        raise SceneError("missing its angle (or position)", path=str(scene.path), key=f"drivers.{name}")
     return row
 
 
@@ -229,12 +218,12 @@ def _still_free(mechanism: Mechanism, names: list[str]) -> str:
             f"spinning about its own axis): {advice}")
 
 
-def _motors_note(scene: Scene, mechanism: Mechanism, table: dict[str, Any]) -> str:
+def _motors_note(scene: Scene, mechanism: Mechanism, table: dict[str, DriverSpec]) -> str:
     """Why a sidecar's motors are not among the drivers, when the scene file names none."""
     if not mechanism.motors or _file_has_drivers(scene) or set(table) <= set(mechanism.motors):
         return ""
     others = ", ".join(n for n in table if n not in mechanism.motors)
-    return (f" ({Path(scene.raw['sidecar']).name}'s motors {', '.join(mechanism.motors)} drive a scene without "
+    return (f" ({Path(scene.file.sidecar).name}'s motors {', '.join(mechanism.motors)} drive a scene without "
             f"[drivers], and a --set on one of them keeps the others; {others} is not a motor, so the drivers "
             "are the ones set)")
 
@@ -242,7 +231,7 @@ def _motors_note(scene: Scene, mechanism: Mechanism, table: dict[str, Any]) -> s
 def scene_guess(scene: Scene, mechanism: Mechanism) -> np.ndarray:
     """Starting configuration from `[guess]`: it picks the assembly branch."""
     q = mechanism.neutral()
-    for name, value in scene.section("guess").items():
+    for name, value in scene.file.guess.items():
         joint = _scene_joint(scene, mechanism, name, "guess")
         if name in mechanism.mimics:
             leader = mechanism.mimics[name].leader
@@ -270,12 +259,12 @@ def scene_solver(scene: Scene, mechanism: Mechanism, drivers: Drivers) -> LoopSo
         ref_drivers = drivers
     if ref_drivers.names != drivers.names:
         ref_drivers = drivers
-    asked = scene.assembly()
+    asked = scene.file.assembly
     try:
         assembly = "keep" if asked is None else parse_assembly(asked, solver.structure) or "any"
     except ValueError as exc:
         raise SceneError(str(exc), path=str(scene.path), key="assembly") from None
-    if mechanism.reference is not None and not scene.section("guess"):
+    if mechanism.reference is not None and not scene.file.guess:
         # a drawn linkage, an MJCF file at qpos0: the pose as drawn is the reference assembly
         drawn = [mechanism.coordinate(mechanism.reference, name) for name in drivers.names]
         solver.set_reference(drawn, mechanism.neutral(), assembly)
@@ -286,15 +275,7 @@ def scene_solver(scene: Scene, mechanism: Mechanism, drivers: Drivers) -> LoopSo
 
 def coincident_points(scene: Scene) -> list[CoincidentPoint]:
     """`[points.NAME] at = "B", link = "link3"`: points of a link under another point."""
-    out = []
-    for name, spec in scene.section("points").items():
-        if not isinstance(spec, dict) or set(spec) != {"at", "link"}:
-            raise SceneError("a point needs exactly at = \"POINT\" (the point of LINK under it) or at = [x, y, z] "
-                             "(coordinates in LINK's frame, with units), and link = \"LINK\"",
-                             path=str(scene.path), key=f"points.{name}")
-        if not isinstance(spec["at"], list):
-            out.append(CoincidentPoint(name, str(spec["at"]), str(spec["link"])))
-    return out
+    return [CoincidentPoint(name, spec.at, spec.link) for name, spec in scene.file.points.items() if spec.coincident]
 
 
 def add_scene_points(scene: Scene, mechanism: Mechanism) -> None:
@@ -303,43 +284,28 @@ def add_scene_points(scene: Scene, mechanism: Mechanism) -> None:
     The coordinates are in the link's frame (for a drawn linkage: origin on its parent
     joint, x from its first listed point to the next). Adds the point to the mechanism.
     """
-    for name, spec in scene.section("points").items():
-        if not isinstance(spec, dict) or not isinstance(spec.get("at"), list):
+    for name, spec in scene.file.points.items():
+        if spec.coincident:
             continue
         key = f"points.{name}"
-        at = spec["at"]
-        if len(at) != 3:
-            raise SceneError(f"at = {at!r} must be three coordinates [x, y, z] with units", path=str(scene.path),
-                             key=key)
-        xyz = [scene.quantity(value, "length", "points", name, "at") for value in at]
-        link = str(spec["link"])
+        link = spec.link
         if link not in mechanism.links:
             raise FrameNotFound(f"link (in [points.{name}])", link, list(mechanism.links), path=str(scene.path))
         if name in mechanism.points or mechanism.model.existFrame(name):
             raise SceneError(f"the model already has a frame called '{name}': name the point otherwise",
                              path=str(scene.path), key=key)
-        mechanism.add_point(name, link, np.array(xyz))
+        mechanism.add_point(name, link, np.array(spec.xyz))
 
 
 def report_lists(scene: Scene) -> tuple[list[str] | None, list[str] | None]:
     """Points and links the scene asks to report (None: all)."""
-    report = scene.section("report")
-    unknown = set(report) - {"points", "links", "limits"}
-    if unknown:
-        raise SceneError(f"unknown key(s) {', '.join(sorted(unknown))} in [report]; known: points, links, limits",
-                         path=str(scene.path), key="report")
-    limit_mode(scene)  # a misspelt value is refused by every command, not only by those that warn
-    return scene.names("report", "points"), scene.names("report", "links")
+    return scene.file.report.points, scene.file.report.links
 
 
 def limit_mode(scene: Scene, asked: str | None = None) -> str:
     """What a joint beyond its URDF limits is: "warn" (default) or "error"; `asked` (the
     command line's --limits) overrides the scene's `[report] limits`."""
-    mode = scene.section("report").get("limits", "warn")  # the scene's value checked even when overridden
-    if mode not in ("warn", "error"):
-        raise SceneError(f"limits must be \"warn\" or \"error\", got {mode!r}", path=str(scene.path),
-                         key="report.limits")
-    return asked or mode
+    return asked or scene.file.report.limits
 
 
 def check_scene_names(scene: Scene, mechanism: Mechanism) -> None:

@@ -5,17 +5,7 @@ previous one, so the sweep stays on the assembly branch it started on (solve_cyc
 how, and the accuracy choices). Poses are produced lazily, a chunk at a time, so a sweep
 of a million poses streams to a CSV file in bounded memory.
 
-Scene keys, all optional:
-
-    [sweep]
-    links = ["link3"]         # what --plot draws (default: every moving link ...)
-    points = ["D"]            # ... and every moving point)
-    steps = 361               # poses, both ends included
-    from = "0 deg"            # first value (default: the scene's)
-    to = "360 deg"            # last value (default: one turn on, or one mechanism size)
-    start = "predictor"       # or "warm", "cold" (see solve_cycle.py)
-    batch = true              # batched poses between exact ones on dense sweeps
-    interpolate = 1           # > 1: every n-th pose solved, the others interpolated
+The scene's `[sweep]` table (its keys, typed) is sweep_table.py's.
 """
 
 from __future__ import annotations
@@ -42,13 +32,8 @@ from pinmech.io.scene_model import (
     scene_drivers,
     scene_solver,
 )
-from pinmech.solve.cycle import STARTS, RangeChunk, solve_range
+from pinmech.solve.cycle import RangeChunk, solve_range
 from pinmech.solve.loops import LoopSolver
-
-#: The `[sweep]` keys and their types.
-SWEEP_KEYS = {"links": list, "points": list, "steps": int, "from": str, "to": str, "start": str,
-              "batch": bool, "interpolate": int, "duration": str, "step": str, "scheme": str, "gain": (int, float)}
-
 
 @dataclass(frozen=True)
 class SweepPose:
@@ -112,42 +97,8 @@ class DriverValues(Sequence):
 
 
 def sweep_options(scene: Scene) -> dict[str, Any]:
-    """The scene's `[sweep]` table, checked (names and types)."""
-    table = scene.section("sweep")
-    for key, value in table.items():
-        kind = SWEEP_KEYS.get(key)
-        if kind is None:
-            raise SceneError(f"unknown key {key}; known: {', '.join(SWEEP_KEYS)}", path=str(scene.path),
-                             key=f"sweep.{key}")
-        if not isinstance(value, kind) or (kind is int and isinstance(value, bool)):
-            raise SceneError(f"must be {getattr(kind, '__name__', 'a number')}, got {value!r}",
-                             path=str(scene.path), key=f"sweep.{key}")
-    if "start" in table and table["start"] not in STARTS:
-        raise SceneError(f"must be one of {', '.join(STARTS)}, got {table['start']!r}", path=str(scene.path),
-                         key="sweep.start")
-    _check_ranges(scene, table)
-    return table
-
-
-#: The `[sweep]` numbers' ranges: the least value, and what it counts.
-_LEAST = {"steps": (2, "poses, both ends included"), "interpolate": (1, "(1: every pose solved)")}
-
-
-def _check_ranges(scene: Scene, table: dict[str, Any]) -> None:
-    """`[sweep]` values in range, blamed on the file and key (not on the flags that
-    would override them): steps >= 2, interpolate >= 1, a known scheme, a gain >= 0."""
-    from pinmech.solve.path import SCHEMES  # here: sweeping needs no path integration
-
-    def bad(key: str, message: str) -> SceneError:
-        return SceneError(message, path=str(scene.path), key=f"sweep.{key}")
-
-    for key, (least, what) in _LEAST.items():
-        if key in table and table[key] < least:
-            raise bad(key, f"must be at least {least} {what}, got {table[key]}")
-    if "scheme" in table and table["scheme"] not in SCHEMES:
-        raise bad("scheme", f"must be one of {', '.join(SCHEMES)}, got {table['scheme']!r}")
-    if "gain" in table and not 0 <= table["gain"] < math.inf:
-        raise bad("gain", f"must be a number from 0 (open loop) up, in 1/s, got {table['gain']!r}")
+    """The `[sweep]` keys the scene gives (validated when it was read), by their names in the file."""
+    return scene.file.sweep.given()
 
 
 def _no_drivers(mechanism: Mechanism, arm_pose: bool = False) -> str:
@@ -183,22 +134,22 @@ class Sweep:
 
     @classmethod
     def from_scene(cls, scene: Scene, driver: str | None = None) -> Sweep:
-        """Raises:
+        """The sweep of a scene's driver (its only one unless `driver` names one).
+
+        Raises:
             SceneError: a scene without drivers (a task scene is followed in time by
                 `pinmech path`), or a driver that is not one of the scene's.
         """
         instance_of(scene, Scene, "Sweep.from_scene's scene")
-        sweep_options(scene)
-        if "task" in scene.raw:
+        if scene.is_task:
             raise SceneError("has no [drivers] to sweep; a task scene ([[task]]) is followed in time: "
                              "pinmech path SCENE --duration ... (pinmech animate SCENE --duration ... "
                              "animates it)", path=str(scene.path), key="drivers")
         mechanism = load_mechanism(scene)
-        if not scene.section("drivers"):
-            raise SceneError(_no_drivers(mechanism, "pose" in scene.raw), path=str(scene.path), key="drivers")
+        if not scene.file.drivers:
+            raise SceneError(_no_drivers(mechanism, bool(scene.file.pose)), path=str(scene.path), key="drivers")
         drivers = scene_drivers(scene, mechanism)
         check_scene_names(scene, mechanism)
-        scene.names("sweep", "links"), scene.names("sweep", "points")  # lists of names, or a SceneError now
         name = driver or drivers.names[0]
         if name not in drivers.names:
             raise SceneError(f"'{name}' is not a driver of the scene ({', '.join(drivers.names)})",

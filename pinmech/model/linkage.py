@@ -8,7 +8,7 @@ and validates the file once into a `LinkageSpec`; this module turns a spec into 
 split into pairs); `pinmech.model.linkage_urdf` picks a spanning tree (breadth first from
 the ground), turns every other joint into one loop cut and writes the URDF, whose
 reference configuration is the drawn pose; `load_linkage` makes the Mechanism. See the
-README section "Linkages as drawn" for the format.
+docs page docs/howto/linkage_toml.md for the format.
 
 Conventions of the generated URDF (all in the plane z = 0, axes along z):
   * every link's frame sits on its parent joint, its x axis from the first point the link

@@ -1,0 +1,84 @@
+"""A command's scene, read from its arguments (`--set`, `--angle` shortcuts), and options
+that fall back on the scene's `[sweep]` values, each error blaming the flag or the key written."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any, NamedTuple
+
+from pinmech.exceptions import PinmechError, SceneError
+
+
+def given_text(value: str | None, option: str) -> str | None:
+    """An option's text, None where it was not given; an empty one (an unset shell
+    variable) is an error, never the scene's own value in silence."""
+    if value is not None and not value.strip():
+        from pinmech.exceptions import UnitError
+
+        raise UnitError(f"{option} is empty: give a quantity such as '30 deg' (or leave the option out)")
+    return value
+
+
+class Option(NamedTuple):
+    """An option's value and where it came from: its flag, or the scene's `[sweep]` key
+    (`key` set), so that an error blames the one the user wrote."""
+
+    value: Any
+    flag: str
+    key: str | None
+    scene: Any
+
+    @property
+    def name(self) -> str:
+        """How the user wrote it: "--steps", or "sweep.steps"."""
+        return self.key or self.flag
+
+    @property
+    def where(self) -> str:
+        """Where the user wrote it, for a message: "--steps", or "scene.toml: [sweep] steps"."""
+        if self.key is None:
+            return self.flag
+        return f"{self.scene.path}: [sweep] {self.key.removeprefix('sweep.')}"
+
+    def error(self, message: str) -> PinmechError:
+        """A usage error naming the flag (exit 2), or a scene error naming the file and key (4)."""
+        if self.key is None:
+            return PinmechError(f"{self.flag} {message}")
+        return SceneError(message, path=str(self.scene.path), key=self.key)
+
+    def quantity(self, kind: str) -> float:
+        """The value in SI; a unit error names the flag, or the file and key."""
+        if self.key is None:
+            from pinmech.units import to_si
+
+            return to_si(self.value, kind, where=self.flag)
+        return self.scene.quantity(self.value, kind, self.key)
+
+
+def option_or_scene(given: Any, flag: str, scene, options: dict[str, Any], key: str, default: Any = None) -> Option:
+    """A flag's value if given, else the scene's `[sweep] key`, else `default`."""
+    if given is not None:
+        return Option(given, flag, None, scene)
+    if key in options:
+        return Option(options[key], flag, f"sweep.{key}", scene)
+    return Option(default, flag, None, scene)
+
+
+def scene_from_args(args: argparse.Namespace):
+    from pinmech.io.scene import Scene
+
+    overrides = list(args.overrides)
+    shortcuts = {"angle": args.angle, "speed": args.speed, "acceleration": args.acceleration}
+    for key, value in shortcuts.items():
+        given_text(value, f"--{key}")
+    if any(shortcuts.values()):
+        scene = Scene.load(args.scene)
+        drivers = list(scene.file.drivers)
+        if len(drivers) != 1:
+            raise PinmechError(f"--angle/--speed/--acceleration need a single driver; {args.scene} has "
+                               f"{len(drivers)}: use --set drivers.NAME.angle=...")
+        name = drivers[0]
+        spec = scene.file.drivers[name]
+        keys = {"angle": spec.key_of(0), "speed": spec.key_of(1), "acceleration": "acceleration"}
+        overrides += [f'drivers.{name}.{keys[k]}="{v}"' for k, v in shortcuts.items() if v]
+    return Scene.load(args.scene, overrides)

@@ -1,0 +1,104 @@
+"""A scene's `[sweep]` table, typed and validated once (what `pinmech sweep`, `path` and
+`animate` read when no flag overrides it):
+
+    [sweep]
+    links = ["link3"]         # what --plot draws (default: every moving link ...)
+    points = ["D"]            # ... and every moving point)
+    steps = 361               # poses, both ends included (at least 2)
+    from = "0 deg"            # first value (default: the scene's)
+    to = "360 deg"            # last value (default: one turn on, or one mechanism size)
+    start = "predictor"       # or "warm", "cold" (see solve/cycle.py)
+    batch = true              # batched poses between exact ones on dense sweeps
+    interpolate = 1           # > 1: every n-th pose solved, the others interpolated
+    duration = "0.08 s"       # a task scene followed in time: how long,
+    step = "1 ms"             # its time step,
+    scheme = "taylor"         # its integration scheme (euler, taylor, rk4)
+    gain = 0                  # and its feedback on the drift [1/s]
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from pydantic import Field, field_validator, model_validator
+
+from pinmech.io.scene_fields import Refused, Table, names, positive_quantity, written_value
+
+#: The `[sweep]` keys and their types.
+SWEEP_KEYS = {"links": list, "points": list, "steps": int, "from": str, "to": str, "start": str,
+              "batch": bool, "interpolate": int, "duration": str, "step": str, "scheme": str, "gain": (int, float)}
+#: The `[sweep]` numbers' ranges: the least value, and what it counts.
+_LEAST = {"steps": (2, "poses, both ends included"), "interpolate": (1, "(1: every pose solved)")}
+
+
+class SweepSpec(Table):
+    """`[sweep]`: each key None where the scene does not give it (the command's default then).
+
+    Driver values (`from`, `to`) stay as written: their unit is the swept joint's."""
+
+    links: list[str] | None = None
+    points: list[str] | None = None
+    steps: int | None = None
+    first: str | None = Field(None, alias="from")
+    last: str | None = Field(None, alias="to")
+    start: str | None = None
+    batch: bool | None = None
+    interpolate: int | None = None
+    duration: str | None = None
+    step: str | None = None
+    scheme: str | None = None
+    gain: float | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _known_keys(cls, data: Any) -> Any:
+        if not isinstance(data, dict):
+            raise Refused(f"[sweep] must be a table, got {data!r}")
+        for key, value in data.items():
+            kind = SWEEP_KEYS.get(key)
+            if kind is None:
+                raise Refused(f"unknown key {key}; known: {', '.join(SWEEP_KEYS)}", at=(key,))
+            if not isinstance(value, kind) or (kind is int and isinstance(value, bool)):
+                raise Refused(f"must be {getattr(kind, '__name__', 'a number')}, got {value!r}", at=(key,))
+            if key in _LEAST and value < _LEAST[key][0]:
+                raise Refused(f"must be at least {_LEAST[key][0]} {_LEAST[key][1]}, got {value}", at=(key,))
+        return {k: (float(v) if k == "gain" else v) for k, v in data.items()}
+
+    @field_validator("links", "points", mode="before")
+    @classmethod
+    def _names(cls, value: Any) -> list[str] | None:
+        return names(value)
+
+    @field_validator("start", "scheme")
+    @classmethod
+    def _one_of(cls, value: str, info) -> str:
+        from pinmech.solve.cycle import STARTS
+        from pinmech.solve.path import SCHEMES  # here: sweeping needs no path integration
+
+        choices = STARTS if info.field_name == "start" else SCHEMES
+        if value not in choices:
+            raise Refused(f"must be one of {', '.join(choices)}, got {value!r}")
+        return value
+
+    @field_validator("gain")
+    @classmethod
+    def _gain(cls, value: float) -> float:
+        if not 0 <= value < math.inf:
+            raise Refused(f"must be a number from 0 (open loop) up, in 1/s, got {value!r}")
+        return value
+
+    @field_validator("first", "last")
+    @classmethod
+    def _driver_value(cls, value: str) -> str:
+        return written_value(value)
+
+    @field_validator("duration", "step")
+    @classmethod
+    def _time(cls, value: str) -> str:
+        positive_quantity(value, "time", "a positive time")
+        return value
+
+    def given(self) -> dict[str, Any]:
+        """The keys the scene gives, by their names in the file ("from", "steps", ...)."""
+        return self.model_dump(by_alias=True, exclude_none=True)
