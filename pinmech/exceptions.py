@@ -333,3 +333,4 @@ class MissingTool(PinmechError):
         super().__init__(message)
         self.tool = tool
         self.option = option
+

@@ -48,7 +48,8 @@ def test_a_tolerance_study_counts_every_variant(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("edit, code, message", [
-    (("kind = \"tolerance\"", "kind = \"workspace\""), 4, "kind: kind = 'workspace' is not one of sensitivity, tolerance, grid"),
+    (("kind = \"tolerance\"", "kind = \"orbit\""), 4, "kind: kind = 'orbit' is not one of sensitivity, tolerance, grid, workspace"),
+    (("kind = \"tolerance\"", "kind = \"workspace\""), 4, "unknown key(s) outputs, params, samples, seed, steps; known: batch"),
     (("tolerance = \"0.1 mm\"\n", "tolerance = \"-0.1 mm\"\n"), 4, "params.crank.tolerance: tolerance = '-0.1 mm' must be a positive length"),
     (("joint = \"A\"", "joint = \"Q\""), 4, "unknown joint 'Q'"),
     (("points = [\"P\"]", "points = [\"nowhere\"]"), 4, "outputs.points: unknown point 'nowhere'"),

@@ -19,6 +19,7 @@ from pinmech.cli.solve import add_parser as add_solve_parser
 from pinmech.cli.sweep import add_parser as add_sweep_parser
 from pinmech.cli.view import add_parser as add_view_parser
 from pinmech.design.study_cli import add_parser as add_study_parser
+from pinmech.design.synthesis_cli import add_parser as add_synth_parser
 
 
 def build_parser(command: str | None = None, *, parser_class: type[argparse.ArgumentParser] = argparse.ArgumentParser
@@ -55,4 +56,5 @@ SUBCOMMANDS = {
     "build": add_build_parser,
     "check": add_check_parser,
     "study": add_study_parser,
+    "synth": add_synth_parser,
 }

@@ -46,6 +46,10 @@ def built(spec: StudySpec) -> tuple:
 
 def solve_batch(spec: StudySpec, batch: Batch) -> BatchResult:
     """One batch, on the mechanism this process built (a Dask task)."""
+    if spec.kind == "workspace":
+        from pinmech.design.workspace_batch import run_workspace_batch
+
+        return run_workspace_batch(spec, batch)
     sm, outputs = built(spec)
     if spec.kind == "grid":
         from pinmech.design.grid import run_grid_batch

@@ -6,7 +6,8 @@
 
 Kinds: "sensitivity" (exact dy/dp over the cycle, sensitivity.py), "tolerance"
 (seeded Monte Carlo beside the linear estimate, tolerance.py) and "grid" (the outputs over
-a grid of parameter values, grid.py), run in batches here or on Dask (cluster.py).
+a grid of parameter values, grid.py) and "workspace" (a parallel mechanism's workspace,
+singularity loci and conditioning, workspace.py), run in batches here or on Dask (cluster.py).
 """
 
 from __future__ import annotations
@@ -22,6 +23,10 @@ from pinmech.design.grid import grid_size
 from pinmech.design.sensitivity import cycle_sensitivity
 from pinmech.design.study_file import StudySpec, load_study
 from pinmech.design.tolerance import Batch, BatchResult, Spread, batches, spread
+from pinmech.design.workspace import WorkspaceResult, run_workspace
+from pinmech.design.workspace_file import WorkspaceSpec, is_workspace, parse_workspace
+from pinmech.exceptions import SceneError
+from pinmech.toml_file import read_toml
 
 
 @dataclass(frozen=True)
@@ -67,8 +72,8 @@ class StudyResult:
         return np.concatenate([b.extra for b in self.batches])
 
 
-def study(path: str | Path | StudySpec, *, workers: int = 0, scheduler: str | None = None,
-          progress: Callable[[int, int], None] | None = None) -> StudyResult:
+def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, scheduler: str | None = None,
+          progress: Callable[[int, int], None] | None = None) -> StudyResult | WorkspaceResult:
     """Run a study file.
 
     Args:
@@ -80,12 +85,15 @@ def study(path: str | Path | StudySpec, *, workers: int = 0, scheduler: str | No
 
     Raises:
         SceneError: a bad study file (FrameNotFound: a name the model lacks); the scene's
-            and model's errors.
+            and model's errors; for a workspace study, a mechanism that is not parallel
+            (key "scene") or a grid reaching no point (key "workspace").
         LoopClosureError: the nominal does not assemble.
         SweepError: the nominal's cycle fails.
         ImportError: naming `pinmech[study]`, without Dask.
     """
-    spec = path if isinstance(path, StudySpec) else load_study(path)
+    spec = path if isinstance(path, (StudySpec, WorkspaceSpec)) else _load(Path(path))
+    if spec.kind == "workspace":
+        return run_workspace(spec, workers=workers, scheduler=scheduler, progress=progress)
     sm, outputs = built(spec)
     cycle = sm.cycle(sm.nominal)
     if cycle.cause:
@@ -109,3 +117,9 @@ def study(path: str | Path | StudySpec, *, workers: int = 0, scheduler: str | No
     if spec.kind == "grid":
         return StudyResult(**common, batches=tuple(results))
     return StudyResult(**common, spread=spread(sm, outputs, results), batches=tuple(results))
+
+
+def _load(path: Path) -> StudySpec | WorkspaceSpec:
+    """A study file of any kind, validated."""
+    raw = read_toml(path, "study", SceneError)
+    return parse_workspace(raw, path) if is_workspace(raw) else load_study(path)

@@ -49,7 +49,7 @@ class ProgressBar:
 
 def add_parser(sub) -> None:
     """The `study` subcommand's arguments."""
-    study = sub.add_parser("study", help="run a design study (sensitivity, tolerance or grid) from a study file",
+    study = sub.add_parser("study", help="run a design study (sensitivity, tolerance, grid or workspace) from a study file",
                            description="Run a study file (models/studies/*.toml): exact sensitivities over the "
                            "cycle, or a seeded Monte Carlo tolerance study on Dask. Exit codes as `pinmech --help`.")
     study.add_argument("study_file", help="study file (TOML), e.g. models/studies/four_bar_tolerance.toml")
@@ -62,7 +62,7 @@ def add_parser(sub) -> None:
                        help="write PREFIX.csv, PREFIX.parquet (pyarrow) and PREFIX.json")
     study.add_argument("--plot", action="store_true",
                        help="with --out: PREFIX_sensitivity.png, and PREFIX_histogram.png for a tolerance study, "
-                            "PREFIX_grid.png for a 1-D or 2-D grid study")
+                            "PREFIX_grid.png for a 1-D or 2-D grid study, PREFIX_workspace.png for a workspace study")
     study.add_argument("--json", action="store_true", help="print the JSON summary instead of the text one")
     study.add_argument("--quiet", action="store_true",
                        help="no progress bar (there is none either when stderr is not a terminal)")
@@ -88,6 +88,8 @@ def cmd_study(args: argparse.Namespace) -> int:
     finally:
         if bar is not None:
             bar.close()
+    if result.spec.kind == "workspace":
+        return _workspace_output(result, args)
     print(json.dumps(summary(result), indent=2) if args.json else text(result))
     if args.out:
         written = write(result, args.out)
@@ -99,5 +101,22 @@ def cmd_study(args: argparse.Namespace) -> int:
                 written.append(grid_figure(result, f"{args.out}_grid.png"))
             if result.spread is not None:
                 written.append(tolerance_histograms(result, f"{args.out}_histogram.png"))
+        print("wrote " + ", ".join(str(p) for p in written), file=sys.stderr)
+    return 0
+
+
+def _workspace_output(result, args: argparse.Namespace) -> int:
+    """A workspace study's summary, table, JSON and map."""
+    import json
+
+    from pinmech.design.workspace_report import summary, text, write
+
+    print(json.dumps(summary(result), indent=2) if args.json else text(result))
+    if args.out:
+        written = write(result, args.out)
+        if args.plot:
+            from pinmech.design.workspace_plot import workspace_figure
+
+            written.append(workspace_figure(result, f"{args.out}_workspace.png"))
         print("wrote " + ", ".join(str(p) for p in written), file=sys.stderr)
     return 0

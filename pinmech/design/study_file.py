@@ -53,7 +53,7 @@ from pinmech.units import to_si
 
 from pinmech.toml_file import read_toml
 
-KINDS = ("sensitivity", "tolerance", "grid")
+KINDS = ("sensitivity", "tolerance", "grid", "workspace")
 _TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs", "batch", "grid"}
 _GRID_KEYS = {"from", "to", "count"}
 _GRID_MAX = 1_000_000  # grid points in all
@@ -136,6 +136,8 @@ def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
     kind = raw.get("kind", "sensitivity")
     if kind not in KINDS:
         raise where.error("kind", f"kind = {kind!r} is not one of {', '.join(KINDS)}")
+    if kind == "workspace":
+        raise where.error("kind", "a workspace study is read by pinmech.study (design/workspace_file.py)")
     _refuse_unused(raw, kind, where)
     scene = raw.get("scene")
     if not isinstance(scene, str):

@@ -151,14 +151,18 @@ def grid_table(result: StudyResult) -> dict[str, list]:
 
 def write(result: StudyResult, prefix: str | Path, *, parquet: bool = True) -> list[Path]:
     """PREFIX.csv, PREFIX.json and (with pyarrow) PREFIX.parquet; the paths written."""
+    return write_tables(table(result), summary(result), prefix, parquet=parquet)
+
+
+def write_tables(columns: dict[str, list], summary_: dict, prefix: str | Path, *, parquet: bool = True) -> list[Path]:
+    """Columns to PREFIX.csv (and PREFIX.parquet with pyarrow), a summary to PREFIX.json."""
     prefix = Path(prefix)
-    columns = table(result)
     paths = [prefix.with_suffix(".csv"), prefix.with_suffix(".json")]
     with paths[0].open("w", newline="", encoding="utf-8") as f:
         writer = csv.writer(f)
         writer.writerow(columns)
         writer.writerows(zip(*columns.values()))
-    paths[1].write_text(json.dumps(summary(result), indent=2) + "\n", encoding="utf-8")
+    paths[1].write_text(json.dumps(summary_, indent=2) + "\n", encoding="utf-8")
     if parquet:
         try:
             import pyarrow as pa

@@ -1,0 +1,284 @@
+"""Synthesis files (`models/synthesis/*.toml`): parsed and validated once into a
+`SynthesisSpec`. A path-generation task of a four-bar:
+
+    title = "Four-bar through ten points"
+    task = "path"                    # the coupler point through the targets, in order
+    topology = "four-bar"
+    targets = [["120 mm", "35 mm"], ["110 mm", "52 mm"], ...]
+    timing = ["0 deg", "30 deg", ...]   # optional: the crank's turn from the first target
+    seed = 1                          # the search's random stream (same seed, same linkage)
+    population = 20                   # DE population per parameter; generations: at most
+    generations = 400
+    keep = 3                          # distinct linkages written, best first
+
+    [bounds]                          # every parameter, [lower, upper] with units
+    O2 = { x = ["-60 mm", "60 mm"], y = ["-60 mm", "60 mm"] }    # ground-pivot regions
+    O4 = { x = ["40 mm", "160 mm"], y = ["-60 mm", "60 mm"] }
+    crank = ["10 mm", "80 mm"]
+    coupler = ["40 mm", "200 mm"]
+    rocker = ["20 mm", "160 mm"]
+    point = { along = ["-150 mm", "150 mm"], across = ["-150 mm", "150 mm"] }
+
+    [constraints]
+    grashof = "crank-rocker"          # a Grashof class (grashof.py), or "any" (default)
+    transmission = "30 deg"           # least transmission angle over the motion
+    ratio = 6                         # longest / shortest link at most
+    direction = "either"              # the crank's turn: "ccw", "cw" or "either"
+
+A function-generation task (the rocker's turns a function of the crank's):
+
+    task = "function"
+    ground = "100 mm"                 # O2 at (0, 0), O4 at (ground, 0)
+    pairs = [["0 deg", "0 deg"], ["10.9 deg", "21.2 deg"], ...]   # [crank turn, rocker turn]
+    [bounds]
+    crank = ["20 mm", "300 mm"]
+    coupler = ["20 mm", "300 mm"]
+    rocker = ["20 mm", "300 mm"]
+
+A motion-generation task (the coupler through poses): `task = "motion"`, `poses =
+[["x", "y", "angle"], ...]` (the coupler point's place and the coupler's angle) instead
+of `targets`, the path's bounds (the angle between the poses' angles and the bar A -> B
+is searched as well).
+
+Every mistake is a SceneError naming the synthesis file and the key.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pinmech.exceptions import SceneError
+from pinmech.toml_file import read_toml
+from pinmech.units import to_si
+
+TASKS = ("path", "function", "motion")
+TOPOLOGIES = ("four-bar",)
+CLASSES = ("any", "grashof", "crank-rocker", "double-crank", "double-rocker", "triple rocker")
+DIRECTIONS = ("ccw", "cw", "either")
+_TOP = {"title", "task", "topology", "targets", "timing", "seed", "population", "generations", "keep",
+        "bounds", "constraints", "pairs", "ground", "poses"}
+_ONLY = {"targets": "path", "timing": "path", "pairs": "function", "ground": "function", "poses": "motion"}
+_BOUNDS = ("O2", "O4", "crank", "coupler", "rocker", "point")
+_CONSTRAINTS = {"grashof", "transmission", "ratio", "direction"}
+_LIMITS = {"seed": (0, 2**32 - 1), "population": (5, 1000), "generations": (1, 100_000), "keep": (1, 20)}
+
+
+@dataclass(frozen=True)
+class SynthesisSpec:
+    """A validated synthesis file (SI: m, rad).
+
+    Attributes:
+        targets: (N, 2) the coupler point's targets in the order of the motion [m]; for a
+            function, the pairs (crank turn, rocker turn) from the first pair [rad].
+        timing: (N,) the crank's turn from the first target to each [rad], or None
+            (then the crank angles are free, their order checked).
+        lower, upper: (9,) bounds of (O2x, O2y, O4x, O4y, crank, coupler, rocker, along,
+            across) [m] (synthesis_fourbar.NAMES); for a function (3,) of crank, coupler,
+            rocker [m].
+        ground: a function generator's ground O2 -> O4 along x [m] (0 for a path).
+        angles: (N,) the coupler's angles at the poses of a motion task [rad] (its
+            positions are `targets`), else None.
+        grashof: the Grashof class asked ("any": none).
+        transmission: the least transmission angle allowed over the motion [rad].
+        ratio: the longest link over the shortest, at most.
+        direction: the crank's turn from target to target: "ccw", "cw" or "either".
+    """
+
+    path: Path
+    title: str
+    task: str
+    topology: str
+    targets: np.ndarray
+    timing: np.ndarray | None
+    lower: np.ndarray
+    upper: np.ndarray
+    grashof: str = "any"
+    ground: float = 0.0
+    transmission: float = 0.0
+    ratio: float = math.inf
+    direction: str = "either"
+    seed: int = 0
+    population: int = 20
+    generations: int = 400
+    keep: int = 3
+    angles: np.ndarray | None = None
+
+    def __hash__(self) -> int:
+        return hash((self.path, self.title, self.targets.tobytes(), self.seed))
+
+
+def load_synthesis(path: str | Path) -> SynthesisSpec:
+    """Read and check a synthesis file. Raises SceneError naming the file and the key."""
+    path = Path(path)
+    return parse_synthesis(read_toml(path, "synthesis", SceneError), path)
+
+
+def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
+    """The SynthesisSpec of a synthesis file's TOML content `raw`."""
+    w = _Where(path)
+    w.known(raw, _TOP, "")
+    task = w.choice(raw, "task", TASKS, None)
+    topology = w.choice(raw, "topology", TOPOLOGIES, "four-bar")
+    for key, only in _ONLY.items():
+        if key in raw and task != only:
+            raise w.error(key, f"{key} is for task = \"{only}\" (this file's task is {task!r})")
+    if task == "function":
+        targets, timing = _pairs(raw, w), None
+        lower, upper = _bounds(raw, w, ("crank", "coupler", "rocker"))
+        ground = w.positive_length(raw, "ground")
+    else:
+        targets = _targets(raw, w, "poses" if task == "motion" else "targets")
+        timing = _timing(raw, w, len(targets)) if "timing" in raw else None
+        lower, upper = _bounds(raw, w, _BOUNDS)
+        ground = 0.0
+    c = raw.get("constraints", {})
+    w.known(c, _CONSTRAINTS, "constraints")
+    transmission = w.quantity(c, "transmission", "angle", "constraints") if "transmission" in c else 0.0
+    if not 0 <= transmission < math.pi / 2:
+        raise w.error("constraints.transmission", f"transmission = {c['transmission']!r} must be from 0 to 90 deg")
+    ratio = c.get("ratio", math.inf)
+    if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not ratio > 1:
+        raise w.error("constraints.ratio", f"ratio = {ratio!r} must be a number above 1 (longest / shortest link)")
+    direction = w.choice(c, "direction", DIRECTIONS, "either", "constraints")
+    turns = timing if timing is not None else targets[:, 0] if task == "function" else None
+    if turns is not None and direction != "either" and (turns[-1] > 0) != (direction == "ccw"):
+        raise w.error("constraints.direction", f"direction = {direction!r}, but the crank's turns given go "
+                      f"{'ccw' if turns[-1] > 0 else 'cw'}")
+    counts = {k: w.whole(raw, k, d) for k, d in (("seed", 0), ("population", 20), ("generations", 400), ("keep", 3))}
+    angles = None
+    if task == "motion":
+        targets, angles = targets[:, :2].copy(), targets[:, 2].copy()
+    return SynthesisSpec(path, str(raw.get("title", path.stem)), task, topology, targets, timing, lower, upper,
+                         w.choice(c, "grashof", CLASSES, "any", "constraints"), ground, transmission, float(ratio),
+                         direction, angles=angles, **counts)
+
+
+def _targets(raw: dict[str, Any], w: _Where, key: str = "targets") -> np.ndarray:
+    """Path targets [x, y] [m], or motion poses [x, y, angle] [m, m, rad] (key "poses")."""
+    value = raw.get(key)
+    width, example = (3, '["120 mm", "35 mm", "30 deg"]') if key == "poses" else (2, '["120 mm", "35 mm"]')
+    if not isinstance(value, list) or len(value) < 3:
+        raise w.error(key, f"give at least 3 {key}, [{example}, ...], in the order of the motion")
+    rows = []
+    for i, t in enumerate(value):
+        if not isinstance(t, list) or len(t) != width:
+            raise w.error(f"{key}[{i}]", f"{t!r} must be {'[x, y, angle]' if width == 3 else '[x, y]'} with units, "
+                          f"e.g. {example}")
+        kinds = ("length", "length", "angle")[:width]
+        rows.append([to_si(x, kind, where=f"{w.path}, {key}[{i}]") for x, kind in zip(t, kinds)])
+    out = np.array(rows)
+    gaps = np.linalg.norm(np.diff(out[:, :2], axis=0), axis=1)
+    if np.any(gaps == 0):
+        i = int(np.argmin(gaps))
+        raise w.error(f"{key}[{i + 1}]", f"{key}[{i + 1}] is at {key}[{i}]'s place")
+    return out
+
+
+def _pairs(raw: dict[str, Any], w: _Where) -> np.ndarray:
+    value = raw.get("pairs")
+    if not isinstance(value, list) or len(value) < 3:
+        raise w.error("pairs", "give at least 3 pairs [crank turn, rocker turn] from the first, e.g. "
+                      "[[\"0 deg\", \"0 deg\"], [\"30 deg\", \"12 deg\"], ...]")
+    rows = []
+    for i, t in enumerate(value):
+        if not isinstance(t, list) or len(t) != 2:
+            raise w.error(f"pairs[{i}]", f"{t!r} must be [crank turn, rocker turn] with units")
+        rows.append([to_si(x, "angle", where=f"{w.path}, pairs[{i}]") for x in t])
+    out = np.array(rows)
+    if np.any(out[0] != 0):
+        raise w.error("pairs[0]", "the first pair is the start: [\"0 deg\", \"0 deg\"]")
+    step = np.diff(out[:, 0])
+    if not (np.all(step > 0) or np.all(step < 0)) or abs(out[-1, 0]) >= 2 * math.pi:
+        raise w.error("pairs", "the crank turns must grow (ccw) or fall (cw) strictly, within one turn")
+    return out
+
+
+def _timing(raw: dict[str, Any], w: _Where, n: int) -> np.ndarray:
+    value = raw["timing"]
+    if not isinstance(value, list) or len(value) != n:
+        raise w.error("timing", f"give one crank turn per target ({n}), from \"0 deg\" at the first")
+    t = np.array([to_si(x, "angle", where=f"{w.path}, timing[{i}]") for i, x in enumerate(value)])
+    step = np.diff(t)
+    if t[0] != 0 or not (np.all(step > 0) or np.all(step < 0)) or abs(t[-1]) >= 2 * math.pi:
+        raise w.error("timing", "the crank's turns must start at 0 deg and grow (ccw) or fall (cw) strictly, "
+                      "within one turn")
+    return t
+
+
+def _bounds(raw: dict[str, Any], w: _Where, names: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+    table = raw.get("bounds")
+    w.known(table, set(names), "bounds")
+    missing = [k for k in names if k not in table]
+    if missing:
+        raise w.error("bounds", f"missing {', '.join(missing)}: every parameter needs [lower, upper]")
+    pairs = []
+    for name, axes in (("O2", ("x", "y")), ("O4", ("x", "y")), ("crank", ()), ("coupler", ()), ("rocker", ()),
+                       ("point", ("along", "across"))):
+        if name not in names:
+            continue
+        entry = table[name]
+        if axes:
+            w.known(entry, set(axes), f"bounds.{name}")
+            pairs += [w.interval(entry.get(a), f"bounds.{name}.{a}") for a in axes]
+        else:
+            pairs.append(w.interval(entry, f"bounds.{name}", positive=True))
+    lower, upper = np.array(pairs).T
+    return lower, upper
+
+
+class _Where:
+    """The synthesis file, for errors naming it and the key."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+
+    def error(self, key: str, message: str) -> SceneError:
+        return SceneError(message, path=str(self.path), key=key)
+
+    def known(self, table: Any, keys: set[str], key: str) -> None:
+        if not isinstance(table, dict):
+            raise self.error(key or "(top)", f"must be a table, got {table!r}")
+        unknown = sorted(set(table) - keys)
+        if unknown:
+            raise self.error(f"{key}.{unknown[0]}" if key else unknown[0],
+                             f"unknown key(s) {', '.join(unknown)}; known: {', '.join(sorted(keys))}")
+
+    def choice(self, table: dict, key: str, allowed: tuple[str, ...], default: str | None, under: str = "") -> str:
+        full = f"{under}.{key}" if under else key
+        value = table.get(key, default)
+        if value not in allowed:
+            raise self.error(full, f"{key} = {value!r} is not one of {', '.join(allowed)}")
+        return value
+
+    def whole(self, raw: dict, key: str, default: int) -> int:
+        value = raw.get(key, default)
+        low, high = _LIMITS[key]
+        if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+            raise self.error(key, f"{key} = {value!r} must be a whole number from {low} to {high}")
+        return value
+
+    def positive_length(self, raw: dict, key: str) -> float:
+        if key not in raw:
+            raise self.error(key, f"give {key} = \"100 mm\" (the ground O2 -> O4)")
+        value = to_si(raw[key], "length", where=f"{self.path}, {key}")
+        if not value > 0:
+            raise self.error(key, f"{key} = {raw[key]!r} must be a positive length")
+        return value
+
+    def quantity(self, table: dict, name: str, kind: str, under: str) -> float:
+        return to_si(table[name], kind, where=f"{self.path}, {under}.{name}")
+
+    def interval(self, value: Any, key: str, positive: bool = False) -> tuple[float, float]:
+        if not isinstance(value, list) or len(value) != 2:
+            raise self.error(key, f"{value!r} must be [lower, upper] with units, e.g. [\"10 mm\", \"80 mm\"]")
+        lo, hi = (to_si(v, "length", where=f"{self.path}, {key}") for v in value)
+        if not lo < hi:
+            raise self.error(key, f"lower {value[0]} is not below upper {value[1]}")
+        if positive and not lo > 0:
+            raise self.error(key, f"lower {value[0]} must be a positive length")
+        return lo, hi

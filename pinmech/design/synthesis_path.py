@@ -1,0 +1,72 @@
+"""Refining a path-generation candidate: least squares on the targets with the exact
+Jacobian (implicit-function theorem, synthesis_fourbar.point_jacobian), then the defect
+and constraint checks again (synthesis_motion.causes)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pinmech.design.synthesis_file import SynthesisSpec
+from pinmech.design.synthesis_fourbar import point_jacobian, pose
+from pinmech.design.synthesis_motion import causes, grashof_label, progress, transmission_range
+from pinmech.design.synthesis_objective import evaluate_path, extent, split
+from pinmech.design.synthesis_result import Linkage
+
+
+def refined_path(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage | None:
+    """The candidate x on assembly s0 refined by least squares (bounds kept), or x itself
+    if the refined one has a defect; None if neither is free of them."""
+    import scipy.optimize as opt
+
+    z, theta0 = split(x[None])
+    theta = evaluate_path(spec, s0, x[None]).theta[0]
+    timed = spec.timing is not None
+    v0 = np.concatenate((z[0], theta0 if timed else theta))
+    S = extent(spec.targets)
+
+    def unpack(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return v[:9], (v[9] + spec.timing if timed else v[9:])
+
+    def residual(v: np.ndarray) -> np.ndarray:
+        zz, th = unpack(v)
+        r = ((pose(zz[None], np.array([s0]), th[None]).P[0] - spec.targets) / S).ravel()
+        return np.where(np.isfinite(r), r, 1.0)  # where the dyad does not close: a step refused
+
+    def jacobian(v: np.ndarray) -> np.ndarray:
+        zz, th = unpack(v)
+        _, dz, dt = point_jacobian(zz, s0, th)
+        n = len(th)
+        Jt = np.zeros((n, 2, n))
+        Jt[np.arange(n), :, np.arange(n)] = dt
+        Jt = Jt.sum(axis=2, keepdims=True) if timed else Jt
+        return np.concatenate((dz, Jt), axis=2).reshape(2 * n, -1) / S
+
+    lower = np.concatenate((spec.lower, np.full(len(v0) - 9, -np.inf)))
+    upper = np.concatenate((spec.upper, np.full(len(v0) - 9, np.inf)))
+    candidates = []
+    try:
+        with np.errstate(all="ignore"):
+            fit = opt.least_squares(residual, np.clip(v0, lower, upper), jac=jacobian, bounds=(lower, upper),
+                                    method="trf", x_scale="jac", ftol=1e-15, xtol=1e-15, gtol=1e-15, max_nfev=400)
+        candidates.append(fit.x)
+    except (np.linalg.LinAlgError, ValueError):  # a fold or an open dyad on the way: keep x
+        pass
+    candidates.append(v0)
+    for v in candidates:
+        lk = _linkage(spec, *unpack(v), s0)
+        if lk is not None:
+            return lk
+    return None
+
+
+def _linkage(spec: SynthesisSpec, z: np.ndarray, theta: np.ndarray, s: float) -> Linkage | None:
+    """The Linkage z on assembly s with crank angles theta at the targets, or None if its
+    motion has a defect or breaks a constraint."""
+    Z, Sa, T = z[None], np.array([s]), theta[None]
+    if not np.all(np.isfinite(theta)) or causes(spec, Z, Sa, T)[0]:
+        return None
+    way, span = progress(T, spec.direction)
+    low, high = transmission_range(Z, Sa, T, way, span)
+    errors = np.linalg.norm(pose(Z, Sa, T).P[0] - spec.targets, axis=1)
+    return Linkage(z.copy(), s, np.array(theta), int(way[0]), errors, (float(low[0]), float(high[0])),
+                   grashof_label(z))

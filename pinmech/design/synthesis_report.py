@@ -1,0 +1,179 @@
+"""A synthesis's report: text and JSON (errors at each target in mm, the defects checked,
+the transmission-angle range, the rejected candidates by cause) and its figure (the
+targets over each linkage's coupler curve, the linkage drawn at the first target)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from pinmech.design.synthesis_fourbar import NAMES, pose
+from pinmech.design.synthesis_linkage import motion_values
+from pinmech.design.synthesis_result import Linkage, SynthesisResult
+
+DEFECTS = {
+    "branch": "none: every pose on one assembly (B {side} of A -> O4), by construction",
+    "circuit": "none: no fold of the dyad between the first and the last target",
+    "order": "none: the crank turns {way} from target to target, within one turn",
+}
+
+
+def linkage_summary(lk: Linkage) -> dict:
+    """One linkage's numbers, in mm and deg."""
+    side, way = ("left" if lk.s > 0 else "right"), ("counter-clockwise" if lk.way > 0 else "clockwise")
+    return {
+        "dimensions_mm": {n: round(float(v) * 1e3, 9) for n, v in zip(NAMES, lk.z)},
+        "ground_mm": round(math.hypot(lk.z[2] - lk.z[0], lk.z[3] - lk.z[1]) * 1e3, 9),
+        "assembly": side,
+        "grashof": lk.grashof,
+        "crank_deg": [round(math.degrees(v), 6) for v in motion_values(lk)],
+        **({"errors_mm": [float(e) * 1e3 for e in lk.errors], "max_error_relative": float(np.max(lk.errors) / lk.size)}
+           if lk.task != "function" else
+           {"errors_deg": [math.degrees(float(e)) for e in lk.errors], "rocker_start_deg": math.degrees(lk.phi0)}),
+        **({"angle_errors_deg": [math.degrees(float(e)) for e in lk.angle_errors],
+            "offset_deg": math.degrees(lk.phi0)} if lk.angle_errors is not None else {}),
+        "transmission_deg": [round(math.degrees(v), 3) for v in lk.transmission],
+        "defects": {k: v.format(side=side, way=way) for k, v in DEFECTS.items()},
+    }
+
+
+def summary(result: SynthesisResult) -> dict:
+    """The JSON summary of a synthesis."""
+    return {
+        "file": str(result.spec.path),
+        "task": result.spec.task,
+        "topology": result.spec.topology,
+        "targets": len(result.spec.targets),
+        "seed": result.spec.seed,
+        "evaluations": result.evaluations,
+        "generations": result.generations,
+        "rejected": dict(sorted(result.rejected.items())),
+        "linkages": [linkage_summary(lk) for lk in result.linkages],
+    }
+
+
+def text(result: SynthesisResult) -> str:
+    """The text report."""
+    s = summary(result)
+    lines = [f"{result.spec.title}: {s['task']} generation, {s['topology']}, {s['targets']} targets, seed {s['seed']}",
+             f"search: {s['evaluations']} candidates over {s['generations']} generations; rejected: "
+             + (", ".join(f"{n} {c}" for c, n in s["rejected"].items()) or "none")]
+    if not s["linkages"]:
+        lines.append("no linkage meets the targets without a defect and within the constraints")
+    for i, lk in enumerate(s["linkages"], start=1):
+        d = lk["dimensions_mm"]
+        lines += [
+            f"linkage {i}: O2 ({d['O2x']:.6g}, {d['O2y']:.6g}) mm, O4 ({d['O4x']:.6g}, {d['O4y']:.6g}) mm, "
+            f"ground {lk['ground_mm']:.6g}, crank {d['crank']:.6g}, coupler {d['coupler']:.6g}, "
+            f"rocker {d['rocker']:.6g} mm, P at {d['along']:.6g} along and {d['across']:.6g} across A->B; "
+            f"{lk['grashof']}, assembly {lk['assembly']}",
+            _errors(lk),
+            f"  crank at the targets [deg]: {', '.join(f'{v:.6g}' for v in lk['crank_deg'])}",
+            f"  transmission angle over the motion: {lk['transmission_deg'][0]:.4g} .. {lk['transmission_deg'][1]:.4g} deg",
+        ]
+        lines += [f"  {k} defect: {v}" for k, v in lk["defects"].items()]
+    return "\n".join(lines)
+
+
+def _errors(lk: dict) -> str:
+    if "angle_errors_deg" in lk:
+        return (f"  error at each pose [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
+                f"(max {lk['max_error_relative']:.3g} of its size); [deg]: "
+                f"{', '.join(f'{e:.3g}' for e in lk['angle_errors_deg'])} (the poses' angle is A->B's + "
+                f"{lk['offset_deg']:.6g} deg)")
+    if "errors_mm" in lk:
+        return (f"  error at each target [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
+                f"(max {lk['max_error_relative']:.3g} of its size)")
+    return (f"  rocker angle error at each pair [deg]: {', '.join(f'{e:.3g}' for e in lk['errors_deg'])} "
+            f"(rocker at {lk['rocker_start_deg']:.6g} deg at the first pair)")
+
+
+def _pyplot():
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError as exc:
+        raise ImportError(f'synthesis figures need matplotlib: pip install "pinmech[plot]" ({exc})') from exc
+    return plt
+
+
+def figure(result: SynthesisResult, path: str | Path) -> Path:
+    """One panel per linkage: the targets, the coupler curve over the motion (solid) and
+    the rest of its turn on the same assembly (dotted), the linkage at the first target."""
+    if result.spec.task == "function":
+        return function_figure(result, path)
+    plt = _pyplot()
+    n = max(len(result.linkages), 1)
+    fig, axes = plt.subplots(1, n, figsize=(4.6 * n + 0.6, 4.6), squeeze=False)
+    T = result.spec.targets * 1e3
+    for ax, lk, i in zip(axes[0], result.linkages, range(1, n + 1)):
+        values = motion_values(lk)
+        motion = np.linspace(values[0], values[-1], 400)
+        turn = np.linspace(values[0], values[0] + 2 * math.pi * lk.way, 721)
+        s = np.array([lk.s])
+        whole, along = pose(lk.z[None], s, turn[None]).P[0] * 1e3, pose(lk.z[None], s, motion[None]).P[0] * 1e3
+        ax.plot(whole[:, 0], whole[:, 1], ":", color="0.6", lw=1, label="coupler curve (same assembly)")
+        ax.plot(along[:, 0], along[:, 1], "-", color="tab:blue", lw=1.6, label="motion through the targets")
+        p = pose(lk.z[None], s, values[:1][None])
+        O2, O4, A, B, P = lk.z[:2] * 1e3, lk.z[2:4] * 1e3, p.A[0, 0] * 1e3, p.B[0, 0] * 1e3, p.P[0, 0] * 1e3
+        ax.plot(*np.array([O2, A, B, O4]).T, "-o", color="k", lw=1.4, ms=3)
+        ax.fill(*np.array([A, B, P]).T, color="tab:orange", alpha=0.3)
+        ax.plot(*np.array([O2, O4]).T, "^", color="k", ms=8)
+        ax.plot(T[:, 0], T[:, 1], "x", color="tab:red", ms=8, mew=2, label="targets")
+        if result.spec.angles is not None:  # the poses' angles, and the coupler's at each pose
+            L = 0.15 * float(np.ptp(T, axis=0).max())
+            a = result.spec.angles
+            ax.quiver(T[:, 0], T[:, 1], np.cos(a), np.sin(a), color="tab:red", angles="xy", scale_units="xy",
+                      scale=1 / L, width=0.006, label="pose angles")
+            q = pose(lk.z[None], s, lk.theta[None])
+            c = np.arctan2(q.B[0, :, 1] - q.A[0, :, 1], q.B[0, :, 0] - q.A[0, :, 0]) + lk.phi0
+            ax.quiver(q.P[0, :, 0] * 1e3, q.P[0, :, 1] * 1e3, np.cos(c), np.sin(c), color="tab:blue",
+                      angles="xy", scale_units="xy", scale=1 / L, width=0.003, label="coupler at the poses")
+        for k, t in enumerate(T, start=1):
+            ax.annotate(str(k), t, textcoords="offset points", xytext=(4, 4), fontsize=8, color="tab:red")
+        ax.set_aspect("equal")
+        ax.set_title(f"linkage {i}: max error {np.max(lk.errors) * 1e3:.2g} mm\n"
+                     f"{lk.grashof}, transmission {math.degrees(lk.transmission[0]):.0f}.."
+                     f"{math.degrees(lk.transmission[1]):.0f} deg", fontsize=9)
+        ax.set_xlabel("x [mm]")
+        ax.set_ylabel("y [mm]")
+        ax.grid(alpha=0.3)
+    if result.linkages:
+        axes[0][0].legend(fontsize=7, loc="best")
+    fig.suptitle(result.spec.title)
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def function_figure(result: SynthesisResult, path: str | Path) -> Path:
+    """The rocker's turn against the crank's over the motion for each linkage, and the pairs."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    pairs = np.degrees(result.spec.targets)
+    for i, lk in enumerate(result.linkages, start=1):
+        values = motion_values(lk)
+        crank = np.linspace(values[0], values[-1], 300)
+        B = pose(lk.z[None], np.array([lk.s]), crank[None]).B[0]
+        phi = np.unwrap(np.arctan2(B[:, 1], B[:, 0] - lk.z[2]))
+        turn = np.degrees(phi - lk.phi0)
+        turn -= 360 * np.round((turn[0]) / 360)
+        ax.plot(np.degrees(crank - crank[0]), turn, lw=1.5,
+                label=f"linkage {i}: max error {math.degrees(np.max(lk.errors)):.2g} deg")
+    ax.plot(pairs[:, 0], pairs[:, 1], "x", color="tab:red", ms=8, mew=2, label="pairs asked")
+    ax.set_xlabel("crank turn from the first pair [deg]")
+    ax.set_ylabel("rocker turn [deg]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(result.spec.title)
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -1,0 +1,69 @@
+"""What a synthesis returns: the linkages found, each able to say how closely it meets
+its targets, and the candidates rejected by cause."""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from pinmech.design.synthesis_file import SynthesisSpec
+
+
+@dataclass(frozen=True)
+class Linkage:
+    """A synthesised four-bar that meets the targets without defects.
+
+    Attributes:
+        z: (O2x, O2y, O4x, O4y, crank, coupler, rocker, along, across) [m].
+        s: the assembly (+1: B left of A -> O4, -1: right).
+        theta: the crank's angle at each target [rad] (world x, ccw).
+        way: the crank's turn from target to target (+1 ccw, -1 cw).
+        errors: |P - target| at each target [m] (path), or the rocker's angle error at
+            each pair [rad] (function).
+        transmission: the least and greatest transmission angle over the motion [rad].
+        grashof: its Grashof class.
+        task: "path", "function" or "motion".
+        phi0: a function generator's rocker angle asked at the first pair, or a motion
+            generator's angle from the bar A -> B to the poses' line [rad].
+        angle_errors: a motion generator's coupler angle error at each pose [rad].
+    """
+
+    z: np.ndarray
+    s: float
+    theta: np.ndarray
+    way: int
+    errors: np.ndarray
+    transmission: tuple[float, float]
+    grashof: str
+    task: str = "path"
+    phi0: float = 0.0
+    angle_errors: np.ndarray | None = None
+
+    @property
+    def size(self) -> float:
+        """The linkage's size: its longest link [m]."""
+        return float(max(math.hypot(self.z[2] - self.z[0], self.z[3] - self.z[1]), *self.z[4:7]))
+
+    def meets(self, relative: float) -> bool:
+        """Whether every target is met within `relative` of the linkage's size (path; a
+        motion's angles within `relative` rad too), or every output angle within `relative`
+        rad (function)."""
+        if self.task == "function":
+            return bool(np.max(self.errors) <= relative)
+        angles = self.angle_errors if self.angle_errors is not None else np.zeros(1)
+        return bool(np.max(self.errors) <= relative * self.size and np.max(angles) <= relative)
+
+
+@dataclass
+class SynthesisResult:
+    """The linkages found (best first), the candidates rejected by cause, and the search's
+    counts (evaluations, generations)."""
+
+    spec: SynthesisSpec
+    linkages: list[Linkage]
+    rejected: Counter = field(default_factory=Counter)
+    evaluations: int = 0
+    generations: int = 0

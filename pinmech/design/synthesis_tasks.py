@@ -1,0 +1,36 @@
+"""Each synthesis task's search rows: their bounds, their batch objective, the refinement
+of one row and the classical starting rows (path: synthesis_objective and
+synthesis_path; function: synthesis_function; motion: synthesis_poses)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pinmech.design.synthesis_file import SynthesisSpec
+from pinmech.design.synthesis_function import evaluate_function, freudenstein_rows, function_bounds, refined_function
+from pinmech.design.synthesis_objective import BatchValues, evaluate_path, path_bounds
+from pinmech.design.synthesis_path import refined_path
+from pinmech.design.synthesis_poses import evaluate_poses, poses_bounds, refined_poses
+from pinmech.design.synthesis_result import Linkage
+
+
+def search_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
+    """The bounds of the task's search rows."""
+    return {"function": function_bounds, "motion": poses_bounds}.get(spec.task, path_bounds)(spec)
+
+
+def evaluate(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchValues:
+    """The task's objective of rows x on one assembly (a Dask task)."""
+    return {"function": evaluate_function, "motion": evaluate_poses}.get(spec.task, evaluate_path)(spec, assembly, x)
+
+
+def refined(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Linkage | None:
+    """Row x refined with the exact Jacobian, checked for defects (None: it has one)."""
+    return {"function": refined_function, "motion": refined_poses}.get(spec.task, refined_path)(spec, assembly, x)
+
+
+def classical_rows(spec: SynthesisSpec) -> np.ndarray:
+    """Rows from the classical closed forms (Freudenstein for functions), best first."""
+    if spec.task == "function":
+        return freudenstein_rows(spec)
+    return np.zeros((0, len(search_bounds(spec))))

@@ -1,0 +1,119 @@
+"""Workspace studies of parallel mechanisms (`kind = "workspace"`): the reachable workspace
+of each working mode and assembly mode on a task-space grid, the type I and type II
+singularity loci, the conditioning map, and the area or volume with its bound.
+
+    import pinmech
+    result = pinmech.study("models/studies/five_bar_workspace.toml", workers=2)
+    print(result.measures["+-"].value)      # m^2
+
+The grid's points are solved in batches here or on Dask (cluster.py); the maps are then
+read from the whole grid (workspace_maps.py).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from pinmech.design.cluster import run_batches
+from pinmech.design.tolerance import batches
+from pinmech.design.workspace_batch import FIELDS, WorkspaceBatch, built
+from pinmech.design.workspace_file import WorkspaceSpec
+from pinmech.design.workspace_maps import Measure, boundary_edges, distances, measure, sign_change_edges
+from pinmech.exceptions import SceneError
+
+
+@dataclass(frozen=True)
+class WorkspaceResult:
+    """A workspace study's maps (SI; grid axes first, then the mode axis).
+
+    Attributes:
+        spec: the study file; modes: working modes ("+-": a sign a leg); motors: motor names.
+        length: the characteristic length L [m]; coords: each axis's values [m].
+        reached: (grid..., modes) bool; motor_q: (grid..., modes, legs) [rad or m];
+        values: det1, det2, sigma1, sigma2, kappa (grid..., modes) (NaN where not reached);
+        measures: per mode, and per "mode/assembly" (assembly "+" or "-": the sign of det
+            Phi_p), the area [m^2] or volume [m^3] with its bound;
+        type1, type2: per mode, locus midpoints (k, axes) [m]; dist1, dist2: (grid...,
+            modes) distance to them [m] (within `locus_bound`).
+    """
+
+    spec: WorkspaceSpec
+    modes: tuple[str, ...]
+    motors: tuple[str, ...]
+    length: float
+    coords: list[np.ndarray]
+    reached: np.ndarray
+    motor_q: np.ndarray
+    values: dict[str, np.ndarray]
+    measures: dict[str, Measure]
+    type1: dict[str, np.ndarray]
+    type2: dict[str, np.ndarray]
+    dist1: np.ndarray
+    dist2: np.ndarray
+
+    @property
+    def steps(self) -> tuple[float, ...]:
+        """The grid's steps [m]."""
+        return tuple(float(c[1] - c[0]) for c in self.coords)
+
+    @property
+    def locus_bound(self) -> float:
+        """How far [m] a locus midpoint (and so a distance) can be from the locus: half the largest step."""
+        return max(self.steps) / 2
+
+    @property
+    def kind(self) -> str:
+        """"area" for a plane grid, "volume" for a box."""
+        return "area" if len(self.coords) == 2 else "volume"
+
+
+def run_workspace(spec: WorkspaceSpec, *, workers: int = 0, scheduler: str | None = None,
+                  progress: Callable[[int, int], None] | None = None) -> WorkspaceResult:
+    """Solve the study's grid (here, or on Dask) and read its maps; `progress` is called with
+    (grid points done, grid points) as each batch finishes.
+
+    Raises:
+        SceneError: the study file's or the scene's mistakes, a mechanism that is not parallel
+            (key "scene"), a grid where no point is reached in any mode (key "workspace");
+            FrameNotFound: an unknown end point.
+    """
+    wm = built(spec)  # here first: the file's and the mechanism's errors before any worker starts
+    todo = batches(spec.size, spec.batch)
+    done = [0]
+
+    def tick(batch) -> None:
+        done[0] += batch.count
+        progress(done[0], spec.size)
+
+    results: list[WorkspaceBatch] = run_batches(spec, todo, workers=workers, scheduler=scheduler,
+                                                progress=tick if progress else None)
+    shape = tuple(a.count for a in spec.axes)
+    modes = wm.modes
+    reached = np.concatenate([b.reached for b in results]).reshape(*shape, len(modes))
+    if not reached.any():
+        span = ", ".join(f"{a.name} {a.start / spec.unit_si:g} to {a.stop / spec.unit_si:g} {spec.unit}"
+                         for a in spec.axes)
+        raise SceneError(f"no grid point is reachable in working modes {', '.join(modes)}: the grid "
+                         f"({span}) misses the workspace of '{spec.point}'", path=str(spec.path), key="workspace")
+    values = {f: np.concatenate([b.values[f] for b in results]).reshape(*shape, len(modes)) for f in FIELDS}
+    motor_q = np.concatenate([b.motors for b in results]).reshape(*shape, len(modes), len(wm.legs))
+    coords = [np.asarray(a.values) for a in spec.axes]
+    steps = tuple(float(c[1] - c[0]) for c in coords)
+    mesh = np.stack(np.meshgrid(*coords, indexing="ij"), axis=-1)
+    measures, type1, type2 = {}, {}, {}
+    dist1, dist2 = np.full(reached.shape, np.nan), np.full(reached.shape, np.nan)
+    for k, mode in enumerate(modes):
+        here = reached[..., k]
+        measures[mode] = measure(here, steps)
+        for sign, label in ((1, "+"), (-1, "-")):
+            measures[f"{mode}/{label}"] = measure(here & (np.sign(values["det2"][..., k]) == sign), steps)
+        type1[mode] = np.concatenate([boundary_edges(here, coords), sign_change_edges(values["det1"][..., k], coords)])
+        type2[mode] = sign_change_edges(values["det2"][..., k], coords)
+        points = mesh[here]
+        dist1[..., k][here] = distances(points, type1[mode])
+        dist2[..., k][here] = distances(points, type2[mode])
+    return WorkspaceResult(spec, modes, wm.motors, wm.length, coords, reached, motor_q, values, measures,
+                           type1, type2, dist1, dist2)

@@ -1,0 +1,143 @@
+"""A workspace study file (`kind = "workspace"`): parsed and validated once into a `WorkspaceSpec`.
+
+    title = "Five-bar: reachable workspace and singularity loci"
+    scene = "../scenes/five_bar.toml"     # the mechanism; its motors are the actuators
+    kind = "workspace"
+    batch = 500                            # grid points a Dask task
+
+    [workspace]
+    point = "closedloop1_A"                # the end point (a named point or frame)
+    x = { from = "-100 mm", to = "200 mm", count = 121 }   # one axis per motor: x, y (plane)
+    y = { from = "-60 mm", to = "200 mm", count = 105 }    # or x, y, z (space)
+    modes = ["+-", "-+"]                   # working modes (a sign per leg, motors' order); default all
+    length = "60 mm"                       # characteristic length of the dimensionless Jacobian
+
+Every mistake is a SceneError naming the study file, the key and the value as written.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from pinmech.design.study_file import GridAxis, _Where
+from pinmech.exceptions import SceneError
+from pinmech.toml_file import read_toml
+from pinmech.units import to_si
+
+_TOP = {"title", "scene", "kind", "batch", "workspace"}
+_KEYS = {"point", "x", "y", "z", "modes", "length"}
+_AXIS_KEYS = {"from", "to", "count"}
+_MAX_POINTS = 2_000_000
+
+
+@dataclass(frozen=True)
+class WorkspaceSpec:
+    """A validated workspace study (lengths in m).
+
+    Attributes:
+        path: the study file; scene: the scene file it names; kind: "workspace".
+        point: the end point's name; axes: the task-space grid's axes (named x, y, z) [m].
+        modes: the working modes asked ("+-" ...: one sign a leg, in the motors' order),
+            () for every one; length: the characteristic length [m] (None: the mechanism's).
+        batch: grid points a batch (a Dask task); unit, unit_si: the user's length unit
+            (from the first axis's `from`) and its size [m].
+    """
+
+    path: Path
+    title: str
+    scene: Path
+    point: str
+    axes: tuple[GridAxis, ...]
+    modes: tuple[str, ...]
+    length: float | None
+    batch: int
+    unit: str
+    unit_si: float
+    kind: str = "workspace"
+    seed: int = 0
+
+    @property
+    def size(self) -> int:
+        """Grid points in all."""
+        return math.prod(a.count for a in self.axes)
+
+
+def load_workspace(path: str | Path) -> WorkspaceSpec:
+    """Read and check a workspace study file. Raises SceneError naming the file and the key."""
+    path = Path(path)
+    return parse_workspace(read_toml(path, "study", SceneError), path)
+
+
+def parse_workspace(raw: dict[str, Any], path: Path) -> WorkspaceSpec:
+    """The WorkspaceSpec of a study file's TOML content `raw` (relative paths: from its folder)."""
+    where = _Where(path)
+    where.known(raw, _TOP, "")
+    scene = raw.get("scene")
+    if not isinstance(scene, str):
+        raise where.error("scene", f"scene = {scene!r}: give the scene file, e.g. \"../scenes/five_bar.toml\"")
+    table = raw.get("workspace")
+    if not isinstance(table, dict):
+        raise where.error("workspace", "a workspace study needs a [workspace] table: point = \"P\", "
+                          "x = { from = \"-100 mm\", to = \"100 mm\", count = 51 }, y = ...")
+    where.known(table, _KEYS, "workspace")
+    point = table.get("point")
+    if not isinstance(point, str) or not point:
+        raise where.error("workspace.point", f"point = {point!r}: name the end point, e.g. point = \"tool\"")
+    names = [k for k in ("x", "y", "z") if k in table]
+    if names not in (["x", "y"], ["x", "y", "z"]):
+        raise where.error("workspace", f"give the grid's axes x, y (a plane) or x, y, z (a box); got {names or 'none'}")
+    axes = tuple(_axis(n, table[n], where) for n in names)
+    size = math.prod(a.count for a in axes)
+    if size > _MAX_POINTS:
+        raise where.error("workspace", f"{size} grid points is more than {_MAX_POINTS}: lower the counts")
+    length = _length(table, where)
+    unit = _unit(table["x"]["from"])
+    batch = where.whole(raw, "batch", 500)
+    return WorkspaceSpec(path, str(raw.get("title", path.stem)), path.parent / scene, point, axes,
+                         _modes(table.get("modes", []), where), length, batch, unit,
+                         to_si(f"1 {unit}", "length", where=f"{path}, workspace.x.from"))
+
+
+def _axis(name: str, entry: Any, where: _Where) -> GridAxis:
+    key = f"workspace.{name}"
+    where.known(entry, _AXIS_KEYS, key)
+    missing = sorted(_AXIS_KEYS - set(entry))
+    if missing:
+        example = '{ from = "-100 mm", to = "100 mm", count = 51 }'
+        raise where.error(key, f"missing {', '.join(missing)}: give {example}")
+    count = entry["count"]
+    if isinstance(count, bool) or not isinstance(count, int) or not 2 <= count <= 10_000:
+        raise where.error(f"{key}.count", f"count = {count!r} must be a whole number from 2 to 10000")
+    start, stop = where.length(entry, "from", key), where.length(entry, "to", key)
+    if not start < stop:
+        raise where.error(key, f"from {entry['from']} is not below to {entry['to']}")
+    return GridAxis(name, "xyz".index(name), start, stop, count)
+
+
+def _length(table: dict, where: _Where) -> float | None:
+    if "length" not in table:
+        return None
+    return where.positive(table, "length", "workspace")
+
+
+def _modes(value: Any, where: _Where) -> tuple[str, ...]:
+    if not isinstance(value, list) or not all(isinstance(m, str) and m and set(m) <= {"+", "-"} for m in value):
+        raise where.error("workspace.modes", f"modes = {value!r} must be a list of sign strings, one sign a "
+                          "leg in the motors' order, e.g. [\"+-\", \"-+\"]")
+    return tuple(dict.fromkeys(value))
+
+
+def _unit(text: Any) -> str:
+    """The unit written after the number ("-100 mm" -> "mm"); metres if none."""
+    parts = str(text).split(maxsplit=1)
+    return parts[1].strip() if len(parts) == 2 else "m"
+
+
+def is_workspace(raw: dict[str, Any]) -> bool:
+    """Whether a study file's content asks for a workspace study."""
+    return raw.get("kind") == "workspace"
+
+

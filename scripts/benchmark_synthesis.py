@@ -1,0 +1,65 @@
+"""Speed of four-bar path generation: the coupler point through 10 points of the bundled
+four-bar's coupler curve (taken at full precision, the linkage hidden), synthesised to
+<= 1e-6 relative target error without defects, once per seed; the wall time of each run,
+its median and spread, its candidates a second, and the ratio to Pyslvs' published figure
+(differential evolution, population 400 x 1,000 generations, 51 s on an i7-6700).
+
+    python scripts/benchmark_synthesis.py --seeds 1 2 3 4 5
+
+The goal (issue 26): at most 60 s on this 2-core machine. Needs `pip install "pinmech[study]"`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from pinmech.design.synthesis_file import load_synthesis  # noqa: E402
+from pinmech.design.synthesis_fourbar import pose  # noqa: E402
+from pinmech.design.synthesis_search import synthesise  # noqa: E402
+
+PYSLVS_SECONDS = 51.0  # Pyslvs' documentation: DE, population 400, 1,000 generations, i7-6700
+GOAL_SECONDS = 60.0
+BUNDLED = np.array([0, 0, 0.1, 0, 0.04, 0.12, 0.08, 0.06610894, -0.01138455])  # four_bar.toml (synthesis test)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
+    parser.add_argument("--generations", type=int, default=400)
+    args = parser.parse_args(argv)
+    spec = load_synthesis(ROOT / "models" / "synthesis" / "four_bar_path.toml")
+    crank = np.radians(np.arange(20.0, 300.0, 30.0))
+    targets = pose(BUNDLED[None], np.ones(1), crank[None]).P[0]
+    times, rates, met = [], [], 0
+    for seed in args.seeds:
+        run = spec.__class__(**{**spec.__dict__, "targets": targets, "seed": seed, "keep": 1,
+                                "generations": args.generations})
+        t0 = time.perf_counter()
+        result = synthesise(run)
+        dt = time.perf_counter() - t0
+        best = result.linkages[0] if result.linkages else None
+        error = float(np.max(best.errors) / best.size) if best else math.inf
+        met += error <= 1e-6
+        times.append(dt)
+        rates.append(result.evaluations / dt)
+        print(f"seed {seed}: {dt:6.1f} s, {result.evaluations} candidates ({result.evaluations / dt:.0f}/s), "
+              f"{result.generations} generations, max error {error:.2e} of the size")
+    med = statistics.median(times)
+    print(f"\n{met}/{len(args.seeds)} runs met 1e-6; wall time median {med:.1f} s (min {min(times):.1f}, "
+          f"max {max(times):.1f}); goal {GOAL_SECONDS:.0f} s; Pyslvs' published {PYSLVS_SECONDS:.0f} s: "
+          f"ratio {med / PYSLVS_SECONDS:.2f}; candidates a second median {statistics.median(rates):.0f} "
+          f"(Pyslvs ~7,800/s)")
+
+
+if __name__ == "__main__":
+    main()
