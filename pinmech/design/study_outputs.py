@@ -1,5 +1,5 @@
 """A study's outputs: their names and kinds, their values over a cycle (all poses in one
-call of the compiled core's `frame_motion`), and their Jacobians at a pose.
+call of the compiled core's `frames_along`), and their Jacobians at a pose.
 
 Outputs, in this order (`[outputs]` of the study file):
 
@@ -30,7 +30,7 @@ from pinmech.exceptions import SceneError
 from pinmech.design.study_stroke import Stroke
 from pinmech.design.study_torque import DriverTorques
 from pinmech.design.study_transmission import dyad_pins, transmission_row, transmission_values
-from pinmech.solve.core import CompiledModel
+from pinmech.solve.core import _core
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -89,28 +89,35 @@ class StudyOutputs:
             self.e1 = e1 / np.linalg.norm(e1)
             self.e2 = np.cross(self.normal, self.e1)
         self.pins = sorted({f for d in self.dyads for f in (d.near, d.joint, d.ground) if f >= 0})
-        frames = self.points + self.links + self.omega + self.alpha + self.pins
-        compiled = CompiledModel(sm.model, frames)
-        self._core = compiled.kinematics(sm.model)  # reads the variant's placements at each call
-        self._frames = list(range(len(compiled.frame_ids)))
-        self._index = {key: [compiled.frames[f] for f in fs] for key, fs in
+        rows = {f: i for i, f in enumerate(dict.fromkeys(self.points + self.links + self.omega + self.alpha
+                                                          + self.pins))}
+        self._frames = np.array(list(rows), dtype=np.int32)  # read with the variant's placements at each call
+        self._data = sm.model.createData()
+        self._index = {key: [rows[f] for f in fs] for key, fs in
                        (("points", self.points), ("links", self.links), ("omega", self.omega), ("alpha", self.alpha),
-                                                                  ("pins", self.pins))}
+                        ("pins", self.pins))}
+
+    def _kinematics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """The frames' kinematics rows (n, F, KINEMATICS_COLUMNS): position 0:3, rotation 3:12,
+        linear and angular velocity 12:18, classical linear and angular acceleration 18:24."""
+        K = np.empty((len(q), len(self._frames), _core.KINEMATICS_COLUMNS))
+        _core.frames_along(self.sm.model, self._data, q, v, a, self._frames, K)
+        return K
 
     def cycle(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         """The outputs (steps, n_out) at the poses q with rates v, a (steps, nq / nv) of the
         variant now written in the model [m, rad, m/s, rad/s, rad/s^2]."""
         q, v, a = (np.ascontiguousarray(x, dtype=float).reshape(len(q), -1) for x in (q, v, a))
         n, P, R = len(q), None, None
-        if self._frames:
-            P, R, _, W, _, alpha = (x.reshape(n, len(self._frames), -1)
-                                    for x in self._core.frame_motion(q, v, a, self._frames))
+        if len(self._frames):
+            K = self._kinematics(q, v, a)
+            P, R, W, alpha = K[..., 0:3], K[..., 3:12], K[..., 15:18], K[..., 21:24]
             at = self._index
         columns = self._pose_columns(q, P, R)
         columns += [v[:, iv] for _, iv in self.sliders]
-        if self._frames:
+        if len(self._frames):
             columns += list((W[:, at["omega"]] @ self.normal).T) if at["omega"] else []
-        if self._frames:
+        if len(self._frames):
             columns += list((alpha[:, at["alpha"]] @ self.normal).T) if at["alpha"] else []
         for stroke in self.strokes:
             top, _, low, _ = stroke.extremes(q)
@@ -121,10 +128,11 @@ class StudyOutputs:
     def pose_values(self, q: np.ndarray) -> np.ndarray:
         """The pose outputs (the first n_pose) at one pose q (nq,) [m, rad]."""
         q = np.ascontiguousarray(q, dtype=float).reshape(1, -1)
-        if not self._frames:
+        if not len(self._frames):
             return np.array(self._pose_columns(q, None, None)).reshape(-1)
         zero = np.zeros((1, self.sm.model.nv))
-        P, R = (x.reshape(1, len(self._frames), -1) for x in self._core.frame_motion(q, zero, zero, self._frames)[:2])
+        K = self._kinematics(q, zero, zero)
+        P, R = K[..., 0:3], K[..., 3:12]
         return np.array(self._pose_columns(q, P, R)).reshape(-1)
 
     def _pose_columns(self, q: np.ndarray, P: np.ndarray | None, R: np.ndarray | None) -> list[np.ndarray]:
