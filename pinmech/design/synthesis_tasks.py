@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from pinmech.design.burmester import four_bar_rows
 from pinmech.design.synthesis_file import SynthesisSpec
 from pinmech.design.synthesis_function import evaluate_function, freudenstein_rows, function_bounds, refined_function
 from pinmech.design.synthesis_objective import BatchValues, evaluate_path, path_bounds
@@ -30,7 +31,12 @@ def refined(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Linkage | No
 
 
 def classical_rows(spec: SynthesisSpec) -> np.ndarray:
-    """Rows from the classical closed forms (Freudenstein for functions), best first."""
+    """Rows from the classical closed forms (Freudenstein for functions, Burmester's dyad
+    pairs for four poses, those within the bounds), best first."""
     if spec.task == "function":
         return freudenstein_rows(spec)
+    if spec.task == "motion" and len(spec.targets) == 4:
+        rows = four_bar_rows(spec.targets, spec.angles)
+        inside = np.all((rows[:, :9] >= spec.lower) & (rows[:, :9] <= spec.upper), axis=1)
+        return rows[inside]
     return np.zeros((0, len(search_bounds(spec))))
