@@ -1,5 +1,5 @@
 """Synthesis files: every mistake is one line on stderr naming the file and the key, with
-the scene-file exit code (4); a synthesis that finds nothing says why (exit 2)."""
+the scene-file exit code (4); a synthesis that finds nothing says why (SynthesisError, exit 15)."""
 
 from __future__ import annotations
 
@@ -63,7 +63,7 @@ def test_no_linkage_found_is_an_error_with_the_rejected_counts(tmp_path, capsys)
     path = _edited(tmp_path, 'transmission = "25 deg"', 'transmission = "89 deg"')
     text = path.read_text().replace("generations = 400", "generations = 3").replace("population = 15", "population = 5")
     path.write_text(text)
-    assert main(["synth", str(path), "--out", str(tmp_path / "none")]) == 2
+    assert main(["synth", str(path), "--out", str(tmp_path / "none")]) == 15
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and str(path) in err and "transmission angle" in err
 

@@ -38,7 +38,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
     from pinmech.design.synthesis_linkage import engine_check, write_linkage
     from pinmech.design.synthesis_report import figure, summary, text
     from pinmech.design.synthesis_search import synthesise
-    from pinmech.exceptions import OptionRefused, PinmechError
+    from pinmech.exceptions import OptionRefused, SynthesisError
 
     if args.plot and not args.out:
         raise OptionRefused("--plot writes PREFIX.png: give --out PREFIX too", options=["--plot"])
@@ -46,10 +46,9 @@ def cmd_synth(args: argparse.Namespace) -> int:
     result = synthesise(spec, workers=args.workers, scheduler=args.scheduler)
     if not result.linkages:
         causes = ", ".join(f"{n} {c}" for c, n in sorted(result.rejected.items())) or "none"
-        # PinmechError itself (exit 2): a class of its own needs its row in the README's table of exit codes
-        raise PinmechError(f"{spec.path}: no linkage meets the targets without a defect and within the constraints "
-                           f"after {result.evaluations} candidates (rejected: {causes}); widen the bounds or the "
-                           "constraints, or raise generations")
+        raise SynthesisError(f"no linkage meets the targets without a defect and within the constraints "
+                             f"after {result.evaluations} candidates (rejected: {causes}); widen the bounds or the "
+                             "constraints, or raise generations", path=str(spec.path), rejected=dict(result.rejected))
     report = summary(result)
     lines = [text(result)]
     written = []
