@@ -20,7 +20,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import math
+
 import numpy as np
+
+from pinmech.solve.grashof import four_bar_class
 
 #: Names of a four-bar candidate's entries, in order.
 NAMES = ("O2x", "O2y", "O4x", "O4y", "crank", "coupler", "rocker", "along", "across")
@@ -63,6 +67,21 @@ def pose(z: np.ndarray, s: np.ndarray, theta: np.ndarray) -> FourBarPose:
     cos_mu = np.clip((r3 * r3 + r4 * r4 - D2) / (2 * r3 * r4), -1.0, 1.0)
     return FourBarPose(np.stack((ax, ay), -1), np.stack((bx, by), -1), np.stack((px, py), -1), closes,
                        np.arccos(cos_mu))
+
+
+def label(z: np.ndarray) -> str:
+    """The Grashof class of one candidate (grashof.four_bar_class: crank at O2, rocker at O4)."""
+    return four_bar_class(*lengths(z))[0]
+
+
+def lengths(z: np.ndarray) -> tuple[float, ...]:
+    """The four links of one candidate (ground, crank, coupler, rocker) [m]."""
+    return math.hypot(z[2] - z[0], z[3] - z[1]), float(z[4]), float(z[5]), float(z[6])
+
+
+def size(z: np.ndarray) -> float:
+    """The four-bar's size: its longest link [m]."""
+    return float(max(lengths(z)))
 
 
 def ground_angle(z: np.ndarray) -> np.ndarray:
