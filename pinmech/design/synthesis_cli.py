@@ -57,7 +57,8 @@ def cmd_synth(args: argparse.Namespace) -> int:
             files = write_linkage(lk, f"{args.out}_{i}", f"{spec.title}: linkage {i}", str(spec.path))
             check = engine_check(files[1], lk, spec.targets, spec.angles)
             entry["files"] = [str(p) for p in files]
-            scale, unit = (1e3, "mm") if lk.task != "function" else (180 / 3.141592653589793, "deg")
+            angular = lk.task == "function" and lk.topology == "four-bar"
+            scale, unit = (180 / 3.141592653589793, "deg") if angular else (1e3, "mm")
             entry[f"engine_errors_{unit}"] = [float(e) * scale for e in check.errors]
             also = ""
             if check.angle_errors is not None:
