@@ -23,6 +23,8 @@ import math
 
 import numpy as np
 
+from pinmech.model.compass import compass
+
 
 def compatibility(places: np.ndarray, angles: np.ndarray) -> np.ndarray:
     """D1..D4 (complex) of four poses: places (4, 2) [m], angles (4,) [rad]."""
@@ -66,14 +68,13 @@ def dyads(places: np.ndarray, angles: np.ndarray, samples: int = 72) -> tuple[np
 
 
 def _triangle(K: complex, r3: float, r4: float) -> list[complex]:
-    """The X with |X| = r3 and |K - X| = r4 (two, one or none): the circles about 0 and K."""
-    L = abs(K)
-    if L == 0 or L > r3 + r4 or L < abs(r3 - r4):
+    """The X with |X| = r3 and |K - X| = r4 (two, one or none): the circles about 0 and K
+    meet (model/compass.py)."""
+    if K == 0:
         return []
-    along = (r3 * r3 - r4 * r4 + L * L) / (2 * L)
-    h = math.sqrt(max(r3 * r3 - along * along, 0.0))
-    u = K / L
-    return [u * (along + 1j * h), u * (along - 1j * h)]
+    ends = np.array([[0.0, 0.0], [K.real, K.imag]])
+    points, meets = compass(ends[0], ends[1], r3, r4, np.array([1.0, -1.0]))
+    return [complex(*p) for p in points] if bool(meets.all()) else []
 
 
 def four_bar_rows(places: np.ndarray, angles: np.ndarray, samples: int = 72) -> np.ndarray:
