@@ -26,7 +26,8 @@ def _engine_pins(tmp_path: Path, crank_deg: np.ndarray) -> tuple[np.ndarray, np.
     from pinmech.io.sweep import Sweep
 
     scene = tmp_path / "bundled_scene.toml"
-    scene.write_text(f'title = "bundled slider-crank"\nlinkage = "{(ROOT / "models/linkages/slider_crank.toml").as_posix()}"\n'
+    linkage = (ROOT / "models/linkages/slider_crank.toml").as_posix()
+    scene.write_text(f'title = "bundled slider-crank"\nlinkage = "{linkage}"\n'
                      '[drivers.O]\nangle = "0 deg"\n[report]\npoints = ["A", "B"]\n', encoding="utf-8")
     sweep = Sweep.from_scene(Scene.load(scene))
     dense = np.radians(np.unique(np.concatenate((np.arange(0.0, 300.0, 1.0), crank_deg))))

@@ -171,8 +171,8 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
     if task == "motion":
         targets, angles = targets[:, :2].copy(), targets[:, 2].copy()
     return SynthesisSpec(path, str(raw.get("title", path.stem)), task, topology, targets, timing, lower, upper,
-                         w.choice(c, "grashof", SLIDER_CLASSES if slider else CLASSES, "any", "constraints"), ground, transmission, float(ratio),
-                         direction, angles=angles, **counts)
+                         w.choice(c, "grashof", SLIDER_CLASSES if slider else CLASSES, "any", "constraints"), ground,
+                         transmission, float(ratio), direction, angles=angles, **counts)
 
 
 def _targets(raw: dict[str, Any], w: _Where, key: str = "targets") -> np.ndarray:

@@ -31,11 +31,11 @@ def linkage_summary(lk: Linkage) -> dict:
                                 if n != "slide"}, "slide_deg": round(math.degrees(lk.z[2]), 9)} if slider else
              {"dimensions_mm": {n: round(float(v) * 1e3, 9) for n, v in zip(kinematics(lk.topology).NAMES, lk.z)},
               "ground_mm": round(math.hypot(lk.z[2] - lk.z[0], lk.z[3] - lk.z[1]) * 1e3, 9)})
-    if lk.task != "function":
-        errors = {"errors_mm": [float(e) * 1e3 for e in lk.errors], "max_error_relative": float(np.max(lk.errors) / lk.size)}
-    elif slider:
-        errors = {"errors_mm": [float(e) * 1e3 for e in lk.errors], "max_error_relative": float(np.max(lk.errors) / lk.size),
-                  "slider_start_mm": lk.phi0 * 1e3}
+    if lk.task != "function" or slider:
+        errors = {"errors_mm": [float(e) * 1e3 for e in lk.errors],
+                  "max_error_relative": float(np.max(lk.errors) / lk.size)}
+        if lk.task == "function":
+            errors["slider_start_mm"] = lk.phi0 * 1e3
     else:
         errors = {"errors_deg": [math.degrees(float(e)) for e in lk.errors], "rocker_start_deg": math.degrees(lk.phi0)}
     return {

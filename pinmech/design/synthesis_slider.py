@@ -10,7 +10,8 @@ rod at `along` A -> B from A and `across` to its left. The block's pin B = H + x
 At a crank angle theta, A = O2 + crank e(theta) is h = (A - H) . n = crank sin(theta -
 slide) - offset from the line; the rod reaches it while |h| <= rod, and then x = (A - H) .
 u + s sqrt(rod^2 - h^2): the assembly s = +1 puts B ahead of A's foot along u, s = -1
-behind. The folds, where |h| = rod (the rod square to the slide), are at sin(theta - slide) = (offset +- rod) / crank, in closed form:
+behind. The folds, where |h| = rod (the rod square to the slide), are at sin(theta -
+slide) = (offset +- rod) / crank, in closed form:
 a motion on one s that passes no fold is continuation on one assembly, exactly.
 
 The transmission angle mu is the rod's angle from the slide's normal (90 deg: the rod

@@ -41,7 +41,8 @@ def _span(spec: SynthesisSpec) -> float:
     return float(max(np.ptp(spec.targets[:, 1]), 1e-12))
 
 
-def _travel_errors(spec: SynthesisSpec, z: np.ndarray, s: np.ndarray, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _travel_errors(spec: SynthesisSpec, z: np.ndarray, s: np.ndarray,
+                   theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The block's travel from the first pair minus the travel asked (n, N) [m], and its
     place along the slide at the first pair (n,) [m]."""
     x = slide_position(z, pose(z, s, theta).B)
