@@ -30,6 +30,7 @@ from pinmech.exceptions import (
     SceneError,
     SingularPoseError,
     SweepError,
+    SynthesisError,
     TaskError,
     UnitError,
 )
@@ -153,6 +154,7 @@ __all__ = [
     "SingularPoseError",
     "Sweep",
     "SweepError",
+    "SynthesisError",
     "SweepForces",
     "SweepPose",
     "StudyResult",

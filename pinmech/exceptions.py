@@ -334,3 +334,20 @@ class MissingTool(PinmechError):
         self.tool = tool
         self.option = option
 
+
+
+class SynthesisError(PinmechError):
+    """A dimensional synthesis found no linkage that meets its targets without a defect
+    (branch, circuit, order) and within its constraints: the candidates rejected, by cause.
+
+    Attributes:
+        path: the synthesis file.
+        rejected: the candidates rejected, by cause ({cause: count}).
+    """
+
+    exit_code = 15
+
+    def __init__(self, message: str, *, path: str | None = None, rejected: dict[str, int] | None = None):
+        super().__init__(f"{path}: {message}" if path else message)
+        self.path = path
+        self.rejected = dict(rejected or {})

@@ -5,7 +5,8 @@ Exit codes: 0 success; 1 hand values mismatch (`check`); 2 usage or other pinmec
 the mobility; 6 a loop cannot close; 7 singular pose, or forces not determined; 8 inconsistent
 task; 9 a drawing input out of range; 10 another assembly than the scene's (or none reachable
 on it); 11 the drivers cannot go further (a fold: limit angle, extreme, stroke); 12 a joint
-beyond its limits (URDF <limit>, MJCF range; with --limits error); 13 forces that fail their own power balance; 14 a planar design diagnostic asked of a spatial mechanism.
+beyond its limits (URDF <limit>, MJCF range; with --limits error); 13 forces that fail their own power balance; 14 a planar design diagnostic asked of a spatial mechanism;
+15 a synthesis that found no linkage (without defects, within its constraints).
 An output file that cannot be written is 2.
 Stopped by a signal: 128 + its number (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP), outputs kept
 as NAME.partial.

@@ -32,6 +32,7 @@ def build_parser(command: str | None = None, *, parser_class: type[argparse.Argu
         epilog="Exit codes: 0 ok, 1 check mismatch, 2 error, 3 URDF, 4 scene, 5 mobility, "
         "6 loop cannot close, 7 singular pose (or undetermined forces), 8 task, 9 drawing, 10 assembly, "
         "11 driver limit, 12 joint limit (--limits error), 13 forces off their balance, 14 design diagnostic (spatial), "
+        "15 synthesis found no linkage, "
         "130 Ctrl-C (128 + signal).",
     )
     parser.add_argument("--version", action="version", version=f"pinmech {__version__}")

@@ -38,7 +38,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
     from pinmech.design.synthesis_linkage import engine_check, write_linkage
     from pinmech.design.synthesis_report import figure, summary, text
     from pinmech.design.synthesis_search import synthesise
-    from pinmech.exceptions import OptionRefused, PinmechError
+    from pinmech.exceptions import OptionRefused, SynthesisError
 
     if args.plot and not args.out:
         raise OptionRefused("--plot writes PREFIX.png: give --out PREFIX too", options=["--plot"])
@@ -46,10 +46,9 @@ def cmd_synth(args: argparse.Namespace) -> int:
     result = synthesise(spec, workers=args.workers, scheduler=args.scheduler)
     if not result.linkages:
         causes = ", ".join(f"{n} {c}" for c, n in sorted(result.rejected.items())) or "none"
-        # PinmechError itself (exit 2): a class of its own needs its row in the README's table of exit codes
-        raise PinmechError(f"{spec.path}: no linkage meets the targets without a defect and within the constraints "
-                           f"after {result.evaluations} candidates (rejected: {causes}); widen the bounds or the "
-                           "constraints, or raise generations")
+        raise SynthesisError(f"no linkage meets the targets without a defect and within the constraints "
+                             f"after {result.evaluations} candidates (rejected: {causes}); widen the bounds or the "
+                             "constraints, or raise generations", path=str(spec.path), rejected=dict(result.rejected))
     report = summary(result)
     lines = [text(result)]
     written = []
@@ -58,7 +57,8 @@ def cmd_synth(args: argparse.Namespace) -> int:
             files = write_linkage(lk, f"{args.out}_{i}", f"{spec.title}: linkage {i}", str(spec.path))
             check = engine_check(files[1], lk, spec.targets, spec.angles)
             entry["files"] = [str(p) for p in files]
-            scale, unit = (1e3, "mm") if lk.task != "function" else (180 / 3.141592653589793, "deg")
+            angular = lk.task == "function" and lk.topology == "four-bar"
+            scale, unit = (180 / 3.141592653589793, "deg") if angular else (1e3, "mm")
             entry[f"engine_errors_{unit}"] = [float(e) * scale for e in check.errors]
             also = ""
             if check.angle_errors is not None:

@@ -57,13 +57,23 @@ from pinmech.toml_file import read_toml
 from pinmech.units import to_si
 
 TASKS = ("path", "function", "motion")
-TOPOLOGIES = ("four-bar",)
+TOPOLOGIES = ("four-bar", "slider-crank")
 CLASSES = ("any", "grashof", "crank-rocker", "double-crank", "double-rocker", "triple rocker")
+SLIDER_CLASSES = ("any", "crank", "rocker")  # grashof.slider_crank_class: the crank turns fully, or not
 DIRECTIONS = ("ccw", "cw", "either")
 _TOP = {"title", "task", "topology", "targets", "timing", "seed", "population", "generations", "keep",
         "bounds", "constraints", "pairs", "ground", "poses"}
 _ONLY = {"targets": "path", "timing": "path", "pairs": "function", "ground": "function", "poses": "motion"}
-_BOUNDS = ("O2", "O4", "crank", "coupler", "rocker", "point")
+#: Each (topology, task)'s bounds: the parameters in the order of a candidate's row, each
+#: with its axes (none: a length, positive unless it is an offset); "angle" axes are angles.
+_BOUNDS = {
+    ("four-bar", "path"): (("O2", ("x", "y")), ("O4", ("x", "y")), ("crank", ()), ("coupler", ()), ("rocker", ()),
+                           ("point", ("along", "across"))),
+    ("four-bar", "function"): (("crank", ()), ("coupler", ()), ("rocker", ())),
+    ("slider-crank", "path"): (("O2", ("x", "y")), ("slide", ("angle", "offset")), ("crank", ()), ("rod", ()),
+                               ("point", ("along", "across"))),
+    ("slider-crank", "function"): (("crank", ()), ("rod", ()), ("offset", ())),
+}
 _CONSTRAINTS = {"grashof", "transmission", "ratio", "direction"}
 _LIMITS = {"seed": (0, 2**32 - 1), "population": (5, 1000), "generations": (1, 100_000), "keep": (1, 20)}
 
@@ -127,14 +137,21 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
     for key, only in _ONLY.items():
         if key in raw and task != only:
             raise w.error(key, f"{key} is for task = \"{only}\" (this file's task is {task!r})")
+    slider = topology == "slider-crank"
+    if slider and task == "motion":
+        raise w.error("task", "motion generation is for the four-bar only (a slider-crank's rod through poses "
+                      "is not there yet): use task = \"path\" or \"function\"")
     if task == "function":
-        targets, timing = _pairs(raw, w), None
-        lower, upper = _bounds(raw, w, ("crank", "coupler", "rocker"))
-        ground = w.positive_length(raw, "ground")
+        targets, timing = _pairs(raw, w, "length" if slider else "angle"), None
+        lower, upper = _bounds(raw, w, _BOUNDS[topology, "function"])
+        ground = 0.0 if slider else w.positive_length(raw, "ground")
+        if slider and "ground" in raw:
+            raise w.error("ground", "a slider-crank's function has no ground length: its slide is along x, "
+                          "`offset` from the crank's pivot (bounds.offset)")
     else:
         targets = _targets(raw, w, "poses" if task == "motion" else "targets")
         timing = _timing(raw, w, len(targets)) if "timing" in raw else None
-        lower, upper = _bounds(raw, w, _BOUNDS)
+        lower, upper = _bounds(raw, w, _BOUNDS[topology, "path"])
         ground = 0.0
     c = raw.get("constraints", {})
     w.known(c, _CONSTRAINTS, "constraints")
@@ -154,8 +171,8 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
     if task == "motion":
         targets, angles = targets[:, :2].copy(), targets[:, 2].copy()
     return SynthesisSpec(path, str(raw.get("title", path.stem)), task, topology, targets, timing, lower, upper,
-                         w.choice(c, "grashof", CLASSES, "any", "constraints"), ground, transmission, float(ratio),
-                         direction, angles=angles, **counts)
+                         w.choice(c, "grashof", SLIDER_CLASSES if slider else CLASSES, "any", "constraints"), ground,
+                         transmission, float(ratio), direction, angles=angles, **counts)
 
 
 def _targets(raw: dict[str, Any], w: _Where, key: str = "targets") -> np.ndarray:
@@ -179,19 +196,22 @@ def _targets(raw: dict[str, Any], w: _Where, key: str = "targets") -> np.ndarray
     return out
 
 
-def _pairs(raw: dict[str, Any], w: _Where) -> np.ndarray:
+def _pairs(raw: dict[str, Any], w: _Where, output: str = "angle") -> np.ndarray:
+    """[crank turn, output's change] from the first pair [rad, rad or m]: the output a
+    rocker's turn (angle) or a slider's travel (length)."""
     value = raw.get("pairs")
+    what, zero = ("rocker turn", "0 deg") if output == "angle" else ("slider travel", "0 mm")
     if not isinstance(value, list) or len(value) < 3:
-        raise w.error("pairs", "give at least 3 pairs [crank turn, rocker turn] from the first, e.g. "
-                      "[[\"0 deg\", \"0 deg\"], [\"30 deg\", \"12 deg\"], ...]")
+        raise w.error("pairs", f"give at least 3 pairs [crank turn, {what}] from the first, e.g. "
+                      f"[[\"0 deg\", \"{zero}\"], [\"30 deg\", \"12 {zero.split()[1]}\"], ...]")
     rows = []
     for i, t in enumerate(value):
         if not isinstance(t, list) or len(t) != 2:
-            raise w.error(f"pairs[{i}]", f"{t!r} must be [crank turn, rocker turn] with units")
-        rows.append([to_si(x, "angle", where=f"{w.path}, pairs[{i}]") for x in t])
+            raise w.error(f"pairs[{i}]", f"{t!r} must be [crank turn, {what}] with units")
+        rows.append([to_si(x, kind, where=f"{w.path}, pairs[{i}]") for x, kind in zip(t, ("angle", output))])
     out = np.array(rows)
     if np.any(out[0] != 0):
-        raise w.error("pairs[0]", "the first pair is the start: [\"0 deg\", \"0 deg\"]")
+        raise w.error("pairs[0]", f"the first pair is the start: [\"0 deg\", \"{zero}\"]")
     step = np.diff(out[:, 0])
     if not (np.all(step > 0) or np.all(step < 0)) or abs(out[-1, 0]) >= 2 * math.pi:
         raise w.error("pairs", "the crank turns must grow (ccw) or fall (cw) strictly, within one turn")
@@ -210,23 +230,23 @@ def _timing(raw: dict[str, Any], w: _Where, n: int) -> np.ndarray:
     return t
 
 
-def _bounds(raw: dict[str, Any], w: _Where, names: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+def _bounds(raw: dict[str, Any], w: _Where, layout: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """The bounds of each parameter of `layout` (_BOUNDS), in its order [m, rad]."""
     table = raw.get("bounds")
+    names = [name for name, _ in layout]
     w.known(table, set(names), "bounds")
     missing = [k for k in names if k not in table]
     if missing:
         raise w.error("bounds", f"missing {', '.join(missing)}: every parameter needs [lower, upper]")
     pairs = []
-    for name, axes in (("O2", ("x", "y")), ("O4", ("x", "y")), ("crank", ()), ("coupler", ()), ("rocker", ()),
-                       ("point", ("along", "across"))):
-        if name not in names:
-            continue
+    for name, axes in layout:
         entry = table[name]
         if axes:
             w.known(entry, set(axes), f"bounds.{name}")
-            pairs += [w.interval(entry.get(a), f"bounds.{name}.{a}") for a in axes]
+            pairs += [w.interval(entry.get(a), f"bounds.{name}.{a}", kind="angle" if a == "angle" else "length")
+                      for a in axes]
         else:
-            pairs.append(w.interval(entry, f"bounds.{name}", positive=True))
+            pairs.append(w.interval(entry, f"bounds.{name}", positive=name != "offset"))
     lower, upper = np.array(pairs).T
     return lower, upper
 
@@ -273,10 +293,11 @@ class _Where:
     def quantity(self, table: dict, name: str, kind: str, under: str) -> float:
         return to_si(table[name], kind, where=f"{self.path}, {under}.{name}")
 
-    def interval(self, value: Any, key: str, positive: bool = False) -> tuple[float, float]:
+    def interval(self, value: Any, key: str, positive: bool = False, kind: str = "length") -> tuple[float, float]:
         if not isinstance(value, list) or len(value) != 2:
-            raise self.error(key, f"{value!r} must be [lower, upper] with units, e.g. [\"10 mm\", \"80 mm\"]")
-        lo, hi = (to_si(v, "length", where=f"{self.path}, {key}") for v in value)
+            example = '["-10 deg", "10 deg"]' if kind == "angle" else '["10 mm", "80 mm"]'
+            raise self.error(key, f"{value!r} must be [lower, upper] with units, e.g. {example}")
+        lo, hi = (to_si(v, kind, where=f"{self.path}, {key}") for v in value)
         if not lo < hi:
             raise self.error(key, f"lower {value[0]} is not below upper {value[1]}")
         if positive and not lo > 0:

@@ -7,7 +7,7 @@ ground pivots O2 (crank) and O4 (rocker), link lengths, and the coupler point P 
 `along` the coupler's bar A -> B and `across` to the left of it. The assembly s = +1 puts
 B to the left of the line A -> O4 (the drawn linkage's `side = "left"`), s = -1 right.
 
-At a crank angle theta the dyad A-B-O4 closes (the compass of models/model/linkage.py):
+At a crank angle theta the dyad A-B-O4 closes (model/compass.py, as a drawn linkage's B):
 D = |O4 - A|, B = A + a u + s h n with a = (coupler^2 - rocker^2 + D^2) / 2D,
 h = sqrt(coupler^2 - a^2), u the unit A -> O4 and n = u turned +90 deg. It closes while
 |coupler - rocker| <= D <= coupler + rocker; D depends on theta through cos(theta - g)
@@ -20,7 +20,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import math
+
 import numpy as np
+
+from pinmech.model.compass import compass
+from pinmech.solve.grashof import four_bar_class
 
 #: Names of a four-bar candidate's entries, in order.
 NAMES = ("O2x", "O2y", "O4x", "O4y", "crank", "coupler", "rocker", "along", "across")
@@ -49,20 +54,32 @@ def pose(z: np.ndarray, s: np.ndarray, theta: np.ndarray) -> FourBarPose:
     col = [z[:, k, None] for k in range(9)]
     o2x, o2y, o4x, o4y, r2, r3, r4, pu, pv = col
     ax, ay = o2x + r2 * np.cos(theta), o2y + r2 * np.sin(theta)
-    dx, dy = o4x - ax, o4y - ay
-    D2 = dx * dx + dy * dy
-    D = np.sqrt(D2)
-    a = (r3 * r3 - r4 * r4 + D2) / (2 * D)
-    h2 = r3 * r3 - a * a
-    closes = h2 >= 0
-    h = np.sqrt(np.where(closes, h2, np.nan)) * np.asarray(s, dtype=float)[:, None]
-    ux, uy = dx / D, dy / D
-    bx, by = ax + a * ux - h * uy, ay + a * uy + h * ux
+    A = np.stack((ax, ay), -1)
+    O4 = np.stack(np.broadcast_arrays(o4x, o4y), -1)
+    B, closes = compass(A, O4, r3, r4, np.asarray(s, dtype=float)[:, None])
+    B = np.where(closes[..., None], B, np.nan)
+    bx, by = B[..., 0], B[..., 1]
+    D2 = (o4x - ax) ** 2 + (o4y - ay) ** 2
     ex, ey = (bx - ax) / r3, (by - ay) / r3
     px, py = ax + pu * ex - pv * ey, ay + pu * ey + pv * ex
     cos_mu = np.clip((r3 * r3 + r4 * r4 - D2) / (2 * r3 * r4), -1.0, 1.0)
-    return FourBarPose(np.stack((ax, ay), -1), np.stack((bx, by), -1), np.stack((px, py), -1), closes,
+    return FourBarPose(A, B, np.stack((px, py), -1), closes,
                        np.arccos(cos_mu))
+
+
+def label(z: np.ndarray) -> str:
+    """The Grashof class of one candidate (grashof.four_bar_class: crank at O2, rocker at O4)."""
+    return four_bar_class(*lengths(z))[0]
+
+
+def lengths(z: np.ndarray) -> tuple[float, ...]:
+    """The four links of one candidate (ground, crank, coupler, rocker) [m]."""
+    return math.hypot(z[2] - z[0], z[3] - z[1]), float(z[4]), float(z[5]), float(z[6])
+
+
+def size(z: np.ndarray) -> float:
+    """The four-bar's size: its longest link [m]."""
+    return float(max(lengths(z)))
 
 
 def ground_angle(z: np.ndarray) -> np.ndarray:

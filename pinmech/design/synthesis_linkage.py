@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.design.synthesis_fourbar import pose
+from pinmech.design.synthesis_kinematics import kinematics
 from pinmech.design.synthesis_result import Linkage
 
 _STEP = math.radians(1.0)  # the engine's sweep: at most this crank step between poses
@@ -33,12 +33,25 @@ def linkage_toml(lk: Linkage, title: str, source: str) -> str:
     from pinmech.model.linkage_spec import linkage_spec
     from pinmech.model.linkage_write import linkage_toml as written
 
-    p = pose(lk.z[None], np.array([lk.s]), lk.theta[:1][None])
+    p = kinematics(lk.topology).pose(lk.z[None], np.array([lk.s]), lk.theta[:1][None])
     A, P = p.A[0, 0], p.P[0, 0]
     z = lk.z
     path = lk.task != "function"
+    slider = lk.topology == "slider-crank"
     what = {"path": "the coupler point P through the targets", "motion": "the coupler through the poses",
-            "function": "the rocker's turns as the function asks"}[lk.task]
+            "function": "the slider's travel" if slider else "the rocker's turns"}[lk.task]
+    if slider:
+        B = p.B[0, 0]
+        joints = {"O2": [_mm(z[0]), _mm(z[1])], "A": [_mm(A[0]), _mm(A[1])], "B": [_mm(B[0]), _mm(B[1])]}
+        if path:
+            joints["P"] = [_mm(P[0]), _mm(P[1])]
+        raw = {"title": title, "ground": ["O2"], "joints": joints,
+               "links": {"crank": ["O2", "A"], "rod": ["A", "B", "P"] if path else ["A", "B"], "piston": ["B"]},
+               "sliders": {"slide": {"block": "piston", "on": "ground", "at": "B",
+                                     "along": f"{math.degrees(z[2]):.15g} deg"}}}
+        header = (f"Synthesised by `pinmech synth {source}`: {what}.\n"
+                  f"Drawn at the first target's pose (crank O2 at {math.degrees(lk.theta[0]):.6g} deg from x).")
+        return written(linkage_spec(raw, source), header)
     joints = {"O2": [_mm(z[0]), _mm(z[1])], "O4": [_mm(z[2]), _mm(z[3])], "A": [_mm(A[0]), _mm(A[1])],
               "B": {"from": ["A", "O4"], "lengths": [_mm(z[5]), _mm(z[6])], "side": "left" if lk.s > 0 else "right"}}
     if path:
@@ -63,6 +76,8 @@ def scene_toml(lk: Linkage, linkage_file: str, title: str) -> str:
     steps = int(math.ceil(abs(values[-1] - values[0]) / _STEP)) + 1
     shown = {"path": "points = [\"P\"]", "motion": "points = [\"P\"]\nlinks = [\"coupler\"]",
              "function": "links = [\"rocker\"]"}[lk.task]
+    if lk.topology == "slider-crank":
+        shown = "points = [\"B\", \"P\"]" if lk.task == "path" else "points = [\"B\"]"
     return "\n".join([
         "# The synthesised linkage swept through its targets:",
         "#   pinmech sweep THIS_FILE --plot fig.png",
@@ -129,6 +144,12 @@ def engine_check(scene_file: str | Path, lk: Linkage, targets: np.ndarray,
             return EngineCheck(P, np.linalg.norm(P - targets, axis=1))
         turn = np.array([m.links["coupler"].angle for m in poses]) + lk.phi0 - angles
         return EngineCheck(P, np.linalg.norm(P - targets, axis=1), np.abs(np.mod(turn + math.pi, 2 * math.pi) - math.pi))
+    if lk.topology == "slider-crank":  # the block's place along the slide from H, against the travel asked
+        from pinmech.design.synthesis_slider import slide_position
+
+        B = np.array([m.points["B"].position[:2] for m in poses])
+        x = slide_position(lk.z[None], B[None])[0]
+        return EngineCheck(x, np.abs(x - (lk.phi0 + targets[:, 1])))
     phi = np.array([m.links["rocker"].angle for m in poses])
     wanted = lk.phi0 + targets[:, 1]  # the rocker's angles asked: its start plus the pairs' turns
     return EngineCheck(phi, np.abs(np.mod(phi - wanted + math.pi, 2 * math.pi) - math.pi))

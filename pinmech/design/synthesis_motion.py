@@ -20,8 +20,7 @@ import math
 import numpy as np
 
 from pinmech.design.synthesis_file import SynthesisSpec
-from pinmech.design.synthesis_fourbar import folds, ground_angle, pose
-from pinmech.solve.grashof import four_bar_class
+from pinmech.design.synthesis_kinematics import kinematics
 
 #: Rejection causes, in the order they are checked.
 CAUSES = ("does not close", "targets out of order", "fold within the motion", "Grashof class", "link ratio",
@@ -57,26 +56,30 @@ def within(angle: np.ndarray, start: np.ndarray, way: np.ndarray, span: np.ndarr
 
 
 def transmission_range(z: np.ndarray, s: np.ndarray, theta: np.ndarray, way: np.ndarray,
-                       span: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The least and the greatest transmission angle mu [rad] over each motion. mu follows
-    D = |A O4| alone, which is monotonic in cos(theta - g) between theta = g and g + pi:
+                       span: np.ndarray, topology: str = "four-bar") -> tuple[np.ndarray, np.ndarray]:
+    """The least and the greatest transmission angle mu [rad] over each motion. A four-bar's
+    mu follows D = |A O4| alone, which is monotonic in cos(theta - g) between theta = g and
+    g + pi (a slider-crank's, the distance of A from the slide, in sin(theta - slide)):
     its extremes are at the motion's ends or at g, g + pi when the crank passes them."""
-    g = ground_angle(z)
+    k = kinematics(topology)
+    g = k.ground_angle(z)
     extra = np.stack((g, g + math.pi), -1)
     inside = within(extra, theta[:, 0], way, span)
     at = np.concatenate((theta[:, :1], theta[:, -1:], np.where(inside, extra, theta[:, :1])), axis=1)
-    mu = pose(z, s, at).mu
+    mu = k.pose(z, s, at).mu
     return mu.min(axis=1), mu.max(axis=1)
 
 
 def causes(spec: SynthesisSpec, z: np.ndarray, s: np.ndarray, theta: np.ndarray) -> list[str]:
     """Each candidate's rejection cause ("" if none): z (n, 9), s (n,), the crank angles
     at the targets theta (n, N) [rad]."""
-    closes = pose(z, s, theta).closes.all(axis=1)
+    k = kinematics(spec.topology)
+    closes = k.pose(z, s, theta).closes.all(axis=1)
     way, span = progress(theta, spec.direction)
-    fold_angles, _ = folds(z)
+    fold_angles, _ = k.folds(z)
     crosses = within(fold_angles, theta[:, 0], way, np.nan_to_num(span)).any(axis=1)
-    mu_low, mu_high = transmission_range(z, s, theta, np.where(way == 0, 1, way), np.nan_to_num(span))
+    mu_low, mu_high = transmission_range(z, s, theta, np.where(way == 0, 1, way), np.nan_to_num(span),
+                                         spec.topology)
     quality = np.minimum(mu_low, math.pi - mu_high)
     out = []
     for i in range(len(z)):
@@ -86,21 +89,20 @@ def causes(spec: SynthesisSpec, z: np.ndarray, s: np.ndarray, theta: np.ndarray)
     return out
 
 
-def grashof_label(z: np.ndarray) -> str:
-    """The Grashof class of one candidate (grashof.four_bar_class: crank at O2, rocker at O4)."""
-    ground = math.hypot(z[2] - z[0], z[3] - z[1])
-    return four_bar_class(ground, z[4], z[5], z[6])[0]
+def grashof_label(z: np.ndarray, topology: str = "four-bar") -> str:
+    """The Grashof class of one candidate (a slider-crank's: "crank" or "rocker")."""
+    return kinematics(topology).label(z)
 
 
 def _shape(spec: SynthesisSpec, z: np.ndarray) -> str:
     """"Grashof class" or "link ratio" where the candidate's lengths break them, else ""."""
     if spec.grashof != "any":
-        label = grashof_label(z)
+        label = grashof_label(z, spec.topology)
         grashof = label not in ("triple rocker",)
         if not (label == spec.grashof or (spec.grashof == "grashof" and grashof)):
             return "Grashof class"
     if math.isfinite(spec.ratio):
-        lengths = (math.hypot(z[2] - z[0], z[3] - z[1]), z[4], z[5], z[6])
+        lengths = kinematics(spec.topology).lengths(z)
         if max(lengths) > spec.ratio * min(lengths):
             return "link ratio"
     return ""

@@ -1,4 +1,5 @@
-"""The path-generation objective of a batch of four-bar candidates, for the global search.
+"""The path-generation objective of a batch of four-bar (or slider-crank) candidates, for
+the global search.
 
 A search row x = (z (9)[, theta0]): the four-bar z (synthesis_fourbar.NAMES) and with
 timing the crank's angle theta0 [rad] at the first target; each search is on one assembly
@@ -18,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinmech.design.synthesis_file import SynthesisSpec
-from pinmech.design.synthesis_fourbar import pose
+from pinmech.design.synthesis_kinematics import kinematics
 from pinmech.design.synthesis_motion import causes
 
 SAMPLES = 180  # crank angles over a turn for the nearest-point search (2 deg apart)
@@ -40,10 +41,11 @@ def extent(targets: np.ndarray) -> float:
     return float(np.linalg.norm(targets.max(axis=0) - targets.min(axis=0)))
 
 
-def split(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Search rows x (n, 9 or 10) -> z (n, 9), theta0 (n,) [rad] (0 without timing)."""
-    theta0 = x[:, 9] if x.shape[1] > 9 else np.zeros(len(x))
-    return x[:, :9], theta0
+def split(x: np.ndarray, width: int = 9) -> tuple[np.ndarray, np.ndarray]:
+    """Search rows x (n, width [+ 1]) -> z (n, width), theta0 (n,) [rad] (0 without
+    timing); width: the topology's parameters (9 for a four-bar, 8 for a slider-crank)."""
+    theta0 = x[:, width] if x.shape[1] > width else np.zeros(len(x))
+    return x[:, :width], theta0
 
 
 def path_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
@@ -53,14 +55,14 @@ def path_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
 
 
 def nearest_angles(z: np.ndarray, s: np.ndarray, targets: np.ndarray, angles: np.ndarray | None = None,
-                   gamma: np.ndarray | None = None) -> np.ndarray:
+                   gamma: np.ndarray | None = None, topology: str = "four-bar") -> np.ndarray:
     """Each target's crank angle (n, N) [rad] where the coupler curve on assembly s passes
     nearest it (NaN if the dyad closes nowhere). With the poses' angles (N,) [rad] and the
     candidates' offsets gamma (n,) [rad], nearest in pose: |P - T|^2 + S^2 |e(phi3 + gamma)
     - e(angle)|^2 (phi3 the direction A -> B, S the targets' extent)."""
     step = 2 * math.pi / SAMPLES
     grid = np.arange(SAMPLES) * step
-    p = pose(z, s, np.broadcast_to(grid, (len(z), SAMPLES)))
+    p = kinematics(topology).pose(z, s, np.broadcast_to(grid, (len(z), SAMPLES)))
     P = p.P  # (n, M, 2)
     dx = P[:, None, :, 0] - targets[None, :, None, 0]
     dy = P[:, None, :, 1] - targets[None, :, None, 1]
@@ -85,15 +87,15 @@ def nearest_angles(z: np.ndarray, s: np.ndarray, targets: np.ndarray, angles: np
 
 
 def evaluate_path(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchValues:
-    """The objective of search rows x (n, 9 or 10) on one assembly (+1 or -1), row by row
+    """The objective of search rows x (n, width or width + 1) on one assembly (+1 or -1), row by row
     (the same numbers however the rows are split into batches)."""
-    z, theta0 = split(np.atleast_2d(np.asarray(x, dtype=float)))
+    z, theta0 = split(np.atleast_2d(np.asarray(x, dtype=float)), len(spec.lower))
     s = np.full(len(z), float(assembly))
     if spec.timing is not None:
         theta = theta0[:, None] + spec.timing[None, :]
     else:
-        theta = nearest_angles(z, s, spec.targets)
-    P = pose(z, s, np.nan_to_num(theta)).P
+        theta = nearest_angles(z, s, spec.targets, topology=spec.topology)
+    P = kinematics(spec.topology).pose(z, s, np.nan_to_num(theta)).P
     d2 = ((P - spec.targets[None]) ** 2).sum(-1) / extent(spec.targets) ** 2
     found = causes(spec, z, s, np.nan_to_num(theta))
     found = [c or ("does not close" if not np.all(np.isfinite(d2[i])) else "") for i, c in enumerate(found)]

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from pinmech.design.synthesis_file import SynthesisSpec
-from pinmech.design.synthesis_fourbar import point_jacobian, pose
+from pinmech.design.synthesis_kinematics import kinematics
 from pinmech.design.synthesis_motion import causes, grashof_label, progress, transmission_range
 from pinmech.design.synthesis_objective import evaluate_path, extent, split
 from pinmech.design.synthesis_result import Linkage
@@ -18,31 +18,32 @@ def refined_path(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage | Non
     if the refined one has a defect; None if neither is free of them."""
     import scipy.optimize as opt
 
-    z, theta0 = split(x[None])
+    k, width = kinematics(spec.topology), len(spec.lower)
+    z, theta0 = split(x[None], width)
     theta = evaluate_path(spec, s0, x[None]).theta[0]
     timed = spec.timing is not None
     v0 = np.concatenate((z[0], theta0 if timed else theta))
     S = extent(spec.targets)
 
     def unpack(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return v[:9], (v[9] + spec.timing if timed else v[9:])
+        return v[:width], (v[width] + spec.timing if timed else v[width:])
 
     def residual(v: np.ndarray) -> np.ndarray:
         zz, th = unpack(v)
-        r = ((pose(zz[None], np.array([s0]), th[None]).P[0] - spec.targets) / S).ravel()
+        r = ((k.pose(zz[None], np.array([s0]), th[None]).P[0] - spec.targets) / S).ravel()
         return np.where(np.isfinite(r), r, 1.0)  # where the dyad does not close: a step refused
 
     def jacobian(v: np.ndarray) -> np.ndarray:
         zz, th = unpack(v)
-        _, dz, dt = point_jacobian(zz, s0, th)
+        _, dz, dt = k.point_jacobian(zz, s0, th)
         n = len(th)
         Jt = np.zeros((n, 2, n))
         Jt[np.arange(n), :, np.arange(n)] = dt
         Jt = Jt.sum(axis=2, keepdims=True) if timed else Jt
         return np.concatenate((dz, Jt), axis=2).reshape(2 * n, -1) / S
 
-    lower = np.concatenate((spec.lower, np.full(len(v0) - 9, -np.inf)))
-    upper = np.concatenate((spec.upper, np.full(len(v0) - 9, np.inf)))
+    lower = np.concatenate((spec.lower, np.full(len(v0) - width, -np.inf)))
+    upper = np.concatenate((spec.upper, np.full(len(v0) - width, np.inf)))
     candidates = []
     try:
         with np.errstate(all="ignore"):
@@ -66,7 +67,7 @@ def _linkage(spec: SynthesisSpec, z: np.ndarray, theta: np.ndarray, s: float) ->
     if not np.all(np.isfinite(theta)) or causes(spec, Z, Sa, T)[0]:
         return None
     way, span = progress(T, spec.direction)
-    low, high = transmission_range(Z, Sa, T, way, span)
-    errors = np.linalg.norm(pose(Z, Sa, T).P[0] - spec.targets, axis=1)
+    low, high = transmission_range(Z, Sa, T, way, span, spec.topology)
+    errors = np.linalg.norm(kinematics(spec.topology).pose(Z, Sa, T).P[0] - spec.targets, axis=1)
     return Linkage(z.copy(), s, np.array(theta), int(way[0]), errors, (float(low[0]), float(high[0])),
-                   grashof_label(z))
+                   grashof_label(z, spec.topology), topology=spec.topology)

@@ -9,33 +9,46 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.design.synthesis_fourbar import NAMES, pose
+from pinmech.design.synthesis_kinematics import kinematics
 from pinmech.design.synthesis_linkage import motion_values
 from pinmech.design.synthesis_result import Linkage, SynthesisResult
 
 DEFECTS = {
-    "branch": "none: every pose on one assembly (B {side} of A -> O4), by construction",
-    "circuit": "none: no fold of the dyad between the first and the last target",
+    "branch": "none: every pose on one assembly (B {side}), by construction",
+    "circuit": "none: no fold of the dyad ({fold}) between the first and the last target",
     "order": "none: the crank turns {way} from target to target, within one turn",
 }
 
 
 def linkage_summary(lk: Linkage) -> dict:
     """One linkage's numbers, in mm and deg."""
-    side, way = ("left" if lk.s > 0 else "right"), ("counter-clockwise" if lk.way > 0 else "clockwise")
+    slider = lk.topology == "slider-crank"
+    way = "counter-clockwise" if lk.way > 0 else "clockwise"
+    side = ("ahead" if lk.s > 0 else "behind") if slider else ("left" if lk.s > 0 else "right")
+    where = f"{'ahead of' if lk.s > 0 else 'behind'} A's foot on the slide" if slider else f"{side} of A -> O4"
+    fold = "the rod square to the slide" if slider else "coupler and rocker in line"
+    shape = ({"dimensions_mm": {n: round(float(v) * 1e3, 9) for n, v in zip(kinematics(lk.topology).NAMES, lk.z)
+                                if n != "slide"}, "slide_deg": round(math.degrees(lk.z[2]), 9)} if slider else
+             {"dimensions_mm": {n: round(float(v) * 1e3, 9) for n, v in zip(kinematics(lk.topology).NAMES, lk.z)},
+              "ground_mm": round(math.hypot(lk.z[2] - lk.z[0], lk.z[3] - lk.z[1]) * 1e3, 9)})
+    if lk.task != "function" or slider:
+        errors = {"errors_mm": [float(e) * 1e3 for e in lk.errors],
+                  "max_error_relative": float(np.max(lk.errors) / lk.size)}
+        if lk.task == "function":
+            errors["slider_start_mm"] = lk.phi0 * 1e3
+    else:
+        errors = {"errors_deg": [math.degrees(float(e)) for e in lk.errors], "rocker_start_deg": math.degrees(lk.phi0)}
     return {
-        "dimensions_mm": {n: round(float(v) * 1e3, 9) for n, v in zip(NAMES, lk.z)},
-        "ground_mm": round(math.hypot(lk.z[2] - lk.z[0], lk.z[3] - lk.z[1]) * 1e3, 9),
+        "topology": lk.topology,
+        **shape,
         "assembly": side,
         "grashof": lk.grashof,
         "crank_deg": [round(math.degrees(v), 6) for v in motion_values(lk)],
-        **({"errors_mm": [float(e) * 1e3 for e in lk.errors], "max_error_relative": float(np.max(lk.errors) / lk.size)}
-           if lk.task != "function" else
-           {"errors_deg": [math.degrees(float(e)) for e in lk.errors], "rocker_start_deg": math.degrees(lk.phi0)}),
+        **errors,
         **({"angle_errors_deg": [math.degrees(float(e)) for e in lk.angle_errors],
             "offset_deg": math.degrees(lk.phi0)} if lk.angle_errors is not None else {}),
         "transmission_deg": [round(math.degrees(v), 3) for v in lk.transmission],
-        "defects": {k: v.format(side=side, way=way) for k, v in DEFECTS.items()},
+        "defects": {k: v.format(side=where, way=way, fold=fold) for k, v in DEFECTS.items()},
     }
 
 
@@ -63,12 +76,8 @@ def text(result: SynthesisResult) -> str:
     if not s["linkages"]:
         lines.append("no linkage meets the targets without a defect and within the constraints")
     for i, lk in enumerate(s["linkages"], start=1):
-        d = lk["dimensions_mm"]
         lines += [
-            f"linkage {i}: O2 ({d['O2x']:.6g}, {d['O2y']:.6g}) mm, O4 ({d['O4x']:.6g}, {d['O4y']:.6g}) mm, "
-            f"ground {lk['ground_mm']:.6g}, crank {d['crank']:.6g}, coupler {d['coupler']:.6g}, "
-            f"rocker {d['rocker']:.6g} mm, P at {d['along']:.6g} along and {d['across']:.6g} across A->B; "
-            f"{lk['grashof']}, assembly {lk['assembly']}",
+            f"linkage {i}: {_dimensions(lk)}; {lk['grashof']}, assembly {lk['assembly']}",
             _errors(lk),
             f"  crank at the targets [deg]: {', '.join(f'{v:.6g}' for v in lk['crank_deg'])}",
             f"  transmission angle over the motion: {lk['transmission_deg'][0]:.4g} .. {lk['transmission_deg'][1]:.4g} deg",
@@ -77,12 +86,29 @@ def text(result: SynthesisResult) -> str:
     return "\n".join(lines)
 
 
+def _dimensions(lk: dict) -> str:
+    """A linkage's dimensions, in a line."""
+    d = lk["dimensions_mm"]
+    if lk["topology"] == "slider-crank":
+        point = f", P at {d['along']:.6g} along and {d['across']:.6g} across A->B" if "errors_deg" not in lk and \
+            "slider_start_mm" not in lk else ""
+        return (f"O2 ({d['O2x']:.6g}, {d['O2y']:.6g}) mm, slide at {lk['slide_deg']:.6g} deg offset {d['offset']:.6g}, "
+                f"crank {d['crank']:.6g}, rod {d['rod']:.6g} mm{point}")
+    return (f"O2 ({d['O2x']:.6g}, {d['O2y']:.6g}) mm, O4 ({d['O4x']:.6g}, {d['O4y']:.6g}) mm, "
+            f"ground {lk['ground_mm']:.6g}, crank {d['crank']:.6g}, coupler {d['coupler']:.6g}, "
+            f"rocker {d['rocker']:.6g} mm, P at {d['along']:.6g} along and {d['across']:.6g} across A->B")
+
+
 def _errors(lk: dict) -> str:
     if "angle_errors_deg" in lk:
         return (f"  error at each pose [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
                 f"(max {lk['max_error_relative']:.3g} of its size); [deg]: "
                 f"{', '.join(f'{e:.3g}' for e in lk['angle_errors_deg'])} (the poses' angle is A->B's + "
                 f"{lk['offset_deg']:.6g} deg)")
+    if "slider_start_mm" in lk:
+        return (f"  slider travel error at each pair [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
+                f"(max {lk['max_error_relative']:.3g} of its size; block at {lk['slider_start_mm']:.6g} mm along the "
+                "slide at the first pair)")
     if "errors_mm" in lk:
         return (f"  error at each target [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
                 f"(max {lk['max_error_relative']:.3g} of its size)")
@@ -111,6 +137,7 @@ def figure(result: SynthesisResult, path: str | Path) -> Path:
     fig, axes = plt.subplots(1, n, figsize=(4.6 * n + 0.6, 4.6), squeeze=False)
     T = result.spec.targets * 1e3
     for ax, lk, i in zip(axes[0], result.linkages, range(1, n + 1)):
+        pose = kinematics(lk.topology).pose
         values = motion_values(lk)
         motion = np.linspace(values[0], values[-1], 400)
         turn = np.linspace(values[0], values[0] + 2 * math.pi * lk.way, 721)
@@ -119,10 +146,19 @@ def figure(result: SynthesisResult, path: str | Path) -> Path:
         ax.plot(whole[:, 0], whole[:, 1], ":", color="0.6", lw=1, label="coupler curve (same assembly)")
         ax.plot(along[:, 0], along[:, 1], "-", color="tab:blue", lw=1.6, label="motion through the targets")
         p = pose(lk.z[None], s, values[:1][None])
-        O2, O4, A, B, P = lk.z[:2] * 1e3, lk.z[2:4] * 1e3, p.A[0, 0] * 1e3, p.B[0, 0] * 1e3, p.P[0, 0] * 1e3
-        ax.plot(*np.array([O2, A, B, O4]).T, "-o", color="k", lw=1.4, ms=3)
+        O2, A, B, P = lk.z[:2] * 1e3, p.A[0, 0] * 1e3, p.B[0, 0] * 1e3, p.P[0, 0] * 1e3
+        if lk.topology == "slider-crank":  # the slide's line over the block's travel, the block on it
+            u = np.array([math.cos(lk.z[2]), math.sin(lk.z[2])])
+            ends = np.array([B - 0.6 * lk.size * 1e3 * u, B + 0.6 * lk.size * 1e3 * u])
+            ax.plot(*ends.T, "-", color="0.4", lw=0.8)
+            ax.plot(*np.array([O2, A, B]).T, "-o", color="k", lw=1.4, ms=3)
+            ax.plot(*B, "s", color="k", ms=9, mfc="none")
+            ax.plot(*O2, "^", color="k", ms=8)
+        else:
+            O4 = lk.z[2:4] * 1e3
+            ax.plot(*np.array([O2, A, B, O4]).T, "-o", color="k", lw=1.4, ms=3)
+            ax.plot(*np.array([O2, O4]).T, "^", color="k", ms=8)
         ax.fill(*np.array([A, B, P]).T, color="tab:orange", alpha=0.3)
-        ax.plot(*np.array([O2, O4]).T, "^", color="k", ms=8)
         ax.plot(T[:, 0], T[:, 1], "x", color="tab:red", ms=8, mew=2, label="targets")
         if result.spec.angles is not None:  # the poses' angles, and the coupler's at each pose
             L = 0.15 * float(np.ptp(T, axis=0).max())
@@ -153,22 +189,30 @@ def figure(result: SynthesisResult, path: str | Path) -> Path:
 
 
 def function_figure(result: SynthesisResult, path: str | Path) -> Path:
-    """The rocker's turn against the crank's over the motion for each linkage, and the pairs."""
+    """The rocker's turn (a slider-crank's block travel) against the crank's over the motion
+    for each linkage, and the pairs."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
-    pairs = np.degrees(result.spec.targets)
+    slider = result.spec.topology == "slider-crank"
+    pairs = np.column_stack((np.degrees(result.spec.targets[:, 0]),
+                             result.spec.targets[:, 1] * (1e3 if slider else 180 / math.pi)))
     for i, lk in enumerate(result.linkages, start=1):
+        k = kinematics(lk.topology)
         values = motion_values(lk)
         crank = np.linspace(values[0], values[-1], 300)
-        B = pose(lk.z[None], np.array([lk.s]), crank[None]).B[0]
-        phi = np.unwrap(np.arctan2(B[:, 1], B[:, 0] - lk.z[2]))
-        turn = np.degrees(phi - lk.phi0)
-        turn -= 360 * np.round((turn[0]) / 360)
-        ax.plot(np.degrees(crank - crank[0]), turn, lw=1.5,
-                label=f"linkage {i}: max error {math.degrees(np.max(lk.errors)):.2g} deg")
+        B = k.pose(lk.z[None], np.array([lk.s]), crank[None]).B[0]
+        if slider:
+            out = (k.slide_position(lk.z[None], B[None])[0] - lk.phi0) * 1e3
+            label = f"linkage {i}: max error {np.max(lk.errors) * 1e3:.2g} mm"
+        else:
+            phi = np.unwrap(np.arctan2(B[:, 1], B[:, 0] - lk.z[2]))
+            out = np.degrees(phi - lk.phi0)
+            out -= 360 * np.round((out[0]) / 360)
+            label = f"linkage {i}: max error {math.degrees(np.max(lk.errors)):.2g} deg"
+        ax.plot(np.degrees(crank - crank[0]), out, lw=1.5, label=label)
     ax.plot(pairs[:, 0], pairs[:, 1], "x", color="tab:red", ms=8, mew=2, label="pairs asked")
     ax.set_xlabel("crank turn from the first pair [deg]")
-    ax.set_ylabel("rocker turn [deg]")
+    ax.set_ylabel("slider travel [mm]" if slider else "rocker turn [deg]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(result.spec.title)

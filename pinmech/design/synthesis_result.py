@@ -3,7 +3,6 @@ its targets, and the candidates rejected by cause."""
 
 from __future__ import annotations
 
-import math
 from collections import Counter
 from dataclasses import dataclass, field
 
@@ -14,10 +13,11 @@ from pinmech.design.synthesis_file import SynthesisSpec
 
 @dataclass(frozen=True)
 class Linkage:
-    """A synthesised four-bar that meets the targets without defects.
+    """A synthesised four-bar (or slider-crank) that meets the targets without defects.
 
     Attributes:
-        z: (O2x, O2y, O4x, O4y, crank, coupler, rocker, along, across) [m].
+        z: (O2x, O2y, O4x, O4y, crank, coupler, rocker, along, across) [m]; a slider-crank's
+            synthesis_slider.NAMES.
         s: the assembly (+1: B left of A -> O4, -1: right).
         theta: the crank's angle at each target [rad] (world x, ccw).
         way: the crank's turn from target to target (+1 ccw, -1 cw).
@@ -29,6 +29,7 @@ class Linkage:
         phi0: a function generator's rocker angle asked at the first pair, or a motion
             generator's angle from the bar A -> B to the poses' line [rad].
         angle_errors: a motion generator's coupler angle error at each pose [rad].
+        topology: "four-bar" or "slider-crank".
     """
 
     z: np.ndarray
@@ -41,17 +42,21 @@ class Linkage:
     task: str = "path"
     phi0: float = 0.0
     angle_errors: np.ndarray | None = None
+    topology: str = "four-bar"
 
     @property
     def size(self) -> float:
-        """The linkage's size: its longest link [m]."""
-        return float(max(math.hypot(self.z[2] - self.z[0], self.z[3] - self.z[1]), *self.z[4:7]))
+        """The linkage's size: its longest link [m] (a slider-crank's: the largest of crank,
+        rod and offset)."""
+        from pinmech.design.synthesis_kinematics import kinematics
+
+        return kinematics(self.topology).size(self.z)
 
     def meets(self, relative: float) -> bool:
         """Whether every target is met within `relative` of the linkage's size (path; a
         motion's angles within `relative` rad too), or every output angle within `relative`
-        rad (function)."""
-        if self.task == "function":
+        rad (a four-bar's function; a slider-crank's travel within `relative` of its size)."""
+        if self.task == "function" and self.topology == "four-bar":
             return bool(np.max(self.errors) <= relative)
         angles = self.angle_errors if self.angle_errors is not None else np.zeros(1)
         return bool(np.max(self.errors) <= relative * self.size and np.max(angles) <= relative)

@@ -164,9 +164,11 @@ def _distinct(spec: SynthesisSpec, rows: np.ndarray, energies: np.ndarray, count
 
 
 def _bounded(spec: SynthesisSpec, lk: Linkage) -> np.ndarray:
-    """The linkage's parameters that the file bounds (all 9 for a path; crank, coupler,
-    rocker for a function)."""
-    return lk.z[4:7] if spec.task == "function" else lk.z
+    """The linkage's parameters that the file bounds (all of a path's; crank, coupler,
+    rocker of a four-bar's function, crank, rod, offset of a slider-crank's)."""
+    if spec.task != "function":
+        return lk.z
+    return lk.z[[4, 5, 3]] if spec.topology == "slider-crank" else lk.z[4:7]
 
 
 def _far(spec: SynthesisSpec, a: np.ndarray, b: np.ndarray) -> bool:

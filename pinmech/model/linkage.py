@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from pinmech.exceptions import ModelError, UnitError
+from pinmech.model.compass import compass
 from pinmech.model.linkage_expr import length
 from pinmech.model.linkage_masses import LinkMass, parse_masses
 from pinmech.directions import unit_vector
@@ -213,11 +214,7 @@ def _compass(a: np.ndarray, b: np.ndarray, r1: float, r2: float, left: bool, whe
     if d == 0 or r1 <= 0 or r2 <= 0 or r1 + r2 < d or abs(r1 - r2) > d:
         raise ModelError(f"cannot be drawn: circles of radii {r1:.6g} m and {r2:.6g} m about points "
                          f"{d:.6g} m apart do not meet (the linkage cannot be assembled here)", path=where)
-    u = (b - a) / d
-    along = (d * d + r1 * r1 - r2 * r2) / (2 * d)
-    across = math.sqrt(max(r1 * r1 - along * along, 0.0))
-    normal = np.array([-u[1], u[0]])
-    return a + along * u + (across if left else -across) * normal
+    return compass(a, b, r1, r2, 1.0 if left else -1.0)[0]
 
 
 def _spatial(linkage: Linkage, spec: LinkageSpec) -> None:

@@ -1,0 +1,94 @@
+"""Slider-crank synthesis: the bundled offset slider-crank (models/linkages/slider_crank.toml:
+crank 40 mm, rod 130 mm, slide along x at 50 mm) solved by the engine, sampled, hidden, and
+recovered by path and by function generation without defects; the written linkage swept
+by the engine meets the targets again. And its fold: the rod square to the slide."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from pinmech.design.synthesis_file import SynthesisSpec
+from pinmech.design.synthesis_linkage import engine_check, write_linkage
+from pinmech.design.synthesis_search import synthesise
+from pinmech.design.synthesis_slider import folds, pose
+
+ROOT = Path(__file__).resolve().parents[1]
+CRANK = np.arange(20.0, 300.0, 30.0)  # deg: ten crank angles, ccw, on the bundled linkage's assembly
+
+
+def _engine_pins(tmp_path: Path, crank_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A and B [m] of the bundled drawn slider-crank, solved by the engine's sweep from its
+    drawn pose (crank along x, B ahead on the slide) at these crank angles."""
+    from pinmech.io.scene import Scene
+    from pinmech.io.sweep import Sweep
+
+    scene = tmp_path / "bundled_scene.toml"
+    linkage = (ROOT / "models/linkages/slider_crank.toml").as_posix()
+    scene.write_text(f'title = "bundled slider-crank"\nlinkage = "{linkage}"\n'
+                     '[drivers.O]\nangle = "0 deg"\n[report]\npoints = ["A", "B"]\n', encoding="utf-8")
+    sweep = Sweep.from_scene(Scene.load(scene))
+    dense = np.radians(np.unique(np.concatenate((np.arange(0.0, 300.0, 1.0), crank_deg))))
+    rows = {round(p.value, 12): (p.motion.points["A"].position[:2], p.motion.points["B"].position[:2])
+            for p in sweep.poses(dense)}
+    got = [rows[round(math.radians(c), 12)] for c in crank_deg]
+    return np.array([g[0] for g in got]), np.array([g[1] for g in got])
+
+
+def test_path_synthesis_recovers_the_bundled_slider_crank(tmp_path):
+    # A coupler point on the bundled rod, 60 mm along A -> B and 20 mm to its left, taken
+    # from the engine's A and B at ten crank angles; the linkage hidden, the search (seeded)
+    # meets the points within 1e-8 of the linkage's size (130 mm) and the engine sweeping
+    # the written drawn linkage does too (its Newton tolerance is far below 1e-8).
+    A, B = _engine_pins(tmp_path, CRANK)
+    w = (B - A) / np.linalg.norm(B - A, axis=1)[:, None]
+    targets = A + 0.06 * w + 0.02 * np.stack((-w[:, 1], w[:, 0]), -1)
+    lower = np.array([-0.06, -0.06, math.radians(-30), -0.1, 0.01, 0.04, -0.15, -0.15])
+    upper = np.array([0.06, 0.06, math.radians(30), 0.1, 0.08, 0.2, 0.15, 0.15])
+    spec = SynthesisSpec(Path("test.toml"), "test", "path", "slider-crank", targets, None, lower, upper,
+                         seed=1, population=15, generations=400, keep=1)
+    best = synthesise(spec).linkages[0]
+    assert best.topology == "slider-crank" and best.meets(1e-8)
+    assert best.grashof == "crank"  # 40 + 50 <= 130: the crank turns fully (no fold anywhere)
+    _, scene = write_linkage(best, tmp_path / "found", "found", "test.toml")
+    check = engine_check(scene, best, targets)
+    assert check.errors.max() <= 1e-8 * best.size
+
+
+def test_function_synthesis_recovers_the_bundled_slider_crank(tmp_path):
+    # Six pairs (crank turn, piston travel along x) from the engine's B; the search varies
+    # crank, rod, offset and the first crank angle, and meets the travels within 1e-8 of
+    # the linkage's size; the engine sweeping the written linkage moves its block as asked.
+    A, B = _engine_pins(tmp_path, CRANK[:6])
+    pairs = np.stack((np.radians(CRANK[:6] - CRANK[0]), B[:, 0] - B[0, 0]), -1)
+    spec = SynthesisSpec(Path("test.toml"), "test", "function", "slider-crank", pairs, None,
+                         np.array([0.01, 0.04, -0.1]), np.array([0.1, 0.3, 0.1]), seed=1, population=15,
+                         generations=400, keep=1)
+    best = synthesise(spec).linkages[0]
+    assert best.meets(1e-8)
+    _, scene = write_linkage(best, tmp_path / "found", "found", "test.toml")
+    check = engine_check(scene, best, pairs)
+    assert check.errors.max() <= 1e-8 * best.size
+
+
+def test_the_slider_cranks_folds_are_where_the_rod_is_square_to_the_slide():
+    # A crank that cannot turn fully (crank 60 + offset 20 > rod 50 mm; slide along x at
+    # y = 20 mm): the rod reaches the slide while |A_y - 20 mm| <= 50 mm, A_y = 60 sin(theta),
+    # so the folds are at sin(theta) = (20 +- 50) / 60 (the + one beyond reach): theta =
+    # asin(-0.5) = -30 deg and 180 + 30 = 210 deg. Between them (210 to 330 deg) the rod
+    # cannot reach; just outside it does, nearly square to the slide (its x within
+    # rod * sqrt(2 * 60 mm * cos(30 deg) * 1e-8 rad / 50 mm) ~ 7e-6 m of zero).
+    z = np.array([[0.0, 0.0, 0.0, 0.02, 0.06, 0.05, 0.0, 0.0]])
+    angles, _ = folds(z)
+    found = np.sort(np.mod(np.degrees(angles[0][np.isfinite(angles[0])]), 360.0))
+    assert np.allclose(found, [210.0, 330.0], atol=1e-12)  # acos/asin rounding only
+    tiny = 1e-8  # rad
+    outside = np.radians(found) + np.array([-tiny, tiny])
+    inside = np.radians(found) + np.array([tiny, -tiny])
+    assert not pose(z, np.array([1.0]), inside[None]).closes.any()
+    for s in (1.0, -1.0):  # both assemblies meet at the fold
+        p = pose(z, np.array([s]), outside[None])
+        rod = p.B[0] - p.A[0]
+        assert p.closes.all() and np.all(np.abs(rod[:, 0]) < 1e-5) and np.allclose(np.abs(rod[:, 1]), 0.05, atol=1e-9)
