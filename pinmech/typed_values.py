@@ -19,7 +19,8 @@ _PART = re.compile(r"\.([^.\[]+)|\[(\d+)\]")
 
 class WrongType(ValueError):
     """A value not of its type: `loc` (keys and indices down to it), the type's name as
-    msgspec says it ("str", "int | float", "array", "object"), and the value given."""
+    msgspec says it, None left out ("str", "str | int | float", "array", "object"), and the
+    value given."""
 
     def __init__(self, loc: tuple[str | int, ...], expected: str, given: Any) -> None:
         super().__init__(f"expected {expected}, got {given!r}")
@@ -43,7 +44,8 @@ def typed(value: Any, kind: Any, loc: tuple[str | int, ...] = ()) -> Any:
         match = _AT.search(text)
         inner = _path(match.group(1)) if match else ()
         expected = re.search(r"Expected `([^`]*)`", text)
-        raise WrongType((*loc, *inner), expected.group(1) if expected else text, _at(value, inner)) from None
+        said = " | ".join(arm for arm in expected.group(1).split(" | ") if arm != "null") if expected else text
+        raise WrongType((*loc, *inner), said, _at(value, inner)) from None
 
 
 def given_fields(struct: msgspec.Struct) -> dict[str, Any]:
