@@ -27,8 +27,8 @@ angular acceleration, from a reference assembled at 0 (the closed form's pose, s
 branch is known). Timing, in this one process, interleaved: after a warm-up, each round
 times every (k, path) once, in an order rotated from round to round, garbage collection
 paused; the table gives the median time per pose over the rounds and its spread (fastest
-and slowest round). Two paths: with pinmech's compiled core (pinmech/solve/core.py) and the
-Python path (`pinmech.solve.core.ENABLED = False`).
+and slowest round). One path: pinmech's compiled core (pinmech/solve/core.py), the one
+engine (there is no other path since issue 23).
 
 Correctness: every loop's coupler and output angles (and their rates) against the closed
 form of the four-bar (`chain_closed_form`: the law of cosines, loop after loop, numpy
@@ -70,7 +70,7 @@ LENGTHS = (0.10, 0.12, 0.11, 0.04)
 BRANCH = +1
 OMEGA = 1.0  # crank speed [rad/s]
 ALPHA = 0.0  # crank acceleration [rad/s^2]
-PATHS = ("core", "python")
+PATHS = ("core",)
 
 _LINK = ('<link name="{0}"><inertial><mass value="1"/>'
          '<inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>')
@@ -198,8 +198,7 @@ def chain_guess(mech, cf: ChainMotion, pose: int) -> np.ndarray:
 
 
 def sweep(solver, thetas: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """q, v, a of every pose of a sweep of the crank through thetas (the path as it is:
-    the caller sets pinmech.solve.core.ENABLED)."""
+    """q, v, a of every pose of a sweep of the crank through thetas."""
     from pinmech.solve.cycle import solve_range
 
     chunks = list(solve_range(solver, "O0", thetas, driver_q=np.zeros(1), driver_v=np.array([OMEGA]),
@@ -267,19 +266,12 @@ def make_row(k: int, path: str, poses: int, lengths=LENGTHS) -> Row:
     thetas = np.radians(np.arange(poses) * (360.0 / poses))
     t0 = time.perf_counter()
     mech, solver = chain_solver(k, lengths)
-    use_core = path == "core"
-
     def run():
-        before = core.ENABLED
-        core.ENABLED = use_core
-        try:
-            return sweep(solver, thetas)
-        finally:
-            core.ENABLED = before
+        return sweep(solver, thetas)
     row = Row(k, path, poses, run)
     row.set_up = time.perf_counter() - t0
     q, v, a = run()  # the first call builds the core (core_for), not timed
-    if use_core and core.core_for(solver) is None:
+    if core.core_for(solver) is None:
         raise RuntimeError("the core does not take this chain")
     row.errors = chain_errors(mech, q, v, a, chain_closed_form(thetas, k, lengths=lengths))
     return row
@@ -305,9 +297,6 @@ def measure(loops=LOOPS, poses: int = 360, rounds: int = 7, sample_time: float =
 def one_sweep(k: int, poses: int, path: str, lengths=LENGTHS) -> None:
     """A whole run in this process (under callgrind): set-up, then one sweep of `poses`
     poses 1 degree apart from 0."""
-    import pinmech.solve.core as core
-
-    core.ENABLED = path == "core"
     _, solver = chain_solver(k, lengths)
     sweep(solver, np.radians(np.arange(poses, dtype=float)))  # 1 degree apart
 

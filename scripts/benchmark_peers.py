@@ -34,8 +34,7 @@ row saying "not installed", never a crash):
 - Pinocchio from a plain Python script (the peers' way): a URDF tree, the loop closed by
   hand with frame Jacobians (Newton), rates from J v = 0 and J a = -drift, the drift from
   classical frame accelerations;
-- pinmech's compiled core: its `follow` alone (the C++ loop, from the sweep's first pose),
-  and `Sweep.chunks` with the core ruled out (the Python path it stands in for);
+- pinmech's compiled core: its `follow` alone (the C++ loop, from the sweep's first pose);
 - Pinocchio's passes alone, in C++ (`Core.pinocchio_passes`, on the solved poses): the
   fewest Pinocchio calls any certified answer needs at a pose, with nothing else. P1: the
   joint Jacobians twice (the Newton step at the predicted q; the certifying residual and
@@ -540,22 +539,6 @@ def pinmech_p1_paths(phi: np.ndarray):
     return run, None, ""
 
 
-def pinmech_p1_python_path(phi: np.ndarray):
-    """`Sweep.chunks` with the compiled core ruled out (pinmech.solve.core.ENABLED = False, as
-    PINMECH_CORE=0 does): the Python path the core stands in for."""
-    import pinmech.solve.core
-
-    run, read, _ = pinmech_p1_chunks(phi)
-
-    def python_path():
-        pinmech.solve.core.ENABLED = False
-        try:
-            return run()
-        finally:
-            pinmech.solve.core.ENABLED = True
-    return python_path, read, ""
-
-
 def pinmech_p1_core_follow(phi: np.ndarray):
     """The compiled core's `follow` alone, from the sweep's first pose: the C++ loop
     (Pinocchio's kinematics, the closure rows, the corrector, rates, signature, condition
@@ -678,8 +661,6 @@ def rows_for(poses: int) -> tuple[list[Row], dict]:
         ("P1", "pinmech Sweep.chunks (q, v, a)", poses, "pinmech", lambda: pinmech_p1_chunks(phi)),
         ("P1", "pinmech Sweep.chunks + frame_paths (every output)", poses, None, lambda: pinmech_p1_paths(phi)),
         ("P1", "pinmech Sweep.chunks + evaluate_motion", poses, None, lambda: pinmech_p1_motion(phi)),
-        ("P1", "pinmech Sweep.chunks, Python path (PINMECH_CORE=0)", poses, None,
-         lambda: pinmech_p1_python_path(phi)),
         ("P1", "pinmech compiled core's follow alone (C++ floor)", poses, None, lambda: pinmech_p1_core_follow(phi)),
         ("P1", f"{PASSES} (2 joint Jacobians + 1 kinematics a pose)", poses, None,
          lambda: pinocchio_passes_p1(phi)),

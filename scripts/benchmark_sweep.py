@@ -43,7 +43,7 @@ from interleave import Timed, time_rounds
 
 import pinmech
 import pinmech.io.scene_model
-from pinmech.solve.batch import difference_many
+from pinmech.solve.manifold import difference_many
 from pinmech.io.sweep import Sweep
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -284,16 +284,12 @@ def test_a_parallelogram_keeps_its_branch_through_the_change_points(tmp_path):
     assert sum("change point" in n for n in notes) == 2
 
 
-@pytest.mark.parametrize("core", [True, False])
-def test_a_parallelogram_swept_onto_its_change_points_keeps_its_branch_after_each(tmp_path, monkeypatch, core):
+def test_a_parallelogram_swept_onto_its_change_points_keeps_its_branch_after_each(tmp_path):
     """60 deg apart from 60 deg backwards, poses land exactly on the change points (0, -180,
     -360, -540 deg): those fail by name (singular), and every other row is the
     parallelogram (rocker parallel to the crank) after a note. A failed singular pose used
     to become the sweep's reference, and the next pose, followed from a point where both
     branches meet, came out on the antiparallelogram in silence (from -600 deg on)."""
-    import pinmech.solve.core
-
-    monkeypatch.setattr(pinmech.solve.core, "ENABLED", core)
     mech, solver = _parallelogram(tmp_path, 0.04, 0.10)
     values = np.radians(60 - 60.0 * np.arange(1, 14))
     qs, errors, notes = _sweep(solver, values)

@@ -12,7 +12,6 @@ import pinocchio as pin
 import pytest
 
 from pinmech import Mechanism
-from pinmech.model.closures import CutEvaluator
 from tests._mechanisms import (
     four_bar_urdf,
     slider_crank_prismatic_cut_urdf,
@@ -127,27 +126,3 @@ def _mechanism(which, models_dir, tmp_path):
     texts = {"four_bar": four_bar_urdf, "rsur": spatial_rsur_urdf, "rsur_revolute": spatial_rsur_revolute_cut_urdf,
              "prismatic_cut": slider_crank_prismatic_cut_urdf}
     return Mechanism.from_urdf(write(tmp_path, f"{which}.urdf", texts[which]()))
-
-
-@pytest.mark.parametrize("which", ["r_rtr", "four_bar", "rsur", "rsur_revolute", "prismatic_cut"])
-def test_the_solver_hot_path_gives_the_closures_own_numbers(which, models_dir, tmp_path):
-    """CutEvaluator (few numpy calls, ground frames folded in) against Closure's readable
-    formulas, at a random pose that is not closed: the same sums, to rounding."""
-    mech = _mechanism(which, models_dir, tmp_path)
-    model, data = mech.model, mech.model.createData()
-    q, v = _random_state(model, 3)
-    pin.computeJointJacobians(model, data, q)
-    pin.updateFramePlacements(model, data)
-    for closure in mech.closures:
-        fast = CutEvaluator(closure, model)
-        fast.place(data)
-        np.testing.assert_allclose(fast.residual(), closure.residual(data), rtol=0, atol=1e-15)
-        np.testing.assert_allclose(fast.full_residual(), np.abs(closure.full_residual(data)).max(), rtol=0, atol=1e-15)
-        np.testing.assert_allclose(fast.jacobian(data), closure.jacobian(model, data), rtol=0, atol=1e-14)
-        np.testing.assert_allclose(fast.newton_jacobian(data), closure.residual_jacobian(model, data), rtol=0,
-                                   atol=1e-14)
-    pin.forwardKinematics(model, data, q, v, np.zeros(model.nv))
-    for closure in mech.closures:
-        fast = CutEvaluator(closure, model)
-        fast.place(data)
-        np.testing.assert_allclose(fast.drift(data), closure.drift(model, data), rtol=0, atol=1e-13)

@@ -13,9 +13,8 @@ from pinmech.exceptions import FrameNotFound, ModelError
 from pinmech.solve.sweep_frames import frame_paths
 
 
-@pytest.fixture(params=[True, False], ids=["core", "python"])
-def r_rtr_rows(request, scenes_dir, monkeypatch):
-    monkeypatch.setattr(core, "ENABLED", request.param)
+@pytest.fixture
+def r_rtr_rows(scenes_dir):
     sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(scenes_dir / "r_rtr.toml"))
     chunk = next(sweep.chunks(np.radians(np.arange(0.0, 360.0, 7.0))))
     return sweep.mechanism, chunk.solution

@@ -1,6 +1,6 @@
 """Chains of four-bar loops in series (scripts/benchmark_loops.py, issue 13 item 3): the
 generated URDF, its block-triangular structure, and a sweep against the closed form of
-the four-bar applied loop after loop, with the compiled core and by the Python path.
+the four-bar applied loop after loop, by the compiled core.
 
 No timing here (the script measures it). Tolerances:
 - angles 1e-12 rad (issue 13's bar; the closure tolerance is 1e-13 of each loop's size,
@@ -61,16 +61,12 @@ def test_chain_urdf_is_k_loops_in_series(tmp_path):
         chain.chain_urdf(0)
 
 
-@pytest.mark.parametrize("use_core", [True, False], ids=["core", "python"])
-def test_chain_sweep_meets_the_closed_form(use_core, monkeypatch):
+def test_chain_sweep_meets_the_closed_form():
     """A turn of the crank, 1 degree apart, every loop's coupler and output angle within
     1e-12 rad of the closed form, rates within 1e-11 of the largest. The core solves for
     the dependent joints by forward substitution over the K diagonal blocks."""
-    monkeypatch.setattr(core, "ENABLED", use_core)
     mech, solver, q, v, a = _solve(K, THETAS)
-    assert (core.core_for(solver) is not None) == use_core
-    if use_core:
-        assert core.core_for(solver).solve_blocks == K
+    assert core.core_for(solver).solve_blocks == K
     angle, rate, acceleration = chain.chain_errors(mech, q, v, a, chain.chain_closed_form(THETAS, K))
     assert angle <= 1e-12, angle
     assert rate <= 1e-11 and acceleration <= 1e-11, (rate, acceleration)
@@ -94,7 +90,7 @@ def test_a_chain_listed_last_loop_first_is_solved_in_dependency_order(tmp_path, 
     loop's output column). The core orders the blocks itself, and the sweep meets the
     closed form to the same bars as above (a block solved before the one it leans on
     would read unsolved columns: the corrector would fail and hand every pose to the
-    Python path, and the rates would be wrong)."""
+    pose-by-pose follow, and the rates would be wrong)."""
     text = chain.chain_urdf(K)
     cuts = re.findall(r"<constraint .*?</constraint>", text, flags=re.S)
     for cut in cuts:
@@ -112,7 +108,7 @@ def test_a_chain_listed_last_loop_first_is_solved_in_dependency_order(tmp_path, 
     monkeypatch.setattr(solve_cycle._Cycle, "_compiled",
                         lambda cycle, compiled, xs: compiled_path(cycle, _FollowSpy(compiled, stops), xs))
     q, v, a = chain.sweep(solver, THETAS)
-    assert stops and set(stops) == {0}  # the core took every pose: none handed to the Python path
+    assert stops and set(stops) == {0}  # the core's sweep took every pose: none handed to its pose-by-pose follow
     angle, rate, acceleration = chain.chain_errors(mech, q, v, a, chain.chain_closed_form(THETAS, K))
     assert angle <= 1e-12, angle
     assert rate <= 1e-11 and acceleration <= 1e-11, (rate, acceleration)
@@ -127,22 +123,28 @@ def _conditions(solver, thetas: np.ndarray) -> np.ndarray:
 
 
 @pytest.mark.parametrize("k", [2, 5, 16])
-def test_chain_condition_numbers_are_the_python_paths(k, monkeypatch):
+def test_chain_condition_numbers_are_the_svds(k):
     """The condition numbers a chain's sweep reports, pose by pose: the core's (J_dep
     permuted into block order, a band, bidiagonalized by plane rotations from 5 loops on)
-    against the Python path's (numpy's SVD of its own J_dep). A wrong permutation or band
-    would be off by order one. The bar is tests/test_core.py's against the SVD, 1e-12 +
-    100 n eps kappa with n = 2k (at most 3e-11 here, condition numbers below 40); the two
-    paths' poses differ by rounding only (seen: 5e-15)."""
+    against numpy's SVD of the dimensionless J_dep at the same poses. A wrong permutation
+    or band would be off by order one. The bar is tests/test_core.py's against the SVD,
+    1e-12 + 100 n eps kappa with n = 2k (at most 3e-11 here, condition numbers below 40)."""
     thetas = np.radians(np.arange(0.0, 360.0, 7.0))
-    got = {}
-    for use_core in (True, False):
-        monkeypatch.setattr(core, "ENABLED", use_core)
-        _, solver = chain.chain_solver(k)
-        got[use_core] = _conditions(solver, thetas)
-    assert np.all(got[False] < 40.0)
-    bar = 1e-12 + 100 * 2 * k * np.finfo(float).eps * got[False]
-    assert np.all(np.abs(got[True] / got[False] - 1.0) <= bar)
+    _, solver = chain.chain_solver(k)
+    got = _conditions(solver, thetas)
+    compiled = core.core_for(solver)
+    chunks = list(pinmech.solve_range(solver, solver.drivers[0], thetas, driver_q=np.zeros(1),
+                                      driver_v=np.ones(1), driver_a=np.zeros(1)))
+    want = []
+    for q in np.concatenate([c.solution.q for c in chunks]):
+        compiled.residual(q)
+        J_dep = compiled.jacobian(False)[:, solver._dep_v] * solver._dep_scale
+        sigma = np.linalg.svd(J_dep, compute_uv=False)
+        want.append(sigma[0] / sigma[-1])
+    want = np.array(want)
+    assert np.all(want < 40.0)
+    bar = 1e-12 + 100 * 2 * k * np.finfo(float).eps * want
+    assert np.all(np.abs(got / want - 1.0) <= bar)
 
 
 def test_the_closed_form_moves_every_loop():
@@ -159,6 +161,6 @@ def test_benchmark_loops_runs(tmp_path, capsys):
     out = tmp_path / "loops.md"
     rows = chain.main(["--loops", "2", "--poses", "20", "--rounds", "1", "--sample-time", "0", "--out", str(out)])
     assert out.read_text() == capsys.readouterr().out.rstrip("\n") + "\n"
-    assert {(r.k, r.path) for r in rows} == {(1, "core"), (1, "python"), (2, "core"), (2, "python")}
+    assert {(r.k, r.path) for r in rows} == {(1, "core"), (2, "core")}
     assert all(r.errors[0] <= 1e-12 and len(r.times) == 1 for r in rows)
     assert "| 2 | core |" in out.read_text()

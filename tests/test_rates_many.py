@@ -52,9 +52,7 @@ def models_dir():
     return MODELS
 
 
-@pytest.mark.parametrize("enabled", [True, False], ids=["core", "python"])
-def test_arm_rates_meet_the_closed_form(models_dir, enabled, monkeypatch):
-    monkeypatch.setattr(core, "ENABLED", enabled)
+def test_arm_rates_meet_the_closed_form(models_dir):
     mechanism, solver = _arm(models_dir)
     Q, th1, th2 = _poses(mechanism)
     batch = solver.solve_many(Q)

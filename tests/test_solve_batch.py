@@ -1,6 +1,6 @@
 """Many poses at once: the batch gives the pose-by-pose solver's answers, hands back what
-it cannot take (a far guess, a singular pose), and its array helpers match Pinocchio and
-numpy row by row."""
+it cannot take (a far guess, a singular pose), and the manifold helpers match Pinocchio
+row by row."""
 
 from __future__ import annotations
 
@@ -9,13 +9,8 @@ import pinocchio as pin
 import pytest
 
 from pinmech import LoopSolver
-from pinmech.solve.batch import (
-    BatchSolver,
-    condition_batch,
-    difference_many,
-    integrate_many,
-    solve_batch,
-)
+from pinmech.solve.batch import BatchSolver
+from pinmech.solve.manifold import difference_many, integrate_many
 from tests.test_solve_loops import MECHANISMS
 
 
@@ -94,16 +89,3 @@ def test_manifold_helpers_match_pinocchio_row_by_row(which, models_dir):
     np.testing.assert_allclose(q1, [pin.integrate(model, a, b) for a, b in zip(q0, dq)], atol=1e-14)
     np.testing.assert_allclose(difference_many(model, q0, q1), [pin.difference(model, a, b) for a, b in zip(q0, q1)],
                                atol=1e-13)
-
-
-@pytest.mark.parametrize("k", [1, 2, 3])
-def test_stacked_solves_and_condition_numbers_match_numpy(k):
-    rng = np.random.default_rng(k)
-    A, b = rng.normal(size=(50, k, k)), rng.normal(size=(50, k))
-    np.testing.assert_allclose(solve_batch(A, b), np.linalg.solve(A, b[..., None])[..., 0], rtol=1e-10, atol=1e-12)
-    sigma = np.linalg.svd(A, compute_uv=False)
-    condition, sigma_min = condition_batch(A)
-    np.testing.assert_allclose(condition, sigma[:, 0] / sigma[:, -1], rtol=1e-9)
-    np.testing.assert_allclose(sigma_min, sigma[:, -1], rtol=1e-9)
-    A[0] = 0.0  # exactly singular: an infinite condition number, not an error
-    assert condition_batch(A)[0][0] == np.inf

@@ -245,11 +245,9 @@ def test_rates_at_an_open_loop_are_a_named_error_saying_how_far_open():
     assert info.value.residual == pytest.approx(0.31, abs=5e-3) and "\n" not in str(info.value)
 
 
-@pytest.mark.parametrize("enabled", [True, False], ids=["core", "python"])
-def test_solve_many_refuses_an_open_pose_among_closed_ones(enabled, monkeypatch):
+def test_solve_many_refuses_an_open_pose_among_closed_ones():
     """The compiled core measures no position residual: the poses it solved are checked in
     numpy, and an open one is named by `solve`, as one by one."""
-    monkeypatch.setattr(core, "ENABLED", enabled)
     mech, closed_q, open_q = four_bar_open()
     solver = RateSolver(mech, [Task("P", ("x",), np.array([0.1]), np.zeros(1))])
     batch = solver.solve_many(np.array([closed_q, closed_q]))

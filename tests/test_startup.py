@@ -23,7 +23,7 @@ NOT_FOR_A_SOLVE = (
     "pinmech.io.analysis_task", "pinmech.solve.rates",  # task scenes ([[task]])
     "pinmech.solve.forces", "pinmech.io.forces_scene", "pinmech.solve.forces_report", "pinmech.draw.forces_sweep",
     "pinmech.solve.flywheel",  # force analyses
-    "pinmech.io.sweep", "pinmech.solve.cycle", "pinmech.solve.batch", "pinmech.solve.hermite", "pinmech.solve.cut_arrays",
+    "pinmech.io.sweep", "pinmech.solve.cycle", "pinmech.solve.batch", "pinmech.solve.hermite", "pinmech.solve.manifold",
     "pinmech.io.tables", "pinmech.outputs", "pinmech.solve.path",  # sweeps, paths, their output files
     "pinmech.draw", "pinmech.draw.report_page", "pinmech.draw.polygon", "pinmech.draw.plot", "pinmech.model.link_nodes",
     "pinmech.io.check", "pinmech.model.linkage", "pinmech.model.linkage_urdf", "pinmech.model.mjcf", "pinmech.model.sidecar",

@@ -16,9 +16,7 @@ import pinmech
 import pinmech.solve.core as core
 
 
-@pytest.mark.parametrize("enabled", [True, False], ids=["core", "python"])
-def test_rates_are_every_drivers_motion(scenes_dir, enabled, monkeypatch):
-    monkeypatch.setattr(core, "ENABLED", enabled)
+def test_rates_are_every_drivers_motion(scenes_dir):
     sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(scenes_dir / "five_bar.toml"))
     drivers, solver = sweep.drivers, sweep.solver
     assert np.count_nonzero(drivers.v) == 2  # both motors turn

@@ -58,15 +58,14 @@ def add_parser(sub) -> None:
     sweep.add_argument("--no-predictor", action="store_true", help="same as --start warm")
     sweep.add_argument("--cold-start", action="store_true", help="same as --start cold")
     sweep.add_argument("--no-batch", action="store_true",
-                       help="with the compiled core ruled out (PINMECH_CORE=0), solve every pose on its own "
-                       "(default there: dense sweeps solve the poses between exactly solved ones together); "
-                       "no effect with the core")
+                       help="accepted for old scripts; no effect (the compiled core follows every pose)")
     sweep.add_argument("--interpolate", type=int, metavar="N",
                        help="solve every N-th pose and interpolate the others (quintic Hermite): less "
-                       "accurate, accuracy measured; with the compiled core no faster than the default "
+                       "accurate, accuracy measured; no faster than the default (the compiled core follows "
+                       "every pose) "
                        "(README: Speed and accuracy)")
     sweep.add_argument("--tol", type=float, help="closure tolerance, relative to each loop's size "
-                       "(default 1e-13; 1e-6 gives about 1e-6 and, with the compiled core, saves little)")
+                       "(default 1e-13; 1e-6 gives about 1e-6 and saves little)")
     sweep.add_argument("--max-iterations", type=int, help="Newton iteration cap per pose (default 50)")
     sweep.add_argument("--through-folds", action="store_true",
                        help="at a fold of the driver (a limit angle), go on onto the other branch with the "

@@ -7,13 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace pinmech {
-
-namespace {
-
-// Steps between two looks at Python's signal handlers in a long loop run without the GIL.
-constexpr long SIGNAL_EVERY = 4096;
 
 // Run Python's signal handlers (Ctrl-C, SIGTERM: pinmech's raise Interrupted) from a loop
 // that released the GIL, and leave the loop with the exception they raised.
@@ -21,8 +17,6 @@ void check_signals() {
   nb::gil_scoped_acquire acquire;
   if (PyErr_CheckSignals() != 0) throw nb::python_error();
 }
-
-}  // namespace
 
 // ---------------------------------------------------------------- the corrector
 // LoopSolver.correct(strict=True): full Newton steps, each at least halving the
@@ -66,7 +60,7 @@ bool Core::correct(VectorXd& q, const VectorXd& drivers, int max_iterations, dou
 // ---------------------------------------------------------------- nodes and steps
 // Path.node at a closed q whose placements and Jacobians are in data_: the path
 // derivatives at driver velocity d, the condition number and the signature.
-void Core::node_at(Node& node, const VectorXd& d) {
+void Core::node_at(Node& node, const VectorXd& d, const VectorXd* a_drv) {
   // One factorization of the dimensionless J_dep (columns times dep_scale_) serves the
   // condition number and both solves; a dependent rate is dep_scale_ times its unknown.
   jacobian_into(false);
@@ -92,6 +86,10 @@ void Core::node_at(Node& node, const VectorXd& d) {
   for (size_t i = 0; i < dep_v_.size(); ++i) v(dep_v_[i]) = dep_scale_(Index(i)) * dstep_(Index(i));
   drift_into(node.q, v, drift_);
   rhs_ = -drift_;
+  if (a_drv != nullptr) {
+    for (size_t i = 0; i < drv_v_.size(); ++i) a(drv_v_[i]) = (*a_drv)(Index(i));
+    rhs_.noalias() -= J_ * a;  // driver columns only: a is zero elsewhere yet
+  }
   square_.solve(rhs_, dstep_);
   for (size_t i = 0; i < dep_v_.size(); ++i) a(dep_v_[i]) = dep_scale_(Index(i)) * dstep_(Index(i));
   rhs_.noalias() = J_ * v;
@@ -103,7 +101,7 @@ void Core::node_at(Node& node, const VectorXd& d) {
 
 // Path.step from `from` to p; 0 and `out` filled on success, else why it failed:
 // 1 corrector, 2 trust region, 3 singular, 4 turn, 5 signature changed (a change point
-// when `change` is set: the Python path takes it and names it).
+// when `change` is set: follow_path keeps it, on the branch of continuous tangent).
 int Core::step(const Node& from, double p, const VectorXd& x0, const VectorXd& d, double unit, Node& out, bool& change) {
   change = false;
   const double h = p - from.p;
@@ -133,8 +131,10 @@ int Core::step(const Node& from, double p, const VectorXd& x0, const VectorXd& d
 
 
 // The range mode of solve_cycle._Cycle: from the node (p0, q0, d1, d2) along drivers
-// x(p) = x0 + p d to each of `targets` in turn (Path.follow: first step at most
-// MAX_STEP, doubled after a success, halved after a failure down to PIVOT_BELOW).
+// x(p) = x0 + p d to each of `targets` in turn, each by Path.follow (follow_path, the one
+// implementation of the step rules). It stops where a target needs more than the range
+// mode states: a change point passed or a fold met (the pose-by-pose follow then names
+// and notes it), a pose worse conditioned than max_condition, or rates that overflow.
 // Returns (poses done, why it stopped, q, d1, d2, accuracy columns).
 nb::tuple Core::follow(double p0, const VectorXd& q0, const VectorXd& d1, const VectorXd& d2, const std::vector<int>& signs0,
                  double condition0, const VectorXd& x0, const VectorXd& d, double unit, const VectorXd& targets,
@@ -146,10 +146,15 @@ nb::tuple Core::follow(double p0, const VectorXd& q0, const VectorXd& d1, const 
   RowMatrix acc(n, 7);  // residual, iterations, condition, sigma_min, velocity and acceleration residuals, steps
   Index done = 0;
   int stop = DONE;
-  long attempts = 0;
   {
     nb::gil_scoped_release release;
-    Node node, next;
+    PathSpec path;
+    path.x0 = x0;
+    path.d = d;
+    path.unit = unit;
+    path.d_hat = d / unit;
+    path.scalar = pivots_;
+    Node node;
     node.p = p0;
     node.q = q0;
     node.d1 = d1;
@@ -157,34 +162,13 @@ nb::tuple Core::follow(double p0, const VectorXd& q0, const VectorXd& d1, const 
     node.signs = signs0;
     node.condition = condition0;
     for (; done < n && stop == DONE; ++done) {
-      const double target = targets(done);
-      double h = std::copysign(std::min(std::abs(target - node.p), MAX_STEP / unit), target - node.p);
-      long iterations = 0, steps = 0;
-      while (node.p != target) {
-        if (++attempts % SIGNAL_EVERY == 0) check_signals();  // a span of many turns takes long
-        const double remaining = target - node.p;
-        h = std::copysign(std::min(std::abs(h), std::abs(remaining)), remaining);
-        bool change = false;
-        const int why = step(node, std::abs(h) < std::abs(remaining) ? node.p + h : target, x0, d, unit, next, change);
-        if (why == 0) {
-          std::swap(node, next);
-          iterations += iterations_;
-          ++steps;
-          h *= 2.0;
-          continue;
-        }
-        if (why == 5 && change) {
-          stop = SIGNATURE_CHANGED;
-          break;
-        }
-        if (std::abs(h) * unit > PIVOT_BELOW) {
-          h *= 0.5;
-          continue;
-        }
-        stop = NEEDS_PIVOT;
+      PathResult out;
+      follow_path(node, targets(done), path, out);
+      if (out.status != PATH_DONE || !out.change_points.empty() || !out.folds.empty()) {
+        stop = out.status == PATH_DONE ? SIGNATURE_CHANGED : NEEDS_PIVOT;
         break;
       }
-      if (stop != DONE) break;
+      std::swap(node, out.node);
       if (node.condition > max_condition) {
         stop = CONDITION;
         break;
@@ -196,12 +180,18 @@ nb::tuple Core::follow(double p0, const VectorXd& q0, const VectorXd& d1, const 
       Q.row(done) = node.q.transpose();
       D1.row(done) = node.d1.transpose();
       D2.row(done) = node.d2.transpose();
-      acc.row(done) << node.residual, double(iterations), node.condition, node.sigma_min, node.velocity_residual,
-          node.acceleration_residual, double(steps);
+      acc.row(done) << node.residual, double(out.iterations), node.condition, node.sigma_min, node.velocity_residual,
+          node.acceleration_residual, double(out.steps);
     }
   }
   return nb::make_tuple(done, stop, Q.topRows(done).eval(), D1.topRows(done).eval(), D2.topRows(done).eval(),
                         acc.topRows(done).eval());
+}
+
+void Core::set_pivots(const std::vector<int>& scalar) {
+  for (int v : scalar)
+    if (v < 0 || v >= model_.nv) throw std::invalid_argument("pivot index " + std::to_string(v) + " not in the model");
+  pivots_ = scalar;
 }
 
 // Path.node at a closed q: the path derivatives at driver velocity d, the signature,

@@ -1,19 +1,20 @@
-// pinmech's compiled core: a sweep of one driver followed pose by pose, in C++ on
-// Pinocchio, on the user's own pin.Model (taken by reference from Python: model_ref.cpp).
-//
-// It computes what pinmech/solve_loops.py (closure rows, corrector, rates) and
-// pinmech/continuation.py (predictor, trust region, tangent turn, assembly signature)
-// compute, with the same rules and constants, for the regular steps of a sweep: where a
-// step needs anything more (a signature change, a pivot below PIVOT_BELOW, a singular or
-// overflowing pose, a pose worse conditioned than max_condition) it stops and hands the
-// pose back to the Python path, which names what happened. pinmech/core.py builds it from
-// a LoopSolver; tests/test_core.py checks every number against the closed forms and
-// finite differences.
+// pinmech's compiled core, the one engine: the closure rows, Newton (`close`, `correct`),
+// the predictor-corrector continuation with every assembly rule (trust region, tangent
+// turn, signature, change points, the curve on a joint parameter through folds, landing)
+// and the rate solves, in C++ on Pinocchio, on the user's own pin.Model (taken by
+// reference from Python: model_ref.cpp). Pose (`close`, `rates_at`, `follow_path`), range
+// (`follow`) and batch (BatchSolver's calls) are its modes. Python (pinmech/solve/) orders
+// the calls and names what the core reports (a status and the numbers): where the range
+// mode meets a change point, a fold, a pose worse conditioned than max_condition or
+// overflowing rates, it stops and the pose-by-pose `follow_path` names and notes it.
+// pinmech/solve/core.py builds it from a LoopSolver; tests/test_core.py checks it against
+// closed forms, SVDs and finite differences.
 //
 // One translation unit per concern, so that a change recompiles little and the compile
 // stays within modest memory: condition.cpp (condition numbers), closure.cpp (the model,
 // closure rows, their Jacobians and drift, assembly blocks), continuation.cpp (corrector,
-// predictor-corrector steps, sweeps), rates.cpp (rate problems, frames along a sweep),
+// predictor-corrector steps, sweeps), pivot.cpp (Newton with least squares, the whole
+// path follow: folds, landing, change points), rates.cpp (rate problems, frames along a sweep),
 // model_ref.cpp (the pin.Model from Python), module.cpp (the Python bindings). Pinocchio's
 // algorithms come compiled from libpinocchio_default (PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION),
 // the library the installed `pin` loads: the same version, pinned in pyproject.toml.
@@ -62,9 +63,21 @@ constexpr int CORRECTOR_ITERATIONS = 8;
 constexpr double SINGULAR_NODE = 1e10;
 constexpr int LINE_SEARCH_HALVINGS = 30;
 
+// The constants of the pivot-parametrized curve through folds (pivot.cpp; continuation.py's).
+constexpr double BIFURCATION_STEP = 1e-3;
+constexpr double FOLD_TOL = 1e-12;
+constexpr double LAND_TOL = 1e-12;
+constexpr long MAX_PIVOT_STEPS = 20000;
+constexpr int LAND_ITERATIONS = 50;
+
+// Steps between two looks at Python's signal handlers in a long loop run without the GIL.
+constexpr long SIGNAL_EVERY = 4096;
+// Python's signal handlers, from a loop that released the GIL (continuation.cpp).
+void check_signals();
+
 enum CutType { REVOLUTE, PRISMATIC, SPHERICAL_CUT, FIXED };
 
-// Why a sweep stopped before its last pose (the Python path then takes that pose).
+// Why a sweep stopped before its last pose (the pose-by-pose follow then takes that pose).
 enum Stop { DONE = 0, NEEDS_PIVOT = 1, SIGNATURE_CHANGED = 2, CONDITION = 3, NOT_FINITE = 4 };
 
 // The pin.Model inside a Python object made by the installed `pin` (model_ref.cpp), or
@@ -102,6 +115,41 @@ struct Node {
   double condition = 1.0, sigma_min = 1.0, velocity_residual = 0.0, acceleration_residual = 0.0, residual = 0.0;
 };
 
+// A point of the solution curve in (q, p), followed with one dependent joint's coordinate
+// (`pivot`, a velocity index) as its parameter: its unit tangent (dq in velocity space,
+// then dp in radians or sizes), oriented along the travel, and s, the pivot's displacement
+// since the last change of pivot (pivot.cpp).
+struct CurvePoint {
+  double p = 0.0, s = 0.0;
+  VectorXd q, tangent;
+  int pivot = -1;
+  double dp() const { return tangent(tangent.size() - 1); }
+};
+
+// A straight driver path x(p) = x0 + p d (continuation.Path), with what its curve needs.
+struct PathSpec {
+  VectorXd x0, d, d_hat;  // d_hat = d / unit: drivers' motion per radian or size along the path
+  double unit = 1.0;
+  bool through_folds = false;
+  std::vector<int> scalar;  // dependent velocity indices of one-coordinate joints (pivots)
+  double ds = 1e-3;         // the curve's adaptive pivot step
+};
+
+// How Path.follow ended (pivot.cpp). Python builds the named error from it.
+enum PathStatus { PATH_DONE = 0, PATH_STUCK = 1, PATH_FOLD = 2, PATH_SINGULAR = 3 };
+// Why a path is stuck (continuation.py words them): 1-5 the last failed step's reason
+// (Core::step's codes; 5 the assembly changed: signs_a -> signs_b), then
+enum StuckWhy { NO_PIVOT = 6, ANOTHER_ASSEMBLY_NEAR = 7, TARGET_NOT_CLOSED = 8, TARGET_ON_ANOTHER = 9 };
+
+struct PathResult {
+  int status = PATH_DONE, why = 0;
+  Node node;  // reached (DONE); where it is stuck (STUCK, FOLD); the singular pose (SINGULAR)
+  double p_target = 0.0, fold = NAN;
+  long steps = 0, iterations = 0;
+  std::vector<double> change_points, folds;  // path parameters passed
+  std::vector<int> signs_a, signs_b;
+};
+
 class Core {
  public:
   // `model`: a pin.Model, kept alive and read at every call (a joint or frame placement
@@ -137,12 +185,27 @@ class Core {
 
   // ------------------------------------------------------------ continuation.cpp
   bool correct(VectorXd& q, const VectorXd& drivers, int max_iterations, double& residual_left);
-  void node_at(Node& node, const VectorXd& d);
+  // a_drv: the drivers' accelerations (zero where null: path derivatives)
+  void node_at(Node& node, const VectorXd& d, const VectorXd* a_drv = nullptr);
   int step(const Node& from, double p, const VectorXd& x0, const VectorXd& d, double unit, Node& out, bool& change);
   nb::tuple follow(double p0, const VectorXd& q0, const VectorXd& d1, const VectorXd& d2, const std::vector<int>& signs0,
                    double condition0, const VectorXd& x0, const VectorXd& d, double unit, const VectorXd& targets,
                    double max_condition);
   nb::tuple node(const VectorXd& q, const VectorXd& d);
+
+  // ------------------------------------------------------------ pivot.cpp
+  // LoopSolver.close and correct(strict=False): Newton steps kept where they lower the
+  // residual, else a minimum-norm least-squares step halved until it does; the polish.
+  bool close(VectorXd& q, const VectorXd& drivers, int max_iterations, bool polish_within, double& residual_left);
+  // LoopSolver._rates: v, a at a closed q from the drivers' v and a, with the accuracy.
+  nb::tuple rates_at(const VectorXd& q, const VectorXd& v_drv, const VectorXd& a_drv);
+  nb::tuple close_py(VectorXd q, const VectorXd& drivers, int max_iterations, bool polish_within);
+  // Path.follow from a node to p_target: regular steps, and where they shrink below
+  // PIVOT_BELOW the curve with a dependent joint as parameter (folds, landing).
+  void follow_path(Node& node, double p_target, PathSpec& path, PathResult& out);  // node: worked on in place
+  nb::tuple follow_path_py(double p0, const VectorXd& q0, const VectorXd& d1, const VectorXd& d2,
+                           const std::vector<int>& signs0, double condition0, const VectorXd& x0, const VectorXd& d,
+                           double unit, double p_target, bool through_folds, const std::vector<int>& scalar);
 
   // ------------------------------------------------------------ rates.cpp
   nb::tuple rates(const Eigen::Ref<const RowMatrix>& Q, const std::vector<int>& task_frames,
@@ -159,6 +222,9 @@ class Core {
   // Diagonal blocks the dependent solves go through (0: the whole matrix at once).
   int solve_blocks() const { return int(square_.blocks()); }
   double moved() const { return moved_; }
+  // The dependent velocity indices of one-coordinate joints, the pivots a path's curve
+  // may take through a fold (LoopSolver.dep_is_scalar), for the range mode's `follow`.
+  void set_pivots(const std::vector<int>& scalar);
   // Throws (a ValueError in Python) where the model's joints or frames changed.
   void check_structure() const;
 
@@ -171,6 +237,22 @@ class Core {
   void move_into(const VectorXd& q, const VectorXd& step, VectorXd& out);
   void polish(VectorXd& q, VectorXd& r, double& norm);
   double turn_between(const Node& a, const Node& b, double unit) const;
+  bool newton_update(VectorXd& q, VectorXd& r, double& norm);
+  bool pivot_follow(const Node& node, double p_target, PathSpec& path, int why, PathResult& out);
+  bool stuck(const Node& node, int why, PathResult& out) const;
+  bool land_kept(const Node& start, CurvePoint a, CurvePoint b, double p_target, bool folded, PathSpec& path,
+                 PathResult& out);
+  void plain(const CurvePoint& a, const PathSpec& path, Node& out);
+  bool singular_node(const Node& n) const;
+  void curve_tangent(const VectorXd& q, const PathSpec& path, VectorXd& t);
+  double curve_cos(const VectorXd& a, const VectorXd& b) const;
+  int best_pivot(const VectorXd& tangent, const PathSpec& path) const;
+  void curve_start(const Node& node, double sense, const PathSpec& path, CurvePoint& out);
+  bool close_at(VectorXd& q, double& p, int pivot, const PathSpec& path);
+  bool point_at(const CurvePoint& a, double s, const PathSpec& path, CurvePoint& out);
+  bool advance(const CurvePoint& a, PathSpec& path, CurvePoint& out);
+  void repivot(CurvePoint& a, const PathSpec& path) const;
+  void locate_fold(CurvePoint a, CurvePoint b, const PathSpec& path, CurvePoint& out);
 
   nb::object model_object_;  // the Python pin.Model: alive as long as this core
   const pin::Model& model_;
@@ -196,6 +278,9 @@ class Core {
   double tol_;
   int iterations_ = 0;
   double moved_ = 0.0;
+  std::vector<int> pivots_;
+  Node next_;  // follow_path's step buffer
+  long attempts_ = 0;  // steps tried since the last look at Python's signal handlers
 };
 
 }  // namespace pinmech

@@ -23,6 +23,10 @@ NB_MODULE(_core, m) {
   m.attr("PIVOT_BELOW") = PIVOT_BELOW;
   m.attr("CORRECTOR_ITERATIONS") = CORRECTOR_ITERATIONS;
   m.attr("SINGULAR_NODE") = SINGULAR_NODE;
+  m.attr("BIFURCATION_STEP") = BIFURCATION_STEP;
+  m.attr("FOLD_TOL") = FOLD_TOL;
+  m.attr("LAND_TOL") = LAND_TOL;
+  m.attr("MAX_PIVOT_STEPS") = MAX_PIVOT_STEPS;
   // What the core was compiled against: pinmech/core.py refuses a pin that differs.
   m.attr("PINOCCHIO_VERSION") = PINOCCHIO_VERSION;
   m.attr("BOOST_VERSION") = BOOST_VERSION;
@@ -63,6 +67,11 @@ NB_MODULE(_core, m) {
              const bool ok = core.correct(q, drivers, max_iterations, residual);
              return nb::make_tuple(q, ok ? nb::cast(residual) : nb::none());
            })
+      .def("close", &Core::close_py, nb::arg("q"), nb::arg("drivers"), nb::arg("max_iterations"),
+           nb::arg("polish_within") = true)
+      .def("follow_path", &Core::follow_path_py)
+      .def("rates_at", &Core::rates_at)
+      .def("set_pivots", &Core::set_pivots)
       .def("follow", &Core::follow)
       .def("node", &Core::node)
       .def("rates", &Core::rates)

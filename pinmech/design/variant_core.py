@@ -9,8 +9,8 @@ variant is its parameters written in place and nothing is rebuilt. Wherever the 
 does not finish cleanly (the start does not close by a full Newton step, or closes on
 another assembly; the follow stops at a change point, a fold, a singular or too
 ill-conditioned pose) `follow` returns None and the caller solves the variant by the
-sweep's Python path, which names the cause or takes the pose as the scene's sweep would:
-the core only answers where it has the whole answer.
+scene's sweep (the core's pose-by-pose follow), which names the cause or takes the pose:
+this range call only answers where it has the whole answer.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ class CoreCycle:
     """The compiled follow of a StudyMechanism's cycle, set up once per process.
 
     Attributes:
-        usable: False where the sweep has no compiled core (no loops, PINMECH_CORE=0) or
+        usable: False where the sweep has no compiled core (no loops: an open chain) or
             other drivers move with the swept one (their rates are not the path's).
     """
 

@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from pinmech.solve.continuation import Route
+from pinmech.solve.core import core_for
 from pinmech.exceptions import AssemblyError, PinmechError
 
 #: Newton iterations taking a closed pose to rounding (it is closed to `tol` already:
@@ -50,7 +51,6 @@ def check_guessed_pose(solver, q: np.ndarray, driver_q: np.ndarray,
     try:
         continued = solver.follow(q0, x0, driver_q, route)
     except PinmechError as exc:
-        solver._residual(q)
         raise AssemblyError(
             f"{solver.mechanism.source}: at {where} the pose from the guess cannot be checked against the "
             f"reference's assembly, which cannot be followed there from "
@@ -60,7 +60,6 @@ def check_guessed_pose(solver, q: np.ndarray, driver_q: np.ndarray,
     q_cont, res_cont, _ = _polished(solver, continued, driver_q)
     gap, joint = _largest_gap(solver, q_guess, q_cont)
     bound = max(GAP_FLOOR, GAP_FACTOR * max(res_guess, res_cont) / sigma) if sigma > 0 else GAP_FLOOR
-    solver._residual(q)
     if gap > bound:
         raise AssemblyError(
             f"{solver.mechanism.source}: at {where} the pose from the guess is on another assembly than the "
@@ -73,25 +72,18 @@ def check_guessed_pose(solver, q: np.ndarray, driver_q: np.ndarray,
 
 
 def _polished(solver, q: np.ndarray, driver_q: np.ndarray) -> tuple[np.ndarray, float, float]:
-    """Newton with the drivers held while the residual decreases: (q, its residual, the
-    smallest singular value of the dimensionless dependent Jacobian there)."""
-    q = solver.set_drivers(q, driver_q)
-    r = solver._residual(q)
-    norm = float(np.max(np.abs(r), initial=0.0))
-    for _ in range(POLISH_ITERATIONS):
-        J_dep = solver._residual_jacobian()[:, solver._dep] * solver._dep_scale
-        if norm == 0.0:
-            break
-        step = np.linalg.lstsq(J_dep, -r, rcond=None)[0] * solver._dep_scale
-        trial = solver._move(q, step)
-        r_trial = solver._residual(trial)
-        trial_norm = float(np.max(np.abs(r_trial), initial=0.0))
-        if not trial_norm < norm:
-            solver._residual(q)
-            break
-        q, r, norm = trial, r_trial, trial_norm
-    J_dep = solver._residual_jacobian()[:, solver._dep] * solver._dep_scale
-    sigma = float(np.linalg.svd(J_dep, compute_uv=False)[-1]) if J_dep.size else 1.0
+    """Newton with the drivers held while the residual decreases, at most
+    POLISH_ITERATIONS (the compiled core's `close` with a zero tolerance): (q, its
+    residual, the smallest singular value of the dimensionless dependent Jacobian there)."""
+    compiled = core_for(solver)
+    x = np.asarray(driver_q, dtype=float)
+    tol, compiled.tol = compiled.tol, 0.0
+    try:
+        q = compiled.close(solver.set_drivers(q, x), x, POLISH_ITERATIONS, True)[0]
+    finally:
+        compiled.tol = tol
+    norm = float(np.max(np.abs(compiled.residual(q)), initial=0.0))
+    sigma = float(compiled.rates_at(q, np.zeros(len(x)), np.zeros(len(x)))[4])
     return q, norm, sigma
 
 

@@ -5,9 +5,10 @@ The core reads the model at every call, so a joint or frame placement changed in
 (`model.jointPlacements[j] = ...`) is used at the next call with nothing rebuilt; only a
 changed tree (joints or frames added) or another model object builds a new core. It
 serves every joint Pinocchio has (mimic, composite, helical, universal, ellipsoid...).
-The core follows a sweep pose by pose with the rules of continuation.py; where a step
-needs more than a regular predictor-corrector step (a change point, a fold, a singular
-or too ill-conditioned pose), it stops and the Python path takes that pose (solve_cycle.py).
+It is the one engine: the closure rows, the Newton of `close`, the predictor-corrector
+continuation with every assembly rule (trust region, tangent turn, signature, change
+points, folds followed on a joint parameter) are written once, in C++; Python orders
+the calls and names what the core reports (continuation.py, cycle.py).
 
 The core is compiled against the Pinocchio of the `libpinocchio` build requirement and
 shares `pin`'s Model objects and libraries: both must be the same version (pinned in
@@ -22,7 +23,7 @@ import os
 import numpy as np
 import pinocchio as pin
 
-from pinmech.exceptions import CoreBuildError
+from pinmech.exceptions import CoreBuildError, ModelError
 
 _REINSTALL = "reinstall pinmech beside this pin (`pip install --force-reinstall --no-deps .` in its checkout)"
 
@@ -54,9 +55,6 @@ def check_pinocchio(built: str, loaded: str) -> None:
 _core = _import_core()
 CUT_CODES = {"revolute": 0, "prismatic": 1, "spherical": 2, "fixed": 3}
 DEFAULT_TOL = _core.DEFAULT_TOL
-#: PINMECH_CORE=0 in the environment solves everything by the Python path (tests compare
-#: the two; a user can rule the core out when in doubt).
-ENABLED = os.environ.get("PINMECH_CORE", "1") != "0"
 _NO_ROWS = np.zeros((0, 3))
 
 
@@ -95,10 +93,11 @@ class CompiledModel:
 
 def core_for(solver) -> _core.Core | None:
     """The compiled core of a `LoopSolver` (built once per model and tree; a new tolerance
-    is set on it), or None where it has no loops, or the core's closure rows disagree with
-    the Python ones (then the Python path solves it all)."""
-    if not ENABLED:
-        return None
+    is set on it), or None where it has no loops (an open chain: the drivers are the pose).
+
+    Raises:
+        ModelError: the core reads a loop's closure rows otherwise than its Closure states.
+    """
     cached = solver.__dict__.get("_compiled")
     if cached is None or not cached[0].matches(solver.model):
         cached = (ModelShape(solver.model), _build(solver))
@@ -113,20 +112,25 @@ def _build(solver) -> _core.Core | None:
     closures = solver.mechanism.closures
     if not closures or solver.model.nv == 0:
         return None
-    built = compile_loops(solver.model, closures, solver.mechanism.velocity_scale(), tol=solver.tol,
-                          drv_v=solver._drv_v, dep_v=solver._dep_v, drv_q=solver._drv_q,
-                          blocks=solver.structure.blocks)
-    return None if built is None else built[0]
+    core = compile_loops(solver.model, closures, solver.mechanism.velocity_scale(), tol=solver.tol,
+                         drv_v=solver._drv_v, dep_v=solver._dep_v, drv_q=solver._drv_q,
+                         blocks=solver.structure.blocks, source=str(solver.mechanism.source))[0]
+    core.set_pivots([int(v) for v, ok in zip(solver._dep_v, solver.dep_is_scalar) if ok])
+    return core
 
 
 def compile_loops(model: pin.Model, closures: list, v_scale: np.ndarray, *, extra_frames: list[int] = (),
-                  tol: float = DEFAULT_TOL, drv_v=(), dep_v=(), drv_q=(), blocks=()):
+                  tol: float = DEFAULT_TOL, drv_v=(), dep_v=(), drv_q=(), blocks=(), source: str = ""):
     """A core of the model with its loop closures (rows as the Closure objects state them)
     and the frames asked, with the drivers' and dependent joints' indices for sweeps:
-    (core, its CompiledModel), or None where its closure rows disagree (`agrees`)."""
+    (core, its CompiledModel).
+
+    Raises:
+        ModelError: the core's closure rows disagree with the Closure objects (`disagreement`).
+    """
     compiled = CompiledModel(model, [f for c in closures for f in (c.parent_frame, c.child_frame)]
                              + list(extra_frames))
-    for c in closures:  # what the core copies stays as it is (as CutEvaluator does)
+    for c in closures:  # what the core copies stays as it is
         c.__dict__["_in_use"] = True
     rows6 = [np.ascontiguousarray(c._rows6, dtype=float) for c in closures]
     full = [np.ascontiguousarray(c.selected * c._scale(), dtype=float) for c in closures]
@@ -139,16 +143,22 @@ def compile_loops(model: pin.Model, closures: list, v_scale: np.ndarray, *, extr
         [int(i) for i, _ in drv_q], [int(c) for _, c in drv_q], np.asarray(v_scale, dtype=float),
         [list(map(int, b.rows)) for b in blocks], [list(map(int, b.cols)) for b in blocks], float(tol),
     )
-    return (core, compiled) if agrees(core, model, closures) else None
+    gap = disagreement(core, model, closures)
+    if gap is not None:
+        raise ModelError(f"the compiled core reads the closure rows of loop(s) "
+                         f"{', '.join(c.name for c in closures)} otherwise than they are stated (largest difference "
+                         f"{gap:.3g} of their size at a test pose, above 1e-12): pinmech cannot solve this cut",
+                         path=source or None)
+    return core, compiled
 
 
-def agrees(core: _core.Core, model: pin.Model, closures: list) -> bool:
-    """Whether the core's closure rows and their Jacobian are those the Closure objects
+def disagreement(core: _core.Core, model: pin.Model, closures: list) -> float | None:
+    """None where the core's closure rows and their Jacobian are those the Closure objects
     state, at a seeded random configuration (to 1e-12 of their size; the same formulas in
-    another order agree to 1e-15): a cut the core reads otherwise is left to the Python
-    path instead of giving other numbers."""
+    another order agree to 1e-15), else the largest difference relative to that size: a
+    cut the core would read otherwise is refused, never solved to other numbers."""
     if not closures:
-        return True
+        return None
     rng = np.random.default_rng(20261122)
     q = pin.integrate(model, pin.neutral(model), rng.uniform(-1.0, 1.0, model.nv))
     data = model.createData()
@@ -157,5 +167,5 @@ def agrees(core: _core.Core, model: pin.Model, closures: list) -> bool:
     r = np.concatenate([c.residual(data) for c in closures])
     J = np.vstack([c.jacobian(model, data) for c in closures])
     scale = 1.0 + max(float(np.abs(r).max()), float(np.abs(J).max()))
-    return bool(np.abs(core.residual(q) - r).max() <= 1e-12 * scale
-                and np.abs(core.jacobian(False) - J).max() <= 1e-12 * scale)
+    gap = max(float(np.abs(core.residual(q) - r).max()), float(np.abs(core.jacobian(False) - J).max())) / scale
+    return gap if not gap <= 1e-12 else None

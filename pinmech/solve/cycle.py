@@ -9,11 +9,8 @@ How each pose is found is the user's accuracy choice (README, "Speed and accurac
     start="warm": from the previous pose as it is (O(dx) off: more Newton iterations).
     start="cold": every pose from the same guess (the scene's): slowest, and where two
         assembly branches are close it may land on the other one.
-    batch=True (default, with the predictor, on dense ranges): every 64th pose is
-        solved as above; the poses between are guessed by quintic Hermite interpolation
-        in (q, q', q'') of their solved neighbours, every 8th first, then the rest, and
-        closed and rated together by `BatchSolver` (every pose still meets the
-        tolerance, with its accuracy measured).
+    batch: accepted for compatibility; the compiled core follows every pose with the
+        predictor (the range mode of the one engine, pinmech/csrc).
     interpolate=n: solve every n-th pose exactly (as above) and interpolate the poses
         between (quintic Hermite); their accuracy is measured at the points of each
         interval where the interpolation error peaks: there the poses are also solved
@@ -29,7 +26,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass, field
 from itertools import islice
 
 import numpy as np
@@ -46,32 +42,23 @@ from pinmech.exceptions import (
     PinmechError,
     SingularPoseError,
 )
-from pinmech.solve.hermite import interpolate_poses
 from pinmech.solve.results import Accuracy, LoopSolution
-from pinmech.solve.batch import BatchSolution, BatchSolver, difference_many
+from pinmech.solve.batch import BatchSolution, BatchSolver
+from pinmech.solve.cycle_interpolation import Interpolation
 from pinmech.solve.loops import LoopSolver
+from pinmech.solve.range_chunk import (  # noqa: F401  (RangeChunk: imported from here by users)
+    _ACCURACY,
+    RangeChunk,
+    _accuracy_arrays,
+    _concat,
+    _Fallback,
+    _stack,
+    _store,
+)
 
 STARTS = ("predictor", "warm", "cold")
 #: Poses per chunk: what is held in memory at once.
 CHUNK = 4096
-#: Batched refinement: exact poses every LEVELS[0]-th, then every LEVELS[1]-th, ...,
-#: used when the driver moves less than MAX_SPAN (rad, or lengths of the mechanism)
-#: between the poses of the first level.
-LEVELS = (64, 8, 1)
-MAX_SPAN = 0.12
-#: Where the error of a quintic Hermite interpolant peaks within its interval (to
-#: leading order, s^3 (1 - s)^3 and its derivatives): the middle for positions and
-#: accelerations, (1 - 1/sqrt 5) / 2 for velocities (and its mirror image, as large).
-PEAKS = (0.5, 0.5 - 0.5 / math.sqrt(5.0))
-#: An interpolated pose's error bound: this factor times the largest interpolation error
-#: measured at its interval's peaks (exact poses solved there). The leading-order error
-#: peaks there; higher orders shift the peak and change its height
-#: (tests/test_interpolation_bounds.py checks it against the R-RTR's closed form).
-INTERPOLATION_SAFETY = 4.0
-#: Largest Newton step (rad, or loop sizes) from an interpolated guess to the exact pose it
-#: is measured against: the guess is as good as the interpolation, and the assembly is
-#: checked after (a step to another branch is refused by its signature).
-MEASURE_STEP = 0.05
 #: Driver rates (|w|, w^2, |alpha|) below which scaling path derivatives cannot overflow
 #: float64: q' and q'' of a pose conditioned under any accepted limit stay far below 1e200.
 _SAFE_RATE = 1e100
@@ -79,35 +66,6 @@ _FAILURES = (LoopClosureError, SingularPoseError, AssemblyError, DriverLimitErro
 
 
 _SWEEPS = "the sweep's"  # the assembly a sweep keeps, in messages
-
-
-@dataclass(frozen=True)
-class RangeChunk:
-    """Consecutive poses of a range, as arrays.
-
-    Attributes:
-        start: index of the first pose in the range.
-        values: the swept driver's value at each pose [rad or m].
-        solution: q, v, a and the accuracy of each pose (NaN rows where a pose failed).
-        interpolated: True where a pose was interpolated rather than solved.
-        errors: position in the chunk -> the error of a pose that failed.
-        notes: position in the chunk -> what the path passed on its way to that pose (a
-            change point, or a fold crossed with `through_folds`: the assembly changed).
-    """
-
-    start: int
-    values: np.ndarray
-    solution: BatchSolution
-    interpolated: np.ndarray
-    errors: dict[int, PinmechError] = field(default_factory=dict)
-    notes: dict[int, str] = field(default_factory=dict)
-
-    def __len__(self) -> int:
-        return len(self.values)
-
-    def pose(self, j: int) -> LoopSolution | None:
-        """Pose j of the chunk as a `LoopSolution` (None where it failed)."""
-        return None if j in self.errors else self.solution.solution(j)
 
 
 def solve_range(solver: LoopSolver, driver: str, values: Iterable[float], *, driver_q: np.ndarray,
@@ -162,7 +120,7 @@ def solve_range(solver: LoopSolver, driver: str, values: Iterable[float], *, dri
         index += len(xs)
 
 
-class _Cycle:
+class _Cycle(Interpolation):
     def __init__(self, solver: LoopSolver, driver: str, driver_q: np.ndarray, driver_v: np.ndarray,
                  driver_a: np.ndarray, guess: np.ndarray | None, start: str, batch: bool, interpolate: int,
                  through_folds: bool = False) -> None:
@@ -181,12 +139,8 @@ class _Cycle:
         if interpolate > 1 and (start != "predictor" or not self.alone):
             raise PinmechError("interpolating a sweep needs the predictor start and the other drivers at "
                                "rest (zero speed and acceleration): their motion is not the swept driver's path")
-        batch = batch and self.alone
         self.start, self.interpolate = start, int(interpolate)
-        # the batched levels serve the Python path only: the compiled core follows every pose
-        self.batch = (BatchSolver(solver) if batch and start == "predictor" and solver._cuts
-                      and core_for(solver) is None else None)
-        self.measurer = (self.batch or BatchSolver(solver)) if interpolate > 1 and solver._cuts else None
+        self.measurer = BatchSolver(solver) if interpolate > 1 and solver._cuts else None
         self.guess = None if guess is None else np.asarray(guess, dtype=float)
         self.ref: Node | None = None  # the last pose solved: p is the swept value, d1 and d2 its path derivatives
         self.unit_v = np.zeros_like(self.v_drv)
@@ -197,7 +151,7 @@ class _Cycle:
         self.path = Path(solver, x0, self.unit_v, through_folds=through_folds)  # p = the swept value
         self.mirror = (1.0, 0.0)  # p = a x + b: past each fold crossed, values are mirrored at it
         self.notes: dict[int, str] = {}
-        self._index, self._iterations, self._batching = 0, 0, False
+        self._index, self._iterations, self._sweeping = 0, 0, False
         self.span_scale = float(solver.mechanism.velocity_scale()[solver.mechanism.joint(driver).idx_v])  # 1: a turn
 
     # ------------------------------------------------------------------ chunks
@@ -227,7 +181,7 @@ class _Cycle:
         try:
             if self.interpolate > 1:
                 return self._interpolated(index, xs)
-            q, d1, d2, acc = self._exact(xs, self._levels(xs))
+            q, d1, d2, acc = self._exact(xs)
             return self._actual(index, xs, q, d1, d2, acc, np.zeros(len(xs), dtype=bool))
         except _Fallback:  # near trouble: pose by pose, each failure named
             self.ref = ref
@@ -254,17 +208,6 @@ class _Cycle:
         self.q_drv[k] = self.ref.p
         return self._actual(index, xs, q, d1, d2, acc, np.zeros(len(xs), dtype=bool))
 
-    def _levels(self, xs: np.ndarray) -> tuple[int, ...]:
-        """The batched levels this chunk's spacing allows (LEVELS, MAX_SPAN)."""
-        if self.batch is None or len(xs) < 2:
-            return (1,)
-        steps = np.abs(np.diff(np.concatenate(([self.ref.p], xs))))
-        step = float(steps.max()) / self.span_scale
-        for first in range(len(LEVELS) - 1):
-            if LEVELS[first] * step <= MAX_SPAN:
-                return LEVELS[first:]
-        return (1,)
-
     def _sequential(self, index: int, xs: np.ndarray) -> RangeChunk:
         """Pose after pose through `LoopSolver.solve`; a failing pose is kept as an error."""
         rows, errors, values = [], {}, xs.copy()
@@ -278,51 +221,27 @@ class _Cycle:
                 rows.append(None)
         return RangeChunk(index, values, _stack(rows, self.solver), np.zeros(len(xs), dtype=bool), errors)
 
-    def _exact(self, xs: np.ndarray, levels: tuple[int, ...]):
-        """Every pose exact, in path-derivative terms: q, q', q'' and accuracy arrays.
-
-        The poses of the first level one by one from the predictor, the others batched
-        from Hermite guesses between the poses of the level before (see LEVELS).
-        """
+    def _exact(self, xs: np.ndarray):
+        """Every pose exact, in path-derivative terms: q, q', q'' and accuracy arrays,
+        followed by the compiled core (an open chain's poses one by one: the drivers are
+        the pose)."""
         compiled = core_for(self.solver)
         if compiled is not None:
             return self._compiled(compiled, xs)
         n, nq, nv = len(xs), self.solver.model.nq, self.solver.model.nv
-        ref = self.ref
-        q, d1, d2 = np.empty((n + 1, nq)), np.empty((n + 1, nv)), np.empty((n + 1, nv))
-        q[0], d1[0], d2[0] = ref.q, ref.d1, ref.d2  # slot 0: the pose before the chunk
-        x = np.concatenate(([ref.p], xs))
-        acc = _accuracy_arrays(n + 1)
-        solved = np.zeros(n + 1, dtype=bool)
-        solved[0] = True
-        self._batching = True
-        try:
-            for j in sorted(set(range(levels[0], n + 1, levels[0])) | {n}):
-                self._solve_level(x, j, q, d1, d2, acc, solved)
-        finally:
-            self._batching = False
-        for stride in levels[1:]:
-            targets = np.array([j for j in range(stride, n + 1, stride) if not solved[j]], dtype=int)
-            if not targets.size:
-                continue
-            guesses = self._hermite(x, q, d1, d2, solved, targets)[0]
-            count = len(targets)
-            out = self.batch.try_solve(guesses, self._drivers(x[targets]), np.tile(self.unit_v, (count, 1)),
-                                       np.tile(self.zero, (count, 1)), _on_path=True)
-            if out is None or (ref.signs and np.any(out.signs != np.array(ref.signs))):
-                raise _Fallback
-            q[targets], d1[targets], d2[targets] = out.q, out.v, out.a
-            for name in _ACCURACY:
-                acc[name][targets] = getattr(out, name)
-            solved[targets] = True
-        self.ref = Node(float(x[n]), q[n].copy(), d1[n].copy(), d2[n].copy(), self.ref.signs, acc["condition"][n],
-                        acc["sigma_min"][n])
-        return q[1:], d1[1:], d2[1:], {k: v[1:] for k, v in acc.items()}
+        q, d1, d2 = np.empty((n, nq)), np.empty((n, nv)), np.empty((n, nv))
+        acc = _accuracy_arrays(n)
+        for j, x in enumerate(xs):
+            sol = self._solve(x, actual=False, fail=_Fallback)
+            q[j], d1[j], d2[j] = sol.q, sol.v, sol.a
+            _store(acc, j, sol.accuracy)
+        return q, d1, d2, acc
 
     def _compiled(self, compiled, xs: np.ndarray):
         """Every pose exact, as `_exact`, followed by the compiled core (core.py) from the
         last pose; a pose it hands back (a change point, a fold, a singular or too
-        ill-conditioned pose) is taken by the Python path, then the core goes on."""
+        ill-conditioned pose) is taken by `_solve` (the core's whole path follow, which names
+        what it met), then the core's sweep goes on."""
         n, solver, path = len(xs), self.solver, self.path
         q, d1, d2 = np.empty((n, solver.model.nq)), np.empty((n, solver.model.nv)), np.empty((n, solver.model.nv))
         acc = _accuracy_arrays(n)
@@ -344,50 +263,16 @@ class _Cycle:
                 self.ref = Node(float(xs[j + done - 1]), Q[-1].copy(), D1[-1].copy(), D2[-1].copy(), ref.signs,
                                 float(last[2]), float(last[3]), float(last[4]), float(last[5]), float(last[0]))
                 j += done
-            if j < n:  # the Python path names what the core met
-                self._batching = True
+            if j < n:  # `_solve` names what the sweep met (the core's Path.follow)
+                self._sweeping = True
                 try:
                     sol = self._solve(xs[j], actual=False, fail=_Fallback)
                 finally:
-                    self._batching = False
+                    self._sweeping = False
                 q[j], d1[j], d2[j] = sol.q, sol.v, sol.a
                 _store(acc, j, sol.accuracy)
                 j += 1
         return q, d1, d2, acc
-
-    def _solve_level(self, x: np.ndarray, j: int, q: np.ndarray, d1: np.ndarray, d2: np.ndarray,
-                     acc: dict[str, np.ndarray], solved: np.ndarray) -> None:
-        """Slot j solved exactly (path derivatives), or _Fallback."""
-        sol = self._solve(x[j], actual=False, fail=_Fallback)
-        q[j], d1[j], d2[j] = sol.q, sol.v, sol.a
-        _store(acc, j, sol.accuracy)
-        solved[j] = True
-
-    def _interpolated(self, index: int, xs: np.ndarray) -> RangeChunk:
-        """Exact poses every n-th (batched when dense), Hermite between, accuracy measured."""
-        n, ref = len(xs), self.ref
-        exact_at = np.array(sorted(set(range(self.interpolate - 1, n, self.interpolate)) | {n - 1}), dtype=int)
-        qe, d1e, d2e, acc_e = self._exact(xs[exact_at], self._levels(xs[exact_at]))
-        nq, nv = qe.shape[1], d1e.shape[1]
-        q, d1, d2 = np.empty((n + 1, nq)), np.empty((n + 1, nv)), np.empty((n + 1, nv))
-        acc = _accuracy_arrays(n + 1)
-        slots = exact_at + 1
-        q[0], d1[0], d2[0] = ref.q, ref.d1, ref.d2
-        q[slots], d1[slots], d2[slots] = qe, d1e, d2e
-        for name in _ACCURACY:
-            acc[name][slots] = acc_e[name]
-        acc["condition"][0], acc["sigma_min"][0] = ref.condition, ref.sigma_min
-        solved = np.zeros(n + 1, dtype=bool)
-        solved[0] = True
-        solved[slots] = True
-        x = np.concatenate(([ref.p], xs))
-        targets = np.flatnonzero(~solved)
-        if targets.size:
-            q[targets], d1[targets], d2[targets] = self._hermite(x, q, d1, d2, solved, targets)
-            self._measure(x, q, d1, d2, solved, targets, acc)
-        interpolated = np.zeros(n, dtype=bool)
-        interpolated[targets - 1] = True
-        return self._actual(index, xs, q[1:], d1[1:], d2[1:], {k: v[1:] for k, v in acc.items()}, interpolated)
 
     # ------------------------------------------------------------------ pieces
     def _drivers(self, values: np.ndarray) -> np.ndarray:
@@ -489,9 +374,9 @@ class _Cycle:
 
     def _note(self, route: Route) -> None:
         """Record what a step passed: change points, and folds crossed (values mirrored).
-        The batched levels hand such a step back to the pose-by-pose path, which names
+        The core's sweep hands such a step back to the pose-by-pose path, which names
         the pose."""
-        if (route.change_points or route.folds) and self._batching:
+        if (route.change_points or route.folds) and self._sweeping:
             raise _Fallback
         solver, index = self.solver, self._index
         for x in route.change_points:
@@ -550,143 +435,3 @@ class _Cycle:
         solution = BatchSolution(q, v, a, *(numbers[name] for name in _ACCURACY), solver.drivers,
                                  interpolation=acc["interpolation"] if interpolated.any() else None)
         return RangeChunk(index, xs, solution, interpolated)
-
-    def _hermite(self, x: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray, solved: np.ndarray,
-                 targets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """q, q', q'' at the slots `targets`, between their solved neighbours."""
-        known = np.flatnonzero(solved)
-        at = np.searchsorted(known, targets)
-        return self._hermite_at(x, q, d1, d2, known[at - 1], known[at], x[targets])
-
-    def _hermite_at(self, x: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray, left: np.ndarray,
-                    right: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """q, q', q'' at driver values `at` between slots `left` and `right` (hermite.py)."""
-        try:
-            return interpolate_poses(self.solver.model, x, q, d1, d2, left, right, at)
-        except ValueError:  # two poses at one driver value: pose by pose instead
-            raise _Fallback from None
-
-    def _measure(self, x: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray, solved: np.ndarray,
-                 targets: np.ndarray, acc: dict[str, np.ndarray]) -> None:
-        """Each interpolated pose gets the worst accuracy measured at its interval's error
-        peaks (PEAKS), and the worst condition number of the interval's ends and peaks."""
-        known = np.flatnonzero(solved)
-        right_of = known[np.searchsorted(known, targets)]
-        right = np.unique(right_of)
-        left = known[np.searchsorted(known, right) - 1]
-        at = np.concatenate([x[left] + p * (x[right] - x[left]) for p in PEAKS])
-        reps = len(PEAKS)
-        probe = self._hermite_at(x, q, d1, d2, np.tile(left, reps), np.tile(right, reps), at)
-        m = self.measurer.measure(*probe) if self.measurer is not None else None
-        where = np.searchsorted(right, right_of)
-        for name in ("residual", "velocity_residual", "acceleration_residual"):
-            worst = np.max(getattr(m, name).reshape(reps, -1), axis=0) if m is not None else np.zeros(len(right))
-            acc[name][targets] = worst[where]
-        cond = np.maximum(acc["condition"][left], acc["condition"][right])
-        sigma = np.minimum(acc["sigma_min"][left], acc["sigma_min"][right])
-        if m is not None:
-            cond = np.maximum(cond, np.max(m.condition.reshape(reps, -1), axis=0))
-            sigma = np.minimum(sigma, np.min(m.sigma_min.reshape(reps, -1), axis=0))
-        acc["condition"][targets], acc["sigma_min"][targets] = cond[where], sigma[where]
-        if m is not None:
-            absolute = np.max(self._interpolation_errors(at, probe).reshape(reps, -1, 3), axis=0)[where]
-            acc["interpolation"][targets] = INTERPOLATION_SAFETY * self._relative(absolute, d1[targets], d2[targets])
-
-    def _interpolation_errors(self, at: np.ndarray, probe: tuple) -> np.ndarray:
-        """(N, 3) largest differences between interpolated poses (q, q', q'') and the exact
-        poses at the same driver values: positions [rad, or sizes of the loops], then q'
-        and q'' in the same units per unit of the driver. _Fallback where an exact pose
-        cannot be had (the chunk is then solved pose by pose)."""
-        q, d1, d2 = self._exact_at(at, probe[0])
-        solver = self.solver
-        inv = solver._v_scale_inv
-        dq = difference_many(solver.model, q, probe[0]) * inv
-        return np.stack([np.abs(dq).max(axis=1), np.abs((probe[1] - d1) * inv).max(axis=1),
-                         np.abs((probe[2] - d2) * inv).max(axis=1)], axis=1)
-
-    def _exact_at(self, at: np.ndarray, guesses: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Exact q, q', q'' at driver values `at`, from interpolated guesses: batched, else
-        pose by pose (a guess too far for the batch)."""
-        n, ref = len(at), self.ref
-        out = self.measurer.try_solve(guesses, self._drivers(at), np.tile(self.unit_v, (n, 1)),
-                                      np.tile(self.zero, (n, 1)), max_step=MEASURE_STEP, _on_path=True)
-        if out is not None and not (ref.signs and np.any(out.signs != np.array(ref.signs))):
-            return out.q, out.v, out.a
-        solver = self.solver
-        q, d1, d2 = np.empty_like(guesses), np.empty((n, solver.model.nv)), np.empty((n, solver.model.nv))
-        for i, (x, guess) in enumerate(zip(self._drivers(at), guesses)):
-            q[i], residual = solver.correct(guess, x, max_iterations=solver.max_iterations, strict=False)
-            if residual is None:
-                raise _Fallback
-            try:
-                d1[i], d2[i], *_, signs = solver._rates(q[i], self.unit_v, self.zero)
-            except SingularPoseError:
-                raise _Fallback from None
-            if ref.signs and signs != ref.signs:
-                raise _Fallback
-        return q, d1, d2
-
-    def _relative(self, absolute: np.ndarray, d1: np.ndarray, d2: np.ndarray) -> np.ndarray:
-        """Absolute interpolation errors (positions, q', q'') as relative errors of each
-        pose's positions, velocities and accelerations in the scene's rates: the velocity
-        error over the pose's largest velocity (lengths in loop sizes), likewise for the
-        acceleration q'' w^2 + q' alpha (over w^2 |q'| where every joint's is zero: a
-        mechanism whose joints move in proportion has no acceleration to be relative to)."""
-        w, alpha = abs(float(self.v_drv[self.k])), float(self.a_drv[self.k])
-        inv = self.solver._v_scale_inv
-        v = np.abs(d1 * inv).max(axis=1)
-        a = np.abs((d2 * (w * w) + d1 * alpha) * inv).max(axis=1)
-        a = np.where(a > 0, a, w * w * v)
-        error_a = absolute[:, 2] * (w * w) + absolute[:, 1] * abs(alpha)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            rel_v = np.where(absolute[:, 1] > 0, absolute[:, 1] / v, 0.0)
-            rel_a = np.where(error_a > 0, error_a / a, 0.0)
-        return np.stack([absolute[:, 0], rel_v, rel_a], axis=1)
-
-
-class _Fallback(Exception):
-    """A chunk that the quick path cannot take: solve it pose by pose."""
-
-
-_ACCURACY = ("residual", "iterations", "condition", "sigma_min", "velocity_residual", "acceleration_residual")
-
-
-def _accuracy_arrays(n: int) -> dict[str, np.ndarray]:
-    acc = {name: np.zeros(n) for name in _ACCURACY}
-    acc["iterations"] = np.zeros(n, dtype=int)
-    acc["interpolation"] = np.zeros((n, 3))
-    return acc
-
-
-def _store(acc: dict[str, np.ndarray], j: int, accuracy: Accuracy) -> None:
-    for name, value in zip(_ACCURACY, (accuracy.residual, accuracy.iterations, accuracy.condition,
-                                        accuracy.sigma_min, accuracy.velocity_residual,
-                                        accuracy.acceleration_residual)):
-        acc[name][j] = value
-
-
-def _stack(rows: list[LoopSolution | None], solver: LoopSolver) -> BatchSolution:
-    """LoopSolutions (None where a pose failed: NaN rows) as one BatchSolution."""
-    n, model = len(rows), solver.model
-    q, v, a = np.full((n, model.nq), np.nan), np.full((n, model.nv), np.nan), np.full((n, model.nv), np.nan)
-    acc = {name: np.full(n, np.nan) for name in _ACCURACY}
-    acc["iterations"] = np.zeros(n, dtype=int)
-    for j, sol in enumerate(rows):
-        if sol is not None:
-            q[j], v[j], a[j] = sol.q, sol.v, sol.a
-            _store(acc, j, sol.accuracy)
-    return BatchSolution(q, v, a, *(acc[name] for name in _ACCURACY), solver.drivers)
-
-
-def _concat(a: RangeChunk, b: RangeChunk) -> RangeChunk:
-    """Two consecutive chunks as one."""
-    sa, sb = a.solution, b.solution
-    fields = ("q", "v", "a", *_ACCURACY)
-    added = None
-    if sa.interpolation is not None or sb.interpolation is not None:
-        added = np.concatenate([np.zeros((len(x), 3)) if x.interpolation is None else x.interpolation for x in (sa, sb)])
-    solution = BatchSolution(*(np.concatenate((getattr(sa, f), getattr(sb, f))) for f in fields), sa.drivers,
-                             interpolation=added)
-    errors = {**a.errors, **{len(a) + j: e for j, e in b.errors.items()}}
-    return RangeChunk(a.start, np.concatenate((a.values, b.values)), solution,
-                      np.concatenate((a.interpolated, b.interpolated)), errors)

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from pinmech.solve.batch import difference_many, integrate_many
+from pinmech.solve.manifold import difference_many, integrate_many
 
 
 def interpolate_poses(model: pin.Model, x: np.ndarray, q: np.ndarray, d1: np.ndarray, d2: np.ndarray,

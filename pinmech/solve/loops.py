@@ -1,230 +1,53 @@
 """Close the loops: q, v and a of the dependent joints from the drivers.
 
-Position: Gauss-Newton on the closure residual from frame placements, with a
-backtracking safeguard. Velocity: the constraint Jacobian built from frame Jacobians,
+Position: Newton on the closure residual from frame placements, with a least-squares
+and backtracking safeguard. Velocity: the constraint Jacobian built from frame Jacobians,
 J_dep v_dep = -J_drv v_drv. Acceleration: the same Jacobian and the drift term from
-classical frame accelerations, J_dep a_dep = -J_drv a_drv - Jdot v.
-Nothing here knows which mechanism it solves.
+classical frame accelerations, J_dep a_dep = -J_drv a_drv - Jdot v. Each is computed by
+the compiled core (pinmech/csrc), on the user's own pin.Model; this is its Python face:
+assemblies, references, arguments and named errors. Nothing here knows which mechanism
+it solves.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 import threading
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
-from typing import Any, TypeVar
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pinocchio as pin
 
-from pinmech.arguments import float_array, names, not_real
+from pinmech.arguments import float_array, names
 from pinmech.solve.assembly_check import check_guessed_pose
 from pinmech.solve.branches import AssemblyStructure
-from pinmech.model.closures import CutEvaluator
 from pinmech.solve.continuation import Path, Route
 from pinmech.solve.core import core_for
-from pinmech.exceptions import (
-    AssemblyError,
-    LoopClosureError,
-    MobilityError,
-    OptionError,
-    RateOverflowError,
-    SingularPoseError,
-    UnitError,
-)
+from pinmech.exceptions import AssemblyError, RateOverflowError, SingularPoseError
 from pinmech.model.mechanism import Mechanism
+from pinmech.solve.closure_check import (  # noqa: F401  (importers of these names from here)
+    ROUNDING_LEVEL,
+    describe_joint_values,
+    is_closed,
+    max_abs,
+    not_closed_error,
+    open_loops_error,
+)
+from pinmech.solve.driver_values import check_mobility, index_view, one_coordinate, ordered_values, turn_remainder
 from pinmech.solve.results import Accuracy, LoopSolution
+from pinmech.solve.solver_options import (  # noqa: F401  (names users and other modules import from here)
+    DEFAULT_MAX_CONDITION,
+    DEFAULT_TOL,
+    MAX_STEP,
+    POLISH,
+    SOLVER_RANGES,
+    Reference,
+    SolverOptions,
+    checked_option,
+    serialized,
+)
 
-#: Default closure tolerance (dimensionless: metres per metre of mechanism, or radians).
-DEFAULT_TOL = 1e-13
-#: A closure residual below this (relative to the size) is rounding, not a loop out of reach.
-ROUNDING_LEVEL = 1e-14
-#: Largest Newton step of one joint [rad, or mechanism sizes for a prismatic joint].
-MAX_STEP = 1.0
-#: Default largest condition number accepted before a pose is called singular. Near a
-#: singularity accelerations lose accuracy like eps x condition^3 (tests/test_singular.py),
-#: so 1e4 keeps every acceleration pinmech gives to about 1e-3 relative or better.
-DEFAULT_MAX_CONDITION = 1e4
-#: With the default tolerance or a tighter one, a pose that ends between this residual and
-#: the tolerance gets one more Newton step: it costs one kinematics pass and lands at
-#: rounding level, so results do not depend on how close the guess happened to be.
-POLISH = 1e-15
-#: The ranges of the solver's options, for the Python API as for a scene's [solver] table.
-SOLVER_RANGES = {"tol": (1e-16, 1e-3), "max_iterations": (1, 1000), "max_condition": (1.0, math.inf)}
-
-_Method = TypeVar("_Method", bound=Callable[..., Any])
-
-
-def serialized(method: _Method) -> _Method:
-    """A solver method that holds the solver's lock: threads sharing one solver take turns
-    (its Pinocchio `Data` and buffers hold one pose at a time), the same thread re-enters.
-    It first reads again what the user may have changed in the model (`refresh`, where
-    the solver has one)."""
-    @functools.wraps(method)
-    def locked(self, *args, **kwargs):
-        if self.lock._is_owned():  # called from within the solver: held and refreshed already
-            return method(self, *args, **kwargs)
-        with self.lock:
-            refresh = getattr(self, "refresh", None)
-            if refresh is not None:
-                refresh()
-            return method(self, *args, **kwargs)
-    return locked  # type: ignore[return-value]
-
-
-def checked_option(name: str, value: Any) -> float | int:
-    """A solver option within `SOLVER_RANGES` (a number, not NaN; max_iterations whole).
-
-    Raises:
-        OptionError: naming the option, the value and the range.
-    """
-    low, high = SOLVER_RANGES[name]
-    whole = name == "max_iterations"
-    try:
-        number = float(value) if isinstance(value, (int, float, np.number)) and not isinstance(value, bool) else math.nan
-    except OverflowError:  # an int beyond float64
-        number = math.inf
-    ok = low <= number <= high and (not whole or number == int(number))  # NaN is in no range
-    if not ok:
-        kind = "a whole number" if whole else "a number"
-        raise OptionError(f"{name} = {value!r} must be {kind} in [{low:g}, {high:g}]", option=name, value=value)
-    return int(number) if whole else number
-
-
-def _turn_remainder(x0: float, x1: float) -> float:
-    """x1 - x0 less its whole turns [rad], with the sign of x1 - x0: the rest of the way
-    once the turns repeat. The angles are reduced by sin and cos, whose argument
-    reduction is exact: x1 - x0 itself, rounded to the spacing of x1, lost the pose
-    (0.06 rad at 1e15 rad, and the loop was left open by 0.03 of its size)."""
-    reduced = math.remainder(math.atan2(math.sin(x1), math.cos(x1)) - math.atan2(math.sin(x0), math.cos(x0)),
-                             2 * math.pi)
-    if reduced * (x1 - x0) < 0:
-        reduced += math.copysign(2 * math.pi, x1 - x0)
-    return reduced
-
-
-def describe_joint_values(mechanism: Mechanism, names: Sequence[str], values: Sequence[float]) -> str:
-    """One-dof joints' values as a user reads them in an error: angles in degrees, lengths
-    in metres ("O2 = 90 deg, slide = 0.15 m")."""
-    out = []
-    for name, value in zip(names, values):
-        if mechanism.joint(name).is_angular:
-            out.append(f"{name} = {math.degrees(value):.10g} deg")
-        else:
-            out.append(f"{name} = {value:.10g} m")
-    return ", ".join(out)
-
-
-def is_closed(independent, full, tol: float):
-    """Whether a pose's loops are closed: its independent closure rows within `tol`, and
-    every selected row (the ones reduced away as out of the plane too) within ten times
-    max(tol, 1e-12), as `LoopSolver.close` accepts them (all dimensionless: lengths in
-    loop sizes, angles in rad). Floats give a bool, arrays of poses an array of them."""
-    return (independent <= tol) & (full <= max(tol, 1e-12) * 10)
-
-
-def open_loops_error(mechanism: Mechanism, data: pin.Data, q: np.ndarray, residual: float, tol: float,
-                     where: str) -> LoopClosureError:
-    """The error for rates asked at a pose whose loops are open: each open loop's gap
-    between its cut frames [m] and the misalignment of its axes [deg], the residual
-    relative to the loop's size, and the tolerance. `data` holds q's joint placements."""
-    pin.updateFramePlacements(mechanism.model, data)
-    said = []
-    for c in mechanism.closures:
-        if is_closed(float(np.max(np.abs(c.residual(data)), initial=0.0)),
-                     float(np.max(np.abs(c.full_residual(data)), initial=0.0)), tol):
-            continue
-        r6, rows = c.residual6(data), c.selected
-        gap = float(np.linalg.norm(rows[:, :3] @ r6[:3]))  # the distance its rows constrain [m]
-        turn = float(np.linalg.norm(rows[:, 3:] @ r6[3:]))  # rad, or the sine of the axes' angle
-        angle = math.degrees(math.asin(min(turn, 1.0)) if c.cut_type == "revolute" else turn)
-        said.append(f"loop {c.name}'s cut frames are {gap:.3g} m apart ({gap / c.length_scale:.3g} of its size, "
-                    f"{c.length_scale:.3g} m)" + (f", axes {angle:.3g} deg apart" if rows[:, 3:].any() else ""))
-    return LoopClosureError(
-        f"{mechanism.source}: {where}: the loops are open: {'; '.join(said)} (largest closure row "
-        f"{residual:.3g}, tolerance {tol:g}, both of the loop's size); rates hold only where the loops "
-        "are closed: close them first (LoopSolver.solve or close) and pass that q",
-        residual=float(residual), iterations=0, partial=q)
-
-
-def _max_abs(x: np.ndarray) -> float:
-    """Largest |x_i| (0 when empty); plain Python below 9 entries, where numpy's call costs more."""
-    if x.size < 9:
-        return max(map(abs, x.tolist()), default=0.0)
-    return float(np.max(np.abs(x)))
-
-
-def _solve_square(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """A x = b for a small square A: closed forms up to 2x2 (a microsecond, where
-    np.linalg.solve costs three), LU above. NaN where A is exactly singular."""
-    n = A.shape[0]
-    if n == 1:
-        a = float(A[0, 0])
-        return np.array((float(b[0]) / a,)) if a != 0.0 else np.full(1, np.nan)
-    if n == 2:
-        (a, c), (d, e) = A.tolist()
-        f, g = b.tolist()
-        det = a * e - c * d
-        if det == 0.0:
-            return np.full(2, np.nan)
-        return np.array(((e * f - c * g) / det, (a * g - d * f) / det))
-    try:
-        return np.linalg.solve(A, b)
-    except np.linalg.LinAlgError:
-        return np.full(n, np.nan)
-
-
-def _condition(A: np.ndarray) -> tuple[float, float]:
-    """2-norm condition number and smallest singular value of a square A: closed forms up
-    to 2x2 (sigma_max = |(a+e, c-d)|/2 + |(a-e, c+d)|/2, a sum without cancellation, and
-    sigma_max sigma_min = |det A|), SVD above."""
-    n = A.shape[0]
-    if n == 0:
-        return 1.0, 1.0
-    if n == 1:
-        s = abs(float(A[0, 0]))
-        return (1.0 if s > 0 else math.inf), s
-    if n == 2:
-        (a, c), (d, e) = A.tolist()
-        s_max = 0.5 * (math.hypot(a + e, c - d) + math.hypot(a - e, c + d))
-        det = abs(a * e - c * d)
-        s_min = det / s_max if s_max > 0 else 0.0
-        return (s_max * s_max / det if det > 0 else math.inf), s_min
-    sigma = np.linalg.svd(A, compute_uv=False)
-    return (float(sigma[0] / sigma[-1]) if sigma[-1] > 0 else math.inf), float(sigma[-1])
-
-
-def _index(indices: np.ndarray) -> slice | np.ndarray:
-    """A slice when the indices are contiguous (a view, cheaper than fancy indexing)."""
-    if len(indices) and np.array_equal(indices, np.arange(indices[0], indices[-1] + 1)):
-        return slice(int(indices[0]), int(indices[-1]) + 1)
-    return indices
-
-
-@dataclass(frozen=True)
-class Reference:
-    """The pose that names the assembly: the drivers' values [rad or m], the closed q,
-    its assembly signature, whether other poses must keep it (False: "any"), and the
-    Newton iterations that closed it from its guess."""
-
-    driver_q: np.ndarray
-    q: np.ndarray
-    signs: tuple[int, ...]
-    keep: bool = True
-    iterations: int = 0
-
-    def __post_init__(self) -> None:
-        """The arrays are read-only copies: the solver goes on from them, so a write into
-        the ones the API returns must not change its reference."""
-        for name in ("driver_q", "q"):
-            array = np.array(getattr(self, name), dtype=float)
-            array.flags.writeable = False
-            object.__setattr__(self, name, array)
-
-
-class LoopSolver:
+class LoopSolver(SolverOptions):
     """Solves one mechanism pose after pose, keeping Pinocchio `Data` and buffers alive.
 
     Assemblies: `set_reference` closes the loops once at given driver values from a
@@ -276,130 +99,55 @@ class LoopSolver:
         dependent = np.ones(self.model.nv, dtype=bool)  # not np.setdiff1d: it imports numpy.ma (11 ms)
         dependent[self._drv_v] = False
         self._dep_v = np.flatnonzero(dependent)
-        self._check_mobility()
-        self._drv, self._dep = _index(self._drv_v), _index(self._dep_v)
+        check_mobility(mechanism, self.drivers)
+        self._drv, self._dep = index_view(self._drv_v), index_view(self._dep_v)
         self._drv_q = [(mechanism.joint(n).idx_q, mechanism.joint(n).kind == "continuous") for n in self.drivers]
-        self._cuts = [CutEvaluator(c, self.model) for c in mechanism.closures]
-        self._step = np.zeros(self.model.nv)
+        self._cuts = list(mechanism.closures)  # the loops (their rows: the compiled core's)
+        for c in self._cuts:  # what the core's rows are built from stays as it is
+            c.__dict__["_in_use"] = True
+        self._ground = [c.parent_frame for c in mechanism.closures
+                        if self.model.frames[c.parent_frame].parentJoint == 0]
+        self._ground_at = [self.model.frames[f].placement.copy() for f in self._ground]
         self._dep_scale = mechanism.velocity_scale()[self._dep_v]  # dimensionless columns
         self._v_scale_inv = 1.0 / mechanism.velocity_scale()
         self.dep_is_scalar = [self._one_coordinate(int(v)) for v in self._dep_v]
-        self._zero_a = np.zeros(self.model.nv)
         self.structure = AssemblyStructure(self.model, mechanism.closures, self._dep_v, mechanism.plane_normal)
         self.reference: Reference | None = None
         self.iterations = 0  # Newton iterations of the last `correct`
         self.moved = 0.0  # sum of the scaled sizes of its steps: a bound on how far it moved q
 
-    # ------------------------------------------------------------------ options
-    @property
-    def tol(self) -> float:
-        """Closure tolerance (dimensionless, of each loop's size), in SOLVER_RANGES."""
-        return self._tol
-
-    @tol.setter
-    def tol(self, value: float) -> None:
-        self._tol = checked_option("tol", value)
-
-    @property
-    def max_iterations(self) -> int:
-        """Newton iteration cap, in SOLVER_RANGES."""
-        return self._max_iterations
-
-    @max_iterations.setter
-    def max_iterations(self, value: int) -> None:
-        self._max_iterations = checked_option("max_iterations", value)
-
-    @property
-    def max_condition(self) -> float:
-        """Largest condition number accepted before a pose is singular, in SOLVER_RANGES."""
-        return self._max_condition
-
-    @max_condition.setter
-    def max_condition(self, value: float) -> None:
-        self._max_condition = checked_option("max_condition", value)
-
     def refresh(self) -> None:
         """Read again the placements of ground cut frames, which the user may have moved in
-        the model since the last call (the hot path folds them into its row matrices); the
+        the model since the last call (the core reads the model at every call): the
         reference pose, closed for the old placement, is then closed again from itself."""
-        moved = [cut.refresh() for cut in self._cuts]
+        now = [self.model.frames[f].placement for f in self._ground]  # by index: frames may be added
+        moved = any(a != b for a, b in zip(now, self._ground_at))
+        if moved:
+            self._ground_at = [m.copy() for m in now]
         ref = self.reference
-        if any(moved) and ref is not None:
+        if moved and ref is not None:
             q, _, _ = self.close(ref.q, ref.driver_q)
             signs = self._rates(q, np.zeros(len(self.drivers)), np.zeros(len(self.drivers)))[-1]
             self.reference = Reference(ref.driver_q, q, signs, ref.keep)
 
     def _one_coordinate(self, v: int) -> bool:
-        """Velocity index v moves one coordinate alone: a one-freedom joint, or a one-freedom
-        joint inside a composite (MJCF's several hinges in one body), which the
-        continuation can hold fixed as its curve's parameter."""
-        for joint in self.model.joints[1:]:
-            if joint.idx_v <= v < joint.idx_v + joint.nv:
-                if joint.nv == 1:
-                    return True
-                if joint.shortname() != "JointModelComposite":
-                    return False
-                offset = joint.idx_v
-                for part in joint.extract().joints:
-                    if offset <= v < offset + part.nv:
-                        return part.nv == 1
-                    offset += part.nv
-        return False
-
-    def _joint_nv(self, v: int) -> int:
-        for joint in self.model.joints[1:]:
-            if joint.idx_v <= v < joint.idx_v + joint.nv:
-                return joint.nv
-        return 0
-
-    # ------------------------------------------------------------------ set-up
-    def _check_mobility(self) -> None:
-        if len(set(self.drivers)) != len(self.drivers):
-            raise MobilityError(f"a joint is driven twice: {', '.join(self.drivers)}",
-                                mobility=self.mechanism.mobility, drivers=len(self.drivers))
-        mobility = self.mechanism.mobility
-        if mobility != len(self.drivers):
-            rows = self.mechanism.constraint_rows
-            raise MobilityError(
-                f"{self.mechanism.source}: the mechanism has {self.model.nv} joint freedoms and "
-                f"{rows} independent closure equations, so mobility {mobility}; "
-                f"{len(self.drivers)} driver(s) given ({', '.join(self.drivers) or 'none'})",
-                mobility=mobility,
-                drivers=len(self.drivers),
-            )
+        return one_coordinate(self.model, v)
 
     # ------------------------------------------------------------------ pieces
     def _residual(self, q: np.ndarray) -> np.ndarray:
-        """Independent closure rows at q; leaves joint placements, Jacobians and the cut
-        frames' placements in self.data."""
-        pin.computeJointJacobians(self.model, self.data, q)
-        cuts = self._cuts
-        if len(cuts) == 1:
-            cuts[0].place(self.data)
-            return cuts[0].residual()
-        for cut in cuts:
-            cut.place(self.data)
-        return np.concatenate([c.residual() for c in cuts]) if cuts else np.zeros(0)
+        """Independent closure rows at q (dimensionless), from the compiled core."""
+        compiled = core_for(self)
+        return compiled.residual(q) if compiled is not None else np.zeros(0)
 
     def _full_residual(self) -> float:
-        return max((c.full_residual() for c in self._cuts), default=0.0)
+        """Largest error over every selected row at the q of the last `_residual`."""
+        compiled = core_for(self)
+        return compiled.full_residual() if compiled is not None else 0.0
 
-    def _stack(self, rows: list[np.ndarray]) -> np.ndarray:
-        if len(rows) == 1:
-            return rows[0]
-        return np.vstack(rows) if rows else np.zeros((0, self.model.nv))
-
-    def _jacobian(self) -> np.ndarray:
-        return self._stack([c.jacobian(self.data) for c in self._cuts])
-
-    def _residual_jacobian(self) -> np.ndarray:
-        return self._stack([c.newton_jacobian(self.data) for c in self._cuts])
-
-    def _drift(self) -> np.ndarray:
-        cuts = self._cuts
-        if len(cuts) == 1:
-            return cuts[0].drift(self.data)
-        return np.concatenate([c.drift(self.data) for c in cuts]) if cuts else np.zeros(0)
+    def _place(self, q: np.ndarray) -> None:
+        """self.data at q: joint placements, joint Jacobians and every frame placement."""
+        pin.computeJointJacobians(self.model, self.data, q)
+        pin.updateFramePlacements(self.model, self.data)
 
     def set_drivers(self, q: np.ndarray, driver_q: Sequence[float]) -> np.ndarray:
         """A copy of q with the drivers' coordinates written in."""
@@ -425,23 +173,13 @@ class LoopSolver:
                 residual that stops decreasing).
         """
         q = self.set_drivers(q_guess, driver_q)
-        r = self._residual(q)
-        norm = _max_abs(r)
-        iterations = 0
-        while norm > self._tol and iterations < self._max_iterations:
-            J_dep = self._residual_jacobian()[:, self._dep]
-            q, r, norm, ok = self._newton_update(q, J_dep, r, norm)
-            iterations += 1
-            if not ok:
-                break
-        if POLISH < norm <= self._tol <= DEFAULT_TOL and iterations < self._max_iterations:
-            J_dep = self._residual_jacobian()[:, self._dep]
-            q, r, norm, _ = self._newton_update(q, J_dep, r, norm)  # kept only if it helps
-            iterations += 1
-        full = self._full_residual()
-        if not is_closed(norm, full, self._tol):
-            self._raise_not_closed(q, max(norm, full), iterations, driver_q)
-        return q, iterations, max(norm, full)
+        compiled = core_for(self)
+        if compiled is None:  # an open chain: the drivers are the pose
+            return q, 0, 0.0
+        q, ok, residual, iterations = compiled.close(q, np.asarray(driver_q, dtype=float), self._max_iterations, True)
+        if not ok:
+            self._raise_not_closed(q, residual, iterations, driver_q)
+        return q, iterations, residual
 
     def correct(self, q_guess: np.ndarray, driver_q: np.ndarray, *, max_iterations: int,
                 strict: bool = True) -> tuple[np.ndarray, float | None]:
@@ -452,107 +190,31 @@ class LoopSolver:
         that does not contract is not close to one root); else as `close`, with the
         least-squares and backtracking safeguard."""
         q = self.set_drivers(q_guess, driver_q)
-        r = self._residual(q)
-        norm = _max_abs(r)
-        self.iterations, self.moved = 0, 0.0
-        for _ in range(max_iterations):
-            if norm <= self._tol:
-                break
-            J_dep = self._residual_jacobian()[:, self._dep]
-            self.iterations += 1
-            if strict:
-                step = _solve_square(J_dep, -r) if J_dep.shape[0] == J_dep.shape[1] else np.full(1, np.nan)
-                if not math.isfinite(sum(step.tolist())):
-                    return q, None
-                q_new = self._move(q, step)
-                r_new = self._residual(q_new)
-                new_norm = _max_abs(r_new)
-                if new_norm > 0.5 * norm and new_norm > self._tol:
-                    self._residual(q)
-                    return q, None
-                q, r, norm = q_new, r_new, new_norm
-            else:
-                q, r, norm, ok = self._newton_update(q, J_dep, r, norm)
-                if not ok:
-                    return q, None
-        if POLISH < norm <= self._tol <= DEFAULT_TOL:
-            J_dep = self._residual_jacobian()[:, self._dep]
-            q, r, norm, _ = self._newton_update(q, J_dep, r, norm)
-            self.iterations += 1
-        full = self._full_residual()
-        if not is_closed(norm, full, self._tol):
-            return q, None
-        return q, max(norm, full)
+        compiled = core_for(self)
+        if compiled is None:
+            self.iterations, self.moved = 0, 0.0
+            return q, 0.0
+        x = np.asarray(driver_q, dtype=float)
+        if strict:
+            q, residual = compiled.correct(q, x, max_iterations)
+        else:
+            q, ok, residual, _ = compiled.close(q, x, max_iterations, False)
+            residual = residual if ok else None
+        self.iterations, self.moved = compiled.iterations, compiled.moved
+        return q, residual
 
     def scaled_norm(self, dv: np.ndarray) -> float:
         """Largest |component| of a velocity-space vector, prismatic parts in mechanism
         sizes (dimensionless)."""
-        return _max_abs(dv * self._v_scale_inv)
+        return max_abs(dv * self._v_scale_inv)
 
     def describe_drivers(self, values: Sequence[float]) -> str:
         """Driver values as a user reads them: angles in degrees, lengths in metres."""
         return describe_joint_values(self.mechanism, self.drivers, values)
 
-    def _newton_update(self, q: np.ndarray, J_dep: np.ndarray, r: np.ndarray,
-                       norm: float) -> tuple[np.ndarray, np.ndarray, float, bool]:
-        """A full Newton step when it lowers the residual (the usual case near a solution);
-        else a minimum-norm least-squares step, halved until the residual decreases."""
-        if J_dep.shape[0] == J_dep.shape[1]:
-            step = _solve_square(J_dep, -r)
-            if math.isfinite(sum(step.tolist())):
-                trial = self._move(q, step)
-                r_trial = self._residual(trial)
-                trial_norm = _max_abs(r_trial)
-                if trial_norm < norm:
-                    return trial, r_trial, trial_norm, True
-                self._residual(q)
-        step = np.linalg.lstsq(J_dep, -r, rcond=None)[0]
-        return self._line_search(q, step, norm)
-
-    def _move(self, q: np.ndarray, step: np.ndarray) -> np.ndarray:
-        """q moved by a step of the dependent joints, shortened to at most MAX_STEP.
-
-        From a guess where the Jacobian is singular a solve returns steps of 1e16 rad,
-        after which no step can move those joints (a unit in the last place of 1e16 is 2).
-        """
-        size = float(np.max(np.abs(step / self._dep_scale), initial=0.0))  # rad, or sizes of the mechanism
-        if size > MAX_STEP:
-            step = step * (MAX_STEP / size)
-        self.moved += min(size, MAX_STEP)
-        self._step[:] = 0.0
-        self._step[self._dep_v] = step
-        return pin.integrate(self.model, q, self._step)
-
-    def _line_search(self, q: np.ndarray, step: np.ndarray, norm: float) -> tuple[np.ndarray, np.ndarray, float, bool]:
-        """Backtracking: halve the Newton step until the residual decreases."""
-        alpha = 1.0
-        for _ in range(30):
-            trial = self._move(q, alpha * step)
-            r = self._residual(trial)
-            trial_norm = _max_abs(r)
-            if trial_norm < norm:
-                return trial, r, trial_norm, True
-            alpha *= 0.5
-        return q, self._residual(q), norm, False  # data back at q
-
     def _raise_not_closed(self, q: np.ndarray, norm: float, iterations: int, driver_q: Sequence[float]) -> None:
-        drivers = self.describe_drivers(driver_q)
-        names = ", ".join(c.name for c in self.mechanism.closures)
-        solved = float(np.max(np.abs(self._residual(q)), initial=0.0))  # the rows Newton solves
-        if norm <= ROUNDING_LEVEL:
-            why = f"that is rounding level: the tolerance {self.tol:g} is tighter than floating point allows"
-        elif solved <= self.tol:
-            why = ("the rows dropped as out of the mechanism's plane do not close: the two sides of the cut "
-                   "are not in one plane (check the z of the origins and the axes)")
-        else:
-            why = "the pose is out of reach for these dimensions, or the guess is on no branch"
-        raise LoopClosureError(
-            f"{self.mechanism.source}: loop(s) {names} cannot be closed at {drivers} "
-            f"(residual {norm:.3g} of the loop's size after {iterations} Newton iterations): {why}",
-            residual=float(norm),
-            iterations=iterations,
-            partial=q,
-        )
+        solved = max_abs(self._residual(q))  # the rows Newton solves
+        raise not_closed_error(self.mechanism, q, norm, solved, self.tol, iterations, self.describe_drivers(driver_q))
 
     @serialized
     def rates(self, q: np.ndarray, driver_v: Sequence[float], driver_a: Sequence[float], *,
@@ -561,8 +223,7 @@ class LoopSolver:
         q's closure residual (dimensionless, as `Accuracy.residual`).
 
         Args:
-            at_q: the solver's data already holds q's placements and Jacobians (as `close`
-                leaves them), so they are not computed again.
+            at_q: q is the solver's own (closed by it): not checked again.
             closed: refuse a q whose loops are open beyond `tol` (False: an interpolated
                 pose, whose error the caller states; the residual is still measured).
 
@@ -573,14 +234,9 @@ class LoopSolver:
         """
         if not at_q:  # a user's q: checked (shape, finite, real, unit norms), never cast
             q = self.mechanism.checked_q(q)
-        if at_q:
-            for cut in self._cuts:
-                cut.place(self.data)
-            rows = np.concatenate([c.residual() for c in self._cuts]) if self._cuts else np.zeros(0)
-        else:
-            rows = self._residual(q)
-        independent, full = _max_abs(rows), self._full_residual()
+        independent, full = max_abs(self._residual(q)), self._full_residual()
         if closed and not is_closed(independent, full, self._tol):
+            self._place(q)
             raise open_loops_error(self.mechanism, self.data, q, max(independent, full), self._tol,
                                    f"rates at {self.describe_drivers(self._driver_values(q))}")
         v, a, *numbers, _ = self._rates(q, driver_v, driver_a)
@@ -588,35 +244,32 @@ class LoopSolver:
 
     def _rates(self, q: np.ndarray, driver_v, driver_a, limit: float | None = None) -> tuple:
         """v, a, condition, sigma_min, velocity and acceleration residuals, and the assembly
-        signature (data at q). A condition number over `limit` (default: max_condition)
-        is a SingularPoseError."""
-        J = self._jacobian()
-        J_dep, J_drv = J[:, self._dep], J[:, self._drv]
-        condition, sigma_min = _condition(J_dep * self._dep_scale)
-        if condition > (self.max_condition if limit is None else limit):
-            raise SingularPoseError(
-                f"{self.mechanism.source}: the loop constraint Jacobian is singular at "
-                f"{self.describe_drivers(self._driver_values(q))} "
-                f"(condition number {condition:.3g} > {self.max_condition:.3g}, smallest singular "
-                f"value {sigma_min:.3g}): the dependent joints' rates are undefined",
-                condition=condition,
-                sigma_min=sigma_min,
-                partial=q,
-            )
+        signature at a closed q, from the compiled core. A condition number over `limit`
+        (default: max_condition) is a SingularPoseError."""
         v = np.zeros(self.model.nv)
-        v[self._drv] = driver_v
         a = np.zeros(self.model.nv)
-        a[self._drv] = driver_a
-        if not J.size:
-            return v, a, condition, sigma_min, 0.0, 0.0, ()
-        signs = self.structure.signs(J_dep)
-        v[self._dep] = _solve_square(J_dep, -(J_drv @ v[self._drv]))
-        pin.forwardKinematics(self.model, self.data, q, v, self._zero_a)
-        drift = self._drift()
-        a[self._dep] = _solve_square(J_dep, -(J_drv @ a[self._drv]) - drift)
+        compiled = core_for(self)
+        if compiled is None:  # an open chain: every joint is a driver
+            v[self._drv], a[self._drv] = driver_v, driver_a
+            return v, a, 1.0, 1.0, 0.0, 0.0, ()
+        v, a, signs, condition, sigma_min, v_res, a_res, _ = compiled.rates_at(
+            q, np.asarray(driver_v, dtype=float), np.asarray(driver_a, dtype=float))
+        if condition > (self.max_condition if limit is None else limit):
+            raise self._singular_error(q, condition, sigma_min)
         if condition <= self.max_condition and not math.isfinite(sum(v.tolist()) + sum(a.tolist())):
             raise self._overflow(q, driver_v, driver_a)  # a regular pose: the driver rates are too large
-        return v, a, condition, sigma_min, _max_abs(J @ v), _max_abs(J @ a + drift), signs
+        return v, a, condition, sigma_min, v_res, a_res, tuple(signs)
+
+    def _singular_error(self, q: np.ndarray, condition: float, sigma_min: float) -> SingularPoseError:
+        """The error for a pose whose dependent-joint Jacobian is conditioned worse than
+        max_condition: the drivers' values, the condition number and the smallest
+        singular value."""
+        return SingularPoseError(
+            f"{self.mechanism.source}: the loop constraint Jacobian is singular at "
+            f"{self.describe_drivers(self._driver_values(q))} "
+            f"(condition number {condition:.3g} > {self.max_condition:.3g}, smallest singular "
+            f"value {sigma_min:.3g}): the dependent joints' rates are undefined",
+            condition=float(condition), sigma_min=float(sigma_min), partial=q)
 
     def _overflow(self, q: np.ndarray, driver_v, driver_a) -> RateOverflowError:
         return RateOverflowError(
@@ -653,6 +306,7 @@ class LoopSolver:
         if isinstance(assembly, Mapping):
             wrong = [n for n, s in zip(self.structure.names, signs) if n in assembly and assembly[n] != s]
             if wrong:
+                self._place(q)
                 found = self.structure.assembly(signs, self.data)
                 raise AssemblyError(
                     f"{self.mechanism.source}: at {self.describe_drivers(dq)} the guess closes on assembly "
@@ -696,7 +350,7 @@ class LoopSolver:
         if guess is None and ref is not None and ref.keep:
             route = Route(tuple(ref.driver_q.tolist()))
             q = self.follow(ref.q, ref.driver_q, dq, route)
-            residual = max(_max_abs(self._residual(q)), self._full_residual())
+            residual = max(max_abs(self._residual(q)), self._full_residual())
             iterations = route.iterations if route.steps else ref.iterations  # the reference itself: its Newton
             return self._solution(q, dv, da, residual, iterations, route)
         if guess is None and ref is not None:  # assembly "any": Newton from the reference pose
@@ -733,22 +387,11 @@ class LoopSolver:
             q_turn = self.follow(q0, x0, once, route)
             if self.turn_gap(q0, q_turn) <= max(1e3 * self.tol, 1e-10):
                 rest = x0.copy()
-                rest[k] += _turn_remainder(float(x0[k]), float(x1[k]))
+                rest[k] += turn_remainder(float(x0[k]), float(x1[k]))
                 return self.set_drivers(self.follow(q0, x0, rest, route), x1)
             return self.follow(q_turn, once, x1, route)
         path = Path(self, x0, x1 - x0, through_folds=through_folds)
-        start = path.node(0.0, q0)
-        compiled = core_for(self)
-        if compiled is not None:  # regular steps all the way: the compiled core; else the Python path
-            done, _, Q, _, _, numbers = compiled.follow(
-                0.0, start.q, start.d1, start.d2, list(start.signs), start.condition, path.x0, path.d, path.unit,
-                np.ones(1), math.inf)
-            if done:
-                route.steps += int(numbers[0, 6])
-                route.iterations += int(numbers[0, 1])
-                return Q[0]
-        node = path.follow(start, 1.0, route)
-        return node.q
+        return path.follow(path.node(0.0, q0), 1.0, route).q
 
     def turn_gap(self, q0: np.ndarray, q1: np.ndarray) -> float:
         """Largest joint difference between two poses, angles modulo a turn [rad], slides
@@ -766,6 +409,7 @@ class LoopSolver:
                   route: Route | None) -> LoopSolution:
         """Rates at a closed q (data at q), the assembly checked against the reference."""
         v, a, *numbers, signs = self._rates(q, dv, da)
+        self._place(q)
         ref = self.reference
         if ref is not None and ref.keep and signs != ref.signs and not (route and (route.folds or route.change_points)):
             expected, found = self.structure.assembly(ref.signs), self.structure.assembly(signs, self.data)
@@ -786,29 +430,4 @@ class LoopSolver:
         return float_array(guess, "guess", (self.model.nq,), self.mechanism.source)
 
     def _ordered(self, values: Sequence[float] | Mapping[str, float] | None) -> np.ndarray:
-        if (type(values) is np.ndarray and values.shape == (len(self.drivers),) and values.dtype == float
-                and math.isfinite(sum(values.tolist()))):
-            return values  # already in order (a sweep's arrays: no conversion)
-        if values is None:
-            return np.zeros(len(self.drivers))
-        if isinstance(values, Mapping):
-            unknown = set(values) - set(self.drivers)
-            if unknown:
-                raise MobilityError(f"{', '.join(sorted(unknown))} is not a driver ({', '.join(self.drivers)})",
-                                    mobility=self.mechanism.mobility, drivers=len(self.drivers))
-            values = [values.get(n, 0.0) for n in self.drivers]
-        wrong = not_real(values)
-        if wrong:
-            hint = ": convert quantities first, e.g. pinmech.to_si('30 deg', 'angle')" if wrong == "text" else ""
-            raise UnitError(f"driver values of {', '.join(self.drivers)} must be real numbers in SI (rad or m), "
-                            f"got {wrong}, which pinmech does not cast{hint}")
-        try:
-            out = np.asarray(values, dtype=float).reshape(-1)
-        except (TypeError, ValueError, OverflowError):
-            raise UnitError(f"driver values of {', '.join(self.drivers)} must be numbers in SI (rad or m), "
-                            f"got {values!r:.80}: convert quantities first, e.g. pinmech.to_si('30 deg', "
-                            f"'angle')") from None
-        if out.shape != (len(self.drivers),) or not math.isfinite(sum(out.tolist())):
-            raise MobilityError(f"expected {len(self.drivers)} finite driver value(s), got {values!r}",
-                                mobility=self.mechanism.mobility, drivers=len(self.drivers))
-        return out
+        return ordered_values(values, self.drivers, self.mechanism.mobility)

@@ -276,8 +276,6 @@ class RateSolver:
         them (built once per model tree: it reads placements changed in the model), or None."""
         from pinmech.solve import core
 
-        if not core.ENABLED:
-            return None
         cached = self.__dict__.get("_core")
         if cached is None or not cached[0].matches(self.model):
             frames = [f for c in self.mechanism.closures for f in (c.parent_frame, c.child_frame)] + self.frames

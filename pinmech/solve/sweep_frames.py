@@ -93,8 +93,6 @@ def _pose_by_pose(model: pin.Model, names: tuple[str, ...], fids: list[int], q: 
 def _core_for(mechanism: Mechanism, fids: list[int]):
     """A core on the mechanism's model with these frames and its lock (built once per set of
     frames and per model tree: placements changed in the model are read at every call)."""
-    if not core.ENABLED:
-        return None
     model = mechanism.model
     cache = mechanism.__dict__.setdefault("_frame_cores", {})
     cached = cache.get(tuple(fids))

@@ -1,0 +1,85 @@
+"""Whether a pose's loops are closed, and the error that says how far open they are
+(each cut's gap [m] and misalignment [deg]), in the user's words."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+import pinocchio as pin
+
+from pinmech.exceptions import LoopClosureError
+from pinmech.model.mechanism import Mechanism
+
+#: A closure residual below this (relative to the size) is rounding, not a loop out of reach.
+ROUNDING_LEVEL = 1e-14
+
+def describe_joint_values(mechanism: Mechanism, names: Sequence[str], values: Sequence[float]) -> str:
+    """One-dof joints' values as a user reads them in an error: angles in degrees, lengths
+    in metres ("O2 = 90 deg, slide = 0.15 m")."""
+    out = []
+    for name, value in zip(names, values):
+        if mechanism.joint(name).is_angular:
+            out.append(f"{name} = {math.degrees(value):.10g} deg")
+        else:
+            out.append(f"{name} = {value:.10g} m")
+    return ", ".join(out)
+
+
+def is_closed(independent, full, tol: float):
+    """Whether a pose's loops are closed: its independent closure rows within `tol`, and
+    every selected row (the ones reduced away as out of the plane too) within ten times
+    max(tol, 1e-12), as `LoopSolver.close` accepts them (all dimensionless: lengths in
+    loop sizes, angles in rad). Floats give a bool, arrays of poses an array of them."""
+    return (independent <= tol) & (full <= max(tol, 1e-12) * 10)
+
+
+def open_loops_error(mechanism: Mechanism, data: pin.Data, q: np.ndarray, residual: float, tol: float,
+                     where: str) -> LoopClosureError:
+    """The error for rates asked at a pose whose loops are open: each open loop's gap
+    between its cut frames [m] and the misalignment of its axes [deg], the residual
+    relative to the loop's size, and the tolerance. `data` holds q's joint placements."""
+    pin.updateFramePlacements(mechanism.model, data)
+    said = []
+    for c in mechanism.closures:
+        if is_closed(float(np.max(np.abs(c.residual(data)), initial=0.0)),
+                     float(np.max(np.abs(c.full_residual(data)), initial=0.0)), tol):
+            continue
+        r6, rows = c.residual6(data), c.selected
+        gap = float(np.linalg.norm(rows[:, :3] @ r6[:3]))  # the distance its rows constrain [m]
+        turn = float(np.linalg.norm(rows[:, 3:] @ r6[3:]))  # rad, or the sine of the axes' angle
+        angle = math.degrees(math.asin(min(turn, 1.0)) if c.cut_type == "revolute" else turn)
+        said.append(f"loop {c.name}'s cut frames are {gap:.3g} m apart ({gap / c.length_scale:.3g} of its size, "
+                    f"{c.length_scale:.3g} m)" + (f", axes {angle:.3g} deg apart" if rows[:, 3:].any() else ""))
+    return LoopClosureError(
+        f"{mechanism.source}: {where}: the loops are open: {'; '.join(said)} (largest closure row "
+        f"{residual:.3g}, tolerance {tol:g}, both of the loop's size); rates hold only where the loops "
+        "are closed: close them first (LoopSolver.solve or close) and pass that q",
+        residual=float(residual), iterations=0, partial=q)
+
+
+def max_abs(x: np.ndarray) -> float:
+    """Largest |x_i| (0 when empty); plain Python below 9 entries, where numpy's call costs more."""
+    if x.size < 9:
+        return max(map(abs, x.tolist()), default=0.0)
+    return float(np.max(np.abs(x)))
+
+
+def not_closed_error(mechanism: Mechanism, q: np.ndarray, norm: float, solved: float, tol: float, iterations: int,
+                     where: str) -> LoopClosureError:
+    """The error for loops Newton could not close at the drivers `where` (in the user's
+    words): the residual left (`norm`, every selected row; `solved`, the rows Newton
+    solves, both of the loop's size) and why, as far as the numbers tell."""
+    names = ", ".join(c.name for c in mechanism.closures)
+    if norm <= ROUNDING_LEVEL:
+        why = f"that is rounding level: the tolerance {tol:g} is tighter than floating point allows"
+    elif solved <= tol:
+        why = ("the rows dropped as out of the mechanism's plane do not close: the two sides of the cut "
+               "are not in one plane (check the z of the origins and the axes)")
+    else:
+        why = "the pose is out of reach for these dimensions, or the guess is on no branch"
+    return LoopClosureError(
+        f"{mechanism.source}: loop(s) {names} cannot be closed at {where} "
+        f"(residual {norm:.3g} of the loop's size after {iterations} Newton iterations): {why}",
+        residual=float(norm), iterations=iterations, partial=q)
