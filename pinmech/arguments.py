@@ -17,6 +17,9 @@ import numpy as np
 from pinmech.exceptions import ModelError
 
 
+_FLOAT64 = np.dtype(np.float64)  # numpy's one instance of it (an `is` test: no conversion)
+
+
 def float_array(value: Any, name: str, shape: tuple[int | None, ...], source: str | None = None) -> np.ndarray:
     """`value` as a float64 array of `shape` (None: any length on that axis), every entry
     finite: the one check of an array argument of the Python API. Complex, boolean or text
@@ -25,7 +28,7 @@ def float_array(value: Any, name: str, shape: tuple[int | None, ...], source: st
     Raises:
         ModelError: naming `name`, the shape wanted and what was given (`source`: the model file).
     """
-    if (type(value) is np.ndarray and value.dtype == np.float64 and len(shape) == 1  # one pose's vector:
+    if (type(value) is np.ndarray and value.dtype is _FLOAT64 and len(shape) == 1  # one pose's vector:
             and value.shape == shape and all(map(math.isfinite, value.tolist()))):  # plain floats, no numpy calls
         return value
     wrong = not_real(value)

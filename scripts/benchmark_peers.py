@@ -640,10 +640,8 @@ def pinocchio_passes_p2(th1: np.ndarray, th2: np.ndarray):
     cells = {type(c.cell_contents).__name__: c.cell_contents for c in run_many.__closure__}
     solver, Q = cells["RateSolver"], cells["ndarray"]
     compiled = solver._compiled()
-    if compiled is None:
-        raise RuntimeError("the compiled core does not take this model")
     V = solver.solve_many(Q).v
-    return (lambda: compiled[0].pinocchio_passes(Q, V, 1)), None, "v solved in set-up"
+    return (lambda: compiled.pinocchio_passes(Q, V, 1)), None, "v solved in set-up"
 
 
 # ------------------------------------------------------------------ measuring

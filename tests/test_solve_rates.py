@@ -161,7 +161,9 @@ def test_over_determined_task_is_an_error_or_least_squares(arm):
     np.testing.assert_allclose(sol.v, np.linalg.lstsq(w[:, None] * J, w * [1.0, 0.0, 0.0, 2.0], rcond=None)[0],
                                rtol=1e-12)
     assert sol.method == "least_squares" and sol.rank == 3 and sol.nullspace_dim == 0
-    np.testing.assert_allclose(sol.achieved_velocity, J @ sol.v, rtol=1e-12)  # what the report shows
+    # what the report shows; atol: a row that cancels to zero keeps rounding of its terms
+    # (about 1, eps each), summed in another order by the core than by numpy
+    np.testing.assert_allclose(sol.achieved_velocity, J @ sol.v, rtol=1e-12, atol=1e-14)
     assert sol.velocity_error == pytest.approx(np.max(np.abs(J @ sol.v - [1.0, 0.0, 0.0, 2.0])))
     assert sol.velocity_error > 0.1  # v_D - v_C = omega_CD x CD: 1 m/s apart needs CD to turn, wz = 0 forbids it
 
@@ -306,13 +308,9 @@ def test_solve_many_measures_each_cut_type_as_the_closures_do(build, tmp_path):
         mech = Mechanism.from_urdf(_mechanisms.write(tmp_path, f"{build}.urdf", text))
     assert {c.cut_type for c in mech.closures} == {build}
     solver = RateSolver(mech, [Task(next(iter(mech.links)), ("x",), np.array([0.1]), np.zeros(1))])
-    compiled = solver._compiled()
-    if compiled is None:
-        pytest.skip("the compiled core is not built here")
     rng = np.random.default_rng(7)
     Q = np.array([pin.integrate(mech.model, mech.neutral(), rng.normal(size=mech.model.nv)) for _ in range(20)])
-    core, frames, rows, local, row_scale = compiled
-    numbers = core.rates(Q, frames, rows, local, solver.x_dot, solver.x_ddot, row_scale, solver.max_condition)[2]
+    numbers = solver._rates(Q, solver.x_dot, solver.x_ddot)[:, 2 * mech.model.nv:]  # after v and a
     independent, full = numbers[:, 5], numbers[:, 6]
     data = mech.model.createData()
     for i, q in enumerate(Q):

@@ -31,6 +31,7 @@
 #include <cmath>
 #include <vector>
 
+#include "buffer.hpp"
 #include "condition.hpp"
 #include "square_solve.hpp"
 
@@ -83,6 +84,27 @@ enum Stop { DONE = 0, NEEDS_PIVOT = 1, SIGNATURE_CHANGED = 2, CONDITION = 3, NOT
 // The pin.Model inside a Python object made by the installed `pin` (model_ref.cpp), or
 // nullptr where the object is no pin.Model.
 pin::Model* borrow_model(PyObject* obj);
+// The pin.Data inside a Python object made by the installed `pin`, or nullptr.
+pin::Data* borrow_data(PyObject* obj);
+
+// ------------------------------------------------------------ kinematics.cpp
+// A row per frame, then per joint: position (3) [m], rotation (9, row-major), velocity
+// (3) [m/s], angular velocity (3) [rad/s], classical acceleration (3) [m/s^2], angular
+// acceleration (3) [rad/s^2], world axes (LOCAL_WORLD_ALIGNED).
+constexpr int KINEMATICS_COLUMNS = 24;
+// Numbers `Core::rates` gives a pose (rates.cpp).
+constexpr int RATE_NUMBERS = 9;
+// Pinocchio's forward kinematics at (q, v, a) in `data`, then a row per frame and joint
+// asked written at `out` (ids checked by the caller).
+void pose_kinematics(const pin::Model& model, pin::Data& data, const double* q, const double* v, const double* a,
+                     const int* frames, Index nframes, const int* joints, Index njoints, double* out);
+// One pose on the user's model and data (arrays: buffer.hpp): `out`, float64 of
+// (frames + joints) * KINEMATICS_COLUMNS items, gets the rows.
+void frames_at(nb::handle model, nb::handle data, nb::handle q, nb::handle v, nb::handle a, nb::handle frames,
+               nb::handle joints, nb::handle out);
+// N poses (Q, V, A: N rows): `out`, N * frames * KINEMATICS_COLUMNS items, pose by pose.
+void frames_along(nb::handle model, nb::handle data, nb::handle Q, nb::handle V, nb::handle A, nb::handle frames,
+                  nb::handle out);
 
 // A column of data.J (Pinocchio's joint Jacobians, nvExtended columns: a mimic joint has
 // its own, already times its scaling) and the velocity column it adds to (a mimic
@@ -208,11 +230,23 @@ class Core {
                            double unit, double p_target, bool through_folds, const std::vector<int>& scalar);
 
   // ------------------------------------------------------------ rates.cpp
-  nb::tuple rates(const Eigen::Ref<const RowMatrix>& Q, const std::vector<int>& task_frames,
-                  const std::vector<std::vector<int>>& task_rows, const std::vector<int>& task_local,
-                  const VectorXd& x_dot, const VectorXd& x_ddot, const VectorXd& row_scale, double max_condition);
-  nb::tuple frame_motion(const Eigen::Ref<const RowMatrix>& Q, const Eigen::Ref<const RowMatrix>& V,
-                         const Eigen::Ref<const RowMatrix>& A, const std::vector<int>& frames);
+  // The task rows RateSolver.solve stacks under the closure rows: frames (indices into
+  // this core's frames), the components (0-5: x y z wx wy wz) of each, and whether each is
+  // read in the frame's own axes.
+  void set_task(const std::vector<int>& task_frames, const std::vector<std::vector<int>>& task_rows,
+                const std::vector<int>& task_local);
+  // The stacked Jacobian (closure rows, then task rows) at q, not made dimensionless.
+  MatrixXd stacked_jacobian(const Eigen::Ref<const VectorXd>& q);
+  // How the rate task is solved: the row and column scales that make it dimensionless,
+  // the method asked (0 exact, 1 least squares, 2 damped), the damping, max_condition.
+  void set_rate_options(const VectorXd& row_scale, const VectorXd& v_scale, int method, double damping,
+                        double max_condition);
+  // Columns of `rates`' answer a pose: v, a (nv each), RATE_NUMBERS numbers, the achieved
+  // task rows' velocities and accelerations.
+  int rate_columns() const { return 2 * model_.nv + RATE_NUMBERS + 2 * int(task_size_); }
+  // RateSolver.solve at every row of Q (n rows of nq, buffer.hpp), the task's values
+  // x_dot, x_ddot; `out` (n * rate_columns() float64) gets the answers (see rates.cpp).
+  void rates(nb::handle Q, nb::handle x_dot, nb::handle x_ddot, int structural_rank, nb::handle out);
   RowMatrix pinocchio_passes(const Eigen::Ref<const RowMatrix>& Q, const Eigen::Ref<const RowMatrix>& V,
                              int jacobians);
 
@@ -253,6 +287,8 @@ class Core {
   bool advance(const CurvePoint& a, PathSpec& path, CurvePoint& out);
   void repivot(CurvePoint& a, const PathSpec& path) const;
   void locate_fold(CurvePoint a, CurvePoint b, const PathSpec& path, CurvePoint& out);
+  void task_jacobian_into(const VectorXd& q, MatrixXd& J);
+  void task_drift_into(const VectorXd& q, const VectorXd& v, VectorXd& drift);
 
   nb::object model_object_;  // the Python pin.Model: alive as long as this core
   const pin::Model& model_;
@@ -281,6 +317,15 @@ class Core {
   std::vector<int> pivots_;
   Node next_;  // follow_path's step buffer
   long attempts_ = 0;  // steps tried since the last look at Python's signal handlers
+  // the rate task (set_task)
+  std::vector<pin::FrameIndex> task_frames_;
+  std::vector<std::vector<int>> task_rows_;
+  std::vector<int> task_local_;
+  Index task_size_ = 0;
+  Matrix6Xd task_J_;
+  VectorXd rate_row_scale_, rate_v_scale_;
+  int rate_method_ = 0;
+  double rate_damping_ = 1e-3, rate_max_condition_ = 1e8;
 };
 
 }  // namespace pinmech

@@ -19,3 +19,13 @@ pinocchio::Model* borrow_model(PyObject* obj) {
 }
 
 }  // namespace pinmech
+
+namespace pinmech {
+
+pinocchio::Data* borrow_data(PyObject* obj) {
+  boost::python::extract<pinocchio::Data&> get(obj);
+  if (!get.check()) return nullptr;
+  return &get();
+}
+
+}  // namespace pinmech

@@ -39,6 +39,13 @@ NB_MODULE(_core, m) {
         return condition_of(A, A.rows() > 0 && lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0, work);
       },
       "2-norm condition number and smallest singular value of a square A, as the core computes them");
+  m.attr("KINEMATICS_COLUMNS") = KINEMATICS_COLUMNS;
+  m.attr("RATE_NUMBERS") = RATE_NUMBERS;
+  m.def("frames_at", &frames_at,
+        "frames_at(model, data, q, v, a, frames, joints, out): forwardKinematics(q, v, a) in the user's data, "
+        "then a row per frame and joint asked into out (kinematics.cpp)");
+  m.def("frames_along", &frames_along,
+        "frames_along(model, data, Q, V, A, frames, out): frames_at at every row, into out (N, frames * 24)");
   nb::class_<Core>(m, "Core")
       .def(nb::init<nb::object, const std::vector<int>&, const std::vector<int>&, const std::vector<int>&,
                     const std::vector<int>&, const Eigen::Ref<const RowMatrix>&, const Eigen::Ref<const RowMatrix>&,
@@ -75,6 +82,9 @@ NB_MODULE(_core, m) {
       .def("follow", &Core::follow)
       .def("node", &Core::node)
       .def("rates", &Core::rates)
-      .def("frame_motion", &Core::frame_motion)
+      .def("set_task", &Core::set_task)
+      .def("set_rate_options", &Core::set_rate_options)
+      .def_prop_ro("rate_columns", &Core::rate_columns)
+      .def("stacked_jacobian", &Core::stacked_jacobian)
       .def("pinocchio_passes", &Core::pinocchio_passes);
 }

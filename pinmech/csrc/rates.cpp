@@ -1,5 +1,5 @@
-// pinmech's compiled core: rate problems at many poses, frames along a sweep, and
-// Pinocchio's own share of a pose (see core.hpp for the whole).
+// pinmech's compiled core: rate problems at one pose or many, and Pinocchio's own share
+// of a pose (see core.hpp for the whole).
 #include "core.hpp"
 
 #include <pinocchio/algorithm/frames.hpp>
@@ -7,156 +7,273 @@
 #include <pinocchio/algorithm/kinematics.hpp>
 
 #include <Eigen/LU>
+#include <Eigen/SVD>
 
 #include <stdexcept>
 
 namespace pinmech {
 
 // ---------------------------------------------------------------- rate problems
-// RateSolver.solve at every row of Q, for square tasks ("exact"): closure rows stacked
-// over task rows (frame Jacobian rows in world axes, or the frame's own with `local`),
-// made dimensionless by `row_scale` and the velocity scale; v and a by LU. A pose whose
-// stacked Jacobian is not square, or conditioned worse than max_condition, gets status
-// 1 and no numbers: the Python path names it.
-nb::tuple Core::rates(const Eigen::Ref<const RowMatrix>& Q, const std::vector<int>& task_frames,
-                const std::vector<std::vector<int>>& task_rows, const std::vector<int>& task_local,
-                const VectorXd& x_dot, const VectorXd& x_ddot, const VectorXd& row_scale, double max_condition) {
-  check_structure();
-  const Index n = Q.rows(), nv = model_.nv;
-  Index m_task = 0;
-  for (const auto& rows : task_rows) m_task += Index(rows.size());
-  const Index m = rows_ + m_task;
-  if (Q.cols() != model_.nq || x_dot.size() != m_task || x_ddot.size() != m_task || row_scale.size() != m ||
-      task_frames.size() != task_rows.size() || task_local.size() != task_rows.size())
-    throw std::invalid_argument("rates: arrays of the wrong sizes");
-  for (int f : task_frames)
-    if (f < 0 || size_t(f) >= frames_.size()) throw std::invalid_argument("unknown frame index");
-  RowMatrix V = RowMatrix::Constant(n, nv, NAN), A = RowMatrix::Constant(n, nv, NAN);
-  // condition, sigma_min, closure v and a residuals, status, then q's closure residuals
-  // (independent rows, full rows: LoopSolver's is_closed reads both)
-  RowMatrix numbers = RowMatrix::Constant(n, 7, NAN);
-  RowMatrix achieved_v = RowMatrix::Constant(n, m_task, NAN), achieved_a = RowMatrix::Constant(n, m_task, NAN);
-  {
-    nb::gil_scoped_release release;
-    MatrixXd J(m, nv), Jd(m, nv);
-    VectorXd q(model_.nq), v(nv), a(nv), rhs(m), drift(m), x(nv), achieved(m);
-    Matrix6Xd JT(6, nv);
-    Eigen::PartialPivLU<MatrixXd> lu;
-    ConditionWork condition_work;
-    for (Index i = 0; i < n; ++i) {
-      q = Q.row(i).transpose();
-      if (rows_) {
-        residual_into(q, r_);
-        numbers(i, 5) = max_abs(r_);
-        numbers(i, 6) = full_residual();
-        jacobian_into(false);
-        J.topRows(rows_) = J_;
-      } else {
-        numbers(i, 5) = numbers(i, 6) = 0.0;
-        pin::computeJointJacobians(model_, data_, q);
-      }
-      Index row = rows_;
-      for (size_t t = 0; t < task_frames.size(); ++t) {
-        const pin::FrameIndex f = frames_[size_t(task_frames[t])];
-        const pin::SE3& M = pin::updateFramePlacement(model_, data_, f);
-        JT.setZero();
-        pin::getFrameJacobian(model_, data_, f, pin::LOCAL_WORLD_ALIGNED, JT);
-        if (task_local[t]) {
-          tmp3_.noalias() = M.rotation().transpose() * JT.topRows<3>();
-          JT.topRows<3>() = tmp3_;
-          tmp3_.noalias() = M.rotation().transpose() * JT.bottomRows<3>();
-          JT.bottomRows<3>() = tmp3_;
-        }
-        for (int k : task_rows[t]) J.row(row++) = JT.row(k);
-      }
-      Jd = row_scale.asDiagonal() * J * v_scale_.asDiagonal();
-      if (m != nv) {
-        numbers(i, 4) = 1;
-        continue;
-      }
-      lu.compute(Jd);
-      const auto [cond, smin] =
-          condition_of(Jd, lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0, condition_work);
-      if (!(cond < max_condition)) {
-        numbers(i, 4) = 1;
-        continue;
-      }
-      rhs.head(rows_).setZero();
-      rhs.tail(m_task) = x_dot;
-      x = lu.solve(row_scale.cwiseProduct(rhs));
-      v = v_scale_.cwiseProduct(x);
-      if (rows_) drift_into(q, v, drift_);
-      else pin::forwardKinematics(model_, data_, q, v, zero_);
-      drift.head(rows_) = drift_;
-      row = rows_;
-      for (size_t t = 0; t < task_frames.size(); ++t) {
-        const pin::FrameIndex f = frames_[size_t(task_frames[t])];
-        const pin::Motion acc = pin::getFrameClassicalAcceleration(model_, data_, f, pin::LOCAL_WORLD_ALIGNED);
-        Vector6d e;
-        e.head<3>() = acc.linear();
-        e.tail<3>() = acc.angular();
-        if (task_local[t]) {
-          const Matrix3d RT = data_.oMf[f].rotation().transpose();
-          e.head<3>() = RT * acc.linear();
-          e.tail<3>() = RT * acc.angular();
-        }
-        for (int k : task_rows[t]) drift(row++) = e(k);
-      }
-      rhs.head(rows_).setZero();
-      rhs.tail(m_task) = x_ddot;
-      rhs -= drift;
-      x = lu.solve(row_scale.cwiseProduct(rhs));
-      a = v_scale_.cwiseProduct(x);
-      V.row(i) = v.transpose();
-      A.row(i) = a.transpose();
-      achieved.noalias() = J * v;
-      achieved_v.row(i) = achieved.tail(m_task).transpose();
-      const double closure_v = rows_ ? max_abs(achieved.head(rows_)) : 0.0;
-      achieved.noalias() = J * a;
-      achieved += drift;
-      achieved_a.row(i) = achieved.tail(m_task).transpose();
-      const double closure_a = rows_ ? max_abs(achieved.head(rows_)) : 0.0;
-      numbers.block<1, 5>(i, 0) << cond, smin, closure_v, closure_a, 0.0;
+// RateSolver.solve (pinmech/solve/rates.py states the problem and names its errors): at q,
+// the closure rows stacked over the task rows (frame Jacobian rows in world axes, or the
+// frame's own with `local`), J q_dot = x_dot and J q_ddot = x_ddot - Jdot q_dot, Jdot
+// q_dot being each row's acceleration at zero joint acceleration (the closure drift; a
+// task frame's classical acceleration after forwardKinematics(q, q_dot, 0)). Solved on J
+// made dimensionless (rows times row_scale, columns times v_scale), so that the condition
+// number, the minimum norm and the damping weigh a turn of one radian like a slide of one
+// mechanism size.
+//
+// Condition number over the rank: a square J through its LU and condition_of; otherwise,
+// or where a square J looks singular, from its singular values (Jacobi SVD). The rank is
+// min(m, n) unless sigma[rank - 1] <= sigma[0] / max_condition; there it is at most
+// `structural_rank`, the rank at generic poses (RateSolver._structural_rank), or, with
+// structural_rank < 0, the pose gets status RATES_NEED_RANK and no numbers (the caller
+// finds the structural rank and asks again).
+//
+// Methods (`method`: 0 exact, 1 least squares, 2 damped, as asked): damped -> damped
+// least squares J^T (J J^T + damping^2 I)^-1; else a rank below the rows -> status
+// RATES_INCONSISTENT unless least squares; else condition > max_condition -> status
+// RATES_SINGULAR; else rank below the rows -> least squares, square -> exact (LU), wider
+// -> minimum norm; least squares and minimum norm through the SVD truncated to the rank.
+// The method used is returned as its code (rates.py's _USED).
+namespace {
+
+enum RateStatus { RATES_OK = 0, RATES_NEED_RANK = 1, RATES_INCONSISTENT = 2, RATES_SINGULAR = 3 };
+enum RateMethodUsed { USED_EXACT = 0, USED_MINIMUM_NORM = 1, USED_LEAST_SQUARES = 2, USED_DAMPED = 3 };
+constexpr int ASKED_LEAST_SQUARES = 1, ASKED_DAMPED = 2;
+
+// Work buffers of one `rates` call, sized once for all its poses.
+struct RateWork {
+  MatrixXd J, Jd, JJt;
+  VectorXd q, b, x, rhs, drift, achieved, y;
+  Eigen::PartialPivLU<MatrixXd> lu, lu_damped;
+  Eigen::JacobiSVD<MatrixXd> svd;
+  ConditionWork condition;
+  bool lu_ready = false;
+
+  RateWork(Index m, Index nv, Index nq) : J(m, nv), Jd(m, nv), q(nq), b(m), x(nv), rhs(m), drift(m), achieved(m) {}
+
+  // x = the method's solution of Jd x = b (Jd factored for it).
+  void apply(int used, int rank) {
+    if (used == USED_EXACT) {
+      x = lu.solve(b);
+    } else if (used == USED_DAMPED) {
+      x.noalias() = Jd.transpose() * lu_damped.solve(b);
+    } else {  // the pseudo-inverse truncated to the rank
+      y.noalias() = svd.matrixU().leftCols(rank).transpose() * b;
+      y.array() /= svd.singularValues().head(rank).array();
+      x.noalias() = svd.matrixV().leftCols(rank) * y;
     }
   }
-  return nb::make_tuple(V, A, numbers, achieved_v, achieved_a);
+};
+
+}  // namespace
+
+void Core::set_task(const std::vector<int>& task_frames, const std::vector<std::vector<int>>& task_rows,
+                    const std::vector<int>& task_local) {
+  if (task_frames.size() != task_rows.size() || task_local.size() != task_rows.size())
+    throw std::invalid_argument("set_task: frames, rows and local of different lengths");
+  std::vector<pin::FrameIndex> frames;
+  Index size = 0;
+  for (size_t t = 0; t < task_frames.size(); ++t) {
+    if (task_frames[t] < 0 || size_t(task_frames[t]) >= frames_.size())
+      throw std::invalid_argument("unknown frame index");
+    for (int k : task_rows[t])
+      if (k < 0 || k > 5) throw std::invalid_argument("task rows are components 0 to 5");
+    frames.push_back(frames_[size_t(task_frames[t])]);
+    size += Index(task_rows[t].size());
+  }
+  task_frames_ = frames;
+  task_size_ = size;
+  task_rows_ = task_rows;
+  task_local_ = task_local;
+  task_J_ = Matrix6Xd::Zero(6, model_.nv);
 }
 
-// ---------------------------------------------------------------- frames along a sweep
-// Positions, rotations, velocities and classical accelerations (world axes) of frames
-// at every pose: (N, F, 3) arrays and (N, F, 9) rotations, row by row.
-nb::tuple Core::frame_motion(const Eigen::Ref<const RowMatrix>& Q, const Eigen::Ref<const RowMatrix>& V,
-                       const Eigen::Ref<const RowMatrix>& A, const std::vector<int>& frames) {
+// J (rows_ + task rows, nv) at q; leaves data_ at q with the joint Jacobians, the cut
+// frames' and task frames' placements, and r_ the independent closure rows.
+void Core::task_jacobian_into(const VectorXd& q, MatrixXd& J) {
+  if (rows_) {
+    residual_into(q, r_);
+    jacobian_into(false);
+    J.topRows(rows_) = J_;
+  } else {
+    pin::computeJointJacobians(model_, data_, q);
+  }
+  Index row = rows_;
+  for (size_t t = 0; t < task_frames_.size(); ++t) {
+    const pin::FrameIndex f = task_frames_[t];
+    const pin::SE3& M = pin::updateFramePlacement(model_, data_, f);
+    task_J_.setZero();
+    pin::getFrameJacobian(model_, data_, f, pin::LOCAL_WORLD_ALIGNED, task_J_);
+    if (task_local_[t]) {
+      tmp3_.noalias() = M.rotation().transpose() * task_J_.topRows<3>();
+      task_J_.topRows<3>() = tmp3_;
+      tmp3_.noalias() = M.rotation().transpose() * task_J_.bottomRows<3>();
+      task_J_.bottomRows<3>() = tmp3_;
+    }
+    for (int k : task_rows_[t]) J.row(row++) = task_J_.row(k);
+  }
+}
+
+// Jdot v of every row at (q, v): the closure drift, then the task frames' classical
+// accelerations at zero joint acceleration (data_'s frame placements at q kept).
+void Core::task_drift_into(const VectorXd& q, const VectorXd& v, VectorXd& drift) {
+  if (rows_) {
+    drift_into(q, v, drift_);
+    drift.head(rows_) = drift_;
+  } else {
+    pin::forwardKinematics(model_, data_, q, v, zero_);
+  }
+  Index row = rows_;
+  for (size_t t = 0; t < task_frames_.size(); ++t) {
+    const pin::FrameIndex f = task_frames_[t];
+    const pin::Motion acc = pin::getFrameClassicalAcceleration(model_, data_, f, pin::LOCAL_WORLD_ALIGNED);
+    Vector6d e;
+    e.head<3>() = acc.linear();
+    e.tail<3>() = acc.angular();
+    if (task_local_[t]) {
+      const Matrix3d RT = data_.oMf[f].rotation().transpose();
+      e.head<3>() = RT * acc.linear();
+      e.tail<3>() = RT * acc.angular();
+    }
+    for (int k : task_rows_[t]) drift(row++) = e(k);
+  }
+}
+
+MatrixXd Core::stacked_jacobian(const Eigen::Ref<const VectorXd>& q) {
   check_structure();
-  const Index n = Q.rows(), nf = Index(frames.size());
-  if (Q.cols() != model_.nq || V.cols() != model_.nv || A.cols() != model_.nv || V.rows() != n || A.rows() != n)
-    throw std::invalid_argument("q, v and a of the wrong shapes");
-  for (int f : frames)
-    if (f < 0 || size_t(f) >= frames_.size()) throw std::invalid_argument("unknown frame index");
-  RowMatrix P(n, 3 * nf), R(n, 9 * nf), Vel(n, 3 * nf), Omega(n, 3 * nf), Acc(n, 3 * nf), Alpha(n, 3 * nf);
+  if (q.size() != model_.nq) throw std::invalid_argument("stacked_jacobian: q of the wrong size");
+  MatrixXd J(rows_ + task_size_, model_.nv);
+  task_jacobian_into(q, J);
+  return J;
+}
+
+void Core::set_rate_options(const VectorXd& row_scale, const VectorXd& v_scale, int method, double damping,
+                            double max_condition) {
+  if (row_scale.size() != rows_ + task_size_ || v_scale.size() != model_.nv || method < 0 || method > 2)
+    throw std::invalid_argument("set_rate_options: scales of the wrong sizes, or an unknown method");
+  rate_row_scale_ = row_scale;
+  rate_v_scale_ = v_scale;
+  rate_method_ = method;
+  rate_damping_ = damping;
+  rate_max_condition_ = max_condition;
+}
+
+void Core::rates(nb::handle Q_object, nb::handle x_dot_object, nb::handle x_ddot_object, int structural_rank,
+                 nb::handle out_object) {
+  check_structure();
+  const Index nv = model_.nv, m_task = task_size_, m = rows_ + m_task;
+  if (m_task == 0 || rate_row_scale_.size() != m || rate_v_scale_.size() != nv)
+    throw std::invalid_argument("rates: no task or no options set (set_task, set_rate_options)");
+  const Buffer bq(Q_object, 'd', -1, false, "q");
+  if (model_.nq == 0 || bq.size() % model_.nq != 0) throw std::invalid_argument("q: rows of nq numbers needed");
+  const Index n = bq.size() / model_.nq, width = rate_columns();
+  const Buffer bxd(x_dot_object, 'd', m_task, false, "x_dot"), bxdd(x_ddot_object, 'd', m_task, false, "x_ddot");
+  const Buffer bout(out_object, 'd', n * width, true, "out");
+  const Eigen::Map<const RowMatrix> Q(bq.doubles(), n, model_.nq);
+  const Eigen::Map<const VectorXd> x_dot(bxd.doubles(), m_task), x_ddot(bxdd.doubles(), m_task);
+  Eigen::Map<RowMatrix> out(bout.doubles(), n, width);
+  out.setConstant(NAN);
+  auto V = out.leftCols(nv);
+  auto A = out.middleCols(nv, nv);
+  auto numbers = out.middleCols(2 * nv, RATE_NUMBERS);
+  auto achieved_v = out.middleCols(2 * nv + RATE_NUMBERS, m_task);
+  auto achieved_a = out.rightCols(m_task);
+  const VectorXd& row_scale = rate_row_scale_;
+  const VectorXd& v_scale = rate_v_scale_;
+  const int method = rate_method_;
+  const double damping = rate_damping_, max_condition = rate_max_condition_;
   {
     nb::gil_scoped_release release;
-    VectorXd q(model_.nq), v(model_.nv), a(model_.nv);
+    RateWork w(m, nv, model_.nq);
+    VectorXd v(nv), a(nv);
+    const int full_rank = int(std::min(m, nv));
     for (Index i = 0; i < n; ++i) {
-      q = Q.row(i).transpose();
-      v = V.row(i).transpose();
-      a = A.row(i).transpose();
-      pin::forwardKinematics(model_, data_, q, v, a);
-      for (Index k = 0; k < nf; ++k) {
-        const pin::FrameIndex f = frames_[size_t(frames[size_t(k)])];
-        const pin::SE3& M = pin::updateFramePlacement(model_, data_, f);
-        const pin::Motion vel = pin::getFrameVelocity(model_, data_, f, pin::LOCAL_WORLD_ALIGNED);
-        const pin::Motion acc = pin::getFrameClassicalAcceleration(model_, data_, f, pin::LOCAL_WORLD_ALIGNED);
-        P.block<1, 3>(i, 3 * k) = M.translation().transpose();
-        for (int r = 0; r < 3; ++r) R.block<1, 3>(i, 9 * k + 3 * r) = M.rotation().row(r);
-        Vel.block<1, 3>(i, 3 * k) = vel.linear().transpose();
-        Omega.block<1, 3>(i, 3 * k) = vel.angular().transpose();
-        Acc.block<1, 3>(i, 3 * k) = acc.linear().transpose();
-        Alpha.block<1, 3>(i, 3 * k) = acc.angular().transpose();
+      w.q = Q.row(i).transpose();
+      task_jacobian_into(w.q, w.J);
+      numbers(i, 5) = rows_ ? max_abs(r_) : 0.0;
+      numbers(i, 6) = rows_ ? full_residual() : 0.0;
+      w.Jd.noalias() = row_scale.asDiagonal() * w.J * v_scale.asDiagonal();
+      double condition = INFINITY, sigma_min = 0.0;
+      int rank = full_rank;
+      bool settled = false;  // the square fast path gave the condition number
+      w.lu_ready = false;
+      if (m == nv && m > 0) {
+        w.lu.compute(w.Jd);
+        w.lu_ready = true;
+        const auto [c, s] = condition_of(w.Jd, w.lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0, w.condition);
+        if (c < max_condition) {
+          condition = c;
+          sigma_min = s;
+          settled = true;
+        }
       }
+      bool svd_ready = false;
+      if (!settled && rank > 0) {
+        w.svd.compute(w.Jd, Eigen::ComputeThinU | Eigen::ComputeThinV);
+        svd_ready = true;
+        const VectorXd& sigma = w.svd.singularValues();
+        if (!(sigma(rank - 1) > sigma(0) / max_condition)) {
+          if (structural_rank < 0) {
+            numbers(i, 4) = RATES_NEED_RANK;
+            continue;
+          }
+          rank = std::min(rank, structural_rank);
+        }
+        sigma_min = rank ? sigma(rank - 1) : 0.0;
+        condition = sigma_min > 0 ? sigma(0) / sigma_min : INFINITY;
+      }
+      numbers(i, 0) = condition;
+      numbers(i, 1) = sigma_min;
+      numbers(i, 7) = rank;
+      int used;
+      if (method == ASKED_DAMPED) {
+        used = USED_DAMPED;
+      } else if (rank < m && method != ASKED_LEAST_SQUARES) {
+        numbers(i, 4) = RATES_INCONSISTENT;
+        continue;
+      } else if (condition > max_condition) {
+        numbers(i, 4) = RATES_SINGULAR;
+        continue;
+      } else if (rank < m) {
+        used = USED_LEAST_SQUARES;
+      } else {
+        used = m == nv ? USED_EXACT : USED_MINIMUM_NORM;
+      }
+      if (used == USED_EXACT && !w.lu_ready) w.lu.compute(w.Jd);
+      if (used == USED_DAMPED) {
+        w.JJt.noalias() = w.Jd * w.Jd.transpose();
+        w.JJt.diagonal().array() += damping * damping;
+        w.lu_damped.compute(w.JJt);
+      }
+      if ((used == USED_MINIMUM_NORM || used == USED_LEAST_SQUARES) && !svd_ready)
+        w.svd.compute(w.Jd, Eigen::ComputeThinU | Eigen::ComputeThinV);
+      w.rhs.head(rows_).setZero();
+      w.rhs.tail(m_task) = x_dot;
+      w.b = row_scale.cwiseProduct(w.rhs);
+      w.apply(used, rank);
+      v = v_scale.cwiseProduct(w.x);
+      task_drift_into(w.q, v, w.drift);
+      w.rhs.head(rows_).setZero();
+      w.rhs.tail(m_task) = x_ddot;
+      w.rhs -= w.drift;
+      w.b = row_scale.cwiseProduct(w.rhs);
+      w.apply(used, rank);
+      a = v_scale.cwiseProduct(w.x);
+      V.row(i) = v.transpose();
+      A.row(i) = a.transpose();
+      w.achieved.noalias() = w.J * v;
+      achieved_v.row(i) = w.achieved.tail(m_task).transpose();
+      numbers(i, 2) = rows_ ? max_abs(w.achieved.head(rows_)) : 0.0;
+      w.achieved.noalias() = w.J * a;
+      w.achieved += w.drift;
+      achieved_a.row(i) = w.achieved.tail(m_task).transpose();
+      numbers(i, 3) = rows_ ? max_abs(w.achieved.head(rows_)) : 0.0;
+      numbers(i, 4) = RATES_OK;
+      numbers(i, 8) = used;
     }
   }
-  return nb::make_tuple(P, R, Vel, Omega, Acc, Alpha);
 }
 
 // ---------------------------------------------------------------- Pinocchio's share

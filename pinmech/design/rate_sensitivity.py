@@ -15,6 +15,10 @@ with (dv_X/dq) S from the world Jacobian's time variation at q_dot = S (_FrameRa
 C_dep dv_dep/dp_k = -dG/dp_k (the driver's speed held), and an output's speed derivative
 follows: a slider's ds_dot/dp = dv/dp at its index; a link's d(omega)/dp =
 n . ((dw_f/dq) S_k + J_f,ang dv/dp_k).
+
+A drawn linkage's param (drawn_params.py) moves no frame by a translation u; it changes
+the placements themselves, so dG/dp_k and each frame's velocity at fixed q and v gain the
+drawing's own change, the central differences of J(q) v over the drawings at p +- STEP.
 """
 
 from __future__ import annotations
@@ -91,6 +95,10 @@ def velocity_sensitivity(sm, q: np.ndarray, v: np.ndarray, dq_dp: np.ndarray,
                                    for c in mech.closures])
         for i, f in enumerate(frames):
             dV[i, :, k] = rates.change(f)
+        if place.drawn:  # the drawing's own change at fixed q and v: its central differences
+            dG[:, k] += place.column(lambda: _jacobians(sm, q, None) @ v)
+            for i, f in enumerate(frames):
+                dV[i, :, k] += place.column(lambda f=f: _jacobians(sm, q, f) @ v)
     dv = np.zeros((model.nv, n_par))
     dv[dep] = -np.linalg.solve(J[:, dep], dG)
     return dv, dV
@@ -101,6 +109,19 @@ def link_omega_sensitivity(sm, frame: int, normal: np.ndarray, dV: np.ndarray, d
     its change at fixed v (dV (6, n_par)) plus J_ang dv/dp."""
     J = pin.getFrameJacobian(sm.model, sm.data, frame, _LWA).reshape(6, -1)
     return normal @ (dV[3:] + J[3:] @ dv_dp)
+
+
+def _jacobians(sm, q: np.ndarray, frame: int | None) -> np.ndarray:
+    """The closure's velocity rows (frame None) or a frame's world-aligned Jacobian (6, nv)
+    at q with the placements now in the model (a Data of its own)."""
+    if not hasattr(sm, "_fd_data"):
+        sm._fd_data = sm.model.createData()
+    data = sm._fd_data
+    pin.computeJointJacobians(sm.model, data, q)
+    pin.updateFramePlacements(sm.model, data)
+    if frame is None:
+        return np.vstack([c.jacobian(sm.model, data) for c in sm.mechanism.closures])
+    return pin.getFrameJacobian(sm.model, data, frame, _LWA).reshape(6, -1)
 
 
 def _cut_rows(sm, cut, rates: _FrameRates, S: np.ndarray, place, u: np.ndarray, moved: np.ndarray) -> np.ndarray:

@@ -15,7 +15,10 @@ at all: J_p = rows6 @ [R_P^T (u_C - u_P); 0].
 
 An output y(q, p) (a point's world position, a link's angle in the plane, a slider's
 coordinate) then has dy/dp = J_y dq/dp + dy/dp|_q, the last term u where the parameter
-moves the point's frame; speeds (a slider's, a link's omega): rate_sensitivity.py.
+moves the point's frame (for a drawn linkage's param, J_p and dy/dp|_q are central
+differences of the drawing at fixed q, drawn_params.py); speeds (a slider's, a link's
+omega): rate_sensitivity.py; a link's angular acceleration: accel_sensitivity.py; a
+driver's torque: central differences of re-solved variants (variant_differences.py).
 """
 
 from __future__ import annotations
@@ -24,9 +27,12 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import SceneError, SingularPoseError
+from pinmech.design.accel_sensitivity import acceleration_sensitivity
 from pinmech.design.rate_sensitivity import link_omega_sensitivity, velocity_sensitivity
 from pinmech.design.study_outputs import StudyOutputs
+from pinmech.design.study_stroke import stroke_sensitivity
 from pinmech.design.study_variant import StudyMechanism, VariantCycle
+from pinmech.design.variant_differences import central_differences
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -36,6 +42,9 @@ def parameter_jacobian(sm: StudyMechanism, data: pin.Data) -> np.ndarray:
     (`data` at q with frame placements up to date)."""
     columns = []
     for place in sm.placements:
+        if place.drawn:  # the drawing's central differences at fixed q (drawn_params.py)
+            columns.append(place.column(lambda: _closure_residual(sm, sm.q_at)))
+            continue
         u = place.direction(data)
         rows = []
         for c in sm.mechanism.closures:
@@ -45,6 +54,14 @@ def parameter_jacobian(sm: StudyMechanism, data: pin.Data) -> np.ndarray:
             rows.append(c._rows6 @ d6)
         columns.append(np.concatenate(rows))
     return np.array(columns).T
+
+
+def _closure_residual(sm: StudyMechanism, q: np.ndarray) -> np.ndarray:
+    """The closure residual (rows,) at q with the placements now in the model (own Data)."""
+    if not hasattr(sm, "_fd_data"):
+        sm._fd_data = sm.model.createData()
+    pin.framesForwardKinematics(sm.model, sm._fd_data, q)
+    return np.concatenate([c.residual(sm._fd_data) for c in sm.mechanism.closures])
 
 
 def configuration_sensitivity(sm: StudyMechanism, data: pin.Data) -> np.ndarray:
@@ -65,23 +82,41 @@ def configuration_sensitivity(sm: StudyMechanism, data: pin.Data) -> np.ndarray:
     return dq
 
 
-def output_sensitivity(sm: StudyMechanism, outputs: StudyOutputs, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """dy/dp (n_out, n_par) at the closed pose q with joint velocities v [m/m, rad/m, per s
-    per m] (rate outputs: rate_sensitivity.py)."""
+def output_sensitivity(sm: StudyMechanism, outputs: StudyOutputs, q: np.ndarray, v: np.ndarray,
+                       a: np.ndarray | None = None) -> np.ndarray:
+    """dy/dp at the closed pose q with joint velocities v (and accelerations a: the
+    alphas' rows too) [m/m, rad/m, per s per m, per s^2 per m]: the rows of the outputs
+    before `outputs.strokes_at` (rate outputs: rate_sensitivity.py, accel_sensitivity.py)."""
     data = sm.at(q)
     Y_q, Y_p = outputs.jacobians(data)
+    for k, place in enumerate(sm.placements):
+        if place.drawn:  # the drawing's central differences at fixed q (drawn_params.py)
+            Y_p[:, k] = place.column(lambda: outputs.pose_values(q))
     dq = configuration_sensitivity(sm, data)
     rows = [Y_q @ dq + Y_p]
-    if outputs.sliders or outputs.omega:
+    alpha = a is not None and bool(outputs.alpha)
+    if outputs.sliders or outputs.omega or alpha:
         dv, dV = velocity_sensitivity(sm, q, v, dq, outputs.omega)
         rows += [dv[[iv for _, iv in outputs.sliders]]]
         rows += [link_omega_sensitivity(sm, f, outputs.normal, dV[i], dv)[None] for i, f in enumerate(outputs.omega)]
+        if alpha:
+            rows += [acceleration_sensitivity(sm, q, v, a, dq, dv, outputs.alpha)]
     return np.vstack(rows)
 
 
 def cycle_sensitivity(sm: StudyMechanism, outputs: StudyOutputs, cycle: VariantCycle) -> tuple[np.ndarray, np.ndarray]:
     """The outputs (steps, n_out) and dy/dp (steps, n_out, n_par) at each pose of a solved
-    cycle of the variant now written in the model."""
+    cycle of the variant now written in the model. Exact but for the driver torques:
+    central differences of re-solved variants (variant_differences.py)."""
     y = outputs.cycle(cycle.q, cycle.v, cycle.a)
-    dy = np.array([output_sensitivity(sm, outputs, qi, vi) for qi, vi in zip(cycle.q, cycle.v)])
+    dy = np.zeros((*y.shape, len(sm.placements)))
+    head = outputs.strokes_at.start
+    if head:
+        dy[:, :head] = [output_sensitivity(sm, outputs, qi, vi, ai) for qi, vi, ai in zip(cycle.q, cycle.v, cycle.a)]
+    if outputs.strokes:  # the envelope theorem at each stroke's extremes (study_stroke.py)
+        dy[:, outputs.strokes_at] = [stroke_sensitivity(sm, s, *s.extremes(cycle.q)[1::2],
+                                                        lambda q: configuration_sensitivity(sm, sm.at(q)))
+                                     for s in outputs.strokes]
+    if outputs.torque_at.stop > outputs.torque_at.start:
+        dy[:, outputs.torque_at] = central_differences(sm, outputs, outputs.torque_at)
     return y, dy

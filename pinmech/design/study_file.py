@@ -24,12 +24,18 @@
     point = "P"                          # a URDF fixed link, an MJCF site, a robot.yaml loop frame)
     component = "x"                      # (or body = "coupler": an MJCF body's pos)
 
+    [params.crank_drawn]                 # a drawn linkage's [params] entry (a scene with linkage = ...):
+    param = "crank"                      # the linkage is redrawn for each variant; no component
+
     [outputs]
     points = ["P"]                       # world x, y, z of these points [m]
     links = ["rocker"]                   # angle of these links about the plane normal [rad]
     sliders = ["slide"]                  # a prismatic joint's s [m] and s_dot [m/s]
     omega = ["rocker"]                   # angular speed about the plane normal [rad/s]
     transmission = ["B"]                 # the transmission angle of the dyad with middle pin B [rad]
+    alpha = ["rocker"]                   # angular acceleration about the plane normal [rad/s^2]
+    strokes = ["slide"]                  # a prismatic joint's max - min of s over the cycle [m]
+    torque = ["O2"]                      # a driver's torque [N m] or force [N] (the scene's masses, loads)
 
     # kind = "grid": 1 to 3 of the parameters over evenly spaced values (the others at nominal)
     [grid.crank]
@@ -57,9 +63,9 @@ KINDS = ("sensitivity", "tolerance", "grid", "workspace")
 _TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs", "batch", "grid"}
 _GRID_KEYS = {"from", "to", "count"}
 _GRID_MAX = 1_000_000  # grid points in all
-_TARGETS = ("joint", "cut", "point", "body")
-_PARAM_KEYS = {"joint", "cut", "point", "body", "side", "component", "nominal", "bounds", "tolerance", "k", "sigma", "distribution"}
-_OUTPUT_KEYS = {"points", "links", "sliders", "omega", "transmission"}
+_TARGETS = ("joint", "cut", "point", "body", "param")
+_PARAM_KEYS = {"joint", "cut", "point", "body", "param", "side", "component", "nominal", "bounds", "tolerance", "k", "sigma", "distribution"}
+_OUTPUT_KEYS = {"points", "links", "sliders", "omega", "transmission", "alpha", "strokes", "torque"}
 _LIMITS = {"steps": (1, 100_000), "samples": (1, 10_000_000), "seed": (0, 2**63 - 1), "batch": (1, 1_000_000)}
 #: Keys only some kinds use: any other kind refuses them (a key read by nobody would be a
 #: silent no-op). Top-level keys, then [params.NAME] keys.
@@ -102,6 +108,8 @@ class StudySpec:
         points, links: the outputs (point positions, link angles).
         sliders, omega: prismatic joints (s and s_dot), links' angular speeds (study_outputs.py).
         transmission: dyads by their middle pin, for their transmission angle.
+        alpha: links' angular accelerations; strokes: prismatic joints' max - min of s.
+        torque: drivers whose torque (force) the scene's masses and loads need.
         grid: a grid study's axes (1 to 3), in the [grid] table's order; () otherwise.
     """
 
@@ -120,6 +128,9 @@ class StudySpec:
     sliders: tuple[str, ...] = ()
     omega: tuple[str, ...] = ()
     transmission: tuple[str, ...] = ()
+    alpha: tuple[str, ...] = ()
+    strokes: tuple[str, ...] = ()
+    torque: tuple[str, ...] = ()
 
 
 def load_study(path: str | Path) -> StudySpec:
@@ -156,7 +167,8 @@ def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
     return StudySpec(path, str(raw.get("title", path.stem)), (path.parent / scene), kind, counts["steps"],
                      counts["samples"], counts["seed"], counts["batch"], parsed, named["points"],
                      named["links"], _grid(raw, kind, parsed, where), named["sliders"], named["omega"],
-                     named["transmission"])
+                     named["transmission"], named["alpha"], named["strokes"],
+                     named["torque"])
 
 
 def _refuse_unused(raw: dict[str, Any], kind: str, where: _Where) -> None:
@@ -219,7 +231,8 @@ def _parameter(name: str, table: Any, where: _Where) -> Parameter:
     given = [t for t in _TARGETS if t in table]
     if len(given) != 1:
         raise where.error(key, "give one of joint = \"NAME\" (its origin), cut = \"NAME\" (a cut frame's origin), "
-                          "point = \"NAME\" (a named point) or body = \"NAME\" (an MJCF body's pos)")
+                          "point = \"NAME\" (a named point), body = \"NAME\" (an MJCF body's pos) or param = \"NAME\" "
+                          "(a drawn linkage's [params] entry)")
     target = given[0]
     if not isinstance(table[target], str):
         raise where.error(f"{key}.{target}", f"{target} = {table[target]!r} must be a name")
@@ -228,7 +241,9 @@ def _parameter(name: str, table: Any, where: _Where) -> Parameter:
         raise where.error(f"{key}.side", f"side = {side!r} must be \"parent\" or \"child\"")
     if target != "cut" and "side" in table:
         raise where.error(f"{key}.side", f"side is for a cut's frames; a {target} has one origin")
-    component = table.get("component")
+    component = table.get("component", "x" if target == "param" else None)
+    if target == "param" and "component" in table:
+        raise where.error(f"{key}.component", "a drawn linkage's param is a length of its own: it has no component")
     if component not in AXES:
         raise where.error(f"{key}.component", f"component = {component!r} must be \"x\", \"y\" or \"z\"")
     nominal = where.length(table, "nominal", key) if "nominal" in table else None

@@ -1,5 +1,5 @@
 """A study's outputs: their names and kinds, their values over a cycle (all poses in one
-call of the compiled core's `frame_motion`), and their Jacobians at a pose.
+call of the compiled core's `frames_along`), and their Jacobians at a pose.
 
 Outputs, in this order (`[outputs]` of the study file):
 
@@ -10,9 +10,15 @@ Outputs, in this order (`[outputs]` of the study file):
     transmission = ["B"]  B.mu: the transmission angle of the dyad whose middle pin is B [rad]
                           (study_transmission.py)
     omega = ["rocker"]    rocker.omega: angular speed about the plane normal [rad/s]
+    alpha = ["rocker"]    rocker.alpha: angular acceleration about the plane normal [rad/s^2]
+                          (its sensitivity: accel_sensitivity.py)
+    strokes = ["slide"]   slide.stroke: max - min of s over the cycle [m], the same at every
+                          pose (study_stroke.py)
+    torque = ["O2"]       O2.torque: the driver's torque [N m] (a prismatic one's force [N])
+                          from the scene's masses and loads (study_torque.py; its
+                          sensitivity: variant_differences.py)
 
-Speeds are those of the scene's driver speed. (A link's angular acceleration is not an
-output yet: its exact sensitivity needs the derivative of the acceleration drift.)
+Speeds and accelerations are those of the scene's driver speed and acceleration.
 """
 
 from __future__ import annotations
@@ -21,8 +27,10 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import SceneError
+from pinmech.design.study_stroke import Stroke
+from pinmech.design.study_torque import DriverTorques
 from pinmech.design.study_transmission import dyad_pins, transmission_row, transmission_values
-from pinmech.solve.core import CompiledModel
+from pinmech.solve.core import _core
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -31,15 +39,18 @@ class StudyOutputs:
     """A study's outputs on a StudyMechanism `sm`.
 
     Attributes:
-        names: "P.x", "rocker.angle", "slide.s", "slide.s_dot", "rocker.omega".
-        kinds: "length", "angle", "speed", "angular speed", each.
+        names: "P.x", "rocker.angle", "B.mu", "slide.s", "slide.s_dot", "rocker.omega",
+            "rocker.alpha", "slide.stroke", "O2.torque" (in this order).
+        kinds: "length", "angle", "speed", "angular speed", "angular acceleration", "torque"
+            (or "force"), each.
         n_pose: how many outputs (the first ones) depend on q alone.
+        alpha_at, strokes_at, torque_at: where those outputs sit in `names` (slices).
     """
 
     def __init__(self, sm) -> None:
         mech, spec = sm.mechanism, sm.spec
         self.sm, self.normal = sm, mech.plane_normal
-        planar = [("links", spec.links), ("omega", spec.omega)]
+        planar = [("links", spec.links), ("omega", spec.omega), ("alpha", spec.alpha)]
         for key, names in planar:
             if names and self.normal is None:
                 raise SceneError("link angles and their rates are outputs of planar mechanisms; name points instead",
@@ -49,19 +60,28 @@ class StudyOutputs:
                     raise SceneError(f"unknown link '{name}' (the model has: {', '.join(mech.links)})",
                                      path=str(spec.path), key=f"outputs.{key}")
         self.sliders = [_slider(mech, name, spec) for name in spec.sliders]
+        self.torques = DriverTorques(sm, spec.torque)
+        self.strokes = [Stroke(sm, name, *_slider(mech, name, spec, "outputs.strokes")) for name in spec.strokes]
         self.points = [mech.frame_id(_checked_point(mech, name, spec)) for name in spec.points]
         self.links = [mech.links[name] for name in spec.links]
         self.omega = [mech.links[name] for name in spec.omega]
+        self.alpha = [mech.links[name] for name in spec.alpha]
         self.dyads = (dyad_pins(mech, list(sm.solver.drivers), spec.transmission, str(spec.path))
                       if spec.transmission else [])
         self.axes = _plane_axes(self.normal)
         self.names = ([f"{n}.{'xyz'[k]}" for n in spec.points for k in self.axes] + [f"{n}.angle" for n in spec.links]
                       + [f"{n}.mu" for n in spec.transmission] + [f"{n}.s" for n in spec.sliders] + [f"{n}.s_dot" for n in spec.sliders]
-                      + [f"{n}.omega" for n in spec.omega])
+                      + [f"{n}.omega" for n in spec.omega] + [f"{n}.alpha" for n in spec.alpha]
+                      + [f"{n}.stroke" for n in spec.strokes] + self.torques.names)
         self.kinds = (["length"] * (len(spec.points) * len(self.axes)) + ["angle"] * len(spec.links)
                       + ["angle"] * len(spec.transmission)
                       + ["length"] * len(spec.sliders) + ["speed"] * len(spec.sliders)
-                      + ["angular speed"] * len(spec.omega))
+                      + ["angular speed"] * len(spec.omega) + ["angular acceleration"] * len(spec.alpha)
+                      + ["length"] * len(spec.strokes) + self.torques.kinds)
+        end = len(self.names)
+        self.torque_at = slice(end - len(spec.torque), end)
+        self.strokes_at = slice(self.torque_at.start - len(spec.strokes), self.torque_at.start)
+        self.alpha_at = slice(self.strokes_at.start - len(spec.alpha), self.strokes_at.start)
         self.n_pose = len(self.points) * len(self.axes) + len(self.links) + len(self.dyads) + len(self.sliders)
         if self.normal is not None:
             e1 = np.eye(3)[int(np.argmin(np.abs(self.normal)))]
@@ -69,31 +89,64 @@ class StudyOutputs:
             self.e1 = e1 / np.linalg.norm(e1)
             self.e2 = np.cross(self.normal, self.e1)
         self.pins = sorted({f for d in self.dyads for f in (d.near, d.joint, d.ground) if f >= 0})
-        frames = self.points + self.links + self.omega + self.pins
-        compiled = CompiledModel(sm.model, frames)
-        self._core = compiled.kinematics(sm.model)  # reads the variant's placements at each call
-        self._frames = list(range(len(compiled.frame_ids)))
-        self._index = {key: [compiled.frames[f] for f in fs] for key, fs in
-                       (("points", self.points), ("links", self.links), ("omega", self.omega), ("pins", self.pins))}
+        rows = {f: i for i, f in enumerate(dict.fromkeys(self.points + self.links + self.omega + self.alpha
+                                                          + self.pins))}
+        self._frames = np.array(list(rows), dtype=np.int32)  # read with the variant's placements at each call
+        self._data = sm.model.createData()
+        self._index = {key: [rows[f] for f in fs] for key, fs in
+                       (("points", self.points), ("links", self.links), ("omega", self.omega), ("alpha", self.alpha),
+                        ("pins", self.pins))}
+
+    def _kinematics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """The frames' kinematics rows (n, F, KINEMATICS_COLUMNS): position 0:3, rotation 3:12,
+        linear and angular velocity 12:18, classical linear and angular acceleration 18:24."""
+        K = np.empty((len(q), len(self._frames), _core.KINEMATICS_COLUMNS))
+        _core.frames_along(self.sm.model, self._data, q, v, a, self._frames, K)
+        return K
 
     def cycle(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         """The outputs (steps, n_out) at the poses q with rates v, a (steps, nq / nv) of the
         variant now written in the model [m, rad, m/s, rad/s, rad/s^2]."""
         q, v, a = (np.ascontiguousarray(x, dtype=float).reshape(len(q), -1) for x in (q, v, a))
-        n, columns = len(q), []
-        if self._frames:
-            P, R, _, W, _, _ = (x.reshape(n, len(self._frames), -1)
-                                for x in self._core.frame_motion(q, v, a, self._frames))
+        n, P, R = len(q), None, None
+        if len(self._frames):
+            K = self._kinematics(q, v, a)
+            P, R, W, alpha = K[..., 0:3], K[..., 3:12], K[..., 15:18], K[..., 21:24]
+            at = self._index
+        columns = self._pose_columns(q, P, R)
+        columns += [v[:, iv] for _, iv in self.sliders]
+        if len(self._frames):
+            columns += list((W[:, at["omega"]] @ self.normal).T) if at["omega"] else []
+        if len(self._frames):
+            columns += list((alpha[:, at["alpha"]] @ self.normal).T) if at["alpha"] else []
+        for stroke in self.strokes:
+            top, _, low, _ = stroke.extremes(q)
+            columns.append(np.full(n, top - low))
+        columns += list(self.torques.values(q, v, a).T)
+        return np.column_stack(columns) if columns else np.zeros((len(q), 0))
+
+    def pose_values(self, q: np.ndarray) -> np.ndarray:
+        """The pose outputs (the first n_pose) at one pose q (nq,) [m, rad]."""
+        q = np.ascontiguousarray(q, dtype=float).reshape(1, -1)
+        if not len(self._frames):
+            return np.array(self._pose_columns(q, None, None)).reshape(-1)
+        zero = np.zeros((1, self.sm.model.nv))
+        K = self._kinematics(q, zero, zero)
+        P, R = K[..., 0:3], K[..., 3:12]
+        return np.array(self._pose_columns(q, P, R)).reshape(-1)
+
+    def _pose_columns(self, q: np.ndarray, P: np.ndarray | None, R: np.ndarray | None) -> list[np.ndarray]:
+        """Points, link angles, transmission angles, sliders' s at the poses q (n, nq), from
+        the frames' positions P (n, F, 3) and rotations R (n, F, 9)."""
+        columns = []
+        if P is not None:
             at = self._index
             columns += [P[:, i, k] for i in at["points"] for k in self.axes]
             x_axes = R[:, at["links"]][..., [0, 3, 6]]  # each link's x axis (rotation's first column), world
             columns += list(np.arctan2(x_axes @ self.e2, x_axes @ self.e1).T) if at["links"] else []
             x = {f: P[:, i] for f, i in zip(self.pins, at["pins"])}
             columns += [transmission_values(d, x, self.e1, self.e2) for d in self.dyads]
-        columns += [q[:, iq] for iq, _ in self.sliders] + [v[:, iv] for _, iv in self.sliders]
-        if self._frames:
-            columns += list((W[:, at["omega"]] @ self.normal).T) if at["omega"] else []
-        return np.column_stack(columns) if columns else np.zeros((len(q), 0))
+        return columns + [q[:, iq] for iq, _ in self.sliders]
 
     def jacobians(self, data: pin.Data) -> tuple[np.ndarray, np.ndarray]:
         """The pose outputs' (dy/dq on the tangent space (n_pose, nv), dy/dp at fixed q
@@ -125,13 +178,13 @@ class StudyOutputs:
         return np.array(rows_q).reshape(-1, model.nv), np.array(rows_p).reshape(-1, n_par)
 
 
-def _slider(mech, name: str, spec) -> tuple[int, int]:
-    """(idx_q, idx_v) of a prismatic joint named in outputs.sliders."""
+def _slider(mech, name: str, spec, key: str = "outputs.sliders") -> tuple[int, int]:
+    """(idx_q, idx_v) of a prismatic joint named in outputs.sliders (or `key`)."""
     joint = mech.joints.get(name)
     if joint is None or joint.kind != "prismatic":
         sliders = [n for n, j in mech.joints.items() if j.kind == "prismatic"]
         raise SceneError(f"'{name}' is not a prismatic joint of the model (its sliders: "
-                         f"{', '.join(sliders) or 'none'})", path=str(spec.path), key="outputs.sliders")
+                         f"{', '.join(sliders) or 'none'})", path=str(spec.path), key=key)
     return joint.idx_q, joint.idx_v
 
 

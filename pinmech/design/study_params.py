@@ -85,6 +85,8 @@ class Placement:
             a joint origin.
     """
 
+    drawn = False  # a translation component (drawn_params.DrawnPlacement: a drawn length)
+
     def __init__(self, model: pin.Model, joint: int, frames: tuple[int, ...], component: int) -> None:
         self.model, self.joint, self.frames, self.component = model, joint, tuple(frames), component
         self.written_in = model.parents[joint] if not self.frames else joint  # whose axes the component is in
@@ -135,14 +137,26 @@ def subtrees(model: pin.Model) -> dict[int, set[int]]:
     return below
 
 
-def placements(mechanism, params: tuple[Parameter, ...], path: str) -> list[Placement]:
-    """Each parameter's Placement in the mechanism's model.
+def placements(mechanism, params: tuple[Parameter, ...], path: str, scene=None) -> list:
+    """Each parameter's Placement in the mechanism's model (a DrawnPlacement for a drawn
+    linkage's param, drawn_params.py, which needs the scene).
 
     Raises:
-        FrameNotFound: a joint, cut, point or body the model does not have (naming the
-            study file and the parameter).
+        FrameNotFound: a joint, cut, point, body or param the model does not have (naming
+            the study file and the parameter).
+        SceneError: a param on a scene whose model is not a drawn linkage.
     """
-    return [_placement(mechanism, p, f"{path}, params.{p.name}") for p in params]
+    out, drawing = [], None
+    for p in params:
+        where = f"{path}, params.{p.name}"
+        if p.target == "param":
+            from pinmech.design.drawn_params import Drawing, DrawnPlacement
+
+            drawing = drawing or Drawing(scene, mechanism, where)
+            out.append(DrawnPlacement(drawing, p.element, where))
+        else:
+            out.append(_placement(mechanism, p, where))
+    return out
 
 
 def _placement(mechanism, p: Parameter, where: str) -> Placement:

@@ -17,7 +17,8 @@ from pinmech.design.study import StudyResult
 from pinmech.design.tolerance import PERCENTILES, deviation
 
 _SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "speed": (1e3, "mm/s"),
-          "angular speed": (180 / math.pi, "deg/s"), "angular acceleration": (180 / math.pi, "deg/s^2")}
+          "angular speed": (180 / math.pi, "deg/s"), "angular acceleration": (180 / math.pi, "deg/s^2"),
+          "torque": (1.0, "N m"), "force": (1.0, "N")}
 
 
 def _unit(kind: str) -> tuple[float, str]:

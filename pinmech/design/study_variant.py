@@ -57,11 +57,11 @@ class StudyMechanism:
 
     def __init__(self, spec: StudySpec) -> None:
         self.spec = spec
-        scene = Scene.load(spec.scene)
+        self.scene = scene = Scene.load(spec.scene)
         self.sweep = Sweep.from_scene(scene)
         self.mechanism, self.solver = self.sweep.mechanism, self.sweep.solver
         self.model = self.mechanism.model
-        self.placements: list[Placement] = placements(self.mechanism, spec.params, str(spec.path))
+        self.placements: list[Placement] = placements(self.mechanism, spec.params, str(spec.path), scene)
         for p, place in zip(spec.params, self.placements):
             if p.nominal is not None:
                 place.write(p.nominal)
@@ -120,7 +120,8 @@ class StudyMechanism:
         return VariantCycle(self.values, np.vstack(rows), v=np.vstack(v), a=np.vstack(a))
 
     def at(self, q: np.ndarray) -> pin.Data:
-        """self.data with joint Jacobians and every frame placement at q."""
+        """self.data with joint Jacobians and every frame placement at q (kept as self.q_at)."""
+        self.q_at = np.array(q, dtype=float)
         pin.computeJointJacobians(self.model, self.data, q)
         pin.updateFramePlacements(self.model, self.data)
         return self.data

@@ -16,6 +16,7 @@ rows). Named points are massless leaf links hung on fixed joints.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -375,6 +376,6 @@ class Mechanism:
             return m.multiplier * self.coordinate(q, m.leader) + m.offset
         j = self.joint(name)
         if j.kind == "continuous":
-            return float(np.arctan2(q[j.idx_q + 1], q[j.idx_q]))
+            return math.atan2(q[j.idx_q + 1], q[j.idx_q])  # libm's atan2, as numpy's for one pair
         return float(q[j.idx_q])
 

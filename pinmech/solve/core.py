@@ -55,7 +55,6 @@ def check_pinocchio(built: str, loaded: str) -> None:
 _core = _import_core()
 CUT_CODES = {"revolute": 0, "prismatic": 1, "spherical": 2, "fixed": 3}
 DEFAULT_TOL = _core.DEFAULT_TOL
-_NO_ROWS = np.zeros((0, 3))
 
 
 class ModelShape:
@@ -84,11 +83,6 @@ class CompiledModel:
     def __init__(self, model: pin.Model, frame_ids: list[int]) -> None:
         self.frames = {int(fid): i for i, fid in enumerate(dict.fromkeys(int(f) for f in frame_ids))}
         self.frame_ids = list(self.frames)
-
-    def kinematics(self, model: pin.Model) -> _core.Core:
-        """A core of the model with these frames and no loops (for `Core.frame_motion`)."""
-        return _core.Core(model, self.frame_ids, [], [], [], _NO_ROWS, _NO_ROWS, [], [], [], [], [], [],
-                          np.ones(model.nv), [], [], DEFAULT_TOL)
 
 
 def core_for(solver) -> _core.Core | None:

@@ -133,6 +133,17 @@ class ForceSolver:
                              f"have no {mech.mass_source} (give one, or list the links meant to be "
                              "massless: [forces] massless = [...])", path=mech.source)
 
+    @serialized
+    def read_placements(self) -> None:
+        """Copy the joint and frame placements of the mechanism's model into this solver's
+        copy of it (a design study writes each variant's dimensions there in place; the
+        copy would otherwise keep the old ones, which the power balance check catches)."""
+        source = self.mechanism.model
+        for j in range(1, source.njoints):
+            self.model.jointPlacements[j] = source.jointPlacements[j]
+        for f in range(source.nframes):
+            self.model.frames[f].placement = source.frames[f].placement
+
     # ------------------------------------------------------------------ solve
     @serialized
     def solve(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> ForceSolution:

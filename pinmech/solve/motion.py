@@ -12,17 +12,16 @@ import functools
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
-from pinmech.model.closures import _cross
-from pinmech.exceptions import FrameNotFound, ModelError
 from pinmech.arguments import float_array
+from pinmech.exceptions import ModelError
+from pinmech.model.closures import _cross
 from pinmech.model.mechanism import Mechanism
-
-_LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+from pinmech.solve.core import _core
+from pinmech.solve.motion_plan import MotionPlan, motion_plan
 
 
 @dataclass(frozen=True)
@@ -101,14 +100,63 @@ class CoincidentPoint:
     link: str
 
 
-@dataclass(frozen=True)
-class Motion:
-    """Everything a report shows about one solved pose."""
+class _built:
+    """A Motion's dict, built on first reading and kept in the instance (functools'
+    cached_property takes a lock on every first read in Python 3.11: microseconds here)."""
 
-    joints: dict[str, JointMotion]
-    links: dict[str, LinkMotion]
-    points: dict[str, PointMotion]
-    sliders: dict[str, SliderMotion]
+    def __init__(self, build) -> None:
+        self.build, self.name = build, build.__name__
+        self.__doc__ = build.__doc__
+
+    def __get__(self, motion, owner=None):
+        if motion is None:
+            return self
+        value = motion.__dict__[self.name] = self.build(motion)
+        return value
+
+
+class Motion:
+    """Everything a report shows about one solved pose: `joints`, `links`, `points` and
+    `sliders`, dicts by name of JointMotion, LinkMotion, PointMotion and SliderMotion. The
+    numbers are computed when the pose is evaluated; each dict is built when first read."""
+
+    def __init__(self, mechanism: Mechanism, plan: MotionPlan, rows: np.ndarray, q: list[float], v: list[float],
+                 a: list[float]) -> None:
+        self._mechanism, self._plan, self._rows = mechanism, plan, rows
+        self._q, self._v, self._a = q, v, a
+
+    @_built
+    def joints(self) -> dict[str, JointMotion]:
+        return _joint_motions(self._mechanism, self._q, self._v, self._a)
+
+    @_built
+    def links(self) -> dict[str, LinkMotion]:
+        rows, plane = self._rows, self._plan.plane
+        return {name: _link_motion(rows[r], plane) for name, r in self._plan.links}
+
+    @_built
+    def points(self) -> dict[str, PointMotion]:
+        rows = self._rows
+        return {name: _point(rows[r], link) if at is None else _coincident(rows[at], rows[r], link)
+                for name, r, at, link in self._plan.points}
+
+    @_built
+    def sliders(self) -> dict[str, SliderMotion]:
+        rows, q, v, a = self._rows, self._q, self._v, self._a
+        out = {}
+        for name, kind, item in self._plan.sliders:
+            if kind == "joint":
+                joint, r, parent = item
+                out[name] = _slider(joint, rows[r], rows[parent] if parent is not None else None,
+                                    self._mechanism.coordinate(q, name), v[joint.idx_v], a[joint.idx_v])
+            else:
+                closure, parent, child = item
+                out[name] = _cut_slider(closure, rows[parent], rows[child])
+        return out
+
+    def __repr__(self) -> str:
+        return (f"Motion(joints={list(self.joints)}, links={list(self.links)}, points={list(self.points)}, "
+                f"sliders={list(self.sliders)})")
 
 
 def evaluate_motion(
@@ -122,7 +170,8 @@ def evaluate_motion(
     coincident: Iterable[CoincidentPoint] = (),
     links: Iterable[str] | None = None,
 ) -> Motion:
-    """Evaluate joints, links, points and sliders at (q, v, a).
+    """Evaluate joints, links, points and sliders at (q, v, a): Pinocchio's forward
+    kinematics and every asked frame in one compiled call (csrc/kinematics.cpp).
 
     Args:
         mechanism: the model.
@@ -130,76 +179,48 @@ def evaluate_motion(
         points: named points or frames to report (default: all the URDF's points).
         coincident: points of a link coinciding with a named point (e.g. B3 on link 3).
         links: links to report (default: all that move).
+
+    Raises:
+        ModelError: q, v or a not configurations or rates of the model, or data not a
+            pin.Data of its model.
+        FrameNotFound: a point or link the model lacks.
     """
-    model = mechanism.model
     for name, names in (("points", points), ("links", links)):
         if isinstance(names, (str, bytes)):
             raise ModelError(f"{name} must be a list of names, got the string {names!r}", path=mechanism.source)
     q = mechanism.checked_q(q)
-    v, a = (_vector(x, model.nv, name, mechanism) for x, name in ((v, "v"), (a, "a")))
-    if not isinstance(data, pin.Data) or len(data.oMi) != model.njoints or len(data.oMf) != model.nframes:
+    nv = mechanism.model.nv
+    v, a = float_array(v, "v", (nv,), mechanism.source), float_array(a, "a", (nv,), mechanism.source)
+    plan = motion_plan(mechanism, None if points is None else tuple(points), tuple(coincident),
+                       None if links is None else tuple(links), _plane)
+    if not (q.flags.c_contiguous and v.flags.c_contiguous and a.flags.c_contiguous):  # the core reads them so
+        q, v, a = np.ascontiguousarray(q), np.ascontiguousarray(v), np.ascontiguousarray(a)
+    rows = np.empty((plan.rows, _core.KINEMATICS_COLUMNS))
+    try:
+        _core.frames_at(mechanism.model, data, q, v, a, plan.frames, plan.joints, rows)
+    except (TypeError, ValueError):  # no pin.Data, or one of another model (the core checks both)
         raise ModelError("data must be a pin.Data of the mechanism's model (mechanism.model.createData())",
-                         path=mechanism.source)
-    pin.forwardKinematics(model, data, q, v, a)
-    pin.updateFramePlacements(model, data)
-    link_names = list(links) if links is not None else _moving_links(mechanism)
-    link_motion = {n: _link_motion(mechanism, data, n) for n in link_names}
-    point_names = list(points) if points is not None else list(mechanism.points)
-    coincident = list(coincident)
-    point_motion = {}
-    for name in point_names:
-        match = [c for c in coincident if c.name == name]
-        point_motion[name] = _coincident(mechanism, data, match[0]) if match else _point(mechanism, data, name)
-    for c in coincident:
-        point_motion.setdefault(c.name, _coincident(mechanism, data, c))
-    return Motion(
-        joints=_joint_motions(mechanism, q, v, a),
-        links=link_motion,
-        points=point_motion,
-        sliders=_sliders(mechanism, data, q, v, a),
-    )
+                         path=mechanism.source) from None
+    return Motion(mechanism, plan, rows, q.tolist(), v.tolist(), a.tolist())
 
 
-def _sliders(mechanism: Mechanism, data: pin.Data, q: np.ndarray, v: np.ndarray,
-             a: np.ndarray) -> dict[str, SliderMotion]:
-    """Every prismatic joint of the tree, and every prismatic loop cut (a drawn pin-in-slot
-    is cut at its slide), by name."""
-    out = {n: _slider(mechanism, data, n, mechanism.coordinate(q, n), float(v[j.idx_v]), float(a[j.idx_v]))
-           for n, j in mechanism.joints.items() if j.kind == "prismatic"}
-    for closure in mechanism.closures:
-        if closure.cut_type == "prismatic" and closure.name not in out:
-            out[closure.name] = _cut_slider(mechanism, data, closure)
-    return out
-
-
-def _cut_slider(mechanism: Mechanism, data: pin.Data, closure) -> SliderMotion:
+def _cut_slider(closure, parent: np.ndarray, child: np.ndarray) -> SliderMotion:
     """The child cut frame's origin relative to the parent link (the slot), by the
     relative-motion formulas: v_rel = v_C - (v_P + w x r), a_rel = a_C - (a_P + alpha x r
-    + w x (w x r)) - 2 w x v_rel, with r from the parent cut frame's origin to C's."""
-    model = mechanism.model
-    parent, child = closure.parent_frame, closure.child_frame
-    r = data.oMf[child].translation - data.oMf[parent].translation
-    vel_p = pin.getFrameVelocity(model, data, parent, _LWA)
-    acc_p = pin.getFrameClassicalAcceleration(model, data, parent, _LWA)
-    alpha = pin.getFrameAcceleration(model, data, parent, _LWA).angular
-    w = vel_p.angular
-    v_c = pin.getFrameVelocity(model, data, child, _LWA).linear
-    a_c = pin.getFrameClassicalAcceleration(model, data, child, _LWA).linear
-    v_rel = v_c - (vel_p.linear + _cross(w, r))
+    + w x (w x r)) - 2 w x v_rel, with r from the parent cut frame's origin to C's.
+    `parent`, `child`: the cut frames' rows of the core's answer."""
+    r = child[0:3] - parent[0:3]
+    w, alpha = parent[15:18], parent[21:24]
+    v_rel = child[12:15] - (parent[12:15] + _cross(w, r))
     coriolis = 2.0 * _cross(w, v_rel)
-    a_rel = a_c - (acc_p.linear + _cross(alpha, r) + _cross(w, _cross(w, r))) - coriolis
-    axis = data.oMf[parent].rotation @ closure.axis
+    a_rel = child[18:21] - (parent[18:21] + _cross(alpha, r) + _cross(w, _cross(w, r))) - coriolis
+    axis = parent[3:12].reshape(3, 3) @ closure.axis
     return SliderMotion(parent=closure.parent_link, child=closure.child_link, relative_velocity=v_rel,
                         relative_acceleration=a_rel, coriolis_acceleration=coriolis, axis=axis,
                         s=float(axis @ r), s_dot=float(axis @ v_rel), s_ddot=float(axis @ a_rel))
 
 
-def _vector(x: Any, size: int, name: str, mechanism: Mechanism) -> np.ndarray:
-    """x as `size` finite floats, else a ModelError naming the argument and what it got."""
-    return float_array(x, name, (size,), mechanism.source)
-
-
-def _joint_motions(mechanism: Mechanism, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict[str, JointMotion]:
+def _joint_motions(mechanism: Mechanism, q: list[float], v: list[float], a: list[float]) -> dict[str, JointMotion]:
     """Every one-dof joint's coordinate and rates; a `<mimic>` follower's from its leader's."""
     out = {}
     for name, joint in mechanism.joints.items():
@@ -207,11 +228,10 @@ def _joint_motions(mechanism: Mechanism, q: np.ndarray, v: np.ndarray, a: np.nda
             m = mechanism.mimics[name]
             leader = mechanism.joints[m.leader]
             kind = m.kind if m.kind in ("revolute", "continuous", "prismatic") else leader.kind
-            out[name] = JointMotion(mechanism.coordinate(q, name), m.multiplier * float(v[leader.idx_v]),
-                                    m.multiplier * float(a[leader.idx_v]), kind)
+            out[name] = JointMotion(mechanism.coordinate(q, name), m.multiplier * v[leader.idx_v],
+                                    m.multiplier * a[leader.idx_v], kind)
         elif joint.nv == 1:
-            out[name] = JointMotion(mechanism.coordinate(q, name), float(v[joint.idx_v]), float(a[joint.idx_v]),
-                                    joint.kind)
+            out[name] = JointMotion(mechanism.coordinate(q, name), v[joint.idx_v], a[joint.idx_v], joint.kind)
         elif joint.nv > 1:
             out[name] = _multi_dof(mechanism, joint.id, q, v, a)
     return out
@@ -222,47 +242,33 @@ _MULTI_DOF_KINDS = {"JointModelPlanar": "planar", "JointModelSpherical": "spheri
                     "JointModelTranslation": "translation"}
 
 
-def _multi_dof(mechanism: Mechanism, jid: int, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> JointMotion:
+def _multi_dof(mechanism: Mechanism, jid: int, q: list[float], v: list[float], a: list[float]) -> JointMotion:
     """A joint of several freedoms; a planar joint's (cos, sin) pair becomes its angle."""
     joint = mechanism.model.joints[jid]
     kind = _MULTI_DOF_KINDS.get(joint.shortname(), "other")
-    qj = q[joint.idx_q : joint.idx_q + joint.nq].copy()
-    vj, aj = v[joint.idx_v : joint.idx_v + joint.nv].copy(), a[joint.idx_v : joint.idx_v + joint.nv].copy()
+    qj = np.array(q[joint.idx_q : joint.idx_q + joint.nq])
+    vj, aj = np.array(v[joint.idx_v : joint.idx_v + joint.nv]), np.array(a[joint.idx_v : joint.idx_v + joint.nv])
     if kind == "planar":
         qj = np.array([qj[0], qj[1], math.atan2(qj[3], qj[2])])
     return JointMotion(qj, vj, aj, kind)
 
 
-def _moving_links(mechanism: Mechanism) -> list[str]:
-    model = mechanism.model
-    return [n for n, fid in mechanism.links.items() if model.frames[fid].parentJoint != 0]
+def _point(row: np.ndarray, link: str) -> PointMotion:
+    """A frame's origin from its row of the core's answer."""
+    return PointMotion(position=row[0:3], velocity=row[12:15], acceleration=row[18:21], link=link)
 
 
-def _point(mechanism: Mechanism, data: pin.Data, name: str) -> PointMotion:
-    fid = mechanism.frame_id(name)
-    model = mechanism.model
-    return PointMotion(
-        position=data.oMf[fid].translation.copy(),
-        velocity=pin.getFrameVelocity(model, data, fid, _LWA).linear.copy(),
-        acceleration=pin.getFrameClassicalAcceleration(model, data, fid, _LWA).linear.copy(),
-        link=mechanism.link_of_frame(fid),
-    )
+def _link_motion(row: np.ndarray, plane: tuple[list[float], list[float]] | None) -> LinkMotion:
+    """A link's frame from its row of the core's answer."""
+    angle, axis = _plane_angle(row[3:12].tolist(), plane)
+    return LinkMotion(rotation=row[3:12].reshape(3, 3), angular_velocity=row[15:18],
+                      angular_acceleration=row[21:24], angle=angle, angle_axis=axis)
 
 
-def _link_motion(mechanism: Mechanism, data: pin.Data, name: str) -> LinkMotion:
-    if name not in mechanism.links:
-        raise FrameNotFound("link", name, list(mechanism.links), path=mechanism.source)
-    fid = mechanism.links[name]
-    model = mechanism.model
-    rotation = data.oMf[fid].rotation.copy()
-    angle, axis = _plane_angle(rotation, mechanism.plane_normal)
-    return LinkMotion(
-        rotation=rotation,
-        angular_velocity=pin.getFrameVelocity(model, data, fid, _LWA).angular.copy(),
-        angular_acceleration=pin.getFrameAcceleration(model, data, fid, _LWA).angular.copy(),
-        angle=angle,
-        angle_axis=axis,
-    )
+def _plane(normal: np.ndarray | None) -> tuple[list[float], list[float]] | None:
+    """A planar mechanism's plane normal and the world x axis projected on the plane
+    (`_plane_reference`), as floats; None for a spatial mechanism."""
+    return None if normal is None else (normal.tolist(), _plane_reference(*normal.tolist()).tolist())
 
 
 #: A link axis is measured in the plane when its projection on the plane is at least this
@@ -271,18 +277,22 @@ def _link_motion(mechanism: Mechanism, data: pin.Data, name: str) -> LinkMotion:
 _IN_PLANE = 0.5
 
 
-def _plane_angle(rotation: np.ndarray, normal: np.ndarray | None) -> tuple[float | None, str]:
+def _plane_angle(rotation: list[float], plane: tuple[list[float], list[float]] | None) -> tuple[float | None, str]:
     """Angle about the plane normal of the link's x axis (else y, else z: the first that
     lies within 60 deg of the plane), from the world x axis projected on the plane; and
-    which axis was measured."""
-    if normal is None:
+    which axis was measured. `rotation`: the link's rotation, 9 floats row by row; `plane`:
+    the normal and the reference direction (`_plane`), None for a spatial mechanism. Plain
+    floats: a pose's few products cost less than numpy's calls."""
+    if plane is None:
         return None, "x"
-    ref = _plane_reference(*normal.tolist())
+    n, ref = plane
     for k, name in enumerate("xyz"):
-        axis = rotation[:, k]
-        in_plane = axis - normal * float(normal @ axis)
-        if math.hypot(*in_plane.tolist()) >= _IN_PLANE or name == "z":
-            return math.atan2(float(normal @ _cross(ref, in_plane)), float(ref @ in_plane)), name
+        axis = rotation[k::3]  # column k
+        along = n[0] * axis[0] + n[1] * axis[1] + n[2] * axis[2]
+        p0, p1, p2 = axis[0] - n[0] * along, axis[1] - n[1] * along, axis[2] - n[2] * along
+        if math.hypot(p0, p1, p2) >= _IN_PLANE or name == "z":
+            c = (ref[1] * p2 - ref[2] * p1, ref[2] * p0 - ref[0] * p2, ref[0] * p1 - ref[1] * p0)
+            return math.atan2(n[0] * c[0] + n[1] * c[1] + n[2] * c[2], ref[0] * p0 + ref[1] * p1 + ref[2] * p2), name
     raise AssertionError("unreachable")  # pragma: no cover
 
 
@@ -295,34 +305,24 @@ def _plane_reference(nx: float, ny: float, nz: float) -> np.ndarray:
     return ref / np.linalg.norm(ref)
 
 
-def _coincident(mechanism: Mechanism, data: pin.Data, c: CoincidentPoint) -> PointMotion:
-    """Motion of the material point of `c.link` that sits at point `c.at` now (rigid-body formulas)."""
-    if c.link not in mechanism.links:
-        raise FrameNotFound("link", c.link, list(mechanism.links), path=mechanism.source)
-    model = mechanism.model
-    fid = mechanism.links[c.link]
-    at = data.oMf[mechanism.frame_id(c.at)].translation.copy()
-    origin = data.oMf[fid].translation
-    vel = pin.getFrameVelocity(model, data, fid, _LWA)
-    acc = pin.getFrameClassicalAcceleration(model, data, fid, _LWA)
-    spatial_acc = pin.getFrameAcceleration(model, data, fid, _LWA)
-    r = at - origin
-    w, alpha = vel.angular, spatial_acc.angular
+def _coincident(link: np.ndarray, at: np.ndarray, name: str) -> PointMotion:
+    """Motion of the material point of a link that sits at a point now (rigid-body formulas):
+    `link` and `at` are the link frame's and the point's rows of the core's answer."""
+    r = at[0:3] - link[0:3]
+    w, alpha = link[15:18], link[21:24]
     return PointMotion(
-        position=at,
-        velocity=vel.linear + _cross(w, r),
-        acceleration=acc.linear + _cross(alpha, r) + _cross(w, _cross(w, r)),
-        link=c.link,
+        position=at[0:3],
+        velocity=link[12:15] + _cross(w, r),
+        acceleration=link[18:21] + _cross(alpha, r) + _cross(w, _cross(w, r)),
+        link=name,
     )
 
 
-def _slider(mechanism: Mechanism, data: pin.Data, name: str, q: float, rate: float, accel: float) -> SliderMotion:
-    """A tree slider from its coordinate q [m], rate [m/s] and acceleration [m/s^2]."""
-    joint = mechanism.joint(name)
-    model = mechanism.model
-    axis_world = data.oMi[joint.id].rotation @ joint.axis
-    parent_joint = model.parents[joint.id]
-    omega_parent = data.oMi[parent_joint].rotation @ data.v[parent_joint].angular
+def _slider(joint, row: np.ndarray, parent: np.ndarray | None, q: float, rate: float, accel: float) -> SliderMotion:
+    """A tree slider from its joint's row (and its parent joint's, None for the ground) of
+    the core's answer, its coordinate q [m], rate [m/s] and acceleration [m/s^2]."""
+    axis_world = row[3:12].reshape(3, 3) @ joint.axis
+    omega_parent = parent[15:18] if parent is not None else np.zeros(3)
     v_rel = rate * axis_world
     return SliderMotion(
         parent=joint.parent_link,

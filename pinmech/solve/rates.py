@@ -35,6 +35,8 @@ import pinocchio as pin
 from pinmech.arguments import not_real
 from pinmech.exceptions import ModelError, SingularPoseError, TaskError
 from pinmech.model.mechanism import Mechanism
+from pinmech.solve import core
+from pinmech.solve.core import _core
 from pinmech.solve.results import RateSolution
 from pinmech.solve.loops import (
     DEFAULT_MAX_CONDITION,
@@ -54,7 +56,12 @@ METHODS = ("exact", "least_squares", "damped")
 #: quantity pinmech takes (README "Scale and speed"), lambda^2 overflows by 1e155 and the
 #: rates underflow to denormals before that.
 DAMPING_RANGE = (1e-5, 1e50)
-_LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+#: The methods the compiled solve is asked for (csrc/rates.cpp), and the ones it reports.
+_ASKED = {"exact": 0, "least_squares": 1, "damped": 2}
+_USED = ("exact", "minimum_norm", "least_squares", "damped")
+#: Its status per pose: solved; looks singular (asked again with the structural rank);
+#: rows that cannot all hold; singular beyond max_condition.
+_SOLVED, _NEEDS_RANK, _INCONSISTENT, _SINGULAR = 0, 1, 2, 3
 
 
 @dataclass(frozen=True)
@@ -195,38 +202,24 @@ class RateSolver:
         q = self.mechanism.checked_q(q)
         x_dot = self._values(velocity, self.x_dot, "velocity")
         x_ddot = self._values(acceleration, self.x_ddot, "acceleration")
-        J, n_c = self._jacobian(self.data, q)
-        closure = self._closure_residual(q)
-        m, n = J.shape
-        rows, columns = self._scales(n_c)
-        Jd = rows[:, None] * J * columns
-        sigma = np.linalg.svd(Jd, compute_uv=False)
-        rank = min(m, n)
-        if rank and not sigma[rank - 1] > sigma[0] / self.max_condition:
-            rank = min(rank, self._structural_rank()[0])  # only poses that look singular pay
-        sigma_min = float(sigma[rank - 1]) if rank else 0.0
-        condition = float(sigma[0] / sigma_min) if sigma_min > 0 else float("inf")
-        method = self._method(m, n, rank, condition, sigma_min, q)
-        v = columns * self._apply(Jd, rows * np.concatenate((np.zeros(n_c), x_dot)), method, rank)
-        drift = self._drift(q, v, n_c)
-        a = columns * self._apply(Jd, rows * (np.concatenate((np.zeros(n_c), x_ddot)) - drift), method, rank)
-        achieved_v, achieved_a = J @ v, J @ a + drift
+        row = self._rates(q[None], x_dot, x_ddot)[0]
+        nv, m = self.model.nv, x_dot.size
+        first = 2 * nv + _core.RATE_NUMBERS
+        condition, sigma_min, closure_v, closure_a, _, independent, full, rank, used = self._checked(
+            q, row[2 * nv:first])
         return RateSolution(
-            v=v, a=a, method=method, condition=condition, sigma_min=sigma_min,
-            nullspace_dim=n - rank, rank=rank,
-            requested_velocity=x_dot.copy(), achieved_velocity=achieved_v[n_c:],
-            requested_acceleration=x_ddot.copy(), achieved_acceleration=achieved_a[n_c:],
-            closure_velocity_residual=float(np.max(np.abs(achieved_v[:n_c]), initial=0.0)),
-            closure_acceleration_residual=float(np.max(np.abs(achieved_a[:n_c]), initial=0.0)),
-            closure_residual=closure,
+            v=row[:nv], a=row[nv:2 * nv], method=_USED[int(used)], condition=condition, sigma_min=sigma_min,
+            nullspace_dim=nv - int(rank), rank=int(rank),
+            requested_velocity=x_dot.copy(), achieved_velocity=row[first:first + m],
+            requested_acceleration=x_ddot.copy(), achieved_acceleration=row[first + m:],
+            closure_velocity_residual=closure_v, closure_acceleration_residual=closure_a,
+            closure_residual=max(independent, full),
         )
 
     @serialized
     def solve_many(self, q: np.ndarray) -> RateBatch:
         """`solve` at every row of q (N, nq), with the tasks' own velocities and
-        accelerations, as arrays. The compiled core (core.py) takes the poses of a square
-        task ("exact") conditioned under max_condition; `solve` takes the others, and
-        raises as it does.
+        accelerations, as arrays (the same compiled solve, one call for every pose).
 
         Raises:
             ModelError: q is not an (N, nq) array of configurations (as `solve`).
@@ -234,64 +227,83 @@ class RateSolver:
                 that has them.
         """
         q = np.ascontiguousarray(self.mechanism.checked_q(q, many=True))
-        n, m = len(q), self.x_dot.size
-        compiled = self._compiled() if self.method == "exact" else None
-        if compiled is not None:
-            core, frames, rows, local, row_scale = compiled
-            v, a, numbers, achieved_v, achieved_a = core.rates(q, frames, rows, local, self.x_dot, self.x_ddot,
-                                                             row_scale, self.max_condition)
-            condition, sigma_min, closure_v, closure_a, status, independent, full = numbers.T
-            closure = np.maximum(independent, full)  # q's own closure residual, measured by the core
-            status[~is_closed(independent, full, self.tol)] = 1  # open poses go to `solve`, named there
-        else:
-            v, a = np.full((n, self.model.nv), np.nan), np.full((n, self.model.nv), np.nan)
-            condition, sigma_min, closure_v, closure_a, closure = (np.full(n, np.nan) for _ in range(5))
-            achieved_v, achieved_a, status = np.full((n, m), np.nan), np.full((n, m), np.nan), np.ones(n)
-        methods = np.full(n, "exact", dtype=object)
-        for i in np.flatnonzero(status != 0):  # the Python path: other methods, singular and open poses named
-            r = self.solve(q[i])
-            v[i], a[i], condition[i], sigma_min[i] = r.v, r.a, r.condition, r.sigma_min
-            closure_v[i], closure_a[i] = r.closure_velocity_residual, r.closure_acceleration_residual
-            achieved_v[i], achieved_a[i], methods[i] = r.achieved_velocity, r.achieved_acceleration, r.method
-            closure[i] = r.closure_residual
-        return RateBatch(v, a, methods, condition, sigma_min, achieved_v, achieved_a, closure_v, closure_a, closure)
+        out = self._rates(q, self.x_dot, self.x_ddot)
+        nv, m = self.model.nv, self.x_dot.size
+        first = 2 * nv + _core.RATE_NUMBERS
+        v, a, numbers = out[:, :nv], out[:, nv:2 * nv], out[:, 2 * nv:first]
+        achieved_v, achieved_a = out[:, first:first + m], out[:, first + m:]
+        condition, sigma_min, closure_v, closure_a, status, independent, full, _, used = numbers.T
+        bad = (status != _SOLVED) | ~is_closed(independent, full, self.tol)
+        for i in np.flatnonzero(bad)[:1]:  # the first pose that has an error raises it, named
+            self._checked(q[i], numbers[i])
+        methods = np.array(_USED, dtype=object)[used.astype(int)]
+        return RateBatch(v, a, methods, condition, sigma_min, achieved_v, achieved_a, closure_v, closure_a,
+                         np.maximum(independent, full))
 
-    def _closure_residual(self, q: np.ndarray) -> float:
-        """q's closure residual (dimensionless, as `LoopSolver`'s; data at q, frames placed).
+    def _rates(self, q: np.ndarray, x_dot: np.ndarray, x_ddot: np.ndarray) -> np.ndarray:
+        """The compiled rate solve at every row of q (csrc/rates.cpp), a row a pose: v, a
+        (nv each), RATE_NUMBERS numbers (condition, sigma_min, closure velocity and
+        acceleration residuals, status, q's independent and full closure residuals, rank,
+        method code), the achieved task rows' velocities and accelerations. Poses that look
+        singular are solved again with the task's structural rank."""
+        core = self._compiled()
+        out = np.empty((len(q), core.rate_columns))
+        core.rates(q, x_dot, x_ddot, self._generic[0] if self._generic is not None else -1, out)
+        status = 2 * self.model.nv + 4
+        if _NEEDS_RANK in out[:, status].tolist():  # only poses that look singular pay for the structural rank
+            again = np.flatnonzero(out[:, status] == _NEEDS_RANK)
+            more = np.empty((again.size, out.shape[1]))
+            core.rates(np.ascontiguousarray(q[again]), x_dot, x_ddot, self._structural_rank()[0], more)
+            out[again] = more
+        return out
 
-        Raises:
-            LoopClosureError: the loops are open beyond `tol` (`is_closed`)."""
-        closures = self.mechanism.closures
-        if not closures:
-            return 0.0
-        independent = max(float(np.max(np.abs(c.residual(self.data)), initial=0.0)) for c in closures)
-        full = max(float(np.max(np.abs(c.full_residual(self.data)), initial=0.0)) for c in closures)
-        if not is_closed(independent, full, self.tol):
+    def _checked(self, q: np.ndarray, numbers: np.ndarray) -> list[float]:
+        """One pose's numbers as floats, or its error: open loops first (how far, in m and
+        deg), then a task that cannot hold, then a singular pose."""
+        values = numbers.tolist()
+        condition, sigma_min, _, _, status, independent, full, rank, _ = values
+        if self.mechanism.closures and not is_closed(independent, full, self.tol):
+            pin.forwardKinematics(self.model, self.data, q)
             raise open_loops_error(self.mechanism, self.data, q, max(independent, full), self.tol,
                                    f"the task's rates at {self._pose(q)}")
-        return max(independent, full)
+        if status == _INCONSISTENT:
+            raise self._inconsistent(int(self.x_dot.size + self._closure_rows), self.model.nv)
+        if status == _SINGULAR:
+            raise SingularPoseError(
+                f"{self.mechanism.source}: the task Jacobian is singular at {self._pose(q)} (condition number "
+                f"{condition:.3g} > {self.max_condition:.3g}, smallest singular value {sigma_min:.3g}); "
+                "ask for method = \"damped\" to get the closest achievable motion",
+                condition=condition, sigma_min=sigma_min, partial=q,
+            )
+        return values
 
     def _compiled(self):
-        """The core with this solver's loops and task frames, and the task rows as it takes
-        them (built once per model tree: it reads placements changed in the model), or None."""
-        from pinmech.solve import core
+        """The core with this solver's loops, task and options (built once per model tree:
+        it reads placements changed in the model; the scales, which a model changed in place
+        changes, and the options are read afresh).
 
+        Raises:
+            ModelError: the core reads a cut otherwise than its closure rows state."""
         cached = self.__dict__.get("_core")
-        if cached is None or not cached[0].matches(self.model):
-            frames = [f for c in self.mechanism.closures for f in (c.parent_frame, c.child_frame)] + self.frames
+        options = (self.mechanism.length_scale, self.method, self.damping, self.max_condition,
+                   *[c.length_scale for c in self.mechanism.closures])
+        if cached is None or cached[0].model is not self.model or not cached[0].same_structure:
             built = core.compile_loops(self.model, self.mechanism.closures, self.mechanism.velocity_scale(),
                                        extra_frames=self.frames)
-            value = None
-            if built is not None:
-                compiled, rebuilt = built
-                n_c = sum(c.rows for c in self.mechanism.closures)
-                value = (compiled, [rebuilt.frames[f] for f in self.frames],
-                         [[int(k) for k in t.rows] for t in self.tasks],
-                         [int(t.reference == "local") for t in self.tasks],
-                         self._scales(n_c)[0])
-            cached = (core.ModelShape(self.model, frames), value)
-            self.__dict__["_core"] = cached
-        return cached[1]
+            compiled, rebuilt = built
+            compiled.set_task([rebuilt.frames[f] for f in self.frames], [[int(k) for k in t.rows] for t in self.tasks],
+                              [int(t.reference == "local") for t in self.tasks])
+            cached = (compiled, None)
+        if cached[1] != options:
+            rows, columns = self._scales(self._closure_rows)
+            cached[0].set_rate_options(rows, columns, _ASKED[self.method], self.damping, self.max_condition)
+            cached = (cached[0], options)
+        self.__dict__["_core"] = cached
+        return cached[0]
+
+    @property
+    def _closure_rows(self) -> int:
+        return sum(c.rows for c in self.mechanism.closures)
 
     def _values(self, given: np.ndarray | None, default: np.ndarray, name: str) -> np.ndarray:
         if given is None:
@@ -300,42 +312,13 @@ class RateSolver:
         if wrong:
             raise ModelError(f"{name} must be real numbers (SI), got {wrong}: pinmech does not cast them",
                              path=self.mechanism.source)
-        values = np.asarray(given, dtype=float)
+        values = np.ascontiguousarray(given, dtype=float)
         if values.shape != default.shape or not np.all(np.isfinite(values)):
             raise TaskError(f"{name} needs {default.size} finite values (rows {', '.join(self.row_names)}), "
                             f"got {given!r}")
         return values
 
     # ------------------------------------------------------------------ rows
-    def _jacobian(self, data: pin.Data, q: np.ndarray) -> tuple[np.ndarray, int]:
-        """Closure rows stacked over task rows at q, and the number of closure rows."""
-        pin.computeJointJacobians(self.model, data, q)
-        pin.updateFramePlacements(self.model, data)
-        rows = [c.jacobian(self.model, data) for c in self.mechanism.closures]
-        n_c = sum(r.shape[0] for r in rows)
-        for task, fid in zip(self.tasks, self.frames):
-            J6 = pin.getFrameJacobian(self.model, data, fid, _LWA)
-            if task.reference == "local":
-                R_T = data.oMf[fid].rotation.T
-                J6 = np.vstack([R_T @ J6[:3], R_T @ J6[3:]])
-            rows.append(J6[task.rows])
-        return np.vstack(rows), n_c
-
-    def _drift(self, q: np.ndarray, v: np.ndarray, n_c: int) -> np.ndarray:
-        """Jdot v of every row: closure drift, then the task frames' classical acceleration
-        at zero joint acceleration (same q as the Jacobian: data.J stays valid)."""
-        pin.forwardKinematics(self.model, self.data, q, v, np.zeros(self.model.nv))
-        pin.updateFramePlacements(self.model, self.data)
-        parts = [c.drift(self.model, self.data) for c in self.mechanism.closures]
-        for task, fid in zip(self.tasks, self.frames):
-            acc = pin.getFrameClassicalAcceleration(self.model, self.data, fid, _LWA)
-            linear, angular = acc.linear, acc.angular
-            if task.reference == "local":
-                R_T = self.data.oMf[fid].rotation.T
-                linear, angular = R_T @ linear, R_T @ angular
-            parts.append(np.concatenate((linear, angular))[task.rows])
-        return np.concatenate(parts) if parts else np.zeros(n_c)
-
     def _dimensionless(self, J: np.ndarray, n_closure: int) -> np.ndarray:
         """J with linear task rows divided by the mechanism's size and prismatic columns
         multiplied by it, so its condition number does not depend on units or size."""
@@ -353,17 +336,17 @@ class RateSolver:
         rows before them: a deficiency no pose can cure. Computed once, and only when a
         pose looks singular, so well-posed tasks never pay for it."""
         if self._generic is None:
-            data = self.model.createData()
+            compiled = self._compiled()
+            n_c = self._closure_rows
             rng = np.random.default_rng(20261122)
             best = None
             for _ in range(_SAMPLES):
                 q = pin.integrate(self.model, pin.neutral(self.model), rng.normal(size=self.model.nv))
-                J, n_c = self._jacobian(data, q)
-                Jd = self._dimensionless(J, n_c)
+                Jd = self._dimensionless(compiled.stacked_jacobian(q), n_c)
                 r = _rank(Jd)
                 if best is None or r > best[0]:
-                    best = (r, Jd, n_c)
-            rank, Jd, n_c = best
+                    best = (r, Jd)
+            rank, Jd = best
             kept: list[int] = list(range(n_c))
             dependent = []
             for i in range(n_c, Jd.shape[0]):
@@ -376,23 +359,7 @@ class RateSolver:
             self._generic = (rank, task_rows, dependent)
         return self._generic
 
-    # ------------------------------------------------------------------ method
-    def _method(self, m: int, n: int, rank: int, condition: float, sigma_min: float, q: np.ndarray) -> str:
-        if self.method == "damped":
-            return "damped"
-        if rank < m and self.method != "least_squares":
-            raise self._inconsistent(m, n)
-        if condition > self.max_condition:
-            raise SingularPoseError(
-                f"{self.mechanism.source}: the task Jacobian is singular at {self._pose(q)} (condition number "
-                f"{condition:.3g} > {self.max_condition:.3g}, smallest singular value {sigma_min:.3g}); "
-                "ask for method = \"damped\" to get the closest achievable motion",
-                condition=condition, sigma_min=sigma_min, partial=q,
-            )
-        if rank < m:
-            return "least_squares"
-        return "exact" if m == n else "minimum_norm"
-
+    # ------------------------------------------------------------------ errors
     def _inconsistent(self, m: int, n: int) -> TaskError:
         hint = "or ask for method = \"least_squares\" (the closest motion, asked vs achieved reported)"
         if m > n:
@@ -413,20 +380,6 @@ class RateSolver:
     def _pose(self, q: np.ndarray) -> str:
         names = [name for name, j in self.mechanism.joints.items() if j.nv == 1]
         return describe_joint_values(self.mechanism, names, [self.mechanism.coordinate(q, n) for n in names])
-
-    def _apply(self, J: np.ndarray, rhs: np.ndarray, method: str, rank: int) -> np.ndarray:
-        """Solve J x = rhs by `method`, J and rhs dimensionless (see `_dimensionless`: the
-        caller scales rows in and columns out), so that the minimum norm, the least squares
-        and the damping weigh a turn of one radian like a slide of one mechanism size: the
-        same answer at any size, in any unit."""
-        if method == "exact":
-            return np.linalg.solve(J, rhs)
-        if method == "damped":
-            return J.T @ np.linalg.solve(J @ J.T + self.damping**2 * np.eye(J.shape[0]), rhs)
-        if rank == min(J.shape):
-            return np.linalg.lstsq(J, rhs, rcond=None)[0]  # minimum-norm or least-squares
-        U, s, Vt = np.linalg.svd(J, full_matrices=False)  # rank-deficient: truncated pseudo-inverse
-        return Vt[:rank].T @ ((U[:, :rank].T @ rhs) / s[:rank])
 
 
 def _rank(J: np.ndarray) -> int:

@@ -2,8 +2,8 @@
 at every pose of a chunk, as arrays, in one call.
 
 The numbers are those of `evaluate_motion` (Pinocchio's forward kinematics, frame
-velocities and classical accelerations in world axes); the compiled core computes them
-for a whole chunk where it rebuilds the model (core.py), Pinocchio pose by pose elsewhere.
+velocities and classical accelerations in world axes), from the same compiled call
+(csrc/kinematics.cpp), here over every pose of a chunk at once.
 """
 
 from __future__ import annotations
@@ -15,12 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from pinmech.solve import core
+from pinmech.solve.core import _core
 from pinmech.exceptions import ModelError
 from pinmech.model.mechanism import Mechanism
-
-_LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-
 
 @dataclass(frozen=True)
 class FramePaths:
@@ -63,44 +60,17 @@ def frame_paths(mechanism: Mechanism, names: Sequence[str], q: np.ndarray, v: np
     if q.shape != (n, model.nq) or v.shape != (n, model.nv) or a.shape != (n, model.nv):
         raise ModelError(f"q, v, a must be ({n}, {model.nq}), ({n}, {model.nv}), ({n}, {model.nv}) arrays, got "
                          f"{q.shape}, {v.shape}, {a.shape}", path=mechanism.source)
-    compiled = _core_for(mechanism, fids)
-    if compiled is not None:
-        kinematics, lock = compiled
-        with lock:  # one core per mechanism and frames: threads sharing it take turns
-            out = kinematics.frame_motion(q, v, a, list(range(len(fids))))
-        shapes = ((n, len(fids), 3), (n, len(fids), 3, 3)) + ((n, len(fids), 3),) * 4
-        return FramePaths(names, *(x.reshape(s) for x, s in zip(out, shapes)))
-    return _pose_by_pose(model, names, fids, q, v, a)
+    data, lock = _data_for(mechanism)
+    with lock:  # one Data per mechanism: threads sharing it take turns
+        rows = np.empty((n, len(fids), _core.KINEMATICS_COLUMNS))
+        _core.frames_along(model, data, q, v, a, np.array(fids, dtype=np.int32), rows)
+    return FramePaths(names, rows[..., 0:3], rows[..., 3:12].reshape(n, len(fids), 3, 3), rows[..., 12:15],
+                      rows[..., 15:18], rows[..., 18:21], rows[..., 21:24])
 
 
-def _pose_by_pose(model: pin.Model, names: tuple[str, ...], fids: list[int], q: np.ndarray, v: np.ndarray,
-                  a: np.ndarray) -> FramePaths:
-    n, f = len(q), len(fids)
-    arrays = [np.empty((n, f, 3)), np.empty((n, f, 3, 3))] + [np.empty((n, f, 3)) for _ in range(4)]
-    data = model.createData()
-    for i in range(n):
-        pin.forwardKinematics(model, data, q[i], v[i], a[i])
-        for k, fid in enumerate(fids):
-            M = pin.updateFramePlacement(model, data, fid)
-            vel = pin.getFrameVelocity(model, data, fid, _LWA)
-            acc = pin.getFrameClassicalAcceleration(model, data, fid, _LWA)
-            for array, value in zip(arrays, (M.translation, M.rotation, vel.linear, vel.angular, acc.linear,
-                                             acc.angular)):
-                array[i, k] = value
-    return FramePaths(names, *arrays)
-
-
-def _core_for(mechanism: Mechanism, fids: list[int]):
-    """A core on the mechanism's model with these frames and its lock (built once per set of
-    frames and per model tree: placements changed in the model are read at every call)."""
-    model = mechanism.model
-    cache = mechanism.__dict__.setdefault("_frame_cores", {})
-    cached = cache.get(tuple(fids))
-    if cached is None or not cached[0].matches(model):
-        try:
-            built = core.CompiledModel(model, fids).kinematics(model)
-        except KeyError:
-            built = None
-        cached = (core.ModelShape(model, fids), None if built is None else (built, threading.Lock()))
-        cache[tuple(fids)] = cached
-    return cached[1]
+def _data_for(mechanism: Mechanism) -> tuple[pin.Data, threading.Lock]:
+    """A pin.Data of the mechanism's model kept for frame_paths, and its lock."""
+    cached = mechanism.__dict__.get("_paths_data")
+    if cached is None or len(cached[0].oMf) != mechanism.model.nframes:  # new, or frames added since
+        cached = mechanism.__dict__["_paths_data"] = (mechanism.model.createData(), threading.Lock())
+    return cached
