@@ -43,9 +43,9 @@ nitpick_ignore_regex = [
                r"distributed|matplotlib|pandas|pyarrow|scipy|os|io|concurrent)\b.*"),
     (r"py:.*", r"(Path|Sequence|Mapping|Iterable|Iterator|Callable|Any|ndarray|NDArray|"
                r"ArrayLike|Literal|Self|IO|TextIO|Figure|Axes|Model|Data)"),
-    # Annotations of typed (pydantic) objects: pydantic's own types, and pinmech's internal
+    # Annotations of typed (msgspec) objects: msgspec's own types, and pinmech's internal
     # entry types named bare in forward references. Dotted names are still checked.
-    (r"py:class", r"(Strict\w+|Annotated|BaseModel|ConfigDict|Field|[A-Z]\w*)"),
+    (r"py:class", r"(Struct|NODEFAULT|Annotated|Union|[A-Z]\w*)"),
     # Types of pinmech's modules that the public API returns but does not export by name.
     (r"py:.*", r"pinmech\.(model|solve|io|design|draw)\..*"),
     (r"py:class", r"(int|float|str|bool|bytes|dict|list|tuple|set|frozenset|object|None|type|"

@@ -155,3 +155,19 @@ def test_a_spec_built_in_code_is_validated_and_draws_as_the_file_does():
         np.testing.assert_array_equal(linkage_from_spec(built).points[name], at)
     with pytest.raises(ModelError, match=r"\[links\] rocker: names joint 'Q', which \[joints\] does not give"):
         LinkageSpec(joints=built.joints, links={**built.links, "rocker": ("O4", "Q")})
+
+
+def test_a_spec_built_in_code_has_its_types_checked_as_a_file_has():
+    """A value of the wrong type given in code (a number where a joint's name is due, a
+    boolean where a length is due) is the same one-line ModelError a file gets, naming the
+    key: building a spec in code is no way around the file's checks. A dict written where a
+    construction is due is read as the construction itself (`from` = its base)."""
+    from pinmech.model.linkage_entries import Polar
+
+    joints = {"O": ("0 mm", "0 mm"), "A": {"from": "O", "length": "40 mm", "angle": "30 deg"}}
+    spec = LinkageSpec(ground=("O",), joints=joints, links={"crank": ("O", "A")})
+    assert spec.joints["A"] == Polar(base="O", length="40 mm", angle="30 deg")
+    with pytest.raises(ModelError, match=r"^<linkage>, title: must be text, got 3$"):
+        LinkageSpec(title=3, ground=("O",), joints=joints, links={"crank": ("O", "A")})
+    with pytest.raises(ModelError, match=r"\[joints\] O: y: must be a quantity .*, got False"):
+        LinkageSpec(ground=("O",), joints={**joints, "O": ("0 mm", False)}, links={"crank": ("O", "A")})

@@ -5,7 +5,7 @@ Random keys and values are written into the bundled scenes (hypothesis, seeded t
 database-free derandomised run), and the scene is read, then solved or swept. The property
 is the house's first rule: what comes out is a result or a PinmechError subclass whose
 message is one line naming the scene file; never another exception (a TypeError deep in
-the solver, a pydantic ValidationError, a KeyError).
+the solver, a msgspec ValidationError, a KeyError).
 """
 
 from __future__ import annotations

@@ -22,7 +22,6 @@ from __future__ import annotations
 from typing import Any, ClassVar
 
 import numpy as np
-from pydantic import field_validator, model_validator
 
 from pinmech.directions import unit_vector, written
 from pinmech.io.scene_fields import Refused, Table, names, positive_quantity, quantity
@@ -38,22 +37,15 @@ class ForcesSpec(Table):
     minimum_norm: bool = False
     static: bool = False
 
-    @field_validator("static", "minimum_norm", mode="before")
     @classmethod
-    def _flag(cls, value: Any) -> bool:
-        if not isinstance(value, bool):
+    def _field(cls, name: str, value: Any) -> Any:
+        if name == "massless":
+            return tuple(names(value))
+        if name == "flywheel":
+            return positive_quantity(value, "moment_of_inertia", "positive").si
+        if not isinstance(value, bool):  # static, minimum_norm
             raise Refused(f"must be true or false, got {value!r}")
         return value
-
-    @field_validator("massless", mode="before")
-    @classmethod
-    def _massless(cls, value: Any) -> tuple[str, ...]:
-        return tuple(names(value))
-
-    @field_validator("flywheel", mode="before")
-    @classmethod
-    def _flywheel(cls, value: Any) -> float:
-        return positive_quantity(value, "moment_of_inertia", "positive").si
 
 
 class GravitySpec(Table):
@@ -63,21 +55,18 @@ class GravitySpec(Table):
     acceleration: float
     direction: tuple[float, float, float]
 
-    @model_validator(mode="before")
     @classmethod
-    def _both(cls, data: Any) -> Any:
+    def _known_keys(cls, data: Any) -> Any:
         if isinstance(data, dict) and set(data) != {"acceleration", "direction"}:
             raise Refused(_GRAVITY_NEEDS)
-        return data
+        return super()._known_keys(data)
 
-    @field_validator("acceleration", mode="before")
     @classmethod
-    def _size(cls, value: Any) -> float:
-        return quantity(value, "acceleration").si
+    def _field(cls, name: str, value: Any) -> Any:
+        return quantity(value, "acceleration").si if name == "acceleration" else cls._direction(value)
 
-    @field_validator("direction", mode="before")
-    @classmethod
-    def _direction(cls, value: Any) -> tuple[float, float, float]:
+    @staticmethod
+    def _direction(value: Any) -> tuple[float, float, float]:
         ok = isinstance(value, list) and len(value) == 3 and all(
             isinstance(x, (int, float)) and not isinstance(x, bool) for x in value)
         if not ok or not np.all(np.isfinite(value)):
@@ -107,9 +96,8 @@ class LoadSpec(Table):
     torque: tuple[float, float, float]
     torque_about_normal: float | None = None
 
-    @model_validator(mode="before")
     @classmethod
-    def _read(cls, data: Any) -> Any:
+    def _known_keys(cls, data: Any) -> Any:
         if not isinstance(data, dict):
             raise Refused(f"write each load as a [[load]] table, got {data!r}")
         unknown = set(data) - {"name", "point", "link", "force", "torque"}

@@ -17,10 +17,8 @@ import difflib
 from pathlib import Path
 from typing import Any
 
-from pydantic import ValidationError, model_validator
-
 from pinmech.io.scene_errors import scene_error
-from pinmech.io.scene_fields import Refused, Table
+from pinmech.io.scene_fields import Invalid, Refused, Table
 
 #: The keys a hand file and each of its [[value]] tables may hold: any other is a typo.
 FILE_KEYS = ("scene", "source", "value")
@@ -37,7 +35,7 @@ def _refuse_unknown(table: dict[str, Any], known: tuple[str, ...], in_entry: boo
             raise Refused(f"unknown key {key!r}{hint}: {holds}", at=(key,))
 
 
-class HandEntry(Table):
+class HandEntry(Table, kw_only=True):
     """One `[[value]]`: where the number lives in the result, and the values as printed."""
 
     label: str | None = None
@@ -46,7 +44,6 @@ class HandEntry(Table):
     unit: str
     kind: str | None = None
 
-    @model_validator(mode="before")
     @classmethod
     def _known_keys(cls, data: Any) -> Any:
         _refuse_unknown(data, ENTRY_KEYS, True)
@@ -65,14 +62,13 @@ class HandEntry(Table):
         return dict(data, hand=tuple(hand))
 
 
-class HandTables(Table):
+class HandTables(Table, kw_only=True):
     """A hand file: its scene (as written, relative to the file), source and entries."""
 
     scene: str
     source: str = ""
     value: tuple[HandEntry, ...]
 
-    @model_validator(mode="before")
     @classmethod
     def _known_keys(cls, data: Any) -> Any:
         if not isinstance(data.get("scene"), str):
@@ -96,6 +92,6 @@ class HandTables(Table):
             SceneError: the first mistake, naming the file and the key.
         """
         try:
-            return cls.model_validate(tables)
-        except ValidationError as exc:
+            return cls.validate(tables)
+        except Invalid as exc:
             raise scene_error(exc, path) from None

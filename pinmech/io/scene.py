@@ -14,6 +14,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import msgspec
+
 from pinmech.arguments import file_path
 from pinmech.exceptions import PinmechError, SceneError
 from pinmech.io.scene_file import MODEL_KEYS, SceneFile
@@ -22,7 +24,7 @@ from pinmech.toml_file import TOMLDecodeError, read_toml, toml_value
 from pinmech.units import JOINT_KINDS, to_si
 
 #: Top-level keys a scene may have.
-KNOWN_KEYS = frozenset(f.alias or name for name, f in SceneFile.model_fields.items())
+KNOWN_KEYS = frozenset(SceneFile.keys())
 #: The tables that turn a scene's force analysis on (forces_scene.py reads them).
 FORCE_KEYS = ("forces", "gravity", "load")
 
@@ -130,7 +132,7 @@ class Scene:
         (a `--set guess...` picks the reference's assembly, `--angle` only the pose)."""
         if self.file_drivers is None or self.file_drivers is self.file.drivers:
             return self
-        return Scene(self.path, self.file.model_copy(update={"drivers": self.file_drivers}), self.file_drivers)
+        return Scene(self.path, msgspec.structs.replace(self.file, drivers=self.file_drivers), self.file_drivers)
 
     def assembly(self) -> Any:
         """The `assembly` value as written: absent (None), "any", or a table loop -> sign."""

@@ -1,23 +1,17 @@
-"""pydantic's ValidationError turned into the one-line SceneError users read: the file, the
-key path where the first mistake is (`sweep.steps`, `load[0].force[1]`), and what was
+"""A table's first mistake (`Invalid`) turned into the one-line SceneError users read: the
+file, the key path where the mistake is (`sweep.steps`, `load[0].force[1]`), and what was
 expected with the value given."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
-
-from pydantic import ValidationError
 
 from pinmech.exceptions import SceneError
-from pinmech.io.scene_fields import Refused
+from pinmech.io.scene_fields import Invalid
 
-#: What each of pydantic's type errors expected, as a scene's reader says it.
-_EXPECTED = {
-    "string_type": "a string", "bool_type": "true or false", "int_type": "a whole number",
-    "float_type": "a number", "list_type": "a list", "tuple_type": "a list", "dict_type": "a table",
-    "model_type": "a table", "int_from_float": "a whole number", "finite_number": "a finite number",
-}
+#: What each of msgspec's type names expects, as a scene's reader says it.
+_EXPECTED = {"str": "a string", "bool": "true or false", "int": "a whole number", "float": "a number",
+             "array": "a list", "object": "a table"}
 
 
 def key_path(loc: tuple[str | int, ...]) -> str:
@@ -28,23 +22,14 @@ def key_path(loc: tuple[str | int, ...]) -> str:
     return out
 
 
-def scene_error(exc: ValidationError, path: Path) -> SceneError:
-    """The first of `exc`'s errors as a SceneError (or the UnitError a quantity raised)."""
-    error = exc.errors(include_url=False)[0]
-    loc = tuple(error["loc"])
-    refused = (error.get("ctx") or {}).get("error")
-    if isinstance(refused, Refused):
-        key = refused.key or key_path(loc + refused.at)
+def scene_error(exc: Invalid, path: Path) -> SceneError:
+    """`exc` as a SceneError (or the UnitError a quantity raised), naming the file and key."""
+    refused = exc.refused
+    if refused is not None:
+        key = refused.key or key_path(exc.loc + refused.at)
         return refused.error(refused.message, path=str(path), key=key or None)
-    return SceneError(_message(error), path=str(path), key=key_path(loc) or None)
-
-
-def _message(error: dict[str, Any]) -> str:
-    kind = error["type"]
-    if kind == "missing":
-        return "missing"
-    if kind == "extra_forbidden":
-        return "unknown key"
-    if kind in _EXPECTED:
-        return f"must be {_EXPECTED[kind]}, got {error.get('input')!r}"
-    return f"{error['msg']}, got {error.get('input')!r}"
+    if exc.wrong is None:
+        return SceneError("missing", path=str(path), key=key_path(exc.loc) or None)
+    expected = exc.wrong.expected.split(" | ")[0]
+    said = f"must be {_EXPECTED[expected]}" if expected in _EXPECTED else f"must be {exc.wrong.expected}"
+    return SceneError(f"{said}, got {exc.wrong.given!r}", path=str(path), key=key_path(exc.loc) or None)

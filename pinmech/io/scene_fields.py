@@ -1,16 +1,20 @@
-"""The pieces every scene table is built from: a strict pydantic table that names its
+"""The pieces every scene table is built from: a strict, frozen msgspec table that names its
 unknown keys, quantities checked through `pinmech.units`, and `Refused`, the one way a
 validator says no (`scene_errors.py` turns it into a SceneError naming the file and key).
 """
 
 from __future__ import annotations
 
+import functools
 import math
-from typing import Any, ClassVar, NamedTuple
+import types
+from typing import Any, ClassVar, NamedTuple, Union
 
-from pydantic import BaseModel, ConfigDict, model_validator
+import msgspec
+from msgspec import structs
 
 from pinmech.exceptions import SceneError, UnitError
+from pinmech.typed_values import WrongType, typed
 from pinmech.units import JOINT_KINDS, to_si
 
 
@@ -92,23 +96,102 @@ def table_of(value: Any, what: str) -> dict[str, Any]:
     return value
 
 
-class Table(BaseModel):
+class Invalid(Exception):
+    """A table's first mistake and where it is: `loc` (keys and indices from the file's top),
+    with the `Refused` a check raised, or the `WrongType` of a value, or "missing"."""
+
+    def __init__(self, loc: tuple[str | int, ...], refused: Refused | None = None,
+                 wrong: WrongType | None = None) -> None:
+        super().__init__(loc)
+        self.loc, self.refused, self.wrong = loc, refused, wrong
+
+
+class Table(msgspec.Struct, frozen=True, forbid_unknown_fields=True, kw_only=True):
     """A scene table: strict types, frozen, every key it does not know refused by name.
 
+    Build one from a file's table with `validate`: `_known_keys` checks the raw table,
+    `_field` each value given (before its type is checked), `_after` the object built.
     Subclasses set `unknown_hint` for their own wording of the known keys."""
 
-    model_config = ConfigDict(extra="forbid", strict=True, frozen=True, populate_by_name=True,
-                              arbitrary_types_allowed=True)
     unknown_hint: ClassVar[str | None] = None
 
-    @model_validator(mode="before")
+    @classmethod
+    def keys(cls) -> list[str]:
+        """The table's keys, as the file writes them."""
+        return [f.encode_name for f in _fields(cls)]
+
     @classmethod
     def _known_keys(cls, data: Any) -> Any:
         if not isinstance(data, dict):
             raise Refused(f"must be a table, got {data!r}")
-        known = [f.alias or name for name, f in cls.model_fields.items()]
+        known = cls.keys()
         unknown = sorted(set(data) - set(known))
         if unknown:
             hint = cls.unknown_hint or f"known: {', '.join(known)}"
             raise Refused(f"unknown key(s) {', '.join(unknown)}; {hint}")
         return data
+
+    @classmethod
+    def _field(cls, name: str, value: Any) -> Any:
+        """A value given for field `name`, checked and converted (before its type check)."""
+        return value
+
+    def _after(self) -> None:
+        """Checks across fields, once every field has its type."""
+
+    @classmethod
+    def validate(cls, data: Any, loc: tuple[str | int, ...] = ()) -> Any:
+        """The table `data` (as TOML reads it) validated into this class.
+
+        Raises:
+            Invalid: the first mistake, with its key path below `loc`.
+        """
+        try:
+            data = cls._known_keys(data)
+        except Refused as exc:
+            raise Invalid(loc, exc) from None
+        values = {}
+        for f in _fields(cls):
+            here = (*loc, f.encode_name)
+            if f.encode_name not in data:
+                if f.default is msgspec.NODEFAULT and f.default_factory is msgspec.NODEFAULT:
+                    raise Invalid(here)
+                continue
+            try:
+                values[f.name] = _typed(cls._field(f.name, data[f.encode_name]), f.type, here)
+            except Refused as exc:
+                raise Invalid(here, exc) from None
+            except WrongType as exc:
+                raise Invalid(exc.loc, wrong=exc) from None
+        table = cls(**values)
+        try:
+            table._after()
+        except Refused as exc:
+            raise Invalid(loc, exc) from None
+        return table
+
+
+@functools.cache
+def _fields(cls: type) -> tuple[structs.FieldInfo, ...]:
+    return structs.fields(cls)
+
+
+def _typed(value: Any, kind: Any, loc: tuple[str | int, ...]) -> Any:
+    """`value` of type `kind`: a Table (or a dict or tuple of them, or one or None) validated
+    as a table, any other type checked by msgspec."""
+    if isinstance(kind, type) and issubclass(kind, Table):
+        return kind.validate(value, loc)
+    origin, args = getattr(kind, "__origin__", None), getattr(kind, "__args__", ())
+    if isinstance(kind, types.UnionType) or origin is Union:
+        given = [arm for arm in args if arm is not type(None)]
+        if len(given) == 1 and value is not None:  # `X | None`: X, tables in it validated
+            return _typed(value, given[0], loc)
+    elif origin is dict and _is_table(args[1]) and isinstance(value, dict):
+        return {name: args[1].validate(item, (*loc, name)) for name, item in value.items()}
+    elif origin is tuple and _is_table(args[0]) and isinstance(value, (list, tuple)):
+        return tuple(args[0].validate(item, (*loc, i)) for i, item in enumerate(value))
+    return typed(value, kind, loc)
+
+
+def _is_table(kind: Any) -> bool:
+    return isinstance(kind, type) and issubclass(kind, Table)

@@ -11,11 +11,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from pydantic import ValidationError, field_validator, model_validator
+import msgspec
 
 from pinmech.io.force_tables import ForcesSpec, GravitySpec, LoadSpec, load_list
 from pinmech.io.scene_errors import scene_error
-from pinmech.io.scene_fields import Refused, Table, names, table_of, written_value
+from pinmech.io.scene_fields import Invalid, Refused, Table, names, table_of, written_value
 from pinmech.io.scene_tables import DriverSpec, PointSpec, RatesSpec, ReportSpec, SolverSpec, TaskSpec, task_list
 from pinmech.io.sweep_table import SweepSpec
 
@@ -41,20 +41,19 @@ class SceneFile(Table):
     lock: dict[str, Any] = {}
     move: tuple[str, ...] | None = None
     points: dict[str, PointSpec] = {}
-    report: ReportSpec = ReportSpec()
-    solver: SolverSpec = SolverSpec()
-    rates: RatesSpec = RatesSpec()
+    report: ReportSpec = msgspec.field(default_factory=ReportSpec)
+    solver: SolverSpec = msgspec.field(default_factory=SolverSpec)
+    rates: RatesSpec = msgspec.field(default_factory=RatesSpec)
     task: tuple[TaskSpec, ...] | None = None
-    sweep: SweepSpec = SweepSpec()
+    sweep: SweepSpec = msgspec.field(default_factory=SweepSpec)
     assembly: Any = None
     forces: ForcesSpec | None = None
     gravity: GravitySpec | None = None
     load: tuple[LoadSpec, ...] | None = None
 
-    @model_validator(mode="before")
     @classmethod
     def _known_keys(cls, data: Any) -> Any:
-        known = sorted(f.alias or name for name, f in cls.model_fields.items())
+        known = sorted(cls.keys())
         unknown = sorted(set(data) - set(known))
         if unknown:
             raise Refused(f"unknown key(s) {', '.join(unknown)}; known: {', '.join(known)}")
@@ -71,44 +70,43 @@ class SceneFile(Table):
                 data = dict(data, **{key: tuple(data[key])})
         return data
 
-    @field_validator("drivers", "points", "report", "solver", "rates", "sweep", "forces", mode="before")
     @classmethod
-    def _table(cls, value: Any, info) -> Any:
-        return table_of(value, info.field_name)
+    def _field(cls, name: str, value: Any) -> Any:
+        if name in ("drivers", "points", "report", "solver", "rates", "sweep", "forces"):
+            return table_of(value, name)
+        if name in ("guess", "pose", "lock"):
+            return cls._joint_values(name, value)
+        checks = {"move": cls._move, "task": cls._task, "load": cls._load, "assembly": cls._assembly}
+        return checks[name](value) if name in checks else value
 
-    @field_validator("guess", "pose", "lock", mode="before")
-    @classmethod
-    def _joint_values(cls, value: Any, info) -> dict[str, Any]:
-        table = table_of(value, info.field_name)
-        for name, item in table.items():
+    @staticmethod
+    def _joint_values(name: str, value: Any) -> dict[str, Any]:
+        table = table_of(value, name)
+        for joint, item in table.items():
             try:
                 written_value(item)
             except Refused as exc:
-                raise Refused(exc.message, at=(name,), error=exc.error) from None
+                raise Refused(exc.message, at=(joint,), error=exc.error) from None
         return table
 
-    @field_validator("move", mode="before")
-    @classmethod
-    def _move(cls, value: Any) -> tuple[str, ...]:
+    @staticmethod
+    def _move(value: Any) -> tuple[str, ...]:
         if not isinstance(value, list) or not all(isinstance(n, str) for n in value):
             raise Refused("move must be a list of joint names")
         if not value:
             raise Refused("move = [] leaves no joint to move: name the joints the scene moves")
         return tuple(names(value))
 
-    @field_validator("task", mode="before")
-    @classmethod
-    def _task(cls, value: Any) -> Any:
+    @staticmethod
+    def _task(value: Any) -> Any:
         return tuple(task_list(list(value) if isinstance(value, tuple) else value))
 
-    @field_validator("load", mode="before")
-    @classmethod
-    def _load(cls, value: Any) -> Any:
+    @staticmethod
+    def _load(value: Any) -> Any:
         return tuple(load_list(list(value) if isinstance(value, tuple) else value))
 
-    @field_validator("assembly", mode="before")
-    @classmethod
-    def _assembly(cls, value: Any) -> Any:
+    @staticmethod
+    def _assembly(value: Any) -> Any:
         if value != "any" and not isinstance(value, dict):  # its signs: parse_assembly, against the loops
             raise Refused(f'must be "any" or a table such as assembly = {{ B = "+" }}, got {value!r}')
         return value
@@ -131,6 +129,6 @@ class SceneFile(Table):
             SceneError (UnitError for a quantity): the first mistake, naming the file and key.
         """
         try:
-            return cls.model_validate(tables)
-        except ValidationError as exc:
+            return cls.validate(tables)
+        except Invalid as exc:
             raise scene_error(exc, path) from None

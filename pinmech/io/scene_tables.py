@@ -10,8 +10,6 @@ from __future__ import annotations
 
 from typing import Any, ClassVar
 
-from pydantic import field_validator, model_validator
-
 from pinmech.io.scene_fields import Quantity, Refused, Table, names, positive_number, quantity, written_value
 from pinmech.solve.loops import SOLVER_RANGES  # the accepted [solver] values, the solver's own
 
@@ -29,19 +27,16 @@ class DriverSpec(Table):
     velocity: Any = None
     acceleration: Any = None
 
-    @field_validator("*", mode="before")
     @classmethod
-    def _written(cls, value: Any, info) -> Any:
-        return value if value is None else written_value(value, DRIVER_KEYS[info.field_name])
+    def _field(cls, name: str, value: Any) -> Any:
+        return value if value is None else written_value(value, DRIVER_KEYS[name])
 
-    @model_validator(mode="after")
-    def _one_per_order(self) -> DriverSpec:
+    def _after(self) -> None:
         for first, second in (("angle", "position"), ("speed", "velocity")):
             if getattr(self, first) is not None and getattr(self, second) is not None:
                 raise Refused(f"{second} repeats another key of the same order")
         if self.angle is None and self.position is None:
             raise Refused("missing its angle (or position)")
-        return self
 
     def given(self) -> list[tuple[str, int, Any]]:
         """(key, order, value as written) of each key given, in the order of DRIVER_KEYS."""
@@ -72,17 +67,15 @@ class PointSpec(Table):
     at: Any
     link: str
 
-    @model_validator(mode="before")
     @classmethod
-    def _both(cls, data: Any) -> Any:
+    def _known_keys(cls, data: Any) -> Any:
         if isinstance(data, dict) and set(data) != {"at", "link"}:
             raise Refused(_POINT_NEEDS)
-        return data
+        return super()._known_keys(data)
 
-    @field_validator("at", mode="before")
     @classmethod
-    def _at(cls, value: Any) -> Any:
-        if isinstance(value, str):
+    def _field(cls, name: str, value: Any) -> Any:
+        if name != "at" or isinstance(value, str):
             return value
         if not isinstance(value, list) or len(value) != 3:
             raise Refused(f"at = {value!r} must be three coordinates [x, y, z] with units, or a point's name")
@@ -106,14 +99,10 @@ class ReportSpec(Table):
     links: Any = None
     limits: Any = "warn"
 
-    @field_validator("points", "links", mode="before")
     @classmethod
-    def _names(cls, value: Any) -> list[str] | None:
-        return names(value)
-
-    @field_validator("limits", mode="before")
-    @classmethod
-    def _limits(cls, value: Any) -> str:
+    def _field(cls, name: str, value: Any) -> Any:
+        if name != "limits":
+            return names(value)
         if value not in ("warn", "error"):
             raise Refused(f"limits must be \"warn\" or \"error\", got {value!r}")
         return value
@@ -126,7 +115,6 @@ class SolverSpec(Table):
     max_iterations: Any = None
     max_condition: Any = None
 
-    @model_validator(mode="before")
     @classmethod
     def _known_keys(cls, data: Any) -> Any:
         if not isinstance(data, dict):
@@ -136,12 +124,11 @@ class SolverSpec(Table):
                 raise Refused(f"unknown solver option {key}; known: {', '.join(SOLVER_RANGES)}", at=(key,))
         return data
 
-    @field_validator("*", mode="before")
     @classmethod
-    def _in_range(cls, value: Any, info) -> Any:
-        key = f"solver.{info.field_name}"
-        number = positive_number(value, key, *SOLVER_RANGES[info.field_name])
-        if info.field_name == "max_iterations":
+    def _field(cls, name: str, value: Any) -> Any:
+        key = f"solver.{name}"
+        number = positive_number(value, key, *SOLVER_RANGES[name])
+        if name == "max_iterations":
             if number != int(number):  # 2.7 was cut to 2 in silence
                 raise Refused(f"{key} = {value!r} must be a whole number of iterations")
             return int(number)
@@ -159,9 +146,12 @@ class RatesSpec(Table):
     damping: Any = None
     max_condition: Any = None
 
-    @field_validator("method", mode="before")
     @classmethod
-    def _method(cls, value: Any) -> str:
+    def _field(cls, name: str, value: Any) -> Any:
+        return cls._method(value) if name == "method" else cls._number(name, value)
+
+    @staticmethod
+    def _method(value: Any) -> str:
         from pinmech.solve.rates import METHODS
 
         if not isinstance(value, str):
@@ -170,15 +160,14 @@ class RatesSpec(Table):
             raise Refused(f"must be one of {', '.join(METHODS)}, got {value!r}")
         return value
 
-    @field_validator("damping", "max_condition", mode="before")
-    @classmethod
-    def _number(cls, value: Any, info) -> float:
+    @staticmethod
+    def _number(name: str, value: Any) -> float:
         from pinmech.solve.rates import DAMPING_RANGE
 
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
             raise Refused(f"must be a positive number, got {value!r}")
-        low, high = DAMPING_RANGE if info.field_name == "damping" else SOLVER_RANGES["max_condition"]
-        return positive_number(value, f"rates.{info.field_name}", low, high)
+        low, high = DAMPING_RANGE if name == "damping" else SOLVER_RANGES["max_condition"]
+        return positive_number(value, f"rates.{name}", low, high)
 
     def options(self) -> dict[str, Any]:
         """The settings given, as RateSolver's keyword arguments."""
@@ -198,7 +187,6 @@ class TaskSpec(Table):
     acceleration: tuple[float, ...]
     reference: str = "world"
 
-    @model_validator(mode="before")
     @classmethod
     def _known_keys(cls, data: Any) -> Any:
         from pinmech.solve.rates import COMPONENTS

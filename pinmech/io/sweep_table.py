@@ -21,9 +21,10 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from pydantic import Field, field_validator, model_validator
+import msgspec
 
 from pinmech.io.scene_fields import Refused, Table, names, positive_quantity, written_value
+from pinmech.typed_values import given_fields
 
 #: The `[sweep]` keys and their types.
 SWEEP_KEYS = {"links": list, "points": list, "steps": int, "from": str, "to": str, "start": str,
@@ -40,8 +41,8 @@ class SweepSpec(Table):
     links: list[str] | None = None
     points: list[str] | None = None
     steps: int | None = None
-    first: str | None = Field(None, alias="from")
-    last: str | None = Field(None, alias="to")
+    first: str | None = msgspec.field(default=None, name="from")
+    last: str | None = msgspec.field(default=None, name="to")
     start: str | None = None
     batch: bool | None = None
     interpolate: int | None = None
@@ -50,7 +51,6 @@ class SweepSpec(Table):
     scheme: str | None = None
     gain: float | None = None
 
-    @model_validator(mode="before")
     @classmethod
     def _known_keys(cls, data: Any) -> Any:
         if not isinstance(data, dict):
@@ -65,40 +65,31 @@ class SweepSpec(Table):
                 raise Refused(f"must be at least {_LEAST[key][0]} {_LEAST[key][1]}, got {value}", at=(key,))
         return {k: (float(v) if k == "gain" else v) for k, v in data.items()}
 
-    @field_validator("links", "points", mode="before")
     @classmethod
-    def _names(cls, value: Any) -> list[str] | None:
-        return names(value)
+    def _field(cls, name: str, value: Any) -> Any:
+        """Each value's type is checked already (`_known_keys`): here, what it may be."""
+        if name in ("links", "points"):
+            return names(value)
+        if name in ("start", "scheme"):
+            return cls._one_of(name, value)
+        if name == "gain" and not 0 <= value < math.inf:
+            raise Refused(f"must be a number from 0 (open loop) up, in 1/s, got {value!r}")
+        if name in ("first", "last"):
+            return written_value(value)
+        if name in ("duration", "step"):
+            positive_quantity(value, "time", "a positive time")
+        return value
 
-    @field_validator("start", "scheme")
-    @classmethod
-    def _one_of(cls, value: str, info) -> str:
+    @staticmethod
+    def _one_of(name: str, value: str) -> str:
         from pinmech.solve.cycle import STARTS
         from pinmech.solve.path import SCHEMES  # here: sweeping needs no path integration
 
-        choices = STARTS if info.field_name == "start" else SCHEMES
+        choices = STARTS if name == "start" else SCHEMES
         if value not in choices:
             raise Refused(f"must be one of {', '.join(choices)}, got {value!r}")
         return value
 
-    @field_validator("gain")
-    @classmethod
-    def _gain(cls, value: float) -> float:
-        if not 0 <= value < math.inf:
-            raise Refused(f"must be a number from 0 (open loop) up, in 1/s, got {value!r}")
-        return value
-
-    @field_validator("first", "last")
-    @classmethod
-    def _driver_value(cls, value: str) -> str:
-        return written_value(value)
-
-    @field_validator("duration", "step")
-    @classmethod
-    def _time(cls, value: str) -> str:
-        positive_quantity(value, "time", "a positive time")
-        return value
-
     def given(self) -> dict[str, Any]:
         """The keys the scene gives, by their names in the file ("from", "steps", ...)."""
-        return self.model_dump(by_alias=True, exclude_none=True)
+        return given_fields(self)

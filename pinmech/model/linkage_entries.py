@@ -1,30 +1,31 @@
-"""The entries of a drawn-linkage file, typed (pydantic v2): constructions, sliders, slots and
-masses as written, and pydantic's errors said as one line naming the file and the key.
+"""The entries of a drawn-linkage file, typed (frozen msgspec Structs): constructions, sliders,
+slots and masses as written, and a value of the wrong type said as one line naming the file
+and the key.
 `pinmech.model.linkage_spec.LinkageSpec` holds them."""
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal, Union
+from typing import Literal, Union
 
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, StrictFloat, StrictInt, StrictStr, Tag
-from pydantic import ValidationError
+import msgspec
 
 from pinmech.exceptions import ModelError
+from pinmech.typed_values import WrongType
 
 #: A quantity as the file writes it: "40 mm", "crank", "2*a + b", "30 deg", or a number.
-Written = StrictStr | StrictInt | StrictFloat
+Written = Union[str, int, float]
 #: the file's tables (the other keys: title, ground, balls)
 TABLES = ("params", "joints", "links", "sliders", "slots", "colors", "axes", "masses")
 
 
-class _Entry(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+class _Entry(msgspec.Struct, frozen=True, forbid_unknown_fields=True, kw_only=True):
+    """An entry of a table: strict types, frozen, unknown keys refused."""
 
 
 class Polar(_Entry):
     """`{from = "O", length = "m", angle = "30 deg"}`: at `length` from a joint, `angle` from x."""
 
-    base: StrictStr = Field(alias="from")
+    base: str = msgspec.field(name="from")
     length: Written
     angle: Written
 
@@ -32,7 +33,7 @@ class Polar(_Entry):
 class Compass(_Entry):
     """`{from = ["A", "B"], lengths = [|A..|, |B..|], side = "left"}`: left or right of A -> B."""
 
-    bases: tuple[StrictStr, StrictStr] = Field(alias="from")
+    bases: tuple[str, str] = msgspec.field(name="from")
     lengths: tuple[Written, Written]
     side: Literal["left", "right"]
 
@@ -40,25 +41,25 @@ class Compass(_Entry):
 class Slider(_Entry):
     """`{block = LINK, on = LINK, at = JOINT, along = ANGLE or [P, Q]}`: a prismatic pair."""
 
-    block: StrictStr | None = None
-    on: StrictStr | None = None
-    at: StrictStr | None = None
-    along: Written | tuple[StrictStr, ...] | None = None
+    block: str | None = None
+    on: str | None = None
+    at: str | None = None
+    along: Written | tuple[str, ...] | None = None
 
 
 class Slot(_Entry):
     """`{pin = LINK, slot = LINK, along = ANGLE or [P, Q]}`: the pin of the key's name in a slot."""
 
-    pin: StrictStr | None = None
-    slot: StrictStr | None = None
-    along: Written | tuple[StrictStr, ...] | None = None
+    pin: str | None = None
+    slot: str | None = None
+    along: Written | tuple[str, ...] | None = None
 
 
 class MassSpec(_Entry):
     """`{mass, at, izz}` (planar) or `{mass, at, inertia = [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]}`."""
 
     mass: Written | None = None
-    at: StrictStr | tuple[Written, ...] | None = None
+    at: str | tuple[Written, ...] | None = None
     izz: Written | None = None
     inertia: tuple[Written, ...] | None = None
 
@@ -66,32 +67,27 @@ class MassSpec(_Entry):
 Coordinates = tuple[Written, ...]
 
 
-def _joint_kind(entry: Any) -> str:
-    """Which form a `[joints]` entry takes (its shape is checked before: `_joint`)."""
-    if isinstance(entry, (Polar, Compass)):
-        return type(entry).__name__
-    if isinstance(entry, dict):
-        return "Polar" if isinstance(entry.get("from"), str) else "Compass"
-    return "coordinates"
-
-
 #: A joint's place at the drawn pose: coordinates as written, or a construction.
-Joint = Annotated[Union[Annotated[Coordinates, Tag("coordinates")], Annotated[Polar, Tag("Polar")],
-                        Annotated[Compass, Tag("Compass")]], Discriminator(_joint_kind)]
+Joint = Union[Coordinates, Polar, Compass]
 
 
-#: pydantic's error types, said as pinmech says them
-_SAID = {"string_type": "must be text", "tuple_type": "must be a list", "dict_type": "must be a table",
-         "float_type": "must be a number", "float_parsing": "must be a number", "finite_number": "must be finite"}
+def joint_type(entry: object) -> type:
+    """The type a `[joints]` entry takes (its shape is checked before: `linkage_spec._joint`)."""
+    if isinstance(entry, (Polar, Compass)):
+        return type(entry)
+    if isinstance(entry, dict):
+        return Polar if isinstance(entry.get("from"), str) else Compass
+    return Coordinates
 
 
-def as_model_error(exc: ValidationError, source: str) -> ModelError:
-    """pydantic's first error as one line: `[table] name`, the key in it, what was wrong."""
-    error = exc.errors(include_url=False)[0]
-    raw = [str(part) for part in error["loc"]]
-    union = any(part in ("str", "int", "float") for part in raw)
-    loc = [part for part in raw if part not in ("str", "int", "float", "coordinates", "Polar", "Compass")
-           and not part.startswith(("tuple[", "function-"))]
+#: msgspec's type names, said as pinmech says them
+_SAID = {"str": "must be text", "array": "must be a list", "object": "must be a table", "float": "must be a number",
+         "int": "must be a number"}
+
+
+def as_model_error(exc: WrongType, source: str) -> ModelError:
+    """A value of the wrong type as one line: `[table] name`, the key in it, what was wrong."""
+    loc = [str(part) for part in exc.loc]
     if loc and loc[0] in TABLES and len(loc) > 1:
         element, inner = f"[{loc[0]}] {loc[1]}", loc[2:]
         if loc[0] == "joints" and len(inner) == 1 and inner[0] in "012":
@@ -99,11 +95,11 @@ def as_model_error(exc: ValidationError, source: str) -> ModelError:
     else:
         element, inner = (loc[0] if loc else None), loc[1:]
     key = f"{' '.join(inner)}: " if inner else ""
-    message = _SAID.get(error["type"], error["msg"])
-    if union:
+    message = _SAID.get(exc.expected, f"must be {exc.expected}")
+    if " | " in exc.expected:  # a quantity's (str | int | float) or a centre of mass's (str | array)
         message = 'must be a quantity as text ("40 mm", "30 deg") or a number'
         if inner and inner[0] == "at":
             message = "the centre of mass is a joint's name or [x, y] (or [x, y, z]) with units"
-    got = error.get("input")
+    got = exc.given
     shown = "" if isinstance(got, dict) else f", got {got!r:.60}"
     return ModelError(f"{key}{message}{shown}", path=source, element=element)

@@ -1,4 +1,4 @@
-"""A drawn-linkage file as one typed, validated object: `LinkageSpec` (pydantic v2).
+"""A drawn-linkage file as one typed, validated object: `LinkageSpec` (a frozen msgspec Struct).
 
 The file is read once (`read_linkage_spec`) into a `LinkageSpec` holding what it writes, as
 it writes it: quantities stay the user's text (`"40 mm"`, `"2*a + b"`, `"30 deg"`), names
@@ -13,26 +13,26 @@ joints and write or load the result.
 
 from __future__ import annotations
 
-from typing import Any
+from contextvars import ContextVar
+from typing import Any, Union
 
-from pydantic import BaseModel, ConfigDict, StrictStr, ValidationError, ValidationInfo, field_validator
-from pydantic import model_validator
+import msgspec
+from msgspec import structs
 
 from pinmech.directions import unit_vector, written
 from pinmech.exceptions import ModelError
 from pinmech.model.linkage_entries import (TABLES as _TABLES, Compass, Joint, MassSpec, Polar, Slider, Slot, Written,
-                                           as_model_error as _as_model_error)
+                                           as_model_error as _as_model_error, joint_type)
 from pinmech.model.linkage_expr import check_param_name
+from pinmech.typed_values import WrongType, typed
 
 GROUND = "ground"
 _KEYS = {"title", "ground", "balls", *_TABLES}
+#: The file a spec is being read from, for its messages (`linkage_spec`; "<linkage>" in code).
+_SOURCE: ContextVar[str] = ContextVar("linkage_source", default="<linkage>")
 
 
-def _source(info: ValidationInfo) -> str:
-    return (info.context or {}).get("source", "<linkage>")
-
-
-class LinkageSpec(BaseModel):
+class LinkageSpec(msgspec.Struct, frozen=True, forbid_unknown_fields=True, kw_only=True):
     """A drawn linkage as its file writes it, validated: build one with `read_linkage_spec`
     (a file), `linkage_spec` (TOML's tables) or `LinkageSpec(...)` in code; draw it with
     `linkage_from_spec`, write it with `linkage_toml`. Frozen: `with_params` makes a changed
@@ -50,89 +50,39 @@ class LinkageSpec(BaseModel):
         masses: link -> `MassSpec`; colors: link -> a colour (kept, not read).
     """
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-    title: StrictStr | None = None
-    ground: tuple[StrictStr, ...] = ()
+    title: Union[str, None] = None
+    ground: tuple[str, ...] = ()
     params: dict[str, Written] = {}
     joints: dict[str, Joint] = {}
-    links: dict[str, tuple[StrictStr, ...]] = {}
+    links: dict[str, tuple[str, ...]] = {}
     sliders: dict[str, Slider] = {}
     slots: dict[str, Slot] = {}
-    colors: dict[str, StrictStr] = {}
+    colors: dict[str, str] = {}
     axes: dict[str, tuple[float, float, float]] = {}
-    balls: tuple[StrictStr, ...] = ()
+    balls: tuple[str, ...] = ()
     masses: dict[str, MassSpec] = {}
 
-    @model_validator(mode="before")
-    @classmethod
-    def _known_keys(cls, raw: Any, info: ValidationInfo) -> Any:
-        if not isinstance(raw, dict):
-            raise ModelError("a linkage file is a table of keys", path=_source(info))
-        unknown = set(raw) - _KEYS
-        if unknown:
-            raise ModelError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_KEYS))}",
-                             path=_source(info))
+    def __post_init__(self) -> None:
+        """Every table's shape, every value's type (msgspec, strict), every name referred to.
+
+        Raises:
+            ModelError: the first mistake, naming the file (`_SOURCE`) and the key.
+        """
+        source = _SOURCE.get()
         for key in _TABLES:
-            if not isinstance(raw.get(key, {}), dict):
-                raise ModelError(f"[{key}] must be a table", path=_source(info), element=key)
-        return raw
-
-    @field_validator("params", mode="before")
-    @classmethod
-    def _param_names(cls, value: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
-        for name in value:
-            check_param_name(name, _source(info))
-        return value
-
-    @field_validator("ground", "balls", mode="before")
-    @classmethod
-    def _name_list(cls, value: Any, info: ValidationInfo) -> list[str]:
-        return _names(value, info.field_name, _source(info))
-
-    @field_validator("links", mode="before")
-    @classmethod
-    def _link_lists(cls, value: dict[str, Any], info: ValidationInfo) -> dict[str, list[str]]:
-        for name in value:
-            if name == GROUND:
-                raise ModelError("the ground is listed by ground = [...], not as a link", path=_source(info),
-                                 element="[links] ground")
-        return {name: _names(names, f"[links] {name}", _source(info)) for name, names in value.items()}
-
-    @field_validator("joints", mode="before")
-    @classmethod
-    def _joint_shapes(cls, value: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
-        return {name: _joint(spec, f"[joints] {name}", _source(info)) for name, spec in value.items()}
-
-    @field_validator("axes", mode="before")
-    @classmethod
-    def _axis_shapes(cls, value: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
-        for name, axis in value.items():
-            where = f"[axes] {name}"
-            if (not isinstance(axis, (list, tuple)) or len(axis) != 3
-                    or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in axis)):
-                raise ModelError(f"an axis is three numbers, e.g. [0, 0, 1], got {axis!r}", path=_source(info),
-                                 element=where)
-            if unit_vector(axis) is None:
-                raise ModelError(f"{written(axis)} is not a direction (zero or not finite)", path=_source(info),
-                                 element=where)
-        return value
-
-    @field_validator("sliders", "slots", "masses", mode="before")
-    @classmethod
-    def _entry_keys(cls, value: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
-        shape = _SHAPES[info.field_name]
-        for name, spec in value.items():
-            if isinstance(spec, BaseModel):  # an entry built in code, typed already
-                continue
-            if not isinstance(spec, dict) or not set(spec) <= set(shape[0]):
-                raise ModelError(shape[1], path=_source(info), element=f"[{info.field_name}] {name}")
-        return value
-
-    @model_validator(mode="after")
-    def _references(self, info: ValidationInfo) -> LinkageSpec:
-        _check_references(self, _source(info))
-        return self
+            if not isinstance(getattr(self, key), dict):
+                raise ModelError(f"[{key}] must be a table", path=source, element=key)
+        for field in structs.fields(self):
+            value = getattr(self, field.name)
+            check = _CHECKS.get(field.name)
+            if check is not None:
+                value = check(value, field.name, source)
+            try:
+                value = _joints_typed(value) if field.name == "joints" else typed(value, field.type, (field.name,))
+            except WrongType as exc:
+                raise _as_model_error(exc, source) from None
+            structs.force_setattr(self, field.name, value)
+        _check_references(self, source)
 
     # ------------------------------------------------------------------ for programs
     @property
@@ -152,7 +102,51 @@ class LinkageSpec(BaseModel):
                 raise ModelError(f"'{name}' is not a parameter (params: {', '.join(self.params) or 'none'})",
                                  element="[params]")
         params = {**self.params, **{n: f"{float(v)!r} m" for n, v in lengths_m.items()}}
-        return linkage_spec({**self.model_dump(mode="json", by_alias=True, exclude_defaults=True), "params": params})
+        return linkage_spec({**msgspec.to_builtins(self), "params": params})
+
+
+def _param_names(value: dict[str, Any], key: str, source: str) -> dict[str, Any]:
+    for name in value:
+        check_param_name(name, source)
+    return value
+
+
+def _link_lists(value: dict[str, Any], key: str, source: str) -> dict[str, list[str]]:
+    for name in value:
+        if name == GROUND:
+            raise ModelError("the ground is listed by ground = [...], not as a link", path=source,
+                             element="[links] ground")
+    return {name: _names(names, f"[links] {name}", source) for name, names in value.items()}
+
+
+def _joint_shapes(value: dict[str, Any], key: str, source: str) -> dict[str, Any]:
+    return {name: _joint(spec, f"[joints] {name}", source) for name, spec in value.items()}
+
+
+def _joints_typed(value: dict[str, Any]) -> dict[str, Any]:
+    """Each joint as its type: coordinates, a Polar or a Compass construction (`joint_type`)."""
+    return {name: typed(spec, joint_type(spec), ("joints", name)) for name, spec in value.items()}
+
+
+def _axis_shapes(value: dict[str, Any], key: str, source: str) -> dict[str, Any]:
+    for name, axis in value.items():
+        where = f"[axes] {name}"
+        if (not isinstance(axis, (list, tuple)) or len(axis) != 3
+                or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in axis)):
+            raise ModelError(f"an axis is three numbers, e.g. [0, 0, 1], got {axis!r}", path=source, element=where)
+        if unit_vector(axis) is None:
+            raise ModelError(f"{written(axis)} is not a direction (zero or not finite)", path=source, element=where)
+    return value
+
+
+def _entry_keys(value: dict[str, Any], key: str, source: str) -> dict[str, Any]:
+    shape = _SHAPES[key]
+    for name, spec in value.items():
+        if isinstance(spec, msgspec.Struct):  # an entry built in code, typed already
+            continue
+        if not isinstance(spec, dict) or not set(spec) <= set(shape[0]):
+            raise ModelError(shape[1], path=source, element=f"[{key}] {name}")
+    return value
 
 
 _SHAPES = {
@@ -164,6 +158,7 @@ _SHAPES = {
 
 
 def _names(value: Any, where: str, source: str) -> list[str]:
+    """A list of joint names, none twice."""
     if not isinstance(value, (list, tuple)) or not all(isinstance(n, str) for n in value):
         raise ModelError(f"must be a list of joint names, e.g. [\"A\", \"B\"], got {value!r}", path=source,
                          element=where)
@@ -223,10 +218,17 @@ def linkage_spec(raw: dict[str, Any], source: str = "<linkage>") -> LinkageSpec:
     Raises:
         ModelError: one line naming `source` and the first key in error.
     """
+    if not isinstance(raw, dict):
+        raise ModelError("a linkage file is a table of keys", path=source)
+    unknown = set(raw) - _KEYS
+    if unknown:
+        raise ModelError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_KEYS))}",
+                         path=source)
+    token = _SOURCE.set(source)
     try:
-        return LinkageSpec.model_validate(raw, context={"source": source})
-    except ValidationError as exc:
-        raise _as_model_error(exc, source) from None
+        return LinkageSpec(**raw)
+    finally:
+        _SOURCE.reset(token)
 
 
 def _check_references(spec: LinkageSpec, source: str) -> None:
@@ -312,3 +314,8 @@ def _check_mass(link: str, mass: MassSpec, spec: LinkageSpec, source: str) -> No
     if not isinstance(mass.at, (str, tuple)) or (isinstance(mass.at, tuple) and len(mass.at) not in (2, 3)):
         raise ModelError(f"at = {mass.at!r}: the centre of mass is a joint's name or [x, y] (or [x, y, z]) "
                          "with units", path=source, element=where)
+
+
+#: The shape checks of the tables that have one, before their types are checked.
+_CHECKS = {"params": _param_names, "ground": _names, "balls": _names, "links": _link_lists, "joints": _joint_shapes,
+           "axes": _axis_shapes, "sliders": _entry_keys, "slots": _entry_keys, "masses": _entry_keys}

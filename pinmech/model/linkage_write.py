@@ -12,6 +12,7 @@ import re
 
 from pinmech.model.linkage_entries import Compass, MassSpec, Polar, Slider, Slot
 from pinmech.model.linkage_spec import LinkageSpec
+from pinmech.typed_values import given_fields
 
 _BARE = re.compile(r"[A-Za-z0-9_-]+")
 
@@ -53,7 +54,7 @@ def _joint(joint: tuple | Polar | Compass) -> str:
 
 def _entry(entry: Polar | Compass | Slider | Slot | MassSpec) -> str:
     """An inline table of the entry's given fields, by their file names (`from`)."""
-    fields = entry.model_dump(by_alias=True, exclude_none=True)
+    fields = given_fields(entry)
     return "{ " + ", ".join(f"{_key(k)} = {_value(v)}" for k, v in fields.items()) + " }"
 
 
