@@ -37,7 +37,7 @@ def add_force_arguments(parser: argparse.ArgumentParser) -> None:
                         help="statics: forces with zero speeds and accelerations ([forces] static = true)")
     parser.add_argument("--minimum-norm", dest="minimum_norm", action="store_true",
                         help="forces not determined: the minimum-norm reactions instead of an error "
-                             "(a scene's redundant loops are refused before; see README, Forces)")
+                             "(a scene's redundant loops are refused before; see docs/howto/forces.md)")
 
 
 def add_limits_argument(parser: argparse.ArgumentParser) -> None:

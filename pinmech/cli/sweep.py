@@ -63,7 +63,7 @@ def add_parser(sub) -> None:
                        help="solve every N-th pose and interpolate the others (quintic Hermite): less "
                        "accurate, accuracy measured; no faster than the default (the compiled core follows "
                        "every pose) "
-                       "(README: Speed and accuracy)")
+                       "(docs/explanation/speed.md)")
     sweep.add_argument("--tol", type=float, help="closure tolerance, relative to each loop's size "
                        "(default 1e-13; 1e-6 gives about 1e-6 and saves little)")
     sweep.add_argument("--max-iterations", type=int, help="Newton iteration cap per pose (default 50)")
@@ -186,7 +186,7 @@ def _timing_step(args: argparse.Namespace, scene, kind: str) -> float | None:
 
 
 def _design_summary(sweep, span: float, through_folds: bool) -> list[str]:
-    """The sweep's design diagnostics (README: Design diagnostics); the time ratio when the
+    """The sweep's design diagnostics (docs/howto/diagnostics.md); the time ratio when the
     driver made exactly one turn."""
     import math
 

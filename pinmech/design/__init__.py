@@ -1,1 +1,1 @@
-"""pinmech.solve.diagnostics: see the README's Layout."""
+"""pinmech.design: design studies and synthesis; see docs/explanation/layout.md."""

@@ -1,4 +1,4 @@
-"""Headless chromium, photographing a saved page: the README's pictures and the page tests
+"""Headless chromium, photographing a saved page: the docs' pictures and the page tests
 take the same route.
 
 The command line that works here (Debian's chromium, no GPU, no network, root): software

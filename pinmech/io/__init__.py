@@ -1,1 +1,1 @@
-"""pinmech.io: see the README's Layout."""
+"""pinmech.io: see docs/explanation/layout.md."""

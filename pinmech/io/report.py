@@ -256,7 +256,7 @@ def _assembly_lines(t: _Text, analysis: Analysis) -> None:
     sol = analysis.solution
     if sol.assembly is None:
         return
-    t.head("Assembly (sign of each loop block's Jacobian determinant; README: Assemblies)")
+    t.head("Assembly (sign of each loop block's Jacobian determinant; docs/explanation/assemblies.md)")
     for name, sign, label in zip(sol.assembly.names, sol.assembly.signs, sol.assembly.labels):
         word = "+" if sign > 0 else "-" if sign < 0 else "0"
         t.row(f"loop {name}", label if label == word else f"{label} ({word})")

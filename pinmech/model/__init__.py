@@ -1,1 +1,1 @@
-"""pinmech.model: see the README's Layout."""
+"""pinmech.model: see docs/explanation/layout.md."""

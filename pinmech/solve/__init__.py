@@ -1,1 +1,1 @@
-"""pinmech.solve: see the README's Layout."""
+"""pinmech.solve: see docs/explanation/layout.md."""

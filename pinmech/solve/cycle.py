@@ -1,6 +1,6 @@
 """A driver swept through a range: every pose closed and rated, on one assembly branch.
 
-How each pose is found is the user's accuracy choice (README, "Speed and accuracy"):
+How each pose is found is the user's accuracy choice (docs/explanation/speed.md):
 
     start="predictor" (default): from the previous exact pose moved along the path,
         q (+) (q' dx + q'' dx^2 / 2) on the configuration manifold, where q' and q''

@@ -117,7 +117,7 @@ def _centre_dict(linkage: PlanarLinkage, c: InstantCentre) -> dict:
 
 def design_lines(design: Design) -> list[str]:
     """The text report's section."""
-    title = "Design diagnostics (README: Design diagnostics)"
+    title = "Design diagnostics (docs/howto/diagnostics.md)"
     lines = ["", title, "-" * len(title)]
     if not design.applicable:
         return lines + [f"  planar diagnostics: not applicable ({design.reason})"]

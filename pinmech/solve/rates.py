@@ -53,7 +53,7 @@ METHODS = ("exact", "least_squares", "damped")
 #: Accepted damping lambda (dimensionless). Below 1e-5, lambda^2 drowns in the rounding of
 #: J J^T (the damped answer is off by about eps / lambda^2: 4e-7 at 1e-5, 8e-5 at 1e-6, and
 #: at 1e-9 the damped matrix is singular in float64); above 1e50, the bound on every
-#: quantity pinmech takes (README "Scale and speed"), lambda^2 overflows by 1e155 and the
+#: quantity pinmech takes (docs/explanation/accuracy.md), lambda^2 overflows by 1e155 and the
 #: rates underflow to denormals before that.
 DAMPING_RANGE = (1e-5, 1e50)
 #: The methods the compiled solve is asked for (csrc/rates.cpp), and the ones it reports.
