@@ -20,7 +20,8 @@ from pinmech.design.freudenstein import freudenstein_k, link_lengths
 from pinmech.design.synthesis_file import SynthesisSpec
 from pinmech.design.synthesis_fourbar import pose, rocker_jacobian
 from pinmech.design.synthesis_motion import causes, grashof_label, progress, transmission_range
-from pinmech.design.synthesis_objective import REJECTED, BatchValues
+from pinmech.design.synthesis_objective import BatchValues, batch_values
+from pinmech.design.synthesis_refine import refine
 from pinmech.design.synthesis_result import Linkage
 
 _GRID = 24  # Freudenstein starts: theta0 and phi0 every 15 deg
@@ -57,9 +58,7 @@ def evaluate_function(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Ba
     phi = np.arctan2(B[..., 1], B[..., 0] - spec.ground)
     err2 = (_wrapped(phi - wanted) / _span(spec)) ** 2
     found = causes(spec, z, s, theta)
-    found = [c or ("does not close" if not np.all(np.isfinite(err2[i])) else "") for i, c in enumerate(found)]
-    values = np.array([REJECTED if c else float(err2[i].sum()) for i, c in enumerate(found)])
-    return BatchValues(values, found, theta)
+    return batch_values(found, err2, theta)
 
 
 def freudenstein_rows(spec: SynthesisSpec) -> np.ndarray:
@@ -78,8 +77,6 @@ def freudenstein_rows(spec: SynthesisSpec) -> np.ndarray:
 def refined_function(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage | None:
     """The row x on assembly s0 refined by least squares (bounds kept), or x itself if the
     refined one has a defect; None if neither is free of them."""
-    import scipy.optimize as opt
-
     span = _span(spec)
 
     def residual(v: np.ndarray) -> np.ndarray:
@@ -95,20 +92,7 @@ def refined_function(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage |
 
     lower = np.concatenate((spec.lower, [-np.inf, -np.inf]))
     upper = np.concatenate((spec.upper, [np.inf, np.inf]))
-    candidates = []
-    try:
-        with np.errstate(all="ignore"):
-            fit = opt.least_squares(residual, np.clip(x, lower, upper), jac=jacobian, bounds=(lower, upper),
-                                    method="trf", x_scale="jac", ftol=1e-15, xtol=1e-15, gtol=1e-15, max_nfev=400)
-        candidates.append(fit.x)
-    except (np.linalg.LinAlgError, ValueError):  # a fold or an open dyad on the way: keep x
-        pass
-    candidates.append(np.asarray(x, dtype=float))
-    for v in candidates:
-        lk = _linkage(spec, v, s0, np.abs(residual(v)) * span)
-        if lk is not None:
-            return lk
-    return None
+    return refine(residual, jacobian, x, lower, upper, lambda v: _linkage(spec, v, s0, np.abs(residual(v)) * span))
 
 
 def _linkage(spec: SynthesisSpec, v: np.ndarray, s: float, errors: np.ndarray) -> Linkage | None:

@@ -36,6 +36,15 @@ class BatchValues:
     theta: np.ndarray
 
 
+def batch_values(found: list[str], err2: np.ndarray, theta: np.ndarray) -> BatchValues:
+    """The BatchValues of rows with causes found (n,), squared relative errors err2 (n, N)
+    and crank angles theta (n, N) [rad]: "does not close" added where an error is not
+    finite, the sum of err2 where accepted, else REJECTED."""
+    found = [c or ("does not close" if not np.all(np.isfinite(err2[i])) else "") for i, c in enumerate(found)]
+    values = np.array([REJECTED if c else float(err2[i].sum()) for i, c in enumerate(found)])
+    return BatchValues(values, found, theta)
+
+
 def extent(targets: np.ndarray) -> float:
     """S: the diagonal of the targets' bounding box [m], the scale of relative errors."""
     return float(np.linalg.norm(targets.max(axis=0) - targets.min(axis=0)))
@@ -98,6 +107,4 @@ def evaluate_path(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchV
     P = kinematics(spec.topology).pose(z, s, np.nan_to_num(theta)).P
     d2 = ((P - spec.targets[None]) ** 2).sum(-1) / extent(spec.targets) ** 2
     found = causes(spec, z, s, np.nan_to_num(theta))
-    found = [c or ("does not close" if not np.all(np.isfinite(d2[i])) else "") for i, c in enumerate(found)]
-    values = np.array([REJECTED if c else float(d2[i].sum()) for i, c in enumerate(found)])
-    return BatchValues(values, found, theta)
+    return batch_values(found, d2, theta)

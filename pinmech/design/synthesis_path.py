@@ -10,14 +10,13 @@ from pinmech.design.synthesis_file import SynthesisSpec
 from pinmech.design.synthesis_kinematics import kinematics
 from pinmech.design.synthesis_motion import causes, grashof_label, progress, transmission_range
 from pinmech.design.synthesis_objective import evaluate_path, extent, split
+from pinmech.design.synthesis_refine import refine
 from pinmech.design.synthesis_result import Linkage
 
 
 def refined_path(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage | None:
     """The candidate x on assembly s0 refined by least squares (bounds kept), or x itself
     if the refined one has a defect; None if neither is free of them."""
-    import scipy.optimize as opt
-
     k, width = kinematics(spec.topology), len(spec.lower)
     z, theta0 = split(x[None], width)
     theta = evaluate_path(spec, s0, x[None]).theta[0]
@@ -44,20 +43,7 @@ def refined_path(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage | Non
 
     lower = np.concatenate((spec.lower, np.full(len(v0) - width, -np.inf)))
     upper = np.concatenate((spec.upper, np.full(len(v0) - width, np.inf)))
-    candidates = []
-    try:
-        with np.errstate(all="ignore"):
-            fit = opt.least_squares(residual, np.clip(v0, lower, upper), jac=jacobian, bounds=(lower, upper),
-                                    method="trf", x_scale="jac", ftol=1e-15, xtol=1e-15, gtol=1e-15, max_nfev=400)
-        candidates.append(fit.x)
-    except (np.linalg.LinAlgError, ValueError):  # a fold or an open dyad on the way: keep x
-        pass
-    candidates.append(v0)
-    for v in candidates:
-        lk = _linkage(spec, *unpack(v), s0)
-        if lk is not None:
-            return lk
-    return None
+    return refine(residual, jacobian, v0, lower, upper, lambda v: _linkage(spec, *unpack(v), s0))
 
 
 def _linkage(spec: SynthesisSpec, z: np.ndarray, theta: np.ndarray, s: float) -> Linkage | None:

@@ -18,7 +18,8 @@ import numpy as np
 from pinmech.design.synthesis_file import SynthesisSpec
 from pinmech.design.synthesis_fourbar import link_angle_jacobian, point_jacobian, pose
 from pinmech.design.synthesis_motion import causes, grashof_label, progress, transmission_range
-from pinmech.design.synthesis_objective import REJECTED, BatchValues, extent, nearest_angles
+from pinmech.design.synthesis_objective import BatchValues, batch_values, extent, nearest_angles
+from pinmech.design.synthesis_refine import refine
 from pinmech.design.synthesis_result import Linkage
 
 
@@ -45,16 +46,12 @@ def evaluate_poses(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Batch
     d2 = ((p.P - spec.targets[None]) ** 2).sum(-1) / extent(spec.targets) ** 2
     d2 = d2 + 2 * (1 - np.cos(_coupler_angle(p) + gamma[:, None] - spec.angles[None]))
     found = causes(spec, z, s, np.nan_to_num(theta))
-    found = [c or ("does not close" if not np.all(np.isfinite(d2[i])) else "") for i, c in enumerate(found)]
-    values = np.array([REJECTED if c else float(d2[i].sum()) for i, c in enumerate(found)])
-    return BatchValues(values, found, theta)
+    return batch_values(found, d2, theta)
 
 
 def refined_poses(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage | None:
     """The row x on assembly s0 refined by least squares (bounds kept), or x itself if the
     refined one has a defect; None if neither is free of them."""
-    import scipy.optimize as opt
-
     theta = evaluate_poses(spec, s0, x[None]).theta[0]
     n, S = len(spec.targets), extent(spec.targets)
     v0 = np.concatenate((x, theta))
@@ -75,22 +72,9 @@ def refined_poses(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage | No
 
     lower = np.concatenate((spec.lower, np.full(1 + n, -np.inf)))
     upper = np.concatenate((spec.upper, np.full(1 + n, np.inf)))
-    candidates = []
-    if np.all(np.isfinite(theta)):
-        try:
-            with np.errstate(all="ignore"):
-                fit = opt.least_squares(residual, np.clip(v0, lower, upper), jac=jacobian, bounds=(lower, upper),
-                                        method="trf", x_scale="jac", ftol=1e-15, xtol=1e-15, gtol=1e-15,
-                                        max_nfev=400)
-            candidates.append(fit.x)
-        except (np.linalg.LinAlgError, ValueError):  # a fold or an open dyad on the way: keep x
-            pass
-        candidates.append(v0)
-    for v in candidates:
-        lk = _linkage(spec, v, s0)
-        if lk is not None:
-            return lk
-    return None
+    if not np.all(np.isfinite(theta)):  # a pose the coupler never comes near: nothing to refine
+        return None
+    return refine(residual, jacobian, v0, lower, upper, lambda v: _linkage(spec, v, s0))
 
 
 def _linkage(spec: SynthesisSpec, v: np.ndarray, s: float) -> Linkage | None:

@@ -18,7 +18,8 @@ import numpy as np
 
 from pinmech.design.synthesis_file import SynthesisSpec
 from pinmech.design.synthesis_motion import causes, grashof_label, progress, transmission_range
-from pinmech.design.synthesis_objective import REJECTED, BatchValues
+from pinmech.design.synthesis_objective import BatchValues, batch_values
+from pinmech.design.synthesis_refine import refine
 from pinmech.design.synthesis_result import Linkage
 from pinmech.design.synthesis_slider import loop_jacobian, pose, slide_position
 
@@ -57,16 +58,12 @@ def evaluate_slider_function(spec: SynthesisSpec, assembly: float, x: np.ndarray
     err, _ = _travel_errors(spec, z, s, theta)
     err2 = (err / _span(spec)) ** 2
     found = causes(spec, z, s, theta)
-    found = [c or ("does not close" if not np.all(np.isfinite(err2[i])) else "") for i, c in enumerate(found)]
-    values = np.array([REJECTED if c else float(err2[i].sum()) for i, c in enumerate(found)])
-    return BatchValues(values, found, theta)
+    return batch_values(found, err2, theta)
 
 
 def refined_slider_function(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage | None:
     """The row x on assembly s0 refined by least squares (bounds kept), or x itself if the
     refined one has a defect; None if neither is free of them."""
-    import scipy.optimize as opt
-
     span = _span(spec)
 
     def residual(v: np.ndarray) -> np.ndarray:
@@ -82,20 +79,7 @@ def refined_slider_function(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Li
 
     lower = np.concatenate((spec.lower, [-np.inf]))
     upper = np.concatenate((spec.upper, [np.inf]))
-    candidates = []
-    try:
-        with np.errstate(all="ignore"):
-            fit = opt.least_squares(residual, np.clip(x, lower, upper), jac=jacobian, bounds=(lower, upper),
-                                    method="trf", x_scale="jac", ftol=1e-15, xtol=1e-15, gtol=1e-15, max_nfev=400)
-        candidates.append(fit.x)
-    except (np.linalg.LinAlgError, ValueError):  # a fold or an open dyad on the way: keep x
-        pass
-    candidates.append(np.asarray(x, dtype=float))
-    for v in candidates:
-        lk = _linkage(spec, v, s0)
-        if lk is not None:
-            return lk
-    return None
+    return refine(residual, jacobian, x, lower, upper, lambda v: _linkage(spec, v, s0))
 
 
 def _linkage(spec: SynthesisSpec, v: np.ndarray, s: float) -> Linkage | None:
