@@ -53,11 +53,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from pinmech.exceptions import SceneError
+from pinmech.design.file_where import FileWhere, load_file
 from pinmech.design.study_params import AXES, DISTRIBUTIONS, Parameter
 from pinmech.units import to_si
 
-from pinmech.toml_file import read_toml
 
 KINDS = ("sensitivity", "tolerance", "grid", "workspace")
 _TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs", "batch", "grid"}
@@ -135,9 +134,7 @@ class StudySpec:
 
 def load_study(path: str | Path) -> StudySpec:
     """Read and check a study file. Raises SceneError naming the file and the key."""
-    path = Path(path)
-    raw = read_toml(path, "study", SceneError)
-    return parse_study(raw, path)
+    return load_file(path, "study", parse_study)
 
 
 def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
@@ -304,28 +301,10 @@ def _names(value: Any, where: _Where, key: str) -> tuple[str, ...]:
     return tuple(value)
 
 
-class _Where:
+class _Where(FileWhere):
     """The study file, for errors naming it and the key."""
 
-    def __init__(self, path: Path) -> None:
-        self.path = path
-
-    def error(self, key: str, message: str) -> SceneError:
-        return SceneError(message, path=str(self.path), key=key)
-
-    def known(self, table: Any, keys: set[str], key: str) -> None:
-        if not isinstance(table, dict):
-            raise self.error(key, f"must be a table, got {table!r}")
-        unknown = sorted(set(table) - keys)
-        if unknown:
-            raise self.error(key or unknown[0], f"unknown key(s) {', '.join(unknown)}; known: {', '.join(sorted(keys))}")
-
-    def whole(self, raw: dict, key: str, default: int) -> int:
-        value = raw.get(key, default)
-        low, high = _LIMITS[key]
-        if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
-            raise self.error(key, f"{key} = {value!r} must be a whole number from {low} to {high}")
-        return value
+    limits = _LIMITS
 
     def length(self, table: dict, name: str, key: str) -> float:
         return to_si(table[name], "length", where=f"{self.path}, {key}.{name}")

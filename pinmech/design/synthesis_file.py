@@ -52,8 +52,7 @@ from typing import Any
 
 import numpy as np
 
-from pinmech.exceptions import SceneError
-from pinmech.toml_file import read_toml
+from pinmech.design.file_where import FileWhere, load_file
 from pinmech.units import to_si
 
 TASKS = ("path", "function", "motion")
@@ -124,8 +123,7 @@ class SynthesisSpec:
 
 def load_synthesis(path: str | Path) -> SynthesisSpec:
     """Read and check a synthesis file. Raises SceneError naming the file and the key."""
-    path = Path(path)
-    return parse_synthesis(read_toml(path, "synthesis", SceneError), path)
+    return load_file(path, "synthesis", parse_synthesis)
 
 
 def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
@@ -251,35 +249,17 @@ def _bounds(raw: dict[str, Any], w: _Where, layout: tuple) -> tuple[np.ndarray, 
     return lower, upper
 
 
-class _Where:
+class _Where(FileWhere):
     """The synthesis file, for errors naming it and the key."""
 
-    def __init__(self, path: Path) -> None:
-        self.path = path
-
-    def error(self, key: str, message: str) -> SceneError:
-        return SceneError(message, path=str(self.path), key=key)
-
-    def known(self, table: Any, keys: set[str], key: str) -> None:
-        if not isinstance(table, dict):
-            raise self.error(key or "(top)", f"must be a table, got {table!r}")
-        unknown = sorted(set(table) - keys)
-        if unknown:
-            raise self.error(f"{key}.{unknown[0]}" if key else unknown[0],
-                             f"unknown key(s) {', '.join(unknown)}; known: {', '.join(sorted(keys))}")
+    limits = _LIMITS
+    dotted = True
 
     def choice(self, table: dict, key: str, allowed: tuple[str, ...], default: str | None, under: str = "") -> str:
         full = f"{under}.{key}" if under else key
         value = table.get(key, default)
         if value not in allowed:
             raise self.error(full, f"{key} = {value!r} is not one of {', '.join(allowed)}")
-        return value
-
-    def whole(self, raw: dict, key: str, default: int) -> int:
-        value = raw.get(key, default)
-        low, high = _LIMITS[key]
-        if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
-            raise self.error(key, f"{key} = {value!r} must be a whole number from {low} to {high}")
         return value
 
     def positive_length(self, raw: dict, key: str) -> float:

@@ -22,9 +22,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from pinmech.design.file_where import load_file
 from pinmech.design.study_file import GridAxis, _Where
-from pinmech.exceptions import SceneError
-from pinmech.toml_file import read_toml
 from pinmech.units import to_si
 
 _TOP = {"title", "scene", "kind", "batch", "workspace"}
@@ -67,8 +66,7 @@ class WorkspaceSpec:
 
 def load_workspace(path: str | Path) -> WorkspaceSpec:
     """Read and check a workspace study file. Raises SceneError naming the file and the key."""
-    path = Path(path)
-    return parse_workspace(read_toml(path, "study", SceneError), path)
+    return load_file(path, "study", parse_workspace)
 
 
 def parse_workspace(raw: dict[str, Any], path: Path) -> WorkspaceSpec:
