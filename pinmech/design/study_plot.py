@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from pinmech.design.figure_file import pyplot, save
 from pinmech.design.study import StudyResult
 from pinmech.design.tolerance import deviation
 
@@ -16,20 +17,9 @@ _SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "speed": (1e3,
           "torque": (1.0, "N m"), "force": (1.0, "N")}
 
 
-def _pyplot():
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as exc:
-        raise ImportError(f'study figures need matplotlib: pip install "pinmech[plot]" ({exc})') from exc
-    return plt
-
-
 def sensitivity_bars(result: StudyResult, path: str | Path) -> Path:
     """One panel per output: the largest |dy/dp| over the cycle for each parameter."""
-    plt = _pyplot()
+    plt = pyplot("study")
     n = len(result.outputs)
     fig, axes = plt.subplots(1, n, figsize=(3.2 * n + 1, 3.4), squeeze=False)
     for j, ax in enumerate(axes[0]):
@@ -40,13 +30,13 @@ def sensitivity_bars(result: StudyResult, path: str | Path) -> Path:
         ax.set_title(result.outputs[j])
         ax.set_xlabel(f"max |d/dp| over the cycle [{unit}/mm]")
     fig.suptitle(f"{result.spec.title}: sensitivities over the cycle of {result.driver}")
-    return _save(plt, fig, path)
+    return save(plt, fig, path)
 
 
 def tolerance_histograms(result: StudyResult, path: str | Path) -> Path:
     """One panel per output: the variants' deviation at the pose where the linear sigma is
     largest, with the linear estimate's normal density and its worst case over it."""
-    plt = _pyplot()
+    plt = pyplot("study")
     s, (_, y, causes) = result.spread, result.variants
     ok = np.array([not c for c in causes], dtype=bool)
     dev = deviation(y[ok], result.nominal, result.kinds)
@@ -69,7 +59,7 @@ def tolerance_histograms(result: StudyResult, path: str | Path) -> Path:
         ax.legend(fontsize=7)
     failed = len(causes) - int(ok.sum())
     fig.suptitle(f"{result.spec.title}: {len(causes)} variants, {failed} failed (counted by cause)")
-    return _save(plt, fig, path)
+    return save(plt, fig, path)
 
 
 def grid_figure(result: StudyResult, path: str | Path) -> Path:
@@ -83,7 +73,7 @@ def grid_figure(result: StudyResult, path: str | Path) -> Path:
     if len(axes_g) > 2:
         raise OptionRefused(f"{result.spec.path}: a grid of {len(axes_g)} parameters has no figure (1-D or 2-D only); "
                             "read the table", options=["--plot"])
-    plt = _pyplot()
+    plt = pyplot("study")
     panels = _grid_panels(result)
     failed = np.array([bool(c) for c in result.variants[2]])
     fig, axes = plt.subplots(1, len(panels), figsize=(3.8 * len(panels) + 1, 3.6), squeeze=False)
@@ -95,7 +85,7 @@ def grid_figure(result: StudyResult, path: str | Path) -> Path:
                       f"max - min over the cycle [{unit}]" if hi is not lo else f"least over the cycle [{unit}]")
         ax.set_title(title)
     fig.suptitle(f"{result.spec.title}: {len(failed)} points, {int(failed.sum())} failed (marked)")
-    return _save(plt, fig, path)
+    return save(plt, fig, path)
 
 
 def _grid_panels(result: StudyResult) -> list[tuple[str, str, np.ndarray, np.ndarray]]:
@@ -147,12 +137,4 @@ def _grid_map(fig, ax, axes_g, value: np.ndarray, failed: np.ndarray, label: str
 def _half(centres: np.ndarray) -> float:
     """Half a cell's width around evenly spaced centres (a single centre: 0.5)."""
     return float(centres[1] - centres[0]) / 2 if len(centres) > 1 else 0.5
-
-
-def _save(plt, fig, path: str | Path) -> Path:
-    """Lay the figure out, write it (format from the suffix) and close it."""
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
 

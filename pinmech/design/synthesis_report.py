@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from pinmech.design.figure_file import pyplot, save
 from pinmech.design.synthesis_kinematics import kinematics
 from pinmech.design.synthesis_linkage import motion_values
 from pinmech.design.synthesis_result import Linkage, SynthesisResult
@@ -116,23 +117,12 @@ def _errors(lk: dict) -> str:
             f"(rocker at {lk['rocker_start_deg']:.6g} deg at the first pair)")
 
 
-def _pyplot():
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as exc:
-        raise ImportError(f'synthesis figures need matplotlib: pip install "pinmech[plot]" ({exc})') from exc
-    return plt
-
-
 def figure(result: SynthesisResult, path: str | Path) -> Path:
     """One panel per linkage: the targets, the coupler curve over the motion (solid) and
     the rest of its turn on the same assembly (dotted), the linkage at the first target."""
     if result.spec.task == "function":
         return function_figure(result, path)
-    plt = _pyplot()
+    plt = pyplot("synthesis")
     n = max(len(result.linkages), 1)
     fig, axes = plt.subplots(1, n, figsize=(4.6 * n + 0.6, 4.6), squeeze=False)
     T = result.spec.targets * 1e3
@@ -181,17 +171,13 @@ def figure(result: SynthesisResult, path: str | Path) -> Path:
     if result.linkages:
         axes[0][0].legend(fontsize=7, loc="best")
     fig.suptitle(result.spec.title)
-    fig.tight_layout()
-    path = Path(path)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(plt, fig, path)
 
 
 def function_figure(result: SynthesisResult, path: str | Path) -> Path:
     """The rocker's turn (a slider-crank's block travel) against the crank's over the motion
     for each linkage, and the pairs."""
-    plt = _pyplot()
+    plt = pyplot("synthesis")
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     slider = result.spec.topology == "slider-crank"
     pairs = np.column_stack((np.degrees(result.spec.targets[:, 0]),
@@ -216,8 +202,4 @@ def function_figure(result: SynthesisResult, path: str | Path) -> Path:
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(result.spec.title)
-    fig.tight_layout()
-    path = Path(path)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(plt, fig, path)

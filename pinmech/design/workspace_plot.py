@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.design.study_plot import _pyplot
+from pinmech.design.figure_file import pyplot
 from pinmech.design.workspace import WorkspaceResult
 
 _SLICES = 4
@@ -17,7 +17,7 @@ _SLICES = 4
 
 def workspace_figure(result: WorkspaceResult, path: str | Path) -> Path:
     """A workspace map per working mode (a row of z slices each for a box grid), as PNG or SVG."""
-    plt = _pyplot()
+    plt = pyplot("study")
     from matplotlib.colors import LogNorm
 
     planes = _planes(result)
