@@ -32,6 +32,18 @@ def _study(scene: str, params: dict, points=(), links=(), steps: int = 25) -> St
     return StudyMechanism(parse_study(raw, STUDIES / "inline.toml"))
 
 
+def _implicit_and_differences(raw: dict, path: Path) -> tuple[StudyOutputs, np.ndarray, np.ndarray]:
+    """The outputs of the sensitivity study `raw` (read as if at path), dy/dp over its
+    nominal cycle by the implicit-function theorem, and central differences of re-solved
+    variants (h = 1e-6 m), both (steps, n_out, n_par)."""
+    sm = StudyMechanism(parse_study(raw, path))
+    out = StudyOutputs(sm)
+    cycle = sm.cycle(sm.nominal)
+    assert not cycle.cause, cycle.detail
+    _, dy = cycle_sensitivity(sm, out, cycle)
+    return out, dy, _resolved_differences(sm, out, 1e-6)
+
+
 def _resolved_differences(sm: StudyMechanism, outputs: StudyOutputs, h: float) -> np.ndarray:
     """(steps, n_out, n_par) central differences of variants re-solved over the cycle at p +- h e_k."""
     columns = []
@@ -148,12 +160,7 @@ def test_speed_sensitivities_are_central_differences_of_resolved_variants(scene,
         if target == "cut":
             table[name]["side"] = "child" if name in ("F", "rocker") else "parent"
     raw = {"scene": f"../scenes/{scene}", "kind": "sensitivity", "steps": 25, "params": table, "outputs": outputs}
-    sm = StudyMechanism(parse_study(raw, STUDIES / "inline.toml"))
-    out = StudyOutputs(sm)
-    cycle = sm.cycle(sm.nominal)
-    assert not cycle.cause, cycle.detail
-    _, dy = cycle_sensitivity(sm, out, cycle)
-    expected = _resolved_differences(sm, out, 1e-6)
+    out, dy, expected = _implicit_and_differences(raw, STUDIES / "inline.toml")
     scale = np.abs(expected).max(axis=(0, 2))
     assert np.all(scale > 0)
     np.testing.assert_allclose(dy, expected, rtol=0, atol=1e-6 * scale.max())
@@ -194,12 +201,7 @@ def test_mjcf_robot_yaml_and_scene_point_parameters_are_central_differences(tmp_
     |dy/dp|, plus 1e-9 absolute for the outputs a parameter does not move."""
     path = _scene_with_a_point(tmp_path) if scene.startswith("tmp:") else f"{SCENES}/{scene}"
     raw = {"scene": path, "kind": "sensitivity", "steps": 13, "params": params, "outputs": outputs}
-    sm = StudyMechanism(parse_study(raw, tmp_path / "inline.toml"))
-    out = StudyOutputs(sm)
-    cycle = sm.cycle(sm.nominal)
-    assert not cycle.cause, cycle.detail
-    _, dy = cycle_sensitivity(sm, out, cycle)
-    expected = _resolved_differences(sm, out, 1e-6)
+    out, dy, expected = _implicit_and_differences(raw, tmp_path / "inline.toml")
     scale = np.abs(expected).max(axis=(0, 2))
     assert np.abs(expected).max(axis=(0, 1)).min() > 1e-3  # every parameter moves some output
     for j, name in enumerate(out.names):
