@@ -15,12 +15,21 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "models" / "synthesis" / "four_bar_path.toml"
 
 
-def _edited(tmp_path: Path, old: str, new: str) -> Path:
-    text = EXAMPLE.read_text(encoding="utf-8")
+def _edited(tmp_path: Path, old: str, new: str, example: Path = EXAMPLE) -> Path:
+    """The example with its first `old` replaced by `new`, written as tmp_path / bad.toml."""
+    text = example.read_text(encoding="utf-8")
     assert old in text
     path = tmp_path / "bad.toml"
     path.write_text(text.replace(old, new, 1), encoding="utf-8")
     return path
+
+
+def _refused_naming_file_and_key(path: Path, key: str, capsys) -> None:
+    """`pinmech synth path` exits 4 with one line on stderr naming the file and the key."""
+    assert main(["synth", str(path)]) == 4
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "Traceback" not in err
+    assert str(path) in err and re.search(rf"[ ,]{re.escape(key)}[:,. ]", err), err
 
 
 @pytest.mark.parametrize("old, new, key", [
@@ -44,11 +53,7 @@ def _edited(tmp_path: Path, old: str, new: str) -> Path:
     ('seed = 2', 'seeds = 2', "seeds"),
 ])
 def test_a_bad_synthesis_file_is_one_line_naming_file_and_key(tmp_path, capsys, old, new, key):
-    path = _edited(tmp_path, old, new)
-    assert main(["synth", str(path)]) == 4
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "Traceback" not in err
-    assert str(path) in err and re.search(rf"[ ,]{re.escape(key)}[:,. ]", err), err
+    _refused_naming_file_and_key(_edited(tmp_path, old, new), key, capsys)
 
 
 def test_a_missing_synthesis_file_is_named(tmp_path, capsys):
@@ -96,13 +101,7 @@ FUNCTION = ROOT / "models" / "synthesis" / "four_bar_function.toml"
     ('ratio = 6', 'ratio = 6\ndirection = "cw"', "constraints.direction"),
 ])
 def test_a_bad_function_file_is_one_line_naming_file_and_key(tmp_path, capsys, old, new, key):
-    text = FUNCTION.read_text(encoding="utf-8")
-    assert old in text
-    path = tmp_path / "bad.toml"
-    path.write_text(text.replace(old, new, 1), encoding="utf-8")
-    assert main(["synth", str(path)]) == 4
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and str(path) in err and re.search(rf"[ ,]{re.escape(key)}[:,. ]", err), err
+    _refused_naming_file_and_key(_edited(tmp_path, old, new, FUNCTION), key, capsys)
 
 
 SLIDER_PATH = ROOT / "models" / "synthesis" / "slider_crank_path.toml"
@@ -119,13 +118,7 @@ SLIDER_FUNCTION = ROOT / "models" / "synthesis" / "slider_crank_function.toml"
     (SLIDER_FUNCTION, 'keep = 2', 'keep = 2\nground = "100 mm"', "ground"),
 ])
 def test_a_bad_slider_crank_file_is_one_line_naming_file_and_key(tmp_path, capsys, example, old, new, key):
-    text = example.read_text(encoding="utf-8")
-    assert old in text
-    path = tmp_path / "bad.toml"
-    path.write_text(text.replace(old, new, 1), encoding="utf-8")
-    assert main(["synth", str(path)]) == 4
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and str(path) in err and re.search(rf"[ ,]{re.escape(key)}[:,. ]", err), err
+    _refused_naming_file_and_key(_edited(tmp_path, old, new, example), key, capsys)
 
 
 def test_the_slider_crank_example_writes_a_linkage_the_engine_reproduces(tmp_path, capsys):
