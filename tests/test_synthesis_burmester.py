@@ -15,26 +15,12 @@ from pinmech.design.synthesis_fourbar import pose
 from pinmech.design.synthesis_linkage import engine_check, write_linkage
 from pinmech.design.synthesis_poses import evaluate_poses, refined_poses
 from pinmech.design.synthesis_tasks import classical_rows
+from tests._engine_poses import engine_poses
 
 ROOT = Path(__file__).resolve().parents[1]
 CRANK = np.array([65.0, 125.0, 185.0, 245.0])  # deg: four poses of the hidden crank-rocker
 WIDE_LOWER = np.array([-0.5, -0.5, -0.5, -0.5, 0.002, 0.002, 0.002, -0.5, -0.5])
 WIDE_UPPER = np.array([0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5])
-
-
-def _engine_poses(crank_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """P [m] and the coupler's angle [rad] of the bundled drawn four-bar (O2 (0, 0), O4
-    (100 mm, 0), crank 40, coupler 120, rocker 80 mm), solved by the engine."""
-    from pinmech.io.scene import Scene
-    from pinmech.io.sweep import Sweep
-
-    sweep = Sweep.from_scene(Scene.load(ROOT / "models/scenes/four_bar_drawn.toml"))
-    wanted = np.radians(crank_deg)
-    dense = np.unique(np.concatenate((np.radians(np.arange(60.0, 340.0, 1.0)), wanted)))
-    rows = {round(p.value, 12): (p.motion.points["P"].position[:2], p.motion.links["coupler"].angle)
-            for p in sweep.poses(dense)}
-    got = [rows[round(w, 12)] for w in wanted]
-    return np.array([g[0] for g in got]), np.array([g[1] for g in got])
 
 
 def _rotate(v: np.ndarray, angle: float) -> np.ndarray:
@@ -55,7 +41,7 @@ def test_centre_points_see_their_circle_point_on_one_circle():
     # carried to C_j = P_j + R(alpha_j - alpha_1)(C - P_1); (M, C) is a Burmester dyad when
     # the four C_j are at one distance from M. Rounding grows with the dyad's radius, so
     # the spread is bounded by 1e-9 of the larger of that radius and the poses' size.
-    places, angles = _engine_poses(CRANK)
+    places, angles = engine_poses(CRANK)
     M, C = dyads(places, angles)
     assert len(M) >= 40  # the curve has points for most of the 72 turns beta_2
     size = float(np.max(np.linalg.norm(places - places[0], axis=1)))
@@ -70,7 +56,7 @@ def test_centre_points_lie_on_the_inverse_motions_circle_point_curve():
     # back into the first pose's frame from each pose, m_j = P_1 + R(alpha_1 - alpha_j)(M - P_j),
     # gives four points on one circle. The hidden linkage's ground pivots O2 (0, 0) and O4
     # (0.1, 0) must pass this check (they are centre points), and every computed M too.
-    places, angles = _engine_poses(CRANK)
+    places, angles = engine_poses(CRANK)
 
     def spread(m: np.ndarray) -> float:
         back = [places[0] + _rotate(m - places[j], angles[0] - angles[j]) for j in range(4)]
@@ -92,7 +78,7 @@ def test_a_burmester_dyad_pair_carries_the_coupler_through_the_four_poses(tmp_pa
     # and written (four poses leave a two-parameter family: the refinement may slide along
     # it), the engine sweeping the written linkage meets the poses to 1e-8 of the
     # linkage's size and 1e-8 rad (the engine's Newton tolerance is far below).
-    places, angles = _engine_poses(CRANK)
+    places, angles = engine_poses(CRANK)
     spec = SynthesisSpec(Path("test.toml"), "test", "motion", "four-bar", places, None, WIDE_LOWER, WIDE_UPPER,
                          seed=1, population=15, generations=1, keep=1, angles=angles)
     rows = classical_rows(spec)

@@ -10,25 +10,11 @@ import numpy as np
 from pinmech.design.synthesis_file import SynthesisSpec
 from pinmech.design.synthesis_linkage import engine_check, write_linkage
 from pinmech.design.synthesis_search import synthesise
+from tests._engine_poses import engine_poses
 
 ROOT = Path(__file__).resolve().parents[1]
 LOWER = np.array([-0.06, -0.06, 0.04, -0.06, 0.01, 0.04, 0.02, -0.15, -0.15])
 UPPER = np.array([0.06, 0.06, 0.16, 0.06, 0.08, 0.2, 0.16, 0.15, 0.15])
-
-
-def _engine_poses(crank_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """P [m] and the coupler's angle [rad] (its bar A -> B from x) of the bundled drawn
-    four-bar, solved by the engine at these crank angles (from the scene's 60 deg, one way)."""
-    from pinmech.io.scene import Scene
-    from pinmech.io.sweep import Sweep
-
-    sweep = Sweep.from_scene(Scene.load(ROOT / "models/scenes/four_bar_drawn.toml"))
-    wanted = np.radians(crank_deg)
-    dense = np.unique(np.concatenate((np.radians(np.arange(60.0, 340.0, 1.0)), wanted)))
-    rows = {round(p.value, 12): (p.motion.points["P"].position[:2], p.motion.links["coupler"].angle)
-            for p in sweep.poses(dense)}
-    got = [rows[round(w, 12)] for w in wanted]
-    return np.array([g[0] for g in got]), np.array([g[1] for g in got])
 
 
 def test_motion_synthesis_recovers_the_bundled_four_bar(tmp_path):
@@ -36,7 +22,7 @@ def test_motion_synthesis_recovers_the_bundled_four_bar(tmp_path):
     # the bundled four-bar, from the engine. The synthesis meets them within 1e-8 of the
     # linkage's size and 1e-8 rad, and the engine sweeping the written linkage does too.
     crank = np.arange(65.0, 335.0, 45.0)
-    places, angles = _engine_poses(crank)
+    places, angles = engine_poses(crank)
     angles = angles + np.radians(30.0)
     spec = SynthesisSpec(Path("test.toml"), "test", "motion", "four-bar", places, None, LOWER, UPPER,
                          seed=1, population=15, generations=400, keep=1, angles=angles)
