@@ -15,6 +15,23 @@ SCENES = MODELS / "scenes"
 sys.path.insert(0, str(ROOT / "scripts"))
 
 
+FOUR_BAR_LENGTHS = {"crank": 0, "coupler": 1, "rocker": 2, "ground": 3}  # (a, b, c, d)
+
+
+def length_slopes(formula, values, params, nominal, h: float = 1e-6):
+    """Central differences (steps, n_par) of a hand formula(values, a, b, c, d) of the
+    four-bar over the study parameters `params` (named crank, coupler, rocker, ground),
+    each length stepped by +- h [m] from `nominal` (a, b, c, d) [m]."""
+    import numpy as np
+
+    slopes = []
+    for param in params:
+        step = np.zeros(4)
+        step[FOUR_BAR_LENGTHS[param.name]] = h
+        slopes.append((formula(values, *(nominal + step)) - formula(values, *(nominal - step))) / (2 * h))
+    return np.stack(slopes, axis=-1)
+
+
 @pytest.fixture
 def models_dir() -> Path:
     return MODELS

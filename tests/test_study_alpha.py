@@ -17,6 +17,7 @@ from pinmech.design.study_file import parse_study
 from pinmech.design.study_outputs import StudyOutputs
 from pinmech.design.study_variant import StudyMechanism
 from pinmech.exceptions import SceneError
+from tests.conftest import length_slopes
 
 STUDIES = Path(__file__).resolve().parents[1] / "models" / "studies"
 OMEGA2 = 4 * np.pi  # the scene's 120 rpm, constant: alpha2 = 0
@@ -71,15 +72,7 @@ def test_rocker_alpha_and_its_sensitivity_are_nortons_closed_form():
     expected = norton_alpha4(cycle.values, *nominal)
     np.testing.assert_allclose(y[:, 1], expected, rtol=0, atol=1e-8)
     assert np.abs(expected).max() > 100  # a real acceleration, not a zero compared with a zero
-    order = {"crank": 0, "coupler": 1, "rocker": 2, "ground": 3}
-    h = 1e-6
-    slopes = []
-    for param in sm.spec.params:
-        step = np.zeros(4)
-        step[order[param.name]] = h
-        slopes.append((norton_alpha4(cycle.values, *(nominal + step))
-                       - norton_alpha4(cycle.values, *(nominal - step))) / (2 * h))
-    slopes = np.stack(slopes, axis=-1)
+    slopes = length_slopes(norton_alpha4, cycle.values, sm.spec.params, nominal, h=1e-6)
     np.testing.assert_allclose(dy[:, 1], slopes, rtol=0, atol=1e-7 * np.abs(slopes).max())
     for k, place in enumerate(sm.placements):  # the model keeps the nominal afterwards
         assert place.read() == sm.nominal[k]

@@ -16,6 +16,7 @@ from pinmech.design.study_file import parse_study
 from pinmech.design.study_outputs import StudyOutputs
 from pinmech.design.study_variant import StudyMechanism
 from pinmech.exceptions import SceneError
+from tests.conftest import length_slopes
 
 STUDIES = Path(__file__).resolve().parents[1] / "models" / "studies"
 OMEGA2 = 4 * np.pi  # models/scenes/four_bar_dynamic.toml: 120 rpm, gravity 9.81 m/s^2 along -y,
@@ -52,14 +53,7 @@ def test_driver_torque_and_its_sensitivity_are_newton_euler_by_hand():
     y, dy = cycle_sensitivity(sm, outputs, cycle)
     nominal = np.array([0.04, 0.12, 0.08, 0.10])  # a, b, c, d
     np.testing.assert_allclose(y[:, 0], hand_torque(cycle.values, *nominal), rtol=0, atol=1e-10)
-    order = {"crank": 0, "coupler": 1, "rocker": 2, "ground": 3}
-    h, slopes = 1e-6, []
-    for param in sm.spec.params:
-        step = np.zeros(4)
-        step[order[param.name]] = h
-        slopes.append((hand_torque(cycle.values, *(nominal + step))
-                       - hand_torque(cycle.values, *(nominal - step))) / (2 * h))
-    slopes = np.stack(slopes, axis=-1)
+    slopes = length_slopes(hand_torque, cycle.values, sm.spec.params, nominal, h=1e-6)
     assert np.abs(slopes).max() > 1.0  # the lengths do move the torque
     np.testing.assert_allclose(dy[:, 0], slopes, rtol=0, atol=1e-6 * np.abs(slopes).max())
 
