@@ -148,19 +148,8 @@ nb::tuple Core::follow(double p0, const VectorXd& q0, const VectorXd& d1, const 
   int stop = DONE;
   {
     nb::gil_scoped_release release;
-    PathSpec path;
-    path.x0 = x0;
-    path.d = d;
-    path.unit = unit;
-    path.d_hat = d / unit;
-    path.scalar = pivots_;
-    Node node;
-    node.p = p0;
-    node.q = q0;
-    node.d1 = d1;
-    node.d2 = d2;
-    node.signs = signs0;
-    node.condition = condition0;
+    PathSpec path = make_path(x0, d, unit, false, pivots_);
+    Node node = start_node(p0, q0, d1, d2, signs0, condition0);
     for (; done < n && stop == DONE; ++done) {
       PathResult out;
       follow_path(node, targets(done), path, out);

@@ -157,6 +157,32 @@ struct PathSpec {
   double ds = 1e-3;         // the curve's adaptive pivot step
 };
 
+// A path along drivers x(p) = x0 + p d, `unit` the drivers' size (radians or lengths) a unit of p.
+inline PathSpec make_path(const VectorXd& x0, const VectorXd& d, double unit, bool through_folds,
+                          const std::vector<int>& scalar) {
+  PathSpec path;
+  path.x0 = x0;
+  path.d = d;
+  path.unit = unit;
+  path.d_hat = d / unit;
+  path.through_folds = through_folds;
+  path.scalar = scalar;
+  return path;
+}
+
+// The node a path starts from: its p, pose, path derivatives, signature and condition number.
+inline Node start_node(double p, const VectorXd& q, const VectorXd& d1, const VectorXd& d2,
+                       const std::vector<int>& signs, double condition) {
+  Node node;
+  node.p = p;
+  node.q = q;
+  node.d1 = d1;
+  node.d2 = d2;
+  node.signs = signs;
+  node.condition = condition;
+  return node;
+}
+
 // How Path.follow ended (pivot.cpp). Python builds the named error from it.
 enum PathStatus { PATH_DONE = 0, PATH_STUCK = 1, PATH_FOLD = 2, PATH_SINGULAR = 3 };
 // Why a path is stuck (continuation.py words them): 1-5 the last failed step's reason
@@ -272,6 +298,8 @@ class Core {
   void polish(VectorXd& q, VectorXd& r, double& norm);
   double turn_between(const Node& a, const Node& b, double unit) const;
   bool newton_update(VectorXd& q, VectorXd& r, double& norm);
+  // q + step taken (q, r, norm updated) where its residual is below norm; else q untouched.
+  bool lowered(VectorXd& q, const VectorXd& step, VectorXd& r, double& norm);
   bool pivot_follow(const Node& node, double p_target, PathSpec& path, int why, PathResult& out);
   bool stuck(const Node& node, int why, PathResult& out) const;
   bool land_kept(const Node& start, CurvePoint a, CurvePoint b, double p_target, bool folded, PathSpec& path,

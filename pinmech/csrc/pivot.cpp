@@ -21,6 +21,17 @@
 namespace pinmech {
 
 // ---------------------------------------------------------------- close
+bool Core::lowered(VectorXd& q, const VectorXd& step, VectorXd& r, double& norm) {
+  move_into(q, step, q_new_);
+  residual_into(q_new_, r_new_);
+  const double trial = max_abs(r_new_);
+  if (!(trial < norm)) return false;
+  q.swap(q_new_);
+  r.swap(r_new_);
+  norm = trial;
+  return true;
+}
+
 bool Core::newton_update(VectorXd& q, VectorXd& r, double& norm) {
   // Jdep_ holds the Newton Jacobian at q (jacobian_into(true))
   if (Jdep_.rows() == Jdep_.cols()) {
@@ -28,15 +39,7 @@ bool Core::newton_update(VectorXd& q, VectorXd& r, double& norm) {
     square_.factor(Jdep_);
     square_.solve(rhs_, dstep_);
     if (dstep_.allFinite()) {
-      move_into(q, dstep_, q_new_);
-      residual_into(q_new_, r_new_);
-      const double trial = max_abs(r_new_);
-      if (trial < norm) {
-        q.swap(q_new_);
-        r.swap(r_new_);
-        norm = trial;
-        return true;
-      }
+      if (lowered(q, dstep_, r, norm)) return true;
       residual_into(q, r);
     }
   }
@@ -46,17 +49,8 @@ bool Core::newton_update(VectorXd& q, VectorXd& r, double& norm) {
   svd.setThreshold(std::numeric_limits<double>::epsilon() * double(std::max(Jdep_.rows(), Jdep_.cols())));
   const VectorXd step = svd.solve(VectorXd(-r));
   double alpha = 1.0;
-  for (int k = 0; k < 30; ++k, alpha *= 0.5) {
-    move_into(q, alpha * step, q_new_);
-    residual_into(q_new_, r_new_);
-    const double trial = max_abs(r_new_);
-    if (trial < norm) {
-      q.swap(q_new_);
-      r.swap(r_new_);
-      norm = trial;
-      return true;
-    }
-  }
+  for (int k = 0; k < 30; ++k, alpha *= 0.5)
+    if (lowered(q, alpha * step, r, norm)) return true;
   residual_into(q, r);  // data back at q
   return false;
 }
@@ -423,20 +417,8 @@ nb::tuple Core::follow_path_py(double p0, const VectorXd& q0, const VectorXd& d1
   if (Index(dep_v_.size()) != rows_) throw std::invalid_argument("the dependent Jacobian must be square");
   for (int v : scalar)
     if (v < 0 || v >= model_.nv) throw std::invalid_argument("pivot index not in the model");
-  PathSpec path;
-  path.x0 = x0;
-  path.d = d;
-  path.unit = unit;
-  path.d_hat = d / unit;
-  path.through_folds = through_folds;
-  path.scalar = scalar;
-  Node node;
-  node.p = p0;
-  node.q = q0;
-  node.d1 = d1;
-  node.d2 = d2;
-  node.signs = signs0;
-  node.condition = condition0;
+  PathSpec path = make_path(x0, d, unit, through_folds, scalar);
+  Node node = start_node(p0, q0, d1, d2, signs0, condition0);
   PathResult out;
   {
     nb::gil_scoped_release release;
