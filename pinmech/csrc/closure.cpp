@@ -117,10 +117,12 @@ VectorXd Core::residual(const VectorXd& q) {
   return r;
 }
 
-// The independent closure rows at q; leaves joint placements, Jacobians and the cut
-// frames' placements in data_ (LoopSolver._residual).
+// The independent closure rows at q; leaves joint placements and the cut frames'
+// placements in data_ (LoopSolver._residual). The joint Jacobians at q follow at the first
+// jacobian_into (most residuals are the last of a Newton solve, no Jacobian needed).
 void Core::residual_into(const VectorXd& q, VectorXd& r) {
-  pin::computeJointJacobians(model_, data_, q);
+  pin::forwardKinematics(model_, data_, q);
+  joint_jacobians_ = false;
   for (const Cut& cut : cuts_) {
     pin::updateFramePlacement(model_, data_, cut.parent);
     pin::updateFramePlacement(model_, data_, cut.child);
@@ -141,8 +143,13 @@ MatrixXd Core::jacobian(bool newton) {
 }
 
 
-// J_ = the stacked rows' Jacobian, Jdep_ its dependent columns (data_ at q).
+// J_ = the stacked rows' Jacobian, Jdep_ its dependent columns at the q of the last
+// residual_into; data_ then has the joint Jacobians at q too.
 void Core::jacobian_into(bool newton) {
+  if (!joint_jacobians_) {
+    pin::computeJointJacobians(model_, data_);  // from the placements residual_into left
+    joint_jacobians_ = true;
+  }
   for (const Cut& cut : cuts_) relative_jacobian(cut, newton);
   for (size_t i = 0; i < dep_v_.size(); ++i) Jdep_.col(Index(i)) = J_.col(dep_v_[i]);
 }
