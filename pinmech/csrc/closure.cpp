@@ -63,6 +63,7 @@ Core::Core(nb::object model, const std::vector<int>& frame_ids, const std::vecto
     cuts_.push_back(cut);
   }
   rows_ = offset;
+  errors_.assign(ncuts, Vector6d::Zero());
   const Index nv = model_.nv;
   if (v_scale.size() != nv) throw std::invalid_argument("velocity scale of the wrong size");
   for (const auto* indices : {&drv_v_, &dep_v_})
@@ -123,16 +124,20 @@ VectorXd Core::residual(const VectorXd& q) {
 void Core::residual_into(const VectorXd& q, VectorXd& r) {
   pin::forwardKinematics(model_, data_, q);
   joint_jacobians_ = false;
-  for (const Cut& cut : cuts_) {
+  for (size_t c = 0; c < cuts_.size(); ++c) {
+    const Cut& cut = cuts_[c];
     pin::updateFramePlacement(model_, data_, cut.parent);
     pin::updateFramePlacement(model_, data_, cut.child);
-    r.segment(cut.offset, cut.rows6.rows()).noalias() = cut.rows6 * error6(cut);
+    errors_[c] = error6(cut);
+    // lazyProduct: at most 6 x 6, coefficient by coefficient (not the general matrix-vector kernel)
+    r.segment(cut.offset, cut.rows6.rows()).noalias() = cut.rows6.lazyProduct(errors_[c]);
   }
 }
 
+// Every selected row's largest |value| at the q of the last residual_into (its errors).
 double Core::full_residual() const {
   double worst = 0.0;
-  for (const Cut& cut : cuts_) worst = std::max(worst, max_abs(cut.full * error6(cut)));
+  for (size_t c = 0; c < cuts_.size(); ++c) worst = std::max(worst, max_abs(cuts_[c].full.lazyProduct(errors_[c])));
   return worst;
 }
 
@@ -179,7 +184,7 @@ void Core::drift_into(const VectorXd& q, const VectorXd& v, VectorXd& out) {
     Vector6d e;
     e.head<3>() = MP.rotation().transpose() * (d_dot - wP.cross(d));
     e.tail<3>() = MP.rotation().transpose() * (aC.angular() - aP.angular() - wP.cross(vC.angular() - wP));
-    out.segment(cut.offset, cut.rows6.rows()).noalias() = cut.rows6 * e;
+    out.segment(cut.offset, cut.rows6.rows()).noalias() = cut.rows6.lazyProduct(e);
   }
 }
 
@@ -276,16 +281,16 @@ void Core::relative_jacobian(const Cut& cut, bool newton) {
     const Vector3d w = data_.J.col(c.extended).tail<3>();
     e.head<3>().noalias() = RT * (data_.J.col(c.extended).head<3>() + w.cross(pC));
     e.tail<3>().noalias() = MRT * w;
-    if (cut.shared_columns) J_.block(cut.offset, c.v, k, 1).noalias() += cut.rows6 * e;
-    else J_.block(cut.offset, c.v, k, 1).noalias() = cut.rows6 * e;
+    if (cut.shared_columns) J_.block(cut.offset, c.v, k, 1).noalias() += cut.rows6.lazyProduct(e);
+    else J_.block(cut.offset, c.v, k, 1).noalias() = cut.rows6.lazyProduct(e);
   }
   for (const JointColumn& c : cut.parent_cols) {  // minus P's frame velocity at P, and P turning delta
     const Vector3d w = data_.J.col(c.extended).tail<3>();
     const Vector3d v = data_.J.col(c.extended).head<3>() + w.cross(pP);
     e.head<3>().noalias() = RT * (delta.cross(w) - v);
     e.tail<3>().noalias() = -(MRT * w);
-    if (cut.shared_columns) J_.block(cut.offset, c.v, k, 1).noalias() += cut.rows6 * e;
-    else J_.block(cut.offset, c.v, k, 1).noalias() = cut.rows6 * e;
+    if (cut.shared_columns) J_.block(cut.offset, c.v, k, 1).noalias() += cut.rows6.lazyProduct(e);
+    else J_.block(cut.offset, c.v, k, 1).noalias() = cut.rows6.lazyProduct(e);
   }
 }
 

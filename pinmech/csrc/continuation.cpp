@@ -81,20 +81,21 @@ void Core::node_at(Node& node, const VectorXd& d, const VectorXd* a_drv) {
   v.setZero(model_.nv);
   a.setZero(model_.nv);
   for (size_t i = 0; i < drv_v_.size(); ++i) v(drv_v_[i]) = d(Index(i));
-  rhs_.noalias() = -(J_ * v);  // driver columns only: v is zero elsewhere yet
+  rhs_.setZero();
+  for (size_t i = 0; i < drv_v_.size(); ++i) rhs_.noalias() -= J_.col(drv_v_[i]) * d(Index(i));  // v's only nonzeros yet
   square_.solve(rhs_, dstep_);
   for (size_t i = 0; i < dep_v_.size(); ++i) v(dep_v_[i]) = dep_scale_(Index(i)) * dstep_(Index(i));
   drift_into(node.q, v, drift_);
   rhs_ = -drift_;
   if (a_drv != nullptr) {
     for (size_t i = 0; i < drv_v_.size(); ++i) a(drv_v_[i]) = (*a_drv)(Index(i));
-    rhs_.noalias() -= J_ * a;  // driver columns only: a is zero elsewhere yet
+    for (size_t i = 0; i < drv_v_.size(); ++i) rhs_.noalias() -= J_.col(drv_v_[i]) * a(drv_v_[i]);  // a's only nonzeros yet
   }
   square_.solve(rhs_, dstep_);
   for (size_t i = 0; i < dep_v_.size(); ++i) a(dep_v_[i]) = dep_scale_(Index(i)) * dstep_(Index(i));
-  rhs_.noalias() = J_ * v;
+  rhs_.noalias() = J_.lazyProduct(v);  // small: coefficient by coefficient
   node.velocity_residual = max_abs(rhs_);
-  rhs_.noalias() = J_ * a;
+  rhs_.noalias() = J_.lazyProduct(a);
   rhs_ += drift_;
   node.acceleration_residual = max_abs(rhs_);
 }

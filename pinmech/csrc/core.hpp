@@ -342,6 +342,7 @@ class Core {
   ConditionWork condition_work_;
   double tol_;
   bool joint_jacobians_ = false;  // data_.J is at the q of the last residual_into
+  std::vector<Vector6d, Eigen::aligned_allocator<Vector6d>> errors_;  // each cut's error6 there
   int iterations_ = 0;
   double moved_ = 0.0;
   std::vector<int> pivots_;
