@@ -9,6 +9,8 @@ import numpy as np
 from pinmech.design.burmester import four_bar_rows
 from pinmech.design.synthesis_file import SynthesisSpec
 from pinmech.design.synthesis_function import evaluate_function, freudenstein_rows, function_bounds, refined_function
+from pinmech.design.synthesis_inverted_function import (evaluate_inverted_function, inverted_function_bounds,
+                                                        refined_inverted_function)
 from pinmech.design.synthesis_objective import BatchValues, evaluate_path, path_bounds
 from pinmech.design.synthesis_path import refined_path
 from pinmech.design.synthesis_poses import evaluate_poses, poses_bounds, refined_poses
@@ -18,26 +20,31 @@ from pinmech.design.synthesis_slider_function import (evaluate_slider_function, 
 
 
 def _task(spec: SynthesisSpec) -> str:
-    """The task's key: "slider function" for a slider-crank's function (its own rows)."""
-    return "slider function" if spec.task == "function" and spec.topology == "slider-crank" else spec.task
+    """The task's key: "slider function" for a slider-crank's function, "inverted function" for an
+    inverted slider-crank's (their own rows)."""
+    if spec.task == "function" and spec.topology != "four-bar":
+        return {"slider-crank": "slider function", "inverted-slider-crank": "inverted function"}[spec.topology]
+    return spec.task
 
 
 def search_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
     """The bounds of the task's search rows."""
     return {"function": function_bounds, "motion": poses_bounds,
-            "slider function": slider_function_bounds}.get(_task(spec), path_bounds)(spec)
+            "slider function": slider_function_bounds, "inverted function": inverted_function_bounds}.get(_task(spec), path_bounds)(spec)
 
 
 def evaluate(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchValues:
     """The task's objective of rows x on one assembly (a Dask task)."""
     return {"function": evaluate_function, "motion": evaluate_poses,
-            "slider function": evaluate_slider_function}.get(_task(spec), evaluate_path)(spec, assembly, x)
+            "slider function": evaluate_slider_function,
+            "inverted function": evaluate_inverted_function}.get(_task(spec), evaluate_path)(spec, assembly, x)
 
 
 def refined(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Linkage | None:
     """Row x refined with the exact Jacobian, checked for defects (None: it has one)."""
     return {"function": refined_function, "motion": refined_poses,
-            "slider function": refined_slider_function}.get(_task(spec), refined_path)(spec, assembly, x)
+            "slider function": refined_slider_function,
+            "inverted function": refined_inverted_function}.get(_task(spec), refined_path)(spec, assembly, x)
 
 
 def classical_rows(spec: SynthesisSpec) -> np.ndarray:
@@ -45,7 +52,7 @@ def classical_rows(spec: SynthesisSpec) -> np.ndarray:
     pairs for four poses, those within the bounds), best first."""
     if spec.task == "function" and spec.topology == "four-bar":
         return freudenstein_rows(spec)
-    if spec.task == "motion" and len(spec.targets) == 4:
+    if spec.task == "motion" and spec.topology == "four-bar" and len(spec.targets) == 4:
         rows = four_bar_rows(spec.targets, spec.angles)
         inside = np.all((rows[:, :9] >= spec.lower) & (rows[:, :9] <= spec.upper), axis=1)
         return rows[inside]
