@@ -92,3 +92,26 @@ def test_the_slider_cranks_folds_are_where_the_rod_is_square_to_the_slide():
         p = pose(z, np.array([s]), outside[None])
         rod = p.B[0] - p.A[0]
         assert p.closes.all() and np.all(np.abs(rod[:, 0]) < 1e-5) and np.allclose(np.abs(rod[:, 1]), 0.05, atol=1e-9)
+
+
+def test_motion_synthesis_recovers_the_bundled_slider_crank(tmp_path):
+    # Seven poses of the bundled rod: the place of its point 60 mm along A -> B and 20 mm to
+    # its left, and a part's angle 17 deg from the rod's line, from the engine's A and B.
+    # The linkage hidden, the search (the rod's angle offset gamma searched too) meets the
+    # places within 1e-8 of the linkage's size and the angles within 1e-8 rad; the engine,
+    # sweeping the written linkage, reports the rod's point and angle as closely.
+    crank = CRANK[:7]
+    A, B = _engine_pins(tmp_path, crank)
+    w = (B - A) / np.linalg.norm(B - A, axis=1)[:, None]
+    places = A + 0.06 * w + 0.02 * np.stack((-w[:, 1], w[:, 0]), -1)
+    angles = np.arctan2(w[:, 1], w[:, 0]) + math.radians(17.0)
+    lower = np.array([-0.06, -0.06, math.radians(-30), -0.1, 0.01, 0.04, -0.15, -0.15])
+    upper = np.array([0.06, 0.06, math.radians(30), 0.1, 0.08, 0.2, 0.15, 0.15])
+    spec = SynthesisSpec(Path("test.toml"), "test", "motion", "slider-crank", places, None, lower, upper,
+                         seed=1, population=15, generations=400, keep=1, angles=angles)
+    best = synthesise(spec).linkages[0]
+    assert best.topology == "slider-crank" and best.task == "motion" and best.meets(1e-8)
+    np.testing.assert_allclose(best.z[3:6], [0.05, 0.04, 0.13], atol=1e-8 * 0.13)  # offset, crank, rod: the hidden
+    _, scene = write_linkage(best, tmp_path / "found", "found", "test.toml")
+    check = engine_check(scene, best, places, angles)
+    assert check.errors.max() <= 1e-8 * best.size and check.angle_errors.max() <= 1e-8
