@@ -11,7 +11,10 @@ slot, pinned to the crank at A) at `along` u and `across` n from A.
 At a crank angle theta, A = O2 + crank e(theta) and A - O4 = x u + offset n (A on the slot's
 line, x its place along the slot from the foot F = O4 + offset n): with D = |A - O4|,
 x = s sqrt(D^2 - offset^2) and phi = atan2(A - O4) - atan2(offset, x). The assembly s = +1
-puts A ahead of the foot along u, s = -1 behind. It closes while D >= |offset|; D depends
+puts A ahead of the foot along u, s = -1 behind: the same linkage as s = +1 with the offset's
+sign changed (u and n turned half a turn), so the search takes s = +1 alone (ASSEMBLIES),
+the guide's direction u pointing from the slot's foot towards the crank's pin, and the
+offset's sign saying on which side of O4 the slot passes. It closes while D >= |offset|; D depends
 on theta through cos(theta - g) alone (g the direction O2 -> O4), so the folds, where
 D = |offset| (the slot's line through A square to O4 -> A: the block cannot be pushed
 along it, and the two assemblies meet), are at cos(theta - g) = (crank^2 + L^2 -
@@ -35,9 +38,12 @@ import numpy as np
 
 from pinmech.design.synthesis_fourbar import FourBarPose, ground_angle
 
-__all__ = ["NAMES", "pose", "guide_angle", "folds", "ground_angle", "label", "lengths", "size", "loop_jacobian",
+__all__ = ["ASSEMBLIES", "NAMES", "pose", "guide_angle", "folds", "ground_angle", "label", "lengths", "size", "loop_jacobian",
            "point_jacobian", "guide_jacobian"]
 
+#: The assemblies searched: s = -1 with an offset e is s = +1 with -e (u, n and x turned
+#: half a turn: A - O4 = x u + e n = (-x)(-u) + (-e)(-n)), the same linkage; so one.
+ASSEMBLIES = (1.0,)
 #: Names of an inverted slider-crank candidate's entries, in order.
 NAMES = ("O2x", "O2y", "O4x", "O4y", "crank", "offset", "along", "across")
 _PERP = np.array([[0.0, -1.0], [1.0, 0.0]])

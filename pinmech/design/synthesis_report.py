@@ -30,7 +30,7 @@ def linkage_summary(lk: Linkage) -> dict:
     where = f"{'ahead of' if lk.s > 0 else 'behind'} A's foot on the slide" if slider else f"{side} of A -> O4"
     fold = "the rod square to the slide" if slider else "coupler and rocker in line"
     if inverted:
-        where = f"A {'ahead of' if lk.s > 0 else 'behind'} the slot's foot F along the guide"
+        where = f"= F, the slot's foot, {'behind' if lk.s > 0 else 'ahead of'} the crank's pin A along the guide"
         fold = "|O4 A| = |offset|, the slot square to O4 -> A"
     shape = ({"dimensions_mm": {n: round(float(v) * 1e3, 9) for n, v in zip(kinematics(lk.topology).NAMES, lk.z)
                                 if n != "slide"}, "slide_deg": round(math.degrees(lk.z[2]), 9)} if slider else
@@ -152,11 +152,21 @@ def figure(result: SynthesisResult, path: str | Path) -> Path:
             ax.plot(*np.array([O2, A, B]).T, "-o", color="k", lw=1.4, ms=3)
             ax.plot(*B, "s", color="k", ms=9, mfc="none")
             ax.plot(*O2, "^", color="k", ms=8)
+        elif lk.topology == "inverted-slider-crank":  # the guide O4 -> F and its slot past A, the block at A
+            O4 = lk.z[2:4] * 1e3
+            u = (A - B) / max(float(np.linalg.norm(A - B)), 1e-12)
+            ax.plot(*np.array([O4, B, A + 0.3 * lk.size * 1e3 * u]).T, "-", color="0.4", lw=1.4)
+            ax.plot(*np.array([O2, A]).T, "-o", color="k", lw=1.4, ms=3)
+            ax.plot(*A, "s", color="k", ms=9, mfc="none")
+            ax.plot(*np.array([O2, O4]).T, "^", color="k", ms=8)
         else:
             O4 = lk.z[2:4] * 1e3
             ax.plot(*np.array([O2, A, B, O4]).T, "-o", color="k", lw=1.4, ms=3)
             ax.plot(*np.array([O2, O4]).T, "^", color="k", ms=8)
-        ax.fill(*np.array([A, B, P]).T, color="tab:orange", alpha=0.3)
+        if lk.topology == "inverted-slider-crank":  # P on the block, at A
+            ax.plot(*np.array([A, P]).T, "-", color="tab:orange", lw=3, alpha=0.6)
+        else:
+            ax.fill(*np.array([A, B, P]).T, color="tab:orange", alpha=0.3)
         ax.plot(T[:, 0], T[:, 1], "x", color="tab:red", ms=8, mew=2, label="targets")
         if result.spec.angles is not None:  # the poses' angles, and the coupler's at each pose
             L = 0.15 * float(np.ptp(T, axis=0).max())

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from pinmech.design.synthesis_file import SynthesisSpec, load_synthesis
+from pinmech.design.synthesis_kinematics import kinematics
 from pinmech.design.synthesis_result import Linkage, SynthesisResult
 from pinmech.design.synthesis_tasks import classical_rows, evaluate, refined, search_bounds
 
@@ -86,7 +87,7 @@ def _run(spec: SynthesisSpec, mapper: PopulationMap) -> SynthesisResult:
     until the assembly's generations are spent; the best distinct refined, best first."""
     found: list[Linkage] = []
     generations = 0
-    for assembly in (1.0, -1.0):
+    for assembly in getattr(kinematics(spec.topology), "ASSEMBLIES", (1.0, -1.0)):
         mapper.assembly = assembly
         left, restart = spec.generations, 0
         while left > 0 and not any(lk.meets(_MET) for lk in found):
