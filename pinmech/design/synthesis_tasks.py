@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from pinmech.design.burmester import four_bar_rows
+from pinmech.design.slider_three_poses import slider_crank_rows
 from pinmech.design.synthesis_file import SynthesisSpec
 from pinmech.design.synthesis_function import evaluate_function, freudenstein_rows, function_bounds, refined_function
 from pinmech.design.synthesis_inverted_function import (evaluate_inverted_function, inverted_function_bounds,
@@ -49,11 +50,17 @@ def refined(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Linkage | No
 
 def classical_rows(spec: SynthesisSpec) -> np.ndarray:
     """Rows from the classical closed forms (Freudenstein for functions, Burmester's dyad
-    pairs for four poses, those within the bounds), best first."""
+    pairs for four poses of a four-bar, the slider-crank's three-pose construction, those
+    within the bounds), best first."""
     if spec.task == "function" and spec.topology == "four-bar":
         return freudenstein_rows(spec)
     if spec.task == "motion" and spec.topology == "four-bar" and len(spec.targets) == 4:
         rows = four_bar_rows(spec.targets, spec.angles)
         inside = np.all((rows[:, :9] >= spec.lower) & (rows[:, :9] <= spec.upper), axis=1)
+        return rows[inside]
+    if spec.task == "motion" and spec.topology == "slider-crank" and len(spec.targets) == 3:
+        reach = spec.upper[5] + float(np.abs(np.concatenate((spec.lower[6:], spec.upper[6:]))).max())  # |B - P|
+        rows = slider_crank_rows(spec.targets, spec.angles, spec.lower[:2], spec.upper[:2], reach)[:, :9]
+        inside = np.all((rows[:, :8] >= spec.lower) & (rows[:, :8] <= spec.upper), axis=1)
         return rows[inside]
     return np.zeros((0, len(search_bounds(spec))))
