@@ -99,8 +99,8 @@ def slider_crank_row(places: np.ndarray, angles: np.ndarray, a: np.ndarray, b: n
 def slider_crank_rows(places: np.ndarray, angles: np.ndarray, low: np.ndarray, high: np.ndarray, reach: float,
                       grid: int = 9, turns: int = 24) -> np.ndarray:
     """Rows (k, 10) of `slider_crank_row` (its assembly last) for crank pivots O2 at the
-    centres of a grid x grid of cells over the box low..high (2,) [m] and `turns` slider points on the circle's arc within
-    `reach` [m] of P (the arc where |b| <= reach: a few poses close together make the circle
+    centres of a grid x grid of cells over the box low..high (2,) [m] and `turns` slider
+    points on the circle's arc within `reach` [m] of P (the arc where |b| <= reach: a few poses close together make the circle
     large, and most of it gives rods far too long).
 
     A centre point O2 gives its circle point a by the inverse motion: seen from the rod, O2

@@ -171,8 +171,9 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
     angles = None
     if task == "motion":
         targets, angles = targets[:, :2].copy(), targets[:, 2].copy()
+    classes = CLASSES if topology == "four-bar" else SLIDER_CLASSES
     return SynthesisSpec(path, str(raw.get("title", path.stem)), task, topology, targets, timing, lower, upper,
-                         w.choice(c, "grashof", CLASSES if topology == "four-bar" else SLIDER_CLASSES, "any", "constraints"), ground,
+                         w.choice(c, "grashof", classes, "any", "constraints"), ground,
                          transmission, float(ratio), direction, angles=angles, **counts)
 
 

@@ -38,8 +38,8 @@ import numpy as np
 
 from pinmech.design.synthesis_fourbar import FourBarPose, ground_angle
 
-__all__ = ["ASSEMBLIES", "NAMES", "pose", "guide_angle", "folds", "ground_angle", "label", "lengths", "size", "loop_jacobian",
-           "point_jacobian", "guide_jacobian"]
+__all__ = ["ASSEMBLIES", "NAMES", "pose", "guide_angle", "folds", "ground_angle", "label", "lengths", "size",
+           "loop_jacobian", "point_jacobian", "guide_jacobian"]
 
 #: The assemblies searched: s = -1 with an offset e is s = +1 with -e (u, n and x turned
 #: half a turn: A - O4 = x u + e n = (-x)(-u) + (-e)(-n)), the same linkage; so one.

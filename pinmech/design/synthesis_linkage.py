@@ -1,6 +1,7 @@
-"""A synthesised four-bar (slider-crank, inverted slider-crank) written as a drawn linkage (models/linkages/*.toml) with a scene
-that sweeps its crank through the targets, and checked by the engine: the scene solved by
-continuation from the first target's pose, the coupler point read at every target.
+"""A synthesised four-bar (slider-crank, inverted slider-crank) written as a drawn linkage
+(models/linkages/*.toml) with a scene that sweeps its crank through the targets, and checked
+by the engine: the scene solved by continuation from the first target's pose, the coupler
+point read at every target.
 
 The drawn linkage is written by the drawn linkage's own writer (model/linkage_write.py).
 """

@@ -30,8 +30,8 @@ def _task(spec: SynthesisSpec) -> str:
 
 def search_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
     """The bounds of the task's search rows."""
-    return {"function": function_bounds, "motion": poses_bounds,
-            "slider function": slider_function_bounds, "inverted function": inverted_function_bounds}.get(_task(spec), path_bounds)(spec)
+    return {"function": function_bounds, "motion": poses_bounds, "slider function": slider_function_bounds,
+            "inverted function": inverted_function_bounds}.get(_task(spec), path_bounds)(spec)
 
 
 def evaluate(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchValues:
