@@ -107,7 +107,8 @@ def test_path_synthesis_recovers_the_bundled_inverted_slider_crank(tmp_path):
     # A point of the block (on the crank's pin, sliding in the guide's slot) 30 mm along the
     # slot and 20 mm to its left of the pin, from the engine's pin and guide angle at ten
     # crank angles; the linkage hidden. The search meets the points within 1e-8 of the
-    # linkage's size (100 mm), and the engine sweeping the written drawn linkage too.
+    # linkage's size (100 mm), and the engine sweeping the written drawn linkage too. (Seeds
+    # 0 to 4 all meet it, in 3 to 19 s each on the shared machine; one seed is tested here.)
     crank = np.arange(100.0, 370.0, 30.0)
     B, phi = _engine_pin_and_guide(tmp_path, crank)
     u = np.stack((np.cos(phi), np.sin(phi)), -1)
