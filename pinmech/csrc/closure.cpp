@@ -119,11 +119,13 @@ VectorXd Core::residual(const VectorXd& q) {
 }
 
 // The independent closure rows at q; leaves joint placements and the cut frames'
-// placements in data_ (LoopSolver._residual). The joint Jacobians at q follow at the first
-// jacobian_into (most residuals are the last of a Newton solve, no Jacobian needed).
-void Core::residual_into(const VectorXd& q, VectorXd& r) {
-  pin::forwardKinematics(model_, data_, q);
-  joint_jacobians_ = false;
+// placements in data_ (LoopSolver._residual). The joint Jacobians at q come in the same
+// pass where `jacobians` (a Jacobian will be taken here), else at the first jacobian_into
+// (most residuals are the last of a Newton solve: no Jacobian is taken there).
+void Core::residual_into(const VectorXd& q, VectorXd& r, bool jacobians) {
+  if (jacobians) pin::computeJointJacobians(model_, data_, q);
+  else pin::forwardKinematics(model_, data_, q);
+  joint_jacobians_ = jacobians;
   for (size_t c = 0; c < cuts_.size(); ++c) {
     const Cut& cut = cuts_[c];
     pin::updateFramePlacement(model_, data_, cut.parent);

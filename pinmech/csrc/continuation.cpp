@@ -24,7 +24,7 @@ void check_signals() {
 bool Core::correct(VectorXd& q, const VectorXd& drivers, int max_iterations, double& residual_left) {
   set_drivers(q, drivers);
   VectorXd& r = r_;
-  residual_into(q, r);
+  residual_into(q, r, true);  // a predicted pose: Newton's Jacobian is taken there
   double norm = max_abs(r);
   iterations_ = 0;
   moved_ = 0.0;

@@ -273,7 +273,7 @@ class Core {
 
   // ------------------------------------------------------------ closure rows (closure.cpp)
   VectorXd residual(const VectorXd& q);
-  void residual_into(const VectorXd& q, VectorXd& r);
+  void residual_into(const VectorXd& q, VectorXd& r, bool jacobians = false);
   double full_residual() const;
   MatrixXd jacobian(bool newton);
   void jacobian_into(bool newton);
