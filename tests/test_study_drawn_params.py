@@ -133,5 +133,5 @@ def test_two_drawn_params_written_one_after_the_other_are_both_drawn():
     B = _left(A, O4, 0.12, 0.08)
     C = _left(O4, B, 0.06, 0.05, -1.0)
     D = _left(C, O6, 0.095, 0.075)
-    P = _left(C, D, 0.05, 0.06)
+    P = _left(C, D, 0.045, 0.065)  # the file's CP, DP
     np.testing.assert_allclose(StudyOutputs(sm).pose_values(cycle.q[0]), P, atol=1e-12)

@@ -7,37 +7,44 @@ from __future__ import annotations
 import numpy as np
 
 from pinmech.design.burmester import four_bar_rows
-from pinmech.design.synthesis_file import SynthesisSpec
+from pinmech.design.synthesis_file import SIX_BARS, SynthesisSpec
 from pinmech.design.synthesis_function import evaluate_function, freudenstein_rows, function_bounds, refined_function
 from pinmech.design.synthesis_objective import BatchValues, evaluate_path, path_bounds
 from pinmech.design.synthesis_path import refined_path
 from pinmech.design.synthesis_poses import evaluate_poses, poses_bounds, refined_poses
 from pinmech.design.synthesis_result import Linkage
+from pinmech.design.synthesis_sixbar import evaluate_sixbar, refined_sixbar, sixbar_bounds
 from pinmech.design.synthesis_slider_function import (evaluate_slider_function, refined_slider_function,
                                                       slider_function_bounds)
 
 
 def _task(spec: SynthesisSpec) -> str:
-    """The task's key: "slider function" for a slider-crank's function (its own rows)."""
+    """The task's key: "slider function" for a slider-crank's function (its own rows);
+    "six-bar" for a Watt's or a Stephenson's path or function (on the engine)."""
+    if spec.topology in SIX_BARS:
+        return "six-bar"
     return "slider function" if spec.task == "function" and spec.topology == "slider-crank" else spec.task
 
 
 def search_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
     """The bounds of the task's search rows."""
     return {"function": function_bounds, "motion": poses_bounds,
-            "slider function": slider_function_bounds}.get(_task(spec), path_bounds)(spec)
+            "slider function": slider_function_bounds,
+            "six-bar": sixbar_bounds}.get(_task(spec), path_bounds)(spec)
 
 
 def evaluate(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchValues:
     """The task's objective of rows x on one assembly (a Dask task)."""
     return {"function": evaluate_function, "motion": evaluate_poses,
-            "slider function": evaluate_slider_function}.get(_task(spec), evaluate_path)(spec, assembly, x)
+            "slider function": evaluate_slider_function,
+            "six-bar": evaluate_sixbar}.get(_task(spec), evaluate_path)(spec, assembly, x)
 
 
 def refined(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Linkage | None:
     """Row x refined with the exact Jacobian, checked for defects (None: it has one)."""
     return {"function": refined_function, "motion": refined_poses,
-            "slider function": refined_slider_function}.get(_task(spec), refined_path)(spec, assembly, x)
+            "slider function": refined_slider_function,
+            "six-bar": refined_sixbar}.get(_task(spec), refined_path)(spec, assembly, x)
 
 
 def classical_rows(spec: SynthesisSpec) -> np.ndarray:
