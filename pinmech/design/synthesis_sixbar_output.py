@@ -138,6 +138,8 @@ def figure(spec: SynthesisSpec, result, path: str | Path) -> Path:
                                                else f"{np.max(lk.errors) * 1e3:.2g} mm")
         if spec.task == "path":
             ax.plot(y[:, 0] * 1e3, y[:, 1] * 1e3, lw=1.5, label=label + " (the whole turn)")
+            at = np.argmin(np.abs(t.grid - crank_values(lk, t.p0)[0]))
+            _draw_links(ax, spec, t, Q[at], "k" if i == 1 else "0.6")
         else:
             start = crank_values(lk, t.p0)[0]
             turn = np.mod(t.grid - start, 2 * math.pi)
@@ -161,3 +163,26 @@ def figure(spec: SynthesisSpec, result, path: str | Path) -> Path:
     ax.legend(fontsize=8)
     ax.set_title(spec.title)
     return save(plt, fig, path)
+
+
+def _draw_links(ax, spec: SynthesisSpec, t, q: np.ndarray, colour: str) -> None:
+    """The linkage at pose q: each link's pins joined, the ground pins as triangles [mm]."""
+    import pinocchio as pin
+
+    linkage, _, _ = _template(spec)
+    mech, data = t.sm.mechanism, t.sm.model.createData()
+    pin.framesForwardKinematics(t.sm.model, data, q)
+    where = {}
+    for name in linkage.joints:
+        try:
+            where[name] = data.oMf[mech.frame_id(name)].translation[:2] * 1e3
+        except Exception:  # a joint without a frame of its name: not drawn
+            continue
+    for joints in linkage.links.values():
+        xy = np.array([where[j] for j in joints if j in where])
+        if len(xy) > 1:
+            ax.fill(*np.vstack((xy, xy[:1])).T, color=colour, alpha=0.15) if len(xy) > 2 else None
+            ax.plot(*np.vstack((xy, xy[:1])).T if len(xy) > 2 else xy.T, "-o", color=colour, lw=1.2, ms=3)
+    ground = np.array([where[j] for j in linkage.ground if j in where])
+    if len(ground):
+        ax.plot(*ground.T, "^", color=colour, ms=8, ls="none")
