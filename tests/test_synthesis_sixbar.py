@@ -96,6 +96,38 @@ def test_recovers_the_bundled_watt_from_ten_points_of_its_last_dyad(tmp_path):
     assert np.max(np.linalg.norm(swept - targets, axis=1)) <= 1e-8 * best.size
 
 
+def stephenson_point(theta: np.ndarray, link5: float, link6: float, CP: float, DP: float) -> np.ndarray:
+    """P on link5 of models/linkages/stephenson_params.toml's four-bar, C (70, 70 mm from A,
+    B) and O6 (165, 105) mm, at crank angles theta [rad] [m], (n, 2)."""
+    theta = np.asarray(theta, dtype=float)
+    O4, O6 = np.broadcast_to([0.1, 0.0], (*theta.shape, 2)), np.broadcast_to([0.165, 0.105], (*theta.shape, 2))
+    A = 0.04 * np.stack((np.cos(theta), np.sin(theta)), -1)
+    B = _meet(A, O4, 0.12, 0.08)
+    C = _meet(A, B, 0.07, 0.07)
+    D = _meet(C, O6, link5, link6)
+    return _meet(C, D, CP, DP)
+
+
+def test_recovers_a_stephenson_from_points_without_timing():
+    # A point of the Stephenson's link5 draws a closed loop: ten points of it (crank 20..290
+    # deg) in order, without timing; each target's crank value is the nearest point of the
+    # candidate's curve, then refined. The four params of link5, link6 and P hidden in a
+    # box of +-2 mm: the linkage found meets the closed form within 1e-8 of its size (165
+    # mm), the crank values it reports are the hidden ones (within 1e-6 rad).
+    hidden = {"link5": 0.12, "link6": 0.09, "CP": 0.06, "DP": 0.07}
+    theta = np.radians(20.0 + 30.0 * np.arange(10))
+    targets = stephenson_point(theta, **hidden)
+    raw = {"task": "path", "topology": "stephenson", "scene": "../scenes/stephenson_params.toml", "point": "P",
+           "targets": [[f"{float(x)!r} m", f"{float(y)!r} m"] for x, y in targets], "seed": 1, "population": 6,
+           "generations": 30, "keep": 1,
+           "bounds": {k: [f"{v - 0.002!r} m", f"{v + 0.002!r} m"] for k, v in hidden.items()}}
+    best = synthesise(parse_synthesis(raw, SYNTHESIS / "inline.toml")).linkages[0]
+    assert best.meets(1e-8)
+    found = stephenson_point(best.theta, *best.z)
+    assert np.max(np.linalg.norm(found - targets, axis=1)) <= 1e-8 * best.size
+    np.testing.assert_allclose(np.mod(best.theta, 2 * math.pi), theta, atol=1e-6)
+
+
 def test_targets_met_only_across_a_fold_of_the_second_loop_give_no_answer():
     # link5 = 50, link6 = 40 mm: |C O6| reaches 94.9 mm near crank 231 deg, beyond their
     # 90 mm sum, so the second loop folds and does not close there on any assembly. Points
