@@ -150,6 +150,26 @@ def test_targets_met_only_across_a_fold_of_the_second_loop_give_no_answer():
     assert sum(result.rejected.values()) == result.evaluations
 
 
+def test_a_crank_range_given_by_the_template_scene_is_followed_instead_of_a_turn(tmp_path):
+    # The same folding second loop (link5 50, link6 40 mm), its template scene sweeping the
+    # crank from 0 to 150 deg only, where it closes: the candidates are followed over that
+    # range, and the hidden linkage is found from seven timed points of it within 1e-8 of
+    # its size (the closed form).
+    scene = tmp_path / "watt_range.toml"
+    scene.write_text(f'linkage = "{(ROOT / "models/linkages/watt_params.toml").as_posix()}"\n'
+                     '[drivers.O2]\nangle = "0 deg"\n[sweep]\nfrom = "0 deg"\nto = "150 deg"\n', encoding="utf-8")
+    hidden = {"link5": 0.05, "link6": 0.04, "CP": 0.05, "DP": 0.06}
+    theta = np.radians(20.0 * np.arange(1, 8))
+    targets = watt_point(theta, **hidden)
+    bounds = {k: (v - 0.002, v + 0.002) for k, v in hidden.items()}
+    spec = _watt_spec(targets, theta - theta[0], bounds, seed=1, population=6, generations=30, keep=1,
+                      scene=str(scene))
+    best = synthesise(spec).linkages[0]
+    assert best.meets(1e-8)
+    found = watt_point(best.theta, *best.z)
+    assert np.max(np.linalg.norm(found - targets, axis=1)) <= 1e-8 * best.size
+
+
 def test_stephenson_function_pairs_of_a_closed_form_are_met(tmp_path):
     # The bundled Stephenson function file's pairs come from the closed form (A, B, C on the
     # coupler, D): its hidden dyad (link5 120, link6 90 mm, O6 (160, 110) mm, crank from 30

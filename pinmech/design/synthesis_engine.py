@@ -3,12 +3,13 @@ whose candidate values are written into the user's model in place (the study's d
 drawn_params.py, through a StudyMechanism built from the synthesis file) and followed by
 the compiled core over the crank's whole turn on one assembly (variant_core.py).
 
-The turn starts at the drawn pose (the scene's driver value there), where the drawn
-linkage's `side =` choices fix the assembly; a candidate is rejected, with its cause, when
+The follow starts at the drawn pose (the scene's driver value there), where the drawn
+linkage's `side =` choices fix the assembly, and goes over the crank's range: the template
+scene's [sweep] from .. to if it gives them, else a whole turn from the drawn pose; a candidate is rejected, with its cause, when
 it cannot be drawn ("does not assemble at the start"), when its start closes on another
 assembly (its signature differs from the template's: "other assembly at the start"), or
 when the follow meets a fold ("fold within the turn": a circuit defect, the crank cannot
-complete its turn) or passes a change point ("change point within the turn": a branch
+complete its range) or passes a change point ("change point within the turn": a branch
 defect) or an ill-conditioned pose ("singular pose"). Whatever it reports is read along
 that one continuation.
 
@@ -25,7 +26,7 @@ from pinmech.design.study_file import parse_study
 from pinmech.design.study_outputs import StudyOutputs
 from pinmech.design.study_variant import StudyMechanism
 from pinmech.design.synthesis_file import SynthesisSpec
-from pinmech.exceptions import ModelError
+from pinmech.exceptions import ModelError, SceneError
 
 GRID = 360  # poses over the crank's turn (1 deg apart) for the nearest points and the transmission
 #: The core's reasons (variant_core.STOPS and the start's), as a synthesis names them.
@@ -42,7 +43,9 @@ class EngineTemplate:
         sm: the StudyMechanism of the scene with the free params as drawn study params.
         outputs: the coupler point's x, y (path) or the output link's angle (function),
             then the transmission angle of each dyad in spec.pins.
-        grid: the crank's values over one turn from the drawn pose [rad], GRID + 1 of them.
+        start, stop: the crank's range [rad]: the template scene's [sweep] from .. to, else
+            one turn from its driver's value (full: a whole turn).
+        grid: the crank's values over the range [rad], GRID + 1 of them (poses: distinct).
     """
 
     def __init__(self, spec: SynthesisSpec) -> None:
@@ -58,7 +61,14 @@ class EngineTemplate:
         self.template = dict(self.drawing.values)
         self.core = self.sm.core
         self.p0 = self.core.p0
-        self.grid = self.p0 + np.linspace(0.0, 2 * math.pi, GRID + 1)
+        self.start, self.stop = float(self.sm.values[0]), float(self.sm.values[-1])  # the scene's [sweep] from..to
+        if not self.stop > self.start:
+            raise SceneError(f"a six-bar synthesis follows the crank up from [sweep] from to to: give to above from "
+                             f"(from {math.degrees(self.start):.6g} deg, to {math.degrees(self.stop):.6g} deg)",
+                             path=str(spec.scene), key="sweep")
+        self.full = math.isclose(self.stop - self.start, 2 * math.pi, abs_tol=1e-12)
+        self.grid = np.linspace(self.start, self.stop, GRID + 1)
+        self.poses = GRID if self.full else GRID + 1  # distinct poses of the grid (a full turn's ends are one)
         self.width = 2 if spec.task == "path" else 1  # the point's x, y or the link's angle
 
     def write(self, p: np.ndarray) -> str:
@@ -82,6 +92,12 @@ class EngineTemplate:
         if path is None:
             return np.zeros((0, self.sm.model.nq)), np.zeros((0, self.sm.model.nv)), _CAUSES.get(why, why)
         return path[0], path[1], ""
+
+    def mapped(self, theta: np.ndarray) -> np.ndarray:
+        """Crank values theta [rad] as values of the range (start + a turn's multiple); NaN
+        where one lies outside a range that is not a whole turn."""
+        value = self.start + np.mod(np.asarray(theta, dtype=float) - self.start, 2 * math.pi)
+        return value if self.full else np.where(value <= self.stop, value, np.nan)
 
     def values(self, Q: np.ndarray) -> np.ndarray:
         """The outputs (n, width + len(pins)) at the poses Q: P's x, y [m] or the link's

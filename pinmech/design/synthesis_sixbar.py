@@ -4,12 +4,12 @@ and function generation (the output link's turns against the crank's).
 
 A search row is x = (p[, theta0]): the free params p [m] (spec.free), and with timing (or
 for a function) the crank's value theta0 at the first target [rad]. Each candidate is
-drawn, written into the model and followed by the compiled core over the crank's whole
-turn from its drawn pose, on that one assembly (a fold, a change point or another assembly
+drawn, written into the model and followed by the compiled core over the crank's range (a
+whole turn unless the template scene's [sweep] gives from .. to), on that one assembly (a fold, a change point or another assembly
 at the start is its cause of rejection). Then, along that one continuation:
 
 - without timing, each target's crank value is where the coupler curve passes nearest it
-  (the nearest of GRID poses, then the vertex of the parabola through it and its
+  (the nearest of the range's poses, then the vertex of the parabola through it and its
   neighbours); **order** ("targets out of order"): those values must progress one way,
   within one turn (synthesis_motion.progress), as the four-bar's;
 - with timing (a function's pairs), the crank values theta0 + turns are followed exactly;
@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from pinmech.design.synthesis_engine import GRID, EngineTemplate, template
+from pinmech.design.synthesis_engine import EngineTemplate, template
 from pinmech.design.synthesis_file import SynthesisSpec
 from pinmech.design.synthesis_motion import MIN_TRANSMISSION, progress, within
 from pinmech.design.synthesis_objective import REJECTED, BatchValues, extent
@@ -73,34 +73,36 @@ def _row(spec: SynthesisSpec, t: EngineTemplate, x: np.ndarray) -> tuple[float, 
         if cause:
             return REJECTED, cause, none
         Y = t.values(Q)
-        theta, err2 = _nearest(t.grid[:GRID], Y[:GRID, :2], spec.targets)
-        return _judged(spec, t, theta, err2, t.grid[:GRID], Y[:GRID])
+        theta, err2 = _nearest(t.grid[:t.poses], Y[:t.poses, :2], spec.targets, t.full)
+        return _judged(spec, t, theta, err2, t.grid[:t.poses], Y[:t.poses])
     theta = x[n] + _turns(spec)
     motion = check_motion(spec, t, theta)
     if isinstance(motion, str):
         return REJECTED, motion, none
     err2, grid_y = motion
-    return _judged(spec, t, theta, err2, t.grid[:GRID], grid_y)
+    return _judged(spec, t, theta, err2, t.grid[:t.poses], grid_y)
 
 
 def check_motion(spec: SynthesisSpec, t: EngineTemplate,
                  theta: np.ndarray) -> str | tuple[np.ndarray, np.ndarray]:
-    """The linkage now written followed over its turn and through the crank values theta
+    """The linkage now written followed over its range and through the crank values theta
     (N,) [rad]: the cause where it fails, else each target's squared error (relative to
     the targets' extent for a path; [rad^2] for a function's turns) and the outputs at
-    the turn's GRID poses."""
-    values, at, grid_at = _merged(t, theta)
+    the range's grid poses."""
+    mapped = t.mapped(theta)
+    if np.any(np.isnan(mapped)):
+        return "target outside the crank's range"
+    values, at, grid_at = _merged(t, mapped)
     Q, _, cause = t.follow(values)
     if cause:
         return cause
     Y = t.values(Q)
-    return _errors2(spec, Y[at, :t.width]), Y[grid_at[:GRID]]
+    return _errors2(spec, Y[at, :t.width]), Y[grid_at[:t.poses]]
 
 
-def _merged(t: EngineTemplate, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The follow's values: the turn's grid and theta mapped into it, increasing [rad];
-    where theta's and the grid's values are among them."""
-    mapped = t.p0 + np.mod(theta - t.p0, _TWO_PI)
+def _merged(t: EngineTemplate, mapped: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The follow's values: the range's grid and the crank values `mapped` into it
+    (EngineTemplate.mapped), increasing [rad]; where theirs and the grid's are among them."""
     both = np.concatenate((t.grid, mapped))
     order = np.argsort(both, kind="stable")
     where = np.empty(len(both), dtype=int)
@@ -120,17 +122,18 @@ def _wrapped(a: np.ndarray) -> np.ndarray:
     return np.mod(a + math.pi, _TWO_PI) - math.pi
 
 
-def _nearest(grid: np.ndarray, P: np.ndarray, targets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each target's crank value where the curve P (M, 2) over the turn's grid (M,) passes
+def _nearest(grid: np.ndarray, P: np.ndarray, targets: np.ndarray, wrap: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Each target's crank value where the curve P (M, 2) over the range's grid (M,) passes
     nearest it [rad], and the squared distance there over the targets' extent squared (the
-    parabola's vertex through the nearest pose's and its neighbours')."""
+    parabola's vertex through the nearest pose's and its neighbours'; wrap: the grid is a
+    whole turn, its first pose the last's neighbour)."""
     d2 = ((P[None, :, :] - targets[:, None, :]) ** 2).sum(-1) / extent(targets) ** 2  # (N, M)
     M, step = len(grid), grid[1] - grid[0]
     k = np.argmin(d2, axis=1)
     rows = np.arange(len(targets))
     fm, f0, fp = d2[rows, (k - 1) % M], d2[rows, k], d2[rows, (k + 1) % M]
     curve = fm - 2 * f0 + fp
-    ok = curve > 0
+    ok = (curve > 0) & (wrap | ((k > 0) & (k < M - 1)))
     shift = np.where(ok, np.clip(0.5 * (fm - fp) / np.where(ok, curve, 1.0), -0.5, 0.5), 0.0)
     vertex = np.where(ok, f0 - 0.5 * shift * (fm - fp) / 2, f0)
     return grid[k] + shift * step, np.maximum(vertex, 0.0)
@@ -177,7 +180,9 @@ def refined_sixbar(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Linka
         p, th = unpack(v)
         if t.write(p):
             return None
-        mapped = t.p0 + np.mod(th - t.p0, _TWO_PI)
+        mapped = t.mapped(th)
+        if np.any(np.isnan(mapped)):
+            return None
         order = np.argsort(mapped, kind="stable")
         Q, D1, cause = t.follow(mapped[order])
         if cause:
@@ -227,11 +232,11 @@ def sixbar_linkage(spec: SynthesisSpec, p: np.ndarray, theta: np.ndarray) -> Lin
     way, span = progress(theta[None], spec.direction)
     if way[0] == 0:
         return None
-    low, high = transmission(spec, t, theta, way, span, t.grid[:GRID], grid_y)
+    low, high = transmission(spec, t, theta, way, span, t.grid[:t.poses], grid_y)
     if low < max(spec.transmission, MIN_TRANSMISSION if spec.pins else 0.0):
         return None
     scale = extent(spec.targets) if spec.task == "path" else 1.0
-    values, at, _ = _merged(t, theta)
+    values, at, _ = _merged(t, t.mapped(theta))
     phi0 = 0.0
     if spec.task == "function":
         Q, _, _ = t.follow(values)

@@ -37,9 +37,9 @@ def linkage_toml(spec: SynthesisSpec, lk: Linkage) -> str:
     return written(found, header)
 
 
-def crank_values(lk: Linkage, p0: float) -> np.ndarray:
-    """The crank's values at the targets on the turn from the drawn pose p0 [rad]."""
-    return p0 + np.mod(lk.theta - p0, 2 * math.pi)
+def crank_values(lk: Linkage, start: float) -> np.ndarray:
+    """The crank's values at the targets on the range from `start` [rad]."""
+    return start + np.mod(lk.theta - start, 2 * math.pi)
 
 
 def scene_toml(spec: SynthesisSpec, lk: Linkage, linkage_file: str) -> str:
@@ -47,15 +47,15 @@ def scene_toml(spec: SynthesisSpec, lk: Linkage, linkage_file: str) -> str:
     from pinmech.design.synthesis_engine import template
 
     t = template(spec)
-    driver, start = t.sm.sweep.driver, t.p0
+    driver = t.sm.sweep.driver
     shown = f"points = [\"{spec.point}\"]" if spec.task == "path" else f"links = [\"{spec.output}\"]"
-    deg = math.degrees(start)
+    deg = [f"\"{math.degrees(v):.15g} deg\"" for v in (t.p0, t.start, t.stop)]
     return "\n".join([
-        "# The synthesised six-bar turned once by its crank from the drawn pose:",
+        "# The synthesised six-bar, its crank driven from the drawn pose over the range searched:",
         "#   pinmech sweep THIS_FILE --plot fig.png",
         f"title = \"{spec.title}\"", f"linkage = \"{linkage_file}\"", "",
-        f"[drivers.{driver}]", f"angle = \"{deg:.15g} deg\"", "",
-        "[sweep]", f"from = \"{deg:.15g} deg\"", f"to = \"{deg + 360:.15g} deg\"", "steps = 361", shown, "",
+        f"[drivers.{driver}]", f"angle = {deg[0]}", "",
+        "[sweep]", f"from = {deg[1]}", f"to = {deg[2]}", "steps = 361", shown, "",
         "[report]", shown, ""])
 
 
@@ -69,8 +69,8 @@ def write_linkage(spec: SynthesisSpec, lk: Linkage, prefix: str | Path) -> tuple
 
 
 def engine_check(spec: SynthesisSpec, scene_file: str | Path, lk: Linkage) -> np.ndarray:
-    """The written scene swept by the engine (pinmech sweep's path) from its drawn pose
-    through the targets' crank values, poses at most _STEP apart: the distance of the
+    """The written scene swept by the engine (pinmech sweep's path) from its drawn pose to
+    the range's start, then up through the targets' crank values, poses at most _STEP apart: the distance of the
     coupler point from each target [m], or the output's turn error at each pair [rad].
 
     Raises:
@@ -79,10 +79,13 @@ def engine_check(spec: SynthesisSpec, scene_file: str | Path, lk: Linkage) -> np
     from pinmech.io.scene import Scene
     from pinmech.io.sweep import Sweep
 
-    sweep = Sweep.from_scene(Scene.load(scene_file))
-    values = crank_values(lk, sweep.start)
+    from pinmech.design.synthesis_engine import template
+
+    sweep, t = Sweep.from_scene(Scene.load(scene_file)), template(spec)
+    values = crank_values(lk, t.start)
     order = np.argsort(values)
-    dense, at = [sweep.start], []
+    dense = list(np.linspace(sweep.start, t.start, max(int(math.ceil(abs(t.start - sweep.start) / _STEP)), 1) + 1))
+    at = []
     for v in values[order]:
         n = max(int(math.ceil((v - dense[-1]) / _STEP)), 1)
         dense += list(np.linspace(dense[-1], v, n + 1)[1:])
@@ -138,10 +141,10 @@ def figure(spec: SynthesisSpec, result, path: str | Path) -> Path:
                                                else f"{np.max(lk.errors) * 1e3:.2g} mm")
         if spec.task == "path":
             ax.plot(y[:, 0] * 1e3, y[:, 1] * 1e3, lw=1.5, label=label + " (the whole turn)")
-            at = np.argmin(np.abs(t.grid - crank_values(lk, t.p0)[0]))
+            at = np.argmin(np.abs(t.grid - crank_values(lk, t.start)[0]))
             _draw_links(ax, spec, t, Q[at], "k" if i == 1 else "0.6")
         else:
-            start = crank_values(lk, t.p0)[0]
+            start = crank_values(lk, t.start)[0]
             turn = np.mod(t.grid - start, 2 * math.pi)
             order = np.argsort(turn)
             phi = np.unwrap(y[order, 0])
