@@ -34,6 +34,7 @@ from pinmech.design.synthesis_motion import MIN_TRANSMISSION, progress, within
 from pinmech.design.synthesis_objective import REJECTED, BatchValues, extent
 from pinmech.design.synthesis_refine import refine
 from pinmech.design.synthesis_result import Linkage
+from pinmech.exceptions import PinmechError
 
 _TWO_PI = 2 * math.pi
 FULL_TURN = "crank turns fully"  # a six-bar's class: the follow has taken the crank round a whole turn
@@ -204,7 +205,10 @@ def refined_sixbar(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Linka
         at = poses(v)
         if at is None:
             raise np.linalg.LinAlgError("the candidate does not follow its motion")
-        parts = [t.jacobians(q, d1) for q, d1 in zip(*at)]
+        try:
+            parts = [t.jacobians(q, d1) for q, d1 in zip(*at)]
+        except PinmechError as exc:  # a pose too ill-conditioned, a drawing at p +- h that does not close
+            raise np.linalg.LinAlgError(str(exc)) from exc
         N = len(parts)
         J = np.zeros((N, t.width, len(v)))
         for i, (dp, dth) in enumerate(parts):
