@@ -206,12 +206,15 @@ def _six_bar(raw: dict[str, Any], w: _Where, path: Path, task: str, topology: st
     scene_path = path.parent / raw["scene"]
     try:
         scene = Scene.load(scene_path)
-        if scene.model_kind != "linkage":
-            raise w.error("scene", f"{raw['scene']} gives its model by '{scene.model_kind}': a six-bar's scene "
-                          "names a drawn linkage (linkage = \"...\") with [params]")
-        linkage, _ = read_linkage_spec(scene.model_file("linkage"))
     except PinmechError as exc:
         raise w.error("scene", f"{raw['scene']} cannot be read: {exc}") from exc
+    if scene.model_kind != "linkage":
+        raise w.error("scene", f"{raw['scene']} gives its model by '{scene.model_kind}': a six-bar's scene "
+                      "names a drawn linkage (linkage = \"...\") with [params]")
+    try:
+        linkage, _ = read_linkage_spec(scene.model_file("linkage"))
+    except PinmechError as exc:
+        raise w.error("scene", f"{raw['scene']}'s linkage cannot be read: {exc}") from exc
     name, kind = ("output", "link") if task == "function" else ("point", "joint")
     named = raw.get(name, "P" if task == "path" else None)
     known = linkage.links if task == "function" else linkage.joints
