@@ -29,7 +29,9 @@ class Linkage:
         phi0: a function generator's rocker angle asked at the first pair, or a motion
             generator's angle from the bar A -> B to the poses' line [rad].
         angle_errors: a motion generator's coupler angle error at each pose [rad].
-        topology: "four-bar", "slider-crank", "watt" or "stephenson".
+        topology: "four-bar", "slider-crank" or "inverted-slider-crank" (z: its
+            synthesis_inverted.NAMES; phi0 of a function: the guide's angle at the first pair),
+            "watt" or "stephenson".
         params: a six-bar's drawn linkage's [params] (z: its free ones, spec.free) [m].
     """
 
@@ -59,8 +61,9 @@ class Linkage:
     def meets(self, relative: float) -> bool:
         """Whether every target is met within `relative` of the linkage's size (path; a
         motion's angles within `relative` rad too), or every output angle within `relative`
-        rad (a four-bar's function; a slider-crank's travel within `relative` of its size)."""
-        if self.task == "function" and self.topology != "slider-crank":
+        rad (a four-bar's, an inverted slider-crank's or a six-bar's function; a slider-crank's
+        travel within `relative` of its size)."""
+        if self.task == "function" and self.topology != "slider-crank":  # an output angle
             return bool(np.max(self.errors) <= relative)
         angles = self.angle_errors if self.angle_errors is not None else np.zeros(1)
         return bool(np.max(self.errors) <= relative * self.size and np.max(angles) <= relative)
