@@ -14,12 +14,15 @@ file's `batch` (variants a task) sets it; a four-bar variant over 73 poses takes
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 from pinmech.design.study_file import StudySpec
 from pinmech.design.tolerance import Batch, BatchResult, run_batch
 
 _EXTRA = 'pip install "pinmech[study]"'
+#: run(spec, batches, progress=None) -> results in batch order
+Runner = Callable[..., list]
 #: StudySpec -> (StudyMechanism, StudyOutputs), built once per process.
 _BUILT: dict[StudySpec, tuple] = {}
 
@@ -69,20 +72,35 @@ def run_batches(spec: StudySpec, batches: list[Batch], *, workers: int = 0, sche
             it from --scheduler or $DASK_SCHEDULER_ADDRESS (`scheduler_address`).
         progress: called with each batch as it finishes (on Dask: in the order they finish).
     """
+    with batch_runner(workers=workers, scheduler=scheduler) as run:
+        return run(spec, batches, progress)
+
+
+@contextmanager
+def batch_runner(*, workers: int = 0, scheduler: str | None = None) -> Iterator[Runner]:
+    """A `run(spec, batches, progress)` for several rounds of batches on one cluster (a
+    workspace study's grid, then its refinement levels): in this process (workers 0, no
+    scheduler), on a LocalCluster started once, or on the scheduler given."""
     if scheduler is None and workers == 0:
-        results = []
-        for batch in batches:
-            results.append(solve_batch(spec, batch))
-            if progress:
-                progress(batch)
-        return results
+        yield _serial
+        return
     distributed = require_dask()
     if scheduler is not None:
         with distributed.Client(scheduler, timeout="20s") as client:
-            return _gathered(client, spec, batches, progress, distributed)
-    with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address="127.0.0.1:0",
-                                  host="127.0.0.1") as cluster, distributed.Client(cluster) as client:
-        return _gathered(client, spec, batches, progress, distributed)
+            yield lambda spec, todo, progress=None: _gathered(client, spec, todo, progress, distributed)
+        return
+    with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                  dashboard_address="127.0.0.1:0", host="127.0.0.1") as cluster, distributed.Client(cluster) as client:
+        yield lambda spec, todo, progress=None: _gathered(client, spec, todo, progress, distributed)
+
+
+def _serial(spec: StudySpec, batches: list[Batch], progress: Callable[[Batch], None] | None = None) -> list:
+    results = []
+    for batch in batches:
+        results.append(solve_batch(spec, batch))
+        if progress:
+            progress(batch)
+    return results
 
 
 def scheduler_address(option: str | None) -> str | None:

@@ -11,6 +11,8 @@
     y = { from = "-60 mm", to = "200 mm", count = 105 }    # or x, y, z (space)
     modes = ["+-", "-+"]                   # working modes (a sign per leg, motors' order); default all
     length = "60 mm"                       # characteristic length of the dimensionless Jacobian
+    refine_depth = 6                       # halve the boundary's cells up to 6 times ...
+    area_tolerance = 0.01                  # ... or until the area's bound is 1 % of it
 
 Every mistake is a SceneError naming the study file, the key and the value as written.
 """
@@ -24,12 +26,14 @@ from typing import Any
 
 from pinmech.design.file_where import load_file
 from pinmech.design.study_file import GridAxis, _Where
+from pinmech.design.workspace_measure import MAX_DEPTH
 from pinmech.units import to_si
 
 _TOP = {"title", "scene", "kind", "batch", "workspace"}
-_KEYS = {"point", "x", "y", "z", "modes", "length"}
+_KEYS = {"point", "x", "y", "z", "modes", "length", "refine_depth", "area_tolerance"}
 _AXIS_KEYS = {"from", "to", "count"}
 _MAX_POINTS = 2_000_000
+_DEFAULT_DEPTH = 6  # halvings when only area_tolerance is given: 1/64 of a step at most
 
 
 @dataclass(frozen=True)
@@ -43,6 +47,9 @@ class WorkspaceSpec:
             () for every one; length: the characteristic length [m] (None: the mechanism's).
         batch: grid points a batch (a Dask task); unit, unit_si: the user's length unit
             (from the first axis's `from`) and its size [m].
+        refine_depth: halvings of the cells the workspace's boundary crosses (0: none);
+            area_tolerance: stop halving once the bound is this share of the area (None:
+            halve `refine_depth` times).
     """
 
     path: Path
@@ -55,6 +62,8 @@ class WorkspaceSpec:
     batch: int
     unit: str
     unit_si: float
+    refine_depth: int = 0
+    area_tolerance: float | None = None
     kind: str = "workspace"
     seed: int = 0
 
@@ -94,9 +103,11 @@ def parse_workspace(raw: dict[str, Any], path: Path) -> WorkspaceSpec:
     length = _length(table, where)
     unit = _unit(table["x"]["from"])
     batch = where.whole(raw, "batch", 500)
+    tolerance = _tolerance(table, where)
+    depth = _depth(table, where, _DEFAULT_DEPTH if tolerance is not None else 0)
     return WorkspaceSpec(path, str(raw.get("title", path.stem)), path.parent / scene, point, axes,
                          _modes(table.get("modes", []), where), length, batch, unit,
-                         to_si(f"1 {unit}", "length", where=f"{path}, workspace.x.from"))
+                         to_si(f"1 {unit}", "length", where=f"{path}, workspace.x.from"), depth, tolerance)
 
 
 def _axis(name: str, entry: Any, where: _Where) -> GridAxis:
@@ -119,6 +130,24 @@ def _length(table: dict, where: _Where) -> float | None:
     if "length" not in table:
         return None
     return where.positive(table, "length", "workspace")
+
+
+def _depth(table: dict, where: _Where, default: int) -> int:
+    value = table.get("refine_depth", default)
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= MAX_DEPTH:
+        raise where.error("workspace.refine_depth", f"refine_depth = {value!r} must be a whole number of "
+                          f"halvings from 0 to {MAX_DEPTH}")
+    return value
+
+
+def _tolerance(table: dict, where: _Where) -> float | None:
+    if "area_tolerance" not in table:
+        return None
+    value = table["area_tolerance"]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value < 1:
+        raise where.error("workspace.area_tolerance", f"area_tolerance = {value!r} must be a share of the area "
+                          "between 0 and 1 (a number, e.g. 0.01 for 1 %)")
+    return float(value)
 
 
 def _modes(value: Any, where: _Where) -> tuple[str, ...]:
