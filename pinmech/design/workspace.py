@@ -72,9 +72,11 @@ class WorkspaceResult:
 
 
 def run_workspace(spec: WorkspaceSpec, *, workers: int = 0, scheduler: str | None = None,
-                  progress: Callable[[int, int], None] | None = None) -> WorkspaceResult:
+                  progress: Callable[[int, int], None] | None = None):
     """Solve the study's grid (here, or on Dask) and read its maps; `progress` is called with
-    (grid points done, grid points) as each batch finishes.
+    (grid points done, grid points) as each batch finishes. A task-space grid gives a
+    WorkspaceResult, a grid over the motors (`[workspace.actuators]`) an ActuatorResult
+    (workspace_actuator.py).
 
     Raises:
         SceneError: the study file's or the scene's mistakes, a mechanism that is not parallel
@@ -82,6 +84,10 @@ def run_workspace(spec: WorkspaceSpec, *, workers: int = 0, scheduler: str | Non
             FrameNotFound: an unknown end point.
     """
     wm = built(spec)  # here first: the file's and the mechanism's errors before any worker starts
+    if spec.space == "actuator":
+        from pinmech.design.workspace_actuator import run_actuator_workspace
+
+        return run_actuator_workspace(spec, wm, workers=workers, scheduler=scheduler, progress=progress)
     todo = batches(spec.size, spec.batch)
     done = [0]
 

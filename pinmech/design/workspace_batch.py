@@ -56,12 +56,16 @@ def grid_points(spec: WorkspaceSpec, start: int, count: int) -> np.ndarray:
     return np.column_stack([v[i] for v, i in zip(values, index)])
 
 
-def run_workspace_batch(spec: WorkspaceSpec, batch: Batch | PointsBatch) -> WorkspaceBatch:
+def run_workspace_batch(spec: WorkspaceSpec, batch: Batch | PointsBatch):
     """Solve the batch's grid points in every mode, or its given points each in its own mode
     (then `reached`, `motors` and `values` have one mode column: the point's)."""
     wm = built(spec)
     if isinstance(batch, PointsBatch):
         return _given_points(wm, batch)
+    if spec.space == "actuator":
+        from pinmech.design.workspace_actuator import run_actuator_batch
+
+        return run_actuator_batch(spec, wm, batch)
     modes, legs = len(wm.modes), len(wm.legs)
     reached = np.zeros((batch.count, modes), bool)
     motors = np.full((batch.count, modes, legs), np.nan)
