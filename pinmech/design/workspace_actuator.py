@@ -52,7 +52,8 @@ class ActuatorResult:
     assembly slot "+", "-").
 
     Attributes:
-        spec: the study file; motors: the axes' motor names (the file's order); length: L [m];
+        spec: the study file; motors: the axes' motor names (the file's order); angular:
+            whether each axis is a turn [rad] (else a slide [m]); length: L [m];
         coords: each axis's motor values [rad or m]; reached: (grid..., 2) bool;
         end: (grid..., 2, task axes) end point [m]; modes: (grid..., 2) working modes;
         values: det1, det2, sigma1, sigma2, kappa (grid..., 2);
@@ -63,6 +64,7 @@ class ActuatorResult:
 
     spec: WorkspaceSpec
     motors: tuple[str, ...]
+    angular: tuple[bool, ...]
     length: float
     coords: list[np.ndarray]
     reached: np.ndarray
@@ -149,5 +151,6 @@ def run_actuator_workspace(spec: WorkspaceSpec, wm: WorkspaceMechanism, *, worke
     measures["any"] = measure(reached.any(axis=-1), steps)
     type1 = {a: sign_change_edges(values["det1"][..., k], coords) for k, a in enumerate(ASSEMBLIES)}
     type2 = {a: boundary_edges(reached[..., k], coords) for k, a in enumerate(ASSEMBLIES)}
-    return ActuatorResult(spec, tuple(a.name for a in spec.axes), wm.length, coords, reached, end, modes, values,
-                          measures, type1, type2)
+    angular = tuple(not wm.prismatic_motor[wm.motors.index(a.name)] for a in spec.axes)
+    return ActuatorResult(spec, tuple(a.name for a in spec.axes), angular, wm.length, coords, reached, end, modes,
+                          values, measures, type1, type2)
