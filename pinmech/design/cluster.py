@@ -8,7 +8,10 @@ index (tolerance.py), so the results are the same bit for bit however many worke
 them, and in whatever order they finish: they are gathered in batch order.
 
 A batch should hold 0.1 to 1 s of work (a Dask task costs about 3 ms here): the study
-file's `batch` (variants a task) sets it; a four-bar variant over 73 poses takes ~2.5 ms.
+file's `batch` (variants a task) sets it; a four-bar variant over 73 poses takes ~0.2 ms.
+Workers run one thread each, with OpenMP and BLAS pools of one thread (Dask's default
+`distributed.nanny.pre-spawn-environ` sets OMP/MKL/OPENBLAS_NUM_THREADS=1 before a worker
+starts; tests/test_cluster.py checks it).
 """
 
 from __future__ import annotations
@@ -25,6 +28,8 @@ _EXTRA = 'pip install "pinmech[study]"'
 Runner = Callable[..., list]
 #: StudySpec -> (StudyMechanism, StudyOutputs), built once per process.
 _BUILT: dict[StudySpec, tuple] = {}
+#: How many times this process built a study's mechanism (a worker should once a study).
+BUILDS = [0]
 
 
 def require_dask():
@@ -44,6 +49,7 @@ def built(spec: StudySpec) -> tuple:
 
         sm = StudyMechanism(spec)
         _BUILT[spec] = (sm, StudyOutputs(sm))
+        BUILDS[0] += 1
     return _BUILT[spec]
 
 
