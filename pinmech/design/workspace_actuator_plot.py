@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from pinmech.design.figure_file import pyplot
-from pinmech.design.workspace_actuator import ASSEMBLIES, ActuatorResult
+from pinmech.design.workspace_actuator import ActuatorResult
+from pinmech.design.workspace_actuator_batch import ASSEMBLIES
 from pinmech.design.workspace_actuator_report import _scales
 
 

@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from pinmech.design.study_report import write_tables
-from pinmech.design.workspace_actuator import ASSEMBLIES, ActuatorResult
+from pinmech.design.workspace_actuator import ActuatorResult
+from pinmech.design.workspace_actuator_batch import ASSEMBLIES
 
 _AXES = "xyz"
 

@@ -63,7 +63,7 @@ def run_workspace_batch(spec: WorkspaceSpec, batch: Batch | PointsBatch):
     if isinstance(batch, PointsBatch):
         return _given_points(wm, batch)
     if spec.space == "actuator":
-        from pinmech.design.workspace_actuator import run_actuator_batch
+        from pinmech.design.workspace_actuator_batch import run_actuator_batch
 
         return run_actuator_batch(spec, wm, batch)
     modes, legs = len(wm.modes), len(wm.legs)
