@@ -331,10 +331,13 @@ def test_delta_kappa_is_that_of_clavels_jacobian(tmp_path):
 
 # ------------------------------------------------------------------ Dask, outputs, errors
 def test_two_workers_give_the_serial_result_bit_for_bit(tmp_path):
-    """A LocalCluster of 2 worker processes solves the same grid to the same bits."""
+    """A LocalCluster of 2 worker processes solves the same grid, and the same refinement
+    points (one halving of the boundary's cells), to the same bits."""
     path = _five_bar(tmp_path, '{ from = "-60 mm", to = "160 mm", count = 9 }',
-                     '{ from = "-150 mm", to = "150 mm", count = 11 }', 'modes = ["+-", "-+"]', batch=17)
+                     '{ from = "-150 mm", to = "150 mm", count = 11 }', 'modes = ["+-", "-+"]\nrefine_depth = 1',
+                     batch=17)
     serial, spread = pinmech.study(path), pinmech.study(path, workers=2)
+    assert serial.measures == spread.measures and serial.measures["+-"].points > 0
     np.testing.assert_array_equal(serial.reached, spread.reached)
     np.testing.assert_array_equal(serial.motor_q, spread.motor_q)
     for key in serial.values:
