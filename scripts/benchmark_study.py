@@ -28,7 +28,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from interleave import Timed, time_rounds  # noqa: E402
 
-from pinmech.design.cluster import built, run_batches  # noqa: E402
+from pinmech.design.cluster import built, local_cluster, run_batches  # noqa: E402
 from pinmech.design.study_file import load_study  # noqa: E402
 from pinmech.design.tolerance import batches  # noqa: E402
 
@@ -71,10 +71,10 @@ def core_share(spec, todo) -> tuple[float, float]:
 def task_stream_shares(distributed, address: str, spec, todo) -> dict[str, float]:
     """One run on the cluster at `address`, read from Dask's task stream: the wall time [s],
     each worker's share of it spent computing (1: never idle), the tasks' compute time
-    summed over the workers [s], the results' transfer time [s], and the CPU time each worker
-    process got over the wall time (below 1: other processes took its core). (Wall - compute /
-    workers) is what batching, scheduling, result transfer and the client cost, plus any
-    imbalance; a CPU share below the computing share is the machine's other load."""
+    summed over the workers [s], and the CPU time each worker process used over the wall
+    time. (Wall - compute / workers) is what batching, scheduling, result transfer and the
+    client cost, plus any imbalance; a CPU share below the computing share is other
+    processes taking the core, above it the worker's own overhead beside its task."""
     with distributed.Client(address, timeout="20s") as client, distributed.get_task_stream(client) as stream:
         cpu0 = client.run(time.process_time)
         t0 = time.perf_counter()
@@ -82,15 +82,12 @@ def task_stream_shares(distributed, address: str, spec, todo) -> dict[str, float
         wall = time.perf_counter() - t0
         cpu1 = client.run(time.process_time)
     busy: dict[str, float] = {}
-    transfer = 0.0
     for task in stream.data:
         for part in task["startstops"]:
             if part["action"] == "compute":
                 busy[task["worker"]] = busy.get(task["worker"], 0.0) + part["stop"] - part["start"]
-            elif part["action"] == "transfer":
-                transfer += part["stop"] - part["start"]
     return {"wall": wall, "shares": sorted(b / wall for b in busy.values()), "compute": sum(busy.values()),
-            "transfer": transfer, "cpu": sorted((cpu1[w] - cpu0[w]) / wall for w in cpu0)}
+            "cpu": sorted((cpu1[w] - cpu0[w]) / wall for w in cpu0)}
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -113,9 +110,7 @@ def main(argv: list[str] | None = None) -> None:
         distributed = None
     try:
         for n in (1, 2) if distributed else ():
-            cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                               dashboard_address="127.0.0.1:0", host="127.0.0.1",
-                                               silence_logs=logging.ERROR)
+            cluster = local_cluster(n, silence_logs=logging.ERROR)  # as `pinmech study --workers n` starts it
             clusters.append(cluster)
             run_batches(spec, todo[:n], scheduler=cluster.scheduler_address)  # each worker builds the mechanism
             rows[f"Dask, {n} worker{'s' * (n > 1)}"] = Timed(
@@ -148,8 +143,7 @@ def main(argv: list[str] | None = None) -> None:
         shares = ", ".join(f"{x:.0%}" for x in t["shares"])
         cpu = ", ".join(f"{x:.0%}" for x in t["cpu"])
         print(f"task stream, {n} worker{'s' * (n > 1)}: wall {t['wall']:.2f} s, computing {shares} of it "
-              f"(compute {t['compute']:.2f} s in all), result transfers {t['transfer'] * 1e3:.0f} ms; "
-              f"CPU a worker got: {cpu} of the wall")
+              f"(compute {t['compute']:.2f} s in all); CPU a worker used: {cpu} of the wall")
     print(f"CPU time a variant-pose in this process: {cpu * 1e6:.3f} us")
     print(f"time in the core's per-pose follow: {share:.0%} of a serial run; outside it "
           f"(variant writes, assembly check, outputs, batching): {1 - share:.0%}")
