@@ -141,9 +141,9 @@ def main(argv: list[str] | None = None) -> None:
         print(f"two workers / one: median {statistics.median(ratios):.2f} x ({min(ratios):.2f} .. {max(ratios):.2f})")
     for n, t in sorted(streams.items()):
         shares = ", ".join(f"{x:.0%}" for x in t["shares"])
-        cpu = ", ".join(f"{x:.0%}" for x in t["cpu"])
+        got = ", ".join(f"{x:.0%}" for x in t["cpu"])
         print(f"task stream, {n} worker{'s' * (n > 1)}: wall {t['wall']:.2f} s, computing {shares} of it "
-              f"(compute {t['compute']:.2f} s in all); CPU a worker used: {cpu} of the wall")
+              f"(compute {t['compute']:.2f} s in all); CPU a worker used: {got} of the wall")
     print(f"CPU time a variant-pose in this process: {cpu * 1e6:.3f} us")
     print(f"time in the core's per-pose follow: {share:.0%} of a serial run; outside it "
           f"(variant writes, assembly check, outputs, batching): {1 - share:.0%}")
