@@ -3,7 +3,7 @@ engine's closure rows reach at one actuator-space point, for an actuator-space w
 study.
 
 With the motors held, the unknowns are the passive joints (as many as closure rows: the
-engine's `Closure.residual`, dimensionless). Each solution is reached by Newton from a pose
+compiled core's closure residual, dimensionless). Each solution is reached by Newton from a pose
 of a seed table, the motors moved from the seed's values to the target in steps of at most
 10 deg (or 0.05 L) with the loops closed at every step (a short continuation), and every
 line search refusing a step that changes the sign of det Phi_p: the assembly mode. The seed
@@ -30,6 +30,7 @@ import pinocchio as pin
 
 from pinmech.design.workspace_legs import angles, mode_sign, set_angles
 from pinmech.design.workspace_solve import TOL, PointSolution, WorkspaceMechanism
+from pinmech.model.closure_core import closure_rows
 
 TRIES = 8  # nearest seeds tried per assembly sign, until one reaches the target
 _ITERATIONS = 40
@@ -126,19 +127,15 @@ class ForwardKinematics:
 
     # ---------------------------------------------------------------- Newton, motors held
     def _closure(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Closure rows F and dF/dq at q (every joint's column)."""
-        wm = self.wm
-        wm._kinematics(q)
-        closures = wm.mechanism.closures
-        return (np.concatenate([c.residual(wm.data) for c in closures]),
-                np.vstack([c.residual_jacobian(wm.model, wm.data) for c in closures]))
+        """Closure rows F (the compiled core's) and their exact derivative dF/dq at q."""
+        rows = closure_rows(self.wm.mechanism)
+        return rows.residual(q), rows.jacobian(q, newton=True)
 
     def _sign(self, q: np.ndarray) -> int:
         """sign(det Phi_p) at q (0 on a type II singularity): the assembly mode."""
         wm = self.wm
-        wm._kinematics(q)
         p = wm.passive_cols
-        return int(np.sign(np.linalg.det(wm._phi()[:, p] * wm.scale[p])))
+        return int(np.sign(np.linalg.det(wm._phi(q)[:, p] * wm.scale[p])))
 
     def _hold(self, q: np.ndarray, sign: int) -> np.ndarray | None:
         """Close the loops over the passive joints (the motors as in q), keeping the assembly
