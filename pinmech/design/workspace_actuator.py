@@ -35,8 +35,8 @@ class ActuatorResult:
     assembly slot "+", "-").
 
     Attributes:
-        spec: the study file; motors: the axes' motor names (the file's order); angular:
-            whether each axis is a turn [rad] (else a slide [m]); length: L [m];
+        spec: the study file; motors: the axes' motor names (the file's order); angular
+            (each axis): a turn [rad], else a slide [m]; length: L [m];
         coords: each axis's motor values [rad or m]; reached: (grid..., 2) bool;
         end: (grid..., 2, task axes) end point [m]; modes: (grid..., 2) working modes;
         values: det1, det2, sigma1, sigma2, kappa (grid..., 2);
