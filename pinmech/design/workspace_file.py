@@ -161,18 +161,19 @@ def _axis(name: str, entry: Any, where: _Where, key: str = "", param: int | None
     if param is None:
         start, stop = where.length(entry, "from", key), where.length(entry, "to", key)
     else:
-        start, stop = _motor_value(entry, "from", key), _motor_value(entry, "to", key)
+        start, stop = (_motor_value(entry, end, f"{where.path}, {key}") for end in ("from", "to"))
     if not start < stop:
         raise where.error(key, f"from {entry['from']} is not below to {entry['to']}")
     return GridAxis(name, "xyz".index(name) if param is None else param, start, stop, count)
 
 
-def _motor_value(entry: dict, name: str, key: str) -> float:
-    """A motor's value [rad or m] as written: an angle ("30 deg"), else a length ("20 mm")."""
+def _motor_value(entry: dict, name: str, where: str) -> float:
+    """A motor's value [rad or m] as written: an angle ("30 deg"), else a length ("20 mm");
+    `where` names the file and the axis's key in the error."""
     try:
-        return to_si(entry[name], "angle", where=f"{key}.{name}")
+        return to_si(entry[name], "angle", where=f"{where}.{name}")
     except UnitError:
-        return to_si(entry[name], "length", where=f"{key}.{name}")
+        return to_si(entry[name], "length", where=f"{where}.{name}")
 
 
 def _length(table: dict, where: _Where) -> float | None:

@@ -178,8 +178,8 @@ class ForwardKinematics:
 
     # ---------------------------------------------------------------- all assemblies
     def solve(self, target: np.ndarray) -> list[ForwardSolution]:
-        """Every assembly found at motors `target` [rad or m] (motors' order), sorted by
-        sign (+ first) then by end point."""
+        """The assemblies found at motors `target` [rad or m] (motors' order): at most one
+        a sign of det Phi_p, + first."""
         gap = self.table_motors - target
         turn = ~self.wm.prismatic_motor
         gap[:, turn] = (gap[:, turn] + np.pi) % (2 * np.pi) - np.pi
