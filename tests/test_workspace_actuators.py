@@ -190,7 +190,7 @@ def test_cli_writes_the_actuator_table_summary_and_maps(tmp_path, capsys):
      "workspace.actuators.mot1.count", "count = 1 must be a whole number from 2 to 10000"),
     ('mot1 = { from = "-90 deg", to = "90 deg", count = 5 }', "workspace.actuators", "give 2 or 3 motors' ranges"),
     ('mot1 = { from = "-90 kg", to = "90 deg", count = 5 }\nmot2 = { from = "0 deg", to = "9 deg", count = 2 }',
-     "workspace.actuators.mot1.from", "kg"),
+     "workspace.actuators.mot1.from", "-90 kg. is neither an angle nor a length"),
 ])
 def test_bad_actuator_axes_are_named(tmp_path, body, key, message):
     path = tmp_path / "bad.toml"

@@ -173,7 +173,11 @@ def _motor_value(entry: dict, name: str, where: str) -> float:
     try:
         return to_si(entry[name], "angle", where=f"{where}.{name}")
     except UnitError:
-        return to_si(entry[name], "length", where=f"{where}.{name}")
+        try:
+            return to_si(entry[name], "length", where=f"{where}.{name}")
+        except UnitError as exc:
+            raise UnitError(f"{name} = {entry[name]!r} is neither an angle nor a length: give a motor's value "
+                            "as \"30 deg\" (a turn) or \"20 mm\" (a slide)", key=f"{where}.{name}") from exc
 
 
 def _length(table: dict, where: _Where) -> float | None:
