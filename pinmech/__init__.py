@@ -76,6 +76,7 @@ _LAZY = {
     "pinmech.design.synthesis_result": ("SynthesisResult",),
     "pinmech.design.synthesis_search": ("synthesise",),
     "pinmech.design.workspace": ("WorkspaceResult",),
+    "pinmech.design.workspace_actuator": ("ActuatorResult",),
     "pinmech.design.workspace_file": ("WorkspaceSpec", "load_workspace"),
     "pinmech.io.sweep": ("Sweep", "SweepPose"),
     "pinmech.units": ("to_si",),
@@ -102,6 +103,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Accuracy",
+    "ActuatorResult",
     "Analysis",
     "Assembly",
     "AssemblyError",
