@@ -37,7 +37,7 @@ from pinmech.exceptions import ModelError, SingularPoseError, TaskError
 from pinmech.model.mechanism import Mechanism
 from pinmech.solve import core
 from pinmech.solve.core import _core
-from pinmech.solve.results import RateSolution
+from pinmech.solve.results import RateSolution, frozen
 from pinmech.solve.loops import (
     DEFAULT_MAX_CONDITION,
     DEFAULT_TOL,
@@ -178,6 +178,9 @@ class RateSolver:
         self._row_scale = np.array([1.0 / mechanism.length_scale if c in "xyz" else 1.0
                                     for t in self.tasks for c in t.components])
         self._generic: tuple[int, np.ndarray, list[int]] | None = None  # rank, rows, dependent rows
+        #: Where a row of the compiled answer splits (set with the core): nv, the first
+        #: achieved task row, the number of task rows.
+        self._columns = (0, 0, 0)
 
     # ------------------------------------------------------------------ solve
     @serialized
@@ -200,21 +203,20 @@ class RateSolver:
             SingularPoseError: the stacked Jacobian is singular at q, unless "damped".
         """
         q = self.mechanism.checked_q(q)
-        x_dot = self._values(velocity, self.x_dot, "velocity")
-        x_ddot = self._values(acceleration, self.x_ddot, "acceleration")
+        x_dot = self.x_dot if velocity is None else self._values(velocity, self.x_dot, "velocity")
+        x_ddot = self.x_ddot if acceleration is None else self._values(acceleration, self.x_ddot, "acceleration")
         row = self._rates(q[None], x_dot, x_ddot)[0]
-        nv, m = self.model.nv, x_dot.size
-        first = 2 * nv + _core.RATE_NUMBERS
+        nv, first, m = self._columns
         condition, sigma_min, closure_v, closure_a, _, independent, full, rank, used = self._checked(
             q, row[2 * nv:first])
-        return RateSolution(
-            v=row[:nv], a=row[nv:2 * nv], method=_USED[int(used)], condition=condition, sigma_min=sigma_min,
-            nullspace_dim=nv - int(rank), rank=int(rank),
-            requested_velocity=x_dot.copy(), achieved_velocity=row[first:first + m],
-            requested_acceleration=x_ddot.copy(), achieved_acceleration=row[first + m:],
-            closure_velocity_residual=closure_v, closure_acceleration_residual=closure_a,
-            closure_residual=max(independent, full),
-        )
+        rank = int(rank)
+        return frozen(RateSolution, {  # RateSolution(**these), built at a tenth of the cost
+            "v": row[:nv], "a": row[nv:2 * nv], "method": _USED[int(used)], "condition": condition,
+            "sigma_min": sigma_min, "nullspace_dim": nv - rank,
+            "requested_velocity": x_dot.copy(), "achieved_velocity": row[first:first + m],
+            "requested_acceleration": x_ddot.copy(), "achieved_acceleration": row[first + m:],
+            "closure_velocity_residual": closure_v, "closure_acceleration_residual": closure_a,
+            "rank": rank, "closure_residual": max(independent, full)})
 
     @serialized
     def solve_many(self, q: np.ndarray) -> RateBatch:
@@ -294,6 +296,8 @@ class RateSolver:
             compiled.set_task([rebuilt.frames[f] for f in self.frames], [[int(k) for k in t.rows] for t in self.tasks],
                               [int(t.reference == "local") for t in self.tasks])
             cached = (compiled, None)
+            nv = self.model.nv
+            self._columns = (nv, 2 * nv + _core.RATE_NUMBERS, self.x_dot.size)
         if cached[1] != options:
             rows, columns = self._scales(self._closure_rows)
             cached[0].set_rate_options(rows, columns, _ASKED[self.method], self.damping, self.max_condition)
