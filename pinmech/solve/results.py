@@ -20,7 +20,7 @@ def frozen(cls: type[_T], fields: dict[str, Any]) -> _T:
     """An instance of the frozen dataclass `cls` holding `fields` (every field by name, in
     its order): what `cls(**fields)` builds, without the generated __init__, which sets each
     field through object.__setattr__ (about 0.1 us a field: most of a one-pose result's
-    cost). For classes without __post_init__; tests/test_results.py checks each use."""
+    cost). For classes without __post_init__; tests/test_pose_results.py checks each use."""
     instance = _new(cls)
     _set_attribute(instance, "__dict__", fields)
     return instance
