@@ -251,7 +251,7 @@ class RateSolver:
         core = self._compiled()
         out = np.empty((len(q), core.rate_columns))
         core.rates(q, x_dot, x_ddot, self._generic[0] if self._generic is not None else -1, out)
-        status = 2 * self.model.nv + 4
+        status = 2 * self._columns[0] + 4  # nv as the core has it
         if _NEEDS_RANK in out[:, status].tolist():  # only poses that look singular pay for the structural rank
             again = np.flatnonzero(out[:, status] == _NEEDS_RANK)
             more = np.empty((again.size, out.shape[1]))
@@ -287,8 +287,9 @@ class RateSolver:
         Raises:
             ModelError: the core reads a cut otherwise than its closure rows state."""
         cached = self.__dict__.get("_core")
+        closures = self.mechanism.closures
         options = (self.mechanism.length_scale, self.method, self.damping, self.max_condition,
-                   *[c.length_scale for c in self.mechanism.closures])
+                   [c.length_scale for c in closures] if closures else None)
         if cached is None or cached[0].model is not self.model or not cached[0].same_structure:
             built = core.compile_loops(self.model, self.mechanism.closures, self.mechanism.velocity_scale(),
                                        extra_frames=self.frames)
@@ -301,8 +302,7 @@ class RateSolver:
         if cached[1] != options:
             rows, columns = self._scales(self._closure_rows)
             cached[0].set_rate_options(rows, columns, _ASKED[self.method], self.damping, self.max_condition)
-            cached = (cached[0], options)
-        self.__dict__["_core"] = cached
+            self.__dict__["_core"] = cached = (cached[0], options)
         return cached[0]
 
     @property
