@@ -24,6 +24,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import CoreBuildError, ModelError
+from pinmech.seeded import Seeded
 
 _REINSTALL = "reinstall pinmech beside this pin (`pip install --force-reinstall --no-deps .` in its checkout)"
 
@@ -153,7 +154,7 @@ def disagreement(core: _core.Core, model: pin.Model, closures: list) -> float | 
     cut the core would read otherwise is refused, never solved to other numbers."""
     if not closures:
         return None
-    rng = np.random.default_rng(20261122)
+    rng = Seeded(20261122)
     q = pin.integrate(model, pin.neutral(model), rng.uniform(-1.0, 1.0, model.nv))
     data = model.createData()
     pin.computeJointJacobians(model, data, q)

@@ -35,6 +35,7 @@ import pinocchio as pin
 from pinmech.arguments import not_real
 from pinmech.exceptions import ModelError, SingularPoseError, TaskError
 from pinmech.model.mechanism import Mechanism
+from pinmech.seeded import Seeded
 from pinmech.solve import core
 from pinmech.solve.core import _core
 from pinmech.solve.results import RateSolution, frozen
@@ -342,7 +343,7 @@ class RateSolver:
         if self._generic is None:
             compiled = self._compiled()
             n_c = self._closure_rows
-            rng = np.random.default_rng(20261122)
+            rng = Seeded(20261122)
             best = None
             for _ in range(_SAMPLES):
                 q = pin.integrate(self.model, pin.neutral(self.model), rng.normal(size=self.model.nv))
