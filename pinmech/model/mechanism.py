@@ -16,7 +16,6 @@ rows). Named points are massless leaf links hung on fixed joints.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -374,8 +373,5 @@ class Mechanism:
         if name in self.mimics:
             m = self.mimics[name]
             return m.multiplier * self.coordinate(q, m.leader) + m.offset
-        j = self.joint(name)
-        if j.kind == "continuous":
-            return math.atan2(q[j.idx_q + 1], q[j.idx_q])  # libm's atan2, as numpy's for one pair
-        return float(q[j.idx_q])
+        return self.joint(name).coordinate(q)
 

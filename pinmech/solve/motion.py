@@ -132,14 +132,17 @@ class Motion:
 
     @_built
     def links(self) -> dict[str, LinkMotion]:
-        rows, plane = self._rows, self._plan.plane
-        return {name: _link_motion(rows[r], plane) for name, r in self._plan.links}
+        rows, plane, out = self._rows, self._plan.plane, {}
+        for name, r in self._plan.links:  # a loop: a comprehension is one more function call
+            out[name] = _link_motion(rows[r], plane)
+        return out
 
     @_built
     def points(self) -> dict[str, PointMotion]:
-        rows = self._rows
-        return {name: _point(rows[r], link) if at is None else _coincident(rows[at], rows[r], link)
-                for name, r, at, link in self._plan.points}
+        rows, out = self._rows, {}
+        for name, r, at, link in self._plan.points:
+            out[name] = _point(rows[r], link) if at is None else _coincident(rows[at], rows[r], link)
+        return out
 
     @_built
     def sliders(self) -> dict[str, SliderMotion]:
@@ -223,16 +226,16 @@ def _cut_slider(closure, parent: np.ndarray, child: np.ndarray) -> SliderMotion:
 
 def _joint_motions(mechanism: Mechanism, q: list[float], v: list[float], a: list[float]) -> dict[str, JointMotion]:
     """Every one-dof joint's coordinate and rates; a `<mimic>` follower's from its leader's."""
-    out = {}
+    out, mimics = {}, mechanism.mimics
     for name, joint in mechanism.joints.items():
-        if name in mechanism.mimics:
-            m = mechanism.mimics[name]
+        if name in mimics:
+            m = mimics[name]
             leader = mechanism.joints[m.leader]
             kind = m.kind if m.kind in ("revolute", "continuous", "prismatic") else leader.kind
             out[name] = _joint(mechanism.coordinate(q, name), m.multiplier * v[leader.idx_v],
                                m.multiplier * a[leader.idx_v], kind)
         elif joint.nv == 1:
-            out[name] = _joint(mechanism.coordinate(q, name), v[joint.idx_v], a[joint.idx_v], joint.kind)
+            out[name] = _joint(joint.coordinate(q), v[joint.idx_v], a[joint.idx_v], joint.kind)
         elif joint.nv > 1:
             out[name] = _multi_dof(mechanism, joint.id, q, v, a)
     return out
@@ -292,15 +295,18 @@ def _plane_angle(rotation: list[float], plane: tuple[list[float], list[float]] |
     floats: a pose's few products cost less than numpy's calls."""
     if plane is None:
         return None, "x"
-    n, ref = plane
-    for k, name in enumerate("xyz"):
-        axis = rotation[k::3]  # column k
-        along = n[0] * axis[0] + n[1] * axis[1] + n[2] * axis[2]
-        p0, p1, p2 = axis[0] - n[0] * along, axis[1] - n[1] * along, axis[2] - n[2] * along
-        if math.hypot(p0, p1, p2) >= _IN_PLANE or name == "z":
-            c = (ref[1] * p2 - ref[2] * p1, ref[2] * p0 - ref[0] * p2, ref[0] * p1 - ref[1] * p0)
-            return math.atan2(n[0] * c[0] + n[1] * c[1] + n[2] * c[2], ref[0] * p0 + ref[1] * p1 + ref[2] * p2), name
+    (n0, n1, n2), (r0, r1, r2) = plane
+    for k, name in _AXES:
+        a0, a1, a2 = rotation[k], rotation[k + 3], rotation[k + 6]  # column k
+        along = n0 * a0 + n1 * a1 + n2 * a2
+        p0, p1, p2 = a0 - n0 * along, a1 - n1 * along, a2 - n2 * along
+        if math.hypot(p0, p1, p2) >= _IN_PLANE or k == 2:
+            c0, c1, c2 = r1 * p2 - r2 * p1, r2 * p0 - r0 * p2, r0 * p1 - r1 * p0
+            return math.atan2(n0 * c0 + n1 * c1 + n2 * c2, r0 * p0 + r1 * p1 + r2 * p2), name
     raise AssertionError("unreachable")  # pragma: no cover
+
+
+_AXES = ((0, "x"), (1, "y"), (2, "z"))
 
 
 @functools.lru_cache(maxsize=8)
