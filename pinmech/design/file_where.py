@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any, Callable, TypeVar
 
 from pinmech.exceptions import SceneError
+from pinmech.known_keys import unknown_keys
 from pinmech.toml_file import read_toml
 
 Spec = TypeVar("Spec")
@@ -35,10 +36,11 @@ class FileWhere:
         """Refuse a table that is not one, or has a key not in keys (key: the table's name)."""
         if not isinstance(table, dict):
             raise self.error((key or "(top)") if self.dotted else key, f"must be a table, got {table!r}")
-        unknown = sorted(set(table) - keys)
-        if unknown:
-            named = (f"{key}.{unknown[0]}" if key else unknown[0]) if self.dotted else (key or unknown[0])
-            raise self.error(named, f"unknown key(s) {', '.join(unknown)}; known: {', '.join(sorted(keys))}")
+        message = unknown_keys(table, sorted(keys))
+        if message:
+            first = min(set(table) - keys)
+            named = (f"{key}.{first}" if key else first) if self.dotted else (key or first)
+            raise self.error(named, message)
 
     def whole(self, raw: dict, key: str, default: int) -> int:
         """raw[key] (default if absent), a whole number within limits[key]."""

@@ -25,6 +25,7 @@ import numpy as np
 
 from pinmech.directions import unit_vector, written
 from pinmech.io.scene_fields import Refused, Table, names, positive_quantity, quantity
+from pinmech.known_keys import unknown_keys
 
 _GRAVITY_NEEDS = "give acceleration = \"9.81 m/s^2\" and direction = [0, -1, 0] (world frame)"
 
@@ -100,9 +101,9 @@ class LoadSpec(Table):
     def _known_keys(cls, data: Any) -> Any:
         if not isinstance(data, dict):
             raise Refused(f"write each load as a [[load]] table, got {data!r}")
-        unknown = set(data) - {"name", "point", "link", "force", "torque"}
-        if unknown:
-            raise Refused(f"unknown key(s) {', '.join(sorted(unknown))}; {cls.unknown_hint}")
+        message = unknown_keys(data, ("name", "point", "link", "force", "torque"), cls.unknown_hint)
+        if message:
+            raise Refused(message)
         places = [k for k in ("point", "link") if k in data]
         if len(places) != 1 or not isinstance(data[places[0]], str):
             raise Refused("say where the load acts: point = \"NAME\" (a named point) or link = \"NAME\"")

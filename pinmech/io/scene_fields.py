@@ -14,6 +14,7 @@ import msgspec
 from msgspec import structs
 
 from pinmech.exceptions import SceneError, UnitError
+from pinmech.known_keys import unknown_keys
 from pinmech.typed_values import WrongType, typed
 from pinmech.units import JOINT_KINDS, to_si
 
@@ -124,11 +125,9 @@ class Table(msgspec.Struct, frozen=True, forbid_unknown_fields=True, kw_only=Tru
     def _known_keys(cls, data: Any) -> Any:
         if not isinstance(data, dict):
             raise Refused(f"must be a table, got {data!r}")
-        known = cls.keys()
-        unknown = sorted(set(data) - set(known))
-        if unknown:
-            hint = cls.unknown_hint or f"known: {', '.join(known)}"
-            raise Refused(f"unknown key(s) {', '.join(unknown)}; {hint}")
+        message = unknown_keys(data, cls.keys(), cls.unknown_hint)
+        if message:
+            raise Refused(message)
         return data
 
     @classmethod

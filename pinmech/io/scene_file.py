@@ -18,6 +18,7 @@ from pinmech.io.scene_errors import scene_error
 from pinmech.io.scene_fields import Invalid, Refused, Table, names, table_of, written_value
 from pinmech.io.scene_tables import DriverSpec, PointSpec, RatesSpec, ReportSpec, SolverSpec, TaskSpec, task_list
 from pinmech.io.sweep_table import SweepSpec
+from pinmech.known_keys import unknown_keys
 
 #: The keys that name the model file; a scene gives exactly one.
 MODEL_KEYS = ("urdf", "robot", "linkage", "mjcf")
@@ -53,10 +54,9 @@ class SceneFile(Table):
 
     @classmethod
     def _known_keys(cls, data: Any) -> Any:
-        known = sorted(cls.keys())
-        unknown = sorted(set(data) - set(known))
-        if unknown:
-            raise Refused(f"unknown key(s) {', '.join(unknown)}; known: {', '.join(known)}")
+        message = unknown_keys(data, sorted(cls.keys()))
+        if message:
+            raise Refused(message)
         for key in ("urdf", "robot", "linkage", "mjcf", "sidecar", "title"):
             if key in data and not isinstance(data[key], str):
                 raise Refused(f"must be a string, got {data[key]!r}", at=(key,))

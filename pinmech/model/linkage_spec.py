@@ -21,6 +21,7 @@ from msgspec import structs
 
 from pinmech.directions import unit_vector, written
 from pinmech.exceptions import ModelError
+from pinmech.known_keys import unknown_keys
 from pinmech.model.linkage_entries import (TABLES as _TABLES, Compass, Joint, MassSpec, Polar, Slider, Slot, Written,
                                            as_model_error as _as_model_error, joint_type)
 from pinmech.model.linkage_expr import check_param_name
@@ -220,10 +221,9 @@ def linkage_spec(raw: dict[str, Any], source: str = "<linkage>") -> LinkageSpec:
     """
     if not isinstance(raw, dict):
         raise ModelError("a linkage file is a table of keys", path=source)
-    unknown = set(raw) - _KEYS
-    if unknown:
-        raise ModelError(f"unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_KEYS))}",
-                         path=source)
+    message = unknown_keys(raw, sorted(_KEYS))
+    if message:
+        raise ModelError(message, path=source)
     token = _SOURCE.set(source)
     try:
         return LinkageSpec(**raw)

@@ -22,6 +22,7 @@ from typing import Any
 import pinocchio as pin
 
 from pinmech.exceptions import ModelError
+from pinmech.known_keys import unknown_keys
 from pinmech.model.frame_names import frame_named, reduced_model
 from pinmech.model.inertia_check import urdf_inertia_caveats
 from pinmech.model.mechanism import Mechanism
@@ -54,10 +55,9 @@ def read_sidecar(path: str | Path) -> dict[str, Any]:
         raise ModelError(f"malformed YAML: {' '.join(str(exc).split())}", path=source) from exc
     if not isinstance(content, dict):
         raise ModelError("expected keys closed_loop, type, name_mot", path=source)
-    unknown = set(content) - _KEYS
-    if unknown:
-        raise ModelError(f"unknown key(s) {', '.join(sorted(map(str, unknown)))}; known: {', '.join(sorted(_KEYS))}",
-                         path=source)
+    message = unknown_keys(content, sorted(_KEYS))
+    if message:
+        raise ModelError(message, path=source)
     out = {key: content.get(key) or [] for key in _KEYS}
     for key in _KEYS:
         if not isinstance(out[key], list):
