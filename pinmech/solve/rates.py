@@ -310,9 +310,8 @@ class RateSolver:
     def _closure_rows(self) -> int:
         return sum(c.rows for c in self.mechanism.closures)
 
-    def _values(self, given: np.ndarray | None, default: np.ndarray, name: str) -> np.ndarray:
-        if given is None:
-            return default
+    def _values(self, given: np.ndarray, default: np.ndarray, name: str) -> np.ndarray:
+        """Task rows given for one call, checked against the tasks' own (`default`)."""
         wrong = not_real(given)
         if wrong:
             raise ModelError(f"{name} must be real numbers (SI), got {wrong}: pinmech does not cast them",
