@@ -28,3 +28,8 @@ def written(values: Sequence[float] | np.ndarray) -> str:
     """A vector as the user wrote it, every number at full precision ([1e-200, 0, 0])."""
     items = values.tolist() if isinstance(values, np.ndarray) else list(values)
     return "[" + ", ".join(repr(float(x)) if isinstance(x, np.floating) else repr(x) for x in items) + "]"
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b for 3-vectors; np.cross costs ~10 us per call, this ~1 us (hot paths)."""
+    return np.array((a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]))

@@ -160,3 +160,19 @@ def stephenson_six_bar_urdf(a: float = 0.04, b: float = 0.12, c: float = 0.08, d
   <joint name="point_D" type="fixed"><parent link="link5"/><child link="D_pin"/><origin xyz="{b2} 0 0"/></joint>
 </robot>
 """
+
+
+def cut_rows(model, data, closure, selected: bool = False):
+    """A cut's closure rows from Pinocchio's frame placements in `data` (textbook, apart
+    from the core): the pose error [R_P^T (p_C - p_P); a_P x R a_C (revolute), log3 R
+    (prismatic, fixed), 0 (spherical)], R = R_P^T R_C, through the cut's row map (its
+    independent rows, or with `selected` every selected row)."""
+    import numpy as np
+    import pinocchio as pin
+
+    M_P, M_C = data.oMf[closure.parent_frame], data.oMf[closure.child_frame]
+    R = M_P.rotation.T @ M_C.rotation
+    angular = {"revolute": lambda: np.cross(closure.axis, R @ closure.child_axis),
+               "spherical": lambda: np.zeros(3)}.get(closure.cut_type, lambda: pin.log3(R))()
+    error6 = np.concatenate((M_P.rotation.T @ (M_C.translation - M_P.translation), angular))
+    return (closure.selected_rows6 if selected else closure.rows6) @ error6

@@ -26,6 +26,7 @@ from pinmech import (
 )
 from pinmech.solve import core
 from pinmech.solve.rates import DAMPING_RANGE
+from tests._mechanisms import cut_rows
 from tests.conftest import MODELS
 
 DEG = np.pi / 180
@@ -268,7 +269,7 @@ def test_a_loop_closed_within_a_looser_tol_states_its_residual():
     mech.set_coordinate(q, "O4", mech.coordinate(q, "O4") + 1e-9)
     data = mech.model.createData()
     pin.framesForwardKinematics(mech.model, data, q)
-    expected = max(np.abs(c.full_residual(data)).max() for c in mech.closures)
+    expected = max(np.abs(cut_rows(mech.model, data, c, selected=True)).max() for c in mech.closures)
     assert 1e-11 < expected < 1e-8
     task = [Task("P", ("x",), np.array([0.1]), np.zeros(1))]
     with pytest.raises(LoopClosureError, match="tolerance 1e-13"):
@@ -290,11 +291,11 @@ def test_a_loop_closed_within_a_looser_tol_states_its_residual():
 @pytest.mark.parametrize("build", ["prismatic", "spherical", "fixed", "revolute"])
 def test_solve_many_measures_each_cut_type_as_the_closures_do(build, tmp_path):
     """The closure residuals solve_many reads from the compiled core (the rows its rate
-    solve already evaluates at each pose) equal Closure.residual and full_residual at 20
-    random poses, all open, of a prismatic cut, a spherical one (the RSUR), a weld (MJCF
+    solve already evaluates at each pose) equal the textbook rows on Pinocchio's placements
+    (tests/_mechanisms.cut_rows: the independent rows and every selected row) at 20 random
+    poses, all open, of a prismatic cut, a spherical one (the RSUR), a weld (MJCF
     ball_loop, its ball's quaternion in q) and the four-bar's revolute cut: to 1e-12 of
-    1 + the residual (the same formulas in C++, rounding apart; tests/test_core.py holds
-    the rows to 1e-13 of their size)."""
+    1 + the residual (the same formulas, rounding apart)."""
     from pinmech.model.mjcf import load_mjcf
     from tests import _mechanisms
 
@@ -315,8 +316,8 @@ def test_solve_many_measures_each_cut_type_as_the_closures_do(build, tmp_path):
     data = mech.model.createData()
     for i, q in enumerate(Q):
         pin.framesForwardKinematics(mech.model, data, q)
-        want_i = max(np.abs(c.residual(data)).max() for c in mech.closures)
-        want_f = max(np.abs(c.full_residual(data)).max() for c in mech.closures)
+        want_i = max(np.abs(cut_rows(mech.model, data, c)).max() for c in mech.closures)
+        want_f = max(np.abs(cut_rows(mech.model, data, c, selected=True)).max() for c in mech.closures)
         assert want_f > 1e-3  # open: a random pose
         assert independent[i] == pytest.approx(want_i, abs=1e-12 * (1 + want_i))
         assert full[i] == pytest.approx(want_f, abs=1e-12 * (1 + want_f))

@@ -84,16 +84,18 @@ def test_point_jacobian_matches_central_differences():
     assert np.abs(fd - dt).max() < 1e-9
 
 
-def test_recovers_the_bundled_four_bar_from_ten_engine_points(tmp_path):
+@pytest.mark.parametrize("seed", [0, 1, 2, 3, 4])
+def test_recovers_the_bundled_four_bar_from_ten_engine_points(tmp_path, seed):
     # Ten points of the bundled four-bar's coupler curve, solved by the engine (Newton on the
     # URDF the drawn linkage builds, not the closed form), the linkage hidden. The linkage
     # found meets them within 1e-8 of its size, and the engine, sweeping the written
     # linkage from the first target's pose, meets them within 1e-8 too: one assembly, one way.
-    # DE is a heuristic: with this seed and budget it finds the linkage (seed 3 settles on
-    # one 1.3e-2 of its size off; scripts/benchmark_synthesis.py counts the seeds that meet).
+    # On every seed of five: DE is a heuristic, and a run that settles in a local optimum
+    # (seed 3 did, 1.3e-2 of the size off, before a settled run restarted) restarts with the
+    # next seed of the stream. About 8 to 18 s a seed on the shared 2-core machine.
     crank = np.arange(40.0, -230.0, -30.0)  # the crank turning clockwise from 40 deg
     targets = _engine_points(crank)
-    result = synthesise(_spec(targets, seed=5, population=15, generations=400, keep=1))
+    result = synthesise(_spec(targets, seed=seed, population=15, generations=400, keep=1))
     best = result.linkages[0]
     assert best.meets(1e-8)
     linkage, scene = write_linkage(best, tmp_path / "found", "found", "test.toml")

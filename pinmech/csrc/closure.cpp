@@ -157,23 +157,90 @@ VectorXd Core::drift(const VectorXd& q, const VectorXd& v) {
 void Core::drift_into(const VectorXd& q, const VectorXd& v, VectorXd& out) {
   pin::forwardKinematics(model_, data_, q, v, zero_);
   for (const Cut& cut : cuts_) {
-    const pin::SE3 &MP = data_.oMf[cut.parent], &MC = data_.oMf[cut.child];
-    const pin::Motion vP = cut.ground ? pin::Motion::Zero()
-                                      : pin::getFrameVelocity(model_, data_, cut.parent, pin::LOCAL_WORLD_ALIGNED);
-    const pin::Motion vC = pin::getFrameVelocity(model_, data_, cut.child, pin::LOCAL_WORLD_ALIGNED);
-    const pin::Motion aP = cut.ground ? pin::Motion::Zero()
-                                      : pin::getFrameClassicalAcceleration(model_, data_, cut.parent,
-                                                                           pin::LOCAL_WORLD_ALIGNED);
-    const pin::Motion aC = pin::getFrameClassicalAcceleration(model_, data_, cut.child, pin::LOCAL_WORLD_ALIGNED);
-    const Vector3d wP = vP.angular(), delta = MC.translation() - MP.translation();
-    const Vector3d dv = vC.linear() - vP.linear();
-    const Vector3d d = dv - wP.cross(delta);
-    const Vector3d d_dot = aC.linear() - aP.linear() - aP.angular().cross(delta) - wP.cross(dv);
-    Vector6d e;
-    e.head<3>() = MP.rotation().transpose() * (d_dot - wP.cross(d));
-    e.tail<3>() = MP.rotation().transpose() * (aC.angular() - aP.angular() - wP.cross(vC.angular() - wP));
+    pin::updateFramePlacement(model_, data_, cut.parent);  // at this q, whatever the last call's was
+    pin::updateFramePlacement(model_, data_, cut.child);
+    const Vector6d e = relative_acceleration6(frame_motion(cut.parent, cut.ground), frame_motion(cut.child, false));
     out.segment(cut.offset, cut.rows6.rows()).noalias() = cut.rows6 * e;
   }
+}
+
+// A frame's world motion from data_ after forwardKinematics(q, v, a) and its placement
+// (at rest where `ground`: a frame of the ground has no velocity or acceleration).
+FrameMotion<double> Core::frame_motion(pin::FrameIndex frame, bool ground) const {
+  FrameMotion<double> out;
+  out.x = data_.oMf[frame].translation();
+  out.R = data_.oMf[frame].rotation();
+  if (ground) {
+    out.v.setZero();
+    out.w.setZero();
+    out.acc.setZero();
+    out.alpha.setZero();
+    return out;
+  }
+  const pin::Motion V = pin::getFrameVelocity(model_, data_, frame, pin::LOCAL_WORLD_ALIGNED);
+  const pin::Motion A = pin::getFrameClassicalAcceleration(model_, data_, frame, pin::LOCAL_WORLD_ALIGNED);
+  out.v = V.linear();
+  out.w = V.angular();
+  out.acc = A.linear();
+  out.alpha = A.angular();
+  return out;
+}
+
+RowMatrix Core::errors6(const VectorXd& q) {
+  check_structure();
+  residual_into(q, r_);
+  RowMatrix out(Index(cuts_.size()), 6);
+  for (size_t c = 0; c < cuts_.size(); ++c) out.row(Index(c)) = error6(cuts_[c]).transpose();
+  return out;
+}
+
+RowMatrix Core::translation_rows() const {
+  RowMatrix out(rows_, 3);
+  for (const Cut& cut : cuts_)
+    out.middleRows(cut.offset, cut.rows6.rows()).noalias() =
+        cut.rows6.leftCols<3>() * data_.oMf[cut.parent].rotation().transpose();
+  return out;
+}
+
+namespace {
+
+// The frames' motions of a FrameMotion in rows (x, v, w, acc, alpha, then R's three rows),
+// each moved by i h times its change (dx, dv, dw, dacc, dalpha; R by [dtheta]x R).
+FrameMotion<std::complex<double>> stepped(const Eigen::Ref<const RowMatrix>& M, const Eigen::Ref<const RowMatrix>& dM,
+                                          double h) {
+  using C = std::complex<double>;
+  const std::complex<double> ih(0.0, h);
+  auto row = [&](Index i) -> Eigen::Matrix<C, 3, 1> {
+    return M.row(i).transpose().cast<C>() + ih * dM.row(i).transpose().cast<C>();
+  };
+  FrameMotion<C> out;
+  out.x = row(0);
+  out.v = row(1);
+  out.w = row(2);
+  out.acc = row(3);
+  out.alpha = row(4);
+  const Matrix3d R = M.middleRows<3>(5);
+  out.R = R.cast<C>() + ih * (pin::skew(Vector3d(dM.row(5).transpose())) * R).cast<C>();
+  return out;
+}
+
+}  // namespace
+
+VectorXd cut_rows_change(const Eigen::Ref<const RowMatrix>& rows6, int order, const Eigen::Ref<const RowMatrix>& P,
+                         const Eigen::Ref<const RowMatrix>& C, const Eigen::Ref<const RowMatrix>& dP,
+                         const Eigen::Ref<const RowMatrix>& dC) {
+  if (rows6.cols() != 6 || P.rows() != 8 || C.rows() != 8 || dP.rows() != 6 || dC.rows() != 6 || P.cols() != 3 ||
+      C.cols() != 3 || dP.cols() != 3 || dC.cols() != 3)
+    throw std::invalid_argument("cut_rows_change: rows6 (k, 6), P and C (8, 3), dP and dC (6, 3)");
+  if (order != 1 && order != 2) throw std::invalid_argument("cut_rows_change: order 1 (velocity) or 2 (acceleration)");
+  // The complex step: the rows are polynomials in the motions, so Im f(x + i h dx) / h is
+  // their derivative along dx to rounding (the next term is h^2 smaller), with no
+  // difference of nearby values; h shrunk with the changes' size.
+  const double h = 1e-20 / std::max({dP.cwiseAbs().maxCoeff(), dC.cwiseAbs().maxCoeff(), 1.0});
+  const auto Ps = stepped(P, dP, h), Cs = stepped(C, dC, h);
+  const Eigen::Matrix<std::complex<double>, 6, 1> e =
+      order == 1 ? relative_velocity6(Ps, Cs) : relative_acceleration6(Ps, Cs);
+  return rows6 * (e.imag() / h);
 }
 
 std::vector<int> Core::signs(const MatrixXd& J_dep) {
@@ -240,7 +307,7 @@ void Core::relative_columns(Cut& cut) const {
 
 // Rows offset .. offset + k of J_ = the cut's rows6 times its (6, nv) map from joint
 // velocities to (r_dot, w) of C in P; with `newton`, orientation rows carry the
-// derivative of the error measure instead (Closure.residual_jacobian). Columns come
+// derivative of the error measure instead (the exact derivative of the residual). Columns come
 // from data_.J (world axes, at the origin: pin::getFrameJacobian's source), only those
 // of Cut::child_cols and parent_cols; J_'s other columns of these rows stay zero.
 void Core::relative_jacobian(const Cut& cut, bool newton) {

@@ -29,6 +29,7 @@
 #include <pinocchio/multibody.hpp>
 
 #include <cmath>
+#include <complex>
 #include <vector>
 
 #include "buffer.hpp"
@@ -112,6 +113,56 @@ void frames_along(nb::handle model, nb::handle data, nb::handle Q, nb::handle V,
 struct JointColumn {
   Index extended, v;
 };
+
+// A frame's world motion (LOCAL_WORLD_ALIGNED): origin x [m], rotation R, origin velocity v
+// [m/s], angular velocity w [rad/s], origin classical acceleration acc [m/s^2], angular
+// acceleration alpha [rad/s^2]. S: double, or std::complex<double> for a complex step.
+template <typename S>
+struct FrameMotion {
+  Eigen::Matrix<S, 3, 1> x, v, w, acc, alpha;
+  Eigen::Matrix<S, 3, 3> R;
+};
+
+// a x b, analytic in complex entries (Eigen's cross conjugates them).
+template <typename S>
+Eigen::Matrix<S, 3, 1> cross3(const Eigen::Matrix<S, 3, 1>& a, const Eigen::Matrix<S, 3, 1>& b) {
+  return Eigen::Matrix<S, 3, 1>(a(1) * b(2) - a(2) * b(1), a(2) * b(0) - a(0) * b(2), a(0) * b(1) - a(1) * b(0));
+}
+
+// The motion of a cut's child frame C relative to its parent P, in P's axes: the 6-vector
+// its velocity rows select from, (r_dot, w) = (R_P^T (v_C - v_P - w_P x delta), R_P^T (w_C - w_P)),
+// delta = x_C - x_P [m/s, rad/s].
+template <typename S>
+Eigen::Matrix<S, 6, 1> relative_velocity6(const FrameMotion<S>& P, const FrameMotion<S>& C) {
+  Eigen::Matrix<S, 6, 1> e;
+  e.template head<3>() = P.R.transpose() * (C.v - P.v - cross3<S>(P.w, C.x - P.x));
+  e.template tail<3>() = P.R.transpose() * (C.w - P.w);
+  return e;
+}
+
+// Its time derivative, the 6-vector the acceleration rows select from [m/s^2, rad/s^2]:
+// R_P^T (d_dot - w_P x d), d = v_C - v_P - w_P x delta, d_dot = acc_C - acc_P - alpha_P x delta
+// - w_P x (v_C - v_P); and R_P^T (alpha_C - alpha_P - w_P x (w_C - w_P)). At zero joint
+// accelerations, the drift.
+template <typename S>
+Eigen::Matrix<S, 6, 1> relative_acceleration6(const FrameMotion<S>& P, const FrameMotion<S>& C) {
+  using V3 = Eigen::Matrix<S, 3, 1>;
+  const V3 delta = C.x - P.x, dv = C.v - P.v;
+  const V3 d = dv - cross3<S>(P.w, delta);
+  const V3 d_dot = C.acc - P.acc - cross3<S>(P.alpha, delta) - cross3<S>(P.w, dv);
+  Eigen::Matrix<S, 6, 1> e;
+  e.template head<3>() = P.R.transpose() * (d_dot - cross3<S>(P.w, d));
+  e.template tail<3>() = P.R.transpose() * (C.alpha - P.alpha - cross3<S>(P.w, V3(C.w - P.w)));
+  return e;
+}
+
+// The change of a cut's velocity (order 1) or acceleration (order 2) rows, rows6 times the
+// 6-vector above, along a change of both frames' motions (closure.cpp). P, C: (8, 3), rows
+// x, v, w, acc, alpha, then R's three rows; dP, dC: (6, 3), rows dx, dv, dw, dacc, dalpha
+// and dtheta, the frame's turn (dR = [dtheta]x R), all in world axes.
+VectorXd cut_rows_change(const Eigen::Ref<const RowMatrix>& rows6, int order, const Eigen::Ref<const RowMatrix>& P,
+                         const Eigen::Ref<const RowMatrix>& C, const Eigen::Ref<const RowMatrix>& dP,
+                         const Eigen::Ref<const RowMatrix>& dC);
 
 struct Cut {
   int type;
@@ -230,6 +281,12 @@ class Core {
   void drift_into(const VectorXd& q, const VectorXd& v, VectorXd& out);
   std::vector<int> signs(const MatrixXd& J_dep);
   void signs_into(const MatrixXd& J_dep, std::vector<int>& out);
+  // Each cut's pose error (cuts, 6) at q, before selection and scale: C's position in P
+  // [m], its orientation error [rad, or the sine of the axes' angle for a revolute cut].
+  RowMatrix errors6(const VectorXd& q);
+  // (rows, 3) at the q of the last residual: the rows' change per world translation [m] of
+  // the child cut frame (minus it, of the parent's), orientation rows unchanged.
+  RowMatrix translation_rows() const;
 
   // ------------------------------------------------------------ continuation.cpp
   bool correct(VectorXd& q, const VectorXd& drivers, int max_iterations, double& residual_left);
@@ -290,6 +347,7 @@ class Core {
 
  private:
   Vector6d error6(const Cut& cut) const;
+  FrameMotion<double> frame_motion(pin::FrameIndex frame, bool ground) const;
   void relative_columns(Cut& cut) const;
   void relative_jacobian(const Cut& cut, bool newton);
   std::vector<DiagonalBlock> ordered_blocks() const;

@@ -46,6 +46,9 @@ NB_MODULE(_core, m) {
         "then a row per frame and joint asked into out (kinematics.cpp)");
   m.def("frames_along", &frames_along,
         "frames_along(model, data, Q, V, A, frames, out): frames_at at every row, into out (N, frames * 24)");
+  m.def("cut_rows_change", &cut_rows_change,
+        "cut_rows_change(rows6, order, P, C, dP, dC): the change of a cut's velocity (1) or acceleration (2) "
+        "rows along a change of its frames' motions (core.hpp)");
   nb::class_<Core>(m, "Core")
       .def(nb::init<nb::object, const std::vector<int>&, const std::vector<int>&, const std::vector<int>&,
                     const std::vector<int>&, const Eigen::Ref<const RowMatrix>&, const Eigen::Ref<const RowMatrix>&,
@@ -66,6 +69,8 @@ NB_MODULE(_core, m) {
       .def("full_residual", &Core::full_residual)
       .def("jacobian", &Core::jacobian, nb::arg("newton") = false)
       .def("drift", &Core::drift)
+      .def("errors6", &Core::errors6)
+      .def("translation_rows", &Core::translation_rows)
       .def("signs", &Core::signs)
       .def("correct",
            [](Core& core, VectorXd q, const VectorXd& drivers, int max_iterations) {

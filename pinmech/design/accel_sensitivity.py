@@ -21,8 +21,8 @@ w_b, acceleration alpha_b). At fixed a, each frame's quantities change by
     d(velocity) = (dV/dq) S + w x J_lin S + J w + [w_b x u; 0],   dx = J_lin S + u,   d(theta) = J_ang S
     d(acc) = d(spatial linear) + alpha x J_lin S + dw x v + w x dv_tree + alpha_b x u + w_b x (w_b x u)
 
-and differentiating A term by term (d(R_P^T y) = R_P^T (dy - d(theta_P) x y)) gives
-dA/dp_k at fixed a; then J_dep da_dep/dp_k = -dA/dp_k. A link's angular acceleration
+and differentiating A term by term (d(R_P^T y) = R_P^T (dy - d(theta_P) x y), the core's
+`cut_rows_change`) gives dA/dp_k at fixed a; then J_dep da_dep/dp_k = -dA/dp_k. A link's angular acceleration
 alpha_f moves by n . ((d alpha_f at fixed a) + J_f,ang da/dp_k). A drawn linkage's param
 (drawn_params.py) translates nothing by u but turns and moves the placements themselves:
 A and alpha_f gain the drawing's own change at fixed (q, v, a), their central differences
@@ -34,7 +34,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from pinmech.model.closures import _cross
+from pinmech.directions import cross as _cross
+from pinmech.model.closure_core import closure_rows, cut_rows_change
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -96,7 +97,7 @@ def acceleration_sensitivity(sm, q: np.ndarray, v: np.ndarray, a: np.ndarray, dq
     fr = _Frames(sm, q, v, a)
     driven = {mech.driver_index(n) for n in sm.solver.drivers}
     dep = [i for i in range(model.nv) if i not in driven]
-    J = np.vstack([c.jacobian(model, sm.at(q)) for c in mech.closures])
+    J = closure_rows(mech).jacobian(q)
     n_par = len(sm.placements)
     dA, d_alpha = np.zeros((len(J), n_par)), np.zeros((len(frames), 3, n_par))
     for k, place in enumerate(sm.placements):
@@ -117,54 +118,24 @@ def acceleration_sensitivity(sm, q: np.ndarray, v: np.ndarray, a: np.ndarray, dq
 
 
 def _rows_now(sm, q: np.ndarray, v: np.ndarray, a: np.ndarray, frames: list[int]) -> tuple[np.ndarray, np.ndarray]:
-    """The acceleration rows A (rows,) and the frames' angular accelerations (F, 3) at
-    (q, v, a) with the placements now in the model (a Data of its own)."""
+    """The acceleration rows A = J a + drift (rows,) and the frames' angular accelerations
+    (F, 3) at (q, v, a) with the placements now in the model (a Data of its own)."""
+    rows = closure_rows(sm.mechanism)
     if not hasattr(sm, "_acc_now"):
         sm._acc_now = sm.model.createData()
     model, data = sm.model, sm._acc_now
     pin.forwardKinematics(model, data, q, v, a)
-    pin.updateFramePlacements(model, data)
-
-    def motion(f: int) -> tuple:
-        M = data.oMf[f]
-        V, A = pin.getFrameVelocity(model, data, f, _LWA), pin.getFrameAcceleration(model, data, f, _LWA)
-        return M.translation, M.rotation, V.linear, V.angular, A.linear + _cross(V.angular, V.linear), A.angular
-
-    rows = [_rows(c, motion(c.parent_frame), motion(c.child_frame)) for c in sm.mechanism.closures]
-    return np.concatenate(rows), np.array([motion(f)[5] for f in frames]).reshape(-1, 3)
-
-
-def _rows(cut, P: tuple, C: tuple) -> np.ndarray:
-    """A cut's acceleration rows from its frames' (x, R, v, w, acc, alpha) (the module's A)."""
-    lin, ang = _inner(P, C)
-    return cut._rows6 @ np.concatenate((P[1].T @ lin, P[1].T @ ang))
-
-
-def _inner(P: tuple, C: tuple) -> tuple[np.ndarray, np.ndarray]:
-    """The brackets of A (world axes): acc_C - acc_P - alpha_P x delta - w_P x (v_C - v_P)
-    - w_P x a_, and alpha_C - alpha_P - w_P x b."""
-    x_P, _, v_P, w_P, acc_P, al_P = P
-    x_C, _, v_C, w_C, acc_C, al_C = C
-    delta, rel = x_C - x_P, v_C - v_P
-    lin = acc_C - acc_P - _cross(al_P, delta) - _cross(w_P, rel) - _cross(w_P, rel - _cross(w_P, delta))
-    return lin, al_C - al_P - _cross(w_P, w_C - w_P)
+    alphas = [pin.getFrameAcceleration(model, data, f, _LWA).angular for f in frames]
+    return rows.jacobian(q) @ a + rows.drift(q, v), np.array(alphas).reshape(-1, 3)
 
 
 def _cut_rows(cut, fr: _Frames, S, w, moved, carrier) -> np.ndarray:
-    """dA/dp_k of one cut's acceleration rows at fixed a (the module's formula)."""
-    P, C = cut.parent_frame, cut.child_frame
-    x_P, R_P, v_P, w_P, acc_P, al_P = fr(P)[:6]
-    x_C, _, v_C, w_C, acc_C, al_C = fr(C)[:6]
-    dx_P, dth_P, dv_P, dw_P, dacc_P, dal_P = fr.change(P, S, w, moved(P), carrier)
-    dx_C, _, dv_C, dw_C, dacc_C, dal_C = fr.change(C, S, w, moved(C), carrier)
-    delta, d_delta = x_C - x_P, dx_C - dx_P
-    rel, d_rel = v_C - v_P, dv_C - dv_P
-    a_ = rel - _cross(w_P, delta)
-    da_ = d_rel - _cross(dw_P, delta) - _cross(w_P, d_delta)
-    b, db = w_C - w_P, dw_C - dw_P
-    lin, ang = _inner(fr(P)[:6], fr(C)[:6])
-    d_lin = (dacc_C - dacc_P - _cross(dal_P, delta) - _cross(al_P, d_delta) - _cross(dw_P, rel)
-             - _cross(w_P, d_rel) - _cross(dw_P, a_) - _cross(w_P, da_))
-    d_ang = dal_C - dal_P - _cross(dw_P, b) - _cross(w_P, db)
-    R_T = R_P.T
-    return cut._rows6 @ np.concatenate((R_T @ (d_lin - _cross(dth_P, lin)), R_T @ (d_ang - _cross(dth_P, ang))))
+    """dA/dp_k of one cut's acceleration rows at fixed a (the module's formula, in the
+    core's `cut_rows_change`) from both frames' motions and their changes."""
+    motion, change = [], []
+    for f in (cut.parent_frame, cut.child_frame):
+        x, R, v, om, acc, al = fr(f)[:6]
+        dx, dth, dv, dw, dacc, dal = fr.change(f, S, w, moved(f), carrier)
+        motion.append(np.vstack([x, v, om, acc, al, R]))
+        change.append(np.vstack([dx, dv, dw, dacc, dal, dth]))
+    return cut_rows_change(cut, 2, motion[0], motion[1], change[0], change[1])

@@ -2,7 +2,7 @@
 theorem on the velocity closure equations, after the configuration's (sensitivity.py).
 
 Each cut's velocity rows are G = rows6 [R_P^T (v_C - v_P - w_P x delta); R_P^T (w_C - w_P)]
-(`Closure.relative_jacobian6` times v), zero on every variant with the drivers' speeds
+(the compiled core's closure Jacobian times v), zero on every variant with the drivers' speeds
 held. Along a parameter p_k the pose moves by S_k = dq/dp_k and the frames it carries
 translate by u (study_params.Placement); with v held,
 
@@ -26,7 +26,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from pinmech.model.closures import _cross
+from pinmech.directions import cross as _cross
+from pinmech.model.closure_core import closure_rows, cut_rows_change
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -84,7 +85,7 @@ def velocity_sensitivity(sm, q: np.ndarray, v: np.ndarray, dq_dp: np.ndarray,
     rates = _FrameRates(model, data, q, v)
     driven = {mech.driver_index(n) for n in solver.drivers}
     dep = [i for i in range(model.nv) if i not in driven]
-    J = np.vstack([c.jacobian(model, data) for c in mech.closures])
+    J = closure_rows(mech).jacobian(q)
     carried = [rates.joint_omega(_written_in(sm, place)) for place in sm.placements]
     n_par = len(sm.placements)
     dG, dV = np.zeros((len(J), n_par)), np.zeros((len(frames), 6, n_par))
@@ -120,30 +121,23 @@ def _jacobians(sm, q: np.ndarray, frame: int | None) -> np.ndarray:
     pin.computeJointJacobians(sm.model, data, q)
     pin.updateFramePlacements(sm.model, data)
     if frame is None:
-        return np.vstack([c.jacobian(sm.model, data) for c in sm.mechanism.closures])
+        return closure_rows(sm.mechanism).jacobian(q)
     return pin.getFrameJacobian(sm.model, data, frame, _LWA).reshape(6, -1)
 
 
 def _cut_rows(sm, cut, rates: _FrameRates, S: np.ndarray, place, u: np.ndarray, moved: np.ndarray) -> np.ndarray:
-    """dG/dp_k of one cut's velocity rows at fixed v (the module's formula); u: the world
-    direction the parameter moves what it moves, `moved`: the carrying body's angular velocity."""
-    data = sm.data
-    M_P, M_C = data.oMf[cut.parent_frame], data.oMf[cut.child_frame]
-    (V_P, JP), (V_C, JC) = rates(cut.parent_frame), rates(cut.child_frame)
-    u_P = u if place.moves_frame(cut.parent_frame, sm.subtree) else np.zeros(3)
-    u_C = u if place.moves_frame(cut.child_frame, sm.subtree) else np.zeros(3)
-    w_P, delta = V_P[3:], M_C.translation - M_P.translation
-    a = V_C[:3] - V_P[:3] - _cross(w_P, delta)
-    b = V_C[3:] - w_P
-    dV_P, dV_C = rates.change(cut.parent_frame), rates.change(cut.child_frame)
-    dv_P = dV_P[:3] + (_cross(moved, u_P) if u_P.any() else 0.0)
-    dv_C = dV_C[:3] + (_cross(moved, u_C) if u_C.any() else 0.0)
-    d_delta = (JC[:3] - JP[:3]) @ S + u_C - u_P
-    da = dv_C - dv_P - _cross(dV_P[3:], delta) - _cross(w_P, d_delta)
-    db = dV_C[3:] - dV_P[3:]
-    turn = JP[3:] @ S
-    R_T = M_P.rotation.T
-    return cut._rows6 @ np.concatenate((R_T @ (da - _cross(turn, a)), R_T @ (db - _cross(turn, b))))
+    """dG/dp_k of one cut's velocity rows at fixed v (the module's formula, in the core's
+    `cut_rows_change`): each frame moves by dx = J_lin S + u, its velocity by the change at
+    fixed v plus moved x u, turns by J_ang S; u: the world direction the parameter moves
+    what it moves, `moved`: the carrying body's angular velocity."""
+    motion, change = [], []
+    for frame in (cut.parent_frame, cut.child_frame):
+        M, (V, J) = sm.data.oMf[frame], rates(frame)
+        u_f = u if place.moves_frame(frame, sm.subtree) else np.zeros(3)
+        dV = rates.change(frame)
+        motion.append(np.vstack([M.translation, V[:3], V[3:], np.zeros((2, 3)), M.rotation]))
+        change.append(np.vstack([J[:3] @ S + u_f, dV[:3] + _cross(moved, u_f), dV[3:], np.zeros((2, 3)), J[3:] @ S]))
+    return cut_rows_change(cut, 1, motion[0], motion[1], change[0], change[1])
 
 
 def _written_in(sm, place) -> int:

@@ -5,13 +5,13 @@ The closure residual r(q, p) = 0 holds on every variant; with the drivers held,
 
     J_dep dq_dep/dp + J_p = 0    =>    dq/dp = -J_dep^-1 J_p          (tangent space)
 
-J_dep: the closure Jacobian's columns of the dependent joints (`Closure.jacobian`, the
+J_dep: the closure Jacobian's columns of the dependent joints (the compiled core's, the
 derivative of the residual once the loop is closed). J_p, derived here: a parameter is a
 translation component of a placement, so a unit change moves frames rigidly without
 turning them. A joint origin translates the joint's whole subtree along u = R_parent e_k;
 a cut frame's origin translates that frame alone along u = R_joint e_k. The cut's relative
 position r = R_P^T (p_C - p_P) then changes by R_P^T (u_C - u_P), its orientation rows not
-at all: J_p = rows6 @ [R_P^T (u_C - u_P); 0].
+at all: J_p = rows6 @ [R_P^T (u_C - u_P); 0], the core's `translation_rows` times u_C - u_P.
 
 An output y(q, p) (a point's world position, a link's angle in the plane, a slider's
 coordinate) then has dy/dp = J_y dq/dp + dy/dp|_q, the last term u where the parameter
@@ -33,42 +33,33 @@ from pinmech.design.study_outputs import StudyOutputs
 from pinmech.design.study_stroke import stroke_sensitivity
 from pinmech.design.study_variant import StudyMechanism, VariantCycle
 from pinmech.design.variant_differences import central_differences
+from pinmech.model.closure_core import closure_rows
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
 def parameter_jacobian(sm: StudyMechanism, data: pin.Data) -> np.ndarray:
     """J_p (rows, n_par): the closure residual's derivative w.r.t. each parameter at fixed q
-    (`data` at q with frame placements up to date)."""
+    (`data` at sm.q_at, `StudyMechanism.at`, with frame placements up to date)."""
+    rows = closure_rows(sm.mechanism)
+    D = rows.translation_rows(sm.q_at)
     columns = []
     for place in sm.placements:
         if place.drawn:  # the drawing's central differences at fixed q (drawn_params.py)
-            columns.append(place.column(lambda: _closure_residual(sm, sm.q_at)))
+            columns.append(place.column(lambda: rows.residual(sm.q_at)))
             continue
         u = place.direction(data)
-        rows = []
-        for c in sm.mechanism.closures:
-            u_P = u if place.moves_frame(c.parent_frame, sm.subtree) else np.zeros(3)
-            u_C = u if place.moves_frame(c.child_frame, sm.subtree) else np.zeros(3)
-            d6 = np.concatenate((data.oMf[c.parent_frame].rotation.T @ (u_C - u_P), np.zeros(3)))
-            rows.append(c._rows6 @ d6)
-        columns.append(np.concatenate(rows))
+        moved = [u * (place.moves_frame(c.child_frame, sm.subtree) - place.moves_frame(c.parent_frame, sm.subtree))
+                 for c in sm.mechanism.closures]
+        columns.append(np.concatenate([D[at] @ m for at, m in zip(rows.slices, moved)]))
     return np.array(columns).T
-
-
-def _closure_residual(sm: StudyMechanism, q: np.ndarray) -> np.ndarray:
-    """The closure residual (rows,) at q with the placements now in the model (own Data)."""
-    if not hasattr(sm, "_fd_data"):
-        sm._fd_data = sm.model.createData()
-    pin.framesForwardKinematics(sm.model, sm._fd_data, q)
-    return np.concatenate([c.residual(sm._fd_data) for c in sm.mechanism.closures])
 
 
 def configuration_sensitivity(sm: StudyMechanism, data: pin.Data) -> np.ndarray:
     """dq/dp on the tangent space (nv, n_par), drivers held: -J_dep^-1 J_p at the closed q
     of `data`. Raises SingularPoseError where J_dep is singular (a fold, a dead centre)."""
     model, mech, solver = sm.model, sm.mechanism, sm.solver
-    J = np.vstack([c.jacobian(model, data) for c in mech.closures])
+    J = closure_rows(mech).jacobian(sm.q_at)
     driven = {mech.driver_index(n) for n in solver.drivers}
     dep = [v for v in range(model.nv) if v not in driven]
     J_dep = J[:, dep]

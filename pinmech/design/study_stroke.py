@@ -29,6 +29,7 @@ import numpy as np
 
 from pinmech.exceptions import PinmechError, SweepError
 from pinmech.extremum import golden_minimum
+from pinmech.model.closure_core import closure_rows
 
 COARSE = 1e-5  # [rad or m] of the driver: the golden section's bracket, then the secant's first step
 TOL = 1e-13  # [rad or m] of the driver: the secant stops at steps below this
@@ -111,8 +112,7 @@ class Stroke:
     def _slope(self, q: np.ndarray) -> float:
         """ds/dtheta [m/rad or m/m] at a closed pose: dq/dtheta = -J_dep^-1 J_driver."""
         sm = self.sm
-        data = sm.at(q)
-        J = np.vstack([c.jacobian(sm.model, data) for c in sm.mechanism.closures])
+        J = closure_rows(sm.mechanism).jacobian(q)
         drv = [sm.mechanism.driver_index(n) for n in sm.solver.drivers]
         dep = [v for v in range(sm.model.nv) if v not in drv]
         rate = np.zeros(sm.model.nv)

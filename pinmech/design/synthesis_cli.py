@@ -57,7 +57,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
             files = write_linkage(lk, f"{args.out}_{i}", f"{spec.title}: linkage {i}", str(spec.path))
             check = engine_check(files[1], lk, spec.targets, spec.angles)
             entry["files"] = [str(p) for p in files]
-            angular = lk.task == "function" and lk.topology == "four-bar"
+            angular = lk.task == "function" and lk.topology != "slider-crank"
             scale, unit = (180 / 3.141592653589793, "deg") if angular else (1e3, "mm")
             entry[f"engine_errors_{unit}"] = [float(e) * scale for e in check.errors]
             also = ""

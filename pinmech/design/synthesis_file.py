@@ -56,7 +56,7 @@ from pinmech.design.file_where import FileWhere, load_file
 from pinmech.units import to_si
 
 TASKS = ("path", "function", "motion")
-TOPOLOGIES = ("four-bar", "slider-crank")
+TOPOLOGIES = ("four-bar", "slider-crank", "inverted-slider-crank")
 CLASSES = ("any", "grashof", "crank-rocker", "double-crank", "double-rocker", "triple rocker")
 SLIDER_CLASSES = ("any", "crank", "rocker")  # grashof.slider_crank_class: the crank turns fully, or not
 DIRECTIONS = ("ccw", "cw", "either")
@@ -72,6 +72,9 @@ _BOUNDS = {
     ("slider-crank", "path"): (("O2", ("x", "y")), ("slide", ("angle", "offset")), ("crank", ()), ("rod", ()),
                                ("point", ("along", "across"))),
     ("slider-crank", "function"): (("crank", ()), ("rod", ()), ("offset", ())),
+    ("inverted-slider-crank", "path"): (("O2", ("x", "y")), ("O4", ("x", "y")), ("crank", ()), ("offset", ()),
+                                        ("point", ("along", "across"))),
+    ("inverted-slider-crank", "function"): (("crank", ()), ("offset", ())),
 }
 _CONSTRAINTS = {"grashof", "transmission", "ratio", "direction"}
 _LIMITS = {"seed": (0, 2**32 - 1), "population": (5, 1000), "generations": (1, 100_000), "keep": (1, 20)}
@@ -136,9 +139,9 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
         if key in raw and task != only:
             raise w.error(key, f"{key} is for task = \"{only}\" (this file's task is {task!r})")
     slider = topology == "slider-crank"
-    if slider and task == "motion":
-        raise w.error("task", "motion generation is for the four-bar only (a slider-crank's rod through poses "
-                      "is not there yet): use task = \"path\" or \"function\"")
+    if topology == "inverted-slider-crank" and task == "motion":
+        raise w.error("task", "motion generation is for the four-bar and the slider-crank (an inverted "
+                      "slider-crank's block through poses is not there yet): use task = \"path\" or \"function\"")
     if task == "function":
         targets, timing = _pairs(raw, w, "length" if slider else "angle"), None
         lower, upper = _bounds(raw, w, _BOUNDS[topology, "function"])
@@ -168,8 +171,9 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
     angles = None
     if task == "motion":
         targets, angles = targets[:, :2].copy(), targets[:, 2].copy()
+    classes = CLASSES if topology == "four-bar" else SLIDER_CLASSES
     return SynthesisSpec(path, str(raw.get("title", path.stem)), task, topology, targets, timing, lower, upper,
-                         w.choice(c, "grashof", SLIDER_CLASSES if slider else CLASSES, "any", "constraints"), ground,
+                         w.choice(c, "grashof", classes, "any", "constraints"), ground,
                          transmission, float(ratio), direction, angles=angles, **counts)
 
 

@@ -1,6 +1,7 @@
-"""A synthesised four-bar written as a drawn linkage (models/linkages/*.toml) with a scene
-that sweeps its crank through the targets, and checked by the engine: the scene solved by
-continuation from the first target's pose, the coupler point read at every target.
+"""A synthesised four-bar (slider-crank, inverted slider-crank) written as a drawn linkage
+(models/linkages/*.toml) with a scene that sweeps its crank through the targets, and checked
+by the engine: the scene solved by continuation from the first target's pose, the coupler
+point read at every target.
 
 The drawn linkage is written by the drawn linkage's own writer (model/linkage_write.py).
 """
@@ -40,6 +41,13 @@ def linkage_toml(lk: Linkage, title: str, source: str) -> str:
     slider = lk.topology == "slider-crank"
     what = {"path": "the coupler point P through the targets", "motion": "the coupler through the poses",
             "function": "the slider's travel" if slider else "the rocker's turns"}[lk.task]
+    if lk.topology == "inverted-slider-crank":
+        from pinmech.design.synthesis_inverted_write import inverted_tables
+
+        what = what.replace("rocker", "guide")
+        header = (f"Synthesised by `pinmech synth {source}`: {what}.\n"
+                  f"Drawn at the first target's pose (crank O2 at {math.degrees(lk.theta[0]):.6g} deg from x).")
+        return written(linkage_spec(inverted_tables(lk, title), source), header)
     if slider:
         B = p.B[0, 0]
         joints = {"O2": [_mm(z[0]), _mm(z[1])], "A": [_mm(A[0]), _mm(A[1])], "B": [_mm(B[0]), _mm(B[1])]}
@@ -77,7 +85,10 @@ def scene_toml(lk: Linkage, linkage_file: str, title: str) -> str:
     shown = {"path": "points = [\"P\"]", "motion": "points = [\"P\"]\nlinks = [\"coupler\"]",
              "function": "links = [\"rocker\"]"}[lk.task]
     if lk.topology == "slider-crank":
-        shown = "points = [\"B\", \"P\"]" if lk.task == "path" else "points = [\"B\"]"
+        shown = {"path": "points = [\"B\", \"P\"]", "motion": "points = [\"B\", \"P\"]\nlinks = [\"rod\"]",
+                 "function": "points = [\"B\"]"}[lk.task]
+    if lk.topology == "inverted-slider-crank":
+        shown = "points = [\"A\", \"P\"]" if lk.task == "path" else "links = [\"guide\"]"
     return "\n".join([
         "# The synthesised linkage swept through its targets:",
         "#   pinmech sweep THIS_FILE --plot fig.png",
@@ -142,7 +153,8 @@ def engine_check(scene_file: str | Path, lk: Linkage, targets: np.ndarray,
         P = np.array([m.points["P"].position[:2] for m in poses])
         if lk.task == "path":
             return EngineCheck(P, np.linalg.norm(P - targets, axis=1))
-        turn = np.array([m.links["coupler"].angle for m in poses]) + lk.phi0 - angles
+        coupler = "rod" if lk.topology == "slider-crank" else "coupler"
+        turn = np.array([m.links[coupler].angle for m in poses]) + lk.phi0 - angles
         return EngineCheck(P, np.linalg.norm(P - targets, axis=1), np.abs(np.mod(turn + math.pi, 2 * math.pi) - math.pi))
     if lk.topology == "slider-crank":  # the block's place along the slide from H, against the travel asked
         from pinmech.design.synthesis_slider import slide_position
@@ -150,6 +162,7 @@ def engine_check(scene_file: str | Path, lk: Linkage, targets: np.ndarray,
         B = np.array([m.points["B"].position[:2] for m in poses])
         x = slide_position(lk.z[None], B[None])[0]
         return EngineCheck(x, np.abs(x - (lk.phi0 + targets[:, 1])))
-    phi = np.array([m.links["rocker"].angle for m in poses])
+    output = "guide" if lk.topology == "inverted-slider-crank" else "rocker"
+    phi = np.array([m.links[output].angle for m in poses])
     wanted = lk.phi0 + targets[:, 1]  # the rocker's angles asked: its start plus the pairs' turns
     return EngineCheck(phi, np.abs(np.mod(phi - wanted + math.pi, 2 * math.pi) - math.pi))

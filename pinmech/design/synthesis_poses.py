@@ -1,8 +1,8 @@
-"""Four-bar motion generation: the coupler through N poses, its point P at each target
-place and its angle at each target angle, in order.
+"""Motion generation of a four-bar or a slider-crank: the coupler (the rod) through N
+poses, its point P at each target place and its angle at each target angle, in order.
 
-A search row x = (z (9), gamma): the four-bar (synthesis_fourbar.NAMES) and the angle
-gamma [rad] from the bar A -> B to the line the poses' angles are measured on. Each pose's
+A search row x = (z, gamma): the linkage (synthesis_fourbar.NAMES, 9; synthesis_slider.NAMES,
+8) and the angle gamma [rad] from the bar A -> B to the line the poses' angles are measured on. Each pose's
 crank angle is where the coupler comes nearest the pose (synthesis_objective.nearest_angles
 with the angles); the objective is sum_i |P - T_i|^2 / S^2 + (1 - cos(phi3 + gamma -
 angle_i)) * 2; defects and constraints as for paths. Refinement: least squares on the
@@ -16,7 +16,8 @@ import math
 import numpy as np
 
 from pinmech.design.synthesis_file import SynthesisSpec
-from pinmech.design.synthesis_fourbar import link_angle_jacobian, point_jacobian, pose
+from pinmech.design.synthesis_fourbar import link_angle_jacobian
+from pinmech.design.synthesis_kinematics import kinematics
 from pinmech.design.synthesis_motion import causes, grashof_label, progress, transmission_range
 from pinmech.design.synthesis_objective import BatchValues, batch_values, extent, nearest_angles
 from pinmech.design.synthesis_refine import refine
@@ -24,7 +25,7 @@ from pinmech.design.synthesis_result import Linkage
 
 
 def poses_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
-    """The file's bounds of the four-bar, and gamma over a turn."""
+    """The file's bounds of the linkage, and gamma over a turn."""
     return [*zip(spec.lower.tolist(), spec.upper.tolist()), (-math.pi, math.pi)]
 
 
@@ -37,12 +38,13 @@ def _coupler_angle(p) -> np.ndarray:
 
 
 def evaluate_poses(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchValues:
-    """The objective of rows x (n, 10) on one assembly, row by row."""
+    """The objective of rows x (n, width + 1) on one assembly, row by row."""
     x = np.atleast_2d(np.asarray(x, dtype=float))
-    z, gamma = x[:, :9], x[:, 9]
+    w = len(spec.lower)
+    z, gamma = x[:, :w], x[:, w]
     s = np.full(len(z), float(assembly))
-    theta = nearest_angles(z, s, spec.targets, spec.angles, gamma)
-    p = pose(z, s, np.nan_to_num(theta))
+    theta = nearest_angles(z, s, spec.targets, spec.angles, gamma, spec.topology)
+    p = kinematics(spec.topology).pose(z, s, np.nan_to_num(theta))
     d2 = ((p.P - spec.targets[None]) ** 2).sum(-1) / extent(spec.targets) ** 2
     d2 = d2 + 2 * (1 - np.cos(_coupler_angle(p) + gamma[:, None] - spec.angles[None]))
     found = causes(spec, z, s, np.nan_to_num(theta))
@@ -53,21 +55,21 @@ def refined_poses(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage | No
     """The row x on assembly s0 refined by least squares (bounds kept), or x itself if the
     refined one has a defect; None if neither is free of them."""
     theta = evaluate_poses(spec, s0, x[None]).theta[0]
-    n, S = len(spec.targets), extent(spec.targets)
+    n, S, w, k = len(spec.targets), extent(spec.targets), len(spec.lower), kinematics(spec.topology)
     v0 = np.concatenate((x, theta))
 
     def residual(v: np.ndarray) -> np.ndarray:
-        p = pose(v[None, :9], np.array([s0]), v[None, 10:])
-        r = np.concatenate((((p.P[0] - spec.targets) / S).ravel(), _turn(_coupler_angle(p)[0] + v[9] - spec.angles)))
+        p = k.pose(v[None, :w], np.array([s0]), v[None, w + 1:])
+        r = np.concatenate((((p.P[0] - spec.targets) / S).ravel(), _turn(_coupler_angle(p)[0] + v[w] - spec.angles)))
         return np.where(np.isfinite(r), r, 1.0)
 
     def jacobian(v: np.ndarray) -> np.ndarray:
-        _, dPz, dPt = point_jacobian(v[:9], s0, v[10:])
-        _, dphz, dpht = link_angle_jacobian(v[:9], s0, v[10:], 0)
-        J = np.zeros((3 * n, 10 + n))
-        J[:2 * n, :9] = dPz.reshape(2 * n, 9) / S
-        J[:2 * n, 10:] = (dPt[:, :, None] * np.eye(n)[:, None, :]).reshape(2 * n, n) / S
-        J[2 * n:, :9], J[2 * n:, 9], J[2 * n:, 10:] = dphz, 1.0, np.diag(dpht)
+        _, dPz, dPt = k.point_jacobian(v[:w], s0, v[w + 1:])
+        dphz, dpht = _coupler_jacobian(spec.topology, v[:w], s0, v[w + 1:])
+        J = np.zeros((3 * n, w + 1 + n))
+        J[:2 * n, :w] = dPz.reshape(2 * n, w) / S
+        J[:2 * n, w + 1:] = (dPt[:, :, None] * np.eye(n)[:, None, :]).reshape(2 * n, n) / S
+        J[2 * n:, :w], J[2 * n:, w], J[2 * n:, w + 1:] = dphz, 1.0, np.diag(dpht)
         return J
 
     lower = np.concatenate((spec.lower, np.full(1 + n, -np.inf)))
@@ -77,17 +79,31 @@ def refined_poses(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage | No
     return refine(residual, jacobian, v0, lower, upper, lambda v: _linkage(spec, v, s0))
 
 
+def _coupler_jacobian(topology: str, z: np.ndarray, s: float, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """d(the bar A -> B's angle)/dz (m, width) [rad/m] and /dtheta (m,): the four-bar's
+    coupler (synthesis_fourbar.link_angle_jacobian) or the slider-crank's rod
+    (synthesis_slider.loop_jacobian's first row)."""
+    if topology == "slider-crank":
+        from pinmech.design.synthesis_slider import loop_jacobian
+
+        _, dq_z, dq_t = loop_jacobian(z, s, theta)
+        return dq_z[:, 0, :], dq_t[:, 0]
+    return link_angle_jacobian(z, s, theta, 0)[1:]
+
+
 def _linkage(spec: SynthesisSpec, v: np.ndarray, s: float) -> Linkage | None:
-    z, gamma, theta = v[:9], float(v[9]), v[10:]
+    w = len(spec.lower)
+    z, gamma, theta = v[:w], float(v[w]), v[w + 1:]
     Z, S, T = z[None], np.array([s]), theta[None]
     if not np.all(np.isfinite(theta)) or causes(spec, Z, S, T)[0]:
         return None
-    p = pose(Z, S, T)
+    p = kinematics(spec.topology).pose(Z, S, T)
     errors = np.linalg.norm(p.P[0] - spec.targets, axis=1)
     turns = np.abs(_turn(_coupler_angle(p)[0] + gamma - spec.angles))
     if not (np.all(np.isfinite(errors)) and np.all(np.isfinite(turns))):
         return None
     way, span = progress(T, spec.direction)
-    low, high = transmission_range(Z, S, T, way, span)
+    low, high = transmission_range(Z, S, T, way, span, spec.topology)
     return Linkage(z.copy(), s, theta.copy(), int(way[0]), errors, (float(low[0]), float(high[0])),
-                   grashof_label(z), task="motion", phi0=gamma, angle_errors=turns)
+                   grashof_label(z, spec.topology), task="motion", phi0=gamma, angle_errors=turns,
+                   topology=spec.topology)

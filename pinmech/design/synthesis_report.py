@@ -24,10 +24,14 @@ DEFECTS = {
 def linkage_summary(lk: Linkage) -> dict:
     """One linkage's numbers, in mm and deg."""
     slider = lk.topology == "slider-crank"
+    inverted = lk.topology == "inverted-slider-crank"
     way = "counter-clockwise" if lk.way > 0 else "clockwise"
-    side = ("ahead" if lk.s > 0 else "behind") if slider else ("left" if lk.s > 0 else "right")
+    side = ("ahead" if lk.s > 0 else "behind") if slider or inverted else ("left" if lk.s > 0 else "right")
     where = f"{'ahead of' if lk.s > 0 else 'behind'} A's foot on the slide" if slider else f"{side} of A -> O4"
     fold = "the rod square to the slide" if slider else "coupler and rocker in line"
+    if inverted:
+        where = f"= F, the slot's foot, {'behind' if lk.s > 0 else 'ahead of'} the crank's pin A along the guide"
+        fold = "|O4 A| = |offset|, the slot square to O4 -> A"
     shape = ({"dimensions_mm": {n: round(float(v) * 1e3, 9) for n, v in zip(kinematics(lk.topology).NAMES, lk.z)
                                 if n != "slide"}, "slide_deg": round(math.degrees(lk.z[2]), 9)} if slider else
              {"dimensions_mm": {n: round(float(v) * 1e3, 9) for n, v in zip(kinematics(lk.topology).NAMES, lk.z)},
@@ -90,6 +94,10 @@ def text(result: SynthesisResult) -> str:
 def _dimensions(lk: dict) -> str:
     """A linkage's dimensions, in a line."""
     d = lk["dimensions_mm"]
+    if lk["topology"] == "inverted-slider-crank":
+        point = f", P at {d['along']:.6g} along and {d['across']:.6g} across the slot" if "errors_mm" in lk else ""
+        return (f"O2 ({d['O2x']:.6g}, {d['O2y']:.6g}) mm, O4 ({d['O4x']:.6g}, {d['O4y']:.6g}) mm, "
+                f"ground {lk['ground_mm']:.6g}, crank {d['crank']:.6g}, slot offset {d['offset']:.6g} mm{point}")
     if lk["topology"] == "slider-crank":
         point = f", P at {d['along']:.6g} along and {d['across']:.6g} across A->B" if "errors_deg" not in lk and \
             "slider_start_mm" not in lk else ""
@@ -144,11 +152,21 @@ def figure(result: SynthesisResult, path: str | Path) -> Path:
             ax.plot(*np.array([O2, A, B]).T, "-o", color="k", lw=1.4, ms=3)
             ax.plot(*B, "s", color="k", ms=9, mfc="none")
             ax.plot(*O2, "^", color="k", ms=8)
+        elif lk.topology == "inverted-slider-crank":  # the guide O4 -> F and its slot past A, the block at A
+            O4 = lk.z[2:4] * 1e3
+            u = (A - B) / max(float(np.linalg.norm(A - B)), 1e-12)
+            ax.plot(*np.array([O4, B, A + 0.3 * lk.size * 1e3 * u]).T, "-", color="0.4", lw=1.4)
+            ax.plot(*np.array([O2, A]).T, "-o", color="k", lw=1.4, ms=3)
+            ax.plot(*A, "s", color="k", ms=9, mfc="none")
+            ax.plot(*np.array([O2, O4]).T, "^", color="k", ms=8)
         else:
             O4 = lk.z[2:4] * 1e3
             ax.plot(*np.array([O2, A, B, O4]).T, "-o", color="k", lw=1.4, ms=3)
             ax.plot(*np.array([O2, O4]).T, "^", color="k", ms=8)
-        ax.fill(*np.array([A, B, P]).T, color="tab:orange", alpha=0.3)
+        if lk.topology == "inverted-slider-crank":  # P on the block, at A
+            ax.plot(*np.array([A, P]).T, "-", color="tab:orange", lw=3, alpha=0.6)
+        else:
+            ax.fill(*np.array([A, B, P]).T, color="tab:orange", alpha=0.3)
         ax.plot(T[:, 0], T[:, 1], "x", color="tab:red", ms=8, mew=2, label="targets")
         if result.spec.angles is not None:  # the poses' angles, and the coupler's at each pose
             L = 0.15 * float(np.ptp(T, axis=0).max())
@@ -191,14 +209,16 @@ def function_figure(result: SynthesisResult, path: str | Path) -> Path:
             out = (k.slide_position(lk.z[None], B[None])[0] - lk.phi0) * 1e3
             label = f"linkage {i}: max error {np.max(lk.errors) * 1e3:.2g} mm"
         else:
-            phi = np.unwrap(np.arctan2(B[:, 1], B[:, 0] - lk.z[2]))
+            phi = np.unwrap(k.guide_angle(lk.z[None], np.array([lk.s]), crank[None])[0]
+                            if lk.topology == "inverted-slider-crank" else np.arctan2(B[:, 1], B[:, 0] - lk.z[2]))
             out = np.degrees(phi - lk.phi0)
             out -= 360 * np.round((out[0]) / 360)
             label = f"linkage {i}: max error {math.degrees(np.max(lk.errors)):.2g} deg"
         ax.plot(np.degrees(crank - crank[0]), out, lw=1.5, label=label)
     ax.plot(pairs[:, 0], pairs[:, 1], "x", color="tab:red", ms=8, mew=2, label="pairs asked")
     ax.set_xlabel("crank turn from the first pair [deg]")
-    ax.set_ylabel("slider travel [mm]" if slider else "rocker turn [deg]")
+    ax.set_ylabel("slider travel [mm]" if slider else "guide turn [deg]" if result.spec.topology ==
+                  "inverted-slider-crank" else "rocker turn [deg]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(result.spec.title)

@@ -29,7 +29,8 @@ class Linkage:
         phi0: a function generator's rocker angle asked at the first pair, or a motion
             generator's angle from the bar A -> B to the poses' line [rad].
         angle_errors: a motion generator's coupler angle error at each pose [rad].
-        topology: "four-bar" or "slider-crank".
+        topology: "four-bar", "slider-crank" or "inverted-slider-crank" (z: its
+            synthesis_inverted.NAMES; phi0 of a function: the guide's angle at the first pair).
     """
 
     z: np.ndarray
@@ -55,8 +56,9 @@ class Linkage:
     def meets(self, relative: float) -> bool:
         """Whether every target is met within `relative` of the linkage's size (path; a
         motion's angles within `relative` rad too), or every output angle within `relative`
-        rad (a four-bar's function; a slider-crank's travel within `relative` of its size)."""
-        if self.task == "function" and self.topology == "four-bar":
+        rad (a four-bar's or an inverted slider-crank's function; a slider-crank's travel within
+        `relative` of its size)."""
+        if self.task == "function" and self.topology != "slider-crank":  # an output angle
             return bool(np.max(self.errors) <= relative)
         angles = self.angle_errors if self.angle_errors is not None else np.zeros(1)
         return bool(np.max(self.errors) <= relative * self.size and np.max(angles) <= relative)

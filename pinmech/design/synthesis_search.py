@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from pinmech.design.synthesis_file import SynthesisSpec, load_synthesis
+from pinmech.design.synthesis_kinematics import kinematics
 from pinmech.design.synthesis_result import Linkage, SynthesisResult
 from pinmech.design.synthesis_tasks import classical_rows, evaluate, refined, search_bounds
 
@@ -25,6 +26,7 @@ _CLOSE = 3e-2  # from a best relative rms target error below this, every 10th ge
 _MET = 1e-10  # ... and DE stops when the refined best meets every target within this share of its size
 _STRATEGY = "rand1bin"
 _STALL = 100  # generations without a 1 % better best: DE restarts with the next seed
+_SETTLED = 5  # refinements in a row (every 10th generation) landing no 1 % lower: a local optimum, restart
 _RESTART = 7919  # a restart's seed: the file's + this times the restart's number
 _DISTINCT = 0.02  # two linkages whose parameters differ by less than this share of the bounds are one
 
@@ -85,7 +87,7 @@ def _run(spec: SynthesisSpec, mapper: PopulationMap) -> SynthesisResult:
     until the assembly's generations are spent; the best distinct refined, best first."""
     found: list[Linkage] = []
     generations = 0
-    for assembly in (1.0, -1.0):
+    for assembly in getattr(kinematics(spec.topology), "ASSEMBLIES", (1.0, -1.0)):
         mapper.assembly = assembly
         left, restart = spec.generations, 0
         while left > 0 and not any(lk.meets(_MET) for lk in found):
@@ -123,10 +125,13 @@ def _evolved(spec: SynthesisSpec, mapper: PopulationMap, assembly: float, seed: 
 
 def _stopper(spec: SynthesisSpec, assembly: float):
     """DE's callback: True (stop) once the best so far refines to a linkage that meets
-    every target within _MET of its size (tried every 10th generation from _CLOSE on), or
-    once the best has not fallen by 1 % in _STALL generations (a restart does better)."""
+    every target within _MET of its size (tried every 10th generation from _CLOSE on); or
+    once the best has not fallen by 1 % in _STALL generations; or once _SETTLED refinements
+    in a row have landed no 1 % lower (the population creeps down a basin whose bottom
+    misses the targets: a local optimum). A restart with the next seed does better."""
     count = iter(range(10**9))
     best = [np.inf, 0]  # the best objective that was 1 % below the one before, and its generation
+    landed = [np.inf, 0]  # the lowest refined sum of squared errors 1 % below the one before, refinements since
 
     def callback(intermediate_result) -> bool:
         k = next(count)
@@ -137,7 +142,11 @@ def _stopper(spec: SynthesisSpec, assembly: float):
         if k % 10 or intermediate_result.fun > _CLOSE**2 * len(spec.targets):
             return False
         lk = refined(spec, assembly, intermediate_result.x)
-        return lk is not None and lk.meets(_MET)
+        if lk is not None and lk.meets(_MET):
+            return True
+        value = float(np.sum(lk.errors**2)) if lk is not None else np.inf
+        landed[:] = [value, 0] if value < 0.99 * landed[0] else [landed[0], landed[1] + 1]
+        return landed[1] >= _SETTLED
 
     return callback
 

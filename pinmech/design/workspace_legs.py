@@ -3,7 +3,7 @@ each motor's leg owns, and its working mode (the sign of its "elbow").
 
 A leg is a motor joint hanging from the base and every joint below it; its one loop cut
 joins its tip to the platform (or to the leg that carries the end point). With its cut's
-rows (dimensionless, `Closure.jacobian`) over its own joints' columns the leg has a square
+rows (dimensionless, as the compiled core's Jacobian) over its own joints' columns the leg has a square
 block B; the tip's motion B = [m | P] splits into the motor's column m and the passive
 joints' columns P. The leg is serially singular (type I) where m falls into the span of P:
 with n the normal of that span, oriented along the leg's last bar (from its first passive
@@ -128,15 +128,14 @@ def _tip_rows(mechanism: Mechanism, data: pin.Data, leg: Leg) -> np.ndarray:
     c = mechanism.closures[leg.closure]
     jac = pin.getFrameJacobian(mechanism.model, data, leg.frame, _LWA)[:, leg.cols]
     R_T = data.oMf[c.parent_frame].rotation.T
-    return c.basis @ c.selected @ np.vstack([R_T @ jac[:3] / c.length_scale, R_T @ jac[3:]])
+    return c.rows6 @ np.vstack([R_T @ jac[:3], R_T @ jac[3:]])
 
 
 def _bar_rows(mechanism: Mechanism, data: pin.Data, leg: Leg) -> np.ndarray:
     """The leg's last bar (first passive joint -> tip) as the cut's rows see a tip motion."""
     c = mechanism.closures[leg.closure]
     bar = data.oMf[leg.frame].translation - data.oMi[leg.elbow].translation
-    local = data.oMf[c.parent_frame].rotation.T @ bar / c.length_scale
-    return c.basis @ c.selected @ np.concatenate((local, np.zeros(3)))
+    return c.rows6 @ np.concatenate((data.oMf[c.parent_frame].rotation.T @ bar, np.zeros(3)))
 
 
 def set_angles(model: pin.Model, q: np.ndarray, joints: tuple[int, ...], theta: np.ndarray) -> None:

@@ -2,7 +2,7 @@
 and what the Jacobians say there: the engine's closure rows with the end point as driver.
 
 Unknowns: every joint coordinate q. Equations, square (nv of them): the loops' closure rows
-(dimensionless, `Closure.residual`) and the end point's grid coordinates minus the target,
+(dimensionless, the compiled core's) and the end point's grid coordinates minus the target,
 over the characteristic length L. Newton from a seed in the asked working mode (each leg
 seeded from a table of its own sampled poses, the nearest tip of the right sign), with a
 line search that refuses a step changing any leg's mode: a point is reachable in a mode
@@ -31,6 +31,7 @@ from pinmech.design.workspace_legs import Leg, angles, find_legs, mode_sign, pas
 from pinmech.exceptions import SceneError
 from pinmech.io.scene import Scene
 from pinmech.io.scene_model import load_mechanism, scene_drivers
+from pinmech.model.closure_core import closure_rows
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 TOL = 1e-10  # Newton's convergence on the dimensionless residual (closure rows / loop size, end rows / L)
@@ -191,18 +192,17 @@ class WorkspaceMechanism:
         pin.computeJointJacobians(self.model, self.data, q)
         pin.updateFramePlacements(self.model, self.data)
 
-    def _phi(self) -> np.ndarray:
-        """The stacked closure Jacobian (velocity rows, dimensionless) at the placed pose."""
-        return np.vstack([c.jacobian(self.model, self.data) for c in self.mechanism.closures])
+    def _phi(self, q: np.ndarray) -> np.ndarray:
+        """The stacked closure Jacobian (velocity rows, dimensionless) at q."""
+        return closure_rows(self.mechanism).jacobian(q)
 
     def _residual(self, q: np.ndarray, x: np.ndarray, signs: tuple[float, ...]):
         """(F, dF/dq, mode kept) at q: closure rows and end rows over L."""
         self._kinematics(q)
         kept = all(np.sign(mode_sign(self.mechanism, self.data, leg)) == s for leg, s in zip(self.legs, signs))
-        F = np.concatenate([c.residual(self.data) for c in self.mechanism.closures]
-                           + [(self.data.oMf[self.end].translation[self.rows] - x) / self.length])
-        dF = np.vstack([c.residual_jacobian(self.model, self.data) for c in self.mechanism.closures]
-                       + [self._end_rows()])
+        rows = closure_rows(self.mechanism)
+        F = np.concatenate([rows.residual(q), (self.data.oMf[self.end].translation[self.rows] - x) / self.length])
+        dF = np.vstack([rows.jacobian(q, newton=True), self._end_rows()])
         return F, dF, kept
 
     def _end_rows(self) -> np.ndarray:
@@ -245,7 +245,7 @@ class WorkspaceMechanism:
         if q is None:
             return PointSolution(False, np.full(len(self.legs), np.nan))
         self._kinematics(q)
-        phi, end = self._phi(), self._end_rows()
+        phi, end = self._phi(q), self._end_rows()
         K = np.vstack([phi, end]) * self.scale
         a, p = self.motor_cols, self.passive_cols
         phi_p = phi[:, p] * self.scale[p]

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from pinmech.model.closure_core import ClosureRows
 from pinmech.model.closures import Closure
 from pinmech.model.joint_info import _body_frame
 from pinmech.model.urdf_xml import _Cut
@@ -47,17 +48,10 @@ def _reduce_rows(model: pin.Model, closures: list[Closure], columns: np.ndarray)
     """
     if not closures:
         return
-    data = model.createData()
-    samples = _sample_configurations(model, _SAMPLES, columns)
-    stacks: list[list[np.ndarray]] = [[] for _ in closures]
-    for q in samples:
-        pin.computeJointJacobians(model, data, q)
-        pin.updateFramePlacements(model, data)
-        for stack, closure in zip(stacks, closures):
-            rows = closure.selected * closure._scale()
-            stack.append(rows @ closure.relative_jacobian6(model, data) * columns)
-    for stack, closure in zip(stacks, closures):
-        U, s, _ = np.linalg.svd(np.hstack(stack), full_matrices=False)
+    every = ClosureRows(model, closures, selected=True)
+    jacobians = [every.jacobian(q) * columns for q in _sample_configurations(model, _SAMPLES, columns)]
+    for rows, closure in zip(every.slices, closures):
+        U, s, _ = np.linalg.svd(np.hstack([J[rows] for J in jacobians]), full_matrices=False)
         rank = int(np.sum(s > STRUCTURAL_RANK_TOL * max(s[0], 1e-300))) if s.size else 0
         closure.basis = _readable_basis(U[:, :rank])
 

@@ -1,14 +1,13 @@
-"""One loop cut: its closure residual, its constraint Jacobian rows and their drift.
+"""One loop cut, as a description: its frames, type, axes and the basis of its rows.
 
-A cut joins a frame on a parent link (P) to a frame on a child link (C). Everything is
-written as the motion of C relative to P, expressed in P:
+A cut joins a frame on a parent link (P) to a frame on a child link (C). Its rows are
+written on the motion of C relative to P, expressed in P (linear first, then angular):
 
     r = R_P^T (p_C - p_P)                    relative position           [m]
     r_dot = R_P^T (v_C - v_P - w_P x (p_C - p_P))   relative velocity    [m/s]
     w = R_P^T (w_C - w_P)                    relative angular velocity   [rad/s]
 
-and their time derivatives (classical accelerations of both frames). A cut type selects
-rows of this 6-vector (linear first, then angular):
+and their time derivatives. A cut type selects rows of this 6-vector:
 
     spherical  3 rows: r = 0
     revolute   5 rows: r = 0, and w has no component across the joint axis
@@ -17,8 +16,9 @@ rows of this 6-vector (linear first, then angular):
 
 Because the selected directions are fixed in P, the same selection applies exactly at
 the position, velocity and acceleration levels. Rows that vanish identically (a planar
-loop has no out-of-plane motion to constrain) are removed by `mechanism.py`, which
-hands each closure a constant row basis `T`.
+loop has no out-of-plane motion to constrain) are removed by closure_rows.py, which hands
+each closure a constant row basis `T`. The rows themselves are evaluated in one place,
+pinmech's compiled core (closure_core.py): this module holds the description only.
 """
 
 from __future__ import annotations
@@ -26,15 +26,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import pinocchio as pin
 
 CUT_TYPES = ("revolute", "prismatic", "spherical", "fixed")
-_LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a x b for 3-vectors; np.cross costs ~10 us per call, this ~1 us (hot path)."""
-    return np.array((a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]))
 
 
 def _perpendicular_basis(axis: np.ndarray) -> np.ndarray:
@@ -118,84 +111,16 @@ class Closure:
         """(n_sel, 6) selection of the relative motion 6-vector, before reduction."""
         return self._select
 
+    @property
+    def rows6(self) -> np.ndarray:
+        """(rows, 6) basis @ selection @ diag(scale): the map from the relative 6-vector
+        (position over the loop's size, orientation) to the independent rows."""
+        return self._rows6
+
+    @property
+    def selected_rows6(self) -> np.ndarray:
+        """(n_sel, 6) selection @ diag(scale): every selected row, before the basis."""
+        return self._select * self._scale()
+
     def _scale(self) -> np.ndarray:
         return np.concatenate((np.full(3, 1.0 / self.length_scale), np.ones(3)))
-
-    def residual6(self, data: pin.Data) -> np.ndarray:
-        """Relative pose error as a 6-vector in P (position [m], orientation [rad]).
-
-        Needs frame placements up to date (`pin.updateFramePlacements`).
-        """
-        M_P, M_C = data.oMf[self.parent_frame], data.oMf[self.child_frame]
-        R_rel = M_P.rotation.T @ M_C.rotation
-        linear = M_P.rotation.T @ (M_C.translation - M_P.translation)
-        if self.cut_type == "revolute":
-            angular = _cross(self.axis, R_rel @ self.child_axis)
-        elif self.cut_type == "spherical":
-            angular = np.zeros(3)
-        else:
-            angular = pin.log3(R_rel)
-        return np.concatenate((linear, angular))
-
-    def full_residual(self, data: pin.Data) -> np.ndarray:
-        """All selected rows of the scaled pose error, reduced or not (dimensionless)."""
-        return self._select @ (self._scale() * self.residual6(data))
-
-    def residual(self, data: pin.Data) -> np.ndarray:
-        """Independent rows of the scaled pose error (dimensionless)."""
-        return self._rows6 @ self.residual6(data)
-
-    def relative_jacobian6(self, model: pin.Model, data: pin.Data) -> np.ndarray:
-        """(6, nv) map from joint velocities to (r_dot, w) in P.
-
-        Needs `pin.computeJointJacobians` and `pin.updateFramePlacements` at q.
-        """
-        M_P, M_C = data.oMf[self.parent_frame], data.oMf[self.child_frame]
-        # (6, nv) even for a one-dof model, where Pinocchio returns a (6,) vector
-        J_P = pin.getFrameJacobian(model, data, self.parent_frame, _LWA).reshape(6, -1)
-        J_C = pin.getFrameJacobian(model, data, self.child_frame, _LWA).reshape(6, -1)
-        delta = M_C.translation - M_P.translation
-        R_T = M_P.rotation.T
-        linear = R_T @ (J_C[:3] - J_P[:3] + pin.skew(delta) @ J_P[3:])
-        angular = R_T @ (J_C[3:] - J_P[3:])
-        return np.vstack([linear, angular])
-
-    def residual_jacobian(self, model: pin.Model, data: pin.Data) -> np.ndarray:
-        """(rows, nv) exact derivative of `residual` at any q, closed or not (for Newton).
-
-        Position rows are those of `jacobian`; orientation rows carry the derivative of
-        their error measure (a_P x R a_C, or log3 R), which equals the velocity rows only
-        once the loop is closed.
-        """
-        J6 = self.relative_jacobian6(model, data)
-        if self.cut_type != "spherical":
-            M_P, M_C = data.oMf[self.parent_frame], data.oMf[self.child_frame]
-            R_rel = M_P.rotation.T @ M_C.rotation
-            if self.cut_type == "revolute":
-                J6[3:] = -pin.skew(self.axis) @ pin.skew(R_rel @ self.child_axis) @ J6[3:]
-            else:
-                J6[3:] = pin.Jlog3(R_rel) @ R_rel.T @ J6[3:]
-        return self._rows6 @ J6
-
-    def jacobian(self, model: pin.Model, data: pin.Data) -> np.ndarray:
-        """(rows, nv) constraint Jacobian of the independent rows (dimensionless rows)."""
-        return self._rows6 @ self.relative_jacobian6(model, data)
-
-    def drift(self, model: pin.Model, data: pin.Data) -> np.ndarray:
-        """Constraint acceleration at zero joint acceleration, d/dt(J) q_dot (rows,).
-
-        Needs `pin.forwardKinematics(model, data, q, v, 0)` and frame placements.
-        """
-        M_P, M_C = data.oMf[self.parent_frame], data.oMf[self.child_frame]
-        v_P = pin.getFrameVelocity(model, data, self.parent_frame, _LWA)
-        v_C = pin.getFrameVelocity(model, data, self.child_frame, _LWA)
-        a_P = pin.getFrameClassicalAcceleration(model, data, self.parent_frame, _LWA)
-        a_C = pin.getFrameClassicalAcceleration(model, data, self.child_frame, _LWA)
-        w_P, w_C = v_P.angular, v_C.angular
-        delta = M_C.translation - M_P.translation
-        d = v_C.linear - v_P.linear - _cross(w_P, delta)
-        d_dot = a_C.linear - a_P.linear - _cross(a_P.angular, delta) - _cross(w_P, v_C.linear - v_P.linear)
-        R_T = M_P.rotation.T
-        linear = R_T @ (d_dot - _cross(w_P, d))
-        angular = R_T @ (a_C.angular - a_P.angular - _cross(w_P, w_C - w_P))
-        return self._rows6 @ np.concatenate((linear, angular))

@@ -101,12 +101,12 @@ def joint_kinds(path: str | Path) -> dict[str, str]:
 
 def _check_closed(mech) -> None:
     """The drawn pose closes every loop (a guard: it does by construction)."""
-    import pinocchio as pin
+    from pinmech.model.closure_core import closure_rows
 
-    data = mech.model.createData()
-    pin.framesForwardKinematics(mech.model, data, mech.reference)
-    for closure in mech.closures:
-        gap = float(np.max(np.abs(closure.residual(data)), initial=0.0))
+    rows = closure_rows(mech)
+    residual = rows.residual(mech.reference)
+    for closure, at in zip(mech.closures, rows.slices):
+        gap = float(np.max(np.abs(residual[at]), initial=0.0))
         if gap > 1e-9:
             raise ModelError(f"loop cut {closure.name} is open by {gap:.3g} (relative) at the drawn pose",
                              path=mech.source)

@@ -43,6 +43,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.exceptions import ModelError
+from pinmech.model.closure_core import closure_rows
 from pinmech.model.frame_names import frame_named
 from pinmech.model.inertia_check import check_mjcf_inertias
 from pinmech.model.mjcf_composite import place_composites_as_mujoco
@@ -351,10 +352,10 @@ def _check_sites(mech: Mechanism, elements: list[ET.Element], source: str) -> No
 
 
 def _check_closed(mech: Mechanism, source: str) -> None:
-    data = mech.model.createData()
-    pin.framesForwardKinematics(mech.model, data, mech.neutral())
-    for closure in mech.closures:
-        gap = float(np.max(np.abs(closure.residual(data)), initial=0.0))
+    rows = closure_rows(mech)
+    residual = rows.residual(mech.neutral())
+    for closure, at in zip(mech.closures, rows.slices):
+        gap = float(np.max(np.abs(residual[at]), initial=0.0))
         if gap > _CLOSE_TOL:
             raise ModelError(f"the loop {closure.name} is open by {gap:.3g} (of the size {mech.length_scale:.4g} m) "
                              "at qpos0 as Pinocchio read it", path=source, element=f"<equality> {closure.name}")

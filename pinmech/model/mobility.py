@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from pinmech.model.closure_core import closure_rows
 from pinmech.seeded import Seeded
 
 #: Singular values below this fraction of the largest count as zero (dimensionless rows).
@@ -46,31 +47,22 @@ class RankReport:
     redundant: tuple[str, ...] = ()
 
 
-def stacked_jacobian(mech, data: pin.Data, q: np.ndarray, scale: np.ndarray | None = None) -> np.ndarray:
+def stacked_jacobian(mech, q: np.ndarray, scale: np.ndarray | None = None) -> np.ndarray:
     """Every closure's rows, stacked, with dimensionless columns (prismatic x size) at q;
     `scale`: the mechanism's `velocity_scale()`, when the caller has it already."""
-    pin.computeJointJacobians(mech.model, data, q)
-    pin.updateFramePlacements(mech.model, data)
-    rows = [c.jacobian(mech.model, data) for c in mech.closures]
-    J = np.vstack(rows) if rows else np.zeros((0, mech.model.nv))
-    return J * (mech.velocity_scale() if scale is None else scale)
+    return closure_rows(mech).jacobian(q) * (mech.velocity_scale() if scale is None else scale)
 
 
-def _residual(mech, data: pin.Data, q: np.ndarray) -> np.ndarray:
-    pin.framesForwardKinematics(mech.model, data, q)
-    parts = [c.residual(data) for c in mech.closures]
-    return np.concatenate(parts) if parts else np.zeros(0)
-
-
-def close_least_squares(mech, data: pin.Data, q: np.ndarray, iterations: int = 60,
+def close_least_squares(mech, q: np.ndarray, iterations: int = 60,
                         scale: np.ndarray | None = None) -> np.ndarray | None:
     """Gauss-Newton with minimum-norm steps: a closed configuration near q, or None."""
     scale = mech.velocity_scale() if scale is None else scale
+    rows = closure_rows(mech)
     for _ in range(iterations):
-        r = _residual(mech, data, q)
+        r = rows.residual(q)
         if np.max(np.abs(r), initial=0.0) < _CLOSE_TOL:
             return q
-        J = stacked_jacobian(mech, data, q, scale)
+        J = rows.jacobian(q) * scale
         step = np.linalg.lstsq(J, -r, rcond=1e-10)[0]
         size = np.max(np.abs(step), initial=0.0)
         if size > 0.5:
@@ -92,12 +84,11 @@ def constraint_rank(mech) -> RankReport:
     rows = sum(c.rows for c in mech.closures)
     if rows == 0:
         return RankReport(0, 0, mech.neutral())
-    data = mech.model.createData()
     scale = mech.velocity_scale()  # fixed while the rank is sought: computed once
-    q0 = _closed_start(mech, data, scale)
+    q0 = _closed_start(mech, scale)
     if q0 is None:
         return RankReport(rows, rows, None)
-    J0 = stacked_jacobian(mech, data, q0, scale)
+    J0 = stacked_jacobian(mech, q0, scale)
     if _rank(J0) == rows:  # no pose has more than full rank: the neighbours below could not raise it
         return RankReport(rows, rows, q0)
     rng = Seeded(20261122)
@@ -108,17 +99,17 @@ def constraint_rank(mech) -> RankReport:
             break
         step = null @ rng.normal(size=null.shape[1])
         step *= _STEP / max(np.max(np.abs(step)), 1e-300)
-        q = close_least_squares(mech, data, pin.integrate(mech.model, q0, step * scale), scale=scale)
+        q = close_least_squares(mech, pin.integrate(mech.model, q0, step * scale), scale=scale)
         if q is not None:
             poses.append(q)
     if len(poses) == 1:  # no neighbour closed: other closed poses, so one singular pose cannot decide
         seeds = Seeded(11)
         for _ in range(4):
             start = pin.integrate(mech.model, q0, seeds.normal(size=mech.model.nv) * scale)
-            q = close_least_squares(mech, data, start, scale=scale)
+            q = close_least_squares(mech, start, scale=scale)
             if q is not None:
                 poses.append(q)
-    jacobians = [J0] + [stacked_jacobian(mech, data, q, scale) for q in poses[1:]]
+    jacobians = [J0] + [stacked_jacobian(mech, q, scale) for q in poses[1:]]
     ranks = [_rank(J) for J in jacobians]
     best = int(np.argmax(ranks))
     rank = ranks[best]
@@ -134,15 +125,15 @@ def constraint_rank(mech) -> RankReport:
     return RankReport(rank, rows, poses[best], redundant)
 
 
-def _closed_start(mech, data: pin.Data, scale: np.ndarray) -> np.ndarray | None:
+def _closed_start(mech, scale: np.ndarray) -> np.ndarray | None:
     """The reference configuration, closed; else a few seeded starts around it."""
-    q = close_least_squares(mech, data, mech.neutral(), scale=scale)
+    q = close_least_squares(mech, mech.neutral(), scale=scale)
     rng = Seeded(7)
     for _ in range(3):
         if q is not None:
             return q
         start = pin.integrate(mech.model, mech.neutral(), rng.normal(size=mech.model.nv) * scale)
-        q = close_least_squares(mech, data, start, scale=scale)
+        q = close_least_squares(mech, start, scale=scale)
     return q
 
 
@@ -162,8 +153,7 @@ def idle_joints(mech, drivers: list[str], q: np.ndarray | None) -> list[str]:
     """
     if q is None:
         return []
-    data = mech.model.createData()
-    J = stacked_jacobian(mech, data, q)
+    J = stacked_jacobian(mech, q)
     held = {mech.joints[n].idx_v for n in drivers if n in mech.joints}
     free = [i for i in range(mech.model.nv) if i not in held]
     null = _null_space(J[:, free])
@@ -189,7 +179,8 @@ def moving_joints(mech, drivers: list[str], q: np.ndarray | None) -> list[str]:
         return []
     model, data = mech.model, mech.model.createData()
     scale = mech.velocity_scale()
-    J = stacked_jacobian(mech, data, q, scale)  # also leaves the joint Jacobians at q in data
+    J = stacked_jacobian(mech, q, scale)
+    pin.computeJointJacobians(model, data, q)
     held = {mech.joints[n].idx_v for n in drivers if n in mech.joints}
     free = [i for i in range(model.nv) if i not in held]
     null = _null_space(J[:, free])

@@ -7,9 +7,9 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-import pinocchio as pin
 
 from pinmech.exceptions import LoopClosureError
+from pinmech.model.closure_core import closure_rows
 from pinmech.model.mechanism import Mechanism
 
 #: A closure residual below this (relative to the size) is rounding, not a loop out of reach.
@@ -35,18 +35,19 @@ def is_closed(independent, full, tol: float):
     return (independent <= tol) & (full <= max(tol, 1e-12) * 10)
 
 
-def open_loops_error(mechanism: Mechanism, data: pin.Data, q: np.ndarray, residual: float, tol: float,
+def open_loops_error(mechanism: Mechanism, q: np.ndarray, residual: float, tol: float,
                      where: str) -> LoopClosureError:
     """The error for rates asked at a pose whose loops are open: each open loop's gap
     between its cut frames [m] and the misalignment of its axes [deg], the residual
-    relative to the loop's size, and the tolerance. `data` holds q's joint placements."""
-    pin.updateFramePlacements(mechanism.model, data)
+    relative to the loop's size, and the tolerance."""
+    rows_at = closure_rows(mechanism)
+    errors, independent = rows_at.errors6(q), rows_at.residual(q)
     said = []
-    for c in mechanism.closures:
-        if is_closed(float(np.max(np.abs(c.residual(data)), initial=0.0)),
-                     float(np.max(np.abs(c.full_residual(data)), initial=0.0)), tol):
+    for c, r6, at in zip(mechanism.closures, errors, rows_at.slices):
+        if is_closed(float(np.max(np.abs(independent[at]), initial=0.0)),
+                     float(np.max(np.abs(c.selected_rows6 @ r6), initial=0.0)), tol):
             continue
-        r6, rows = c.residual6(data), c.selected
+        rows = c.selected
         gap = float(np.linalg.norm(rows[:, :3] @ r6[:3]))  # the distance its rows constrain [m]
         turn = float(np.linalg.norm(rows[:, 3:] @ r6[3:]))  # rad, or the sine of the axes' angle
         angle = math.degrees(math.asin(min(turn, 1.0)) if c.cut_type == "revolute" else turn)

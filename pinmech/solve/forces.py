@@ -6,7 +6,7 @@ constraint forces and the external loads, read
     M(q) q_ddot + h(q, q_dot) = S^T tau + J_c^T lambda + sum_p J_p^T f_p
 
 h holds the Coriolis, centrifugal and gravity terms, S picks the driven joints, J_c stacks
-the cuts' independent constraint rows (`Closure.jacobian`, the rows the velocity solve
+the cuts' independent constraint rows (the compiled core's Jacobian, the rows the velocity solve
 uses) and J_p the loads' frame Jacobians. Pinocchio's RNEA with the loads as external
 forces gives b = M q_ddot + h - sum J_p^T f_p, and the square system
 
@@ -36,7 +36,8 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.arguments import float_array, names
-from pinmech.model.closures import _cross
+from pinmech.directions import cross as _cross
+from pinmech.model.closure_core import cached_rows
 from pinmech.exceptions import BalanceError, IndeterminateForcesError, ModelError, OptionError
 from pinmech.model.mechanism import Mechanism
 from pinmech.solve.force_results import (ForceSolution, Load, PowerBalance, Reaction, advantage_unit,
@@ -156,7 +157,7 @@ class ForceSolver:
         model, data = self.model, self.data
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
-        J_c = self._constraint_jacobian()
+        J_c = self._constraint_jacobian(q)
         virtual = v if np.any(v != 0) else self._virtual_velocity(J_c)
         power_terms = self._power_terms(q, v, a, virtual)
         load_wrenches = self._load_wrenches()
@@ -203,9 +204,9 @@ class ForceSolver:
                            "term these forces leave out", power_residual=power, equation_residual=equations,
                            bound=bound)
 
-    def _constraint_jacobian(self) -> np.ndarray:
-        rows = [c.jacobian(self.model, self.data) for c in self.mechanism.closures]
-        return np.vstack(rows) if rows else np.zeros((0, self.model.nv))
+    def _constraint_jacobian(self, q: np.ndarray) -> np.ndarray:
+        """The closure rows' Jacobian (rows, nv) at q on this solver's model (the core's)."""
+        return cached_rows(self, self.model, self.mechanism.closures).jacobian(q)
 
     def _virtual_velocity(self, J_c: np.ndarray) -> np.ndarray:
         """An admissible motion (J_c v = 0) with every driver at unit rate [rad/s or m/s]."""
@@ -280,7 +281,7 @@ class ForceSolver:
         frames' origins part along the axis; at a closed pin they coincide)."""
         out, start = [], 0
         for c in self.mechanism.closures:
-            f6 = c._rows6.T @ lam[start : start + c.rows]  # relative 6-vector of the cut, in P
+            f6 = c.rows6.T @ lam[start : start + c.rows]  # relative 6-vector of the cut, in P
             start += c.rows
             R = self.data.oMf[c.parent_frame].rotation
             axis = R @ c.axis if c.cut_type in ("revolute", "prismatic") else np.zeros(3)

@@ -237,7 +237,7 @@ class LoopSolver(SolverOptions):
         independent, full = max_abs(self._residual(q)), self._full_residual()
         if closed and not is_closed(independent, full, self._tol):
             self._place(q)
-            raise open_loops_error(self.mechanism, self.data, q, max(independent, full), self._tol,
+            raise open_loops_error(self.mechanism, q, max(independent, full), self._tol,
                                    f"rates at {self.describe_drivers(self._driver_values(q))}")
         v, a, *numbers, _ = self._rates(q, driver_v, driver_a)
         return v, a, Accuracy(max(independent, full), 0, *numbers)

@@ -18,7 +18,7 @@ import pinocchio as pin
 
 from pinmech.arguments import float_array
 from pinmech.exceptions import ModelError
-from pinmech.model.closures import _cross
+from pinmech.directions import cross as _cross
 from pinmech.model.mechanism import Mechanism
 from pinmech.solve.core import _core
 from pinmech.solve.motion_plan import MotionPlan, motion_plan

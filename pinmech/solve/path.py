@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from pinmech.model.closures import _cross
+from pinmech.directions import cross as _cross
 from pinmech.counts import checked_count
 from pinmech.exceptions import TaskError
 from pinmech.model.mechanism import Mechanism

@@ -267,7 +267,7 @@ class RateSolver:
         condition, sigma_min, _, _, status, independent, full, rank, _ = values
         if self.mechanism.closures and not is_closed(independent, full, self.tol):
             pin.forwardKinematics(self.model, self.data, q)
-            raise open_loops_error(self.mechanism, self.data, q, max(independent, full), self.tol,
+            raise open_loops_error(self.mechanism, q, max(independent, full), self.tol,
                                    f"the task's rates at {self._pose(q)}")
         if status == _INCONSISTENT:
             raise self._inconsistent(int(self.x_dot.size + self._closure_rows), self.model.nv)
@@ -283,10 +283,7 @@ class RateSolver:
     def _compiled(self):
         """The core with this solver's loops, task and options (built once per model tree:
         it reads placements changed in the model; the scales, which a model changed in place
-        changes, and the options are read afresh).
-
-        Raises:
-            ModelError: the core reads a cut otherwise than its closure rows state."""
+        changes, and the options are read afresh)."""
         cached = self.__dict__.get("_core")
         closures = self.mechanism.closures
         options = (self.mechanism.length_scale, self.method, self.damping, self.max_condition,
