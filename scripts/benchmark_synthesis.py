@@ -5,6 +5,13 @@ its median and spread, its candidates a second, and the ratio to Pyslvs' publish
 (differential evolution, population 400 x 1,000 generations, 51 s on an i7-6700).
 
     python scripts/benchmark_synthesis.py --seeds 1 2 3 4 5
+    python scripts/benchmark_synthesis.py --six-bar --rounds 7
+
+With --six-bar, the row of a six-bar candidate on the engine (models/synthesis/watt_path.toml):
+a candidate drawn and written into the model in place, then followed by the compiled core
+over the crank's turn (361 poses and the 10 targets'); its cost in microseconds a pose,
+whole and split into the drawing and the follow, timed in interleaved rounds
+(scripts/interleave.py), medians and spread.
 
 The goal (issue 26): at most 60 s on this 2-core machine. Needs `pip install "pinmech[study]"`.
 """
@@ -32,11 +39,53 @@ GOAL_SECONDS = 60.0
 BUNDLED = np.array([0, 0, 0.1, 0, 0.04, 0.12, 0.08, 0.06610894, -0.01138455])  # four_bar.toml (synthesis test)
 
 
+def six_bar_rows(rounds: int, candidates: int = 8) -> tuple[dict[str, list[float]], int]:
+    """The six-bar candidate's cost a pose [s] each round: whole (evaluate), drawing
+    (written in place) and follow (the compiled core over the turn), interleaved; and the
+    poses a candidate is followed through."""
+    from interleave import Timed, time_rounds
+
+    from pinmech.design.synthesis_engine import template
+    from pinmech.design.synthesis_sixbar import _merged
+    from pinmech.design.synthesis_tasks import evaluate
+
+    spec = load_synthesis(ROOT / "models" / "synthesis" / "watt_path.toml")
+    t = template(spec)
+    rng = np.random.default_rng(0)
+    lo, hi = spec.lower, spec.upper
+    rows = np.column_stack((lo + (hi - lo) * rng.random((candidates, len(lo))), np.full(candidates, 1.0)))
+    poses = len(_merged(t, 1.0 + spec.timing)[0])
+    drawn = iter(range(10**9))
+
+    def draw() -> None:  # a new drawing each call (the same values would be skipped)
+        t.write(rows[next(drawn) % candidates] * (1 + 1e-9 * next(drawn)))
+
+    values = _merged(t, 1.0 + spec.timing)[0]
+    timed = {"whole": Timed(lambda: evaluate(spec, 1.0, rows), poses * candidates),
+             "drawing": Timed(draw, poses), "follow": Timed(lambda: t.follow(values), poses)}
+    t.write(rows[0, :len(lo)])
+    time_rounds(list(timed.values()), rounds)
+    return {k: r.times for k, r in timed.items()}, poses
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     parser.add_argument("--generations", type=int, default=400)
+    parser.add_argument("--six-bar", action="store_true", help="the six-bar candidate's row instead")
+    parser.add_argument("--rounds", type=int, default=7)
     args = parser.parse_args(argv)
+    if args.six_bar:
+        sys.path.insert(0, str(ROOT / "scripts"))
+        rows, poses = six_bar_rows(args.rounds)
+        for name, times in rows.items():
+            us = [x * 1e6 for x in times]
+            print(f"six-bar candidate, {name}: {statistics.median(us):.2f} us a pose (min {min(us):.2f}, "
+                  f"max {max(us):.2f}, {len(us)} rounds)")
+        whole = statistics.median(rows["whole"])
+        print(f"a candidate ({poses} poses): {whole * poses * 1e3:.1f} ms; the follow is "
+              f"{statistics.median(rows['follow']) / whole:.2f} of it")
+        return
     spec = load_synthesis(ROOT / "models" / "synthesis" / "four_bar_path.toml")
     crank = np.radians(np.arange(20.0, 300.0, 30.0))
     targets = pose(BUNDLED[None], np.ones(1), crank[None]).P[0]

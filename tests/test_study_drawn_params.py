@@ -111,3 +111,27 @@ def test_a_drawn_param_is_named_and_refused_where_it_does_not_apply():
         _drawn({"x": {"param": "crank", "component": "x"}}, {"links": ["rocker"]}, steps=3)
     with pytest.raises(SceneError, match=r"drawn linkage's \[params\]; this scene's model is given by 'urdf'"):
         _drawn({"x": {"param": "crank"}}, {"links": ["rocker"]}, scene="four_bar.toml", steps=3)
+
+
+def _left(a: np.ndarray, b: np.ndarray, ra: float, rb: float, side: float = 1.0) -> np.ndarray:
+    """The meeting point of the circles (a, ra) and (b, rb), left (side +1) or right of a -> b:
+    the law of cosines, written here apart from pinmech's compass."""
+    d = np.linalg.norm(b - a)
+    along = (d * d + ra * ra - rb * rb) / (2 * d)
+    u = (b - a) / d
+    return a + along * u + side * np.sqrt(ra * ra - along * along) * np.array([-u[1], u[0]])
+
+
+def test_two_drawn_params_written_one_after_the_other_are_both_drawn():
+    """A study writes its params one at a time: the second write must keep the first (the
+    Watt six-bar with link5 and link6 changed: the coupler point P at the drawn pose is the
+    chain of circle intersections with both new lengths; atol 1e-12 m: rounding of 0.2 m)."""
+    sm = _drawn({"link5": {"param": "link5"}, "link6": {"param": "link6"}}, {"points": ["P"]},
+                scene="watt_params.toml", steps=2)
+    cycle = sm.cycle(np.array([0.095, 0.075]))  # from the crank's drawn angle, 0 deg
+    O4, O6, A = np.array([0.1, 0.0]), np.array([0.19, 0.03]), np.array([0.04, 0.0])
+    B = _left(A, O4, 0.12, 0.08)
+    C = _left(O4, B, 0.06, 0.05, -1.0)
+    D = _left(C, O6, 0.095, 0.075)
+    P = _left(C, D, 0.045, 0.065)  # the file's CP, DP
+    np.testing.assert_allclose(StudyOutputs(sm).pose_values(cycle.q[0]), P, atol=1e-12)

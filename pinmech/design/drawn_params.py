@@ -74,9 +74,9 @@ class Drawing:
         from pinmech.model.linkage import linkage_from_spec
         from pinmech.model.linkage_model import linkage_mechanism
 
-        changed = {n: v for n, v in values.items() if v != self.values.get(n)} or values
-        try:
-            mech = linkage_mechanism(linkage_from_spec(self.spec.with_params(**changed), self.source))
+        changed = {n: v for n, v in values.items() if v != self.values.get(n)} or values  # for the message
+        try:  # every value given: the spec holds the file's, not the last drawing's
+            mech = linkage_mechanism(linkage_from_spec(self.spec.with_params(**values), self.source))
             drawn = mech.model
             if mech.urdf_path != self.urdf_path:  # a variant's URDF: not left in the user's cache folder
                 Path(mech.urdf_path).unlink(missing_ok=True)

@@ -35,7 +35,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
     import json
 
     from pinmech.design.synthesis_file import load_synthesis
-    from pinmech.design.synthesis_linkage import engine_check, write_linkage
+    from pinmech.design.synthesis_linkage import EngineCheck, engine_check, write_linkage
     from pinmech.design.synthesis_report import figure, summary, text
     from pinmech.design.synthesis_search import synthesise
     from pinmech.exceptions import OptionRefused, SynthesisError
@@ -54,8 +54,14 @@ def cmd_synth(args: argparse.Namespace) -> int:
     written = []
     if args.out:
         for i, (lk, entry) in enumerate(zip(result.linkages, report["linkages"]), start=1):
-            files = write_linkage(lk, f"{args.out}_{i}", f"{spec.title}: linkage {i}", str(spec.path))
-            check = engine_check(files[1], lk, spec.targets, spec.angles)
+            if spec.scene is not None:  # a six-bar: its template redrawn, the engine's turn
+                from pinmech.design import synthesis_sixbar_output as six
+
+                files = six.write_linkage(spec, lk, f"{args.out}_{i}")
+                check = EngineCheck(None, six.engine_check(spec, files[1], lk))
+            else:
+                files = write_linkage(lk, f"{args.out}_{i}", f"{spec.title}: linkage {i}", str(spec.path))
+                check = engine_check(files[1], lk, spec.targets, spec.angles)
             entry["files"] = [str(p) for p in files]
             angular = lk.task == "function" and lk.topology != "slider-crank"
             scale, unit = (180 / 3.141592653589793, "deg") if angular else (1e3, "mm")

@@ -56,12 +56,13 @@ from pinmech.design.file_where import FileWhere, load_file
 from pinmech.units import to_si
 
 TASKS = ("path", "function", "motion")
-TOPOLOGIES = ("four-bar", "slider-crank", "inverted-slider-crank")
+SIX_BARS = ("watt", "stephenson")  # drawn linkages with [params], solved by the engine (synthesis_engine.py)
+TOPOLOGIES = ("four-bar", "slider-crank", "inverted-slider-crank", *SIX_BARS)
 CLASSES = ("any", "grashof", "crank-rocker", "double-crank", "double-rocker", "triple rocker")
 SLIDER_CLASSES = ("any", "crank", "rocker")  # grashof.slider_crank_class: the crank turns fully, or not
 DIRECTIONS = ("ccw", "cw", "either")
 _TOP = {"title", "task", "topology", "targets", "timing", "seed", "population", "generations", "keep",
-        "bounds", "constraints", "pairs", "ground", "poses"}
+        "bounds", "constraints", "pairs", "ground", "poses", "scene", "point", "output"}
 _ONLY = {"targets": "path", "timing": "path", "pairs": "function", "ground": "function", "poses": "motion"}
 #: Each (topology, task)'s bounds: the parameters in the order of a candidate's row, each
 #: with its axes (none: a length, positive unless it is an offset); "angle" axes are angles.
@@ -76,7 +77,7 @@ _BOUNDS = {
                                         ("point", ("along", "across"))),
     ("inverted-slider-crank", "function"): (("crank", ()), ("offset", ())),
 }
-_CONSTRAINTS = {"grashof", "transmission", "ratio", "direction"}
+_CONSTRAINTS = {"grashof", "transmission", "ratio", "direction", "pins"}
 _LIMITS = {"seed": (0, 2**32 - 1), "population": (5, 1000), "generations": (1, 100_000), "keep": (1, 20)}
 
 
@@ -99,6 +100,10 @@ class SynthesisSpec:
         transmission: the least transmission angle allowed over the motion [rad].
         ratio: the longest link over the shortest, at most.
         direction: the crank's turn from target to target: "ccw", "cw" or "either".
+        scene: a six-bar's template, a scene whose drawn linkage has [params]; free: the
+            params the search varies (lower, upper: their bounds [m]); point: the coupler
+            point of a path; output: the link whose turns a function gives; pins: the
+            dyads' middle pins whose transmission angle is bounded.
     """
 
     path: Path
@@ -119,6 +124,11 @@ class SynthesisSpec:
     generations: int = 400
     keep: int = 3
     angles: np.ndarray | None = None
+    scene: Path | None = None
+    free: tuple[str, ...] = ()
+    point: str = ""
+    output: str = ""
+    pins: tuple[str, ...] = ()
 
     def __hash__(self) -> int:
         return hash((self.path, self.title, self.targets.tobytes(), self.seed))
@@ -138,6 +148,11 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
     for key, only in _ONLY.items():
         if key in raw and task != only:
             raise w.error(key, f"{key} is for task = \"{only}\" (this file's task is {task!r})")
+    if topology in SIX_BARS:
+        return _six_bar(raw, w, path, task, topology)
+    for key in ("scene", "point", "output"):
+        if key in raw:
+            raise w.error(key, f"{key} is for the six-bars (topology = \"watt\" or \"stephenson\")")
     slider = topology == "slider-crank"
     if topology == "inverted-slider-crank" and task == "motion":
         raise w.error("task", "motion generation is for the four-bar and the slider-crank (an inverted "
@@ -155,7 +170,7 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
         lower, upper = _bounds(raw, w, _BOUNDS[topology, "path"])
         ground = 0.0
     c = raw.get("constraints", {})
-    w.known(c, _CONSTRAINTS, "constraints")
+    w.known(c, _CONSTRAINTS - {"pins"}, "constraints")
     transmission = w.quantity(c, "transmission", "angle", "constraints") if "transmission" in c else 0.0
     if not 0 <= transmission < math.pi / 2:
         raise w.error("constraints.transmission", f"transmission = {c['transmission']!r} must be from 0 to 90 deg")
@@ -175,6 +190,71 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
     return SynthesisSpec(path, str(raw.get("title", path.stem)), task, topology, targets, timing, lower, upper,
                          w.choice(c, "grashof", classes, "any", "constraints"), ground,
                          transmission, float(ratio), direction, angles=angles, **counts)
+
+
+def _six_bar(raw: dict[str, Any], w: _Where, path: Path, task: str, topology: str) -> SynthesisSpec:
+    """A Watt or Stephenson six-bar's file: `scene` (its drawn linkage's [params] the
+    template), `point` (path) or `output` (function), `[bounds]` of the params varied."""
+    from pinmech.exceptions import PinmechError
+    from pinmech.io.scene import Scene
+    from pinmech.model.linkage_spec import read_linkage_spec
+
+    if task == "motion":
+        raise w.error("task", f"motion generation is for the four-bar only; a {topology} six-bar does "
+                      "task = \"path\" or \"function\"")
+    for key in ("ground", "point" if task == "function" else "output"):
+        if key in raw:
+            raise w.error(key, f"{key} is not read by a {topology} six-bar's {task} task: remove it")
+    if not isinstance(raw.get("scene"), str):
+        raise w.error("scene", "give scene = \"../scenes/watt_params.toml\": a scene whose drawn linkage has [params]")
+    scene_path = path.parent / raw["scene"]
+    try:
+        scene = Scene.load(scene_path)
+    except PinmechError as exc:
+        raise w.error("scene", f"{raw['scene']} cannot be read: {exc}") from exc
+    if scene.model_kind != "linkage":
+        raise w.error("scene", f"{raw['scene']} gives its model by '{scene.model_kind}': a six-bar's scene "
+                      "names a drawn linkage (linkage = \"...\") with [params]")
+    try:
+        linkage, _ = read_linkage_spec(scene.model_file("linkage"))
+    except PinmechError as exc:
+        raise w.error("scene", f"{raw['scene']}'s linkage cannot be read: {exc}") from exc
+    name, kind = ("output", "link") if task == "function" else ("point", "joint")
+    named = raw.get(name, "P" if task == "path" else None)
+    known = linkage.links if task == "function" else linkage.joints
+    if named not in known:
+        raise w.error(name, f"{name} = {named!r} is not a {kind} of {raw['scene']}'s linkage "
+                      f"(its {kind}s: {', '.join(known)})")
+    table = raw.get("bounds")
+    w.known(table, set(linkage.params), "bounds")
+    if not table:
+        raise w.error("bounds", f"bound at least one of the linkage's [params] ({', '.join(linkage.params)})")
+    lower, upper = np.array([w.interval(v, f"bounds.{k}") for k, v in table.items()]).T
+    c = raw.get("constraints", {})
+    w.known(c, {"transmission", "direction", "pins"}, "constraints")
+    pins = c.get("pins", [])
+    if not isinstance(pins, list) or any(p not in linkage.joints for p in pins):
+        raise w.error("constraints.pins", f"pins = {pins!r} must list joints of the linkage (the dyads' middle pins, "
+                      f"e.g. [\"B\", \"D\"]; its joints: {', '.join(linkage.joints)})")
+    transmission = w.quantity(c, "transmission", "angle", "constraints") if "transmission" in c else 0.0
+    if not 0 <= transmission < math.pi / 2 or (transmission > 0 and not pins):
+        raise w.error("constraints.transmission", f"transmission = {c.get('transmission')!r} must be from 0 to 90 deg, "
+                      "with pins = [...] naming the dyads it bounds")
+    if task == "function":
+        targets, timing = _pairs(raw, w), None
+    else:
+        targets = _targets(raw, w)
+        timing = _timing(raw, w, len(targets)) if "timing" in raw else None
+    direction = w.choice(c, "direction", DIRECTIONS, "either", "constraints")
+    turns = timing if timing is not None else targets[:, 0] if task == "function" else None
+    if turns is not None and direction != "either" and (turns[-1] > 0) != (direction == "ccw"):
+        raise w.error("constraints.direction", f"direction = {direction!r}, but the crank's turns given go "
+                      f"{'ccw' if turns[-1] > 0 else 'cw'}")
+    counts = {k: w.whole(raw, k, d) for k, d in (("seed", 0), ("population", 20), ("generations", 400), ("keep", 3))}
+    return SynthesisSpec(path, str(raw.get("title", path.stem)), task, topology, targets, timing, lower, upper,
+                         transmission=transmission, direction=direction, scene=scene_path, free=tuple(table),
+                         point=named if task == "path" else "", output=named if task == "function" else "",
+                         pins=tuple(pins), **counts)
 
 
 def _targets(raw: dict[str, Any], w: _Where, key: str = "targets") -> np.ndarray:

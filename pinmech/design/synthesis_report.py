@@ -23,6 +23,10 @@ DEFECTS = {
 
 def linkage_summary(lk: Linkage) -> dict:
     """One linkage's numbers, in mm and deg."""
+    if lk.params is not None:  # a six-bar: its drawn linkage's params
+        from pinmech.design.synthesis_sixbar_output import sixbar_summary
+
+        return sixbar_summary(lk)
     slider = lk.topology == "slider-crank"
     inverted = lk.topology == "inverted-slider-crank"
     way = "counter-clockwise" if lk.way > 0 else "clockwise"
@@ -93,6 +97,8 @@ def text(result: SynthesisResult) -> str:
 
 def _dimensions(lk: dict) -> str:
     """A linkage's dimensions, in a line."""
+    if "params_mm" in lk:
+        return ", ".join(f"{n} {v:.6g}" for n, v in lk["params_mm"].items()) + " mm"
     d = lk["dimensions_mm"]
     if lk["topology"] == "inverted-slider-crank":
         point = f", P at {d['along']:.6g} along and {d['across']:.6g} across the slot" if "errors_mm" in lk else ""
@@ -118,6 +124,8 @@ def _errors(lk: dict) -> str:
         return (f"  slider travel error at each pair [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
                 f"(max {lk['max_error_relative']:.3g} of its size; block at {lk['slider_start_mm']:.6g} mm along the "
                 "slide at the first pair)")
+    if "params_mm" in lk and "errors_deg" in lk:
+        return f"  output turn error at each pair [deg]: {', '.join(f'{e:.3g}' for e in lk['errors_deg'])}"
     if "errors_mm" in lk:
         return (f"  error at each target [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
                 f"(max {lk['max_error_relative']:.3g} of its size)")
@@ -128,6 +136,10 @@ def _errors(lk: dict) -> str:
 def figure(result: SynthesisResult, path: str | Path) -> Path:
     """One panel per linkage: the targets, the coupler curve over the motion (solid) and
     the rest of its turn on the same assembly (dotted), the linkage at the first target."""
+    if result.spec.scene is not None:  # a six-bar, on the engine
+        from pinmech.design.synthesis_sixbar_output import figure as sixbar_figure
+
+        return sixbar_figure(result.spec, result, path)
     if result.spec.task == "function":
         return function_figure(result, path)
     plt = pyplot("synthesis")

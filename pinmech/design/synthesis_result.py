@@ -30,7 +30,9 @@ class Linkage:
             generator's angle from the bar A -> B to the poses' line [rad].
         angle_errors: a motion generator's coupler angle error at each pose [rad].
         topology: "four-bar", "slider-crank" or "inverted-slider-crank" (z: its
-            synthesis_inverted.NAMES; phi0 of a function: the guide's angle at the first pair).
+            synthesis_inverted.NAMES; phi0 of a function: the guide's angle at the first pair),
+            "watt" or "stephenson".
+        params: a six-bar's drawn linkage's [params] (z: its free ones, spec.free) [m].
     """
 
     z: np.ndarray
@@ -44,11 +46,14 @@ class Linkage:
     phi0: float = 0.0
     angle_errors: np.ndarray | None = None
     topology: str = "four-bar"
+    params: dict[str, float] | None = None
 
     @property
     def size(self) -> float:
         """The linkage's size: its longest link [m] (a slider-crank's: the largest of crank,
-        rod and offset)."""
+        rod and offset; a six-bar's: its largest param, length or coordinate)."""
+        if self.params is not None:
+            return float(max(abs(v) for v in self.params.values()))
         from pinmech.design.synthesis_kinematics import kinematics
 
         return kinematics(self.topology).size(self.z)
@@ -56,8 +61,8 @@ class Linkage:
     def meets(self, relative: float) -> bool:
         """Whether every target is met within `relative` of the linkage's size (path; a
         motion's angles within `relative` rad too), or every output angle within `relative`
-        rad (a four-bar's or an inverted slider-crank's function; a slider-crank's travel within
-        `relative` of its size)."""
+        rad (a four-bar's, an inverted slider-crank's or a six-bar's function; a slider-crank's
+        travel within `relative` of its size)."""
         if self.task == "function" and self.topology != "slider-crank":  # an output angle
             return bool(np.max(self.errors) <= relative)
         angles = self.angle_errors if self.angle_errors is not None else np.zeros(1)

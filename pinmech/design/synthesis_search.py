@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.design.synthesis_file import SynthesisSpec, load_synthesis
+from pinmech.design.synthesis_file import SIX_BARS, SynthesisSpec, load_synthesis
 from pinmech.design.synthesis_kinematics import kinematics
 from pinmech.design.synthesis_result import Linkage, SynthesisResult
 from pinmech.design.synthesis_tasks import classical_rows, evaluate, refined, search_bounds
@@ -87,7 +87,8 @@ def _run(spec: SynthesisSpec, mapper: PopulationMap) -> SynthesisResult:
     until the assembly's generations are spent; the best distinct refined, best first."""
     found: list[Linkage] = []
     generations = 0
-    for assembly in getattr(kinematics(spec.topology), "ASSEMBLIES", (1.0, -1.0)):
+    assemblies = (1.0,) if spec.topology in SIX_BARS else getattr(kinematics(spec.topology), "ASSEMBLIES", (1.0, -1.0))
+    for assembly in assemblies:  # a six-bar's: as drawn
         mapper.assembly = assembly
         left, restart = spec.generations, 0
         while left > 0 and not any(lk.meets(_MET) for lk in found):
@@ -175,7 +176,7 @@ def _distinct(spec: SynthesisSpec, rows: np.ndarray, energies: np.ndarray, count
 def _bounded(spec: SynthesisSpec, lk: Linkage) -> np.ndarray:
     """The linkage's parameters that the file bounds (all of a path's; crank, coupler,
     rocker of a four-bar's function, crank, rod, offset of a slider-crank's)."""
-    if spec.task != "function":
+    if spec.task != "function" or spec.topology in SIX_BARS:
         return lk.z
     return lk.z[[4, 5, 3]] if spec.topology == "slider-crank" else lk.z[4:7]
 

@@ -8,7 +8,7 @@ import numpy as np
 
 from pinmech.design.burmester import four_bar_rows
 from pinmech.design.slider_three_poses import slider_crank_rows
-from pinmech.design.synthesis_file import SynthesisSpec
+from pinmech.design.synthesis_file import SIX_BARS, SynthesisSpec
 from pinmech.design.synthesis_function import evaluate_function, freudenstein_rows, function_bounds, refined_function
 from pinmech.design.synthesis_inverted_function import (evaluate_inverted_function, inverted_function_bounds,
                                                         refined_inverted_function)
@@ -16,13 +16,17 @@ from pinmech.design.synthesis_objective import BatchValues, evaluate_path, path_
 from pinmech.design.synthesis_path import refined_path
 from pinmech.design.synthesis_poses import evaluate_poses, poses_bounds, refined_poses
 from pinmech.design.synthesis_result import Linkage
+from pinmech.design.synthesis_sixbar import evaluate_sixbar, refined_sixbar, sixbar_bounds
 from pinmech.design.synthesis_slider_function import (evaluate_slider_function, refined_slider_function,
                                                       slider_function_bounds)
 
 
 def _task(spec: SynthesisSpec) -> str:
     """The task's key: "slider function" for a slider-crank's function, "inverted function" for an
-    inverted slider-crank's (their own rows)."""
+    inverted slider-crank's (their own rows); "six-bar" for a Watt's or a Stephenson's path or
+    function (on the engine)."""
+    if spec.topology in SIX_BARS:
+        return "six-bar"
     if spec.task == "function" and spec.topology != "four-bar":
         return {"slider-crank": "slider function", "inverted-slider-crank": "inverted function"}[spec.topology]
     return spec.task
@@ -31,21 +35,24 @@ def _task(spec: SynthesisSpec) -> str:
 def search_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
     """The bounds of the task's search rows."""
     return {"function": function_bounds, "motion": poses_bounds, "slider function": slider_function_bounds,
-            "inverted function": inverted_function_bounds}.get(_task(spec), path_bounds)(spec)
+            "inverted function": inverted_function_bounds,
+            "six-bar": sixbar_bounds}.get(_task(spec), path_bounds)(spec)
 
 
 def evaluate(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchValues:
     """The task's objective of rows x on one assembly (a Dask task)."""
     return {"function": evaluate_function, "motion": evaluate_poses,
             "slider function": evaluate_slider_function,
-            "inverted function": evaluate_inverted_function}.get(_task(spec), evaluate_path)(spec, assembly, x)
+            "inverted function": evaluate_inverted_function,
+            "six-bar": evaluate_sixbar}.get(_task(spec), evaluate_path)(spec, assembly, x)
 
 
 def refined(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Linkage | None:
     """Row x refined with the exact Jacobian, checked for defects (None: it has one)."""
     return {"function": refined_function, "motion": refined_poses,
             "slider function": refined_slider_function,
-            "inverted function": refined_inverted_function}.get(_task(spec), refined_path)(spec, assembly, x)
+            "inverted function": refined_inverted_function,
+            "six-bar": refined_sixbar}.get(_task(spec), refined_path)(spec, assembly, x)
 
 
 def classical_rows(spec: SynthesisSpec) -> np.ndarray:

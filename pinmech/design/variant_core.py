@@ -21,6 +21,8 @@ from pinmech.solve.continuation import Path
 from pinmech.solve.core import core_for
 
 _CORRECT_ITERATIONS = 20  # Newton steps of the start pose's corrector (it needs 2 to 4 here)
+#: Why the core's follow stopped short (its Stop codes, pinmech/csrc/core.hpp), by name.
+STOPS = {1: "fold within the range", 2: "changes assembly", 3: "singular pose", 4: "singular pose"}
 
 
 class CoreCycle:
@@ -52,17 +54,30 @@ class CoreCycle:
     def follow(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """(q, v, a) at every pose of the cycle [rad, m; per s; per s^2] of the variant now
         written in the model, or None where the core hands it back (see the module)."""
-        if not self.usable:
+        path, _ = self.attempt()
+        if path is None:
             return None
+        Q, D1, D2 = path
+        return Q, D1 * self.w, D2 * (self.w * self.w) + D1 * self.alpha
+
+    def attempt(self) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray] | None, str]:
+        """q and its first and second derivatives along the swept driver's value at every
+        pose (q, dq/dp, d2q/dp2 [per rad or m]), or None and why (one of STOPS: the start
+        does not close, closes on another assembly or too ill-conditioned; the follow met a
+        fold, passed a change point, or a pose too ill-conditioned; "" where it answers)."""
+        if not self.usable:
+            return None, "unusable"
         core, solver = self.core, self.solver
         q, residual = core.correct(self.ref_q, self.ref_drv, _CORRECT_ITERATIONS)
         if residual is None:
-            return None
+            return None, "cannot assemble"
         d1, d2, signs, condition = core.node(q, self.unit_v)[:4]
-        if list(signs) != self.signs or not condition <= solver.max_condition:
-            return None
-        done, _, Q, D1, D2, _ = core.follow(self.p0, q, d1, d2, self.signs, condition, self.path.x0, self.path.d,
-                                            self.path.unit, self.targets, solver.max_condition)
+        if list(signs) != self.signs:
+            return None, "other assembly"
+        if not condition <= solver.max_condition:
+            return None, "singular pose"
+        done, stop, Q, D1, D2, _ = core.follow(self.p0, q, d1, d2, self.signs, condition, self.path.x0,
+                                               self.path.d, self.path.unit, self.targets, solver.max_condition)
         if done < len(self.targets):
-            return None
-        return Q, D1 * self.w, D2 * (self.w * self.w) + D1 * self.alpha
+            return None, STOPS.get(int(stop), "singular pose")
+        return (Q, D1, D2), ""
