@@ -260,7 +260,7 @@ void find_eigenvalues(const VectorXd& beta, EigenvalueSearch (&searches)[2], dou
 // allows 1e-14: tests/test_core.py found it).
 // `singular`: the caller's factorization of A (which it also solves with) met an exact zero
 // pivot (used above 3x3).
-std::pair<double, double> condition_of(const MatrixXd& A, bool singular, ConditionWork& work) {
+std::pair<double, double> condition_of(const MatrixXd& A, bool singular, ConditionWork& work, const Band* band) {
   const Index n = A.rows();
   if (n == 0) return {1.0, 1.0};
   if (n == 1) {
@@ -283,15 +283,21 @@ std::pair<double, double> condition_of(const MatrixXd& A, bool singular, Conditi
   int exponent = 0;  // B = A / 2^exponent, its largest entry in [1/2, 1): exact, and no over- or underflow
   std::frexp(largest_entry, &exponent);
   work.B = A * std::ldexp(1.0, -exponent);
-  // The band of exact zeros (J_dep's structure: a chain of loops has kl = 2, ku = 1); the
-  // rotations where they are cheaper than the reflections (measured crossover).
+  // The band: the caller's structural one (J_dep's: a chain of loops has kl = 2, ku = 1),
+  // else that of the exact zeros; the rotations where they are cheaper than the
+  // reflections (measured crossover).
   Index kl = 0, ku = 0;
-  for (Index j = 0; j < n; ++j)
-    for (Index i = 0; i < n; ++i)
-      if (work.B(i, j) != 0.0) {
-        kl = std::max(kl, i - j);
-        ku = std::max(ku, j - i);
-      }
+  if (band != nullptr) {
+    kl = std::min(band->lower, n - 1);
+    ku = std::min(band->upper, n - 1);
+  } else {
+    for (Index j = 0; j < n; ++j)
+      for (Index i = 0; i < n; ++i)
+        if (work.B(i, j) != 0.0) {
+          kl = std::max(kl, i - j);
+          ku = std::max(ku, j - i);
+        }
+  }
   if (11 * (kl + ku) <= 2 * n + 16) band_bidiagonalize(work, kl, ku);
   else bidiagonalize(work);
   const VectorXd &d = work.d, &e = work.e;
@@ -321,12 +327,44 @@ std::pair<double, double> condition_of(const MatrixXd& A, bool singular, Conditi
   const double hi_max = std::min(frobenius, gershgorin) * (1.0 + 4.0 * EPS);
   const double lo_min = (1.0 - 4.0 * EPS) / std::sqrt(inverse_frobenius);
   const double hi_min = std::min(std::abs(d(0)), std::abs(d(n - 1))) * (1.0 + 4.0 * EPS);
-  const bool below = count_below(beta, lo_min) == n;
   EigenvalueSearch searches[2] = {{int(2 * n - 1), hi_max, false, largest * (1.0 - 4.0 * EPS), hi_max},
-                                  {int(n), below ? lo_min : hi_min, below, below ? lo_min : 0.0, hi_min}};
+                                  {int(n), hi_min, false, 0.0, hi_min}};
+  // Warm start: the last call's values (a neighbouring pose's), where a Sturm count puts
+  // each between its singular value and the next one (Laguerre then goes to the former,
+  // monotonically); the count also narrows the bracket. Else the cold start: sigma_max
+  // from above; sigma_min from below, or from above if rounding put the lower bound past it.
+  const double scale = std::ldexp(1.0, -exponent);
+  const double guesses[3] = {work.last_max * scale, work.last_min * scale, lo_min};
+  int counts[3];
+  const bool warm = guesses[0] > searches[0].lo && guesses[0] < hi_max && guesses[1] > 0.0 && guesses[1] < hi_min;
+  if (warm) counts_below<3>(beta, guesses, counts);
+  else counts[2] = count_below(beta, lo_min);
+  bool min_started = false;
+  for (int i = 0; warm && i < 2; ++i) {
+    EigenvalueSearch& s = searches[i];
+    if (counts[i] == s.index) {  // the guess is below the singular value, above the next one down
+      s.x = s.lo = guesses[i];
+      s.right = true;
+    } else if (counts[i] == s.index + 1) {  // above it, below the next one up
+      s.x = s.hi = guesses[i];
+      s.right = false;
+    } else {
+      continue;
+    }
+    min_started = min_started || i == 1;
+  }
+  if (counts[2] == n) {  // lo_min is below sigma_min
+    searches[1].lo = std::max(searches[1].lo, lo_min);
+    if (!min_started) {
+      searches[1].x = lo_min;
+      searches[1].right = true;
+    }
+  }
   double found[2];
   find_eigenvalues(beta, searches, found);
   const double s_max = found[0], s_min = found[1];
+  work.last_max = std::ldexp(s_max, exponent);
+  work.last_min = std::ldexp(s_min, exponent);
   if (!(s_min > 0.0)) return {INFINITY, 0.0};
   return {s_max / s_min, std::ldexp(s_min, exponent)};
 }

@@ -73,7 +73,8 @@ void Core::node_at(Node& node, const VectorXd& d, const VectorXd* a_drv) {
     permuted_ = scaled_(block_rows_, block_cols_);
     conditioned = &permuted_;
   }
-  auto [condition, sigma_min] = condition_of(*conditioned, square_.singular(), condition_work_);
+  auto [condition, sigma_min] =
+      condition_of(*conditioned, square_.singular(), condition_work_, band_ ? &*band_ : nullptr);
   node.condition = condition;
   node.sigma_min = sigma_min;
   signs_into(Jdep_, node.signs);
