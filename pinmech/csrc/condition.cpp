@@ -98,13 +98,24 @@ void rotate_columns(MatrixXd& R, Index p, Index q, Index from, Index to, Rotatio
 // for that to pay (scripts/condition_time.py times both).
 void band_bidiagonalize(ConditionWork& w, Index kl, Index ku) {
   MatrixXd& R = w.B;
-  const Index n = R.rows(), width = kl + ku;
+  const Index n = R.rows();
+  Index width = kl + ku;
   for (Index j = 0; j + 1 < n; ++j)
     for (Index i = std::min(n - 1, j + kl); i > j; --i) {
       if (R(i, j) == 0.0) continue;
       rotate_rows(R, i - 1, i, j, std::min(n - 1, i + width), rotation(R(i - 1, j), R(i, j)));
       R(i, j) = 0.0;
     }
+  // R's upper bandwidth may be narrower than kl + ku where A's band is sparse (a chain of
+  // loops: 2, not 3): chased in steps of the narrower one, the bulges take fewer rotations.
+  Index reach = 0;
+  for (Index i = 0; i + 1 < n; ++i)
+    for (Index j = std::min(n - 1, i + width); j > i + reach; --j)
+      if (R(i, j) != 0.0) {
+        reach = j - i;
+        break;
+      }
+  width = reach;
   for (Index k = 0; k + 2 < n && width >= 2; ++k)
     for (Index j = std::min(n - 1, k + width); j >= k + 2; --j) {
       if (R(k, j) == 0.0) continue;
@@ -353,11 +364,12 @@ std::pair<double, double> condition_of(const MatrixXd& A, bool singular, Conditi
     }
     min_started = min_started || i == 1;
   }
-  if (counts[2] == n) {  // lo_min is below sigma_min
-    searches[1].lo = std::max(searches[1].lo, lo_min);
-    if (!min_started) {
-      searches[1].x = lo_min;
-      searches[1].right = true;
+  if (counts[2] == n) {  // lo_min is below sigma_min: the bracket's lower end, a start from below
+    EigenvalueSearch& s = searches[1];
+    s.lo = std::max(s.lo, lo_min);
+    if (!min_started || (s.right && s.x < lo_min)) {
+      s.x = lo_min;
+      s.right = true;
     }
   }
   double found[2];
