@@ -66,16 +66,20 @@ struct Rotation {
 Rotation rotation(double a, double b) {
   if (b == 0.0) return {1.0, 0.0};
   double r = std::sqrt(a * a + b * b);
-  if (!(r > 1e-150 && r < 1e150)) r = std::hypot(a, b);  // no under- or overflow in the squares
+  // no underflow in the squares (no overflow either: B's entries stay below n, its
+  // largest at most 1 before its orthogonal transformations)
+  if (!(r > 1e-150)) r = std::hypot(a, b);
   const double inv = 1.0 / r;
   return {a * inv, b * inv};
 }
 
 void rotate_rows(MatrixXd& R, Index p, Index q, Index from, Index to, Rotation g) {
-  for (Index t = from; t <= to; ++t) {
-    const double x = R(p, t), y = R(q, t);
-    R(p, t) = g.c * x + g.s * y;
-    R(q, t) = g.c * y - g.s * x;
+  const Index stride = R.outerStride();
+  double *rp = &R(p, from), *rq = &R(q, from);
+  for (Index t = from; t <= to; ++t, rp += stride, rq += stride) {
+    const double x = *rp, y = *rq;
+    *rp = g.c * x + g.s * y;
+    *rq = g.c * y - g.s * x;
   }
 }
 
@@ -100,10 +104,11 @@ void band_bidiagonalize(ConditionWork& w, Index kl, Index ku) {
   MatrixXd& R = w.B;
   const Index n = R.rows();
   Index width = kl + ku;
+  // column j's sweep mixes rows j .. j + kl, none of which reaches past j + kl + ku
   for (Index j = 0; j + 1 < n; ++j)
     for (Index i = std::min(n - 1, j + kl); i > j; --i) {
       if (R(i, j) == 0.0) continue;
-      rotate_rows(R, i - 1, i, j, std::min(n - 1, i + width), rotation(R(i - 1, j), R(i, j)));
+      rotate_rows(R, i - 1, i, j, std::min(n - 1, j + width), rotation(R(i - 1, j), R(i, j)));
       R(i, j) = 0.0;
     }
   // R's upper bandwidth may be narrower than kl + ku where A's band is sparse (a chain of
