@@ -447,7 +447,7 @@ std::optional<Band> Core::structural_band() const {
   std::vector<Index> position_of_v(size_t(model_.nv), -1), position_of_row(size_t(rows_), -1);
   for (Index p = 0; p < n; ++p) position_of_v[size_t(dep_v_[size_t(block_cols_[size_t(p)])])] = p;
   for (Index p = 0; p < Index(block_rows_.size()); ++p) position_of_row[size_t(block_rows_[size_t(p)])] = p;
-  Band band{0, 0};
+  Band band{0, 0, block_rows_, block_cols_};
   for (const Cut& cut : cuts_)
     for (Index r = cut.offset; r < cut.offset + cut.rows6.rows(); ++r) {
       const Index i = position_of_row[size_t(r)];

@@ -99,7 +99,8 @@ void rotate_columns(MatrixXd& R, Index p, Index q, Index from, Index to, Rotatio
 // leaves below the diagonal is chased down the band, w rows a step, by alternating row and
 // column rotations (as LAPACK's dgbbrd). About n^2 w rotations against the dense
 // reflections' 8 n^3 / 3 flops; condition_of takes them where the band is narrow enough
-// for that to pay (scripts/condition_time.py times both).
+// for that to pay (scripts/condition_time.py times both). It reads and writes only
+// entries at most max(kl, 1) below and kl + ku + 1 above the diagonal (bulges included).
 void band_bidiagonalize(ConditionWork& w, Index kl, Index ku) {
   MatrixXd& R = w.B;
   const Index n = R.rows();
@@ -294,28 +295,54 @@ std::pair<double, double> condition_of(const MatrixXd& A, bool singular, Conditi
     return {det > 0 ? s_max * s_max / det : INFINITY, s_min};
   }
   if (singular) return {INFINITY, 0.0};
-  const double largest_entry = A.cwiseAbs().maxCoeff();
-  if (!std::isfinite(largest_entry)) return {INFINITY, 0.0};
-  int exponent = 0;  // B = A / 2^exponent, its largest entry in [1/2, 1): exact, and no over- or underflow
-  std::frexp(largest_entry, &exponent);
-  work.B = A * std::ldexp(1.0, -exponent);
-  // The band: the caller's structural one (J_dep's: a chain of loops has kl = 2, ku = 1),
-  // else that of the exact zeros; the rotations where they are cheaper than the
-  // reflections (measured crossover).
-  Index kl = 0, ku = 0;
+  // The band: the caller's structural one (J_dep's in block order: a chain of loops has
+  // kl = 2, ku = 1), else that of the exact zeros; the rotations where they are cheaper
+  // than the reflections (measured crossover). B = A / 2^exponent, its largest entry in
+  // [1/2, 1): exact, and no over- or underflow; for the rotations in the band's order,
+  // from the band's entries only (the rest are exact zeros).
+  Index kl = n - 1, ku = n - 1;
   if (band != nullptr) {
     kl = std::min(band->lower, n - 1);
     ku = std::min(band->upper, n - 1);
-  } else {
-    for (Index j = 0; j < n; ++j)
-      for (Index i = 0; i < n; ++i)
-        if (work.B(i, j) != 0.0) {
-          kl = std::max(kl, i - j);
-          ku = std::max(ku, j - i);
-        }
   }
-  if (11 * (kl + ku) <= 2 * n + 16) band_bidiagonalize(work, kl, ku);
-  else bidiagonalize(work);
+  int exponent = 0;
+  if (band != nullptr && 11 * (kl + ku) <= 2 * n + 16) {
+    const bool ordered = Index(band->rows.size()) == n && Index(band->cols.size()) == n;
+    const auto row = [&](Index i) { return ordered ? band->rows[size_t(i)] : i; };
+    const auto col = [&](Index j) { return ordered ? band->cols[size_t(j)] : j; };
+    double largest_entry = 0.0;
+    bool finite = true;
+    for (Index j = 0; j < n; ++j)
+      for (Index i = std::max(Index(0), j - ku); i <= std::min(n - 1, j + kl); ++i) {
+        const double v = std::abs(A(row(i), col(j)));
+        finite = finite && v <= std::numeric_limits<double>::max();
+        largest_entry = std::max(largest_entry, v);
+      }
+    if (!finite) return {INFINITY, 0.0};
+    std::frexp(largest_entry, &exponent);
+    const double scale = std::ldexp(1.0, -exponent);
+    work.B.resize(n, n);  // only the entries band_bidiagonalize touches: the band, zeros around it
+    for (Index j = 0; j < n; ++j)
+      for (Index i = std::max(Index(0), j - kl - ku - 1); i <= std::min(n - 1, j + std::max(kl, Index(1))); ++i)
+        work.B(i, j) = i >= j - ku && i <= j + kl ? A(row(i), col(j)) * scale : 0.0;
+    band_bidiagonalize(work, kl, ku);
+  } else {
+    const double largest_entry = A.cwiseAbs().maxCoeff();
+    if (!std::isfinite(largest_entry)) return {INFINITY, 0.0};
+    std::frexp(largest_entry, &exponent);
+    work.B = A * std::ldexp(1.0, -exponent);
+    if (band == nullptr) {
+      kl = ku = 0;
+      for (Index j = 0; j < n; ++j)
+        for (Index i = 0; i < n; ++i)
+          if (work.B(i, j) != 0.0) {
+            kl = std::max(kl, i - j);
+            ku = std::max(ku, j - i);
+          }
+    }
+    if (11 * (kl + ku) <= 2 * n + 16) band_bidiagonalize(work, kl, ku);
+    else bidiagonalize(work);
+  }
   const VectorXd &d = work.d, &e = work.e;
   VectorXd& beta = work.beta;
   beta.resize(2 * n - 1);

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 
 #include <utility>
+#include <vector>
 
 namespace pinmech {
 
@@ -16,10 +17,12 @@ struct ConditionWork {
   double last_max = 0.0, last_min = 0.0;
 };
 
-// A's structural band: every entry more than `lower` below or `upper` above the diagonal
-// is exactly zero (the caller knows it from the matrix's structure).
+// A's structural band: with A's rows and columns in the order `rows`, `cols` (empty: as
+// they are), every entry more than `lower` below or `upper` above the diagonal is exactly
+// zero (the caller knows it from the matrix's structure).
 struct Band {
   Eigen::Index lower, upper;
+  std::vector<Eigen::Index> rows, cols;
 };
 
 // 2-norm condition number and smallest singular value of a square A (condition.cpp).

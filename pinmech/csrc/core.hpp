@@ -394,7 +394,7 @@ class Core {
   std::vector<std::vector<int>> blocks_rows_, blocks_cols_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> tmp3_;
   // work buffers, sized once: a pose allocates nothing
-  MatrixXd J_, Jdep_, scaled_, permuted_;
+  MatrixXd J_, Jdep_, scaled_;
   std::vector<Index> block_rows_, block_cols_;  // J_dep's rows and columns in block order
   std::optional<Band> band_;  // J_dep's structural band in block order (structural_band)
   std::vector<MatrixXd> block_buffers_;
