@@ -118,8 +118,8 @@ def _errors(lk: dict) -> str:
     if "angle_errors_deg" in lk:
         return (f"  error at each pose [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
                 f"(max {lk['max_error_relative']:.3g} of its size); [deg]: "
-                f"{', '.join(f'{e:.3g}' for e in lk['angle_errors_deg'])} (the poses' angle is A->B's + "
-                f"{lk['offset_deg']:.6g} deg)")
+                f"{', '.join(f'{e:.3g}' for e in lk['angle_errors_deg'])} (the poses' angle is "
+                f"{'the link' if 'params_mm' in lk else 'A->B'}'s + {lk['offset_deg']:.6g} deg)")
     if "slider_start_mm" in lk:
         return (f"  slider travel error at each pair [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
                 f"(max {lk['max_error_relative']:.3g} of its size; block at {lk['slider_start_mm']:.6g} mm along the "
