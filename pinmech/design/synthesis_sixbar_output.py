@@ -165,13 +165,14 @@ def figure(spec: SynthesisSpec, result, path: str | Path) -> Path:
             order = np.argsort(turn)
             phi = np.unwrap(y[order, 0])
             ax.plot(np.degrees(turn[order]), np.degrees(phi - np.interp(0.0, turn[order], phi)), lw=1.5, label=label)
-    if spec.task == "motion":  # each pose's angle: a short line from its place
-        T, r = spec.targets * 1e3, 0.08 * max(float(np.ptp(spec.targets * 1e3, axis=0).max()), 1e-9)
-        for (x, y0), a in zip(T, spec.angles):
-            ax.plot([x, x + r * math.cos(a)], [y0, y0 + r * math.sin(a)], "-", color="tab:red", lw=2)
+    if spec.task == "motion":  # each pose's angle: a line from its place, the part's
+        T, r = spec.targets * 1e3, 0.3 * max(float(np.ptp(spec.targets * 1e3, axis=0).max()), 1e-9)
+        for k, ((x, y0), a) in enumerate(zip(T, spec.angles)):
+            ax.plot([x, x + r * math.cos(a)], [y0, y0 + r * math.sin(a)], "-", color="tab:red", lw=1.5,
+                    label="the poses' angles" if k == 0 else None)
     if spec.task != "function":
         T = spec.targets * 1e3
-        ax.plot(T[:, 0], T[:, 1], "x", color="tab:red", ms=8, mew=2, label="targets")
+        ax.plot(T[:, 0], T[:, 1], "x", color="tab:red", ms=8, mew=2, label="poses" if spec.task == "motion" else "targets")
         for k, p in enumerate(T, start=1):
             ax.annotate(str(k), p, textcoords="offset points", xytext=(4, 4), fontsize=8, color="tab:red")
         ax.set_aspect("equal")
