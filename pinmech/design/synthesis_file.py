@@ -156,9 +156,6 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
         if key in raw:
             raise w.error(key, f"{key} is for the six-bars (topology = \"watt\" or \"stephenson\")")
     slider = topology == "slider-crank"
-    if topology == "inverted-slider-crank" and task == "motion":
-        raise w.error("task", "motion generation is for the four-bar and the slider-crank (an inverted "
-                      "slider-crank's block through poses is not there yet): use task = \"path\" or \"function\"")
     if task == "function":
         targets, timing = _pairs(raw, w, "length" if slider else "angle"), None
         lower, upper = _bounds(raw, w, _BOUNDS[topology, "function"])
