@@ -28,7 +28,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from interleave import Timed, time_rounds  # noqa: E402
 
-from pinmech.design.cluster import built, run_batches  # noqa: E402
+from pinmech.design.cluster import built, local_cluster, run_batches  # noqa: E402
 from pinmech.design.study_file import load_study  # noqa: E402
 from pinmech.design.tolerance import batches  # noqa: E402
 
@@ -68,6 +68,28 @@ def core_share(spec, todo) -> tuple[float, float]:
     return spent[0] / total, cpu / (spec.samples * spec.steps)
 
 
+def task_stream_shares(distributed, address: str, spec, todo) -> dict[str, float]:
+    """One run on the cluster at `address`, read from Dask's task stream: the wall time [s],
+    each worker's share of it spent computing (1: never idle), the tasks' compute time
+    summed over the workers [s], and the CPU time each worker process used over the wall
+    time. (Wall - compute / workers) is what batching, scheduling, result transfer and the
+    client cost, plus any imbalance; a CPU share below the computing share is other
+    processes taking the core, above it the worker's own overhead beside its task."""
+    with distributed.Client(address, timeout="20s") as client, distributed.get_task_stream(client) as stream:
+        cpu0 = client.run(time.process_time)
+        t0 = time.perf_counter()
+        run_batches(spec, todo, scheduler=address)
+        wall = time.perf_counter() - t0
+        cpu1 = client.run(time.process_time)
+    busy: dict[str, float] = {}
+    for task in stream.data:
+        for part in task["startstops"]:
+            if part["action"] == "compute":
+                busy[task["worker"]] = busy.get(task["worker"], 0.0) + part["stop"] - part["start"]
+    return {"wall": wall, "shares": sorted(b / wall for b in busy.values()), "compute": sum(busy.values()),
+            "cpu": sorted((cpu1[w] - cpu0[w]) / wall for w in cpu0)}
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=int, default=2000)
@@ -88,14 +110,16 @@ def main(argv: list[str] | None = None) -> None:
         distributed = None
     try:
         for n in (1, 2) if distributed else ():
-            cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                               dashboard_address="127.0.0.1:0", host="127.0.0.1",
-                                               silence_logs=logging.ERROR)
+            cluster = local_cluster(n, silence_logs=logging.ERROR)  # as `pinmech study --workers n` starts it
             clusters.append(cluster)
             run_batches(spec, todo[:n], scheduler=cluster.scheduler_address)  # each worker builds the mechanism
             rows[f"Dask, {n} worker{'s' * (n > 1)}"] = Timed(
                 lambda a=cluster.scheduler_address: run_batches(spec, todo, scheduler=a), poses=poses)
+        loads = [os.getloadavg()[0]]
         time_rounds(list(rows.values()), args.rounds)
+        loads.append(os.getloadavg()[0])
+        streams = {len(c.workers): task_stream_shares(distributed, c.scheduler_address, spec, todo)
+                   for c in clusters}
         share, cpu = core_share(spec, todo)
         full = None
         if args.full and len(clusters) == 2:
@@ -107,13 +131,19 @@ def main(argv: list[str] | None = None) -> None:
         for cluster in clusters:
             cluster.close()
     print(f"tolerance study of the four-bar: {spec.samples} variants x {spec.steps} poses, batches of "
-          f"{spec.batch}, {args.rounds} rounds; load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs")
+          f"{spec.batch} ({len(todo)} tasks), {args.rounds} rounds; load average (1 min) {loads[0]:.1f} before, "
+          f"{loads[1]:.1f} after, on {os.cpu_count()} CPUs")
     for name, row in rows.items():
         us = [t * 1e6 for t in row.times]
         print(f"{name:<18} median {statistics.median(us):6.3f} us a variant-pose  ({min(us):.3f} .. {max(us):.3f})")
     if "Dask, 2 workers" in rows:
         ratios = [a / b for a, b in zip(rows["Dask, 1 worker"].times, rows["Dask, 2 workers"].times)]
         print(f"two workers / one: median {statistics.median(ratios):.2f} x ({min(ratios):.2f} .. {max(ratios):.2f})")
+    for n, t in sorted(streams.items()):
+        shares = ", ".join(f"{x:.0%}" for x in t["shares"])
+        got = ", ".join(f"{x:.0%}" for x in t["cpu"])
+        print(f"task stream, {n} worker{'s' * (n > 1)}: wall {t['wall']:.2f} s, computing {shares} of it "
+              f"(compute {t['compute']:.2f} s in all); CPU a worker used: {got} of the wall")
     print(f"CPU time a variant-pose in this process: {cpu * 1e6:.3f} us")
     print(f"time in the core's per-pose follow: {share:.0%} of a serial run; outside it "
           f"(variant writes, assembly check, outputs, batching): {1 - share:.0%}")

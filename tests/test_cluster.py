@@ -100,3 +100,23 @@ def test_the_variants_do_not_depend_on_the_order_batches_run_in():
     alone = solve_batch(spec, batches(spec.samples, spec.batch)[3])
     np.testing.assert_array_equal(alone.p, whole.p)
     np.testing.assert_array_equal(alone.y, whole.y)
+
+
+def test_each_worker_builds_the_mechanism_once_and_computes_on_one_thread():
+    """8 batches on 2 workers: each worker built the study's mechanism once (not a batch), and
+    its OpenMP and BLAS pools are one thread (nothing else competes for the two cores)."""
+    from pinmech.design.cluster import run_batches
+    from pinmech.design.tolerance import batches
+
+    def state() -> tuple:
+        from pinmech.design import cluster
+
+        return cluster.BUILDS[0], os.environ.get("OMP_NUM_THREADS"), os.environ.get("OPENBLAS_NUM_THREADS")
+
+    spec = _small_spec()
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address="127.0.0.1:0",
+                                  host="127.0.0.1") as cluster, distributed.Client(cluster) as client:
+        run_batches(spec, batches(spec.samples, spec.batch), scheduler=cluster.scheduler_address)
+        seen = client.run(state)
+    assert len(seen) == 2
+    assert all(s == (1, "1", "1") for s in seen.values()), seen

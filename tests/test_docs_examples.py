@@ -179,7 +179,8 @@ def _check_text(block: Block) -> None:
 #: Blocks whose commands take more than a few seconds even at small sizes (a 2000-variant
 #: tolerance study, a 169-point grid): marked slow (`pytest -m "not slow"` leaves them out).
 LONG = ("pinmech study models/studies/four_bar_tolerance.toml", "pinmech study models/studies/four_bar_grid.toml",
-        "models/studies/five_bar_workspace.toml", "models/studies/delta_workspace.toml")  # ~1 and ~4 min
+        "models/studies/five_bar_workspace.toml", "models/studies/delta_workspace.toml",  # ~4 min each
+        "models/studies/five_bar_actuators.toml")
 
 
 def _cases() -> list:

@@ -331,10 +331,13 @@ def test_delta_kappa_is_that_of_clavels_jacobian(tmp_path):
 
 # ------------------------------------------------------------------ Dask, outputs, errors
 def test_two_workers_give_the_serial_result_bit_for_bit(tmp_path):
-    """A LocalCluster of 2 worker processes solves the same grid to the same bits."""
+    """A LocalCluster of 2 worker processes solves the same grid, and the same refinement
+    points (one halving of the boundary's cells), to the same bits."""
     path = _five_bar(tmp_path, '{ from = "-60 mm", to = "160 mm", count = 9 }',
-                     '{ from = "-150 mm", to = "150 mm", count = 11 }', 'modes = ["+-", "-+"]', batch=17)
+                     '{ from = "-150 mm", to = "150 mm", count = 11 }', 'modes = ["+-", "-+"]\nrefine_depth = 1',
+                     batch=17)
     serial, spread = pinmech.study(path), pinmech.study(path, workers=2)
+    assert serial.measures == spread.measures and serial.measures["+-"].points > 0
     np.testing.assert_array_equal(serial.reached, spread.reached)
     np.testing.assert_array_equal(serial.motor_q, spread.motor_q)
     for key in serial.values:
@@ -397,3 +400,32 @@ def test_spec_is_a_workspace_spec(tmp_path):
     path = _five_bar(tmp_path, '{ from = "0 mm", to = "2 mm", count = 3 }', '{ from = "0 mm", to = "1 mm", count = 2 }')
     spec = load_workspace(path)
     assert isinstance(spec, WorkspaceSpec) and spec.size == 6 and spec.unit == "mm"
+
+
+def test_five_bar_refined_area_holds_the_annuli_area_within_the_tolerance_asked(tmp_path):
+    """With area_tolerance = 0.05 on a 10 mm grid, the study's refined interval (the boundary's
+    cells halved and their new corners solved by the engine) holds the lens-formula area, and
+    its half width is under 5 % of the area; the assembly modes' intervals add up to hold it too."""
+    path = _five_bar(tmp_path, '{ from = "-60 mm", to = "160 mm", count = 23 }',
+                     '{ from = "-160 mm", to = "160 mm", count = 33 }', 'modes = ["+-"]\narea_tolerance = 0.05')
+    result = pinmech.study(path)
+    exact = annuli_area()
+    m = result.measures["+-"]
+    lo, hi = m.interval
+    assert lo <= exact <= hi and m.bound <= 0.05 * m.value and m.depth >= 1, (lo, exact, hi, m)
+    plus, minus = result.measures["+-/+"].interval, result.measures["+-/-"].interval
+    assert plus[0] + minus[0] <= exact <= plus[1] + minus[1]
+
+
+@pytest.mark.parametrize("line, message", [
+    ("area_tolerance = 1.5", r"workspace.area_tolerance: area_tolerance = 1.5 must be a share of the area between 0 and 1"),
+    ("area_tolerance = \"1 %\"", r"workspace.area_tolerance: area_tolerance = '1 %' must be a share"),
+    ("refine_depth = 11", r"workspace.refine_depth: refine_depth = 11 must be a whole number of halvings from 0 to 10"),
+    ("refine_depth = 2.5", r"workspace.refine_depth: refine_depth = 2.5 must be a whole number"),
+])
+def test_bad_refinement_keys_are_named_with_their_values(tmp_path, line, message):
+    path = _five_bar(tmp_path, '{ from = "0 mm", to = "1 mm", count = 2 }', '{ from = "0 mm", to = "1 mm", count = 2 }',
+                     line)
+    with pytest.raises(SceneError, match=message) as info:
+        load_workspace(path)
+    assert str(path) in str(info.value) and "\n" not in str(info.value)

@@ -109,14 +109,17 @@ def _workspace_output(result, args: argparse.Namespace) -> int:
     """A workspace study's summary, table, JSON and map."""
     import json
 
-    from pinmech.design.workspace_report import summary, text, write
+    if result.spec.space == "actuator":
+        from pinmech.design.workspace_actuator_plot import actuator_figure as figure
+        from pinmech.design.workspace_actuator_report import summary, text, write
+    else:
+        from pinmech.design.workspace_plot import workspace_figure as figure
+        from pinmech.design.workspace_report import summary, text, write
 
     print(json.dumps(summary(result), indent=2) if args.json else text(result))
     if args.out:
         written = write(result, args.out)
         if args.plot:
-            from pinmech.design.workspace_plot import workspace_figure
-
-            written.append(workspace_figure(result, f"{args.out}_workspace.png"))
+            written.append(figure(result, f"{args.out}_workspace.png"))
         print("wrote " + ", ".join(str(p) for p in written), file=sys.stderr)
     return 0

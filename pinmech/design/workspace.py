@@ -17,11 +17,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pinmech.design.cluster import run_batches
+from pinmech.design.cluster import Runner, batch_runner
 from pinmech.design.tolerance import batches
-from pinmech.design.workspace_batch import FIELDS, WorkspaceBatch, built
+from pinmech.design.workspace_batch import FIELDS, PointsBatch, WorkspaceBatch, built
 from pinmech.design.workspace_file import WorkspaceSpec
-from pinmech.design.workspace_maps import Measure, boundary_edges, distances, measure, sign_change_edges
+from pinmech.design.workspace_maps import boundary_edges, distances, sign_change_edges
+from pinmech.design.workspace_measure import Measure, refined_measures
 from pinmech.exceptions import SceneError
 
 
@@ -71,9 +72,11 @@ class WorkspaceResult:
 
 
 def run_workspace(spec: WorkspaceSpec, *, workers: int = 0, scheduler: str | None = None,
-                  progress: Callable[[int, int], None] | None = None) -> WorkspaceResult:
+                  progress: Callable[[int, int], None] | None = None):
     """Solve the study's grid (here, or on Dask) and read its maps; `progress` is called with
-    (grid points done, grid points) as each batch finishes.
+    (grid points done, grid points) as each batch finishes. A task-space grid gives a
+    WorkspaceResult, a grid over the motors (`[workspace.actuators]`) an ActuatorResult
+    (workspace_actuator.py).
 
     Raises:
         SceneError: the study file's or the scene's mistakes, a mechanism that is not parallel
@@ -81,6 +84,10 @@ def run_workspace(spec: WorkspaceSpec, *, workers: int = 0, scheduler: str | Non
             FrameNotFound: an unknown end point.
     """
     wm = built(spec)  # here first: the file's and the mechanism's errors before any worker starts
+    if spec.space == "actuator":
+        from pinmech.design.workspace_actuator import run_actuator_workspace
+
+        return run_actuator_workspace(spec, wm, workers=workers, scheduler=scheduler, progress=progress)
     todo = batches(spec.size, spec.batch)
     done = [0]
 
@@ -88,8 +95,13 @@ def run_workspace(spec: WorkspaceSpec, *, workers: int = 0, scheduler: str | Non
         done[0] += batch.count
         progress(done[0], spec.size)
 
-    results: list[WorkspaceBatch] = run_batches(spec, todo, workers=workers, scheduler=scheduler,
-                                                progress=tick if progress else None)
+    with batch_runner(workers=workers, scheduler=scheduler) as run:
+        results: list[WorkspaceBatch] = run(spec, todo, tick if progress else None)
+        return _maps(spec, wm, results, run)
+
+
+def _maps(spec: WorkspaceSpec, wm, results: list[WorkspaceBatch], run: Runner) -> WorkspaceResult:
+    """The grid's maps from its batches; the measures refined through `run`."""
     shape = tuple(a.count for a in spec.axes)
     modes = wm.modes
     reached = np.concatenate([b.reached for b in results]).reshape(*shape, len(modes))
@@ -107,9 +119,7 @@ def run_workspace(spec: WorkspaceSpec, *, workers: int = 0, scheduler: str | Non
     dist1, dist2 = np.full(reached.shape, np.nan), np.full(reached.shape, np.nan)
     for k, mode in enumerate(modes):
         here = reached[..., k]
-        measures[mode] = measure(here, steps)
-        for sign, label in ((1, "+"), (-1, "-")):
-            measures[f"{mode}/{label}"] = measure(here & (np.sign(values["det2"][..., k]) == sign), steps)
+        measures.update(_mode_measures(spec, run, k, mode, here, values["det2"][..., k], coords))
         type1[mode] = np.concatenate([boundary_edges(here, coords), sign_change_edges(values["det1"][..., k], coords)])
         type2[mode] = sign_change_edges(values["det2"][..., k], coords)
         points = mesh[here]
@@ -117,3 +127,23 @@ def run_workspace(spec: WorkspaceSpec, *, workers: int = 0, scheduler: str | Non
         dist2[..., k][here] = distances(points, type2[mode])
     return WorkspaceResult(spec, modes, wm.motors, wm.length, coords, reached, motor_q, values, measures,
                            type1, type2, dist1, dist2)
+
+
+def _members(mode: str, reached: np.ndarray, det2: np.ndarray) -> dict[str, np.ndarray]:
+    """A working mode's regions: reached, and reached in each assembly mode (sign of det Phi_p)."""
+    return {mode: reached, f"{mode}/+": reached & (np.sign(det2) > 0), f"{mode}/-": reached & (np.sign(det2) < 0)}
+
+
+def _mode_measures(spec: WorkspaceSpec, run: Runner, k: int, mode: str, reached: np.ndarray, det2: np.ndarray,
+                   coords: list[np.ndarray]) -> dict[str, Measure]:
+    """The area or volume of working mode k and of its two assembly modes, each refined
+    (workspace_measure.py) by solving the new corners in mode k through `run`."""
+    def member(points: np.ndarray) -> dict[str, np.ndarray]:
+        todo = [PointsBatch(b.index, points[b.start : b.start + b.count], np.full(b.count, k))
+                for b in batches(len(points), spec.batch)]
+        done = run(spec, todo)
+        return _members(mode, np.concatenate([d.reached[:, 0] for d in done]),
+                        np.concatenate([d.values["det2"][:, 0] for d in done]))
+
+    return refined_measures(_members(mode, reached, det2), coords, member, depth=spec.refine_depth,
+                            tolerance=spec.area_tolerance)

@@ -27,6 +27,20 @@ class WorkspaceBatch:
     values: dict[str, np.ndarray]
 
 
+@dataclass(frozen=True)
+class PointsBatch:
+    """Points given by their coordinates (count, axes) [m], each in working mode `modes[i]`
+    (an index into the study's modes): a refinement level's new points (a Dask task)."""
+
+    index: int
+    points: np.ndarray
+    modes: np.ndarray
+
+    @property
+    def count(self) -> int:
+        return len(self.points)
+
+
 def built(spec: WorkspaceSpec) -> WorkspaceMechanism:
     """This process's WorkspaceMechanism of the study, built on first use."""
     if spec not in _BUILT:
@@ -42,9 +56,16 @@ def grid_points(spec: WorkspaceSpec, start: int, count: int) -> np.ndarray:
     return np.column_stack([v[i] for v, i in zip(values, index)])
 
 
-def run_workspace_batch(spec: WorkspaceSpec, batch: Batch) -> WorkspaceBatch:
-    """Solve the batch's points in every mode."""
+def run_workspace_batch(spec: WorkspaceSpec, batch: Batch | PointsBatch):
+    """Solve the batch's grid points in every mode, or its given points each in its own mode
+    (then `reached`, `motors` and `values` have one mode column: the point's)."""
     wm = built(spec)
+    if isinstance(batch, PointsBatch):
+        return _given_points(wm, batch)
+    if spec.space == "actuator":
+        from pinmech.design.workspace_actuator_batch import run_actuator_batch
+
+        return run_actuator_batch(spec, wm, batch)
     modes, legs = len(wm.modes), len(wm.legs)
     reached = np.zeros((batch.count, modes), bool)
     motors = np.full((batch.count, modes, legs), np.nan)
@@ -57,3 +78,15 @@ def run_workspace_batch(spec: WorkspaceSpec, batch: Batch) -> WorkspaceBatch:
             for f in FIELDS:
                 values[f][i, k] = getattr(s, f)
     return WorkspaceBatch(batch.start, reached, motors, values)
+
+
+def _given_points(wm: WorkspaceMechanism, batch: PointsBatch) -> WorkspaceBatch:
+    reached = np.zeros((batch.count, 1), bool)
+    motors = np.full((batch.count, 1, len(wm.legs)), np.nan)
+    values = {f: np.full((batch.count, 1), np.nan) for f in FIELDS}
+    for i, (x, k) in enumerate(zip(batch.points, batch.modes)):
+        s = wm.solve(x, wm.modes[int(k)])
+        reached[i, 0], motors[i, 0] = s.reached, s.motors
+        for f in FIELDS:
+            values[f][i, 0] = getattr(s, f)
+    return WorkspaceBatch(batch.index, reached, motors, values)

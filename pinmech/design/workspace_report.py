@@ -14,8 +14,9 @@ from pinmech.design.workspace import WorkspaceResult
 
 
 def summary(result: WorkspaceResult) -> dict:
-    """The JSON summary: the grid, L, and per working mode the area or volume with its bound,
-    per assembly mode likewise, the least and median kappa, and the loci's sizes."""
+    """The JSON summary: the grid, L, and per working mode the area or volume with its bound
+    (and the refinement that got it), per assembly mode likewise, the least and median
+    kappa, and the loci's sizes."""
     spec, u = result.spec, result.spec.unit_si
     power = len(result.coords)
     unit = f"{spec.unit}^{power}"
@@ -29,6 +30,7 @@ def summary(result: WorkspaceResult) -> dict:
             "assembly_modes": {a: {result.kind: result.measures[f"{mode}/{a}"].value / u**power,
                                    "bound": result.measures[f"{mode}/{a}"].bound / u**power} for a in "+-"},
             "points_reached": int(result.reached[..., k].sum()),
+            "refinement": {"halvings": m.depth, "points_solved": m.points},
             "kappa_least": _finite(finite.min()) if finite.size else None,
             "kappa_median": _finite(np.median(finite)) if finite.size else None,
             "type1_locus_points": len(result.type1[mode]), "type2_locus_points": len(result.type2[mode]),
@@ -60,6 +62,11 @@ def text(result: WorkspaceResult) -> str:
             f"{e['kappa_median']:>9.4g}" if e["kappa_median"] is not None else f"{'-':>9}")
         edge = "  (reaches the grid's edge: the workspace may go on beyond it)" if e["reaches_grid_edge"] else ""
         lines.append(f"{mode:<8}{parts[0]:>26}{parts[1]:>26}{parts[2]:>26}{kappa}{edge}")
+    refined = [f"{mode} {e['refinement']['halvings']} halvings, {e['refinement']['points_solved']} more points"
+               for mode, e in s["working_modes"].items() if e["refinement"]["points_solved"]]
+    if refined:
+        lines.append("boundary cells refined: " + "; ".join(refined) + " (bounds hold if the boundary crosses "
+                     "each cell edge at most once)")
     return "\n".join(lines)
 
 

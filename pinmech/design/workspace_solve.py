@@ -70,12 +70,9 @@ class WorkspaceMechanism:
         where = str(spec.path)
         self.motors = tuple(scene_drivers(scene, m).names)
         self.legs = find_legs(m, self.motors, where)
-        if len(spec.axes) != len(self.legs):
-            raise SceneError(f"{len(self.legs)} motors need {len(self.legs)} grid axes "
-                             f"({'x, y' if len(self.legs) == 2 else 'x, y, z'}); the file gives {len(spec.axes)}",
-                             path=where, key="workspace")
+        _check_axes(spec, self.motors, where)
         self.end = m.frame_id(spec.point)
-        self.rows = np.array([a.param for a in spec.axes])
+        self.rows = np.array(spec.task_rows)
         self.length = spec.length or m.length_scale
         self.scale = m.velocity_scale()
         self.q0 = m.neutral()
@@ -244,6 +241,10 @@ class WorkspaceMechanism:
         q = self.inverse(x, mode)
         if q is None:
             return PointSolution(False, np.full(len(self.legs), np.nan))
+        return self.measures(q)
+
+    def measures(self, q: np.ndarray) -> PointSolution:
+        """The Jacobians' measures at a closed pose q (any working and assembly mode)."""
         self._kinematics(q)
         phi, end = self._phi(q), self._end_rows()
         K = np.vstack([phi, end]) * self.scale
@@ -270,3 +271,17 @@ def resolve_modes(spec: WorkspaceSpec, legs: int) -> tuple[str, ...]:
         raise SceneError(f"working mode {bad[0]!r} has {len(bad[0])} signs; the mechanism has {legs} legs "
                          f"(one sign a leg, in the motors' order)", path=str(spec.path), key="workspace.modes")
     return spec.modes
+
+
+def _check_axes(spec: WorkspaceSpec, motors: tuple[str, ...], where: str) -> None:
+    """As many task axes as motors, or (an actuator-space grid) one axis a motor, named."""
+    if spec.space == "actuator":
+        names = tuple(a.name for a in spec.axes)
+        if sorted(names) != sorted(motors):
+            raise SceneError(f"the actuator grid's axes ({', '.join(names)}) must be the motors "
+                             f"({', '.join(motors)}), one each", path=where, key="workspace.actuators")
+        return
+    if len(spec.axes) != len(motors):
+        raise SceneError(f"{len(motors)} motors need {len(motors)} grid axes "
+                         f"({'x, y' if len(motors) == 2 else 'x, y, z'}); the file gives {len(spec.axes)}",
+                         path=where, key="workspace")
