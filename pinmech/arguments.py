@@ -29,7 +29,7 @@ def float_array(value: Any, name: str, shape: tuple[int | None, ...], source: st
         ModelError: naming `name`, the shape wanted and what was given (`source`: the model file).
     """
     if (type(value) is np.ndarray and value.dtype is _FLOAT64 and len(shape) == 1  # one pose's vector:
-            and value.shape == shape and all(map(math.isfinite, value.tolist()))):  # plain floats, no numpy calls
+            and value.shape == shape and all_finite(value.tolist())):  # plain floats, no numpy calls
         return value
     wrong = not_real(value)
     if wrong:
@@ -44,6 +44,13 @@ def float_array(value: Any, name: str, shape: tuple[int | None, ...], source: st
         raise ModelError(f"{name} must be {_shape_words(shape)} finite numbers (SI), got shape {out.shape}"
                          + ("" if not right else " with a non-finite number"), path=source)
     return out
+
+
+def all_finite(values: list[float]) -> bool:
+    """Whether every float of `values` is finite: their sum is (one pass in C), unless it
+    overflowed, when each is looked at (a NaN or an infinity makes the sum NaN or infinite)."""
+    total = sum(values)
+    return total - total == 0.0 or all(map(math.isfinite, values))
 
 
 def _shape_words(shape: tuple[int | None, ...]) -> str:

@@ -13,7 +13,7 @@ import os
 import sys
 import tempfile
 from pathlib import Path
-from typing import IO
+from typing import IO, Callable
 
 from pinmech.exceptions import PinmechError
 from pinmech.interrupts import SIGNALS
@@ -116,6 +116,25 @@ def write_whole(path: str | Path, text: str) -> None:
         output.abandon()
         raise
     output.commit()
+
+
+def write_with(path: str | Path, write: Callable[[Path], object]) -> Path:
+    """Write a file whole: `write(temporary)` fills a temporary file in its folder, renamed
+    over `path` when it returns; on a failure what was written is kept as NAME.partial and
+    `path` is left as it was (a figure, a Parquet table: writers that want a file name)."""
+    output = OutputFile(path)
+    output.open(text=False)
+    try:
+        write(output.temporary)
+    except BaseException:
+        output.abandon()
+        raise
+    return output.commit()
+
+
+def beside(prefix: str | Path, ending: str) -> Path:
+    """PREFIX + ending ("run.2" and ".csv" give "run.2.csv": a dot in the prefix is kept)."""
+    return Path(f"{prefix}{ending}")
 
 
 def plot_path(path: str, option: str = "--plot") -> Path:

@@ -23,6 +23,7 @@ compiled core) and timed in the same rounds: a before/after ratio under one mach
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import sys
 from pathlib import Path
@@ -125,7 +126,10 @@ def main(argv: list[str] | None = None) -> None:
     for t in timed.values():
         t.calls = args.calls
         t.run()
+    load = os.getloadavg()[0]
     time_rounds(list(timed.values()), args.rounds)
+    print(f"{args.rounds} interleaved rounds of {args.calls} calls; load average {load:.1f} before, "
+          f"{os.getloadavg()[0]:.1f} after (a shared machine: read the fastest rounds too)\n")
     print("| call | us (median) | spread (fastest - slowest round) |\n| --- | --- | --- |")
     for name, t in timed.items():
         us = [x * 1e6 for x in t.times]

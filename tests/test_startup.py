@@ -29,6 +29,12 @@ NOT_FOR_A_SOLVE = (
     "pinmech.io.check", "pinmech.model.linkage", "pinmech.model.linkage_urdf", "pinmech.model.mjcf", "pinmech.model.sidecar",
     "json", "pint", "matplotlib", "meshcat",
     "pydantic",  # no longer a dependency: scene tables are msgspec Structs (building pydantic models cost ~0.15 s)
+    "numpy.random",  # sample poses are drawn by pinmech.seeded (numpy.random and its hashlib/secrets: ~10 ms)
+    "difflib",  # only for a name that is not a URDF one
+    # the other subcommands: each module is imported when its subcommand is chosen
+    "pinmech.cli.forces", "pinmech.cli.sweep", "pinmech.cli.path", "pinmech.cli.snapshot", "pinmech.cli.animate",
+    "pinmech.cli.polygon", "pinmech.cli.report", "pinmech.cli.view", "pinmech.cli.build", "pinmech.cli.check",
+    "pinmech.design.study_cli", "pinmech.design.synthesis_cli",
 )
 
 _SOLVE_IN_A_FRESH_PROCESS = """

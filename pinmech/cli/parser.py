@@ -1,25 +1,14 @@
 """The complete argument parser of the `pinmech` command: `build_parser()` (the docs' CLI
 reference is generated from it). Each subcommand adds its own sub-parser (its module's
-`add_parser`); a new subcommand is one line in `SUBCOMMANDS`."""
+`add_parser`), and its module is imported only when its parser is built: `pinmech solve`
+imports none of the other subcommands. A new subcommand is one line in `SUBCOMMANDS`."""
 
 from __future__ import annotations
 
 import argparse
+import importlib
 
 from pinmech import __version__
-from pinmech.cli.animate import add_parser as add_animate_parser
-from pinmech.cli.build import add_parser as add_build_parser
-from pinmech.cli.check import add_parser as add_check_parser
-from pinmech.cli.forces import add_parser as add_forces_parser
-from pinmech.cli.path import add_parser as add_path_parser
-from pinmech.cli.polygon import add_parser as add_polygon_parser
-from pinmech.cli.report import add_parser as add_report_parser
-from pinmech.cli.snapshot import add_parser as add_snapshot_parser
-from pinmech.cli.solve import add_parser as add_solve_parser
-from pinmech.cli.sweep import add_parser as add_sweep_parser
-from pinmech.cli.view import add_parser as add_view_parser
-from pinmech.design.study_cli import add_parser as add_study_parser
-from pinmech.design.synthesis_cli import add_parser as add_synth_parser
 
 
 def build_parser(command: str | None = None, *, parser_class: type[argparse.ArgumentParser] = argparse.ArgumentParser
@@ -37,25 +26,26 @@ def build_parser(command: str | None = None, *, parser_class: type[argparse.Argu
     )
     parser.add_argument("--version", action="version", version=f"pinmech {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-    for name, add in SUBCOMMANDS.items():
+    for name, module in SUBCOMMANDS.items():
         if command is None or name == command:
-            add(sub)
+            importlib.import_module(module).add_parser(sub)
     return parser
 
 
-#: Each subcommand's parser, in the order `pinmech --help` lists them.
+#: Each subcommand's module (its `add_parser` adds its sub-parser), in the order
+#: `pinmech --help` lists them.
 SUBCOMMANDS = {
-    "solve": add_solve_parser,
-    "forces": add_forces_parser,
-    "sweep": add_sweep_parser,
-    "path": add_path_parser,
-    "snapshot": add_snapshot_parser,
-    "animate": add_animate_parser,
-    "polygon": add_polygon_parser,
-    "report": add_report_parser,
-    "view": add_view_parser,
-    "build": add_build_parser,
-    "check": add_check_parser,
-    "study": add_study_parser,
-    "synth": add_synth_parser,
+    "solve": "pinmech.cli.solve",
+    "forces": "pinmech.cli.forces",
+    "sweep": "pinmech.cli.sweep",
+    "path": "pinmech.cli.path",
+    "snapshot": "pinmech.cli.snapshot",
+    "animate": "pinmech.cli.animate",
+    "polygon": "pinmech.cli.polygon",
+    "report": "pinmech.cli.report",
+    "view": "pinmech.cli.view",
+    "build": "pinmech.cli.build",
+    "check": "pinmech.cli.check",
+    "study": "pinmech.design.study_cli",
+    "synth": "pinmech.design.synthesis_cli",
 }

@@ -63,6 +63,7 @@ Core::Core(nb::object model, const std::vector<int>& frame_ids, const std::vecto
     cuts_.push_back(cut);
   }
   rows_ = offset;
+  errors_.assign(ncuts, Vector6d::Zero());
   const Index nv = model_.nv;
   if (v_scale.size() != nv) throw std::invalid_argument("velocity scale of the wrong size");
   for (const auto* indices : {&drv_v_, &dep_v_})
@@ -117,20 +118,28 @@ VectorXd Core::residual(const VectorXd& q) {
   return r;
 }
 
-// The independent closure rows at q; leaves joint placements, Jacobians and the cut
-// frames' placements in data_ (LoopSolver._residual).
-void Core::residual_into(const VectorXd& q, VectorXd& r) {
-  pin::computeJointJacobians(model_, data_, q);
-  for (const Cut& cut : cuts_) {
+// The independent closure rows at q; leaves joint placements and the cut frames'
+// placements in data_ (LoopSolver._residual). The joint Jacobians at q come in the same
+// pass where `jacobians` (a Jacobian will be taken here), else at the first jacobian_into
+// (most residuals are the last of a Newton solve: no Jacobian is taken there).
+void Core::residual_into(const VectorXd& q, VectorXd& r, bool jacobians) {
+  if (jacobians) pin::computeJointJacobians(model_, data_, q);
+  else pin::forwardKinematics(model_, data_, q);
+  joint_jacobians_ = jacobians;
+  for (size_t c = 0; c < cuts_.size(); ++c) {
+    const Cut& cut = cuts_[c];
     pin::updateFramePlacement(model_, data_, cut.parent);
     pin::updateFramePlacement(model_, data_, cut.child);
-    r.segment(cut.offset, cut.rows6.rows()).noalias() = cut.rows6 * error6(cut);
+    errors_[c] = error6(cut);
+    // lazyProduct: at most 6 x 6, coefficient by coefficient (not the general matrix-vector kernel)
+    r.segment(cut.offset, cut.rows6.rows()).noalias() = cut.rows6.lazyProduct(errors_[c]);
   }
 }
 
+// Every selected row's largest |value| at the q of the last residual_into (its errors).
 double Core::full_residual() const {
   double worst = 0.0;
-  for (const Cut& cut : cuts_) worst = std::max(worst, max_abs(cut.full * error6(cut)));
+  for (size_t c = 0; c < cuts_.size(); ++c) worst = std::max(worst, max_abs(cuts_[c].full.lazyProduct(errors_[c])));
   return worst;
 }
 
@@ -141,8 +150,13 @@ MatrixXd Core::jacobian(bool newton) {
 }
 
 
-// J_ = the stacked rows' Jacobian, Jdep_ its dependent columns (data_ at q).
+// J_ = the stacked rows' Jacobian, Jdep_ its dependent columns at the q of the last
+// residual_into; data_ then has the joint Jacobians at q too.
 void Core::jacobian_into(bool newton) {
+  if (!joint_jacobians_) {
+    pin::computeJointJacobians(model_, data_);  // from the placements residual_into left
+    joint_jacobians_ = true;
+  }
   for (const Cut& cut : cuts_) relative_jacobian(cut, newton);
   for (size_t i = 0; i < dep_v_.size(); ++i) Jdep_.col(Index(i)) = J_.col(dep_v_[i]);
 }
@@ -156,11 +170,12 @@ VectorXd Core::drift(const VectorXd& q, const VectorXd& v) {
 
 void Core::drift_into(const VectorXd& q, const VectorXd& v, VectorXd& out) {
   pin::forwardKinematics(model_, data_, q, v, zero_);
+  joint_jacobians_ = false;  // data_.J is computed again from these placements where asked
   for (const Cut& cut : cuts_) {
     pin::updateFramePlacement(model_, data_, cut.parent);  // at this q, whatever the last call's was
     pin::updateFramePlacement(model_, data_, cut.child);
     const Vector6d e = relative_acceleration6(frame_motion(cut.parent, cut.ground), frame_motion(cut.child, false));
-    out.segment(cut.offset, cut.rows6.rows()).noalias() = cut.rows6 * e;
+    out.segment(cut.offset, cut.rows6.rows()).noalias() = cut.rows6.lazyProduct(e);
   }
 }
 
@@ -336,16 +351,16 @@ void Core::relative_jacobian(const Cut& cut, bool newton) {
     const Vector3d w = data_.J.col(c.extended).tail<3>();
     e.head<3>().noalias() = RT * (data_.J.col(c.extended).head<3>() + w.cross(pC));
     e.tail<3>().noalias() = MRT * w;
-    if (cut.shared_columns) J_.block(cut.offset, c.v, k, 1).noalias() += cut.rows6 * e;
-    else J_.block(cut.offset, c.v, k, 1).noalias() = cut.rows6 * e;
+    if (cut.shared_columns) J_.block(cut.offset, c.v, k, 1).noalias() += cut.rows6.lazyProduct(e);
+    else J_.block(cut.offset, c.v, k, 1).noalias() = cut.rows6.lazyProduct(e);
   }
   for (const JointColumn& c : cut.parent_cols) {  // minus P's frame velocity at P, and P turning delta
     const Vector3d w = data_.J.col(c.extended).tail<3>();
     const Vector3d v = data_.J.col(c.extended).head<3>() + w.cross(pP);
     e.head<3>().noalias() = RT * (delta.cross(w) - v);
     e.tail<3>().noalias() = -(MRT * w);
-    if (cut.shared_columns) J_.block(cut.offset, c.v, k, 1).noalias() += cut.rows6 * e;
-    else J_.block(cut.offset, c.v, k, 1).noalias() = cut.rows6 * e;
+    if (cut.shared_columns) J_.block(cut.offset, c.v, k, 1).noalias() += cut.rows6.lazyProduct(e);
+    else J_.block(cut.offset, c.v, k, 1).noalias() = cut.rows6.lazyProduct(e);
   }
 }
 

@@ -24,7 +24,7 @@ void check_signals() {
 bool Core::correct(VectorXd& q, const VectorXd& drivers, int max_iterations, double& residual_left) {
   set_drivers(q, drivers);
   VectorXd& r = r_;
-  residual_into(q, r);
+  residual_into(q, r, true);  // a predicted pose: Newton's Jacobian is taken there
   double norm = max_abs(r);
   iterations_ = 0;
   moved_ = 0.0;
@@ -48,7 +48,7 @@ bool Core::correct(VectorXd& q, const VectorXd& drivers, int max_iterations, dou
     norm = new_norm;
   }
   if (POLISH < norm && norm <= tol_ && tol_ <= DEFAULT_TOL) {
-    polish(q, r, norm);
+    polish(q, r, norm, iterations_ > 0);
     ++iterations_;
   }
   const double full = full_residual();
@@ -81,20 +81,21 @@ void Core::node_at(Node& node, const VectorXd& d, const VectorXd* a_drv) {
   v.setZero(model_.nv);
   a.setZero(model_.nv);
   for (size_t i = 0; i < drv_v_.size(); ++i) v(drv_v_[i]) = d(Index(i));
-  rhs_.noalias() = -(J_ * v);  // driver columns only: v is zero elsewhere yet
+  rhs_.setZero();
+  for (size_t i = 0; i < drv_v_.size(); ++i) rhs_.noalias() -= J_.col(drv_v_[i]) * d(Index(i));  // v's only nonzeros yet
   square_.solve(rhs_, dstep_);
   for (size_t i = 0; i < dep_v_.size(); ++i) v(dep_v_[i]) = dep_scale_(Index(i)) * dstep_(Index(i));
   drift_into(node.q, v, drift_);
   rhs_ = -drift_;
   if (a_drv != nullptr) {
     for (size_t i = 0; i < drv_v_.size(); ++i) a(drv_v_[i]) = (*a_drv)(Index(i));
-    rhs_.noalias() -= J_ * a;  // driver columns only: a is zero elsewhere yet
+    for (size_t i = 0; i < drv_v_.size(); ++i) rhs_.noalias() -= J_.col(drv_v_[i]) * a(drv_v_[i]);  // a's only nonzeros yet
   }
   square_.solve(rhs_, dstep_);
   for (size_t i = 0; i < dep_v_.size(); ++i) a(dep_v_[i]) = dep_scale_(Index(i)) * dstep_(Index(i));
-  rhs_.noalias() = J_ * v;
+  rhs_.noalias() = J_.lazyProduct(v);  // small: coefficient by coefficient
   node.velocity_residual = max_abs(rhs_);
-  rhs_.noalias() = J_ * a;
+  rhs_.noalias() = J_.lazyProduct(a);
   rhs_ += drift_;
   node.acceleration_residual = max_abs(rhs_);
 }
@@ -223,29 +224,40 @@ void Core::move_into(const VectorXd& q, const VectorXd& step, VectorXd& out) {
 
 // LoopSolver._newton_update at the polish: the full step if it lowers the residual,
 // else the step halved until it does (a square regular J_dep: least squares is Newton).
-void Core::polish(VectorXd& q, VectorXd& r, double& norm) {
+// `factored`: square_ holds J_dep factored at the last Newton iterate, one step before q;
+// its full step (a chord step: from a residual near tol it lands within rounding, as
+// Newton's does, the step between the two Jacobians being small) is tried first and kept
+// where it lowers the residual, else the polish is Newton's at q.
+void Core::polish(VectorXd& q, VectorXd& r, double& norm, bool factored) {
+  if (factored && polish_step(q, r, norm, 0)) return;
   jacobian_into(true);
-  rhs_ = -r;
   square_.factor(Jdep_);
+  polish_step(q, r, norm, LINE_SEARCH_HALVINGS);
+}
+
+// The step of square_'s factorization from q, halved up to `halvings` times until it
+// lowers the residual (q, r, norm then updated; true); else data_ is left at q.
+bool Core::polish_step(VectorXd& q, VectorXd& r, double& norm, int halvings) {
+  rhs_ = -r;
   square_.solve(rhs_, dstep_);
-  if (!dstep_.allFinite()) return;
-  double alpha = 1.0;
-  for (int k = 0; k <= LINE_SEARCH_HALVINGS; ++k, alpha *= 0.5) {
-    move_into(q, alpha * dstep_, q_new_);
+  if (!dstep_.allFinite()) return false;
+  for (int k = 0; k <= halvings; ++k, dstep_ *= 0.5) {  // halving: exact
+    move_into(q, dstep_, q_new_);
     residual_into(q_new_, r_new_);
     const double trial_norm = max_abs(r_new_);
     if (trial_norm < norm) {
       q.swap(q_new_);
       r.swap(r_new_);
       norm = trial_norm;
-      return;
+      return true;
     }
   }
   residual_into(q, r);  // data back at q
+  return false;
 }
 
 double Core::turn_between(const Node& a, const Node& b, double unit) const {
-  const VectorXd ta = a.d1.cwiseProduct(v_scale_inv_), tb = b.d1.cwiseProduct(v_scale_inv_);
+  const auto ta = a.d1.cwiseProduct(v_scale_inv_), tb = b.d1.cwiseProduct(v_scale_inv_);  // lazy: no temporaries
   const double na = std::sqrt(ta.squaredNorm() + unit * unit), nb_ = std::sqrt(tb.squaredNorm() + unit * unit);
   const double c = (ta.dot(tb) + unit * unit) / (na * nb_);
   return std::acos(std::max(-1.0, std::min(1.0, c)));

@@ -273,7 +273,7 @@ class Core {
 
   // ------------------------------------------------------------ closure rows (closure.cpp)
   VectorXd residual(const VectorXd& q);
-  void residual_into(const VectorXd& q, VectorXd& r);
+  void residual_into(const VectorXd& q, VectorXd& r, bool jacobians = false);
   double full_residual() const;
   MatrixXd jacobian(bool newton);
   void jacobian_into(bool newton);
@@ -353,7 +353,8 @@ class Core {
   std::vector<DiagonalBlock> ordered_blocks() const;
   void set_drivers(VectorXd& q, const VectorXd& drivers) const;
   void move_into(const VectorXd& q, const VectorXd& step, VectorXd& out);
-  void polish(VectorXd& q, VectorXd& r, double& norm);
+  void polish(VectorXd& q, VectorXd& r, double& norm, bool factored);
+  bool polish_step(VectorXd& q, VectorXd& r, double& norm, int halvings);
   double turn_between(const Node& a, const Node& b, double unit) const;
   bool newton_update(VectorXd& q, VectorXd& r, double& norm);
   // q + step taken (q, r, norm updated) where its residual is below norm; else q untouched.
@@ -398,6 +399,8 @@ class Core {
   SquareSolve square_;
   ConditionWork condition_work_;
   double tol_;
+  bool joint_jacobians_ = false;  // data_.J is at the q of the last residual_into
+  std::vector<Vector6d, Eigen::aligned_allocator<Vector6d>> errors_;  // each cut's error6 there
   int iterations_ = 0;
   double moved_ = 0.0;
   std::vector<int> pivots_;

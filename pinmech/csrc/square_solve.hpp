@@ -15,7 +15,11 @@ using Eigen::Index;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-inline double max_abs(const Eigen::Ref<const VectorXd>& x) { return x.size() ? x.cwiseAbs().maxCoeff() : 0.0; }
+// The largest |entry| of a vector or of a vector expression (evaluated lazily: no temporary).
+template <typename Derived>
+inline double max_abs(const Eigen::MatrixBase<Derived>& x) {
+  return x.size() ? x.cwiseAbs().maxCoeff() : 0.0;
+}
 
 // A x = b for a small square A, as solve_loops._solve_square: closed forms up to 2x2, LU
 // with partial pivoting above; NaN where A is exactly singular. Factored once for several

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from pinmech.outputs import write_with
+
 
 def pyplot(what: str):
     """matplotlib.pyplot on the Agg backend; ImportError naming the extra if missing
@@ -18,9 +20,13 @@ def pyplot(what: str):
     return plt
 
 
-def save(plt, fig, path: str | Path) -> Path:
-    """Lay the figure out, write it (format from the suffix, 110 dpi) and close it."""
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+def save(plt, fig, path: str | Path, *, tight: bool = True) -> Path:
+    """Lay the figure out (unless `tight` is False: a figure with a colour bar over several
+    axes), write it whole (format from the suffix, 110 dpi; see `write_with`) and close it."""
+    if tight:
+        fig.tight_layout()
+    try:
+        write_with(path, lambda temporary: fig.savefig(temporary, dpi=110))
+    finally:
+        plt.close(fig)
     return Path(path)

@@ -6,6 +6,7 @@ lengths in mm, angles in deg, sensitivities in mm/mm and deg/mm.
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
 from pathlib import Path
@@ -15,6 +16,7 @@ import numpy as np
 from pinmech.design.grid import cycle_range, failures
 from pinmech.design.study import StudyResult
 from pinmech.design.tolerance import PERCENTILES, deviation
+from pinmech.outputs import beside, write_whole, write_with
 
 _SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "speed": (1e3, "mm/s"),
           "angular speed": (180 / math.pi, "deg/s"), "angular acceleration": (180 / math.pi, "deg/s^2"),
@@ -157,19 +159,18 @@ def write(result: StudyResult, prefix: str | Path, *, parquet: bool = True) -> l
 
 def write_tables(columns: dict[str, list], summary_: dict, prefix: str | Path, *, parquet: bool = True) -> list[Path]:
     """Columns to PREFIX.csv (and PREFIX.parquet with pyarrow), a summary to PREFIX.json."""
-    prefix = Path(prefix)
-    paths = [prefix.with_suffix(".csv"), prefix.with_suffix(".json")]
-    with paths[0].open("w", newline="", encoding="utf-8") as f:
-        writer = csv.writer(f)
-        writer.writerow(columns)
-        writer.writerows(zip(*columns.values()))
-    paths[1].write_text(json.dumps(summary_, indent=2) + "\n", encoding="utf-8")
+    paths = [beside(prefix, ".csv"), beside(prefix, ".json")]
+    text = io.StringIO(newline="")
+    writer = csv.writer(text)
+    writer.writerow(columns)
+    writer.writerows(zip(*columns.values()))
+    write_whole(paths[0], text.getvalue())
+    write_whole(paths[1], json.dumps(summary_, indent=2) + "\n")
     if parquet:
         try:
             import pyarrow as pa
             import pyarrow.parquet as pq
         except ImportError as exc:
             raise ImportError(f'a Parquet table needs pyarrow: pip install "pinmech[study]" ({exc})') from exc
-        pq.write_table(pa.table(columns), prefix.with_suffix(".parquet"))
-        paths.append(prefix.with_suffix(".parquet"))
+        paths.append(write_with(beside(prefix, ".parquet"), lambda path: pq.write_table(pa.table(columns), path)))
     return paths

@@ -39,6 +39,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
     from pinmech.design.synthesis_report import figure, summary, text
     from pinmech.design.synthesis_search import synthesise
     from pinmech.exceptions import OptionRefused, SynthesisError
+    from pinmech.outputs import write_whole
 
     if args.plot and not args.out:
         raise OptionRefused("--plot writes PREFIX.png: give --out PREFIX too", options=["--plot"])
@@ -74,8 +75,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
                          f"within {check.errors.max() * scale:.3g} {unit}{also}")
             written += files
         json_path = f"{args.out}.json"
-        with open(json_path, "w", encoding="utf-8") as f:
-            json.dump(report, f, indent=2)
+        write_whole(json_path, json.dumps(report, indent=2))
         written.append(json_path)
         if args.plot:
             written.append(figure(result, f"{args.out}.png"))

@@ -16,6 +16,7 @@ import numpy as np
 
 from pinmech.design.synthesis_kinematics import kinematics
 from pinmech.design.synthesis_result import Linkage
+from pinmech.outputs import write_whole
 
 _STEP = math.radians(1.0)  # the engine's sweep: at most this crank step between poses
 
@@ -115,8 +116,8 @@ def write_linkage(lk: Linkage, prefix: str | Path, title: str, source: str) -> t
     """PREFIX.toml (the drawn linkage) and PREFIX_scene.toml (its sweep); their paths."""
     prefix = Path(prefix)
     linkage, scene = prefix.with_name(prefix.name + ".toml"), prefix.with_name(prefix.name + "_scene.toml")
-    linkage.write_text(linkage_toml(lk, title, source), encoding="utf-8")
-    scene.write_text(scene_toml(lk, linkage.name, title), encoding="utf-8")
+    write_whole(linkage, linkage_toml(lk, title, source))
+    write_whole(scene, scene_toml(lk, linkage.name, title))
     return linkage, scene
 
 

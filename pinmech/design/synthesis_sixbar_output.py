@@ -11,6 +11,7 @@ import numpy as np
 
 from pinmech.design.synthesis_file import SynthesisSpec
 from pinmech.design.synthesis_result import Linkage
+from pinmech.outputs import write_whole
 
 _STEP = math.radians(1.0)  # the engine check's sweep: at most this crank step between poses
 
@@ -70,8 +71,8 @@ def write_linkage(spec: SynthesisSpec, lk: Linkage, prefix: str | Path) -> tuple
     """PREFIX.toml (the drawn linkage) and PREFIX_scene.toml (its turn); their paths."""
     prefix = Path(prefix)
     linkage, scene = prefix.with_name(prefix.name + ".toml"), prefix.with_name(prefix.name + "_scene.toml")
-    linkage.write_text(linkage_toml(spec, lk), encoding="utf-8")
-    scene.write_text(scene_toml(spec, lk, linkage.name), encoding="utf-8")
+    write_whole(linkage, linkage_toml(spec, lk))
+    write_whole(scene, scene_toml(spec, lk, linkage.name))
     return linkage, scene
 
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.design.figure_file import pyplot
+from pinmech.design.figure_file import pyplot, save
 from pinmech.design.workspace_actuator import ActuatorResult
 from pinmech.design.workspace_actuator_batch import ASSEMBLIES
 from pinmech.design.workspace_actuator_report import _scales
@@ -51,9 +51,7 @@ def actuator_figure(result: ActuatorResult, path: str | Path) -> Path:
     axs[0, 0].legend(loc="upper left", fontsize=7, markerscale=3)
     fig.colorbar(image, ax=axs, label=f"kappa (J over L = {result.length / u:.4g} {unit})", shrink=0.6)
     fig.suptitle(f"{result.spec.title} (actuator space)", fontsize=10)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    return save(plt, fig, path, tight=False)
 
 
 def _slice(result: ActuatorResult):

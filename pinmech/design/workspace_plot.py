@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.design.figure_file import pyplot
+from pinmech.design.figure_file import pyplot, save
 from pinmech.design.workspace import WorkspaceResult
 
 _SLICES = 4
@@ -53,9 +53,7 @@ def workspace_figure(result: WorkspaceResult, path: str | Path) -> Path:
     axs[0, 0].legend(loc="upper left", fontsize=7, markerscale=3)
     fig.colorbar(image, ax=axs, label=f"kappa (J over L = {result.length / u:.4g} {unit})", shrink=0.6)
     fig.suptitle(f"{result.spec.title}: workspace of '{result.spec.point}'", fontsize=10)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    return save(plt, fig, path, tight=False)
 
 
 def _number(x: float) -> str:

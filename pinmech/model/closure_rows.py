@@ -12,6 +12,7 @@ from pinmech.model.closure_core import ClosureRows
 from pinmech.model.closures import Closure
 from pinmech.model.joint_info import _body_frame
 from pinmech.model.urdf_xml import _Cut
+from pinmech.seeded import Seeded
 
 #: Singular values below this fraction of the largest mark a row as structurally zero.
 STRUCTURAL_RANK_TOL = 1e-9
@@ -34,7 +35,7 @@ def _make_closure(model: pin.Model, cut: _Cut) -> Closure:
 
 def _sample_configurations(model: pin.Model, count: int, scale: np.ndarray | float = 1.0) -> list[np.ndarray]:
     """Seeded random configurations: about a radian, or `scale` metres for a slide, from neutral."""
-    rng = np.random.default_rng(20261122)
+    rng = Seeded(20261122)
     q0 = pin.neutral(model)
     return [pin.integrate(model, q0, scale * rng.normal(size=model.nv)) for _ in range(count)]
 

@@ -9,8 +9,10 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from pinmech.arguments import float_array
+from pinmech.arguments import all_finite, float_array
 from pinmech.exceptions import ModelError
+
+_FLOAT64 = np.dtype(np.float64)  # numpy's one instance of it (an `is` test: no conversion)
 
 #: A configuration's quaternions and (cos, sin) pairs must have a norm within this of 1
 #: (Pinocchio's own `isNormalized` precision): Pinocchio reads a quaternion of norm n as a
@@ -47,12 +49,12 @@ def checked_configuration(q: Any, nq: int, parts: list[tuple[str, int, int, str]
         ModelError: naming the argument and what it got (a non-unit quaternion: the
             joint and its norm).
     """
+    if not many and type(q) is np.ndarray and q.dtype is _FLOAT64 and q.shape == (nq,):
+        values = q.tolist()  # one pose (evaluate_motion, solve) as plain floats: no numpy call
+        if all_finite(values) and _unit_norms(values, parts):
+            return q
     out = float_array(q, name, (None, nq) if many else (nq,), source)
     rows = out if many else out[None]
-    if not many:  # one pose (evaluate_motion, solve): plain floats, a microsecond, not numpy's 30
-        values = out.tolist()
-        if all(abs(math.hypot(*values[start:stop]) - 1.0) <= UNIT_NORM_TOL for _, start, stop, _ in parts):
-            return out
     for joint, start, stop, what in parts:
         norms = np.sqrt(np.sum(rows[:, start:stop] ** 2, axis=1))
         bad = np.flatnonzero(~(np.abs(norms - 1.0) <= UNIT_NORM_TOL))
@@ -62,4 +64,12 @@ def checked_configuration(q: Any, nq: int, parts: list[tuple[str, int, int, str]
                              f"(within {UNIT_NORM_TOL:g}): normalise it (pinocchio.normalize(model, q)); "
                              "pinmech does not guess which rotation was meant", path=source)
     return out
+
+
+def _unit_norms(values: list[float], parts: list[tuple[str, int, int, str]]) -> bool:
+    """Whether every quaternion and (cos, sin) pair of one pose's `values` has unit norm."""
+    for _, start, stop, _ in parts:
+        if not abs(math.hypot(*values[start:stop]) - 1.0) <= UNIT_NORM_TOL:  # NaN fails too
+            return False
+    return True
 

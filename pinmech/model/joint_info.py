@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -37,6 +38,13 @@ class JointInfo:
     @property
     def is_angular(self) -> bool:
         return self.kind in ("revolute", "continuous")
+
+    def coordinate(self, q: Sequence[float]) -> float:
+        """Its coordinate in configuration q [rad or m] (a one-dof joint's; a continuous
+        joint's angle in (-pi, pi] from its (cos, sin) pair)."""
+        if self.kind == "continuous":
+            return math.atan2(q[self.idx_q + 1], q[self.idx_q])  # libm's atan2, as numpy's for one pair
+        return float(q[self.idx_q])
 
 
 

@@ -16,7 +16,6 @@ rows). Named points are massless leaf links hung on fixed joints.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -364,18 +363,15 @@ class Mechanism:
             ModelError: naming the argument and what it got (a non-unit quaternion: the
                 joint and its norm).
         """
-        parts = self.__dict__.get("_unit_parts")
-        if parts is None:  # the joints' types are fixed: found once
-            parts = self.__dict__["_unit_parts"] = unit_parts(self.model)
-        return checked_configuration(q, self.model.nq, parts, name, many, self.source)
+        known = self.__dict__.get("_unit_parts")
+        if known is None or known[0] is not self.model:  # a model's joint types are fixed: found once
+            known = self.__dict__["_unit_parts"] = (self.model, self.model.nq, unit_parts(self.model))
+        return checked_configuration(q, known[1], known[2], name, many, self.source)
 
     def coordinate(self, q: np.ndarray, name: str) -> float:
         """A one-dof joint's coordinate (angle in (-pi, pi] for a continuous joint)."""
         if name in self.mimics:
             m = self.mimics[name]
             return m.multiplier * self.coordinate(q, m.leader) + m.offset
-        j = self.joint(name)
-        if j.kind == "continuous":
-            return math.atan2(q[j.idx_q + 1], q[j.idx_q])  # libm's atan2, as numpy's for one pair
-        return float(q[j.idx_q])
+        return self.joint(name).coordinate(q)
 

@@ -20,6 +20,7 @@ import numpy as np
 import pinocchio as pin
 
 from pinmech.model.closure_core import closure_rows
+from pinmech.seeded import Seeded
 
 #: Singular values below this fraction of the largest count as zero (dimensionless rows).
 RANK_TOL = 1e-8
@@ -90,7 +91,7 @@ def constraint_rank(mech) -> RankReport:
     J0 = stacked_jacobian(mech, q0, scale)
     if _rank(J0) == rows:  # no pose has more than full rank: the neighbours below could not raise it
         return RankReport(rows, rows, q0)
-    rng = np.random.default_rng(20261122)
+    rng = Seeded(20261122)
     poses = [q0]
     null = _null_space(J0)
     for _ in range(_NEIGHBOURS):
@@ -102,7 +103,7 @@ def constraint_rank(mech) -> RankReport:
         if q is not None:
             poses.append(q)
     if len(poses) == 1:  # no neighbour closed: other closed poses, so one singular pose cannot decide
-        seeds = np.random.default_rng(11)
+        seeds = Seeded(11)
         for _ in range(4):
             start = pin.integrate(mech.model, q0, seeds.normal(size=mech.model.nv) * scale)
             q = close_least_squares(mech, start, scale=scale)
@@ -127,7 +128,7 @@ def constraint_rank(mech) -> RankReport:
 def _closed_start(mech, scale: np.ndarray) -> np.ndarray | None:
     """The reference configuration, closed; else a few seeded starts around it."""
     q = close_least_squares(mech, mech.neutral(), scale=scale)
-    rng = np.random.default_rng(7)
+    rng = Seeded(7)
     for _ in range(3):
         if q is not None:
             return q

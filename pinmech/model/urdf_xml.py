@@ -152,13 +152,16 @@ def _check_urdf_spelling(root: ET.Element, source: str) -> None:
     and masses are read from, that is a near miss of a URDF name (<orgin>, xzy=) is
     refused with the likely spelling; urdfdom would skip it in silence. Names far from
     these are left alone (URDF files carry extensions)."""
-    import difflib
 
     def near(name: str, known: tuple[str, ...]) -> str | None:
-        if name in known:
+        if name in known or not known:  # not known: an element whose attributes are not checked
             return None
         swapped = [k for k in known if sorted(k) == sorted(name)]  # xzy for xyz
-        match = swapped or difflib.get_close_matches(name, known, n=1, cutoff=0.7)
+        if swapped:
+            return swapped[0]
+        import difflib  # only for a name that is not a URDF one (a file without them does not load it)
+
+        match = difflib.get_close_matches(name, known, n=1, cutoff=0.7)
         return match[0] if match else None
 
     elements = [(j, "joint", f"<joint name=\"{j.get('name', '')}\">") for j in root.iter("joint")]

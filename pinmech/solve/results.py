@@ -3,14 +3,27 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
+
+_T = TypeVar("_T")
+_new, _set_attribute = object.__new__, object.__setattr__
 
 #: Machine epsilon of float64, the rounding of every number pinmech computes.
 EPS = float(np.finfo(float).eps)
 #: Constants of the position, velocity and acceleration bounds (`Accuracy.error_bounds`).
 BOUND_FACTORS = (4.0, 4.0, 16.0)
+
+
+def frozen(cls: type[_T], fields: dict[str, Any]) -> _T:
+    """An instance of the frozen dataclass `cls` holding `fields` (every field by name, in
+    its order): what `cls(**fields)` builds, without the generated __init__, which sets each
+    field through object.__setattr__ (about 0.1 us a field: most of a one-pose result's
+    cost). For classes without __post_init__; tests/test_pose_results.py checks each use."""
+    instance = _new(cls)
+    _set_attribute(instance, "__dict__", fields)
+    return instance
 
 
 @dataclass(frozen=True)
