@@ -168,6 +168,18 @@ def test_chain_condition_numbers_one_degree_apart_are_numpys():
     assert np.all(np.abs(got / want - 1.0) <= 1e-12), np.abs(got / want - 1.0).max()
 
 
+def test_a_sweeps_condition_numbers_do_not_depend_on_what_ran_before():
+    """The condition number's search starts from the previous pose's values within a call,
+    but every call from Python starts cold: the same sweep gives the same bits after an
+    unrelated one (a study's variants run in other orders on other workers and must give
+    the same numbers bit for bit). Exact equality: the same operations on the same inputs."""
+    _, solver = chain.chain_solver(16)
+    first = _conditions(solver, THETAS[:90])
+    _conditions(solver, THETAS[200:260])  # leaves other extreme singular values behind
+    again = _conditions(solver, THETAS[:90])
+    assert np.array_equal(first, again)
+
+
 def test_the_closed_form_moves_every_loop():
     """The drag-link proportions carry the motion to the last loop (no loop at rest), and
     every loop stays far from a toggle (transmission angle at least 29 degrees)."""

@@ -15,6 +15,9 @@ struct ConditionWork {
   Eigen::MatrixXd B;
   Eigen::VectorXd d, e, tmp, beta;  // B's diagonal and superdiagonal; squared Golub-Kahan off-diagonals
   double last_max = 0.0, last_min = 0.0;
+  // Forget the last values: each call from Python starts cold, so its numbers depend on
+  // its own arguments only (a study's variants give the same bits on any worker count).
+  void cold() { last_max = last_min = 0.0; }
 };
 
 // A's structural band: with A's rows and columns in the order `rows`, `cols` (empty: as

@@ -138,6 +138,7 @@ nb::tuple Core::follow(double p0, const VectorXd& q0, const VectorXd& d1, const 
                  double condition0, const VectorXd& x0, const VectorXd& d, double unit, const VectorXd& targets,
                  double max_condition) {
   check_structure();
+  condition_work_.cold();
   if (Index(dep_v_.size()) != rows_) throw std::invalid_argument("the dependent Jacobian must be square");
   const Index n = targets.size();
   RowMatrix Q(n, model_.nq), D1(n, model_.nv), D2(n, model_.nv);
@@ -185,6 +186,7 @@ void Core::set_pivots(const std::vector<int>& scalar) {
 // the condition number and the residuals (closure, velocity, acceleration).
 nb::tuple Core::node(const VectorXd& q, const VectorXd& d) {
   check_structure();
+  condition_work_.cold();
   if (q.size() != model_.nq || d.size() != Index(drv_v_.size())) throw std::invalid_argument("q or d of the wrong size");
   Node out;
   out.q = q;

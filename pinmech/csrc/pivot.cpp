@@ -82,6 +82,7 @@ bool Core::close(VectorXd& q, const VectorXd& drivers, int max_iterations, bool 
 
 nb::tuple Core::close_py(VectorXd q, const VectorXd& drivers, int max_iterations, bool polish_within) {
   check_structure();
+  condition_work_.cold();
   if (q.size() != model_.nq || drivers.size() != Index(drv_q_.size()))
     throw std::invalid_argument("q or the drivers of the wrong size");
   double residual = NAN;
@@ -91,6 +92,7 @@ nb::tuple Core::close_py(VectorXd q, const VectorXd& drivers, int max_iterations
 
 nb::tuple Core::rates_at(const VectorXd& q, const VectorXd& v_drv, const VectorXd& a_drv) {
   check_structure();
+  condition_work_.cold();
   if (q.size() != model_.nq || v_drv.size() != Index(drv_v_.size()) || a_drv.size() != v_drv.size())
     throw std::invalid_argument("q or the drivers' rates of the wrong size");
   if (Index(dep_v_.size()) != rows_) throw std::invalid_argument("the dependent Jacobian must be square");
@@ -411,6 +413,7 @@ nb::tuple Core::follow_path_py(double p0, const VectorXd& q0, const VectorXd& d1
                                const VectorXd& d, double unit, double p_target, bool through_folds,
                                const std::vector<int>& scalar) {
   check_structure();
+  condition_work_.cold();
   if (q0.size() != model_.nq || d1.size() != model_.nv || d2.size() != model_.nv ||
       d.size() != Index(drv_v_.size()) || x0.size() != d.size())
     throw std::invalid_argument("follow_path: arrays of the wrong size");
