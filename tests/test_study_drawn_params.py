@@ -135,3 +135,19 @@ def test_two_drawn_params_written_one_after_the_other_are_both_drawn():
     D = _left(C, O6, 0.095, 0.075)
     P = _left(C, D, 0.045, 0.065)  # the file's CP, DP
     np.testing.assert_allclose(StudyOutputs(sm).pose_values(cycle.q[0]), P, atol=1e-12)
+
+
+def test_a_driver_torque_over_drawn_params_with_masses_is_refused(tmp_path: Path):
+    """A drawn param redraws the joints, not the [masses] (here the coupler's centre of mass
+    `at` the joint A, which the crank param moves): the torque would be the nominal's masses
+    on the variant's geometry, a number that only looks right. It is one named error."""
+    linkages = STUDIES.parent / "linkages"
+    text = (linkages / "four_bar.toml").read_text(encoding="utf-8")
+    (tmp_path / "four_bar.toml").write_text(
+        text + '\n[masses]\ncoupler = { mass = "1 kg", at = "A", izz = "1e-3 kg*m^2" }\n', encoding="utf-8")
+    scene = (STUDIES.parent / "scenes" / "four_bar_drawn.toml").read_text(encoding="utf-8")
+    (tmp_path / "scene.toml").write_text(scene.replace("../linkages/four_bar.toml", "four_bar.toml"), encoding="utf-8")
+    raw = {"scene": "scene.toml", "kind": "sensitivity", "steps": 13, "params": {"crank": {"param": "crank"}},
+           "outputs": {"torque": ["O2"]}}
+    with pytest.raises(SceneError, match=r"outputs\.torque.*drawn params \(crank\).*\[masses\] \(coupler\)"):
+        StudyOutputs(StudyMechanism(parse_study(raw, tmp_path / "study.toml")))

@@ -136,6 +136,7 @@ def test_the_slider_crank_example_writes_a_linkage_the_engine_reproduces(tmp_pat
 INVERTED_PATH = ROOT / "models" / "synthesis" / "inverted_slider_crank_path.toml"
 INVERTED_FUNCTION = ROOT / "models" / "synthesis" / "inverted_slider_crank_function.toml"
 SLIDER_MOTION = ROOT / "models" / "synthesis" / "slider_crank_motion.toml"
+INVERTED_MOTION = ROOT / "models" / "synthesis" / "inverted_slider_crank_motion.toml"
 
 
 @pytest.mark.parametrize("example, old, new, key", [
@@ -145,7 +146,7 @@ SLIDER_MOTION = ROOT / "models" / "synthesis" / "slider_crank_motion.toml"
     (INVERTED_PATH, 'offset = ["-60 mm", "60 mm"]', 'rod = ["40 mm", "60 mm"]', "bounds.rod"),
     (INVERTED_PATH, 'crank = ["20 mm", "150 mm"]', 'crank = ["-20 mm", "150 mm"]', "bounds.crank"),
     (INVERTED_PATH, 'O4 = { x = ["0 mm", "120 mm"]', 'O4 = { x = ["0 mm"]', "bounds.O4.x"),
-    (INVERTED_PATH, 'task = "path"', 'task = "motion"', "task"),
+    (INVERTED_PATH, 'task = "path"', 'task = "motion"', "targets"),  # a motion takes poses
     (INVERTED_PATH, 'direction = "either"', 'grashof = "crank-rocker"', "constraints.grashof"),
     (INVERTED_PATH, '["-50.810 mm", "111.950 mm"]', '["-50.810 mm", "111.950 deg"]', "targets[0]"),
     (INVERTED_FUNCTION, 'ground = "50 mm"', 'ground = "0 mm"', "ground"),
@@ -159,6 +160,14 @@ SLIDER_MOTION = ROOT / "models" / "synthesis" / "slider_crank_motion.toml"
      "poses[1]"),
     (SLIDER_MOTION, 'keep = 2', 'keep = 2\ntargets = [["0 mm", "0 mm"]]', "targets"),
     (SLIDER_MOTION, 'rod = ["40 mm", "200 mm"]', 'rod = ["40 mm", "20 mm"]', "bounds.rod"),
+    (INVERTED_MOTION, '["-112.408 mm", "60.027 mm", "193.082 deg"]', '["-112.408 mm", "60.027 mm"]', "poses[1]"),
+    (INVERTED_MOTION, '["-112.408 mm", "60.027 mm", "193.082 deg"]', '["-112.408 mm", "60.027 mm", "193 mm"]',
+     "poses[1]"),
+    (INVERTED_MOTION, 'keep = 2', 'keep = 2\ntiming = ["0 deg", "1 deg", "2 deg", "3 deg", "4 deg", "5 deg"]',
+     "timing"),  # a path's
+    (INVERTED_MOTION, 'keep = 2', 'keep = 2\nlink = "block"', "link"),  # a six-bar's
+    (INVERTED_MOTION, 'offset = ["-60 mm", "60 mm"]', 'offset = ["60 mm", "-60 mm"]', "bounds.offset"),
+    (INVERTED_MOTION, 'point = { along', 'rod = ["1 mm", "2 mm"]\npoint = { along', "bounds.rod"),
 ])
 def test_a_bad_inverted_or_slider_motion_file_is_one_line_naming_file_and_key(tmp_path, capsys, example, old, new,
                                                                                 key):

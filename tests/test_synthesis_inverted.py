@@ -165,3 +165,48 @@ def test_targets_on_two_circuits_are_never_answered():
     assert not any(lk.meets(1e-4) for lk in result.linkages)
     assert sum(result.rejected.values()) > 0 and set(result.rejected) <= set(CAUSES)
     assert result.rejected["targets out of order"] > 0
+
+
+def _block_poses(crank_deg: np.ndarray, gamma: float) -> tuple[np.ndarray, np.ndarray]:
+    """The bundled R-RTR's block (crank 100 mm about (0, 0), slot through the guide's pivot
+    (50 mm, 0)) in closed form: the slot's direction u from the pivot to the crank's pin A,
+    the block's point 30 mm along u and 20 mm to its left of A [m], and the part's angle,
+    u's plus gamma [rad]."""
+    theta = np.radians(crank_deg)
+    A = 0.1 * np.stack((np.cos(theta), np.sin(theta)), -1)
+    u = (A - [0.05, 0.0]) / np.linalg.norm(A - [0.05, 0.0], axis=1)[:, None]
+    return A + 0.03 * u + 0.02 * np.stack((-u[:, 1], u[:, 0]), -1), np.arctan2(u[:, 1], u[:, 0]) + gamma
+
+
+def test_motion_synthesis_recovers_the_bundled_inverted_slider_crank(tmp_path):
+    # Six poses of the block (its point's place and a part's angle 40 deg from the slot)
+    # at crank 100..300 deg, from the closed form above (a slot through the pivot: u along
+    # O4 -> A), at full precision; the linkage hidden, the part's angle from the slot
+    # searched too. The search meets the places within 1e-8 of the linkage's size (100 mm)
+    # and the angles within 1e-8 rad, and it is the hidden linkage (1e-8 of its size: six
+    # poses fix the eight dimensions and gamma); the engine, sweeping the written drawn
+    # linkage, reports the block's point and angle (its frame's x axis is the slot's
+    # direction) as closely. About 5 s here.
+    places, angles = _block_poses(np.arange(100.0, 340.0, 40.0), math.radians(40.0))
+    spec = SynthesisSpec(Path("test.toml"), "test", "motion", TOPOLOGY, places, None, LOWER, UPPER,
+                         seed=1, population=15, generations=400, keep=1, angles=angles)
+    best = synthesise(spec).linkages[0]
+    assert best.topology == TOPOLOGY and best.task == "motion" and best.meets(1e-8)
+    np.testing.assert_allclose(best.z, [0, 0, 0.05, 0, 0.1, 0, 0.03, 0.02], atol=1e-8 * 0.1)
+    assert abs(best.phi0 - math.radians(40.0)) <= 1e-8
+    _, scene = write_linkage(best, tmp_path / "found", "found", "test.toml")
+    check = engine_check(scene, best, places, angles)
+    assert check.errors.max() <= 1e-8 * best.size and check.angle_errors.max() <= 1e-8
+
+
+def test_the_bundled_inverted_motion_file_holds_poses_of_the_closed_form():
+    # models/synthesis/inverted_slider_crank_motion.toml: its six poses are the bundled
+    # R-RTR block's at crank 100..300 deg, the part 40 deg from the slot, within their
+    # rounding (0.5 um and 0.5e-3 deg).
+    from pinmech.design.synthesis_file import load_synthesis
+
+    spec = load_synthesis(ROOT / "models" / "synthesis" / "inverted_slider_crank_motion.toml")
+    places, angles = _block_poses(np.arange(100.0, 340.0, 40.0), math.radians(40.0))
+    assert spec.task == "motion" and spec.topology == TOPOLOGY
+    assert np.max(np.abs(spec.targets - places)) <= 0.5e-6 + 1e-15
+    assert np.max(np.abs(np.mod(spec.angles - angles + math.pi, 2 * math.pi) - math.pi)) <= math.radians(0.5e-3) + 1e-15

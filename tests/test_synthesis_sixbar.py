@@ -214,7 +214,7 @@ def test_same_seed_gives_the_same_six_bar_on_one_and_two_dask_workers():
     ({"constraints": {"transmission": "20 deg"}}, "constraints.transmission"),
     ({"constraints": {"pins": ["Z"]}}, "constraints.pins"),
     ({"constraints": {"grashof": "crank-rocker"}}, "constraints"),
-    ({"task": "motion"}, "task"),
+    ({"task": "motion"}, "targets"),  # a motion takes poses
     ({"output": "link6"}, "output"),
 ])
 def test_every_bad_key_of_a_six_bar_file_is_named(change, key):

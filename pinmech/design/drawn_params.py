@@ -1,10 +1,11 @@
 """A drawn linkage's `[params]` as study parameters (`param = "crank"` in a study file).
 
-A variant is the linkage redrawn with the changed lengths (`LinkageSpec.with_params`,
-`linkage_from_spec`, `linkage_mechanism`: the compass and polar constructions move other
-drawn points and turn the frames built from them) and its model's joint and frame
-placements, rotations included, copied into the study's `pin.Model` in place (matched by
-name; frames the scene adds, such as its own [points], keep theirs in their links).
+A variant is the linkage's points redrawn with the changed lengths (`linkage_from_spec`
+with the values: the compass and polar constructions move other drawn points and turn the
+frames built from them) and its joint and frame placements, rotations included, computed
+from them (model/linkage_placements.py) and written into the study's `pin.Model` in place;
+no URDF is written and no model built (frames the scene adds, such as its own [points],
+keep theirs in their links).
 
 The exact sensitivity needs the drawing's derivative: the placements at p +- STEP (the
 drawing is a closed-form construction, smooth away from a compass that cannot close) are
@@ -13,14 +14,9 @@ velocity rows' and frames' velocities at fixed q and v, rate_sensitivity.py) are
 central differences over those two drawings; sensitivity.py composes them exactly with the
 implicit-function theorem. Truncation (STEP / L)^2 ~ 1e-10 of a 0.1 m linkage, rounding
 1e-16 L / STEP ~ 1e-11: far below the 1e-7 the tests hold them to.
-
-Each redrawing writes its URDF through the user's cache folder (linkage_model.py); a
-variant's is removed once loaded, the scene's own is kept.
 """
 
 from __future__ import annotations
-
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -47,6 +43,7 @@ class Drawing:
         for name, value in self.spec.params.items():  # in the order written: expressions use earlier ones
             self.values[name] = length(value, self.values, self.source, f"[params] {name}")
         self._drawn: dict[tuple, list] = {}
+        self._placed = None  # the placements' rules (model/linkage_placements.py), at the first drawing
 
     def placements(self, values: dict[str, float]) -> list[tuple[str, int, pin.SE3]]:
         """The placements the linkage draws with these params: (kind, index in the study's
@@ -72,27 +69,18 @@ class Drawing:
 
     def _draw(self, values: dict[str, float]) -> list[tuple[str, int, pin.SE3]]:
         from pinmech.model.linkage import linkage_from_spec
-        from pinmech.model.linkage_model import linkage_mechanism
 
-        changed = {n: v for n, v in values.items() if v != self.values.get(n)} or values  # for the message
         try:  # every value given: the spec holds the file's, not the last drawing's
-            mech = linkage_mechanism(linkage_from_spec(self.spec.with_params(**values), self.source))
-            drawn = mech.model
-            if mech.urdf_path != self.urdf_path:  # a variant's URDF: not left in the user's cache folder
-                Path(mech.urdf_path).unlink(missing_ok=True)
+            linkage = linkage_from_spec(self.spec, self.source, values)
+            if self._placed is None:  # the rules checked once against the loaded model
+                from pinmech.model.linkage_placements import DrawnPlacements
+
+                self._placed = DrawnPlacements(linkage_from_spec(self.spec, self.source, self.values), self.model)
+            return self._placed.placements(linkage)
         except ModelError as exc:
+            changed = {n: v for n, v in values.items() if v != self.values.get(n)} or values
             shown = ", ".join(f"{n} = {v * 1e3:.6g} mm" for n, v in changed.items())
             raise ModelError(f"the linkage cannot be drawn with {shown}: {exc}", path=self.source) from exc
-        model, out = self.model, []
-        if drawn.njoints != model.njoints or list(drawn.names) != list(model.names):
-            raise ModelError(f"redrawn with {changed} the linkage has other joints ({list(drawn.names)})",
-                             path=self.source)
-        out += [("joint", j, drawn.jointPlacements[j].copy()) for j in range(1, drawn.njoints)]
-        index = {(f.name, f.type): i for i, f in enumerate(model.frames)}
-        for f in drawn.frames:
-            if (f.name, f.type) in index:
-                out.append(("frame", index[(f.name, f.type)], f.placement.copy()))
-        return out
 
 
 class DrawnPlacement:

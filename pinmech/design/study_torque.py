@@ -36,6 +36,7 @@ class DriverTorques:
         self.kinds = ["force" if p else "torque" for p in prismatic]
         self._solver = None
         if drivers:
+            _refuse_redrawn_masses(sm, spec)
             try:
                 self._solver = force_solver(sm.scene, sm.mechanism, tuple(solver.drivers), force_settings(sm.scene))
             except PinmechError as exc:
@@ -48,3 +49,16 @@ class DriverTorques:
             return np.zeros((len(q), 0))
         self._solver.read_placements()  # the variant's dimensions, written in the user's model
         return np.array([self._solver.solve(qi, vi, ai).effort[self.columns] for qi, vi, ai in zip(q, v, a)])
+
+
+def _refuse_redrawn_masses(sm, spec) -> None:
+    """A drawn param redraws the joints but not the [masses] (a centre of mass `at` a joint,
+    an inertia written with params): the torque would be the nominal's masses on the
+    variant's geometry. Refused by name rather than answered."""
+    drawn = [place for place in sm.placements if getattr(place, "drawn", False)]
+    masses = sorted(drawn[0].drawing.spec.masses) if drawn else []
+    if masses:
+        raise SceneError(f"a driver torque with drawn params ({', '.join(p.name for p in drawn)}) is not "
+                         f"computed: the links' [masses] ({', '.join(masses)}) are not redrawn with the joints; "
+                         "vary the scene's joint or point placements instead, or leave out the torque",
+                         path=str(spec.path), key="outputs.torque")

@@ -59,7 +59,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
                 from pinmech.design import synthesis_sixbar_output as six
 
                 files = six.write_linkage(spec, lk, f"{args.out}_{i}")
-                check = EngineCheck(None, six.engine_check(spec, files[1], lk))
+                check = EngineCheck(None, *six.engine_check(spec, files[1], lk))
             else:
                 files = write_linkage(lk, f"{args.out}_{i}", f"{spec.title}: linkage {i}", str(spec.path))
                 check = engine_check(files[1], lk, spec.targets, spec.angles)

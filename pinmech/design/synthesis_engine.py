@@ -41,15 +41,17 @@ class EngineTemplate:
 
     Attributes:
         sm: the StudyMechanism of the scene with the free params as drawn study params.
-        outputs: the coupler point's x, y (path) or the output link's angle (function),
-            then the transmission angle of each dyad in spec.pins.
+        outputs: the coupler point's x, y (path), the output link's angle (function), or
+            the point's x, y and its link's angle (motion), then the transmission angle of
+            each dyad in spec.pins.
         start, stop: the crank's range [rad]: the template scene's [sweep] from .. to, else
             one turn from its driver's value (full: a whole turn).
         grid: the crank's values over the range [rad], GRID + 1 of them (poses: distinct).
     """
 
     def __init__(self, spec: SynthesisSpec) -> None:
-        shown = {"points": [spec.point]} if spec.task == "path" else {"links": [spec.output]}
+        shown = {"path": {"points": [spec.point]}, "function": {"links": [spec.output]},
+                 "motion": {"points": [spec.point], "links": [spec.output]}}[spec.task]
         if spec.pins:
             shown["transmission"] = list(spec.pins)
         raw = {"scene": str(spec.scene.resolve()), "kind": "sensitivity", "steps": 2,
@@ -69,7 +71,7 @@ class EngineTemplate:
         self.full = math.isclose(self.stop - self.start, 2 * math.pi, abs_tol=1e-12)
         self.grid = np.linspace(self.start, self.stop, GRID + 1)
         self.poses = GRID if self.full else GRID + 1  # distinct poses of the grid (a full turn's ends are one)
-        self.width = 2 if spec.task == "path" else 1  # the point's x, y or the link's angle
+        self.width = {"path": 2, "function": 1, "motion": 3}[spec.task]  # P's x, y; the link's angle; both
 
     def write(self, p: np.ndarray) -> str:
         """Draw the linkage with the free params p [m] and write it into the model: "" or
@@ -100,8 +102,8 @@ class EngineTemplate:
         return value if self.full else np.where(value <= self.stop, value, np.nan)
 
     def values(self, Q: np.ndarray) -> np.ndarray:
-        """The outputs (n, width + len(pins)) at the poses Q: P's x, y [m] or the link's
-        angle [rad], then the transmission angles [rad]."""
+        """The outputs (n, width + len(pins)) at the poses Q: P's x, y [m] (path), the link's
+        angle [rad] (function), or both (motion), then the transmission angles [rad]."""
         zero = np.zeros((len(Q), self.sm.model.nv))
         return self.outputs.cycle(Q, zero, zero)
 

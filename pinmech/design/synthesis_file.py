@@ -62,7 +62,7 @@ CLASSES = ("any", "grashof", "crank-rocker", "double-crank", "double-rocker", "t
 SLIDER_CLASSES = ("any", "crank", "rocker")  # grashof.slider_crank_class: the crank turns fully, or not
 DIRECTIONS = ("ccw", "cw", "either")
 _TOP = {"title", "task", "topology", "targets", "timing", "seed", "population", "generations", "keep",
-        "bounds", "constraints", "pairs", "ground", "poses", "scene", "point", "output"}
+        "bounds", "constraints", "pairs", "ground", "poses", "scene", "point", "output", "link"}
 _ONLY = {"targets": "path", "timing": "path", "pairs": "function", "ground": "function", "poses": "motion"}
 #: Each (topology, task)'s bounds: the parameters in the order of a candidate's row, each
 #: with its axes (none: a length, positive unless it is an offset); "angle" axes are angles.
@@ -102,8 +102,9 @@ class SynthesisSpec:
         direction: the crank's turn from target to target: "ccw", "cw" or "either".
         scene: a six-bar's template, a scene whose drawn linkage has [params]; free: the
             params the search varies (lower, upper: their bounds [m]); point: the coupler
-            point of a path; output: the link whose turns a function gives; pins: the
-            dyads' middle pins whose transmission angle is bounded.
+            point of a path or a motion; output: the link whose turns a function gives, or
+            the link a motion's poses carry (the file's `link`); pins: the dyads' middle
+            pins whose transmission angle is bounded.
     """
 
     path: Path
@@ -146,17 +147,15 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
     task = w.choice(raw, "task", TASKS, None)
     topology = w.choice(raw, "topology", TOPOLOGIES, "four-bar")
     for key, only in _ONLY.items():
-        if key in raw and task != only:
+        timed_motion = key == "timing" and task == "motion" and topology in SIX_BARS  # a six-bar's poses may be timed
+        if key in raw and task != only and not timed_motion:
             raise w.error(key, f"{key} is for task = \"{only}\" (this file's task is {task!r})")
     if topology in SIX_BARS:
         return _six_bar(raw, w, path, task, topology)
-    for key in ("scene", "point", "output"):
+    for key in ("scene", "point", "output", "link"):
         if key in raw:
             raise w.error(key, f"{key} is for the six-bars (topology = \"watt\" or \"stephenson\")")
     slider = topology == "slider-crank"
-    if topology == "inverted-slider-crank" and task == "motion":
-        raise w.error("task", "motion generation is for the four-bar and the slider-crank (an inverted "
-                      "slider-crank's block through poses is not there yet): use task = \"path\" or \"function\"")
     if task == "function":
         targets, timing = _pairs(raw, w, "length" if slider else "angle"), None
         lower, upper = _bounds(raw, w, _BOUNDS[topology, "function"])
@@ -199,10 +198,9 @@ def _six_bar(raw: dict[str, Any], w: _Where, path: Path, task: str, topology: st
     from pinmech.io.scene import Scene
     from pinmech.model.linkage_spec import read_linkage_spec
 
-    if task == "motion":
-        raise w.error("task", f"motion generation is for the four-bar only; a {topology} six-bar does "
-                      "task = \"path\" or \"function\"")
-    for key in ("ground", "point" if task == "function" else "output"):
+    unread = {"path": ("ground", "output", "link"), "function": ("ground", "point", "link"),
+              "motion": ("ground", "output")}[task]
+    for key in unread:
         if key in raw:
             raise w.error(key, f"{key} is not read by a {topology} six-bar's {task} task: remove it")
     if not isinstance(raw.get("scene"), str):
@@ -220,11 +218,12 @@ def _six_bar(raw: dict[str, Any], w: _Where, path: Path, task: str, topology: st
     except PinmechError as exc:
         raise w.error("scene", f"{raw['scene']}'s linkage cannot be read: {exc}") from exc
     name, kind = ("output", "link") if task == "function" else ("point", "joint")
-    named = raw.get(name, "P" if task == "path" else None)
+    named = raw.get(name, None if task == "function" else "P")
     known = linkage.links if task == "function" else linkage.joints
     if named not in known:
         raise w.error(name, f"{name} = {named!r} is not a {kind} of {raw['scene']}'s linkage "
                       f"(its {kind}s: {', '.join(known)})")
+    carried = _carried(raw, w, linkage, named) if task == "motion" else ""
     table = raw.get("bounds")
     w.known(table, set(linkage.params), "bounds")
     if not table:
@@ -240,11 +239,14 @@ def _six_bar(raw: dict[str, Any], w: _Where, path: Path, task: str, topology: st
     if not 0 <= transmission < math.pi / 2 or (transmission > 0 and not pins):
         raise w.error("constraints.transmission", f"transmission = {c.get('transmission')!r} must be from 0 to 90 deg, "
                       "with pins = [...] naming the dyads it bounds")
+    angles = None
     if task == "function":
         targets, timing = _pairs(raw, w), None
     else:
-        targets = _targets(raw, w)
+        targets = _targets(raw, w, "poses" if task == "motion" else "targets")
         timing = _timing(raw, w, len(targets)) if "timing" in raw else None
+        if task == "motion":
+            targets, angles = targets[:, :2].copy(), targets[:, 2].copy()
     direction = w.choice(c, "direction", DIRECTIONS, "either", "constraints")
     turns = timing if timing is not None else targets[:, 0] if task == "function" else None
     if turns is not None and direction != "either" and (turns[-1] > 0) != (direction == "ccw"):
@@ -253,8 +255,21 @@ def _six_bar(raw: dict[str, Any], w: _Where, path: Path, task: str, topology: st
     counts = {k: w.whole(raw, k, d) for k, d in (("seed", 0), ("population", 20), ("generations", 400), ("keep", 3))}
     return SynthesisSpec(path, str(raw.get("title", path.stem)), task, topology, targets, timing, lower, upper,
                          transmission=transmission, direction=direction, scene=scene_path, free=tuple(table),
-                         point=named if task == "path" else "", output=named if task == "function" else "",
-                         pins=tuple(pins), **counts)
+                         point=named if task != "function" else "", output=named if task == "function" else carried,
+                         pins=tuple(pins), angles=angles, **counts)
+
+
+def _carried(raw: dict[str, Any], w: _Where, linkage, point: str) -> str:
+    """A six-bar motion's `link`: the link the poses carry, one that holds the point."""
+    link = raw.get("link")
+    if link not in linkage.links:
+        raise w.error("link", f"link = {link!r} is not a link of the scene's linkage: give the link the poses "
+                      f"carry (its angle is its x axis, from its first joint to the next; its links: "
+                      f"{', '.join(linkage.links)})")
+    if point not in linkage.links[link]:
+        raise w.error("link", f"link = {link!r} does not carry the point {point!r} (it holds "
+                      f"{', '.join(linkage.links[link])}): a pose is a place and an angle of one link")
+    return link
 
 
 def _targets(raw: dict[str, Any], w: _Where, key: str = "targets") -> np.ndarray:

@@ -45,7 +45,7 @@ def linkage_toml(lk: Linkage, title: str, source: str) -> str:
     if lk.topology == "inverted-slider-crank":
         from pinmech.design.synthesis_inverted_write import inverted_tables
 
-        what = what.replace("rocker", "guide")
+        what = what.replace("rocker", "guide").replace("coupler", "block")
         header = (f"Synthesised by `pinmech synth {source}`: {what}.\n"
                   f"Drawn at the first target's pose (crank O2 at {math.degrees(lk.theta[0]):.6g} deg from x).")
         return written(linkage_spec(inverted_tables(lk, title), source), header)
@@ -89,7 +89,8 @@ def scene_toml(lk: Linkage, linkage_file: str, title: str) -> str:
         shown = {"path": "points = [\"B\", \"P\"]", "motion": "points = [\"B\", \"P\"]\nlinks = [\"rod\"]",
                  "function": "points = [\"B\"]"}[lk.task]
     if lk.topology == "inverted-slider-crank":
-        shown = "points = [\"A\", \"P\"]" if lk.task == "path" else "links = [\"guide\"]"
+        shown = {"path": "points = [\"A\", \"P\"]", "motion": "points = [\"A\", \"P\"]\nlinks = [\"block\"]",
+                 "function": "links = [\"guide\"]"}[lk.task]
     return "\n".join([
         "# The synthesised linkage swept through its targets:",
         "#   pinmech sweep THIS_FILE --plot fig.png",
@@ -154,7 +155,7 @@ def engine_check(scene_file: str | Path, lk: Linkage, targets: np.ndarray,
         P = np.array([m.points["P"].position[:2] for m in poses])
         if lk.task == "path":
             return EngineCheck(P, np.linalg.norm(P - targets, axis=1))
-        coupler = "rod" if lk.topology == "slider-crank" else "coupler"
+        coupler = {"slider-crank": "rod", "inverted-slider-crank": "block"}.get(lk.topology, "coupler")
         turn = np.array([m.links[coupler].angle for m in poses]) + lk.phi0 - angles
         return EngineCheck(P, np.linalg.norm(P - targets, axis=1), np.abs(np.mod(turn + math.pi, 2 * math.pi) - math.pi))
     if lk.topology == "slider-crank":  # the block's place along the slide from H, against the travel asked

@@ -63,21 +63,32 @@ def path_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
     return [*zip(spec.lower.tolist(), spec.upper.tolist()), *timed]
 
 
+def carried_angle(topology: str, p, z: np.ndarray, s: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """The angle [rad] (n, m) of the link a motion carries, at the pose p of candidates z on
+    assemblies s at crank angles theta (n, m): the bar A -> B (the four-bar's coupler, the
+    slider-crank's rod), or the block's slot direction u (the inverted slider-crank's
+    block, which turns with its guide)."""
+    if topology == "inverted-slider-crank":
+        return kinematics(topology).guide_angle(z, s, theta)
+    return np.arctan2(p.B[..., 1] - p.A[..., 1], p.B[..., 0] - p.A[..., 0])
+
+
 def nearest_angles(z: np.ndarray, s: np.ndarray, targets: np.ndarray, angles: np.ndarray | None = None,
                    gamma: np.ndarray | None = None, topology: str = "four-bar") -> np.ndarray:
     """Each target's crank angle (n, N) [rad] where the coupler curve on assembly s passes
     nearest it (NaN if the dyad closes nowhere). With the poses' angles (N,) [rad] and the
     candidates' offsets gamma (n,) [rad], nearest in pose: |P - T|^2 + S^2 |e(phi3 + gamma)
-    - e(angle)|^2 (phi3 the direction A -> B, S the targets' extent)."""
+    - e(angle)|^2 (phi3 the carried link's angle, carried_angle; S the targets' extent)."""
     step = 2 * math.pi / SAMPLES
     grid = np.arange(SAMPLES) * step
-    p = kinematics(topology).pose(z, s, np.broadcast_to(grid, (len(z), SAMPLES)))
+    thetas = np.broadcast_to(grid, (len(z), SAMPLES))
+    p = kinematics(topology).pose(z, s, thetas)
     P = p.P  # (n, M, 2)
     dx = P[:, None, :, 0] - targets[None, :, None, 0]
     dy = P[:, None, :, 1] - targets[None, :, None, 1]
     d2 = dx * dx + dy * dy  # (n, N, M)
     if angles is not None:
-        phi = np.arctan2(p.B[..., 1] - p.A[..., 1], p.B[..., 0] - p.A[..., 0])  # (n, M)
+        phi = carried_angle(topology, p, z, s, thetas)  # (n, M)
         turn = phi[:, None, :] + gamma[:, None, None] - angles[None, :, None]
         d2 = d2 + 2 * extent(targets) ** 2 * (1 - np.cos(turn))
     d2 = np.where(np.isnan(d2), np.inf, d2)

@@ -1,8 +1,11 @@
-"""Motion generation of a four-bar or a slider-crank: the coupler (the rod) through N
-poses, its point P at each target place and its angle at each target angle, in order.
+"""Motion generation of a four-bar, a slider-crank or an inverted slider-crank: the
+coupler (the rod; the block) through N poses, its point P at each target place and its
+angle at each target angle, in order.
 
 A search row x = (z, gamma): the linkage (synthesis_fourbar.NAMES, 9; synthesis_slider.NAMES,
-8) and the angle gamma [rad] from the bar A -> B to the line the poses' angles are measured on. Each pose's
+8; synthesis_inverted.NAMES, 8) and the angle gamma [rad] from the carried link's angle (the
+bar A -> B; the block's slot direction u, synthesis_objective.carried_angle) to the line the
+poses' angles are measured on. Each pose's
 crank angle is where the coupler comes nearest the pose (synthesis_objective.nearest_angles
 with the angles); the objective is sum_i |P - T_i|^2 / S^2 + (1 - cos(phi3 + gamma -
 angle_i)) * 2; defects and constraints as for paths. Refinement: least squares on the
@@ -19,7 +22,7 @@ from pinmech.design.synthesis_file import SynthesisSpec
 from pinmech.design.synthesis_fourbar import link_angle_jacobian
 from pinmech.design.synthesis_kinematics import kinematics
 from pinmech.design.synthesis_motion import causes, grashof_label, progress, transmission_range
-from pinmech.design.synthesis_objective import BatchValues, batch_values, extent, nearest_angles
+from pinmech.design.synthesis_objective import BatchValues, batch_values, carried_angle, extent, nearest_angles
 from pinmech.design.synthesis_refine import refine
 from pinmech.design.synthesis_result import Linkage
 
@@ -33,10 +36,6 @@ def _turn(angle: np.ndarray) -> np.ndarray:
     return np.mod(angle + math.pi, 2 * math.pi) - math.pi
 
 
-def _coupler_angle(p) -> np.ndarray:
-    return np.arctan2(p.B[..., 1] - p.A[..., 1], p.B[..., 0] - p.A[..., 0])
-
-
 def evaluate_poses(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchValues:
     """The objective of rows x (n, width + 1) on one assembly, row by row."""
     x = np.atleast_2d(np.asarray(x, dtype=float))
@@ -44,9 +43,10 @@ def evaluate_poses(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Batch
     z, gamma = x[:, :w], x[:, w]
     s = np.full(len(z), float(assembly))
     theta = nearest_angles(z, s, spec.targets, spec.angles, gamma, spec.topology)
-    p = kinematics(spec.topology).pose(z, s, np.nan_to_num(theta))
+    at = np.nan_to_num(theta)
+    p = kinematics(spec.topology).pose(z, s, at)
     d2 = ((p.P - spec.targets[None]) ** 2).sum(-1) / extent(spec.targets) ** 2
-    d2 = d2 + 2 * (1 - np.cos(_coupler_angle(p) + gamma[:, None] - spec.angles[None]))
+    d2 = d2 + 2 * (1 - np.cos(carried_angle(spec.topology, p, z, s, at) + gamma[:, None] - spec.angles[None]))
     found = causes(spec, z, s, np.nan_to_num(theta))
     return batch_values(found, d2, theta)
 
@@ -59,8 +59,10 @@ def refined_poses(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage | No
     v0 = np.concatenate((x, theta))
 
     def residual(v: np.ndarray) -> np.ndarray:
-        p = k.pose(v[None, :w], np.array([s0]), v[None, w + 1:])
-        r = np.concatenate((((p.P[0] - spec.targets) / S).ravel(), _turn(_coupler_angle(p)[0] + v[w] - spec.angles)))
+        z, s, th = v[None, :w], np.array([s0]), v[None, w + 1:]
+        p = k.pose(z, s, th)
+        phi = carried_angle(spec.topology, p, z, s, th)[0]
+        r = np.concatenate((((p.P[0] - spec.targets) / S).ravel(), _turn(phi + v[w] - spec.angles)))
         return np.where(np.isfinite(r), r, 1.0)
 
     def jacobian(v: np.ndarray) -> np.ndarray:
@@ -80,9 +82,14 @@ def refined_poses(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage | No
 
 
 def _coupler_jacobian(topology: str, z: np.ndarray, s: float, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """d(the bar A -> B's angle)/dz (m, width) [rad/m] and /dtheta (m,): the four-bar's
-    coupler (synthesis_fourbar.link_angle_jacobian) or the slider-crank's rod
-    (synthesis_slider.loop_jacobian's first row)."""
+    """d(the carried link's angle)/dz (m, width) [rad/m] and /dtheta (m,): the four-bar's
+    coupler (synthesis_fourbar.link_angle_jacobian), the slider-crank's rod
+    (synthesis_slider.loop_jacobian's first row) or the inverted slider-crank's block, which
+    turns with its guide (synthesis_inverted.guide_jacobian)."""
+    if topology == "inverted-slider-crank":
+        from pinmech.design.synthesis_inverted import guide_jacobian
+
+        return guide_jacobian(z, s, theta)[1:]
     if topology == "slider-crank":
         from pinmech.design.synthesis_slider import loop_jacobian
 
@@ -99,7 +106,7 @@ def _linkage(spec: SynthesisSpec, v: np.ndarray, s: float) -> Linkage | None:
         return None
     p = kinematics(spec.topology).pose(Z, S, T)
     errors = np.linalg.norm(p.P[0] - spec.targets, axis=1)
-    turns = np.abs(_turn(_coupler_angle(p)[0] + gamma - spec.angles))
+    turns = np.abs(_turn(carried_angle(spec.topology, p, Z, S, T)[0] + gamma - spec.angles))
     if not (np.all(np.isfinite(errors)) and np.all(np.isfinite(turns))):
         return None
     way, span = progress(T, spec.direction)

@@ -12,6 +12,7 @@ import numpy as np
 from pinmech.design.figure_file import pyplot, save
 from pinmech.design.synthesis_kinematics import kinematics
 from pinmech.design.synthesis_linkage import motion_values
+from pinmech.design.synthesis_objective import carried_angle
 from pinmech.design.synthesis_result import Linkage, SynthesisResult
 
 DEFECTS = {
@@ -114,12 +115,19 @@ def _dimensions(lk: dict) -> str:
             f"rocker {d['rocker']:.6g} mm, P at {d['along']:.6g} along and {d['across']:.6g} across A->B")
 
 
+def _carried(lk: dict) -> str:
+    """What a motion's gamma is measured from: the carried link's angle."""
+    if "params_mm" in lk:
+        return "the link"
+    return "the slot" if lk["topology"] == "inverted-slider-crank" else "A->B"
+
+
 def _errors(lk: dict) -> str:
     if "angle_errors_deg" in lk:
         return (f"  error at each pose [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
                 f"(max {lk['max_error_relative']:.3g} of its size); [deg]: "
-                f"{', '.join(f'{e:.3g}' for e in lk['angle_errors_deg'])} (the poses' angle is A->B's + "
-                f"{lk['offset_deg']:.6g} deg)")
+                f"{', '.join(f'{e:.3g}' for e in lk['angle_errors_deg'])} (the poses' angle is "
+                f"{_carried(lk)}'s + {lk['offset_deg']:.6g} deg)")
     if "slider_start_mm" in lk:
         return (f"  slider travel error at each pair [mm]: {', '.join(f'{e:.3g}' for e in lk['errors_mm'])} "
                 f"(max {lk['max_error_relative']:.3g} of its size; block at {lk['slider_start_mm']:.6g} mm along the "
@@ -186,7 +194,7 @@ def figure(result: SynthesisResult, path: str | Path) -> Path:
             ax.quiver(T[:, 0], T[:, 1], np.cos(a), np.sin(a), color="tab:red", angles="xy", scale_units="xy",
                       scale=1 / L, width=0.006, label="pose angles")
             q = pose(lk.z[None], s, lk.theta[None])
-            c = np.arctan2(q.B[0, :, 1] - q.A[0, :, 1], q.B[0, :, 0] - q.A[0, :, 0]) + lk.phi0
+            c = carried_angle(lk.topology, q, lk.z[None], s, lk.theta[None])[0] + lk.phi0
             ax.quiver(q.P[0, :, 0] * 1e3, q.P[0, :, 1] * 1e3, np.cos(c), np.sin(c), color="tab:blue",
                       angles="xy", scale_units="xy", scale=1 / L, width=0.003, label="coupler at the poses")
         for k, t in enumerate(T, start=1):

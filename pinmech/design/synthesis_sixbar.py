@@ -1,9 +1,13 @@
 """Watt and Stephenson six-bar synthesis on the engine (synthesis_engine.py): path
-generation (a coupler point of the last dyad through the targets, with or without timing)
-and function generation (the output link's turns against the crank's).
+generation (a coupler point of the last dyad through the targets, with or without timing),
+function generation (the output link's turns against the crank's) and motion generation
+(a link through poses: its point's place and its angle, with or without timing).
 
-A search row is x = (p[, theta0]): the free params p [m] (spec.free), and with timing (or
-for a function) the crank's value theta0 at the first target [rad]. Each candidate is
+A search row is x = (p[, theta0][, gamma]): the free params p [m] (spec.free), with timing
+(or for a function) the crank's value theta0 at the first target [rad], and for a motion
+the angle gamma from the link's x axis to the poses' line [rad]. A motion's objective is
+the four-bar motion's (synthesis_poses.py): sum |P - T_i|^2 / S^2 + 2 (1 - cos(phi + gamma
+- angle_i)), S the targets' extent, so an angle error e counts as a place error S e. Each candidate is
 drawn, written into the model and followed by the compiled core over the crank's range (a
 whole turn unless the template scene's [sweep] gives from .. to), on that one assembly (a fold, a change point or another assembly
 at the start is its cause of rejection). Then, along that one continuation:
@@ -50,8 +54,15 @@ def _turns(spec: SynthesisSpec) -> np.ndarray:
 
 
 def sixbar_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
-    """The bounds of a search row: the free params', and theta0's when timed."""
-    return [*zip(spec.lower.tolist(), spec.upper.tolist()), *([(-math.pi, math.pi)] if _timed(spec) else [])]
+    """The bounds of a search row: the free params', theta0's when timed, gamma's for a motion."""
+    turn = [(-math.pi, math.pi)]
+    return [*zip(spec.lower.tolist(), spec.upper.tolist()), *(turn if _timed(spec) else []),
+            *(turn if spec.task == "motion" else [])]
+
+
+def _gamma(spec: SynthesisSpec, x: np.ndarray) -> float:
+    """A motion row's gamma (its last column) [rad]; 0 for the other tasks."""
+    return float(x[-1]) if spec.task == "motion" else 0.0
 
 
 def evaluate_sixbar(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchValues:
@@ -74,22 +85,22 @@ def _row(spec: SynthesisSpec, t: EngineTemplate, x: np.ndarray) -> tuple[float, 
         if cause:
             return REJECTED, cause, none
         Y = t.values(Q)
-        theta, err2 = _nearest(t.grid[:t.poses], Y[:t.poses, :2], spec.targets, t.full)
+        theta, err2 = _nearest(t.grid[:t.poses], _distances2(spec, Y[:t.poses], _gamma(spec, x)), t.full)
         return _judged(spec, t, theta, err2, t.grid[:t.poses], Y[:t.poses])
     theta = x[n] + _turns(spec)
-    motion = check_motion(spec, t, theta)
+    motion = check_motion(spec, t, theta, _gamma(spec, x))
     if isinstance(motion, str):
         return REJECTED, motion, none
     err2, grid_y = motion
     return _judged(spec, t, theta, err2, t.grid[:t.poses], grid_y)
 
 
-def check_motion(spec: SynthesisSpec, t: EngineTemplate,
-                 theta: np.ndarray) -> str | tuple[np.ndarray, np.ndarray]:
+def check_motion(spec: SynthesisSpec, t: EngineTemplate, theta: np.ndarray,
+                 gamma: float = 0.0) -> str | tuple[np.ndarray, np.ndarray]:
     """The linkage now written followed over its range and through the crank values theta
     (N,) [rad]: the cause where it fails, else each target's squared error (relative to
-    the targets' extent for a path; [rad^2] for a function's turns) and the outputs at
-    the range's grid poses."""
+    the targets' extent for a path, with a motion's angle term at gamma [rad]; [rad^2] for
+    a function's turns) and the outputs at the range's grid poses."""
     mapped = t.mapped(theta)
     if np.any(np.isnan(mapped)):
         return "target outside the crank's range"
@@ -98,7 +109,7 @@ def check_motion(spec: SynthesisSpec, t: EngineTemplate,
     if cause:
         return cause
     Y = t.values(Q)
-    return _errors2(spec, Y[at, :t.width]), Y[grid_at[:t.poses]]
+    return _errors2(spec, Y[at, :t.width], gamma), Y[grid_at[:t.poses]]
 
 
 def _merged(t: EngineTemplate, mapped: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -111,27 +122,36 @@ def _merged(t: EngineTemplate, mapped: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return both[order], where[len(t.grid):], where[:len(t.grid)]
 
 
-def _errors2(spec: SynthesisSpec, y: np.ndarray) -> np.ndarray:
+def _errors2(spec: SynthesisSpec, y: np.ndarray, gamma: float = 0.0) -> np.ndarray:
     """Squared errors at the targets of outputs y (N, width): the point's distance over the
-    targets' extent, or the output's turn from the first pair against the pair's [rad]."""
-    if spec.task == "path":
-        return ((y - spec.targets) ** 2).sum(axis=1) / extent(spec.targets) ** 2
-    return _wrapped(y[:, 0] - y[0, 0] - spec.targets[:, 1]) ** 2
+    targets' extent (a motion's: with its angle term at gamma [rad]), or the output's turn
+    from the first pair against the pair's [rad]."""
+    if spec.task == "function":
+        return _wrapped(y[:, 0] - y[0, 0] - spec.targets[:, 1]) ** 2
+    return np.diag(_distances2(spec, y, gamma))
+
+
+def _distances2(spec: SynthesisSpec, Y: np.ndarray, gamma: float) -> np.ndarray:
+    """(N, M): each target's squared distance from the outputs Y (M, width) at M poses:
+    |P - T|^2 / S^2, and for a motion + 2 (1 - cos(phi + gamma - angle)) (synthesis_poses)."""
+    d2 = ((Y[None, :, :2] - spec.targets[:, None, :]) ** 2).sum(-1) / extent(spec.targets) ** 2
+    if spec.task == "motion":
+        d2 = d2 + 2 * (1 - np.cos(Y[None, :, 2] + gamma - spec.angles[:, None]))
+    return d2
 
 
 def _wrapped(a: np.ndarray) -> np.ndarray:
     return np.mod(a + math.pi, _TWO_PI) - math.pi
 
 
-def _nearest(grid: np.ndarray, P: np.ndarray, targets: np.ndarray, wrap: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Each target's crank value where the curve P (M, 2) over the range's grid (M,) passes
-    nearest it [rad], and the squared distance there over the targets' extent squared (the
-    parabola's vertex through the nearest pose's and its neighbours'; wrap: the grid is a
-    whole turn, its first pose the last's neighbour)."""
-    d2 = ((P[None, :, :] - targets[:, None, :]) ** 2).sum(-1) / extent(targets) ** 2  # (N, M)
+def _nearest(grid: np.ndarray, d2: np.ndarray, wrap: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Each target's crank value where the curve over the range's grid (M,) passes nearest
+    it [rad], and the squared distance there (d2 (N, M): _distances2; the parabola's vertex
+    through the nearest pose's and its neighbours'; wrap: the grid is a whole turn, its
+    first pose the last's neighbour)."""
     M, step = len(grid), grid[1] - grid[0]
     k = np.argmin(d2, axis=1)
-    rows = np.arange(len(targets))
+    rows = np.arange(len(d2))
     fm, f0, fp = d2[rows, (k - 1) % M], d2[rows, k], d2[rows, (k + 1) % M]
     curve = fm - 2 * f0 + fp
     ok = (curve > 0) & (wrap | ((k > 0) & (k < M - 1)))
@@ -172,13 +192,17 @@ def refined_sixbar(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Linka
     theta = _row(spec, t, x)[2]
     if not np.all(np.isfinite(theta)):
         return None
-    timed = _timed(spec)
-    v0 = np.concatenate((x[:n], x[n:n + 1] if timed else theta))
-    S = extent(spec.targets) if spec.task == "path" else 1.0
-    unpack = (lambda v: (v[:n], v[n] + _turns(spec))) if timed else (lambda v: (v[:n], v[n:]))
+    timed, motion = _timed(spec), spec.task == "motion"
+    v0 = np.concatenate((x[:n], x[n:n + 1] if timed else theta, x[-1:] if motion else []))
+    S = extent(spec.targets) if spec.task != "function" else 1.0
+    scale = np.array([S, S, 1.0]) if motion else np.full(t.width, S)  # a motion's angle row in rad
+    end = len(v0) - 1 if motion else len(v0)  # the crank's columns end before gamma
+
+    def unpack(v: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+        return v[:n], (v[n] + _turns(spec)) if timed else v[n:end], float(v[-1]) if motion else 0.0
 
     def poses(v: np.ndarray):
-        p, th = unpack(v)
+        p, th, _ = unpack(v)
         if t.write(p):
             return None
         mapped = t.mapped(th)
@@ -199,6 +223,9 @@ def refined_sixbar(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Linka
         y = t.values(at[0])[:, :t.width]
         if spec.task == "path":
             return ((y - spec.targets) / S).ravel()
+        if motion:
+            turn = _wrapped(y[:, 2] + unpack(v)[2] - spec.angles)
+            return np.column_stack(((y[:, :2] - spec.targets) / S, turn)).ravel()
         return _wrapped(y[:, 0] - y[0, 0] - spec.targets[:, 1])
 
     def jacobian(v: np.ndarray) -> np.ndarray:
@@ -216,20 +243,24 @@ def refined_sixbar(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Linka
             J[i, :, n if timed else n + i] = dth
         if spec.task == "function":
             J = J - J[:1]
-        return J.reshape(N * t.width, -1) / S
+        J = J / scale[None, :, None]
+        if motion:
+            J[:, 2, -1] = 1.0  # d(phi + gamma - angle)/d gamma
+        return J.reshape(N * t.width, -1)
 
-    lower = np.concatenate((spec.lower, np.full(len(v0) - n, -np.inf)))
+    lower = np.concatenate((spec.lower, np.full(len(v0) - n, -np.inf)))  # theta0 or thetas, gamma: free
     upper = np.concatenate((spec.upper, np.full(len(v0) - n, np.inf)))
     return refine(residual, jacobian, v0, lower, upper, lambda v: sixbar_linkage(spec, *unpack(v)))
 
 
-def sixbar_linkage(spec: SynthesisSpec, p: np.ndarray, theta: np.ndarray) -> Linkage | None:
-    """The Linkage of free params p [m] with crank values theta at the targets [rad], or
-    None where its turn has a defect or its motion breaks a constraint."""
+def sixbar_linkage(spec: SynthesisSpec, p: np.ndarray, theta: np.ndarray, gamma: float = 0.0) -> Linkage | None:
+    """The Linkage of free params p [m] with crank values theta at the targets [rad] (and a
+    motion's gamma [rad]), or None where its turn has a defect or its motion breaks a
+    constraint."""
     t = template(spec)
     if not np.all(np.isfinite(theta)) or t.write(p):
         return None
-    motion = check_motion(spec, t, theta)
+    motion = check_motion(spec, t, theta, gamma)
     if isinstance(motion, str):
         return None
     err2, grid_y = motion
@@ -241,10 +272,16 @@ def sixbar_linkage(spec: SynthesisSpec, p: np.ndarray, theta: np.ndarray) -> Lin
         return None
     scale = extent(spec.targets) if spec.task == "path" else 1.0
     values, at, _ = _merged(t, t.mapped(theta))
-    phi0 = 0.0
-    if spec.task == "function":
+    phi0, errors, turns = gamma, np.sqrt(err2) * scale, None
+    if spec.task != "path":
         Q, _, _ = t.follow(values)
-        phi0 = float(t.values(Q[at[:1]])[0, 0])
+        y = t.values(Q[at])
+        if spec.task == "function":
+            phi0 = float(y[0, 0])
+        else:  # a motion: the place's error [m] and the angle's [rad] apart
+            errors = np.linalg.norm(y[:, :2] - spec.targets, axis=1)
+            turns = np.abs(_wrapped(y[:, 2] + gamma - spec.angles))
     params = {**t.template, **{k: float(v) for k, v in zip(spec.free, p)}}
-    return Linkage(np.array(p, dtype=float), 1.0, np.array(theta, dtype=float), int(way[0]), np.sqrt(err2) * scale,
-                   (low, high), FULL_TURN, task=spec.task, phi0=phi0, topology=spec.topology, params=params)
+    return Linkage(np.array(p, dtype=float), 1.0, np.array(theta, dtype=float), int(way[0]), errors,
+                   (low, high), FULL_TURN, task=spec.task, phi0=phi0, angle_errors=turns, topology=spec.topology,
+                   params=params)

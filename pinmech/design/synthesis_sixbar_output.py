@@ -32,8 +32,9 @@ def linkage_toml(spec: SynthesisSpec, lk: Linkage) -> str:
 
     linkage, _, _ = _template(spec)
     found = linkage.with_params(**{n: lk.params[n] for n in linkage.params})
-    what = "the coupler point " + spec.point + " through the targets" if spec.task == "path" else \
-        f"{spec.output}'s turns against the crank's"
+    what = {"path": f"the coupler point {spec.point} through the targets",
+            "function": f"{spec.output}'s turns against the crank's",
+            "motion": f"{spec.output} through the poses (its point {spec.point} and its angle)"}[spec.task]
     header = f"Synthesised by `pinmech synth {spec.path}`: {what} ({spec.topology} six-bar)."
     return written(found, header)
 
@@ -49,7 +50,7 @@ def scene_toml(spec: SynthesisSpec, lk: Linkage, linkage_file: str) -> str:
 
     t = template(spec)
     driver = t.sm.sweep.driver
-    shown = f"points = [\"{spec.point}\"]" if spec.task == "path" else f"links = [\"{spec.output}\"]"
+    shown = _shown(spec)
     deg = [f"\"{math.degrees(v):.15g} deg\"" for v in (t.p0, t.start, t.stop)]
     return "\n".join([
         "# The synthesised six-bar, its crank driven from the drawn pose over the range searched:",
@@ -58,6 +59,12 @@ def scene_toml(spec: SynthesisSpec, lk: Linkage, linkage_file: str) -> str:
         f"[drivers.{driver}]", f"angle = {deg[0]}", "",
         "[sweep]", f"from = {deg[1]}", f"to = {deg[2]}", "steps = 361", shown, "",
         "[report]", shown, ""])
+
+
+def _shown(spec: SynthesisSpec) -> str:
+    """The scene's outputs: the point (path), the output link (function), both (motion)."""
+    point, link = f"points = [\"{spec.point}\"]", f"links = [\"{spec.output}\"]"
+    return {"path": point, "function": link, "motion": f"{point}\n{link}"}[spec.task]
 
 
 def write_linkage(spec: SynthesisSpec, lk: Linkage, prefix: str | Path) -> tuple[Path, Path]:
@@ -69,10 +76,11 @@ def write_linkage(spec: SynthesisSpec, lk: Linkage, prefix: str | Path) -> tuple
     return linkage, scene
 
 
-def engine_check(spec: SynthesisSpec, scene_file: str | Path, lk: Linkage) -> np.ndarray:
+def engine_check(spec: SynthesisSpec, scene_file: str | Path, lk: Linkage) -> tuple[np.ndarray, np.ndarray | None]:
     """The written scene swept by the engine (pinmech sweep's path) from its drawn pose to
     the range's start, then up through the targets' crank values, poses at most _STEP apart: the distance of the
-    coupler point from each target [m], or the output's turn error at each pair [rad].
+    coupler point from each target [m] (a motion's: and its link's angle error at each pose
+    [rad]), or the output's turn error at each pair [rad] (and None).
 
     Raises:
         SweepError: the engine could not follow the motion (a fold, no closure).
@@ -96,13 +104,17 @@ def engine_check(spec: SynthesisSpec, scene_file: str | Path, lk: Linkage) -> np
     for pose in sweep.poses(np.asarray(dense)):
         if pose.index in wanted:
             m = pose.motion
-            out[wanted[pose.index]] = (m.points[spec.point].position[:2] if spec.task == "path"
-                                       else np.array([m.links[spec.output].angle]))
+            place = m.points[spec.point].position[:2] if spec.task != "function" else np.zeros(0)
+            angle = np.array([m.links[spec.output].angle]) if spec.task != "path" else np.zeros(0)
+            out[wanted[pose.index]] = np.concatenate((place, angle))
     y = np.array(out)
     if spec.task == "path":
-        return np.linalg.norm(y - spec.targets, axis=1)
+        return np.linalg.norm(y - spec.targets, axis=1), None
+    if spec.task == "motion":
+        turn = y[:, 2] + lk.phi0 - spec.angles
+        return np.linalg.norm(y[:, :2] - spec.targets, axis=1), np.abs(np.mod(turn + math.pi, 2 * math.pi) - math.pi)
     turn = y[:, 0] - y[0, 0] - spec.targets[:, 1]
-    return np.abs(np.mod(turn + math.pi, 2 * math.pi) - math.pi)
+    return np.abs(np.mod(turn + math.pi, 2 * math.pi) - math.pi), None
 
 
 def sixbar_summary(lk: Linkage) -> dict:
@@ -117,6 +129,8 @@ def sixbar_summary(lk: Linkage) -> dict:
         "grashof": lk.grashof,
         "crank_deg": [round(math.degrees(v), 6) for v in lk.theta],
         **errors,
+        **({"angle_errors_deg": [math.degrees(float(e)) for e in lk.angle_errors],
+            "offset_deg": math.degrees(lk.phi0)} if lk.angle_errors is not None else {}),
         "transmission_deg": [round(math.degrees(v), 3) for v in lk.transmission],
         "defects": {"branch": "none: the crank's whole turn followed on the drawn assembly, no change point",
                     "circuit": "none: no fold within the crank's whole turn",
@@ -140,7 +154,9 @@ def figure(spec: SynthesisSpec, result, path: str | Path) -> Path:
         y = t.values(Q)
         label = f"linkage {i}: max error " + (f"{math.degrees(np.max(lk.errors)):.2g} deg" if spec.task == "function"
                                                else f"{np.max(lk.errors) * 1e3:.2g} mm")
-        if spec.task == "path":
+        if spec.task == "motion":
+            label += f", {math.degrees(np.max(lk.angle_errors)):.2g} deg"
+        if spec.task != "function":
             ax.plot(y[:, 0] * 1e3, y[:, 1] * 1e3, lw=1.5, label=label + " (the whole turn)")
             at = np.argmin(np.abs(t.grid - crank_values(lk, t.start)[0]))
             _draw_links(ax, spec, t, Q[at], "k" if i == 1 else "0.6")
@@ -150,9 +166,14 @@ def figure(spec: SynthesisSpec, result, path: str | Path) -> Path:
             order = np.argsort(turn)
             phi = np.unwrap(y[order, 0])
             ax.plot(np.degrees(turn[order]), np.degrees(phi - np.interp(0.0, turn[order], phi)), lw=1.5, label=label)
-    if spec.task == "path":
+    if spec.task == "motion":  # each pose's angle: a line from its place, the part's
+        T, r = spec.targets * 1e3, 0.3 * max(float(np.ptp(spec.targets * 1e3, axis=0).max()), 1e-9)
+        for k, ((x, y0), a) in enumerate(zip(T, spec.angles)):
+            ax.plot([x, x + r * math.cos(a)], [y0, y0 + r * math.sin(a)], "-", color="tab:red", lw=1.5,
+                    label="the poses' angles" if k == 0 else None)
+    if spec.task != "function":
         T = spec.targets * 1e3
-        ax.plot(T[:, 0], T[:, 1], "x", color="tab:red", ms=8, mew=2, label="targets")
+        ax.plot(T[:, 0], T[:, 1], "x", color="tab:red", ms=8, mew=2, label="poses" if spec.task == "motion" else "targets")
         for k, p in enumerate(T, start=1):
             ax.annotate(str(k), p, textcoords="offset points", xytext=(4, 4), fontsize=8, color="tab:red")
         ax.set_aspect("equal")

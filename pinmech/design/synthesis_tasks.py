@@ -23,8 +23,8 @@ from pinmech.design.synthesis_slider_function import (evaluate_slider_function, 
 
 def _task(spec: SynthesisSpec) -> str:
     """The task's key: "slider function" for a slider-crank's function, "inverted function" for an
-    inverted slider-crank's (their own rows); "six-bar" for a Watt's or a Stephenson's path or
-    function (on the engine)."""
+    inverted slider-crank's (their own rows); "six-bar" for a Watt's or a Stephenson's path,
+    function or motion (on the engine)."""
     if spec.topology in SIX_BARS:
         return "six-bar"
     if spec.task == "function" and spec.topology != "four-bar":

@@ -100,18 +100,21 @@ def parse_linkage(path: str | Path) -> Linkage:
     return linkage_from_spec(spec, source)
 
 
-def linkage_from_spec(spec: LinkageSpec, source: str = "<linkage>") -> Linkage:
+def linkage_from_spec(spec: LinkageSpec, source: str = "<linkage>", values: dict[str, float] | None = None
+                      ) -> Linkage:
     """The linkage a spec draws: lengths and angles in SI, the drawn pose constructed.
 
     Args:
         spec: a validated linkage (`read_linkage_spec`, `linkage_spec`, or built in code).
         source: the file's name for messages (its stem is the default title).
+        values: every `[params]` value as a length [m], instead of the spec's own (a design
+            study's or a synthesis candidate's redrawing: no text read again).
 
     Raises:
         ModelError: a quantity without units or of the wrong kind, a construction that
             cannot be drawn, names that clash in the URDF it would write.
     """
-    reader = _Reader(source, spec.params)
+    reader = _Reader(source, spec.params, values)
     points = reader.points(spec.joints)
     links = {GROUND: list(spec.ground), **{name: list(names) for name, names in spec.links.items()}}
     title = spec.title if spec.title is not None else Path(source).stem
@@ -155,9 +158,12 @@ def _masses(linkage: Linkage, reader: _Reader, spec: LinkageSpec) -> None:
 class _Reader:
     """Lengths and angles of one file: quantities with units, or names of `[params]`."""
 
-    def __init__(self, source: str, params: dict[str, Any]):
+    def __init__(self, source: str, params: dict[str, Any], values: dict[str, float] | None = None):
         self.source = source
         self.params: dict[str, float] = {}
+        if values is not None:  # already lengths [m], one for every parameter
+            self.params = {name: float(values[name]) for name in params}
+            return
         for name, value in params.items():  # in the order written: a parameter may use earlier ones
             self.params[name] = self.length(value, f"[params] {name}")
 
