@@ -147,6 +147,27 @@ def test_chain_condition_numbers_are_the_svds(k):
     assert np.all(np.abs(got / want - 1.0) <= bar)
 
 
+def test_chain_condition_numbers_one_degree_apart_are_numpys():
+    """Sixteen loops swept a full turn 1 degree apart: every pose's condition number
+    search starts from the last pose's values (and the band is J_dep's structural one, not
+    scanned), so this is the warm-started path at its usual step. Against
+    np.linalg.cond(J_dep, 2) of the dimensionless J_dep at the same poses (LAPACK's SVD), to
+    1e-12 relative: both are backward stable, within about n eps kappa = 32 x 2.2e-16 x 40 =
+    3e-13 of the exact value (condition numbers below 40, checked)."""
+    _, solver = chain.chain_solver(16)
+    got = _conditions(solver, THETAS)
+    compiled = core.core_for(solver)
+    chunks = list(pinmech.solve_range(solver, solver.drivers[0], THETAS, driver_q=np.zeros(1),
+                                      driver_v=np.ones(1), driver_a=np.zeros(1)))
+    want = []
+    for q in np.concatenate([c.solution.q for c in chunks]):
+        compiled.residual(q)
+        want.append(np.linalg.cond(compiled.jacobian(False)[:, solver._dep_v] * solver._dep_scale, 2))
+    want = np.array(want)
+    assert len(want) == len(got) == 360 and np.all(want < 40.0)
+    assert np.all(np.abs(got / want - 1.0) <= 1e-12), np.abs(got / want - 1.0).max()
+
+
 def test_the_closed_form_moves_every_loop():
     """The drag-link proportions carry the motion to the last loop (no loop at rest), and
     every loop stays far from a toggle (transmission angle at least 29 degrees)."""

@@ -95,6 +95,7 @@ Core::Core(nb::object model, const std::vector<int>& frame_ids, const std::vecto
   predicted_ = VectorXd::Zero(nv);
   square_.set_blocks(ordered_blocks());
   square_.order(block_rows_, block_cols_);
+  band_ = structural_band();
 }
 
 bool Core::same_structure() const {
@@ -434,6 +435,32 @@ std::vector<DiagonalBlock> Core::ordered_blocks() const {
     out.push_back(std::move(block));
   }
   return out;
+}
+
+// J_dep's band in block order (block_rows_, block_cols_): the farthest below and above
+// the diagonal any row's support columns reach (each cut's rows are exactly zero outside
+// its child's and parent's columns), known at build, so condition_of need not scan for it
+// at every pose. None where there is no block order.
+std::optional<Band> Core::structural_band() const {
+  if (block_rows_.empty()) return std::nullopt;
+  const Index n = Index(block_cols_.size());
+  std::vector<Index> position_of_v(size_t(model_.nv), -1), position_of_row(size_t(rows_), -1);
+  for (Index p = 0; p < n; ++p) position_of_v[size_t(dep_v_[size_t(block_cols_[size_t(p)])])] = p;
+  for (Index p = 0; p < Index(block_rows_.size()); ++p) position_of_row[size_t(block_rows_[size_t(p)])] = p;
+  Band band{0, 0, block_rows_, block_cols_};
+  for (const Cut& cut : cuts_)
+    for (Index r = cut.offset; r < cut.offset + cut.rows6.rows(); ++r) {
+      const Index i = position_of_row[size_t(r)];
+      if (i < 0) return std::nullopt;
+      for (const auto* cols : {&cut.child_cols, &cut.parent_cols})
+        for (const JointColumn& column : *cols) {
+          const Index j = position_of_v[size_t(column.v)];
+          if (j < 0) continue;  // a driver's column
+          band.lower = std::max(band.lower, i - j);
+          band.upper = std::max(band.upper, j - i);
+        }
+    }
+  return band;
 }
 
 }  // namespace pinmech

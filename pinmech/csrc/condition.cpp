@@ -66,16 +66,20 @@ struct Rotation {
 Rotation rotation(double a, double b) {
   if (b == 0.0) return {1.0, 0.0};
   double r = std::sqrt(a * a + b * b);
-  if (!(r > 1e-150 && r < 1e150)) r = std::hypot(a, b);  // no under- or overflow in the squares
+  // no underflow in the squares (no overflow either: B's entries stay below n, its
+  // largest at most 1 before its orthogonal transformations)
+  if (!(r > 1e-150)) r = std::hypot(a, b);
   const double inv = 1.0 / r;
   return {a * inv, b * inv};
 }
 
 void rotate_rows(MatrixXd& R, Index p, Index q, Index from, Index to, Rotation g) {
-  for (Index t = from; t <= to; ++t) {
-    const double x = R(p, t), y = R(q, t);
-    R(p, t) = g.c * x + g.s * y;
-    R(q, t) = g.c * y - g.s * x;
+  const Index stride = R.outerStride();
+  double *rp = &R(p, from), *rq = &R(q, from);
+  for (Index t = from; t <= to; ++t, rp += stride, rq += stride) {
+    const double x = *rp, y = *rq;
+    *rp = g.c * x + g.s * y;
+    *rq = g.c * y - g.s * x;
   }
 }
 
@@ -95,16 +99,29 @@ void rotate_columns(MatrixXd& R, Index p, Index q, Index from, Index to, Rotatio
 // leaves below the diagonal is chased down the band, w rows a step, by alternating row and
 // column rotations (as LAPACK's dgbbrd). About n^2 w rotations against the dense
 // reflections' 8 n^3 / 3 flops; condition_of takes them where the band is narrow enough
-// for that to pay (scripts/condition_time.py times both).
+// for that to pay (scripts/condition_time.py times both). It reads and writes only
+// entries at most max(kl, 1) below and kl + ku + 1 above the diagonal (bulges included).
 void band_bidiagonalize(ConditionWork& w, Index kl, Index ku) {
   MatrixXd& R = w.B;
-  const Index n = R.rows(), width = kl + ku;
+  const Index n = R.rows();
+  Index width = kl + ku;
+  // column j's sweep mixes rows j .. j + kl, none of which reaches past j + kl + ku
   for (Index j = 0; j + 1 < n; ++j)
     for (Index i = std::min(n - 1, j + kl); i > j; --i) {
       if (R(i, j) == 0.0) continue;
-      rotate_rows(R, i - 1, i, j, std::min(n - 1, i + width), rotation(R(i - 1, j), R(i, j)));
+      rotate_rows(R, i - 1, i, j, std::min(n - 1, j + width), rotation(R(i - 1, j), R(i, j)));
       R(i, j) = 0.0;
     }
+  // R's upper bandwidth may be narrower than kl + ku where A's band is sparse (a chain of
+  // loops: 2, not 3): chased in steps of the narrower one, the bulges take fewer rotations.
+  Index reach = 0;
+  for (Index i = 0; i + 1 < n; ++i)
+    for (Index j = std::min(n - 1, i + width); j > i + reach; --j)
+      if (R(i, j) != 0.0) {
+        reach = j - i;
+        break;
+      }
+  width = reach;
   for (Index k = 0; k + 2 < n && width >= 2; ++k)
     for (Index j = std::min(n - 1, k + width); j >= k + 2; --j) {
       if (R(k, j) == 0.0) continue;
@@ -260,7 +277,7 @@ void find_eigenvalues(const VectorXd& beta, EigenvalueSearch (&searches)[2], dou
 // allows 1e-14: tests/test_core.py found it).
 // `singular`: the caller's factorization of A (which it also solves with) met an exact zero
 // pivot (used above 3x3).
-std::pair<double, double> condition_of(const MatrixXd& A, bool singular, ConditionWork& work) {
+std::pair<double, double> condition_of(const MatrixXd& A, bool singular, ConditionWork& work, const Band* band) {
   const Index n = A.rows();
   if (n == 0) return {1.0, 1.0};
   if (n == 1) {
@@ -278,22 +295,54 @@ std::pair<double, double> condition_of(const MatrixXd& A, bool singular, Conditi
     return {det > 0 ? s_max * s_max / det : INFINITY, s_min};
   }
   if (singular) return {INFINITY, 0.0};
-  const double largest_entry = A.cwiseAbs().maxCoeff();
-  if (!std::isfinite(largest_entry)) return {INFINITY, 0.0};
-  int exponent = 0;  // B = A / 2^exponent, its largest entry in [1/2, 1): exact, and no over- or underflow
-  std::frexp(largest_entry, &exponent);
-  work.B = A * std::ldexp(1.0, -exponent);
-  // The band of exact zeros (J_dep's structure: a chain of loops has kl = 2, ku = 1); the
-  // rotations where they are cheaper than the reflections (measured crossover).
-  Index kl = 0, ku = 0;
-  for (Index j = 0; j < n; ++j)
-    for (Index i = 0; i < n; ++i)
-      if (work.B(i, j) != 0.0) {
-        kl = std::max(kl, i - j);
-        ku = std::max(ku, j - i);
+  // The band: the caller's structural one (J_dep's in block order: a chain of loops has
+  // kl = 2, ku = 1), else that of the exact zeros; the rotations where they are cheaper
+  // than the reflections (measured crossover). B = A / 2^exponent, its largest entry in
+  // [1/2, 1): exact, and no over- or underflow; for the rotations in the band's order,
+  // from the band's entries only (the rest are exact zeros).
+  Index kl = n - 1, ku = n - 1;
+  if (band != nullptr) {
+    kl = std::min(band->lower, n - 1);
+    ku = std::min(band->upper, n - 1);
+  }
+  int exponent = 0;
+  if (band != nullptr && 11 * (kl + ku) <= 2 * n + 16) {
+    const bool ordered = Index(band->rows.size()) == n && Index(band->cols.size()) == n;
+    const auto row = [&](Index i) { return ordered ? band->rows[size_t(i)] : i; };
+    const auto col = [&](Index j) { return ordered ? band->cols[size_t(j)] : j; };
+    double largest_entry = 0.0;
+    bool finite = true;
+    for (Index j = 0; j < n; ++j)
+      for (Index i = std::max(Index(0), j - ku); i <= std::min(n - 1, j + kl); ++i) {
+        const double v = std::abs(A(row(i), col(j)));
+        finite = finite && v <= std::numeric_limits<double>::max();
+        largest_entry = std::max(largest_entry, v);
       }
-  if (11 * (kl + ku) <= 2 * n + 16) band_bidiagonalize(work, kl, ku);
-  else bidiagonalize(work);
+    if (!finite) return {INFINITY, 0.0};
+    std::frexp(largest_entry, &exponent);
+    const double scale = std::ldexp(1.0, -exponent);
+    work.B.resize(n, n);  // only the entries band_bidiagonalize touches: the band, zeros around it
+    for (Index j = 0; j < n; ++j)
+      for (Index i = std::max(Index(0), j - kl - ku - 1); i <= std::min(n - 1, j + std::max(kl, Index(1))); ++i)
+        work.B(i, j) = i >= j - ku && i <= j + kl ? A(row(i), col(j)) * scale : 0.0;
+    band_bidiagonalize(work, kl, ku);
+  } else {
+    const double largest_entry = A.cwiseAbs().maxCoeff();
+    if (!std::isfinite(largest_entry)) return {INFINITY, 0.0};
+    std::frexp(largest_entry, &exponent);
+    work.B = A * std::ldexp(1.0, -exponent);
+    if (band == nullptr) {
+      kl = ku = 0;
+      for (Index j = 0; j < n; ++j)
+        for (Index i = 0; i < n; ++i)
+          if (work.B(i, j) != 0.0) {
+            kl = std::max(kl, i - j);
+            ku = std::max(ku, j - i);
+          }
+    }
+    if (11 * (kl + ku) <= 2 * n + 16) band_bidiagonalize(work, kl, ku);
+    else bidiagonalize(work);
+  }
   const VectorXd &d = work.d, &e = work.e;
   VectorXd& beta = work.beta;
   beta.resize(2 * n - 1);
@@ -321,12 +370,45 @@ std::pair<double, double> condition_of(const MatrixXd& A, bool singular, Conditi
   const double hi_max = std::min(frobenius, gershgorin) * (1.0 + 4.0 * EPS);
   const double lo_min = (1.0 - 4.0 * EPS) / std::sqrt(inverse_frobenius);
   const double hi_min = std::min(std::abs(d(0)), std::abs(d(n - 1))) * (1.0 + 4.0 * EPS);
-  const bool below = count_below(beta, lo_min) == n;
   EigenvalueSearch searches[2] = {{int(2 * n - 1), hi_max, false, largest * (1.0 - 4.0 * EPS), hi_max},
-                                  {int(n), below ? lo_min : hi_min, below, below ? lo_min : 0.0, hi_min}};
+                                  {int(n), hi_min, false, 0.0, hi_min}};
+  // Warm start: the last call's values (a neighbouring pose's), where a Sturm count puts
+  // each between its singular value and the next one (Laguerre then goes to the former,
+  // monotonically); the count also narrows the bracket. Else the cold start: sigma_max
+  // from above; sigma_min from below, or from above if rounding put the lower bound past it.
+  const double scale = std::ldexp(1.0, -exponent);
+  const double guesses[3] = {work.last_max * scale, work.last_min * scale, lo_min};
+  int counts[3];
+  const bool warm = guesses[0] > searches[0].lo && guesses[0] < hi_max && guesses[1] > 0.0 && guesses[1] < hi_min;
+  if (warm) counts_below<3>(beta, guesses, counts);
+  else counts[2] = count_below(beta, lo_min);
+  bool min_started = false;
+  for (int i = 0; warm && i < 2; ++i) {
+    EigenvalueSearch& s = searches[i];
+    if (counts[i] == s.index) {  // the guess is below the singular value, above the next one down
+      s.x = s.lo = guesses[i];
+      s.right = true;
+    } else if (counts[i] == s.index + 1) {  // above it, below the next one up
+      s.x = s.hi = guesses[i];
+      s.right = false;
+    } else {
+      continue;
+    }
+    min_started = min_started || i == 1;
+  }
+  if (counts[2] == n) {  // lo_min is below sigma_min: the bracket's lower end, a start from below
+    EigenvalueSearch& s = searches[1];
+    s.lo = std::max(s.lo, lo_min);
+    if (!min_started || (s.right && s.x < lo_min)) {
+      s.x = lo_min;
+      s.right = true;
+    }
+  }
   double found[2];
   find_eigenvalues(beta, searches, found);
   const double s_max = found[0], s_min = found[1];
+  work.last_max = std::ldexp(s_max, exponent);
+  work.last_min = std::ldexp(s_min, exponent);
   if (!(s_min > 0.0)) return {INFINITY, 0.0};
   return {s_max / s_min, std::ldexp(s_min, exponent)};
 }

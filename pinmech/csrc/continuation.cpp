@@ -66,14 +66,11 @@ void Core::node_at(Node& node, const VectorXd& d, const VectorXd* a_drv) {
   jacobian_into(false);
   scaled_ = Jdep_ * dep_scale_.asDiagonal();
   square_.factor(scaled_);
-  // The condition number of J_dep with its rows and columns in block order (a
-  // permutation: the same singular values), where a chain of loops is a band matrix.
-  const MatrixXd* conditioned = &scaled_;
-  if (!block_rows_.empty()) {
-    permuted_ = scaled_(block_rows_, block_cols_);
-    conditioned = &permuted_;
-  }
-  auto [condition, sigma_min] = condition_of(*conditioned, square_.singular(), condition_work_);
+  // The condition number of J_dep, with its rows and columns in block order where it has
+  // several blocks (a permutation: the same singular values), where a chain of loops is a
+  // band matrix.
+  auto [condition, sigma_min] =
+      condition_of(scaled_, square_.singular(), condition_work_, band_ ? &*band_ : nullptr);
   node.condition = condition;
   node.sigma_min = sigma_min;
   signs_into(Jdep_, node.signs);

@@ -30,6 +30,7 @@
 
 #include <cmath>
 #include <complex>
+#include <optional>
 #include <vector>
 
 #include "buffer.hpp"
@@ -351,6 +352,7 @@ class Core {
   void relative_columns(Cut& cut) const;
   void relative_jacobian(const Cut& cut, bool newton);
   std::vector<DiagonalBlock> ordered_blocks() const;
+  std::optional<Band> structural_band() const;
   void set_drivers(VectorXd& q, const VectorXd& drivers) const;
   void move_into(const VectorXd& q, const VectorXd& step, VectorXd& out);
   void polish(VectorXd& q, VectorXd& r, double& norm, bool factored);
@@ -392,8 +394,9 @@ class Core {
   std::vector<std::vector<int>> blocks_rows_, blocks_cols_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> tmp3_;
   // work buffers, sized once: a pose allocates nothing
-  MatrixXd J_, Jdep_, scaled_, permuted_;
+  MatrixXd J_, Jdep_, scaled_;
   std::vector<Index> block_rows_, block_cols_;  // J_dep's rows and columns in block order
+  std::optional<Band> band_;  // J_dep's structural band in block order (structural_band)
   std::vector<MatrixXd> block_buffers_;
   VectorXd r_, r_new_, rhs_, dstep_, drift_, q_new_, predicted_, x_;
   SquareSolve square_;

@@ -39,6 +39,23 @@ NB_MODULE(_core, m) {
         return condition_of(A, A.rows() > 0 && lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0, work);
       },
       "2-norm condition number and smallest singular value of a square A, as the core computes them");
+  m.def(
+      "conditions",
+      [](const std::vector<MatrixXd>& As, Eigen::Index lower, Eigen::Index upper) {
+        ConditionWork work;  // one for the sequence: each search starts from the last matrix's values
+        const Band band{lower, upper};
+        std::vector<std::pair<double, double>> out;
+        for (const MatrixXd& A : As) {
+          if (A.rows() != A.cols()) throw std::invalid_argument("conditions: every A must be square");
+          const Eigen::PartialPivLU<MatrixXd> lu(A);
+          const bool singular = A.rows() > 0 && lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0.0;
+          out.push_back(condition_of(A, singular, work, lower >= 0 && upper >= 0 ? &band : nullptr));
+        }
+        return out;
+      },
+      nb::arg("As"), nb::arg("lower") = -1, nb::arg("upper") = -1,
+      "condition for each A in turn, as along a path (each search warm-started from the last A's values); "
+      "lower, upper: the structural band (every entry beyond it exactly zero), else found by a scan");
   m.attr("KINEMATICS_COLUMNS") = KINEMATICS_COLUMNS;
   m.attr("RATE_NUMBERS") = RATE_NUMBERS;
   m.def("frames_at", &frames_at,
