@@ -138,3 +138,68 @@ def test_local_axes_and_a_six_dof_arm_equal_solve(scenes_dir):
         r = arm.solve(q)
         np.testing.assert_allclose(batch.v[i], r.v, rtol=0, atol=1e-10 * (1 + np.abs(r.v).max()))
         np.testing.assert_allclose(batch.a[i], r.a, rtol=0, atol=1e-10 * (1 + np.abs(r.a).max()))
+
+
+def _arm_jacobian(th1, th2, th3):
+    """The 3R arm's task Jacobian in closed form (rows: D's x, y [m per rad], CD's wz; columns:
+    the joints A, B, C): joint k turns D about its own axis, d D / d q_k = z x (D - P_k)."""
+    dc = R3 * np.array([math.cos(th3), math.sin(th3)])
+    db = dc + R2 * np.array([math.cos(th2), math.sin(th2)])
+    da = db + R1 * np.array([math.cos(th1), math.sin(th1)])
+    return np.array([[-da[1], -db[1], -dc[1]], [da[0], db[0], dc[0]], [1.0, 1.0, 1.0]])
+
+
+def test_condition_numbers_meet_the_closed_form_jacobians_svd(models_dir):
+    """The condition number and smallest singular value of the dimensionless task Jacobian,
+    from a generic pose to BC bent 1e-7 rad from AB (kappa ~ 1/delta up to ~1e7), against
+    LAPACK's SVD (numpy) of the closed-form Jacobian scaled by the solver's own row and column
+    factors. Any backward-stable SVD gets sigma_min within ~eps sigma_max, so the two agree
+    to ~kappa eps relative: rel 1e-14 kappa + 1e-14 holds with a margin of ~10 for rounding
+    in the Jacobians themselves (closed form vs Pinocchio, each ~eps)."""
+    mechanism, _ = _arm(models_dir)
+    solver = pinmech.RateSolver(mechanism, _arm(models_dir)[1].tasks, max_condition=1e12)
+    ja, jb, jc = (mechanism.joint(x) for x in "ABC")
+    angles = [(0.7, 0.7 - 1.1), (0.2, 1.9)] + [(0.4, 0.4 + d) for d in (1e-1, 1e-3, 1e-5, 1e-7)]
+    Q = np.tile(mechanism.neutral(), (len(angles), 1))
+    for k, (th1, th2) in enumerate(angles):
+        Q[k, [ja.idx_q, jb.idx_q, jc.idx_q]] = th1, th2 - th1, TH_CD - th2
+    batch = solver.solve_many(Q)
+    rows, columns = solver._scales(0)
+    cols = columns[[ja.idx_v, jb.idx_v, jc.idx_v]]
+    for k, (th1, th2) in enumerate(angles):
+        sigma = np.linalg.svd(rows[:, None] * _arm_jacobian(th1, th2, TH_CD) * cols[None, :], compute_uv=False)
+        kappa = sigma[0] / sigma[-1]
+        assert batch.condition[k] == pytest.approx(kappa, rel=1e-14 * kappa + 1e-14)
+        assert batch.sigma_min[k] == pytest.approx(sigma[-1], rel=1e-14 * kappa + 1e-14)
+    assert batch.condition[-1] > 1e6  # the stretched arm was reached
+
+
+def test_six_by_six_condition_numbers_meet_lapack(scenes_dir):
+    """UR5's full-pose task (6 x 6): the condition number and smallest singular value at seeded
+    poses and near the wrist singularity (wrist 2 at 1e-3 rad: wrist 1 and 3 axes nearly
+    aligned, kappa ~ 1e3), against LAPACK's SVD (numpy) of tool0's frame Jacobian from
+    Pinocchio's Python bindings (world-aligned axes), scaled by the solver's row and column
+    factors. Both are backward-stable SVDs: rel 1e-14 kappa + 1e-14, as for the arm above."""
+    import pinocchio as pin
+
+    analysis = pinmech.analyse(pinmech.Scene.load(scenes_dir / "ur5.toml"))
+    mech = analysis.mechanism
+    frame = analysis.scene.file.task[0].frame
+    arm = pinmech.RateSolver(mech, [pinmech.Task(frame, ("x", "y", "z", "wx", "wy", "wz"), np.zeros(6), np.zeros(6))],
+                             max_condition=1e12)
+    rng = np.random.default_rng(5)
+    Q = np.array([mech.neutral() + rng.uniform(-1, 1, mech.model.nq) for _ in range(6)])
+    wrist = mech.joint("wrist_2_joint").idx_q
+    Q[-1, wrist] = 1e-3
+    batch = arm.solve_many(Q)
+    rows, columns = arm._scales(0)
+    model = mech.model
+    data = model.createData()
+    fid = model.getFrameId(frame)
+    for k, q in enumerate(Q):
+        J = pin.computeFrameJacobian(model, data, q, fid, pin.LOCAL_WORLD_ALIGNED)
+        sigma = np.linalg.svd(rows[:, None] * J * columns[None, :], compute_uv=False)
+        kappa = sigma[0] / sigma[-1]
+        assert batch.condition[k] == pytest.approx(kappa, rel=1e-14 * kappa + 1e-14)
+        assert batch.sigma_min[k] == pytest.approx(sigma[-1], rel=1e-14 * kappa + 1e-14)
+    assert batch.condition[-1] > 1e2  # the wrist singularity was approached

@@ -60,6 +60,7 @@ DAMPING_RANGE = (1e-5, 1e50)
 #: The methods the compiled solve is asked for (csrc/rates.cpp), and the ones it reports.
 _ASKED = {"exact": 0, "least_squares": 1, "damped": 2}
 _USED = ("exact", "minimum_norm", "least_squares", "damped")
+_USED_NAMES = np.array(_USED, dtype=object)  # solve_many's methods, indexed by the core's codes (copied out)
 #: Its status per pose: solved; looks singular (asked again with the structural rank);
 #: rows that cannot all hold; singular beyond max_condition.
 _SOLVED, _NEEDS_RANK, _INCONSISTENT, _SINGULAR = 0, 1, 2, 3
@@ -239,7 +240,7 @@ class RateSolver:
         bad = (status != _SOLVED) | ~is_closed(independent, full, self.tol)
         for i in np.flatnonzero(bad)[:1]:  # the first pose that has an error raises it, named
             self._checked(q[i], numbers[i])
-        methods = np.array(_USED, dtype=object)[used.astype(int)]
+        methods = _USED_NAMES[used.astype(np.intp)]
         return RateBatch(v, a, methods, condition, sigma_min, achieved_v, achieved_a, closure_v, closure_a,
                          np.maximum(independent, full))
 
@@ -253,7 +254,7 @@ class RateSolver:
         out = np.empty((len(q), core.rate_columns))
         core.rates(q, x_dot, x_ddot, self._generic[0] if self._generic is not None else -1, out)
         status = 2 * self._columns[0] + 4  # nv as the core has it
-        if _NEEDS_RANK in out[:, status].tolist():  # only poses that look singular pay for the structural rank
+        if (out[:, status] == _NEEDS_RANK).any():  # only poses that look singular pay for the structural rank
             again = np.flatnonzero(out[:, status] == _NEEDS_RANK)
             more = np.empty((again.size, out.shape[1]))
             core.rates(np.ascontiguousarray(q[again]), x_dot, x_ddot, self._structural_rank()[0], more)
