@@ -27,7 +27,7 @@ namespace pinmech {
 // mechanism size.
 //
 // Condition number over the rank: a square J through its LU and, from 3x3 to 6x6,
-// jacobi_condition (condition_of at other sizes or if it fails, and for a zero pivot);
+// condition_of (one-sided Jacobi from 3x3 to 6x6, see condition.cpp);
 // otherwise,
 // or where a square J looks singular, from its singular values (Jacobi SVD). The rank is
 // min(m, n) unless sigma[rank - 1] <= sigma[0] / max_condition; there it is at most
@@ -118,67 +118,6 @@ struct RateWork {
     }
   }
 };
-
-// 2-norm condition number and smallest singular value of a square A of 3 to
-// JACOBI_MAX_N rows, by one-sided Jacobi (Hestenes): plane rotations of A's columns until
-// every pair is orthogonal to |a_p . a_q| <= eps sqrt(|a_p|^2 |a_q|^2); the singular
-// values are then the columns' norms. It is an SVD (backward stable, each sigma within
-// about eps sigma_max, and relatively accurate for a well-scaled A: Demmel and Veselic,
-// SIAM J. Matrix Anal. Appl. 13, 1992); at 3x3, with the size's loops unrolled, 1,400
-// instructions against condition_of's 5,700 (bidiagonalization and bisection; callgrind on
-// the 17.110 arm's 360 poses). Returns false (and the caller uses condition_of) if the
-// sweeps did not converge or A is not finite.
-constexpr Index JACOBI_MAX_N = 6;
-template <int N>
-bool jacobi_condition_fixed(const MatrixXd& A, double& condition, double& sigma_min) {
-  const double largest_entry = A.cwiseAbs().maxCoeff();
-  if (!std::isfinite(largest_entry)) return false;
-  if (largest_entry == 0.0) {
-    condition = INFINITY;
-    sigma_min = 0.0;
-    return true;
-  }
-  int exponent = 0;  // B = A / 2^exponent, its largest entry in [1/2, 1): exact, no over- or underflow
-  std::frexp(largest_entry, &exponent);
-  const double scale = std::ldexp(1.0, -exponent);
-  Eigen::Matrix<double, N, N> B = A * scale;
-  constexpr double eps = std::numeric_limits<double>::epsilon();
-  bool converged = false;
-  for (int sweep = 0; sweep < 60 && !converged; ++sweep) {
-    converged = true;
-    for (int p = 0; p + 1 < N; ++p)
-      for (int q = p + 1; q < N; ++q) {
-        const double alpha = B.col(p).squaredNorm(), beta = B.col(q).squaredNorm(), gamma = B.col(p).dot(B.col(q));
-        if (!(std::abs(gamma) > eps * std::sqrt(alpha * beta))) continue;
-        converged = false;
-        // the rotation that diagonalizes [alpha gamma; gamma beta] (Golub and Van Loan, 8.5.2);
-        // past |zeta| = 1e150, sqrt(1 + zeta^2) is |zeta| to rounding (and would overflow)
-        const double zeta = (beta - alpha) / (2.0 * gamma), size = std::abs(zeta);
-        const double t = std::copysign(1.0, zeta) / (size + (size < 1e150 ? std::sqrt(1.0 + zeta * zeta) : size));
-        const double c = 1.0 / std::sqrt(1.0 + t * t), s = c * t;
-        const Eigen::Matrix<double, N, 1> bp = B.col(p);
-        B.col(p) = c * bp - s * B.col(q);
-        B.col(q) = s * bp + c * B.col(q);
-      }
-  }
-  if (!converged) return false;
-  const Eigen::Matrix<double, N, 1> sigma = B.colwise().norm().transpose();
-  const double largest = sigma.maxCoeff(), smallest = sigma.minCoeff();
-  sigma_min = smallest / scale;
-  condition = smallest > 0 ? largest / smallest : INFINITY;
-  return true;
-}
-
-// The size's own unrolled loops; false (condition_of instead) outside 3 to JACOBI_MAX_N.
-bool jacobi_condition(const MatrixXd& A, double& condition, double& sigma_min) {
-  switch (A.rows()) {
-    case 3: return jacobi_condition_fixed<3>(A, condition, sigma_min);
-    case 4: return jacobi_condition_fixed<4>(A, condition, sigma_min);
-    case 5: return jacobi_condition_fixed<5>(A, condition, sigma_min);
-    case 6: return jacobi_condition_fixed<6>(A, condition, sigma_min);
-    default: return false;
-  }
-}
 
 }  // namespace
 
@@ -317,8 +256,7 @@ void Core::rates(nb::handle Q_object, nb::handle x_dot_object, nb::handle x_ddot
         w.lu_ready = true;
         const bool singular = w.lu.singular();
         double c = INFINITY, s = 0.0;
-        if (m < 3 || m > JACOBI_MAX_N || singular || !jacobi_condition(w.Jd, c, s))
-          std::tie(c, s) = condition_of(w.Jd, singular, w.condition);
+        std::tie(c, s) = condition_of(w.Jd, singular, w.condition);
         if (c < max_condition) {
           condition = c;
           sigma_min = s;
