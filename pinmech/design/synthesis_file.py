@@ -176,12 +176,7 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
     ratio = c.get("ratio", math.inf)
     if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not ratio > 1:
         raise w.error("constraints.ratio", f"ratio = {ratio!r} must be a number above 1 (longest / shortest link)")
-    direction = w.choice(c, "direction", DIRECTIONS, "either", "constraints")
-    turns = timing if timing is not None else targets[:, 0] if task == "function" else None
-    if turns is not None and direction != "either" and (turns[-1] > 0) != (direction == "ccw"):
-        raise w.error("constraints.direction", f"direction = {direction!r}, but the crank's turns given go "
-                      f"{'ccw' if turns[-1] > 0 else 'cw'}")
-    counts = {k: w.whole(raw, k, d) for k, d in (("seed", 0), ("population", 20), ("generations", 400), ("keep", 3))}
+    direction, counts = _direction_and_counts(w, raw, c, task, targets, timing)
     angles = None
     if task == "motion":
         targets, angles = targets[:, :2].copy(), targets[:, 2].copy()
@@ -247,12 +242,7 @@ def _six_bar(raw: dict[str, Any], w: _Where, path: Path, task: str, topology: st
         timing = _timing(raw, w, len(targets)) if "timing" in raw else None
         if task == "motion":
             targets, angles = targets[:, :2].copy(), targets[:, 2].copy()
-    direction = w.choice(c, "direction", DIRECTIONS, "either", "constraints")
-    turns = timing if timing is not None else targets[:, 0] if task == "function" else None
-    if turns is not None and direction != "either" and (turns[-1] > 0) != (direction == "ccw"):
-        raise w.error("constraints.direction", f"direction = {direction!r}, but the crank's turns given go "
-                      f"{'ccw' if turns[-1] > 0 else 'cw'}")
-    counts = {k: w.whole(raw, k, d) for k, d in (("seed", 0), ("population", 20), ("generations", 400), ("keep", 3))}
+    direction, counts = _direction_and_counts(w, raw, c, task, targets, timing)
     return SynthesisSpec(path, str(raw.get("title", path.stem)), task, topology, targets, timing, lower, upper,
                          transmission=transmission, direction=direction, scene=scene_path, free=tuple(table),
                          point=named if task != "function" else "", output=named if task == "function" else carried,
@@ -382,3 +372,15 @@ class _Where(FileWhere):
         if positive and not lo > 0:
             raise self.error(key, f"lower {value[0]} must be a positive length")
         return lo, hi
+
+
+def _direction_and_counts(w, raw: dict, c: dict, task: str, targets: np.ndarray, timing) -> tuple[str, dict]:
+    """The crank's direction (checked against the turns given: the timing, or a function's
+    input angles) and the search's seed, population, generations and keep."""
+    direction = w.choice(c, "direction", DIRECTIONS, "either", "constraints")
+    turns = timing if timing is not None else targets[:, 0] if task == "function" else None
+    if turns is not None and direction != "either" and (turns[-1] > 0) != (direction == "ccw"):
+        raise w.error("constraints.direction", f"direction = {direction!r}, but the crank's turns given go "
+                      f"{'ccw' if turns[-1] > 0 else 'cw'}")
+    counts = {k: w.whole(raw, k, d) for k, d in (("seed", 0), ("population", 20), ("generations", 400), ("keep", 3))}
+    return direction, counts

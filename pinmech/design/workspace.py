@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinmech.design.cluster import Runner, batch_runner
+from pinmech.design.grid_steps import GridSteps
 from pinmech.design.tolerance import batches
 from pinmech.design.workspace_batch import FIELDS, PointsBatch, WorkspaceBatch, built
 from pinmech.design.workspace_file import WorkspaceSpec
@@ -27,7 +28,7 @@ from pinmech.exceptions import SceneError
 
 
 @dataclass(frozen=True)
-class WorkspaceResult:
+class WorkspaceResult(GridSteps):
     """A workspace study's maps (SI; grid axes first, then the mode axis).
 
     Attributes:
@@ -54,16 +55,6 @@ class WorkspaceResult:
     type2: dict[str, np.ndarray]
     dist1: np.ndarray
     dist2: np.ndarray
-
-    @property
-    def steps(self) -> tuple[float, ...]:
-        """The grid's steps [m]."""
-        return tuple(float(c[1] - c[0]) for c in self.coords)
-
-    @property
-    def locus_bound(self) -> float:
-        """How far [m] a locus midpoint (and so a distance) can be from the locus: half the largest step."""
-        return max(self.steps) / 2
 
     @property
     def kind(self) -> str:

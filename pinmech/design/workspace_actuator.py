@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinmech.design.cluster import batch_runner
+from pinmech.design.grid_steps import GridSteps
 from pinmech.design.tolerance import batches
 from pinmech.design.workspace_actuator_batch import ASSEMBLIES, FIELDS, ActuatorBatch
 from pinmech.design.workspace_file import WorkspaceSpec
@@ -30,7 +31,7 @@ from pinmech.exceptions import SceneError
 
 
 @dataclass(frozen=True)
-class ActuatorResult:
+class ActuatorResult(GridSteps):
     """An actuator-space workspace study's maps (SI; the motors' axes first, then the
     assembly slot "+", "-").
 
@@ -57,16 +58,6 @@ class ActuatorResult:
     measures: dict[str, Measure]
     type1: dict[str, np.ndarray]
     type2: dict[str, np.ndarray]
-
-    @property
-    def steps(self) -> tuple[float, ...]:
-        """The grid's steps [rad or m]."""
-        return tuple(float(c[1] - c[0]) for c in self.coords)
-
-    @property
-    def locus_bound(self) -> float:
-        """How far [rad or m] a locus midpoint can be from the locus: half the largest step."""
-        return max(self.steps) / 2
 
 
 def run_actuator_workspace(spec: WorkspaceSpec, wm: WorkspaceMechanism, *, workers: int = 0,
