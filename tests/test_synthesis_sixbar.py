@@ -41,15 +41,21 @@ def _meet(a: np.ndarray, b: np.ndarray, ra: float, rb: float, side: float = 1.0)
     return a + along * u + side * h * np.stack((-u[..., 1], u[..., 0]), -1)
 
 
-def watt_point(theta: np.ndarray, link5: float, link6: float, CP: float, DP: float) -> np.ndarray:
-    """P of the Watt six-bar at crank angles theta [rad] [m], (n, 2)."""
+def watt_pose(theta: np.ndarray, link5: float, link6: float, CP: float, DP: float) -> tuple[np.ndarray, np.ndarray]:
+    """P [m] (n, 2) and link5's angle atan2(D - C) [rad] (n,) of models/linkages/watt.toml's
+    first loop and O6 with this last dyad, at crank angles theta [rad]."""
     theta = np.asarray(theta, dtype=float)
     O4, O6 = np.broadcast_to([0.1, 0.0], (*theta.shape, 2)), np.broadcast_to([0.19, 0.03], (*theta.shape, 2))
     A = 0.04 * np.stack((np.cos(theta), np.sin(theta)), -1)
     B = _meet(A, O4, 0.12, 0.08)
     C = _meet(O4, B, 0.06, 0.05, -1.0)
     D = _meet(C, O6, link5, link6)
-    return _meet(C, D, CP, DP)
+    return _meet(C, D, CP, DP), np.arctan2(D[..., 1] - C[..., 1], D[..., 0] - C[..., 0])
+
+
+def watt_point(theta: np.ndarray, link5: float, link6: float, CP: float, DP: float) -> np.ndarray:
+    """P of the Watt six-bar at crank angles theta [rad] [m], (n, 2)."""
+    return watt_pose(theta, link5, link6, CP, DP)[0]
 
 
 def _watt_spec(targets: np.ndarray, turns: np.ndarray, bounds: dict, **kw):

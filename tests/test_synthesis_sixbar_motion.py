@@ -20,23 +20,11 @@ from pinmech.design.synthesis_file import load_synthesis, parse_synthesis
 from pinmech.design.synthesis_search import synthesise
 from pinmech.design.synthesis_sixbar_output import engine_check, write_linkage
 from pinmech.exceptions import SceneError
-from tests.test_synthesis_sixbar import WATT, _meet
+from tests.test_synthesis_sixbar import WATT, watt_pose
 
 ROOT = Path(__file__).resolve().parents[1]
 SYNTHESIS = ROOT / "models" / "synthesis"
 GAMMA = math.radians(25.0)  # the part's line from link5's C -> D (the bundled file's)
-
-
-def watt_pose(theta: np.ndarray, link5: float, link6: float, CP: float, DP: float) -> tuple[np.ndarray, np.ndarray]:
-    """P [m] (n, 2) and link5's angle atan2(D - C) [rad] (n,) of models/linkages/watt.toml's
-    first loop and O6 with this last dyad, at crank angles theta [rad]."""
-    theta = np.asarray(theta, dtype=float)
-    O4, O6 = np.broadcast_to([0.1, 0.0], (*theta.shape, 2)), np.broadcast_to([0.19, 0.03], (*theta.shape, 2))
-    A = 0.04 * np.stack((np.cos(theta), np.sin(theta)), -1)
-    B = _meet(A, O4, 0.12, 0.08)
-    C = _meet(O4, B, 0.06, 0.05, -1.0)
-    D = _meet(C, O6, link5, link6)
-    return _meet(C, D, CP, DP), np.arctan2(D[..., 1] - C[..., 1], D[..., 0] - C[..., 0])
 
 
 def _turn(a: np.ndarray) -> np.ndarray:

@@ -60,6 +60,16 @@ def test_path_synthesis_recovers_the_bundled_slider_crank(tmp_path, seed):
     assert check.errors.max() <= 1e-8 * best.size
 
 
+def _rod_poses(A: np.ndarray, B: np.ndarray):
+    """The rod's poses from its pins A, B [m]: a point 60 mm along AB and 20 mm across it,
+    the part's line 17 deg from AB; and the search's bounds for a slider-crank's motion."""
+    w = (B - A) / np.linalg.norm(B - A, axis=1)[:, None]
+    places = A + 0.06 * w + 0.02 * np.stack((-w[:, 1], w[:, 0]), -1)
+    angles = np.arctan2(w[:, 1], w[:, 0]) + math.radians(17.0)
+    lower = np.array([-0.06, -0.06, math.radians(-30), -0.1, 0.01, 0.04, -0.15, -0.15])
+    upper = np.array([0.06, 0.06, math.radians(30), 0.1, 0.08, 0.2, 0.15, 0.15])
+    return places, angles, lower, upper
+
 def test_function_synthesis_recovers_the_bundled_slider_crank(tmp_path):
     # Six pairs (crank turn, piston travel along x) from the engine's B; the search varies
     # crank, rod, offset and the first crank angle, and meets the travels within 1e-8 of
@@ -105,11 +115,7 @@ def test_motion_synthesis_recovers_the_bundled_slider_crank(tmp_path):
     # sweeping the written linkage, reports the rod's point and angle as closely.
     crank = CRANK[:7]
     A, B = _engine_pins(tmp_path, crank)
-    w = (B - A) / np.linalg.norm(B - A, axis=1)[:, None]
-    places = A + 0.06 * w + 0.02 * np.stack((-w[:, 1], w[:, 0]), -1)
-    angles = np.arctan2(w[:, 1], w[:, 0]) + math.radians(17.0)
-    lower = np.array([-0.06, -0.06, math.radians(-30), -0.1, 0.01, 0.04, -0.15, -0.15])
-    upper = np.array([0.06, 0.06, math.radians(30), 0.1, 0.08, 0.2, 0.15, 0.15])
+    places, angles, lower, upper = _rod_poses(A, B)
     spec = SynthesisSpec(Path("test.toml"), "test", "motion", "slider-crank", places, None, lower, upper,
                          seed=1, population=15, generations=400, keep=1, angles=angles)
     best = synthesise(spec).linkages[0]
@@ -181,11 +187,7 @@ def test_three_pose_motion_synthesis_meets_the_poses(tmp_path):
     from pinmech.design.synthesis_tasks import classical_rows
 
     A, B = _engine_pins(tmp_path, np.array([20.0, 80.0, 140.0]))
-    w = (B - A) / np.linalg.norm(B - A, axis=1)[:, None]
-    places = A + 0.06 * w + 0.02 * np.stack((-w[:, 1], w[:, 0]), -1)
-    angles = np.arctan2(w[:, 1], w[:, 0]) + math.radians(17.0)
-    lower = np.array([-0.06, -0.06, math.radians(-30), -0.1, 0.01, 0.04, -0.15, -0.15])
-    upper = np.array([0.06, 0.06, math.radians(30), 0.1, 0.08, 0.2, 0.15, 0.15])
+    places, angles, lower, upper = _rod_poses(A, B)
     spec = SynthesisSpec(Path("test.toml"), "test", "motion", "slider-crank", places, None, lower, upper,
                          seed=1, population=5, generations=10, keep=1, angles=angles)
     starts = classical_rows(spec)
