@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinmech.design.cluster import Runner, batch_runner
-from pinmech.design.grid_steps import GridSteps
+from pinmech.design.grid_maps import GridMaps
 from pinmech.design.tolerance import batches
 from pinmech.design.workspace_batch import FIELDS, PointsBatch, WorkspaceBatch, built
 from pinmech.design.workspace_file import WorkspaceSpec
@@ -28,7 +28,7 @@ from pinmech.exceptions import SceneError
 
 
 @dataclass(frozen=True)
-class WorkspaceResult(GridSteps):
+class WorkspaceResult(GridMaps):
     """A workspace study's maps (SI; grid axes first, then the mode axis).
 
     Attributes:
@@ -42,17 +42,8 @@ class WorkspaceResult(GridSteps):
             modes) distance to them [m] (within `locus_bound`).
     """
 
-    spec: WorkspaceSpec
     modes: tuple[str, ...]
-    motors: tuple[str, ...]
-    length: float
-    coords: list[np.ndarray]
-    reached: np.ndarray
     motor_q: np.ndarray
-    values: dict[str, np.ndarray]
-    measures: dict[str, Measure]
-    type1: dict[str, np.ndarray]
-    type2: dict[str, np.ndarray]
     dist1: np.ndarray
     dist2: np.ndarray
 
@@ -116,8 +107,9 @@ def _maps(spec: WorkspaceSpec, wm, results: list[WorkspaceBatch], run: Runner) -
         points = mesh[here]
         dist1[..., k][here] = distances(points, type1[mode])
         dist2[..., k][here] = distances(points, type2[mode])
-    return WorkspaceResult(spec, modes, wm.motors, wm.length, coords, reached, motor_q, values, measures,
-                           type1, type2, dist1, dist2)
+    return WorkspaceResult(spec=spec, motors=wm.motors, length=wm.length, coords=coords, reached=reached,
+                           values=values, measures=measures, type1=type1, type2=type2, modes=modes,
+                           motor_q=motor_q, dist1=dist1, dist2=dist2)
 
 
 def _members(mode: str, reached: np.ndarray, det2: np.ndarray) -> dict[str, np.ndarray]:

@@ -20,18 +20,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinmech.design.cluster import batch_runner
-from pinmech.design.grid_steps import GridSteps
+from pinmech.design.grid_maps import GridMaps
 from pinmech.design.tolerance import batches
 from pinmech.design.workspace_actuator_batch import ASSEMBLIES, FIELDS, ActuatorBatch
 from pinmech.design.workspace_file import WorkspaceSpec
 from pinmech.design.workspace_maps import boundary_edges, sign_change_edges
-from pinmech.design.workspace_measure import Measure, measure
+from pinmech.design.workspace_measure import measure
 from pinmech.design.workspace_solve import WorkspaceMechanism
 from pinmech.exceptions import SceneError
 
 
 @dataclass(frozen=True)
-class ActuatorResult(GridSteps):
+class ActuatorResult(GridMaps):
     """An actuator-space workspace study's maps (SI; the motors' axes first, then the
     assembly slot "+", "-").
 
@@ -46,18 +46,9 @@ class ActuatorResult(GridSteps):
             [rad or m] in actuator space.
     """
 
-    spec: WorkspaceSpec
-    motors: tuple[str, ...]
     angular: tuple[bool, ...]
-    length: float
-    coords: list[np.ndarray]
-    reached: np.ndarray
     end: np.ndarray
     modes: np.ndarray
-    values: dict[str, np.ndarray]
-    measures: dict[str, Measure]
-    type1: dict[str, np.ndarray]
-    type2: dict[str, np.ndarray]
 
 
 def run_actuator_workspace(spec: WorkspaceSpec, wm: WorkspaceMechanism, *, workers: int = 0,
@@ -92,5 +83,6 @@ def run_actuator_workspace(spec: WorkspaceSpec, wm: WorkspaceMechanism, *, worke
     type1 = {a: sign_change_edges(values["det1"][..., k], coords) for k, a in enumerate(ASSEMBLIES)}
     type2 = {a: boundary_edges(reached[..., k], coords) for k, a in enumerate(ASSEMBLIES)}
     angular = tuple(not wm.prismatic_motor[wm.motors.index(a.name)] for a in spec.axes)
-    return ActuatorResult(spec, tuple(a.name for a in spec.axes), angular, wm.length, coords, reached, end, modes,
-                          values, measures, type1, type2)
+    return ActuatorResult(spec=spec, motors=tuple(a.name for a in spec.axes), length=wm.length, coords=coords,
+                          reached=reached, values=values, measures=measures, type1=type1, type2=type2,
+                          angular=angular, end=end, modes=modes)

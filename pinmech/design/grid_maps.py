@@ -1,0 +1,46 @@
+"""What a workspace grid's maps (task space or the motors') share: their grid, what each
+point reached, the determinants and conditioning, the measures, the loci, and what they say
+of their own resolution."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pinmech.design.workspace_file import WorkspaceSpec
+from pinmech.design.workspace_measure import Measure
+
+
+@dataclass(frozen=True)
+class GridMaps:
+    """A workspace study's maps over grid axes `coords` (1-D arrays in the axes' units: m,
+    or rad for a motor's angle); the fields each kind adds are in its own class.
+
+    Attributes:
+        spec: the study; motors: the motors' names; length: the characteristic length [m].
+        reached: (grid..., columns) bool; values: det1, det2, sigma1, sigma2, kappa (grid...,
+            columns); measures: each region's area or volume with its bound; type1, type2:
+            each region's locus midpoints (k, axes).
+    """
+
+    spec: WorkspaceSpec
+    motors: tuple[str, ...]
+    length: float
+    coords: list[np.ndarray]
+    reached: np.ndarray
+    values: dict[str, np.ndarray]
+    measures: dict[str, Measure]
+    type1: dict[str, np.ndarray]
+    type2: dict[str, np.ndarray]
+
+    @property
+    def steps(self) -> tuple[float, ...]:
+        """The grid's steps [the axes' units]."""
+        return tuple(float(c[1] - c[0]) for c in self.coords)
+
+    @property
+    def locus_bound(self) -> float:
+        """How far a locus midpoint (and so a distance to it) can be from the locus: half the
+        largest step [the axes' units]."""
+        return max(self.steps) / 2
