@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pinmech.design.tolerance import batches
 from pinmech.design.workspace_file import WorkspaceSpec
 from pinmech.design.workspace_measure import Measure
 
@@ -44,3 +45,15 @@ class GridMaps:
         """How far a locus midpoint (and so a distance to it) can be from the locus: half the
         largest step [the axes' units]."""
         return max(self.steps) / 2
+
+
+def grid_batches(spec: WorkspaceSpec, run, progress=None) -> list:
+    """The grid's points solved in batches of `spec.batch` by `run` (cluster.batch_runner's:
+    here or on Dask), in order; `progress(points done, points)` after each batch."""
+    done = [0]
+
+    def tick(batch) -> None:
+        done[0] += batch.count
+        progress(done[0], spec.size)
+
+    return run(spec, batches(spec.size, spec.batch), tick if progress else None)

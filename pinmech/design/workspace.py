@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinmech.design.cluster import Runner, batch_runner
-from pinmech.design.grid_maps import GridMaps
+from pinmech.design.grid_maps import GridMaps, grid_batches
 from pinmech.design.tolerance import batches
 from pinmech.design.workspace_batch import FIELDS, PointsBatch, WorkspaceBatch, built
 from pinmech.design.workspace_file import WorkspaceSpec
@@ -70,15 +70,8 @@ def run_workspace(spec: WorkspaceSpec, *, workers: int = 0, scheduler: str | Non
         from pinmech.design.workspace_actuator import run_actuator_workspace
 
         return run_actuator_workspace(spec, wm, workers=workers, scheduler=scheduler, progress=progress)
-    todo = batches(spec.size, spec.batch)
-    done = [0]
-
-    def tick(batch) -> None:
-        done[0] += batch.count
-        progress(done[0], spec.size)
-
     with batch_runner(workers=workers, scheduler=scheduler) as run:
-        results: list[WorkspaceBatch] = run(spec, todo, tick if progress else None)
+        results: list[WorkspaceBatch] = grid_batches(spec, run, progress)
         return _maps(spec, wm, results, run)
 
 

@@ -20,8 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinmech.design.cluster import batch_runner
-from pinmech.design.grid_maps import GridMaps
-from pinmech.design.tolerance import batches
+from pinmech.design.grid_maps import GridMaps, grid_batches
 from pinmech.design.workspace_actuator_batch import ASSEMBLIES, FIELDS, ActuatorBatch
 from pinmech.design.workspace_file import WorkspaceSpec
 from pinmech.design.workspace_maps import boundary_edges, sign_change_edges
@@ -58,15 +57,8 @@ def run_actuator_workspace(spec: WorkspaceSpec, wm: WorkspaceMechanism, *, worke
     Raises:
         SceneError: no cell of the grid assembles in either mode (key "workspace.actuators").
     """
-    todo = batches(spec.size, spec.batch)
-    done = [0]
-
-    def tick(batch) -> None:
-        done[0] += batch.count
-        progress(done[0], spec.size)
-
     with batch_runner(workers=workers, scheduler=scheduler) as run:
-        results: list[ActuatorBatch] = run(spec, todo, tick if progress else None)
+        results: list[ActuatorBatch] = grid_batches(spec, run, progress)
     shape = tuple(a.count for a in spec.axes)
     reached = np.concatenate([b.reached for b in results]).reshape(*shape, 2)
     if not reached.any():
