@@ -16,13 +16,11 @@ from pinmech.design.workspace_measure import Measure
 @dataclass(frozen=True)
 class GridMaps:
     """A workspace study's maps over grid axes `coords` (1-D arrays in the axes' units: m,
-    or rad for a motor's angle); the fields each kind adds are in its own class.
-
-    Attributes:
-        spec: the study; motors: the motors' names; length: the characteristic length [m].
-        reached: (grid..., columns) bool; values: det1, det2, sigma1, sigma2, kappa (grid...,
-            columns); measures: each region's area or volume with its bound; type1, type2:
-            each region's locus midpoints (k, axes).
+    or rad for a motor's angle): the study `spec`, the `motors`' names, the characteristic
+    `length` [m], what each grid point `reached` (grid..., columns), the determinants and
+    conditioning in `values` (det1, det2, sigma1, sigma2, kappa), each region's area or
+    volume with its bound in `measures`, and each region's locus midpoints (k, axes) in
+    `type1` and `type2`. The fields each kind adds are in its own class.
     """
 
     spec: WorkspaceSpec

@@ -31,7 +31,7 @@ from pinmech.exceptions import SceneError
 class WorkspaceResult(GridMaps):
     """A workspace study's maps (SI; grid axes first, then the mode axis).
 
-    Attributes:
+    Fields (SI):
         spec: the study file; modes: working modes ("+-": a sign a leg); motors: motor names.
         length: the characteristic length L [m]; coords: each axis's values [m].
         reached: (grid..., modes) bool; motor_q: (grid..., modes, legs) [rad or m];

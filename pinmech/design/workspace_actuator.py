@@ -34,7 +34,7 @@ class ActuatorResult(GridMaps):
     """An actuator-space workspace study's maps (SI; the motors' axes first, then the
     assembly slot "+", "-").
 
-    Attributes:
+    Fields (SI):
         spec: the study file; motors: the axes' motor names (the file's order); angular
             (each axis): a turn [rad], else a slide [m]; length: L [m];
         coords: each axis's motor values [rad or m]; reached: (grid..., 2) bool;
