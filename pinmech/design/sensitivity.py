@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from pinmech.exceptions import SceneError, SingularPoseError
+from pinmech.exceptions import SingularPoseError
 from pinmech.design.accel_sensitivity import acceleration_sensitivity
 from pinmech.design.rate_sensitivity import link_omega_sensitivity, velocity_sensitivity
 from pinmech.design.study_outputs import StudyOutputs

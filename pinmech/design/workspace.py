@@ -88,7 +88,6 @@ def _maps(spec: WorkspaceSpec, wm, results: list[WorkspaceBatch], run: Runner) -
     values = {f: np.concatenate([b.values[f] for b in results]).reshape(*shape, len(modes)) for f in FIELDS}
     motor_q = np.concatenate([b.motors for b in results]).reshape(*shape, len(modes), len(wm.legs))
     coords = [np.asarray(a.values) for a in spec.axes]
-    steps = tuple(float(c[1] - c[0]) for c in coords)
     mesh = np.stack(np.meshgrid(*coords, indexing="ij"), axis=-1)
     measures, type1, type2 = {}, {}, {}
     dist1, dist2 = np.full(reached.shape, np.nan), np.full(reached.shape, np.nan)
