@@ -96,6 +96,7 @@ class StudyOutputs:
         self._index = {key: [rows[f] for f in fs] for key, fs in
                        (("points", self.points), ("links", self.links), ("omega", self.omega), ("alpha", self.alpha),
                         ("pins", self.pins))}
+        self._columns(len(spec.sliders))
 
     def _kinematics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         """The frames' kinematics rows (n, F, KINEMATICS_COLUMNS): position 0:3, rotation 3:12,
@@ -104,49 +105,60 @@ class StudyOutputs:
         _core.frames_along(self.sm.model, self._data, q, v, a, self._frames, K)
         return K
 
-    def cycle(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+    def _columns(self, n_sliders: int) -> None:
+        """Where each kind of output sits in a row of `names` (slices), and the kinematics
+        entries the points and the links' x axes are gathered from, set once."""
+        ends = np.cumsum([0, len(self.points) * len(self.axes), len(self.links), len(self.dyads), n_sliders,
+                          n_sliders, len(self.omega)])
+        self._points_at, self._links_at, self._mu_at, self._s_at, self._s_dot_at, self._omega_at = (
+            slice(a, b) for a, b in zip(ends[:-1], ends[1:]))
+        at = self._index
+        self._point_rows = np.array([i for i in at["points"] for _ in self.axes], dtype=np.intp)
+        self._point_axes = np.array([k for _ in at["points"] for k in self.axes], dtype=np.intp)
+        self._x_axes = (np.array(at["links"], dtype=np.intp)[:, None], np.array([3, 6, 9]))  # rotation's 1st column
+        self._iq = [iq for iq, _ in self.sliders]
+        self._iv = [iv for _, iv in self.sliders]
+
+    def cycle(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """The outputs (steps, n_out) at the poses q with rates v, a (steps, nq / nv) of the
-        variant now written in the model [m, rad, m/s, rad/s, rad/s^2]."""
+        variant now written in the model [m, rad, m/s, rad/s, rad/s^2], written into `out`
+        (steps, n_out) where given (a batch's row), else into a new array."""
         q, v, a = (np.ascontiguousarray(x, dtype=float).reshape(len(q), -1) for x in (q, v, a))
-        n, P, R = len(q), None, None
-        if len(self._frames):
-            K = self._kinematics(q, v, a)
-            P, R, W, alpha = K[..., 0:3], K[..., 3:12], K[..., 15:18], K[..., 21:24]
-            at = self._index
-        columns = self._pose_columns(q, P, R)
-        columns += [v[:, iv] for _, iv in self.sliders]
-        if len(self._frames):
-            columns += list((W[:, at["omega"]] @ self.normal).T) if at["omega"] else []
-        if len(self._frames):
-            columns += list((alpha[:, at["alpha"]] @ self.normal).T) if at["alpha"] else []
-        for stroke in self.strokes:
+        out = np.empty((len(q), len(self.names))) if out is None else out
+        K = self._kinematics(q, v, a) if len(self._frames) else None
+        self._pose_into(q, K, out)
+        out[:, self._s_dot_at] = v[:, self._iv]
+        if self.omega:
+            out[:, self._omega_at] = K[:, self._index["omega"], 15:18] @ self.normal
+        if self.alpha:
+            out[:, self.alpha_at] = K[:, self._index["alpha"], 21:24] @ self.normal
+        for j, stroke in enumerate(self.strokes):
             top, _, low, _ = stroke.extremes(q)
-            columns.append(np.full(n, top - low))
-        columns += list(self.torques.values(q, v, a).T)
-        return np.column_stack(columns) if columns else np.zeros((len(q), 0))
+            out[:, self.strokes_at.start + j] = top - low
+        if self.torques.names:
+            out[:, self.torque_at] = self.torques.values(q, v, a)
+        return out
 
     def pose_values(self, q: np.ndarray) -> np.ndarray:
         """The pose outputs (the first n_pose) at one pose q (nq,) [m, rad]."""
         q = np.ascontiguousarray(q, dtype=float).reshape(1, -1)
-        if not len(self._frames):
-            return np.array(self._pose_columns(q, None, None)).reshape(-1)
+        out = np.empty((1, self.n_pose))
         zero = np.zeros((1, self.sm.model.nv))
-        K = self._kinematics(q, zero, zero)
-        P, R = K[..., 0:3], K[..., 3:12]
-        return np.array(self._pose_columns(q, P, R)).reshape(-1)
+        self._pose_into(q, self._kinematics(q, zero, zero) if len(self._frames) else None, out)
+        return out[0]
 
-    def _pose_columns(self, q: np.ndarray, P: np.ndarray | None, R: np.ndarray | None) -> list[np.ndarray]:
-        """Points, link angles, transmission angles, sliders' s at the poses q (n, nq), from
-        the frames' positions P (n, F, 3) and rotations R (n, F, 9)."""
-        columns = []
-        if P is not None:
-            at = self._index
-            columns += [P[:, i, k] for i in at["points"] for k in self.axes]
-            x_axes = R[:, at["links"]][..., [0, 3, 6]]  # each link's x axis (rotation's first column), world
-            columns += list(np.arctan2(x_axes @ self.e2, x_axes @ self.e1).T) if at["links"] else []
-            x = {f: P[:, i] for f, i in zip(self.pins, at["pins"])}
-            columns += [transmission_values(d, x, self.e1, self.e2) for d in self.dyads]
-        return columns + [q[:, iq] for iq, _ in self.sliders]
+    def _pose_into(self, q: np.ndarray, K: np.ndarray | None, out: np.ndarray) -> None:
+        """Points, link angles, transmission angles, sliders' s at the poses q (n, nq) into
+        out's first n_pose columns, from the frames' kinematics rows K (n, F, 24)."""
+        if K is not None:
+            out[:, self._points_at] = K[:, self._point_rows, self._point_axes]
+            if self.links:
+                x_axes = K[:, self._x_axes[0], self._x_axes[1]]  # (n, links, 3): each link's x axis, world
+                out[:, self._links_at] = np.arctan2(x_axes @ self.e2, x_axes @ self.e1)
+            x = {f: K[:, i, 0:3] for f, i in zip(self.pins, self._index["pins"])}
+            for j, d in enumerate(self.dyads):
+                out[:, self._mu_at.start + j] = transmission_values(d, x, self.e1, self.e2)
+        out[:, self._s_at] = q[:, self._iq]
 
     def jacobians(self, data: pin.Data) -> tuple[np.ndarray, np.ndarray]:
         """The pose outputs' (dy/dq on the tangent space (n_pose, nv), dy/dp at fixed q

@@ -96,14 +96,17 @@ class Placement:
         return float(self._se3(self.frames[0] if self.frames else -1).translation[self.component])
 
     def write(self, value: float) -> None:
-        """Write the component [m] into the model in place (frames: each moved by the same amount)."""
+        """Write the component [m] into the model in place (frames: each moved by the same
+        amount). Pinocchio 4's bindings hand `translation` as a view of the model's own SE3,
+        so one component is written with no SE3 copied (tests/test_study_params_write.py)."""
         if not self.frames:
-            self.model.jointPlacements[self.joint] = self._moved(self.model.jointPlacements[self.joint], value)
+            self.model.jointPlacements[self.joint].translation[self.component] = value
             return
-        shift = value - self.read()
+        frames, k = self.model.frames, self.component
+        shift = value - float(frames[self.frames[0]].placement.translation[k])
         for f in self.frames:
-            M = self.model.frames[f].placement
-            self.model.frames[f].placement = self._moved(M, float(M.translation[self.component]) + shift)
+            t = frames[f].placement.translation
+            t[k] = float(t[k]) + shift
 
     def direction(self, data: pin.Data) -> np.ndarray:
         """World direction [m/m] a unit change moves what it moves (`data.oMi` up to date):
@@ -117,13 +120,6 @@ class Placement:
         if self.frames:
             return frame in self.frames
         return self.model.frames[frame].parentJoint in subtree[self.joint]
-
-    def _moved(self, M: pin.SE3, value: float) -> pin.SE3:
-        M = M.copy()
-        t = M.translation.copy()
-        t[self.component] = value
-        M.translation = t
-        return M
 
     def _se3(self, frame: int) -> pin.SE3:
         return self.model.jointPlacements[self.joint] if frame < 0 else self.model.frames[frame].placement

@@ -85,12 +85,24 @@ class StudyMechanism:
         for place, value in zip(self.placements, p):
             place.write(float(value))
 
+    def outside(self, p: np.ndarray) -> np.ndarray:
+        """Whether the values p (..., n_par) [m] lie outside a parameter's bounds (...,) bool;
+        a batch (count, n_par) is checked in one call."""
+        return np.any(p < self.lower, axis=-1) | np.any(p > self.upper, axis=-1)
+
     def cycle(self, p: np.ndarray) -> VariantCycle:
-        """The variant with parameters p [m] over the cycle; the model keeps p afterwards.
-        The compiled core follows it in one call (variant_core.py); where it hands the
-        variant back, the scene's sweep solves it and names what failed."""
-        if np.any(p < self.lower) or np.any(p > self.upper):
-            return VariantCycle(self.values, None, "outside bounds", _outside(self.spec, p))
+        """The variant with parameters p [m] over the cycle; the model keeps p afterwards."""
+        return self.rejected(p) if self.outside(p) else self.within(p)
+
+    def rejected(self, p: np.ndarray) -> VariantCycle:
+        """The variant p [m] outside its bounds, with the first parameter outside named."""
+        return VariantCycle(self.values, None, "outside bounds", _outside(self.spec, p))
+
+    def within(self, p: np.ndarray) -> VariantCycle:
+        """The variant with parameters p [m] (within their bounds: `outside` checked) over
+        the cycle; the model keeps p afterwards. The compiled core follows it in one call
+        (variant_core.py); where it hands the variant back, the scene's sweep solves it and
+        names what failed."""
         self.write(p)
         fast = self.core.follow()
         if fast is not None:

@@ -70,11 +70,11 @@ def solve_variants(sm: StudyMechanism, outputs: StudyOutputs, batch: Batch, p: n
     extra = np.full(batch.count, np.nan) if at_variant else None
     causes = []
     try:
-        for i, pi in enumerate(p):
-            cycle = sm.cycle(pi)
+        for i, (pi, outside) in enumerate(zip(p, sm.outside(p).tolist())):
+            cycle = sm.rejected(pi) if outside else sm.within(pi)
             causes.append(cycle.cause)
             if not cycle.cause:
-                y[i] = outputs.cycle(cycle.q, cycle.v, cycle.a)
+                outputs.cycle(cycle.q, cycle.v, cycle.a, out=y[i])
                 if at_variant:
                     extra[i] = at_variant(cycle.q)
     finally:
