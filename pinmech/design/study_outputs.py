@@ -127,7 +127,8 @@ class StudyOutputs:
         out = np.empty((len(q), len(self.names))) if out is None else out
         K = self._kinematics(q, v, a) if len(self._frames) else None
         self._pose_into(q, K, out)
-        out[:, self._s_dot_at] = v[:, self._iv]
+        if self.sliders:
+            out[:, self._s_dot_at] = v[:, self._iv]
         if self.omega:
             out[:, self._omega_at] = K[:, self._index["omega"], 15:18] @ self.normal
         if self.alpha:
@@ -155,10 +156,11 @@ class StudyOutputs:
             if self.links:
                 x_axes = K[:, self._x_axes[0], self._x_axes[1]]  # (n, links, 3): each link's x axis, world
                 out[:, self._links_at] = np.arctan2(x_axes @ self.e2, x_axes @ self.e1)
-            x = {f: K[:, i, 0:3] for f, i in zip(self.pins, self._index["pins"])}
+            x = {f: K[:, i, 0:3] for f, i in zip(self.pins, self._index["pins"])} if self.dyads else {}
             for j, d in enumerate(self.dyads):
                 out[:, self._mu_at.start + j] = transmission_values(d, x, self.e1, self.e2)
-        out[:, self._s_at] = q[:, self._iq]
+        if self.sliders:
+            out[:, self._s_at] = q[:, self._iq]
 
     def jacobians(self, data: pin.Data) -> tuple[np.ndarray, np.ndarray]:
         """The pose outputs' (dy/dq on the tangent space (n_pose, nv), dy/dp at fixed q

@@ -89,6 +89,9 @@ class Placement:
 
     def __init__(self, model: pin.Model, joint: int, frames: tuple[int, ...], component: int) -> None:
         self.model, self.joint, self.frames, self.component = model, joint, tuple(frames), component
+        # the model's own vectors (Boost.Python views, indexed afresh at each write: a frame
+        # added to the model later moves their elements, not them)
+        self._joint_placements, self._model_frames = model.jointPlacements, model.frames
         self.written_in = model.parents[joint] if not self.frames else joint  # whose axes the component is in
 
     def read(self) -> float:
@@ -100,9 +103,9 @@ class Placement:
         amount). Pinocchio 4's bindings hand `translation` as a view of the model's own SE3,
         so one component is written with no SE3 copied (tests/test_study_params_write.py)."""
         if not self.frames:
-            self.model.jointPlacements[self.joint].translation[self.component] = value
+            self._joint_placements[self.joint].translation[self.component] = value
             return
-        frames, k = self.model.frames, self.component
+        frames, k = self._model_frames, self.component
         shift = value - float(frames[self.frames[0]].placement.translation[k])
         for f in self.frames:
             t = frames[f].placement.translation
