@@ -30,6 +30,7 @@ import pstats
 import statistics
 import sys
 import time
+import timeit
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -52,7 +53,8 @@ class Timers:
     calls were timed, while `installed` (the wrappers replace the compiled functions)."""
 
     def __init__(self) -> None:
-        self.solve, self.kinematics, self.calls = 0.0, 0.0, 0
+        self.solve, self.kinematics = 0.0, 0.0
+        self.calls = {"solve": 0, "kinematics": 0}
 
     @contextlib.contextmanager
     def installed(self):
@@ -75,8 +77,22 @@ class Timers:
                 return call(*args)
             finally:
                 setattr(self, total, getattr(self, total) + time.perf_counter() - t0)
-                self.calls += 1
+                self.calls[total] += 1
         return timed
+
+    @staticmethod
+    def cost(n: int = 200_000) -> tuple[float, float]:
+        """The timers' own cost a call [s]: the part outside the timed interval and the part
+        inside it, from n calls of a wrapped no-op (the builtin abs) against n bare ones
+        (the fastest of 5 tries each)."""
+        bare = min(timeit.repeat(lambda: abs(1.0), number=n, repeat=5)) / n
+        tries = []
+        for _ in range(5):
+            probe = Timers()
+            wrapped = probe._timed(abs, "solve")
+            tries.append((timeit.timeit(lambda: wrapped(1.0), number=n) / n, probe.solve / n))
+        total, inside = min(tries)
+        return total - inside, inside - bare
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -112,8 +128,11 @@ def main(argv: list[str] | None = None) -> None:
     wrapped = rows[1].times
     shares_a = [1 - t.solve / total for t, total in zip(timers, totals)]
     shares_b = [1 - (t.solve + t.kinematics) / total for t, total in zip(timers, totals)]
-    cost = [(w - total) / t.calls for t, w, total in zip(timers, wrapped, totals)]
+    cost = [(w - total) / sum(t.calls.values()) for t, w, total in zip(timers, wrapped, totals)]
     outside_b = [(total - t.solve - t.kinematics) / spec.samples for t, total in zip(timers, totals)]
+    out_cost, in_cost = Timers.cost()  # the same run's own estimate: its timers' cost taken off
+    same_run = [1 - (t.solve + t.kinematics - sum(t.calls.values()) * in_cost)
+                / (w - sum(t.calls.values()) * (out_cost + in_cost)) for t, w in zip(timers, wrapped)]
 
     def spread(xs: list[float], fmt: str) -> str:
         return f"median {format(statistics.median(xs), fmt)} ({format(min(xs), fmt)} .. {format(max(xs), fmt)})"
@@ -126,7 +145,10 @@ def main(argv: list[str] | None = None) -> None:
           f"- (b) outside every compiled per-pose call (those and the outputs' kinematics, frames_along): "
           f"{spread([s * 100 for s in shares_b], '.1f')} % of the time, "
           f"{spread([x * 1e6 for x in outside_b], '.1f')} us a variant\n"
-          f"- the timers' own cost (timed run - plain run, a wrapped call): {spread([c * 1e6 for c in cost], '.2f')} us")
+          f"- the timers' own cost a wrapped call: {(out_cost + in_cost) * 1e6:.2f} us ({in_cost * 1e6:.2f} us of it "
+          f"inside the timed interval) by a wrapped no-op; timed run - plain run: "
+          f"{spread([c * 1e6 for c in cost], '.2f')} us\n"
+          f"- (b) from the timed run alone, the no-op's cost taken off: {spread([s * 100 for s in same_run], '.1f')} %")
     if args.profile:
         profile = cProfile.Profile()
         profile.runcall(run_batch, sm, outputs, todo[0])

@@ -110,11 +110,10 @@ class StudyOutputs:
         entries the points and the links' x axes are gathered from, set once."""
         ends = np.cumsum([0, len(self.points) * len(self.axes), len(self.links), len(self.dyads), n_sliders,
                           n_sliders, len(self.omega)])
-        self._points_at, self._links_at, self._mu_at, self._s_at, self._s_dot_at, self._omega_at = (
+        _, self._links_at, self._mu_at, self._s_at, self._s_dot_at, self._omega_at = (
             slice(a, b) for a, b in zip(ends[:-1], ends[1:]))
         at = self._index
-        self._point_rows = np.array([i for i in at["points"] for _ in self.axes], dtype=np.intp)
-        self._point_axes = np.array([k for _ in at["points"] for k in self.axes], dtype=np.intp)
+        self._point_entries = list(enumerate((i, k) for i in at["points"] for k in self.axes))  # (column, (row, k))
         self._x_axes = (np.array(at["links"], dtype=np.intp)[:, None], np.array([3, 6, 9]))  # rotation's 1st column
         self._iq = [iq for iq, _ in self.sliders]
         self._iv = [iv for _, iv in self.sliders]
@@ -152,7 +151,8 @@ class StudyOutputs:
         """Points, link angles, transmission angles, sliders' s at the poses q (n, nq) into
         out's first n_pose columns, from the frames' kinematics rows K (n, F, 24)."""
         if K is not None:
-            out[:, self._points_at] = K[:, self._point_rows, self._point_axes]
+            for column, (row, k) in self._point_entries:  # one strided column each: cheaper than a gather
+                out[:, column] = K[:, row, k]
             if self.links:
                 x_axes = K[:, self._x_axes[0], self._x_axes[1]]  # (n, links, 3): each link's x axis, world
                 out[:, self._links_at] = np.arctan2(x_axes @ self.e2, x_axes @ self.e1)

@@ -105,10 +105,10 @@ class Placement:
         if not self.frames:
             self._joint_placements[self.joint].translation[self.component] = value
             return
-        frames, k = self._model_frames, self.component
-        shift = value - float(frames[self.frames[0]].placement.translation[k])
-        for f in self.frames:
-            t = frames[f].placement.translation
+        k = self.component
+        views = [self._model_frames[f].placement.translation for f in self.frames]
+        shift = value - float(views[0][k])
+        for t in views:
             t[k] = float(t[k]) + shift
 
     def direction(self, data: pin.Data) -> np.ndarray:
