@@ -11,11 +11,12 @@ a run with the compiled per-pose calls wrapped in timers (time.perf_counter):
 - the core's solve calls: `Core.correct` (pose 0 closed from the nominal's), `Core.node`
   (its tangent and assembly signature) and `Core.follow` (every other pose);
 - the outputs' kinematics over the cycle: `_core.frames_along` (the outputs at each pose).
-Each round's shares are the wrapped run's time inside those calls over the plain run's
-total, so the timers' own cost (reported: the wrapped run's extra time a wrapped call) is
-kept out of both shares:
-(a) outside the core's solve calls, (b) outside every compiled per-pose call (the solve
-and the outputs' kinematics). Medians over the rounds, and their spread (min .. max).
+Shares of the time outside (a) the core's solve calls, (b) every compiled per-pose call
+(the solve and the outputs' kinematics), each estimated two ways with the timers' own cost
+kept out: over the plain run of the same round (paired; its noise is the runs' difference),
+and within the timed run, less its timers' cost measured on a wrapped no-op (the builtin
+abs, its part inside the timed interval taken off the inside times too). Medians over the
+rounds and their spread (min .. max).
 
     python scripts/study_overhead.py --samples 10000 --steps 360 --rounds 5
 """
@@ -95,6 +96,41 @@ class Timers:
         return total - inside, inside - bare
 
 
+def shares(t: Timers, plain: float, wrapped: float, cost: tuple[float, float]) -> dict[str, float]:
+    """One round's shares of the time outside (a) the solve calls and (b) every compiled
+    per-pose call: over the plain run's total [s] (paired) and over the timed run's own
+    total [s] less its timers' cost (same run); the inside times less the timers' part
+    inside their intervals (cost: outside, inside the interval, a call [s])."""
+    out_c, in_c = cost
+    solve = t.solve - t.calls["solve"] * in_c
+    both = solve + t.kinematics - t.calls["kinematics"] * in_c
+    own = wrapped - sum(t.calls.values()) * (out_c + in_c)
+    return {"a": 1 - solve / plain, "b": 1 - both / plain, "a same run": 1 - solve / own,
+            "b same run": 1 - both / own, "outside b": plain - both,
+            "timers": (wrapped - plain) / sum(t.calls.values())}
+
+
+def _spread(xs: list[float], scale: float, fmt: str) -> str:
+    xs = [x * scale for x in xs]
+    return f"median {format(statistics.median(xs), fmt)} ({format(min(xs), fmt)} .. {format(max(xs), fmt)})"
+
+
+def report(rounds: list[dict[str, float]], plain: list[float], cost: tuple[float, float], samples: int,
+           poses: int) -> str:
+    """The medians and spreads (min .. max) over the rounds."""
+    col = {k: [r[k] for r in rounds] for k in rounds[0]}
+    solve = ", ".join("Core." + n for n in SOLVE)
+    return (f"- plain run: {_spread(plain, 1e6 / poses, '.3f')} us a variant-pose\n"
+            f"- (a) outside the core's solve calls ({solve}): {_spread(col['a'], 100, '.1f')} % of the plain "
+            f"run's time; from the timed run alone: {_spread(col['a same run'], 100, '.1f')} %\n"
+            f"- (b) outside every compiled per-pose call (those and the outputs' kinematics, frames_along): "
+            f"{_spread(col['b'], 100, '.1f')} % of the plain run's time, {_spread(col['outside b'], 1e6 / samples, '.1f')}"
+            f" us a variant; from the timed run alone: {_spread(col['b same run'], 100, '.1f')} %\n"
+            f"- the timers' own cost a wrapped call: {sum(cost) * 1e6:.2f} us ({cost[1] * 1e6:.2f} us of it inside "
+            f"the timed interval) by a wrapped no-op, taken off; timed run - plain run: "
+            f"{_spread(col['timers'], 1e6, '.2f')} us a wrapped call")
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=int, default=10000, help="variants")
@@ -107,7 +143,6 @@ def main(argv: list[str] | None = None) -> None:
     sm = StudyMechanism(spec)
     outputs = StudyOutputs(sm)
     todo = batches(spec.samples, spec.batch)
-    poses = spec.samples * spec.steps
     timers: list[Timers] = []
     solved: list[int] = []
 
@@ -121,34 +156,14 @@ def main(argv: list[str] | None = None) -> None:
         timers.append(t)
 
     plain()  # warm-up, not timed
-    rows = [Timed(plain), Timed(timed)]
+    rows = [Timed(plain), Timed(timed)]  # seconds a run (poses=1)
     load = os.getloadavg()[0]
     time_rounds(rows, args.rounds)
-    totals = rows[0].times  # seconds a plain run (Timed with poses=1)
-    wrapped = rows[1].times
-    shares_a = [1 - t.solve / total for t, total in zip(timers, totals)]
-    shares_b = [1 - (t.solve + t.kinematics) / total for t, total in zip(timers, totals)]
-    cost = [(w - total) / sum(t.calls.values()) for t, w, total in zip(timers, wrapped, totals)]
-    outside_b = [(total - t.solve - t.kinematics) / spec.samples for t, total in zip(timers, totals)]
-    out_cost, in_cost = Timers.cost()  # the same run's own estimate: its timers' cost taken off
-    same_run = [1 - (t.solve + t.kinematics - sum(t.calls.values()) * in_cost)
-                / (w - sum(t.calls.values()) * (out_cost + in_cost)) for t, w in zip(timers, wrapped)]
-
-    def spread(xs: list[float], fmt: str) -> str:
-        return f"median {format(statistics.median(xs), fmt)} ({format(min(xs), fmt)} .. {format(max(xs), fmt)})"
-
+    cost = Timers.cost()
+    rounds = [shares(t, p, w, cost) for t, p, w in zip(timers, rows[0].times, rows[1].times)]
     print(f"{spec.samples} variants x {spec.steps} poses ({solved[-1]} solved), {args.rounds} interleaved rounds; "
-          f"load average (1 min) {load:.1f} before, {os.getloadavg()[0]:.1f} after, on {os.cpu_count()} CPUs\n"
-          f"- plain run: {spread([t / poses * 1e6 for t in totals], '.3f')} us a variant-pose\n"
-          f"- (a) outside the core's solve calls ({', '.join('Core.' + n for n in SOLVE)}): "
-          f"{spread([s * 100 for s in shares_a], '.1f')} % of the time\n"
-          f"- (b) outside every compiled per-pose call (those and the outputs' kinematics, frames_along): "
-          f"{spread([s * 100 for s in shares_b], '.1f')} % of the time, "
-          f"{spread([x * 1e6 for x in outside_b], '.1f')} us a variant\n"
-          f"- the timers' own cost a wrapped call: {(out_cost + in_cost) * 1e6:.2f} us ({in_cost * 1e6:.2f} us of it "
-          f"inside the timed interval) by a wrapped no-op; timed run - plain run: "
-          f"{spread([c * 1e6 for c in cost], '.2f')} us\n"
-          f"- (b) from the timed run alone, the no-op's cost taken off: {spread([s * 100 for s in same_run], '.1f')} %")
+          f"load average (1 min) {load:.1f} before, {os.getloadavg()[0]:.1f} after, on {os.cpu_count()} CPUs")
+    print(report(rounds, rows[0].times, cost, spec.samples, spec.samples * spec.steps))
     if args.profile:
         profile = cProfile.Profile()
         profile.runcall(run_batch, sm, outputs, todo[0])
