@@ -101,7 +101,7 @@ class Placement:
     def write(self, value: float) -> None:
         """Write the component [m] into the model in place (frames: each moved by the same
         amount). Pinocchio 4's bindings hand `translation` as a view of the model's own SE3,
-        so one component is written with no SE3 copied (tests/test_study_params_write.py)."""
+        so one component is written with no SE3 copied (tests/test_study_variant_writes.py)."""
         if not self.frames:
             self._joint_placements[self.joint].translation[self.component] = value
             return

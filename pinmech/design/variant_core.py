@@ -57,10 +57,8 @@ class CoreCycle:
         path, _ = self.attempt()
         if path is None:
             return None
-        Q, D1, D2 = path  # the core's own new arrays: a is formed in D2's place
-        A = np.multiply(D2, self.w * self.w, out=D2)
-        A += D1 * self.alpha
-        return Q, D1 * self.w, A
+        Q, D1, D2 = path
+        return Q, D1 * self.w, D2 * (self.w * self.w) + D1 * self.alpha
 
     def attempt(self) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray] | None, str]:
         """q and its first and second derivatives along the swept driver's value at every
