@@ -12,11 +12,11 @@ a run with the compiled per-pose calls wrapped in timers (time.perf_counter):
   (its tangent and assembly signature) and `Core.follow` (every other pose);
 - the outputs' kinematics over the cycle: `_core.frames_along` (the outputs at each pose).
 Shares of the time outside (a) the core's solve calls, (b) every compiled per-pose call
-(the solve and the outputs' kinematics), each estimated two ways with the timers' own cost
-kept out: over the plain run of the same round (paired; its noise is the runs' difference),
-and within the timed run, less its timers' cost measured on a wrapped no-op (the builtin
-abs, its part inside the timed interval taken off the inside times too). Medians over the
-rounds and their spread (min .. max).
+(the solve and the outputs' kinematics), with the timers' own cost kept out: within the
+timed run, less its timers' cost measured on a wrapped no-op (the builtin abs; its part
+inside the timed interval taken off the inside times too); and, as a check, over the plain
+run of the same round (paired: noisier, as the two runs' times differ by whatever load
+other processes put on the machine). Medians over the rounds and their spread (min .. max).
 
     python scripts/study_overhead.py --samples 10000 --steps 360 --rounds 5
 """
@@ -121,14 +121,15 @@ def report(rounds: list[dict[str, float]], plain: list[float], cost: tuple[float
     col = {k: [r[k] for r in rounds] for k in rounds[0]}
     solve = ", ".join("Core." + n for n in SOLVE)
     return (f"- plain run: {_spread(plain, 1e6 / poses, '.3f')} us a variant-pose\n"
-            f"- (a) outside the core's solve calls ({solve}): {_spread(col['a'], 100, '.1f')} % of the plain "
-            f"run's time; from the timed run alone: {_spread(col['a same run'], 100, '.1f')} %\n"
+            f"- (a) outside the core's solve calls ({solve}): {_spread(col['a same run'], 100, '.1f')} % of the "
+            f"time (paired with the plain run: {_spread(col['a'], 100, '.1f')} %)\n"
             f"- (b) outside every compiled per-pose call (those and the outputs' kinematics, frames_along): "
-            f"{_spread(col['b'], 100, '.1f')} % of the plain run's time, {_spread(col['outside b'], 1e6 / samples, '.1f')}"
-            f" us a variant; from the timed run alone: {_spread(col['b same run'], 100, '.1f')} %\n"
-            f"- the timers' own cost a wrapped call: {sum(cost) * 1e6:.2f} us ({cost[1] * 1e6:.2f} us of it inside "
-            f"the timed interval) by a wrapped no-op, taken off; timed run - plain run: "
-            f"{_spread(col['timers'], 1e6, '.2f')} us a wrapped call")
+            f"{_spread(col['b same run'], 100, '.1f')} % of the time (paired with the plain run: "
+            f"{_spread(col['b'], 100, '.1f')} %, {_spread(col['outside b'], 1e6 / samples, '.1f')} us a variant)\n"
+            f"- the timers' own cost a wrapped call, taken off: {sum(cost) * 1e6:.2f} us ({cost[1] * 1e6:.2f} us of "
+            f"it inside the timed interval), by a wrapped no-op; timed run - plain run: "
+            f"{_spread(col['timers'], 1e6, '.2f')} us a wrapped call (the paired figures are as good as this "
+            f"agrees: other processes' load moves the plain and the timed runs apart)")
 
 
 def main(argv: list[str] | None = None) -> None:
