@@ -520,11 +520,15 @@ def test_condition_numbers_are_the_svds(n, log_condition, log_size, seed):
        seed=st.integers(0, 2**32 - 1))
 @example(n=32, kl=2, ku=1, log_grade=0.0, seed=1)  # a chain of 16 four-bars
 @example(n=40, kl=2, ku=1, log_grade=6.0, seed=2)
+@example(n=300, kl=2, ku=1, log_grade=0.0, seed=3)  # more bulge chases in flight than the core keeps at once (64)
+@example(n=200, kl=3, ku=4, log_grade=3.0, seed=4)  # several chases a row, many in flight
 def test_condition_numbers_of_band_matrices_are_the_svds(n, kl, ku, log_grade, seed):
     """Band matrices, kl nonzeros below the diagonal and ku above (the dependent Jacobian
     of a chain of loops has 2 and 1), rows graded over up to 8 decades. Where the band is
     narrow (5.5 (kl + ku) <= n + 8) the core bidiagonalizes by plane rotations that keep
-    the band, else by reflections: both give the SVD's numbers, to the bar above."""
+    the band, else by reflections: both give the SVD's numbers, to the bar above. (The
+    rotations chase several bulges down the band at once: an order that let one chase
+    touch what an earlier one has still to touch would give other numbers.)"""
     rng = np.random.default_rng(seed)
     i, j = np.indices((n, n))
     A = np.where((i - j <= kl) & (j - i <= ku), rng.normal(size=(n, n)), 0.0)

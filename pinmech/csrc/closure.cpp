@@ -75,6 +75,11 @@ Core::Core(nb::object model, const std::vector<int>& frame_ids, const std::vecto
   v_scale_inv_ = v_scale.cwiseInverse();
   dep_scale_.resize(Index(dep_v_.size()));
   for (size_t i = 0; i < dep_v_.size(); ++i) dep_scale_(Index(i)) = v_scale(dep_v_[i]);
+  for (const Cut& cut : cuts_)
+    for (Index v : cut.columns) {
+      const auto at = std::find(dep_v_.begin(), dep_v_.end(), int(v));
+      if (at != dep_v_.end()) dep_blocks_.push_back({cut.offset, cut.rows6.rows(), v, Index(at - dep_v_.begin())});
+    }
   blocks_rows_ = block_rows;
   blocks_cols_ = block_cols;
   step_ = VectorXd::Zero(nv);
@@ -159,7 +164,19 @@ void Core::jacobian_into(bool newton) {
     joint_jacobians_ = true;
   }
   for (const Cut& cut : cuts_) relative_jacobian(cut, newton);
-  for (size_t i = 0; i < dep_v_.size(); ++i) Jdep_.col(Index(i)) = J_.col(dep_v_[i]);
+  // J_dep = J_'s dependent columns, copied where they are not structurally zero (a chain
+  // of loops: O(loops), where the whole columns would be O(loops^2))
+  for (const ColumnBlock& b : dep_blocks_) Jdep_.block(b.offset, b.dep, b.rows, 1) = J_.block(b.offset, b.v, b.rows, 1);
+}
+
+// out = J_ x, from each cut's rows' own columns (the others are exactly zero), in
+// ascending column order as the dense product sums them.
+void Core::rows_times(const VectorXd& x, VectorXd& out) const {
+  for (const Cut& cut : cuts_) {
+    auto rows = out.segment(cut.offset, cut.rows6.rows());
+    rows.setZero();
+    for (Index v : cut.columns) rows += J_.block(cut.offset, v, cut.rows6.rows(), 1) * x(v);
+  }
 }
 
 VectorXd Core::drift(const VectorXd& q, const VectorXd& v) {
@@ -317,8 +334,10 @@ void Core::relative_columns(Cut& cut) const {
   for (const auto* cols : {&cut.child_cols, &cut.parent_cols})
     for (const JointColumn& c : *cols) {
       if (std::find(seen.begin(), seen.end(), c.v) != seen.end()) cut.shared_columns = true;
-      seen.push_back(c.v);
+      else seen.push_back(c.v);
     }
+  std::sort(seen.begin(), seen.end());
+  cut.columns = seen;
 }
 
 // Rows offset .. offset + k of J_ = the cut's rows6 times its (6, nv) map from joint

@@ -92,6 +92,63 @@ void rotate_columns(MatrixXd& R, Index p, Index q, Index from, Index to, Rotatio
   }
 }
 
+// The bulge chases of band_bidiagonalize, several at once. For each k (in order) and each
+// j from k + width down to k + 2 (a "chase"): a column rotation clears R(k, j), and the
+// bulge it leaves below the diagonal is chased down the band, `width` rows a step, by a
+// row and a column rotation (as LAPACK's dgbbrd). Each chase is a chain of dependent
+// rotations (a square root and a division each), so one at a time the CPU waits on them;
+// here a chase starts, and steps on, as soon as what it touches lies wholly above and to
+// the left of everything the chases before it still have to touch (their steps only move
+// down the band). Operations on disjoint entries commute, so this performs exactly the
+// sequential order's arithmetic, bit for bit, with up to n / (2 width) chases in flight
+// whose rotations the CPU overlaps. A chase touches rows and columns [k, j] at its start
+// and [r - 1, min(n - 1, r + width)] at a step from the bulge at (r, r - 1).
+struct Chase {
+  Index k, r;  // its row; its bulge's row (r, r - 1)
+};
+
+void chase_bulges(MatrixXd& R, Index width) {
+  const Index n = R.rows();
+  constexpr int MAX_CHASES = 64;
+  Chase active[MAX_CHASES];
+  int count = 0;
+  Index next_k = 0, next_j = std::min(n - 1, width);  // the next chase to start: (k, j)
+  while (count > 0 || next_k + 2 < n) {
+    Index bound = n;  // no index at or past it may be touched: the earlier chases' least one to come
+    int kept = 0;
+    for (int i = 0; i < count; ++i) {
+      Chase c = active[i];
+      if (std::min(n - 1, c.r + width) < bound) {  // a step: the bulge at (r, r - 1), then (r - 1, r + width)
+        const Index r = c.r;
+        if (R(r, r - 1) != 0.0) {
+          rotate_rows(R, r - 1, r, r - 1, std::min(n - 1, r + width), rotation(R(r - 1, r - 1), R(r, r - 1)));
+          R(r, r - 1) = 0.0;
+        }
+        const Index col = r + width;
+        if (col > n - 1 || R(r - 1, col) == 0.0) continue;  // the chase has left the band
+        rotate_columns(R, col - 1, col, r - 1, col, rotation(R(r - 1, col - 1), R(r - 1, col)));
+        R(r - 1, col) = 0.0;
+        c.r = col;
+      }
+      bound = std::min(bound, c.r - 1);
+      active[kept++] = c;
+    }
+    count = kept;
+    while (next_k + 2 < n && count < MAX_CHASES && next_j < bound) {  // start the next chases
+      const Index k = next_k, j = next_j;
+      if (--next_j < next_k + 2) {
+        ++next_k;
+        next_j = std::min(n - 1, next_k + width);
+      }
+      if (R(k, j) == 0.0) continue;
+      rotate_columns(R, j - 1, j, k, j, rotation(R(k, j - 1), R(k, j)));
+      R(k, j) = 0.0;
+      active[count++] = {k, j};
+      bound = j - 1;
+    }
+  }
+}
+
 // Upper bidiagonalization of a band matrix (nonzeros at most kl below and ku above the
 // diagonal) in place by plane rotations, which keep the band: a QR clears the lower band
 // (R then has upper bandwidth w = kl + ku), then each row's entries beyond the
@@ -122,23 +179,7 @@ void band_bidiagonalize(ConditionWork& w, Index kl, Index ku) {
         break;
       }
   width = reach;
-  for (Index k = 0; k + 2 < n && width >= 2; ++k)
-    for (Index j = std::min(n - 1, k + width); j >= k + 2; --j) {
-      if (R(k, j) == 0.0) continue;
-      rotate_columns(R, j - 1, j, k, j, rotation(R(k, j - 1), R(k, j)));
-      R(k, j) = 0.0;
-      for (Index r = j;;) {  // the bulge at (r, r - 1), below the diagonal
-        if (R(r, r - 1) != 0.0) {
-          rotate_rows(R, r - 1, r, r - 1, std::min(n - 1, r + width), rotation(R(r - 1, r - 1), R(r, r - 1)));
-          R(r, r - 1) = 0.0;
-        }
-        const Index c = r + width;  // the bulge at (r - 1, c), beyond the band
-        if (c > n - 1 || R(r - 1, c) == 0.0) break;
-        rotate_columns(R, c - 1, c, r - 1, c, rotation(R(r - 1, c - 1), R(r - 1, c)));
-        R(r - 1, c) = 0.0;
-        r = c;
-      }
-    }
+  if (width >= 2) chase_bulges(R, width);
   w.d.resize(n);
   w.e.resize(n - 1);
   for (Index i = 0; i < n; ++i) {

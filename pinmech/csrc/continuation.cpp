@@ -64,7 +64,8 @@ void Core::node_at(Node& node, const VectorXd& d, const VectorXd* a_drv) {
   // One factorization of the dimensionless J_dep (columns times dep_scale_) serves the
   // condition number and both solves; a dependent rate is dep_scale_ times its unknown.
   jacobian_into(false);
-  scaled_ = Jdep_ * dep_scale_.asDiagonal();
+  for (const ColumnBlock& b : dep_blocks_)  // J_dep times dep_scale_'s diagonal, where not structurally zero
+    scaled_.block(b.offset, b.dep, b.rows, 1) = Jdep_.block(b.offset, b.dep, b.rows, 1) * dep_scale_(b.dep);
   square_.factor(scaled_);
   // The condition number of J_dep, with its rows and columns in block order where it has
   // several blocks (a permutation: the same singular values), where a chain of loops is a
@@ -90,9 +91,9 @@ void Core::node_at(Node& node, const VectorXd& d, const VectorXd* a_drv) {
   }
   square_.solve(rhs_, dstep_);
   for (size_t i = 0; i < dep_v_.size(); ++i) a(dep_v_[i]) = dep_scale_(Index(i)) * dstep_(Index(i));
-  rhs_.noalias() = J_.lazyProduct(v);  // small: coefficient by coefficient
+  rows_times(v, rhs_);
   node.velocity_residual = max_abs(rhs_);
-  rhs_.noalias() = J_.lazyProduct(a);
+  rows_times(a, rhs_);
   rhs_ += drift_;
   node.acceleration_residual = max_abs(rhs_);
 }

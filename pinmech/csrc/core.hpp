@@ -180,6 +180,15 @@ struct Cut {
   std::vector<JointColumn> child_cols, parent_cols;
   // Velocity columns several data.J columns add to (mimic joints): zeroed, then summed.
   bool shared_columns = false;
+  // The distinct velocity columns of child_cols and parent_cols, ascending: the only
+  // columns of the cut's rows of J_ that are not exactly zero.
+  std::vector<Index> columns;
+};
+
+// A piece of J_dep that is not structurally zero: the `rows` rows from `offset` of a cut,
+// in J_dep's column `dep`, which is J_'s velocity column `v`.
+struct ColumnBlock {
+  Index offset, rows, v, dep;
 };
 
 struct Node {
@@ -278,6 +287,7 @@ class Core {
   double full_residual() const;
   MatrixXd jacobian(bool newton);
   void jacobian_into(bool newton);
+  void rows_times(const VectorXd& x, VectorXd& out) const;  // J_ x by each cut's own columns
   VectorXd drift(const VectorXd& q, const VectorXd& v);
   void drift_into(const VectorXd& q, const VectorXd& v, VectorXd& out);
   std::vector<int> signs(const MatrixXd& J_dep);
@@ -394,7 +404,8 @@ class Core {
   std::vector<std::vector<int>> blocks_rows_, blocks_cols_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> tmp3_;
   // work buffers, sized once: a pose allocates nothing
-  MatrixXd J_, Jdep_, scaled_;
+  MatrixXd J_, Jdep_, scaled_;  // J_dep and scaled_ are zero but for dep_blocks_
+  std::vector<ColumnBlock> dep_blocks_;
   std::vector<Index> block_rows_, block_cols_;  // J_dep's rows and columns in block order
   std::optional<Band> band_;  // J_dep's structural band in block order (structural_band)
   std::vector<MatrixXd> block_buffers_;

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.design.figure_file import pyplot, save
+from pinmech.design.figure_file import number_points, pyplot, save
 from pinmech.design.synthesis_kinematics import kinematics
 from pinmech.design.synthesis_linkage import motion_values
 from pinmech.design.synthesis_objective import carried_angle
@@ -197,9 +197,8 @@ def figure(result: SynthesisResult, path: str | Path) -> Path:
             c = carried_angle(lk.topology, q, lk.z[None], s, lk.theta[None])[0] + lk.phi0
             ax.quiver(q.P[0, :, 0] * 1e3, q.P[0, :, 1] * 1e3, np.cos(c), np.sin(c), color="tab:blue",
                       angles="xy", scale_units="xy", scale=1 / L, width=0.003, label="coupler at the poses")
-        for k, t in enumerate(T, start=1):
-            ax.annotate(str(k), t, textcoords="offset points", xytext=(4, 4), fontsize=8, color="tab:red")
         ax.set_aspect("equal")
+        number_points(ax, T)
         ax.set_title(f"linkage {i}: max error {np.max(lk.errors) * 1e3:.2g} mm\n"
                      f"{lk.grashof}, transmission {math.degrees(lk.transmission[0]):.0f}.."
                      f"{math.degrees(lk.transmission[1]):.0f} deg", fontsize=9)
@@ -207,7 +206,7 @@ def figure(result: SynthesisResult, path: str | Path) -> Path:
         ax.set_ylabel("y [mm]")
         ax.grid(alpha=0.3)
     if result.linkages:
-        axes[0][0].legend(fontsize=7, loc="best")
+        axes[0][0].legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22))  # below: never over a pivot
     fig.suptitle(result.spec.title)
     return save(plt, fig, path)
 

@@ -142,7 +142,7 @@ def sixbar_summary(lk: Linkage) -> dict:
 def figure(spec: SynthesisSpec, result, path: str | Path) -> Path:
     """The targets over each linkage's coupler curve over the whole turn (a path), or the
     output's turn against the crank's with the pairs (a function)."""
-    from pinmech.design.figure_file import pyplot, save
+    from pinmech.design.figure_file import number_points, pyplot, save
     from pinmech.design.synthesis_engine import template
 
     t = template(spec)
@@ -174,9 +174,8 @@ def figure(spec: SynthesisSpec, result, path: str | Path) -> Path:
     if spec.task != "function":
         T = spec.targets * 1e3
         ax.plot(T[:, 0], T[:, 1], "x", color="tab:red", ms=8, mew=2, label="poses" if spec.task == "motion" else "targets")
-        for k, p in enumerate(T, start=1):
-            ax.annotate(str(k), p, textcoords="offset points", xytext=(4, 4), fontsize=8, color="tab:red")
         ax.set_aspect("equal")
+        number_points(ax, T)
         ax.set_xlabel("x [mm]")
         ax.set_ylabel("y [mm]")
     else:
@@ -185,7 +184,10 @@ def figure(spec: SynthesisSpec, result, path: str | Path) -> Path:
         ax.set_xlabel("crank turn from the first pair [deg]")
         ax.set_ylabel(f"{spec.output} turn [deg]")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    if spec.task == "function":
+        ax.legend(fontsize=8)
+    else:  # below the drawing, never over a pivot or a pose
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16))
     ax.set_title(spec.title)
     return save(plt, fig, path)
 
