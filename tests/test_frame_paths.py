@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 import pinmech
-import pinmech.solve.core as core
 from pinmech.exceptions import FrameNotFound, ModelError
 from pinmech.solve.sweep_frames import frame_paths
 

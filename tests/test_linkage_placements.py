@@ -57,7 +57,7 @@ def test_watt_redrawn_in_place_closes_at_the_compass_points():
     data = model.createData()
     pin.framesForwardKinematics(model, data, fresh.reference)
     at = {f.name: data.oMf[i].translation[:2] for i, f in enumerate(model.frames)}
-    O2, O4, O6 = np.zeros(2), np.array([p["ground"], 0.0]), np.array([p["O6x"], p["O6y"]])
+    O4, O6 = np.array([p["ground"], 0.0]), np.array([p["O6x"], p["O6y"]])  # O2 at the origin
     A = np.array([p["crank"], 0.0])
     B = _circles(A, O4, p["coupler"], p["rocker"])
     C = _circles(B, O4, p["BC"], p["O4C"])  # right of O4 -> B is left of B -> O4

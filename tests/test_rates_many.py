@@ -18,7 +18,6 @@ import numpy as np
 import pytest
 
 import pinmech
-import pinmech.solve.core as core
 from pinmech.exceptions import ModelError, SingularPoseError
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))

@@ -24,7 +24,6 @@ from pinmech import (
     Task,
     TaskError,
 )
-from pinmech.solve import core
 from pinmech.solve.rates import DAMPING_RANGE
 from tests._mechanisms import cut_rows
 from tests.conftest import MODELS

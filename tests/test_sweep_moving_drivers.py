@@ -10,10 +10,8 @@ silently wrong velocity, off by 2.9 rad/s). h = 1e-5 s of motion: truncation h^2
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 import pinmech
-import pinmech.solve.core as core
 
 
 def test_rates_are_every_drivers_motion(scenes_dir):

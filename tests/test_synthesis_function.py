@@ -4,7 +4,6 @@ and the synthesis recovering that four-bar from crank-rocker pairs."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
