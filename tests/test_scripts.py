@@ -132,3 +132,25 @@ def test_condition_time_errors_are_rounding(capsys):
         cells = [c.strip() for c in row.strip("|").split("|")]
         n, kappa, error = int(cells[0]), float(cells[2]), float(cells[-1])
         assert error <= 1e-12 + 100 * n * np.finfo(float).eps * kappa, row
+
+
+def test_benchmark_peers_ratio_verdicts_follow_the_rows():
+    """Each ratio target (P1 against pylinkage-numba at 1 x, P2 against Pinocchio's passes
+    at 1.5 x, P1's answer against the core's loop at 3 x) is judged from the two rows'
+    medians: a ratio at the limit is met, one just over it is not."""
+    module = importlib.import_module("benchmark_peers")
+    Row = module.Row
+
+    def rows(p1_answer_us, p2_answer_us):
+        us = 1e-6
+        return [Row("P1", module.ANSWERS[0], 360, times=[p1_answer_us * us]),
+                Row("P1", "pylinkage + numba, step_fast_with_kinematics", 360, times=[1.0 * us]),
+                Row("P1", module.FLOOR, 360, times=[0.5 * us]),
+                Row("P2", module.ANSWERS[1], 360, times=[p2_answer_us * us]),
+                Row("P2", module.PASSES + " (1 joint Jacobian)", 360, times=[1.0 * us], is_bound=True)]
+
+    met = module.ratio_verdicts(rows(1.0, 1.5), 360)
+    assert [line.endswith(": met") for line in met] == [True, True, True], met
+    over = module.ratio_verdicts(rows(1.6, 1.51), 360)  # P1 1.6 x the peer, 3.2 x the loop; P2 1.51 x
+    assert [line.endswith("not met") for line in over] == [True, True, True], over
+    assert "1.51 x Pinocchio's passes alone" in over[1]
