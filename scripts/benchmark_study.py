@@ -29,8 +29,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from interleave import Timed, time_rounds  # noqa: E402
 
 from pinmech.design.cluster import built, local_cluster, run_batches  # noqa: E402
-from pinmech.design.study_file import load_study  # noqa: E402
-from pinmech.design.tolerance import batches  # noqa: E402
+from pinmech.design.study.file import load_study  # noqa: E402
+from pinmech.design.study.tolerance import batches  # noqa: E402
 
 STEPS = 360  # poses a turn, as the target
 

@@ -30,9 +30,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from pinmech.design.synthesis_file import load_synthesis  # noqa: E402
-from pinmech.design.synthesis_fourbar import pose  # noqa: E402
-from pinmech.design.synthesis_search import synthesise  # noqa: E402
+from pinmech.design.synthesis.file import load_synthesis  # noqa: E402
+from pinmech.design.synthesis.fourbar import pose  # noqa: E402
+from pinmech.design.synthesis.search import synthesise  # noqa: E402
 
 PYSLVS_SECONDS = 51.0  # Pyslvs' documentation: DE, population 400, 1,000 generations, i7-6700
 GOAL_SECONDS = 60.0
@@ -45,9 +45,9 @@ def six_bar_rows(rounds: int, candidates: int = 8) -> tuple[dict[str, list[float
     poses a candidate is followed through."""
     from interleave import Timed, time_rounds
 
-    from pinmech.design.synthesis_engine import template
-    from pinmech.design.synthesis_sixbar import _merged
-    from pinmech.design.synthesis_tasks import evaluate
+    from pinmech.design.synthesis.engine import template
+    from pinmech.design.synthesis.sixbar import _merged
+    from pinmech.design.synthesis.tasks import evaluate
 
     spec = load_synthesis(ROOT / "models" / "synthesis" / "watt_path.toml")
     t = template(spec)

@@ -2,7 +2,7 @@
 
 The bundled four-bar tolerance study (models/studies/four_bar_tolerance.toml) with
 `--steps` poses over the crank's turn and `--samples` variants, run in this process
-through `design/tolerance.py`'s per-variant loop (`solve_variants`: check the batch's
+through `design/study/tolerance.py`'s per-variant loop (`solve_variants`: check the batch's
 bounds, write each variant's dimensions into the model, close its start pose, follow the
 cycle, read the outputs at every pose).
 
@@ -40,10 +40,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from interleave import Timed, time_rounds  # noqa: E402
 
-from pinmech.design.study_file import load_study  # noqa: E402
-from pinmech.design.study_outputs import StudyOutputs  # noqa: E402
-from pinmech.design.study_variant import StudyMechanism  # noqa: E402
-from pinmech.design.tolerance import batches, run_batch  # noqa: E402
+from pinmech.design.study.file import load_study  # noqa: E402
+from pinmech.design.study.outputs import StudyOutputs  # noqa: E402
+from pinmech.design.study.variant import StudyMechanism  # noqa: E402
+from pinmech.design.study.tolerance import batches, run_batch  # noqa: E402
 from pinmech.solve.core import _core  # noqa: E402
 
 SOLVE = ("correct", "node", "follow")  # the core's calls that solve poses (Core methods)

@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pinmech.design.study import study
-from pinmech.design.study_file import load_study
+from pinmech.design.study.run import study
+from pinmech.design.study.file import load_study
 
 distributed = pytest.importorskip("distributed")
 ROOT = Path(__file__).resolve().parents[1]
@@ -92,7 +92,7 @@ def test_local_cluster_and_a_dask_command_line_cluster_give_the_serial_variants(
 def test_the_variants_do_not_depend_on_the_order_batches_run_in():
     """Batch 3 alone, in a fresh process state, equals batch 3 of the whole run."""
     from pinmech.design.cluster import _BUILT, solve_batch
-    from pinmech.design.tolerance import batches
+    from pinmech.design.study.tolerance import batches
 
     spec = _small_spec()
     whole = study(spec).batches[3]
@@ -106,7 +106,7 @@ def test_each_worker_builds_the_mechanism_once_and_computes_on_one_thread():
     """8 batches on 2 workers: each worker built the study's mechanism once (not a batch), and
     its OpenMP and BLAS pools are one thread (nothing else competes for the two cores)."""
     from pinmech.design.cluster import run_batches
-    from pinmech.design.tolerance import batches
+    from pinmech.design.study.tolerance import batches
 
     def state() -> tuple:
         from pinmech.design import cluster

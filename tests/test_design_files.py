@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from pinmech.design.figure_file import pyplot, save
-from pinmech.design.study_report import write_tables
+from pinmech.design.study.report import write_tables
 
 
 def test_a_prefix_with_a_dot_keeps_it(tmp_path: Path) -> None:

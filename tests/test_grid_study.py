@@ -1,4 +1,4 @@
-"""Grid studies (pinmech/design/grid.py) against the four-bar's closed form.
+"""Grid studies (pinmech/design/study/grid.py) against the four-bar's closed form.
 
 A 1-D grid of the bundled four-bar's crank length a (coupler b = 120, rocker c = 80,
 ground d = 100 mm) checked against two independent references:
@@ -17,10 +17,10 @@ import closed_form
 import numpy as np
 import pytest
 
-from pinmech.design.grid import cycle_range, failures
-from pinmech.design.study import study
-from pinmech.design.study_file import load_study, parse_study
-from pinmech.design.study_report import grid_table, summary
+from pinmech.design.study.grid import cycle_range, failures
+from pinmech.design.study.run import study
+from pinmech.design.study.file import load_study, parse_study
+from pinmech.design.study.report import grid_table, summary
 from pinmech.exceptions import SceneError
 
 STUDIES = Path(__file__).resolve().parents[1] / "models" / "studies"
@@ -159,7 +159,7 @@ def test_a_local_dask_cluster_gives_the_serial_grid(crank_grid):
 
 
 def test_a_three_parameter_grid_has_a_table_but_its_figure_is_refused_by_name(tmp_path):
-    from pinmech.design.study_plot import grid_figure
+    from pinmech.design.study.plot import grid_figure
     from pinmech.exceptions import OptionRefused
 
     raw = _crank_grid(30, 40, 2)

@@ -1,6 +1,6 @@
 """Sensitivities by the implicit-function theorem, checked against finite differences.
 
-Two references, neither of which uses the derivative formulas of pinmech/design/sensitivity.py:
+Two references, neither of which uses the derivative formulas of pinmech/design/study/sensitivity.py:
 - central differences of the closed-form four-bar (scripts/closed_form.py, the law of
   cosines), no pinmech at all;
 - central differences of re-solved variants: each parameter written into the model at
@@ -16,11 +16,11 @@ import numpy as np
 import pytest
 
 from pinmech.exceptions import FrameNotFound, SceneError
-from pinmech.design.sensitivity import cycle_sensitivity
-from pinmech.design.study_outputs import StudyOutputs
-from pinmech.design.study_file import load_study, parse_study
-from pinmech.design.study_variant import StudyMechanism
-from pinmech.design.tolerance import deviation
+from pinmech.design.study.sensitivity import cycle_sensitivity
+from pinmech.design.study.outputs import StudyOutputs
+from pinmech.design.study.file import load_study, parse_study
+from pinmech.design.study.variant import StudyMechanism
+from pinmech.design.study.tolerance import deviation
 
 STUDIES = Path(__file__).resolve().parents[1] / "models" / "studies"
 SCENES = STUDIES.parent / "scenes"

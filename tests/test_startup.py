@@ -34,7 +34,7 @@ NOT_FOR_A_SOLVE = (
     # the other subcommands: each module is imported when its subcommand is chosen
     "pinmech.cli.forces", "pinmech.cli.sweep", "pinmech.cli.path", "pinmech.cli.snapshot", "pinmech.cli.animate",
     "pinmech.cli.polygon", "pinmech.cli.report", "pinmech.cli.view", "pinmech.cli.build", "pinmech.cli.check",
-    "pinmech.design.study_cli", "pinmech.design.synthesis_cli",
+    "pinmech.design.study.cli", "pinmech.design.synthesis.cli",
 )
 
 _SOLVE_IN_A_FRESH_PROCESS = """

@@ -1,7 +1,7 @@
 """A link's angular acceleration as a study output: its value against Norton's closed form
 for the four-bar's rocker (derived here from the loop equation, not from pinmech), and its
 exact sensitivity (the implicit-function theorem on the acceleration closure rows,
-design/accel_sensitivity.py) against central differences of that closed form in the link
+design/study/accel_sensitivity.py) against central differences of that closed form in the link
 lengths, and against central differences of variants re-solved from scratch."""
 
 from __future__ import annotations
@@ -12,10 +12,10 @@ import closed_form
 import numpy as np
 import pytest
 
-from pinmech.design.sensitivity import cycle_sensitivity
-from pinmech.design.study_file import parse_study
-from pinmech.design.study_outputs import StudyOutputs
-from pinmech.design.study_variant import StudyMechanism
+from pinmech.design.study.sensitivity import cycle_sensitivity
+from pinmech.design.study.file import parse_study
+from pinmech.design.study.outputs import StudyOutputs
+from pinmech.design.study.variant import StudyMechanism
 from pinmech.exceptions import SceneError
 from tests.conftest import length_slopes
 

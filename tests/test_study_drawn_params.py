@@ -1,4 +1,4 @@
-"""A drawn linkage's [params] as study parameters (design/drawn_params.py): a variant is
+"""A drawn linkage's [params] as study parameters (design/study/drawn_params.py): a variant is
 the linkage redrawn, its placements (rotations included) copied into the study's model.
 
 References: Norton's four-bar closed form (the law of cosines, scripts/closed_form.py) in
@@ -14,11 +14,11 @@ import closed_form
 import numpy as np
 import pytest
 
-from pinmech.design.sensitivity import cycle_sensitivity
-from pinmech.design.study_file import parse_study
-from pinmech.design.study_outputs import StudyOutputs
-from pinmech.design.study_variant import StudyMechanism
-from pinmech.design.tolerance import deviation
+from pinmech.design.study.sensitivity import cycle_sensitivity
+from pinmech.design.study.file import parse_study
+from pinmech.design.study.outputs import StudyOutputs
+from pinmech.design.study.variant import StudyMechanism
+from pinmech.design.study.tolerance import deviation
 from pinmech.exceptions import FrameNotFound, SceneError
 
 STUDIES = Path(__file__).resolve().parents[1] / "models" / "studies"

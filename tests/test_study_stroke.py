@@ -1,5 +1,5 @@
 """A slider's stroke (max - min of s over the cycle) as a study output, against the
-slider-crank's closed form, and its sensitivity (the envelope theorem, design/study_stroke.py)
+slider-crank's closed form, and its sensitivity (the envelope theorem, design/study/stroke.py)
 against that closed form differentiated by hand.
 
 Offset slider-crank, crank r, rod l, offset e: the piston's extremes are where crank and
@@ -18,10 +18,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pinmech.design.sensitivity import cycle_sensitivity
-from pinmech.design.study_file import parse_study
-from pinmech.design.study_outputs import StudyOutputs
-from pinmech.design.study_variant import StudyMechanism
+from pinmech.design.study.sensitivity import cycle_sensitivity
+from pinmech.design.study.file import parse_study
+from pinmech.design.study.outputs import StudyOutputs
+from pinmech.design.study.variant import StudyMechanism
 from pinmech.exceptions import SceneError
 
 STUDIES = Path(__file__).resolve().parents[1] / "models" / "studies"
@@ -77,7 +77,7 @@ def test_every_tolerance_variants_stroke_is_the_closed_form_at_its_own_lengths()
     """A tolerance study (20 variants, sigma 0.5 mm on r, l and e): each variant's stroke
     equals sqrt((l+r)^2-e^2) - sqrt((l-r)^2-e^2) at its own sampled lengths (tolerance
     1e-13 m: the closure tolerance; the extremes located to the solver's precision)."""
-    from pinmech.design.study import study
+    from pinmech.design.study.run import study
 
     raw = {"scene": "../scenes/slider_crank.toml", "kind": "tolerance", "steps": 70, "samples": 20, "seed": 7,
            "batch": 10, "outputs": {"strokes": ["slide"]},
@@ -96,7 +96,7 @@ def test_the_golden_section_fallback_locates_the_same_stroke(monkeypatch):
     """Where the secant from the poses leaves their bracket, golden section narrows it
     first (forced here): the same stroke and derivatives as the closed form (tolerances as
     above)."""
-    from pinmech.design.study_stroke import Stroke
+    from pinmech.design.study.stroke import Stroke
 
     monkeypatch.setattr(Stroke, "_from_poses", lambda self, q, i, lo, hi: (None, q[i]))
     sm = _slider_crank(10.0)

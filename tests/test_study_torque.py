@@ -1,6 +1,6 @@
 """The driver torque as a study output, against Norton's matrix method by hand
 (scripts/closed_form_forces.py: Newton-Euler link by link, no Pinocchio), and its
-sensitivity (central differences of re-solved variants, design/variant_differences.py)
+sensitivity (central differences of re-solved variants, design/study/variant_differences.py)
 against central differences of that hand solution in the link lengths."""
 
 from __future__ import annotations
@@ -11,10 +11,10 @@ import closed_form_forces as cff
 import numpy as np
 import pytest
 
-from pinmech.design.sensitivity import cycle_sensitivity
-from pinmech.design.study_file import parse_study
-from pinmech.design.study_outputs import StudyOutputs
-from pinmech.design.study_variant import StudyMechanism
+from pinmech.design.study.sensitivity import cycle_sensitivity
+from pinmech.design.study.file import parse_study
+from pinmech.design.study.outputs import StudyOutputs
+from pinmech.design.study.variant import StudyMechanism
 from pinmech.exceptions import SceneError
 from tests.conftest import length_slopes
 

@@ -11,10 +11,10 @@ import closed_form
 import numpy as np
 import pinocchio as pin
 
-from pinmech.design.study_file import parse_study
-from pinmech.design.study_outputs import StudyOutputs
-from pinmech.design.study_variant import StudyMechanism
-from pinmech.design.tolerance import Batch, deviation, solve_variants
+from pinmech.design.study.file import parse_study
+from pinmech.design.study.outputs import StudyOutputs
+from pinmech.design.study.variant import StudyMechanism
+from pinmech.design.study.tolerance import Batch, deviation, solve_variants
 
 STUDIES = Path(__file__).resolve().parents[1] / "models" / "studies"
 ORDER = ("crank", "ground", "coupler", "rocker")  # the study's params: a, d, b, c of the four-bar

@@ -9,12 +9,12 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.design.burmester import dyads
-from pinmech.design.synthesis_file import SynthesisSpec
-from pinmech.design.synthesis_fourbar import pose
-from pinmech.design.synthesis_linkage import engine_check, write_linkage
-from pinmech.design.synthesis_poses import evaluate_poses, refined_poses
-from pinmech.design.synthesis_tasks import classical_rows
+from pinmech.design.synthesis.burmester import dyads
+from pinmech.design.synthesis.file import SynthesisSpec
+from pinmech.design.synthesis.fourbar import pose
+from pinmech.design.synthesis.linkage import engine_check, write_linkage
+from pinmech.design.synthesis.poses import evaluate_poses, refined_poses
+from pinmech.design.synthesis.tasks import classical_rows
 from tests._engine_poses import engine_poses
 
 ROOT = Path(__file__).resolve().parents[1]

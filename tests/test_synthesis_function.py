@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.design.freudenstein import chebyshev_spacing, freudenstein_k, link_lengths
-from pinmech.design.synthesis_file import SynthesisSpec
-from pinmech.design.synthesis_linkage import engine_check, write_linkage
-from pinmech.design.synthesis_search import synthesise
+from pinmech.design.synthesis.freudenstein import chebyshev_spacing, freudenstein_k, link_lengths
+from pinmech.design.synthesis.file import SynthesisSpec
+from pinmech.design.synthesis.linkage import engine_check, write_linkage
+from pinmech.design.synthesis.search import synthesise
 
 ROOT = Path(__file__).resolve().parents[1]
 

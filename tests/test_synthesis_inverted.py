@@ -11,12 +11,12 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.design.synthesis_file import SynthesisSpec
-from pinmech.design.synthesis_inverted import folds, guide_jacobian, point_jacobian, pose
-from pinmech.design.synthesis_linkage import engine_check, write_linkage
-from pinmech.design.synthesis_motion import CAUSES
-from pinmech.design.synthesis_objective import evaluate_path
-from pinmech.design.synthesis_search import synthesise
+from pinmech.design.synthesis.file import SynthesisSpec
+from pinmech.design.synthesis.inverted import folds, guide_jacobian, point_jacobian, pose
+from pinmech.design.synthesis.linkage import engine_check, write_linkage
+from pinmech.design.synthesis.motion import CAUSES
+from pinmech.design.synthesis.objective import evaluate_path
+from pinmech.design.synthesis.search import synthesise
 
 ROOT = Path(__file__).resolve().parents[1]
 TOPOLOGY = "inverted-slider-crank"
@@ -128,7 +128,7 @@ def test_function_synthesis_recovers_the_bundled_inverted_slider_crank(tmp_path)
     # 100 deg, from the engine's guide; ground 50 mm given. The search varies crank, offset
     # and the start angles and meets the guide's turns within 1e-8 rad; the engine sweeping
     # the written linkage turns its guide as asked.
-    from pinmech.design.freudenstein import chebyshev_spacing
+    from pinmech.design.synthesis.freudenstein import chebyshev_spacing
 
     crank = 100.0 + chebyshev_spacing(0.0, 120.0, 4)
     _, phi = _engine_pin_and_guide(tmp_path, crank)
@@ -203,7 +203,7 @@ def test_the_bundled_inverted_motion_file_holds_poses_of_the_closed_form():
     # models/synthesis/inverted_slider_crank_motion.toml: its six poses are the bundled
     # R-RTR block's at crank 100..300 deg, the part 40 deg from the slot, within their
     # rounding (0.5 um and 0.5e-3 deg).
-    from pinmech.design.synthesis_file import load_synthesis
+    from pinmech.design.synthesis.file import load_synthesis
 
     spec = load_synthesis(ROOT / "models" / "synthesis" / "inverted_slider_crank_motion.toml")
     places, angles = _block_poses(np.arange(100.0, 340.0, 40.0), math.radians(40.0))

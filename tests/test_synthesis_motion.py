@@ -7,9 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.design.synthesis_file import SynthesisSpec
-from pinmech.design.synthesis_linkage import engine_check, write_linkage
-from pinmech.design.synthesis_search import synthesise
+from pinmech.design.synthesis.file import SynthesisSpec
+from pinmech.design.synthesis.linkage import engine_check, write_linkage
+from pinmech.design.synthesis.search import synthesise
 from tests._engine_poses import engine_poses
 
 ROOT = Path(__file__).resolve().parents[1]

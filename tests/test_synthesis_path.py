@@ -11,12 +11,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pinmech.design.synthesis_file import SynthesisSpec
-from pinmech.design.synthesis_fourbar import folds, point_jacobian, pose
-from pinmech.design.synthesis_linkage import engine_check, write_linkage
-from pinmech.design.synthesis_motion import CAUSES
-from pinmech.design.synthesis_objective import evaluate_path as evaluate
-from pinmech.design.synthesis_search import synthesise
+from pinmech.design.synthesis.file import SynthesisSpec
+from pinmech.design.synthesis.fourbar import folds, point_jacobian, pose
+from pinmech.design.synthesis.linkage import engine_check, write_linkage
+from pinmech.design.synthesis.motion import CAUSES
+from pinmech.design.synthesis.objective import evaluate_path as evaluate
+from pinmech.design.synthesis.search import synthesise
 
 ROOT = Path(__file__).resolve().parents[1]
 # The bounds of the bundled example: ground pivots in two 120 mm squares, links 10-200 mm.

@@ -1,4 +1,4 @@
-"""Six-bar synthesis on the engine (design/synthesis_sixbar.py): recovery of the bundled
+"""Six-bar synthesis on the engine (design/synthesis/sixbar.py): recovery of the bundled
 Watt six-bar from points of a coupler point of its last dyad, a function of a Stephenson,
 a target set only a defective linkage meets, and the same linkage on 1 and 2 Dask workers.
 
@@ -16,10 +16,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pinmech.design.synthesis_file import parse_synthesis
-from pinmech.design.synthesis_search import synthesise
-from pinmech.design.synthesis_tasks import evaluate
-from pinmech.design.synthesis_sixbar_output import crank_values, write_linkage
+from pinmech.design.synthesis.file import parse_synthesis
+from pinmech.design.synthesis.search import synthesise
+from pinmech.design.synthesis.tasks import evaluate
+from pinmech.design.synthesis.sixbar_output import crank_values, write_linkage
 from pinmech.exceptions import SceneError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -181,7 +181,7 @@ def test_stephenson_function_pairs_of_a_closed_form_are_met(tmp_path):
     # coupler, D): its hidden dyad (link5 120, link6 90 mm, O6 (160, 110) mm, crank from 30
     # deg) meets them within the pairs' rounding (1e-6 deg); a small search in a box of
     # +-1 mm about it finds a linkage meeting them within 1e-6 deg too.
-    from pinmech.design.synthesis_file import load_synthesis
+    from pinmech.design.synthesis.file import load_synthesis
 
     spec = load_synthesis(SYNTHESIS / "stephenson_function.toml")
     theta = math.radians(30.0) + spec.targets[:, 0]

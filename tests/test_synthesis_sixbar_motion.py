@@ -1,4 +1,4 @@
-"""Six-bar motion generation on the engine (design/synthesis_sixbar.py, task = "motion"):
+"""Six-bar motion generation on the engine (design/synthesis/sixbar.py, task = "motion"):
 a link of the Watt's last dyad carried through poses, the bundled file's poses, and every
 bad key of a six-bar motion file.
 
@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pinmech.design.synthesis_file import load_synthesis, parse_synthesis
-from pinmech.design.synthesis_search import synthesise
-from pinmech.design.synthesis_sixbar_output import engine_check, write_linkage
+from pinmech.design.synthesis.file import load_synthesis, parse_synthesis
+from pinmech.design.synthesis.search import synthesise
+from pinmech.design.synthesis.sixbar_output import engine_check, write_linkage
 from pinmech.exceptions import SceneError
 from tests.test_synthesis_sixbar import WATT, watt_pose
 

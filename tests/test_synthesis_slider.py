@@ -11,10 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pinmech.design.synthesis_file import SynthesisSpec
-from pinmech.design.synthesis_linkage import engine_check, write_linkage
-from pinmech.design.synthesis_search import synthesise
-from pinmech.design.synthesis_slider import folds, pose
+from pinmech.design.synthesis.file import SynthesisSpec
+from pinmech.design.synthesis.linkage import engine_check, write_linkage
+from pinmech.design.synthesis.search import synthesise
+from pinmech.design.synthesis.slider import folds, pose
 
 ROOT = Path(__file__).resolve().parents[1]
 CRANK = np.arange(20.0, 300.0, 30.0)  # deg: ten crank angles, ccw, on the bundled linkage's assembly
@@ -134,7 +134,7 @@ def test_the_slider_point_of_three_poses_is_on_the_collinear_points_circle(tmp_p
     # to rounding (1e-12 m: the poses are the engine's, Newton-converged to ~1e-15 m); and
     # the construction with the rod's own A and B gives the bundled linkage back: O2 at the
     # circumcentre of A's positions (0, 0), slide along x at 50 mm, crank 40, rod 130 mm.
-    from pinmech.design.slider_three_poses import slider_circle, slider_crank_row
+    from pinmech.design.synthesis.slider_three_poses import slider_circle, slider_crank_row
 
     A, B = _engine_pins(tmp_path, np.array([20.0, 80.0, 140.0]))
     w = (B - A) / np.linalg.norm(B - A, axis=1)[:, None]
@@ -157,9 +157,9 @@ def test_the_slider_point_of_three_poses_is_on_the_collinear_points_circle(tmp_p
 def test_every_three_pose_construction_carries_the_rod_through_the_poses():
     # Each slider-crank of the three-pose construction (crank pivots O2 on a grid, slider points
     # around the circle; those meeting the poses on two assemblies left out) carries its rod
-    # point through the three places at the poses' angles: its closed form (synthesis_slider.pose, on its assembly, at the crank's angles
+    # point through the three places at the poses' angles: its closed form (design/synthesis/slider.pose, on its assembly, at the crank's angles
     # to A's three positions) within 1e-12 m and rad (rounding of ~100 mm lengths).
-    from pinmech.design.slider_three_poses import slider_crank_rows
+    from pinmech.design.synthesis.slider_three_poses import slider_crank_rows
 
     places = np.array([[0.09, 0.05], [0.082, 0.059], [0.065, 0.064]])
     angles = np.radians([33.0, 25.5, 21.7])
@@ -184,7 +184,7 @@ def test_three_pose_motion_synthesis_meets_the_poses(tmp_path):
     # at most) returns one that meets the poses within 1e-8 of its size and 1e-8 rad, free
     # of defects, the engine sweeping it agreeing. (Three poses leave the slider-crank three
     # free parameters: differential evolution alone finds one as well.)
-    from pinmech.design.synthesis_tasks import classical_rows
+    from pinmech.design.synthesis.tasks import classical_rows
 
     A, B = _engine_pins(tmp_path, np.array([20.0, 80.0, 140.0]))
     places, angles, lower, upper = _rod_poses(A, B)

@@ -8,10 +8,10 @@ from pathlib import Path
 import closed_form
 import numpy as np
 
-from pinmech.design.study_outputs import StudyOutputs
-from pinmech.design.study_file import load_study, parse_study
-from pinmech.design.study_variant import StudyMechanism
-from pinmech.design.tolerance import batches, deviation, run_batch, spread
+from pinmech.design.study.outputs import StudyOutputs
+from pinmech.design.study.file import load_study, parse_study
+from pinmech.design.study.variant import StudyMechanism
+from pinmech.design.study.tolerance import batches, deviation, run_batch, spread
 
 STUDIES = Path(__file__).resolve().parents[1] / "models" / "studies"
 NOMINAL = {"crank": 0.04, "coupler": 0.12, "rocker": 0.08, "ground": 0.10}  # a, b, c, d [m]

@@ -21,7 +21,7 @@ import pytest
 
 import pinmech
 from pinmech.cli import main
-from pinmech.design.workspace_file import load_workspace
+from pinmech.design.workspace.file import load_workspace
 from pinmech.exceptions import SceneError
 from tests.test_workspace_study import (A, BETA0, L1, L2, LA, LB, PHI, R_BASE, R_PLAT, SCENES, ZERO, cross2,
                                         delta_motors)

@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from pinmech.design.workspace_measure import measure, refined_measures
+from pinmech.design.workspace.measure import measure, refined_measures
 from tests.test_workspace_study import annuli_area, in_annuli
 
 

@@ -21,8 +21,8 @@ import pytest
 
 import pinmech
 from pinmech.cli import main
-from pinmech.design.workspace_batch import built
-from pinmech.design.workspace_file import WorkspaceSpec, load_workspace
+from pinmech.design.workspace.batch import built
+from pinmech.design.workspace.file import WorkspaceSpec, load_workspace
 from pinmech.exceptions import FrameNotFound, SceneError
 
 SCENES = Path(__file__).resolve().parents[1] / "models" / "scenes"

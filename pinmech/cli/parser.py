@@ -46,6 +46,6 @@ SUBCOMMANDS = {
     "view": "pinmech.cli.view",
     "build": "pinmech.cli.build",
     "check": "pinmech.cli.check",
-    "study": "pinmech.design.study_cli",
-    "synth": "pinmech.design.synthesis_cli",
+    "study": "pinmech.design.study.cli",
+    "synth": "pinmech.design.synthesis.cli",
 }

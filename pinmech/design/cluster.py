@@ -20,8 +20,8 @@ import os
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
-from pinmech.design.study_file import StudySpec
-from pinmech.design.tolerance import Batch, BatchResult, run_batch
+from pinmech.design.study.file import StudySpec
+from pinmech.design.study.tolerance import Batch, BatchResult, run_batch
 
 _EXTRA = 'pip install "pinmech[study]"'
 #: run(spec, batches, progress=None) -> results in batch order
@@ -54,8 +54,8 @@ def require_dask():
 def built(spec: StudySpec) -> tuple:
     """This process's (StudyMechanism, StudyOutputs) of the study, built on first use."""
     if spec not in _BUILT:
-        from pinmech.design.study_outputs import StudyOutputs
-        from pinmech.design.study_variant import StudyMechanism
+        from pinmech.design.study.outputs import StudyOutputs
+        from pinmech.design.study.variant import StudyMechanism
 
         sm = StudyMechanism(spec)
         _BUILT[spec] = (sm, StudyOutputs(sm))
@@ -66,12 +66,12 @@ def built(spec: StudySpec) -> tuple:
 def solve_batch(spec: StudySpec, batch: Batch) -> BatchResult:
     """One batch, on the mechanism this process built (a Dask task)."""
     if spec.kind == "workspace":
-        from pinmech.design.workspace_batch import run_workspace_batch
+        from pinmech.design.workspace.batch import run_workspace_batch
 
         return run_workspace_batch(spec, batch)
     sm, outputs = built(spec)
     if spec.kind == "grid":
-        from pinmech.design.grid import run_grid_batch
+        from pinmech.design.study.grid import run_grid_batch
 
         return run_grid_batch(sm, outputs, batch)
     return run_batch(sm, outputs, batch)

@@ -1,7 +1,7 @@
 """The compass construction: the point at r1 from a and r2 from b, left or right of a -> b,
 the one closed form used to draw a linkage's `from = [P, Q], lengths = [...]` joints
-(model/linkage.py) and to solve a synthesis candidate's dyads (design/synthesis_fourbar.py,
-design/burmester.py). Batched: arrays broadcast, points in the last axis (2)."""
+(model/linkage.py) and to solve a synthesis candidate's dyads (design/synthesis/fourbar.py,
+design/synthesis/burmester.py). Batched: arrays broadcast, points in the last axis (2)."""
 
 from __future__ import annotations
 

@@ -1,0 +1,1 @@
+"""pinmech.design.study.run: see docs/explanation/layout.md."""

@@ -1,0 +1,125 @@
+"""`pinmech study FILE`: run a design study file and report it (the CLI's face of study.py)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+
+def _workers(text: str) -> int:
+    """--workers: a whole number >= 0 (argparse type)."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of worker processes (0 runs in this process)")
+    return value
+
+
+class ProgressBar:
+    """A tqdm bar of the variants done, moved as each batch finishes (on Dask too)."""
+
+    def __init__(self, tqdm) -> None:
+        self._tqdm, self._bar = tqdm, None
+
+    @classmethod
+    def on_terminal(cls, *, quiet: bool) -> ProgressBar | None:
+        """A bar when stderr is a terminal and not --quiet; None otherwise. Without tqdm,
+        one line naming the extra that brings it, and no bar."""
+        if quiet or not sys.stderr.isatty():
+            return None
+        try:
+            from tqdm import tqdm
+        except ImportError:
+            print('no progress bar: pip install "pinmech[progress]" (tqdm)', file=sys.stderr)
+            return None
+        return cls(tqdm)
+
+    def __call__(self, done: int, total: int) -> None:
+        if self._bar is None:
+            self._bar = self._tqdm(total=total, unit="variant", file=sys.stderr, mininterval=0.5)
+        self._bar.update(done - self._bar.n)
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+
+
+def add_parser(sub) -> None:
+    """The `study` subcommand's arguments."""
+    study = sub.add_parser("study", help="run a design study (sensitivity, tolerance, grid or workspace) from a study file",
+                           description="Run a study file (models/studies/*.toml): exact sensitivities over the "
+                           "cycle, or a seeded Monte Carlo tolerance study on Dask. Exit codes as `pinmech --help`.")
+    study.add_argument("study_file", help="study file (TOML), e.g. models/studies/four_bar_tolerance.toml")
+    study.add_argument("--workers", type=_workers, default=None,
+                       help="Dask worker processes of a LocalCluster (default: the CPU count; 0: in this process)")
+    study.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                       help="a running Dask scheduler (tcp://HOST:PORT) instead of a LocalCluster "
+                            "(default: $DASK_SCHEDULER_ADDRESS if set)")
+    study.add_argument("--out", default=None, metavar="PREFIX",
+                       help="write PREFIX.csv, PREFIX.parquet (pyarrow) and PREFIX.json")
+    study.add_argument("--plot", action="store_true",
+                       help="with --out: PREFIX_sensitivity.png, and PREFIX_histogram.png for a tolerance study, "
+                            "PREFIX_grid.png for a 1-D or 2-D grid study, PREFIX_workspace.png for a workspace study")
+    study.add_argument("--json", action="store_true", help="print the JSON summary instead of the text one")
+    study.add_argument("--quiet", action="store_true",
+                       help="no progress bar (there is none either when stderr is not a terminal)")
+    study.set_defaults(func=cmd_study)
+
+
+def cmd_study(args: argparse.Namespace) -> int:
+    """Run the study; print its summary; write the table, JSON and figures asked."""
+    import json
+
+    from pinmech.design.cluster import scheduler_address
+    from pinmech.exceptions import OptionRefused
+    from pinmech.design.study.run import study
+    from pinmech.design.study.report import summary, text, write
+
+    if args.plot and not args.out:
+        raise OptionRefused("--plot writes PREFIX_*.png: give --out PREFIX too", options=["--plot"])
+    scheduler = scheduler_address(args.scheduler)
+    workers = (os.cpu_count() or 1) if args.workers is None else args.workers
+    bar = ProgressBar.on_terminal(quiet=args.quiet)
+    try:
+        result = study(args.study_file, workers=workers, scheduler=scheduler, progress=bar)
+    finally:
+        if bar is not None:
+            bar.close()
+    if result.spec.kind == "workspace":
+        return _workspace_output(result, args)
+    print(json.dumps(summary(result), indent=2) if args.json else text(result))
+    if args.out:
+        written = write(result, args.out)
+        if args.plot:
+            from pinmech.design.study.plot import grid_figure, sensitivity_bars, tolerance_histograms
+
+            written.append(sensitivity_bars(result, f"{args.out}_sensitivity.png"))
+            if result.spec.kind == "grid":
+                written.append(grid_figure(result, f"{args.out}_grid.png"))
+            if result.spread is not None:
+                written.append(tolerance_histograms(result, f"{args.out}_histogram.png"))
+        print("wrote " + ", ".join(str(p) for p in written), file=sys.stderr)
+    return 0
+
+
+def _workspace_output(result, args: argparse.Namespace) -> int:
+    """A workspace study's summary, table, JSON and map."""
+    import json
+
+    if result.spec.space == "actuator":
+        from pinmech.design.workspace.actuator_plot import actuator_figure as figure
+        from pinmech.design.workspace.actuator_report import summary, text, write
+    else:
+        from pinmech.design.workspace.plot import workspace_figure as figure
+        from pinmech.design.workspace.report import summary, text, write
+
+    print(json.dumps(summary(result), indent=2) if args.json else text(result))
+    if args.out:
+        written = write(result, args.out)
+        if args.plot:
+            written.append(figure(result, f"{args.out}_workspace.png"))
+        print("wrote " + ", ".join(str(p) for p in written), file=sys.stderr)
+    return 0

@@ -1,0 +1,176 @@
+"""A study's results for people and programs: a terminal summary, a table (CSV, and Parquet
+through pyarrow), a JSON summary, and figures (matplotlib). Users' units at this edge:
+lengths in mm, angles in deg, sensitivities in mm/mm and deg/mm.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from pinmech.design.study.grid import cycle_range, failures
+from pinmech.design.study.run import StudyResult
+from pinmech.design.study.tolerance import PERCENTILES, deviation
+from pinmech.outputs import beside, write_whole, write_with
+
+_SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "speed": (1e3, "mm/s"),
+          "angular speed": (180 / math.pi, "deg/s"), "angular acceleration": (180 / math.pi, "deg/s^2"),
+          "torque": (1.0, "N m"), "force": (1.0, "N")}
+
+
+def _unit(kind: str) -> tuple[float, str]:
+    return _SCALE[kind]
+
+
+def summary(result: StudyResult) -> dict:
+    """The JSON summary: per output, the largest |dy/dp| over the cycle for each parameter,
+    and for a tolerance study the spread beside the linear estimate and the failures."""
+    spec = result.spec
+    out = {"study": str(spec.path), "title": spec.title, "kind": spec.kind, "driver": result.driver,
+           "poses": len(result.values), "parameters": {}, "outputs": {}}
+    for k, p in enumerate(spec.params):
+        out["parameters"][p.name] = {"nominal_mm": result.nominal_p[k] * 1e3, "distribution": p.distribution,
+                                     "sigma_mm": p.sigma * 1e3}
+    for j, name in enumerate(result.outputs):
+        scale, unit = _unit(result.kinds[j])
+        entry = {"unit": unit, "nominal_min": float(result.nominal[:, j].min() * scale),
+                 "nominal_max": float(result.nominal[:, j].max() * scale),
+                 f"max_abs_sensitivity_{unit}_per_mm": {p: float(np.abs(result.sensitivity[:, j, k]).max() * scale / 1e3)
+                                                       for k, p in enumerate(result.params)}}
+        if result.spread is not None:
+            s = result.spread
+            entry.update(sigma_max=_finite(s.sigma[:, j].max() * scale),
+                         sigma_linear_max=float(s.sigma_linear[:, j].max() * scale),
+                         worst=_finite(s.worst[j] * scale), worst_linear=float(s.worst_linear[j] * scale),
+                         percentiles={f"{q:g}": _finite(s.percentiles[i, :, j].min() * scale if q < 50 else
+                                                        s.percentiles[i, :, j].max() * scale)
+                                      for i, q in enumerate(PERCENTILES)})
+        out["outputs"][name] = entry
+    if spec.kind == "grid":
+        out.update(_grid_summary(result))
+    if result.spread is not None:
+        out.update(samples=spec.samples, seed=spec.seed, solved=result.spread.solved,
+                   failures=dict(result.spread.failures))
+    return out
+
+
+def _grid_summary(result: StudyResult) -> dict:
+    """A grid study's axes [mm], its points that solved, and the failures by cause."""
+    _, _, causes = result.variants
+    out = {"grid": {a.name: {"from_mm": a.start * 1e3, "to_mm": a.stop * 1e3, "count": a.count}
+                    for a in result.spec.grid},
+           "points": len(causes), "solved": sum(not c for c in causes), "failures": failures(causes)}
+    mu = result.transmission
+    if mu is not None and not np.isnan(mu).all():
+        out["least_transmission_angle_deg"] = float(np.degrees(np.nanmin(mu)))
+    return out
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+def text(result: StudyResult) -> str:
+    """The terminal summary."""
+    s = summary(result)
+    lines = [f"{s['title']} ({s['kind']}, {s['poses']} poses of {s['driver']}"
+             + (f", {s['samples']} variants, seed {s['seed']})" if "samples" in s else ")")]
+    lines.append("parameters: " + ", ".join(f"{n} {p['nominal_mm']:.6g} mm"
+                                            + (f" (sigma {p['sigma_mm']:.3g} mm, {p['distribution']})"
+                                               if p["distribution"] != "fixed" else "")
+                                            for n, p in s["parameters"].items()))
+    lines.append("largest |dy/dp| over the cycle: " + "; ".join(
+        f"{o}: " + ", ".join(f"{p} {v:.4g}" for p, v in e[f"max_abs_sensitivity_{e['unit']}_per_mm"].items())
+        + f" {e['unit']}/mm" for o, e in s["outputs"].items()))
+    if "samples" in s:
+        lines.append(f"{'output':<16}{'sigma max':>12}{'linear':>12}{'worst':>12}{'linear':>12}")
+        for o, e in s["outputs"].items():
+            lines.append(f"{o + ' [' + e['unit'] + ']':<16}" + "".join(
+                f"{v:>12.4g}" if v is not None else f"{'-':>12}"
+                for v in (e["sigma_max"], e["sigma_linear_max"], e["worst"], e["worst_linear"])))
+        failed = ", ".join(f"{c}: {n}" for c, n in s["failures"].items()) or "none"
+        lines.append(f"solved {s['solved']} of {s['samples']} variants; failed: {failed}")
+    if "points" in s:
+        axes = " x ".join(f"{n} {g['from_mm']:.6g}..{g['to_mm']:.6g} mm ({g['count']})" for n, g in s["grid"].items())
+        failed = ", ".join(f"{c}: {n}" for c, n in s["failures"].items()) or "none"
+        lines.append(f"grid {axes}: solved {s['solved']} of {s['points']} points; failed: {failed}")
+        if "least_transmission_angle_deg" in s:
+            lines.append(f"least transmission angle over the grid: {s['least_transmission_angle_deg']:.4g} deg")
+    return "\n".join(lines)
+
+
+def table(result: StudyResult) -> dict[str, list]:
+    """The study's table as columns: one row a pose and output (sensitivity), one row a
+    variant (tolerance: its parameters, its cause, its largest deviation of each output), or
+    one row a grid point (grid: its parameters, its cause, each output's min and max, its
+    least transmission angle)."""
+    if result.spec.kind == "grid":
+        return grid_table(result)
+    if result.spread is None:
+        rows: dict[str, list] = {f"{result.driver} [deg]": [], "output": [], "unit": [], "value": []}
+        rows.update({f"d/d {p} [per mm]": [] for p in result.params})
+        for i, x in enumerate(result.values):
+            for j, name in enumerate(result.outputs):
+                scale, unit = _unit(result.kinds[j])
+                rows[f"{result.driver} [deg]"].append(math.degrees(x))
+                rows["output"].append(name), rows["unit"].append(unit)
+                rows["value"].append(result.nominal[i, j] * scale)
+                for k, p in enumerate(result.params):
+                    rows[f"d/d {p} [per mm]"].append(result.sensitivity[i, j, k] * scale / 1e3)
+        return rows
+    p, y, causes = result.variants
+    rows = {"variant": list(range(len(causes)))}
+    rows.update({f"{name} [mm]": (p[:, k] * 1e3).tolist() for k, name in enumerate(result.params)})
+    rows["cause"] = list(causes)
+    dev = np.abs(deviation(y, result.nominal, result.kinds)).max(axis=1)
+    for j, name in enumerate(result.outputs):
+        scale, unit = _unit(result.kinds[j])
+        rows[f"max |d {name}| [{unit}]"] = (dev[:, j] * scale).tolist()
+    return rows
+
+
+def grid_table(result: StudyResult) -> dict[str, list]:
+    """One row a grid point: its index, parameters [mm], cause ("" if it solved) and each
+    output's min and max over the cycle (NaN where the point failed; angles unwrapped), and
+    the least transmission angle over the cycle for a planar linkage with dyads."""
+    p, y, causes = result.variants
+    rows: dict[str, list] = {"point": list(range(len(causes)))}
+    rows.update({f"{name} [mm]": (p[:, k] * 1e3).tolist() for k, name in enumerate(result.params)})
+    rows["cause"] = list(causes)
+    lo, hi = cycle_range(y, result.kinds)
+    for j, name in enumerate(result.outputs):
+        scale, unit = _unit(result.kinds[j])
+        rows[f"min {name} [{unit}]"] = (lo[:, j] * scale).tolist()
+        rows[f"max {name} [{unit}]"] = (hi[:, j] * scale).tolist()
+    if result.transmission is not None:
+        rows["least transmission angle [deg]"] = np.degrees(result.transmission).tolist()
+    return rows
+
+
+def write(result: StudyResult, prefix: str | Path, *, parquet: bool = True) -> list[Path]:
+    """PREFIX.csv, PREFIX.json and (with pyarrow) PREFIX.parquet; the paths written."""
+    return write_tables(table(result), summary(result), prefix, parquet=parquet)
+
+
+def write_tables(columns: dict[str, list], summary_: dict, prefix: str | Path, *, parquet: bool = True) -> list[Path]:
+    """Columns to PREFIX.csv (and PREFIX.parquet with pyarrow), a summary to PREFIX.json."""
+    paths = [beside(prefix, ".csv"), beside(prefix, ".json")]
+    text = io.StringIO(newline="")
+    writer = csv.writer(text)
+    writer.writerow(columns)
+    writer.writerows(zip(*columns.values()))
+    write_whole(paths[0], text.getvalue())
+    write_whole(paths[1], json.dumps(summary_, indent=2) + "\n")
+    if parquet:
+        try:
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+        except ImportError as exc:
+            raise ImportError(f'a Parquet table needs pyarrow: pip install "pinmech[study]" ({exc})') from exc
+        paths.append(write_with(beside(prefix, ".parquet"), lambda path: pq.write_table(pa.table(columns), path)))
+    return paths

@@ -1,0 +1,1 @@
+"""pinmech.design.synthesis: see docs/explanation/layout.md."""

@@ -1,0 +1,1 @@
+"""pinmech.design.workspace.run: see docs/explanation/layout.md."""
