@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
@@ -13,6 +14,14 @@ SCENES = MODELS / "scenes"
 
 # The independent closed-form derivations live in scripts/ as worked examples.
 sys.path.insert(0, str(ROOT / "scripts"))
+
+
+# Hypothesis: the same examples on every machine and run ("ci", the default: derandomized,
+# no example database), or fresh random ones to flush what a fixed draw misses
+# (`pytest --hypothesis-profile=explore`). A test's own @settings sets only its counts.
+settings.register_profile("ci", derandomize=True, database=None, deadline=None)
+settings.register_profile("explore", derandomize=False, database=None, deadline=None)
+settings.load_profile("ci")
 
 
 FOUR_BAR_LENGTHS = {"crank": 0, "coupler": 1, "rocker": 2, "ground": 3}  # (a, b, c, d)

@@ -27,7 +27,7 @@ from pinmech.solve.rates import RateSolver, Task
 from tests._mechanisms import four_bar_urdf, scaled_urdf
 from tests.conftest import MODELS
 
-SETTINGS = settings(max_examples=40, derandomize=True, deadline=None,
+SETTINGS = settings(max_examples=40, deadline=None,
                     suppress_health_check=[HealthCheck.function_scoped_fixture])
 lengths = st.floats(0.01, 1.0)
 angles = st.floats(-np.pi, np.pi)

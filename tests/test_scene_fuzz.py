@@ -94,7 +94,7 @@ def _said_well(exc: PinmechError, path: Path) -> None:
         assert str(path) in message or path.name in message, message
 
 
-@settings(max_examples=400, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=400, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(mutated(BUNDLED))
 def test_a_wrong_scene_is_read_into_a_scene_or_refused_by_a_named_error(case):
     path, tables = case
@@ -104,7 +104,7 @@ def test_a_wrong_scene_is_read_into_a_scene_or_refused_by_a_named_error(case):
         _said_well(exc, path)
 
 
-@settings(max_examples=120, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(mutated(QUICK))
 def test_a_wrong_scene_is_solved_or_refused_by_a_named_error_never_another_exception(case):
     path, tables = case
@@ -117,7 +117,7 @@ def test_a_wrong_scene_is_solved_or_refused_by_a_named_error_never_another_excep
     assert all(math.isfinite(x) for x in analysis.solution.q)  # a result: finite, or it would have been refused
 
 
-@settings(max_examples=40, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(mutated([SCENES / "r_rtr.toml", SCENES / "slider_crank.toml"]))
 def test_a_wrong_scene_is_swept_or_refused_by_a_named_error(case):
     path, tables = case
@@ -132,7 +132,7 @@ def test_a_wrong_scene_is_swept_or_refused_by_a_named_error(case):
 HANDS = sorted(SCENES.glob("*.hand.toml"))
 
 
-@settings(max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(mutated(HANDS))
 def test_a_wrong_hand_file_is_read_or_refused_by_a_named_error(case):
     """The same for hand-value files: read into HandValues, or one named error."""

@@ -1,0 +1,61 @@
+"""The tests' tolerances, each derived from what the arithmetic guarantees.
+
+A check compares a number pinmech computes with an independent one (a closed form, an identity,
+a published value). Both are rounded, and another libm, BLAS or SIMD path rounds them
+differently (numpy's NPY_DISABLE_CPU_FEATURES="X86_V3 X86_V4 AVX512_ICL AVX512_SPR",
+OPENBLAS_CORETYPE=Prescott), so a bar is never "1e-12 by habit" but one of:
+
+- `rounding(scale, cond)`: a closed form of a few dozen float operations on numbers of size
+  `scale`: each operation (and each libm call) is off by an ulp or so, so the result is within
+  STEPS x eps x scale, times the condition number `cond` of the step that amplifies most (a
+  square root near zero, an acos near +-1, a difference of near-equal numbers).
+- `closure(scale, cond)`: a pose the engine solved, its loops closed to the solver's tolerance
+  (DEFAULT_TOL of the loop's size): pinmech's own position bound (Accuracy.error_bounds,
+  4 x condition x residual), plus the rounding of the closed form it is checked against.
+- `stated(accuracy, scale)`: the bound pinmech prints for one result (Accuracy.error_bounds).
+- `central_difference(scale, h, ...)`: truncation h^2/6 x the third derivative plus the
+  rounding eps x |f| / h of a central difference.
+
+A real error (a wrong branch, frame, sign or unit) is a fraction of the numbers' size, 1e-3
+and up: every bar here is many orders of magnitude below it, so each check can still fail.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pinmech.solve.results import BOUND_FACTORS
+from pinmech.solve.solver_options import DEFAULT_TOL
+
+#: Machine epsilon of float64 [-].
+EPS = float(np.finfo(float).eps)
+#: Rounded operations allowed a test's closed form, a margin over its count (Higham's
+#: gamma_n = n u: n operations lose at most about n half-ulps, here over both sides).
+STEPS = 64
+
+
+def rounding(scale: float, cond: float = 1.0, steps: int = STEPS) -> float:
+    """Bar on a closed form of numbers of size `scale` [their unit]: steps x eps x cond x scale."""
+    return float(steps * EPS * np.max(cond) * np.max(np.abs(scale)))
+
+
+def closure(scale: float, cond: float = 1.0, tol: float = DEFAULT_TOL) -> float:
+    """Bar on a position of a pose the engine closed to `tol` of the loops' size `scale` [m]
+    (or an angle, scale 1 rad), at condition number `cond`: pinmech's position bound
+    4 x cond x tol x scale, plus the rounding of the closed form it is compared with."""
+    return BOUND_FACTORS[0] * float(np.max(cond)) * tol * float(np.max(np.abs(scale))) + rounding(scale, cond)
+
+
+def stated(accuracy, scale: float, order: int = 0) -> float:
+    """pinmech's own bound on a solved pose's positions (order 0), velocities (1) or
+    accelerations (2): `accuracy.error_bounds[order]` x the size `scale` of the numbers."""
+    return float(accuracy.error_bounds[order] * np.max(np.abs(scale))) + rounding(scale, accuracy.condition**order)
+
+
+def central_difference(scale: float, h: float, third: float | None = None, noise: float | None = None) -> float:
+    """Bar on a central difference with step h of a function of size `scale`: truncation
+    h^2/6 x |f'''| (`third`, taken as `scale` when not given: lengths over angles [rad]) plus
+    rounding: the function's own error `noise` (eps x scale when not given) over h."""
+    third = scale if third is None else third
+    noise = EPS * scale if noise is None else noise
+    return float(h * h / 6 * abs(third) + 2 * noise / h) * 4
