@@ -30,6 +30,7 @@ from pinmech.draw import (
 )
 from tests.browser import colour_mask, colour_share, read_png, screenshot, span_share
 from tests.conftest import MODELS
+from tests.tolerance import rounding
 
 needs_meshcat = pytest.mark.skipif(
     importlib.util.find_spec("meshcat") is None,
@@ -87,7 +88,7 @@ def test_the_hand_closed_r_rtr_pose_pins_link3_at_c(r_rtr):
     for theta in np.radians([0, 30, 90, 150, 275]):
         pin.forwardKinematics(model, data, r_rtr_pose(theta))
         np.testing.assert_allclose(
-            data.oMi[model.getJointId("B_slider")].translation, [AC, 0, 0], atol=1e-15
+            data.oMi[model.getJointId("B_slider")].translation, [AC, 0, 0], atol=rounding(AC)
         )
 
 

@@ -22,6 +22,7 @@ from pinmech.design.study.run import study
 from pinmech.design.study.file import load_study, parse_study
 from pinmech.design.study.report import grid_table, summary
 from pinmech.exceptions import SceneError
+from tests.tolerance import rounding
 
 STUDIES = Path(__file__).resolve().parents[1] / "models" / "studies"
 B, C, D = 0.120, 0.080, 0.100  # coupler, rocker, ground of models/four_bar.urdf [m]
@@ -126,7 +127,7 @@ def test_grid_results_do_not_depend_on_the_batching(crank_grid):
 def test_bundled_grid_study_parses():
     spec = load_study(STUDIES / "four_bar_grid.toml")
     assert spec.kind == "grid" and [a.name for a in spec.grid] == ["crank", "ground"]
-    np.testing.assert_allclose(spec.grid[0].values[-1], 0.080, rtol=0, atol=1e-15)  # 20 .. 80 mm
+    np.testing.assert_allclose(spec.grid[0].values[-1], 0.080, rtol=0, atol=rounding(0.080))  # 20 .. 80 mm
 
 
 @pytest.mark.parametrize("change, key", [

@@ -16,6 +16,7 @@ import pytest
 
 from pinmech.cli import main
 from tests.conftest import MODELS, SCENES
+from tests.tolerance import rounding
 
 
 def _cb(angle_deg: float) -> float:
@@ -127,7 +128,7 @@ def test_mjcf_ranges_are_mujocos_limits_and_are_checked(tmp_path, capsys):
     for j in range(m.njnt):
         limit = mech.limits[m.joint(j).name]
         assert m.jnt_limited[j]
-        assert (limit.lower, limit.upper) == pytest.approx(tuple(m.jnt_range[j]), abs=1e-15)
+        assert (limit.lower, limit.upper) == pytest.approx(tuple(m.jnt_range[j]), abs=rounding(math.pi))
     scene = tmp_path / "arm.toml"
     scene.write_text('mjcf = "arm.xml"\n[drivers.shoulder]\nangle = "90 deg"\n[drivers.slide]\nposition = "0 mm"\n'
                      '[report]\nlimits = "error"\n')
@@ -161,7 +162,7 @@ def test_a_limited_ball_joint_is_checked_where_mujoco_finds_it_beyond(tmp_path):
     q = np.array([*(math.sin(angle / 2) * axis), math.cos(angle / 2)])  # Pinocchio: x y z w
     [violation] = limits_at(mech, q)
     assert violation.joint == "ball" and violation.value == pytest.approx(angle, abs=1e-12)
-    assert violation.upper == pytest.approx(math.radians(30), abs=1e-15)
+    assert violation.upper == pytest.approx(math.radians(30), abs=rounding(math.pi))
 
 
 def test_urdf_limits_through_a_sidecar_are_checked(tmp_path, capsys):

@@ -19,6 +19,7 @@ import pytest
 
 from pinmech.exceptions import ModelError
 from pinmech.model.mjcf import load_mjcf
+from tests.tolerance import rounding
 
 mujoco = pytest.importorskip("mujoco")
 MJCF_DIR = Path(__file__).resolve().parents[1] / "models" / "mjcf"
@@ -123,7 +124,7 @@ def test_qpos0_is_the_reference_with_ref_included(tmp_path):
     mech = load_mjcf(path)
     for j in range(m.njnt):  # ref = 30 deg, -45 deg, 0.02 m: MuJoCo's qpos0 in rad and m
         np.testing.assert_allclose(mech.coordinate(mech.neutral(), m.joint(j).name), m.qpos0[m.jnt_qposadr[j]],
-                                   atol=1e-15)
+                                   atol=rounding(np.pi))
 
 
 def test_nested_jointless_bodies_keep_mujocos_mass_and_centre(tmp_path):
@@ -266,7 +267,7 @@ def test_a_composites_sites_sit_where_mujoco_puts_them_ref_included(tmp_path, ca
     d = mujoco.MjData(m)
     mech = load_mjcf(path)
     data = mech.model.createData()
-    np.testing.assert_allclose(mech.neutral(), _composite_q(mech, m, m.qpos0), atol=1e-15)  # qpos0 is the reference
+    np.testing.assert_allclose(mech.neutral(), _composite_q(mech, m, m.qpos0), atol=rounding(np.pi))  # qpos0 is the reference
     rng = np.random.default_rng(3)
     for k in range(4):
         d.qpos[:] = m.qpos0 + (k > 0) * rng.uniform(-0.8, 0.8, m.nq)

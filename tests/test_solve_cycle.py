@@ -17,6 +17,7 @@ from pinmech import PinmechError, Scene
 from pinmech.solve.batch import BatchSolver
 from pinmech.solve.cycle import CHUNK
 from pinmech.io.sweep import Sweep
+from tests.tolerance import rounding
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -118,7 +119,7 @@ def test_a_failure_in_a_dense_batched_sweep_is_named_by_its_angle(tmp_path, mode
     values = np.radians(np.linspace(-20.0, 20.0, 401))
     poses = list(sweep.poses(values, skip_failures=True))
     failed = [p.value for p in poses if p.motion is None]
-    np.testing.assert_allclose(failed, [0.0], atol=1e-15)
+    np.testing.assert_allclose(failed, [0.0], atol=rounding(np.radians(20.0)))
 
 
 def test_options_that_cannot_hold_are_errors(sweep):

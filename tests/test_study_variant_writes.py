@@ -15,6 +15,7 @@ from pinmech.design.study.file import parse_study
 from pinmech.design.study.outputs import StudyOutputs
 from pinmech.design.study.variant import StudyMechanism
 from pinmech.design.study.tolerance import Batch, deviation, solve_variants
+from tests.tolerance import rounding
 
 STUDIES = Path(__file__).resolve().parents[1] / "models" / "studies"
 ORDER = ("crank", "ground", "coupler", "rocker")  # the study's params: a, d, b, c of the four-bar
@@ -66,7 +67,7 @@ def test_written_origins_are_in_the_model_and_in_the_next_solve():
     cycle = sm.within(p)
     for place, value in zip(sm.placements, p):
         if place.frames:
-            assert abs(_fresh(sm.model, place) - value) <= 1e-16
+            assert abs(_fresh(sm.model, place) - value) <= rounding(value)
         else:
             assert _fresh(sm.model, place) == value
     assert not cycle.cause
@@ -82,7 +83,7 @@ def test_a_write_lands_after_frames_are_added_to_the_model():
         sm.model.addFrame(pin.Frame(f"extra{i}", 1, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME))
     for place, value in zip(sm.placements, (0.041, 0.099, 0.121, 0.079)):
         place.write(value)
-        assert abs(_fresh(sm.model, place) - value) <= 1e-16  # as above: one shift for a cut frame
+        assert abs(_fresh(sm.model, place) - value) <= rounding(value)  # as above: one shift for a cut frame
 
 
 def test_a_variant_outside_bounds_mid_batch_keeps_its_cause_and_the_next_one_is_solved():

@@ -17,6 +17,7 @@ from pinmech.design.synthesis.linkage import engine_check, write_linkage
 from pinmech.design.synthesis.motion import CAUSES
 from pinmech.design.synthesis.objective import evaluate_path as evaluate
 from pinmech.design.synthesis.search import synthesise
+from tests.tolerance import rounding
 
 ROOT = Path(__file__).resolve().parents[1]
 # The bounds of the bundled example: ground pivots in two 120 mm squares, links 10-200 mm.
@@ -62,9 +63,9 @@ def test_closed_form_keeps_the_link_lengths_and_the_drawn_point():
     z = _bundled()
     theta = np.linspace(-math.pi, math.pi, 73)[None]
     p = pose(z[None], np.array([1.0]), theta)
-    assert np.allclose(pose(z[None], np.array([1.0]), np.zeros((1, 1))).P[0, 0], [0.1, 0.03], atol=1e-15)
-    assert np.allclose(np.linalg.norm(p.B - p.A, axis=-1), 0.12, atol=1e-14)
-    assert np.allclose(np.linalg.norm(p.B - z[2:4], axis=-1), 0.08, atol=1e-14)
+    assert np.allclose(pose(z[None], np.array([1.0]), np.zeros((1, 1))).P[0, 0], [0.1, 0.03], atol=rounding(0.2))
+    assert np.allclose(np.linalg.norm(p.B - p.A, axis=-1), 0.12, atol=rounding(0.2))
+    assert np.allclose(np.linalg.norm(p.B - z[2:4], axis=-1), 0.08, atol=rounding(0.2))
     assert p.closes.all()  # a crank-rocker: the crank turns fully
 
 

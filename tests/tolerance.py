@@ -12,7 +12,10 @@ OPENBLAS_CORETYPE=Prescott), so a bar is never "1e-12 by habit" but one of:
 - `closure(scale, cond)`: a pose the engine solved, its loops closed to the solver's tolerance
   (DEFAULT_TOL of the loop's size): pinmech's own position bound (Accuracy.error_bounds,
   4 x condition x residual), plus the rounding of the closed form it is checked against.
-- `stated(accuracy, scale)`: the bound pinmech prints for one result (Accuracy.error_bounds).
+- `stated(residual, condition, scale, order)`: the bound pinmech states of one solved pose
+  (Accuracy.error_bounds: 4 k m on positions, 4 k^2 m on rates, 16 k^3 m on accelerations, m
+  the closure residual or eps, k the condition number).
+- `residual(scale)`: a closure residual, at most the solver's tolerance of the loop's size.
 - `central_difference(scale, h, ...)`: truncation h^2/6 x the third derivative plus the
   rounding eps x |f| / h of a central difference.
 
@@ -24,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pinmech.solve.results import BOUND_FACTORS
+from pinmech.solve.results import BOUND_FACTORS, Accuracy
 from pinmech.solve.solver_options import DEFAULT_TOL
 
 #: Machine epsilon of float64 [-].
@@ -46,10 +49,13 @@ def closure(scale: float, cond: float = 1.0, tol: float = DEFAULT_TOL) -> float:
     return BOUND_FACTORS[0] * float(np.max(cond)) * tol * float(np.max(np.abs(scale))) + rounding(scale, cond)
 
 
-def stated(accuracy, scale: float, order: int = 0) -> float:
-    """pinmech's own bound on a solved pose's positions (order 0), velocities (1) or
-    accelerations (2): `accuracy.error_bounds[order]` x the size `scale` of the numbers."""
-    return float(accuracy.error_bounds[order] * np.max(np.abs(scale))) + rounding(scale, accuracy.condition**order)
+def stated(residual: float, condition: float, scale: float, order: int = 0) -> float:
+    """pinmech's own bound (Accuracy.error_bounds) on a solved pose's positions (order 0),
+    velocities (1) or accelerations (2), from the pose's closure `residual` and the rate
+    Jacobian's `condition` number, times the size `scale` of the numbers [their unit]; plus
+    the rounding of the closed form they are checked against."""
+    bounds = Accuracy(float(np.max(residual)), 0, float(np.max(condition)), 0.0).error_bounds
+    return bounds[order] * float(np.max(np.abs(scale))) + rounding(scale, float(np.max(condition)) ** order)
 
 
 def central_difference(scale: float, h: float, third: float | None = None, noise: float | None = None) -> float:
@@ -59,3 +65,9 @@ def central_difference(scale: float, h: float, third: float | None = None, noise
     third = scale if third is None else third
     noise = EPS * scale if noise is None else noise
     return float(h * h / 6 * abs(third) + 2 * noise / h) * 4
+
+
+def residual(scale: float, tol: float = DEFAULT_TOL) -> float:
+    """Bar on the closure residual of a pose the engine solved, loops of size `scale` [m]:
+    the solver's tolerance `tol` of that size, plus the rounding of the rows recomputed."""
+    return tol * float(np.max(np.abs(scale))) + rounding(scale)
