@@ -22,6 +22,7 @@ import pytest
 import pinmech
 from pinmech.exceptions import IndeterminateForcesError, ModelError
 from pinmech.solve.forces import ForceSolver, Load
+from tests.tolerance import closure, rounding
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 G = 9.81
@@ -30,6 +31,8 @@ G = 9.81
 # these poses, so the relative error is ~1e-11 at worst; 1e-9 of the largest force keeps a
 # margin of a hundred while a wrong sign, lever arm or missing term (1e-3 or more) fails.
 RTOL = 1e-9
+# Positions of these poses: closed to the solver's tolerance at condition numbers below 1e2.
+COND = 1e2
 
 
 def slider_crank(theta: float, omega: float, alpha: float, path: Path = MODELS / "slider_crank_dynamic.urdf",
@@ -100,7 +103,7 @@ def test_four_bar_matches_newton_euler_by_hand(deg, rpm, alpha, gravity, torque)
     data = mech.model.createData()
     pin.framesForwardKinematics(mech.model, data, sol.q)
     b_hand = cff.cf.four_bar(theta, omega, alpha, 0.04, 0.12, 0.08, 0.10).B
-    np.testing.assert_allclose(data.oMf[mech.frame_id("B_pin")].translation[:2], b_hand, atol=1e-12)  # same branch
+    np.testing.assert_allclose(data.oMf[mech.frame_id("B_pin")].translation[:2], b_hand, atol=closure(0.16, COND))  # same branch
     scale = np.abs(np.concatenate([hand.F12, hand.F23, hand.F34, hand.F14])).max()
     r = f.reactions
     np.testing.assert_allclose(f.effort[0], hand.T, rtol=0, atol=RTOL * scale * 0.1)
@@ -115,10 +118,10 @@ def test_joint_moments_about_axes_are_the_drivers_and_zero_on_free_pins():
     f = ForceSolver(mech, ["O"], gravity=(0, -G, 0)).solve(sol.q, sol.v, sol.a)
     r = f.reactions
     scale = abs(f.effort[0])
-    assert r["O"].axial_moment == pytest.approx(f.effort[0], rel=1e-12)
-    assert abs(r["A"].axial_moment) < 1e-12 * scale
-    assert abs(r["slide"].axial_force) < 1e-12 * r["slide"].magnitude  # no driving force on the piston
-    np.testing.assert_allclose(r["slide"].normal_force, r["slide"].force, atol=1e-12 * r["slide"].magnitude)
+    assert r["O"].axial_moment == pytest.approx(f.effort[0], rel=rounding(1.0, f.condition))
+    assert abs(r["A"].axial_moment) < rounding(scale, f.condition)
+    assert abs(r["slide"].axial_force) < rounding(r["slide"].magnitude, f.condition)  # no driving force on the piston
+    np.testing.assert_allclose(r["slide"].normal_force, r["slide"].force, atol=rounding(r["slide"].magnitude, f.condition))
 
 
 # --------------------------------------------------------------------- identities
@@ -150,9 +153,9 @@ def test_virtual_power_holds_at_random_poses(which):
         f = ForceSolver(mech, drivers, gravity=rng.normal(size=3) * G,
                         loads=_random_loads(mech, rng, names)).solve(sol.q, sol.v, sol.a)
         assert f.power.velocity == "actual"
-        assert f.power.residual < 1e-12, f.power
-        assert f.equation_residual < 1e-12
-        assert f.is_balanced(1e-12)
+        assert f.power.residual < rounding(1.0, f.condition), f.power
+        assert f.equation_residual < rounding(1.0, f.condition)
+        assert f.is_balanced(rounding(1.0, f.condition))
 
 
 def test_a_spatial_loop_balances_its_power(tmp_path):
@@ -168,7 +171,7 @@ def test_a_spatial_loop_balances_its_power(tmp_path):
         sol = pinmech.LoopSolver(mech, ["R1"]).solve([theta], [2.0], [1.0], guess=mech.neutral())
         load = Load("F", mech.links["coupler"], rng.normal(size=3) * 10, rng.normal(size=3))
         f = ForceSolver(mech, ["R1"], gravity=(0.3, -1.0, -G), loads=[load]).solve(sol.q, sol.v, sol.a)
-        assert f.power.residual < 1e-12 and f.equation_residual < 1e-12
+        assert f.power.residual < rounding(1.0, f.condition) and f.equation_residual < rounding(1.0, f.condition)
         np.testing.assert_array_equal(f.reactions["S"].moment, np.zeros(3))
         assert f.reactions["S"].magnitude > 0
 
@@ -182,9 +185,9 @@ def test_a_driven_slider_gives_the_force_of_equal_power():
     by_piston = ForceSolver(mech, ["slide"], gravity=(0, -G, 0)).solve(sol.q, sol.v, sol.a)
     v_piston = sol.v[mech.joint("slide").idx_v]
     assert by_piston.effort[0] * v_piston == pytest.approx(by_crank.effort[0] * 200.0, rel=1e-10)
-    assert by_piston.reactions["slide"].axial_force == pytest.approx(by_piston.effort[0], rel=1e-12)
-    assert abs(by_piston.reactions["O"].axial_moment) < 1e-12 * abs(by_crank.effort[0])
-    assert by_piston.power.residual < 1e-12
+    assert by_piston.reactions["slide"].axial_force == pytest.approx(by_piston.effort[0], rel=rounding(1.0, by_piston.condition))
+    assert abs(by_piston.reactions["O"].axial_moment) < rounding(abs(by_crank.effort[0]), by_piston.condition)
+    assert by_piston.power.residual < rounding(1.0, by_piston.condition)
 
 
 def test_driver_power_is_the_rate_of_mechanical_energy_by_finite_differences():
@@ -226,7 +229,7 @@ def test_statics_is_virtual_work_by_finite_differences(which):
         force, g = rng.normal(size=3) * [100, 100, 0], np.array([0.0, -G, 0.0])
         load = Load("F", mech.frame_id(point), force, np.zeros(3))
         f = ForceSolver(mech, [driver], gravity=g, loads=[load]).solve(sol.q, sol.v, sol.a)
-        assert f.power.velocity == "virtual" and f.power.residual < 1e-12
+        assert f.power.velocity == "virtual" and f.power.residual < rounding(1.0, f.condition)
 
         def positions(t, build=build, mech=mech, point=point):
             _, s = build(t, 0.0, 0.0)
@@ -278,7 +281,7 @@ def test_forces_scale_from_micrometres_to_kilometres(tmp_path, s):
     for name in ("O", "A", "B", "slide"):
         np.testing.assert_allclose(scaled.reactions[name].force / s, ref.reactions[name].force, rtol=0,
                                    atol=RTOL * ref.reactions["O"].magnitude, err_msg=name)
-    assert scaled.power.residual < 1e-12
+    assert scaled.power.residual < rounding(1.0, scaled.condition)
 
 
 # --------------------------------------------------------------------- errors
@@ -304,11 +307,11 @@ def test_a_link_declared_massless_is_accepted_and_carries_a_two_force_member(tmp
     mech, sol = slider_crank(np.radians(40), 200.0, 0.0, _urdf_without_rod_mass(tmp_path))
     f = ForceSolver(mech, ["O"], massless=["rod"]).solve(sol.q, sol.v, sol.a)
     F_A, F_B = f.reactions["A"].force, f.reactions["B"].force  # crank on rod, rod on piston
-    np.testing.assert_allclose(F_A, F_B, atol=1e-12 * np.linalg.norm(F_A))
+    np.testing.assert_allclose(F_A, F_B, atol=rounding(np.linalg.norm(F_A), f.condition))
     data = mech.model.createData()
     pin.framesForwardKinematics(mech.model, data, sol.q)
     AB = data.oMf[mech.frame_id("B_pin")].translation - data.oMf[mech.frame_id("A_pin")].translation
-    assert abs(np.cross(AB, F_A)[2]) < 1e-12 * np.linalg.norm(AB) * np.linalg.norm(F_A)
+    assert abs(np.cross(AB, F_A)[2]) < rounding(np.linalg.norm(AB) * np.linalg.norm(F_A), f.condition)
 
 
 def _twice_cut(tmp_path: Path) -> Path:
@@ -331,10 +334,10 @@ def test_redundant_loops_are_named_and_minimum_norm_only_when_asked(tmp_path):
     assert (info.value.unknowns, info.value.equations, info.value.exit_code) == (5, 3, 7)
     both = ForceSolver(mech2, ["O"], gravity=(0, -G, 0), minimum_norm=True).solve(sol.q, sol.v, sol.a)
     assert both.method == "minimum_norm"
-    np.testing.assert_allclose(both.effort, single.effort, rtol=1e-12)
+    np.testing.assert_allclose(both.effort, single.effort, rtol=rounding(1.0, both.condition))
     for cut in ("B", "B2"):
         np.testing.assert_allclose(both.reactions[cut].force, single.reactions["B"].force / 2, rtol=1e-10)
-    assert both.power.residual < 1e-12
+    assert both.power.residual < rounding(1.0, both.condition)
 
 
 def test_a_dead_centre_of_the_driver_is_not_determined():
