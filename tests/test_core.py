@@ -30,7 +30,7 @@ from pinmech.solve.loops import DEFAULT_TOL, POLISH
 from tests._mechanisms import cut_rows
 from pinmech.solve.loops import MAX_STEP as MAX_NEWTON_STEP
 from pinmech.io.sweep import Sweep
-from tests.tolerance import rounding
+from tests.tolerance import closure, residual, rounding, stated
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
 import benchmark_loops as chain  # noqa: E402
@@ -167,7 +167,7 @@ def test_sweeps_close_the_loops_and_their_rates_are_finite_differences(scenes_di
         for qi in q[i:i + 3]:
             pin.computeJointJacobians(model, data, qi)
             pin.updateFramePlacements(model, data)
-            assert max(np.abs(cut_rows(model, data, c)).max() for c in sweep.mechanism.closures) <= 1e-12
+            assert max(np.abs(cut_rows(model, data, c)).max() for c in sweep.mechanism.closures) <= residual(1.0)
         checked += 1
         if np.count_nonzero(sweep.drivers.v) > 1:  # the others move too: rates are not the path's alone
             continue
@@ -315,7 +315,7 @@ def test_dimensions_changed_in_the_model_are_used_without_a_rebuild(tmp_path):
     assert core.core_for(solver) is first and not errors
     for i, th in enumerate(theta):
         ref = closed_form.four_bar(th, 1.0, 0.0, a, b, c, d, +1)
-        np.testing.assert_allclose(_rocker_tip(mech, q[i], c, d), ref.B, rtol=0, atol=1e-12 * d)
+        np.testing.assert_allclose(_rocker_tip(mech, q[i], c, d), ref.B, rtol=0, atol=closure(d, chunk.solution.condition[i]))
         omega4 = chunk.solution.v[i][mech.joint("O4").idx_v]
         np.testing.assert_allclose(omega4, float(ref.omega4), rtol=0, atol=1e-10 * (1 + abs(float(ref.omega4))))
 
@@ -332,7 +332,7 @@ def test_a_model_with_a_composite_joint_is_swept_by_the_core(scenes_dir):
     q, v, a, errors, _ = _rows(sweep, np.array([x - h, x, x + h]))
     assert not errors
     for qi in q:
-        assert np.abs(solver._residual(qi)).max() <= 1e-12 and solver._full_residual() <= 1e-12
+        assert np.abs(solver._residual(qi)).max() <= residual(1.0) and solver._full_residual() <= residual(1.0)
     w = float(sweep.drivers.v[sweep.drivers.names.index(sweep.driver)])
     dq1 = pin.difference(solver.model, q[0], q[2]) / (2 * h)
     np.testing.assert_allclose(v[1] / w, dq1, rtol=0, atol=1e-7)
@@ -399,7 +399,7 @@ def test_four_bars_from_micrometres_to_kilometres_meet_the_closed_form(tmp_path,
     assert not errors
     for i, th in enumerate(theta):
         ref = closed_form.four_bar(th, 1.0, 0.0, a, b, c, d, +1)
-        assert np.abs(_rocker_tip(mech, q[i], c, d) - ref.B).max() <= 1e-12 * size, i
+        assert np.abs(_rocker_tip(mech, q[i], c, d) - ref.B).max() <= closure(size, chunk.solution.condition[i]), i
         omega4 = chunk.solution.v[i][mech.joint("O4").idx_v]
         assert abs(omega4 - float(ref.omega4)) <= 1e-10 * (1 + abs(float(ref.omega4))), i
 
@@ -433,7 +433,7 @@ def test_a_link_lengthened_in_the_model_after_a_sweep_is_seen(scenes_dir):
         assert sweep.solver.turn_gap(qa, qb) > 1e-6
         pin.computeJointJacobians(model, data, qb)
         pin.updateFramePlacements(model, data)
-        assert max(np.abs(cut_rows(model, data, c)).max() for c in sweep.mechanism.closures) <= 1e-12
+        assert max(np.abs(cut_rows(model, data, c)).max() for c in sweep.mechanism.closures) <= residual(1.0)
 
 
 # ---------------------------------------------------------------------- chains and condition numbers
@@ -502,7 +502,7 @@ def test_condition_numbers_are_the_svds(n, log_condition, log_size, seed):
     matrices 1x1 to 40x40 (dense: the Householder bidiagonalization),
     condition numbers 1 to 1e12, sizes 1e-8 to 1e8. All are exact to rounding: sigma_max
     to a few eps relative, sigma_min to about eps x condition (the SVD's own accuracy, and
-    what rounding A itself moves it by), so the bar is 1e-12 + 100 n eps kappa. (It found
+    what rounding A itself moves it by), so the bar is 100 n eps kappa. (It found
     the 2x2 closed form losing 1.4e-12 at condition 1.00007, and the 3x3 cofactor inverse
     losing 2e-3 at 1e10.)"""
     rng = np.random.default_rng(seed)
@@ -510,7 +510,7 @@ def test_condition_numbers_are_the_svds(n, log_condition, log_size, seed):
     A = _with_singular_values(rng, s)
     sigma = np.linalg.svd(A, compute_uv=False)
     want = sigma[0] / sigma[-1]
-    bar = 1e-12 + 100 * n * np.finfo(float).eps * want
+    bar = rounding(1.0, want, steps=100 * n)
     for condition, sigma_min in (core._core.condition(A),):
         assert condition == pytest.approx(want, rel=bar)
         assert sigma_min == pytest.approx(sigma[-1], rel=bar)
@@ -537,7 +537,7 @@ def test_condition_numbers_of_band_matrices_are_the_svds(n, kl, ku, log_grade, s
     sigma = np.linalg.svd(A, compute_uv=False)
     assume(sigma[-1] > 0 and sigma[0] / sigma[-1] < 1e12)
     want = sigma[0] / sigma[-1]
-    bar = 1e-12 + 100 * n * np.finfo(float).eps * want
+    bar = rounding(1.0, want, steps=100 * n)
     condition, sigma_min = core._core.condition(A)
     assert condition == pytest.approx(want, rel=bar)
     assert sigma_min == pytest.approx(sigma[-1], rel=bar)
@@ -561,7 +561,7 @@ def test_condition_numbers_of_clustered_singular_values(n, spectrum):
         A = _with_singular_values(rng, s)
         sigma = np.linalg.svd(A, compute_uv=False)
         want = sigma[0] / sigma[-1]
-        bar = 1e-12 + 100 * n * np.finfo(float).eps * want
+        bar = rounding(1.0, want, steps=100 * n)
         condition, sigma_min = core._core.condition(A)
         assert condition == pytest.approx(want, rel=bar)
         assert sigma_min == pytest.approx(sigma[-1], rel=bar)
@@ -609,9 +609,9 @@ def test_pinocchio_passes_compute_pinocchios_kinematics(scenes_dir, name):
     for jacobians in (0, 1, 2):
         got = compiled.pinocchio_passes(Q, V, jacobians)
         assert got.shape == (5, 6)
-        np.testing.assert_allclose(got[:, :3], np.array(want)[:, :3], rtol=0, atol=1e-13 * size)
+        np.testing.assert_allclose(got[:, :3], np.array(want)[:, :3], rtol=0, atol=rounding(size))
         np.testing.assert_allclose(got[:, 3:], np.array(want)[:, 3:], rtol=0,
-                                   atol=1e-13 * size * (1 + np.max(np.abs(V))) ** 2)
+                                   atol=rounding(size * (1 + np.max(np.abs(V))) ** 2))
     with pytest.raises(ValueError, match="wrong shapes"):
         compiled.pinocchio_passes(Q[:, :-1], V, 1)
 
@@ -773,7 +773,7 @@ def test_a_geared_five_bar_with_a_mimic_joint_meets_its_closed_form(tmp_path):
     for i, th in enumerate(theta):
         pin.forwardKinematics(model, data, chunk.solution.q[i], chunk.solution.v[i])
         got = pin.updateFramePlacement(model, data, cut).translation[:2]
-        np.testing.assert_allclose(got, _geared_c(th, **g)[0], rtol=0, atol=1e-12 * g["d"])
+        np.testing.assert_allclose(got, _geared_c(th, **g)[0], rtol=0, atol=stated(chunk.solution.residual[i], chunk.solution.condition[i], g["d"]))
         want_v = (_geared_c(th + h, **g)[0] - _geared_c(th - h, **g)[0]) / (2 * h)
         np.testing.assert_allclose(pin.getFrameVelocity(model, data, cut, lwa).linear[:2], want_v, rtol=0, atol=1e-8)
     # the follower's link through the core's frame_paths: E = (d, 0) + a2 e(offset - theta),
