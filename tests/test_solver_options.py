@@ -28,6 +28,10 @@ from pinmech.solve.batch import BatchSolver
 from pinmech.solve.cycle import solve_range
 from pinmech.io.sweep import Sweep
 from tests._mechanisms import four_bar_urdf, write
+from tests.tolerance import closure, residual, rounding
+
+# The R-RTR's rate Jacobian over a turn: condition numbers up to 2.0 (measured), 2.5 allowed.
+R_RTR_COND = 2.5
 
 A, B, C, D = 0.04, 0.12, 0.08, 0.10
 
@@ -103,16 +107,16 @@ def test_a_ground_cut_frame_moved_after_the_solver_was_built(tmp_path):
     theta3 = mech.coordinate(sol.q, "O2") + mech.coordinate(sol.q, "A")  # the coupler's angle
     cf = min((closed_form.four_bar(1.0, 2.0, 0.5, A, B, C, D + 0.02, branch=b) for b in (1, -1)),
              key=lambda f: abs(np.remainder(float(f.theta3) - theta3 + np.pi, 2 * np.pi) - np.pi))
-    assert abs(np.remainder(float(cf.theta3) - theta3 + np.pi, 2 * np.pi) - np.pi) < 1e-12
+    assert abs(np.remainder(float(cf.theta3) - theta3 + np.pi, 2 * np.pi) - np.pi) < closure(1.0, sol.accuracy.condition)
     data = mech.model.createData()
     pin.framesForwardKinematics(mech.model, data, sol.q)
     gap = np.linalg.norm(data.oMf[c.parent_frame].translation - data.oMf[c.child_frame].translation)
-    assert gap <= 1e-12 * 0.2
+    assert gap <= residual(0.2)
     rocker = mech.joint("rocker_pin")
-    np.testing.assert_allclose(sol.v[rocker.idx_v], cf.omega4 - cf.omega3, rtol=1e-12)  # relative turn
+    np.testing.assert_allclose(sol.v[rocker.idx_v], cf.omega4 - cf.omega3, rtol=closure(1.0, sol.accuracy.condition, 1))  # relative turn
     out = batch.try_solve(sol.q[None], np.array([[1.0]]), np.array([[2.0]]), np.array([[0.5]]))
-    assert out is not None and out.residual[0] <= 1e-13
-    np.testing.assert_allclose(out.v[0], sol.v, rtol=1e-12, atol=1e-15)
+    assert out is not None and out.residual[0] <= residual(1.0)
+    np.testing.assert_allclose(out.v[0], sol.v, rtol=0, atol=closure(np.abs(sol.v).max(), sol.accuracy.condition, 1))
 
 
 def _cut_at_o4(text: str) -> str:
@@ -172,7 +176,8 @@ def test_one_solver_shared_by_two_threads(four_bar, fast_switching):
     for i in range(2):
         for x, sol in zip(angles[i], shared[i]):
             ref = alone.solve([x], [2.0], [0.5])
-            np.testing.assert_allclose(np.r_[sol.q, sol.v, sol.a], np.r_[ref.q, ref.v, ref.a], rtol=1e-12, atol=1e-14)
+            np.testing.assert_allclose(np.r_[sol.q, sol.v, sol.a], np.r_[ref.q, ref.v, ref.a], rtol=0,
+                                       atol=closure(np.abs(np.r_[ref.q, ref.v, ref.a]).max(), ref.accuracy.condition, 2))
 
 
 def test_one_sweep_shared_by_two_threads(r_rtr_scene, fast_switching):
@@ -189,8 +194,8 @@ def test_one_sweep_shared_by_two_threads(r_rtr_scene, fast_switching):
     for rows in shared:
         v = np.array([r[0][:2] for r in rows])
         a = np.array([r[1][:2] for r in rows])
-        assert np.abs(v - cf.vD).max() <= 1e-12 * np.abs(cf.vD).max()
-        assert np.abs(a - cf.aD).max() <= 1e-12 * np.abs(cf.aD).max()
+        assert np.abs(v - cf.vD).max() <= closure(np.abs(cf.vD).max(), R_RTR_COND, 1)
+        assert np.abs(a - cf.aD).max() <= closure(np.abs(cf.aD).max(), R_RTR_COND, 2)
 
 
 # ------------------------------------------------------------------ more of the same kind
@@ -260,7 +265,7 @@ def test_a_rate_solver_shared_by_two_threads(models_dir, fast_switching):
     for i in range(2):
         for x, sol in zip(xs[i], shared[i]):
             ref = alone.solve(pose(x))
-            np.testing.assert_allclose(np.r_[sol.v, sol.a], np.r_[ref.v, ref.a], rtol=1e-12, atol=1e-14)
+            np.testing.assert_allclose(np.r_[sol.v, sol.a], np.r_[ref.v, ref.a], rtol=0, atol=rounding(np.abs(np.r_[ref.v, ref.a]).max(), ref.condition))
 
 
 def test_a_closure_in_use_cannot_change_under_its_solver(four_bar):
@@ -274,7 +279,7 @@ def test_a_closure_in_use_cannot_change_under_its_solver(four_bar):
         c.axis = np.array([1.0, 0.0, 0.0])
     with pytest.raises(ValueError):
         c.axis[0] = 1.0  # read-only
-    assert solver.solve([1.0]).accuracy.residual <= 1e-13
+    assert solver.solve([1.0]).accuracy.residual <= residual(1.0)
 
 
 @pytest.mark.parametrize("force, torque", [((0.0, float("nan"), 0.0), (0.0, 0.0, 0.0)),

@@ -9,9 +9,9 @@ OPENBLAS_CORETYPE=Prescott), so a bar is never "1e-12 by habit" but one of:
   `scale`: each operation (and each libm call) is off by an ulp or so, so the result is within
   STEPS x eps x scale, times the condition number `cond` of the step that amplifies most (a
   square root near zero, an acos near +-1, a difference of near-equal numbers).
-- `closure(scale, cond)`: a pose the engine solved, its loops closed to the solver's tolerance
-  (DEFAULT_TOL of the loop's size): pinmech's own position bound (Accuracy.error_bounds,
-  4 x condition x residual), plus the rounding of the closed form it is checked against.
+- `closure(scale, cond, order)`: a pose the engine solved, its loops closed to the solver's
+  tolerance (DEFAULT_TOL of the loop's size): pinmech's own bound (Accuracy.error_bounds) with
+  that residual, plus the rounding of the closed form it is checked against.
 - `stated(residual, condition, scale, order)`: the bound pinmech states of one solved pose
   (Accuracy.error_bounds: 4 k m on positions, 4 k^2 m on rates, 16 k^3 m on accelerations, m
   the closure residual or eps, k the condition number).
@@ -42,11 +42,14 @@ def rounding(scale: float, cond: float = 1.0, steps: int = STEPS) -> float:
     return float(steps * EPS * np.max(cond) * np.max(np.abs(scale)))
 
 
-def closure(scale: float, cond: float = 1.0, tol: float = DEFAULT_TOL) -> float:
-    """Bar on a position of a pose the engine closed to `tol` of the loops' size `scale` [m]
-    (or an angle, scale 1 rad), at condition number `cond`: pinmech's position bound
-    4 x cond x tol x scale, plus the rounding of the closed form it is compared with."""
-    return BOUND_FACTORS[0] * float(np.max(cond)) * tol * float(np.max(np.abs(scale))) + rounding(scale, cond)
+def closure(scale: float, cond: float = 1.0, order: int = 0, tol: float = DEFAULT_TOL) -> float:
+    """Bar on a pose the engine closed to `tol` of the loops' size, at condition number
+    `cond`: pinmech's bound (Accuracy.error_bounds) with the residual at the tolerance it
+    guarantees, on positions (order 0: 4 k tol), rates (1: 4 k^2 tol) or accelerations
+    (2: 16 k^3 tol), times the size `scale` of the numbers [their unit]; plus the rounding
+    of the closed form they are compared with."""
+    k = float(np.max(cond))
+    return BOUND_FACTORS[order] * k ** (order + 1) * tol * float(np.max(np.abs(scale))) + rounding(scale, k**order)
 
 
 def stated(residual: float, condition: float, scale: float, order: int = 0) -> float:
