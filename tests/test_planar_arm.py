@@ -40,7 +40,7 @@ def cramer():
 def test_the_scene_states_the_texts_pose(result):
     """theta1 = 50 deg, BC 15 deg below the horizontal, CD vertical with D below C."""
     angles = {name: result["links"][name]["angle"] / DEG for name in ("AB", "BC", "CD")}
-    np.testing.assert_allclose(list(angles.values()), [50.0, -15.0, -90.0], rtol=1e-12)
+    np.testing.assert_allclose(list(angles.values()), [50.0, -15.0, -90.0], rtol=rounding(1.0))
     C, D = (np.array(result["points"][p]["position"]) for p in "CD")
     np.testing.assert_allclose(D - C, [0.0, -0.17, 0.0], atol=rounding(0.5))
 
@@ -51,7 +51,7 @@ def test_link_rates_against_cramers_rule(result, cramer):
     alpha = [links[n]["angular_acceleration"][2] for n in ("AB", "BC", "CD")]
     np.testing.assert_allclose(omega[:2], [cramer.omega_AB, cramer.omega_BC], rtol=1e-10)
     np.testing.assert_allclose(alpha[:2], [cramer.alpha_AB, cramer.alpha_BC], rtol=1e-10)
-    np.testing.assert_allclose([omega[2], alpha[2]], [0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose([omega[2], alpha[2]], [0.0, 0.0], atol=rounding(10.0, result["accuracy"]["condition_number"]))
     joints = result["joints"]
     np.testing.assert_allclose([joints[n]["v"] for n in "ABC"], cramer.q_dot, rtol=1e-10)
     np.testing.assert_allclose([joints[n]["a"] for n in "ABC"], cramer.q_ddot, rtol=1e-10)
@@ -59,8 +59,8 @@ def test_link_rates_against_cramers_rule(result, cramer):
 
 def test_D_moves_as_asked(result):
     D = result["points"]["D"]
-    np.testing.assert_allclose(D["velocity"], [1.0, 0.0, 0.0], atol=1e-12)
-    np.testing.assert_allclose(D["acceleration"], [0.0, 0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(D["velocity"], [1.0, 0.0, 0.0], atol=rounding(1.0, result["accuracy"]["condition_number"]))
+    np.testing.assert_allclose(D["acceleration"], [0.0, 0.0, 0.0], atol=rounding(10.0, result["accuracy"]["condition_number"]))
 
 
 def test_json_task_section(result):
@@ -70,9 +70,10 @@ def test_json_task_section(result):
     rows = [(r["frame"], r["component"], r["reference"]) for r in task["rows"]]
     assert rows == [("D", "x", "world"), ("D", "y", "world"), ("CD", "wz", "world")]
     np.testing.assert_allclose([r["requested_velocity"] for r in task["rows"]], [1.0, 0.0, 0.0])
-    np.testing.assert_allclose([r["achieved_velocity"] for r in task["rows"]], [1.0, 0.0, 0.0], atol=1e-12)
-    np.testing.assert_allclose([r["achieved_acceleration"] for r in task["rows"]], 0.0, atol=1e-12)
-    assert task["velocity_error"] < 1e-12 and task["acceleration_error"] < 1e-12
+    np.testing.assert_allclose([r["achieved_velocity"] for r in task["rows"]], [1.0, 0.0, 0.0], atol=rounding(1.0, task["condition_number"]))
+    np.testing.assert_allclose([r["achieved_acceleration"] for r in task["rows"]], 0.0, atol=rounding(10.0, task["condition_number"]))
+    assert task["velocity_error"] < rounding(1.0, task["condition_number"])
+    assert task["acceleration_error"] < rounding(10.0, task["condition_number"])
     assert set(result) >= {"joints", "links", "points", "accuracy", "task"}
 
 
@@ -131,7 +132,7 @@ def test_the_text_solved_its_accelerations_with_unrounded_rates(cramer):
 
     np.testing.assert_allclose(np.round(accelerations(-3.6, -2.4), 1), [-12.4, -17.0])
     exact = accelerations(cramer.omega_AB, -cramer.omega_BC)  # theta2_dot = -omega_BC
-    np.testing.assert_allclose(exact, [cramer.alpha_AB, -cramer.alpha_BC], rtol=1e-12)
+    np.testing.assert_allclose(exact, [cramer.alpha_AB, -cramer.alpha_BC], rtol=rounding(1.0, np.linalg.cond(M)))
     np.testing.assert_allclose(np.round(exact, 1), [-12.1, -16.5])
 
 

@@ -28,6 +28,7 @@ from tests._mechanisms import (
     spatial_rsur_urdf,
     write,
 )
+from tests.tolerance import closure, residual, rounding
 
 H = 1e-6
 RTOL = 1e-7
@@ -90,9 +91,9 @@ def test_rates_are_time_derivatives_of_the_closed_pose(build, models_dir, tmp_pa
 def test_solution_vouches_for_itself(build, models_dir, tmp_path):
     mech, driver, guess = build(models_dir, tmp_path)
     solution = LoopSolver(mech, [driver]).solve([0.4], [1.0], [0.0], guess=guess)
-    assert solution.is_closed(1e-12)
-    assert solution.accuracy.velocity_residual < 1e-12
-    assert solution.accuracy.acceleration_residual < 1e-12
+    assert solution.is_closed(residual(1.0))
+    assert solution.accuracy.velocity_residual < rounding(np.abs(solution.v).max())
+    assert solution.accuracy.acceleration_residual < rounding(np.abs(solution.a).max() + np.abs(solution.v).max() ** 2)
     assert 1 <= solution.accuracy.condition < 1e3
 
 
@@ -110,7 +111,7 @@ def test_slider_crank_slider_position_matches_the_triangle(tmp_path):
     pin.framesForwardKinematics(mech.model, data, sol.q)
     block = data.oMf[mech.links["block"]].translation
     np.testing.assert_allclose(block[:2], [r * np.cos(theta) + np.sqrt(l**2 - (e - r * np.sin(theta)) ** 2), e],
-                               rtol=1e-13, atol=1e-15)
+                               rtol=0, atol=closure(r + l, sol.accuracy.condition))
 
 
 def test_where_the_loop_is_cut_does_not_change_the_motion(tmp_path):
@@ -127,7 +128,7 @@ def test_where_the_loop_is_cut_does_not_change_the_motion(tmp_path):
         np.testing.assert_allclose(
             [a.q[j_a.idx_q], a.v[j_a.idx_v], a.a[j_a.idx_v]],
             [b.q[j_b.idx_q], b.v[j_b.idx_v], b.a[j_b.idx_v]],
-            rtol=1e-12, atol=1e-12,
+            rtol=0, atol=closure(1.0, max(a.accuracy.condition, b.accuracy.condition), 2),
         )
 
 
