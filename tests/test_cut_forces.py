@@ -26,6 +26,7 @@ import pinmech
 from pinmech.solve.forces import ForceSolver, Load
 from pinmech.model.mjcf import load_mjcf
 from tests._mechanisms import spatial_rsur_revolute_cut_urdf, spatial_rsur_urdf
+from tests.tolerance import closure, rounding
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 G = 9.81
@@ -73,7 +74,7 @@ def _solve_slider_crank(path: Path, theta: float, omega: float, alpha: float):
     sol = pinmech.LoopSolver(mech, ["O"]).solve([theta], [omega], [alpha], guess=guess)
     data = mech.model.createData()
     pin.framesForwardKinematics(mech.model, data, sol.q)
-    np.testing.assert_allclose(data.oMf[mech.frame_id("B_pin")].translation[:2], k.B, atol=1e-12)  # same branch
+    np.testing.assert_allclose(data.oMf[mech.frame_id("B_pin")].translation[:2], k.B, atol=closure(0.2, sol.accuracy.condition))  # same branch
     return mech, sol
 
 
@@ -107,7 +108,7 @@ def test_a_slider_crank_cut_at_its_slide_matches_newton_euler_by_hand(tmp_path, 
     B = np.asarray(cff.cf.slider_crank(theta, 0.0, 0.0, 0.05, 0.15, 0.01).B, float)
     np.testing.assert_allclose(sign * _moment_about(slide, B), hand.M14, rtol=0, atol=RTOL * scale * 0.2,
                                err_msg="M14 about B")
-    assert f.power.residual < 1e-12 and f.equation_residual < 1e-12
+    assert f.power.residual < rounding(1.0, f.condition) and f.equation_residual < rounding(1.0, f.condition)
 
 
 # ------------------------------------------------------------ slotted lever cut at its slide
@@ -152,7 +153,7 @@ def test_a_slotted_lever_cut_at_its_slide_matches_newton_euler_by_hand(tmp_path,
     sol = pinmech.LoopSolver(mech, ["A"]).solve([phi], [omega], [alpha], guess=guess)
     data = mech.model.createData()
     pin.framesForwardKinematics(mech.model, data, sol.q)
-    np.testing.assert_allclose(data.oMf[mech.frame_id("D")].translation[:2], k.D, atol=1e-12)  # same branch
+    np.testing.assert_allclose(data.oMf[mech.frame_id("D")].translation[:2], k.D, atol=closure(0.2, sol.accuracy.condition))  # same branch
     f = ForceSolver(mech, ["A"], gravity=(0, -gravity, 0)).solve(sol.q, sol.v, sol.a)
     hand = cff.r_rtr_forces(phi, omega, alpha, *R_RTR_BODIES, gravity=(0.0, -gravity))
     scale = max(np.abs(np.concatenate([hand.F12, hand.F23, hand.F14])).max(), abs(hand.N34))
@@ -166,7 +167,7 @@ def test_a_slotted_lever_cut_at_its_slide_matches_newton_euler_by_hand(tmp_path,
     np.testing.assert_allclose(cut.force[:2], hand.N34 * n, rtol=0, atol=RTOL * scale, err_msg="N34")
     np.testing.assert_allclose(_moment_about(cut, np.asarray(k.B, float)), hand.M34, rtol=0, atol=RTOL * scale * 0.2,
                                err_msg="M34 about B")
-    assert f.power.residual < 1e-12 and f.equation_residual < 1e-12
+    assert f.power.residual < rounding(1.0, f.condition) and f.equation_residual < rounding(1.0, f.condition)
 
 
 # ------------------------------------------------------------------- every cut type, by energy
@@ -268,5 +269,5 @@ def test_every_cut_type_gives_the_torque_of_the_energy_rate(tmp_path, name):
     rate = (energy(poses[theta + h]) - energy(poses[theta - h])) / (2 * h) * omega
     scale = max(abs(f.power.kinetic_rate), abs(f.power.gravity_power), abs(f.effort[0] * omega))
     np.testing.assert_allclose(f.effort[0] * omega, rate, rtol=0, atol=1e-7 * scale)
-    assert f.power.residual < 1e-12 and f.equation_residual < 1e-11
+    assert f.power.residual < rounding(1.0, f.condition) and f.equation_residual < 1e-11
     assert any(r.is_cut for r in f.reactions.values())

@@ -28,6 +28,7 @@ from pinmech import Scene
 from pinmech.cli import main
 from pinmech.io.sweep import Sweep
 from tests._mechanisms import slider_crank_prismatic_cut_urdf
+from tests.tolerance import rounding
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 RPM = 120.0
@@ -239,7 +240,7 @@ def test_the_sweep_json_lines_hold_every_cut_type(name, tmp_path):
             coriolis = float(np.linalg.norm(s["coriolis_acceleration"]))
             row |= _slide_columns(slider, s["s"], s["s_dot"], s["s_ddot"], coriolis)
             axis = np.array(s["axis"])
-            np.testing.assert_allclose(np.array(s["relative_velocity"]), s["s_dot"] * axis, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(np.array(s["relative_velocity"]), s["s_dot"] * axis, rtol=0, atol=rounding(abs(s["s_dot"])))
         for point, p in entry["points"].items():
             row |= _point_columns(point, p["position"], p["velocity"], p["acceleration"])
         rows.append(row)
@@ -324,10 +325,10 @@ def test_a_slide_cut_is_sketched_as_a_tree_slide_is(name, tmp_path):
     else:  # the guide C -> D (link 3's x), the block at B
         u = cf.r_rtr(math.radians(40.0), 0.0, 0.0).u
         expected_dir, on_line = np.array([u[0], u[1], 0.0]), pose.motion.points["D"].position
-    np.testing.assert_allclose(abs(line_dir @ expected_dir), 1.0, atol=1e-12)
-    np.testing.assert_allclose(abs((M_b.rotation @ block.slide_axis) @ expected_dir), 1.0, atol=1e-12)
+    np.testing.assert_allclose(abs(line_dir @ expected_dir), 1.0, atol=rounding(1.0))
+    np.testing.assert_allclose(abs((M_b.rotation @ block.slide_axis) @ expected_dir), 1.0, atol=rounding(1.0))
     gap = (on_line - line_point) - ((on_line - line_point) @ line_dir) * line_dir
-    np.testing.assert_allclose(gap, 0.0, atol=1e-12)
+    np.testing.assert_allclose(gap, 0.0, atol=rounding(1.0))
 
 
 def test_a_hand_check_reads_a_slot_cuts_travel_in_millimetres(tmp_path, capsys):

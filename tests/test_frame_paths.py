@@ -31,13 +31,13 @@ def test_frames_equal_evaluate_motion(r_rtr_rows):
         for name in ("D", "B"):
             k = paths.index(name)
             np.testing.assert_allclose(paths.position[i, k], m.points[name].position, rtol=0, atol=rounding(0.3))
-            np.testing.assert_allclose(paths.velocity[i, k], m.points[name].velocity, rtol=0, atol=1e-13)
-            np.testing.assert_allclose(paths.acceleration[i, k], m.points[name].acceleration, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(paths.velocity[i, k], m.points[name].velocity, rtol=0, atol=rounding(np.abs(m.points[name].velocity).max()))
+            np.testing.assert_allclose(paths.acceleration[i, k], m.points[name].acceleration, rtol=0, atol=rounding(np.abs(m.points[name].acceleration).max()))
         link = m.links["link3"]
         np.testing.assert_allclose(paths.rotation[i, link3], link.rotation, rtol=0, atol=rounding(1.0))
-        np.testing.assert_allclose(paths.angular_velocity[i, link3], link.angular_velocity, rtol=0, atol=1e-13)
+        np.testing.assert_allclose(paths.angular_velocity[i, link3], link.angular_velocity, rtol=0, atol=rounding(np.abs(link.angular_velocity).max()))
         np.testing.assert_allclose(paths.angular_acceleration[i, link3], link.angular_acceleration, rtol=0,
-                                   atol=1e-12)
+                                   atol=rounding(np.abs(link.angular_acceleration).max()))
         assert d == 0
 
 

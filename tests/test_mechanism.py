@@ -129,9 +129,9 @@ def test_a_mimic_joint_follows_its_leader_in_positions_and_rates(tmp_path, model
     position, velocity, acceleration = _tip(*q, *v, *a)
     d = motion.points["D"]
     # The closed form and Pinocchio agree to rounding: 1e-12 of the 0.77 m arm and its rates.
-    np.testing.assert_allclose(d.position[:2], position, atol=1e-12)
-    np.testing.assert_allclose(d.velocity[:2], velocity, atol=1e-12)
-    np.testing.assert_allclose(d.acceleration[:2], acceleration, atol=1e-12)
+    np.testing.assert_allclose(d.position[:2], position, atol=rounding(0.77))
+    np.testing.assert_allclose(d.velocity[:2], velocity, atol=rounding(0.77 * np.abs(v).sum()))
+    np.testing.assert_allclose(d.acceleration[:2], acceleration, atol=rounding(0.77 * (np.abs(a).sum() + np.abs(v).sum() ** 2)))
     c = motion.joints["C"]
     assert (c.q, c.v, c.a) == pytest.approx((2 * -0.7 + 0.1, 2 * -2.1, 2 * 3.0), abs=rounding(6.0))
 
@@ -142,7 +142,7 @@ def test_locking_a_mimic_leader_holds_its_follower_where_it_follows(tmp_path, mo
     from pinmech import evaluate_motion
 
     motion = evaluate_motion(mech, mech.model.createData(), np.array([0.4]), np.array([1.3]), np.array([0.5]))
-    np.testing.assert_allclose(motion.points["D"].position[:2], _tip(0.4, -0.7, 0, 0, 0, 0)[0], atol=1e-12)
+    np.testing.assert_allclose(motion.points["D"].position[:2], _tip(0.4, -0.7, 0, 0, 0, 0)[0], atol=rounding(0.77))
 
 
 @pytest.mark.parametrize(
@@ -177,14 +177,14 @@ def test_a_locked_joint_may_share_its_name_with_a_link(tmp_path, models_dir):
     motion = evaluate_motion(mech, mech.model.createData(), np.array([0.0, -0.6]), np.zeros(2), np.zeros(2))
     th = np.array([0.4, 0.4, -0.2])
     np.testing.assert_allclose(motion.points["D"].position[:2], np.array([np.cos(th), np.sin(th)]) @ [R1, R2, R3],
-                               atol=1e-12)
+                               atol=rounding(0.77))
 
 
 def test_a_model_with_one_freedom_left_loads(models_dir):
     """Pinocchio returns a one-column Jacobian as a vector; the plane is still found."""
     mech = Mechanism.from_urdf(models_dir / "planar_arm.urdf", locked={"B": 0.3, "C": 0.2})
     assert mech.model.nv == 1
-    np.testing.assert_allclose(mech.plane_normal, [0, 0, 1], atol=1e-12)
+    np.testing.assert_allclose(mech.plane_normal, [0, 0, 1], atol=rounding(1.0))
 
 
 def _chain(tmp_path, n: int):

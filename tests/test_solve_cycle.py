@@ -144,6 +144,6 @@ def test_a_sweeps_first_row_at_the_scenes_pose_states_that_poses_own_accuracy(sc
     first = next(iter(sweep.chunks([sweep.start, sweep.start + 0.5])))
     accuracy = first.solution.solution(0).accuracy
     alone = pinmech.analyse(scene).solution.accuracy
-    assert accuracy.residual == pytest.approx(alone.residual, rel=1e-12) and accuracy.residual > 1e-7
-    assert accuracy.sigma_min == pytest.approx(alone.sigma_min, rel=1e-12)
-    assert accuracy.condition == pytest.approx(alone.condition, rel=1e-12)
+    assert accuracy.residual == pytest.approx(alone.residual, rel=rounding(1.0)) and accuracy.residual > 1e-7
+    assert accuracy.sigma_min == pytest.approx(alone.sigma_min, rel=rounding(1.0, alone.condition))
+    assert accuracy.condition == pytest.approx(alone.condition, rel=rounding(1.0, alone.condition))

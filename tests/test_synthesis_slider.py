@@ -97,7 +97,7 @@ def test_the_slider_cranks_folds_are_where_the_rod_is_square_to_the_slide():
     z = np.array([[0.0, 0.0, 0.0, 0.02, 0.06, 0.05, 0.0, 0.0]])
     angles, _ = folds(z)
     found = np.sort(np.mod(np.degrees(angles[0][np.isfinite(angles[0])]), 360.0))
-    assert np.allclose(found, [210.0, 330.0], atol=1e-12)  # acos/asin rounding only
+    assert np.allclose(found, [210.0, 330.0], atol=rounding(360.0))  # acos/asin rounding only
     tiny = 1e-8  # rad
     outside = np.radians(found) + np.array([-tiny, tiny])
     inside = np.radians(found) + np.array([tiny, -tiny])
@@ -149,10 +149,10 @@ def test_the_slider_point_of_three_poses_is_on_the_collinear_points_circle(tmp_p
         return np.array([r @ frame[0], frame[0, 0] * r[1] - frame[0, 1] * r[0]])
 
     centre, radius = slider_circle(places, angles)
-    np.testing.assert_allclose(np.linalg.norm(local(B) - centre), radius, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(local(B) - centre), radius, atol=rounding(0.2))
     row = slider_crank_row(places, angles, local(A), local(B))
-    np.testing.assert_allclose(row[:8], [0, 0, 0, 0.05, 0.04, 0.13, 0.06, 0.02], atol=1e-12)
-    np.testing.assert_allclose(row[8], math.radians(17.0), atol=1e-12)
+    np.testing.assert_allclose(row[:8], [0, 0, 0, 0.05, 0.04, 0.13, 0.06, 0.02], atol=rounding(0.2))
+    np.testing.assert_allclose(row[8], math.radians(17.0), atol=rounding(np.pi))
 
 
 def test_every_three_pose_construction_carries_the_rod_through_the_poses():
