@@ -23,6 +23,24 @@ settings.register_profile("ci", derandomize=True, database=None, deadline=None)
 settings.register_profile("explore", derandomize=False, database=None, deadline=None)
 settings.load_profile("ci")
 
+# Under pytest-xdist (`-n 2 --dist loadgroup`, the README's command) the tests that start a
+# browser, a Dask cluster or a viewer server run one after another on one worker: they spawn
+# processes and bind sockets of their own, and would fight each other (and time out) side by side.
+_SERIAL_FILES = {"test_cluster.py", "test_view_server.py"}
+_SERIAL_WORDS = ("dask", "two_workers", "cluster")
+
+
+def _runs_alone(item: pytest.Item) -> bool:
+    name = item.nodeid.rsplit("::", 1)[-1]
+    return (item.get_closest_marker("browser") is not None or item.path.name in _SERIAL_FILES
+            or any(word in name for word in _SERIAL_WORDS))
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if _runs_alone(item):
+            item.add_marker(pytest.mark.xdist_group("alone"))
+
 
 FOUR_BAR_LENGTHS = {"crank": 0, "coupler": 1, "rocker": 2, "ground": 3}  # (a, b, c, d)
 
