@@ -17,8 +17,9 @@ from closed_form import four_bar
 import pinmech
 from pinmech import FrameNotFound, LoopSolver, Mechanism, ModelError
 from tests.conftest import MODELS
+from tests.tolerance import REGULAR, closure
 
-PLACE_TOL_M = 1e-12
+PLACE_TOL_M = closure(0.1, REGULAR)
 
 
 def test_a_second_point_of_one_name_is_refused():

@@ -170,7 +170,7 @@ def test_four_bar_velocity_of_b_agrees_both_ways(theta2, lengths, branch):
     a = 0.2 * min(lengths)  # a short crank keeps every pose assembled and off toggle
     assume(abs(b - c) + a + 0.1 < d < b + c - a - 0.1)  # keeps off toggle by a margin
     fb = cf.four_bar(theta2, 1.3, -0.7, a, b, c, d, branch)
-    np.testing.assert_allclose(fb.vA + fb.omega3 * cf.perp(fb.B - fb.A), fb.vB, atol=1e-12)
+    np.testing.assert_allclose(fb.vA + fb.omega3 * cf.perp(fb.B - fb.A), fb.vB, atol=rounding(np.abs(fb.vB).max()))
     via_coupler = fb.aA + fb.alpha3 * cf.perp(fb.B - fb.A) - fb.omega3**2 * (fb.B - fb.A)
     np.testing.assert_allclose(via_coupler, fb.aB, atol=1e-11)
 
@@ -237,7 +237,7 @@ def test_arm_rates_with_rotating_hand():
     q = np.diff(th, axis=-1, prepend=0.0)
     state = cf.planar_arm_forward(q, rates.q_dot, rates.q_ddot, *R_ARM)
     np.testing.assert_allclose(state.vD, [[0.3, -0.2]] * 2, rtol=0, atol=rounding(1.0))
-    np.testing.assert_allclose(state.aD, [[1.0, 2.0]] * 2, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(state.aD, [[1.0, 2.0]] * 2, rtol=0, atol=rounding(10.0))
 
 
 def test_arm_forward_finite_differences():

@@ -228,7 +228,7 @@ def test_every_pose_of_a_turn_is_polished_to_rounding(scenes_dir):
         phi3.append(math.atan2(R[1, 0], R[0, 0]))
     ref = closed_form.r_rtr(phi, float(sweep.drivers.v[0]), float(sweep.drivers.a[0]))
     d = np.remainder(np.array(phi3) - ref.phi3 + math.pi, 2 * math.pi) - math.pi
-    assert np.abs(d).max() <= 2e-15
+    assert np.abs(d).max() <= rounding(math.pi, steps=8)
 
 
 def test_path_derivatives_are_finite_differences_of_the_poses(scenes_dir):
@@ -579,7 +579,7 @@ def test_singular_matrices_have_infinite_condition(n):
         B = rng.normal(size=(n, n))
         B[:, -1] = B[:, 0]
         condition, sigma_min = core._core.condition(B)
-        assert condition > 1e15 and sigma_min < 1e-14 * np.abs(B).max()
+        assert condition > 1e15 and sigma_min < rounding(np.linalg.norm(B, 2))
     with pytest.raises(ValueError, match="square"):
         core._core.condition(np.zeros((n, n + 1)))
 

@@ -17,8 +17,9 @@ import pytest
 from closed_form import four_bar
 
 from pinmech.cli import main
+from tests.tolerance import REGULAR, closure
 
-PLACE_TOL_M = 1e-12
+PLACE_TOL_M = closure(0.1, REGULAR)
 A, B, C, D = 0.04, 0.12, 0.08, 0.10  # crank, coupler, rocker, ground [m]
 
 _FILE = """ground = ["O2", "O4"]

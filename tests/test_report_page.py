@@ -21,6 +21,7 @@ from pinmech.draw.sketch import sketch_visuals
 from pinmech.model.link_nodes import sketch_links
 from tests.browser import colour_mask, screenshot, span_share
 from tests.conftest import MODELS, SCENES
+from tests.tolerance import rounding
 
 CRANK_RED, GUIDE_GREEN = (0.85, 0.15, 0.15), (0.15, 0.65, 0.25)  # the R-RTR's link1 and link3
 FRAME_HEIGHT = 520  # the drawing's frame on the page [CSS pixels]
@@ -57,7 +58,7 @@ def test_every_link_without_visuals_is_sketched(tmp_path, name):
             boxes = [g.geometry for g in visuals.geometryObjects if g.parentJoint == link.joint
                      and type(g.geometry).__name__ == "Box"]
             widths = [2 * b.halfSide[1] for b in boxes]
-            assert any(abs(2 * b.halfSide[0] - length - w) < 1e-12 for b, w in zip(boxes, widths))
+            assert any(abs(2 * b.halfSide[0] - length - w) < rounding(length + w) for b, w in zip(boxes, widths))
 
 
 def test_a_slider_block_and_the_pivots_of_a_bare_slider_crank():

@@ -132,7 +132,7 @@ def test_condition_time_errors_are_rounding(capsys):
     for row in rows:
         cells = [c.strip() for c in row.strip("|").split("|")]
         n, kappa, error = int(cells[0]), float(cells[2]), float(cells[-1])
-        assert error <= 1e-12 + 100 * n * np.finfo(float).eps * kappa, row
+        assert error <= rounding(1.0, kappa, steps=100 * n), row
 
 
 def test_benchmark_peers_ratio_verdicts_follow_the_rows():

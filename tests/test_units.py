@@ -167,7 +167,7 @@ def test_typographic_spellings_of_units(text, kind, si):
                                             ("1 kg*m^2", "moment_of_inertia", 1.0)])
 def test_forces_torques_and_inertias_in_si_with_kilograms(text, kind, si):
     # lbf = 4.4482216152605 N exactly (NIST); pint's root mass unit is the gram, SI's the kilogram.
-    assert to_si(text, kind) == pytest.approx(si, rel=1e-12)
+    assert to_si(text, kind) == pytest.approx(si, rel=rounding(1.0))
 
 
 @pytest.mark.parametrize("text, kind", [("1 N", "torque"), ("1 N*m", "force"), ("1 kg", "moment_of_inertia")])
@@ -223,7 +223,7 @@ def test_a_is_refused_as_a_unit_not_read_as_a_year(text, kind):
     with pytest.raises(UnitError, match="year") as caught:
         to_si(text, kind)
     assert "second^1" not in str(caught.value)
-    assert to_si("1 year", "time") == pytest.approx(365.25 * 86400, rel=1e-12)  # Julian year, pint's "year"
+    assert to_si("1 year", "time") == pytest.approx(365.25 * 86400, rel=rounding(1.0))  # Julian year, pint's "year"
 
 
 @pytest.mark.parametrize("text, kind, said", [("1 kgf", "torque", "is a force"), ("1 N*m", "force", "is a torque"),
