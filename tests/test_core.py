@@ -30,7 +30,7 @@ from pinmech.solve.loops import DEFAULT_TOL, POLISH
 from tests._mechanisms import cut_rows
 from pinmech.solve.loops import MAX_STEP as MAX_NEWTON_STEP
 from pinmech.io.sweep import Sweep
-from tests.tolerance import closure, residual, rounding, stated
+from tests.tolerance import STATED_R_RTR, closure, residual, rounding, stated
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
 import benchmark_loops as chain  # noqa: E402
@@ -203,10 +203,10 @@ def test_r_rtr_sweep_meets_the_closed_form(scenes_dir):
         got["aD"].append(pin.getFrameClassicalAcceleration(model, data, point_d, lwa).linear[:2])
     ref = closed_form.r_rtr(phi, float(sweep.drivers.v[0]), float(sweep.drivers.a[0]))
     d = np.remainder(np.array(got["phi3"]) - ref.phi3 + math.pi, 2 * math.pi) - math.pi
-    assert np.abs(d).max() < 1e-13
+    assert np.abs(d).max() < STATED_R_RTR
     for name in ("omega3", "alpha3", "vD", "aD"):
         want = np.asarray(getattr(ref, name))
-        assert np.abs(np.array(got[name]) - want).max() <= 1e-13 * np.abs(want).max(), name
+        assert np.abs(np.array(got[name]) - want).max() <= STATED_R_RTR * np.abs(want).max(), name
 
 
 def test_every_pose_of_a_turn_is_polished_to_rounding(scenes_dir):

@@ -23,7 +23,7 @@ import closed_form
 import pinmech
 import pinmech.solve.core as core
 from pinmech.solve import cycle as solve_cycle
-from tests.tolerance import rounding
+from tests.tolerance import STATED_SWEEP, rounding
 
 # The law of cosines' angles down the chain: rounding times the loops' condition numbers
 # (below 40, checked in test_chain_condition_numbers_one_degree_apart_are_numpys).
@@ -73,7 +73,7 @@ def test_chain_sweep_meets_the_closed_form():
     mech, solver, q, v, a = _solve(K, THETAS)
     assert core.core_for(solver).solve_blocks == K
     angle, rate, acceleration = chain.chain_errors(mech, q, v, a, chain.chain_closed_form(THETAS, K))
-    assert angle <= 1e-12, angle
+    assert angle <= STATED_SWEEP, angle
     assert rate <= 1e-11 and acceleration <= 1e-11, (rate, acceleration)
 
 
@@ -115,7 +115,7 @@ def test_a_chain_listed_last_loop_first_is_solved_in_dependency_order(tmp_path, 
     q, v, a = chain.sweep(solver, THETAS)
     assert stops and set(stops) == {0}  # the core's sweep took every pose: none handed to its pose-by-pose follow
     angle, rate, acceleration = chain.chain_errors(mech, q, v, a, chain.chain_closed_form(THETAS, K))
-    assert angle <= 1e-12, angle
+    assert angle <= STATED_SWEEP, angle
     assert rate <= 1e-11 and acceleration <= 1e-11, (rate, acceleration)
 
 
@@ -200,5 +200,5 @@ def test_benchmark_loops_runs(tmp_path, capsys):
     rows = chain.main(["--loops", "2", "--poses", "20", "--rounds", "1", "--sample-time", "0", "--out", str(out)])
     assert out.read_text() == capsys.readouterr().out.rstrip("\n") + "\n"
     assert {(r.k, r.path) for r in rows} == {(1, "core"), (2, "core")}
-    assert all(r.errors[0] <= 1e-12 and len(r.times) == 1 for r in rows)
+    assert all(r.errors[0] <= STATED_SWEEP and len(r.times) == 1 for r in rows)
     assert "| 2 | core |" in out.read_text()

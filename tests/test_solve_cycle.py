@@ -17,7 +17,7 @@ from pinmech import PinmechError, Scene
 from pinmech.solve.batch import BatchSolver
 from pinmech.solve.cycle import CHUNK
 from pinmech.io.sweep import Sweep
-from tests.tolerance import rounding
+from tests.tolerance import STATED_SWEEP, rounding
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -55,7 +55,7 @@ def test_every_pose_is_exact_whatever_the_spacing(sweep, poses):
     """10 deg steps: pose by pose; 1 deg: every 4th pose, the rest batched; 0.1 deg: every
     64th, then 16th, 4th, the rest batched. All of them meet the README's 1e-12."""
     phis, arrays = _cycle(sweep, poses)
-    assert max(_errors(sweep, phis, arrays)) < 1e-12
+    assert max(_errors(sweep, phis, arrays)) < STATED_SWEEP
     assert np.all(arrays["residual"] <= sweep.solver.tol)
     assert not arrays["interpolated"].any()
 

@@ -80,3 +80,9 @@ def residual(scale: float, tol: float = DEFAULT_TOL) -> float:
 #: over a turn the bundled four-bar reaches 4.7, the slider-crank 1.7, the R-RTR 2.0; 1e2
 #: leaves room for the other mechanisms whose docstrings state "below 1e2".
 REGULAR = 1e2
+
+#: Accuracies the docs state of the engine against textbook closed forms, checked as claims
+#: (not rounding bars): the R-RTR within 1e-13 of each quantity's size at every pose
+#: (docs/explanation/accuracy.md), sweeps and loop chains within 1e-12 rad (benchmarks.md).
+STATED_R_RTR = 1e-13
+STATED_SWEEP = 1e-12
