@@ -51,6 +51,26 @@ NOT_RUN = {
 
 #: Long commands run with small sizes: the option added unless the command gives it.
 SMALL = {"sweep": ("--steps", "13"), "animate": ("--steps", "5"), "study": ("--workers", "0")}
+#: A grid study (a workspace or actuator map) runs on a grid of at most this many points an
+#: axis, its area or volume refined to this relative bound: the same file, commands and code
+#: paths as the page's (the boundary's cells still halved), on a coarser grid (the maps'
+#: numbers are checked in tests/test_workspace_*.py).
+SMALL_GRID, SMALL_BOUND = 9, "0.5"
+
+
+def _small_studies(text: str) -> str:
+    """`text` with each bundled grid study it names (models/studies/NAME.toml with a grid
+    `count`) replaced by a copy in the scratch folder whose counts are at most SMALL_GRID."""
+    for name in sorted(set(re.findall(r"models/studies/(\w+)\.toml", text))):
+        source = (ROOT / "models" / "studies" / f"{name}.toml").read_text(encoding="utf-8")
+        small = re.sub(r"\bcount = (\d+)", lambda m: f"count = {min(int(m.group(1)), SMALL_GRID)}", source)
+        small = re.sub(r"\b(area|volume)_tolerance = [0-9.e-]+", rf"\1_tolerance = {SMALL_BOUND}", small)
+        if small == source or "[workspace]" not in source and "[actuators]" not in source:
+            continue
+        Path("small_studies").mkdir(exist_ok=True)
+        Path("small_studies", f"{name}.toml").write_text(small, encoding="utf-8")
+        text = text.replace(f"models/studies/{name}.toml", f"small_studies/{name}.toml")
+    return text
 
 
 @dataclass(frozen=True)
@@ -126,7 +146,7 @@ def _pinmech(argv: list[str]) -> tuple[int, str]:
 
 
 def _run_bash(block: Block) -> None:
-    for argv in _commands(block.text):
+    for argv in _commands(_small_studies(block.text)):
         command = shlex.join(argv)
         if any(command.startswith(prefix) for prefix in NOT_RUN):
             continue
@@ -194,7 +214,7 @@ def test_the_example_runs(block: Block, scratch: Path) -> None:
         _run_bash(block)
     elif block.language == "python":
         scope: dict = {"__name__": "__docs__"}
-        exec(compile(block.text, str(block), "exec"), scope)  # noqa: S102
+        exec(compile(_small_studies(block.text), str(block), "exec"), scope)  # noqa: S102
     elif block.language == "toml":
         _run_toml(block, scratch)
     elif block.language == "xml":
