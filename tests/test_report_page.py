@@ -216,8 +216,14 @@ def test_an_animation_joins_labels_only_of_points_together_in_every_frame():
 def _pdf_words(pdf) -> tuple[list[tuple[float, float, str]], float]:
     """Every word of the PDF with its left and right edge [pt], and the page width [pt]
     (`pdftotext -bbox`, poppler-utils)."""
+    import os
+    import shutil
     import subprocess
 
+    if shutil.which("pdftotext") is None:  # as tests/browser.py does for chromium
+        if os.environ.get("PINMECH_REQUIRE_BROWSER"):
+            pytest.fail("PINMECH_REQUIRE_BROWSER is set but pdftotext is not installed (apt-get install poppler-utils)")
+        pytest.skip("pdftotext is not installed (apt-get install poppler-utils)")
     out = subprocess.run(["pdftotext", "-bbox", str(pdf), "-"], check=True, capture_output=True, text=True).stdout
     width = float(re.search(r'<page width="([0-9.]+)"', out).group(1))
     words = [(float(a), float(b), html.unescape(w)) for a, b, w in
