@@ -42,6 +42,10 @@ def _parse(page: Path) -> _Links:
     return links
 
 
+# Under xdist the module's tests share one worker, so the site is built once, not once a worker.
+pytestmark = pytest.mark.xdist_group("docs_build")
+
+
 @pytest.fixture(scope="module")
 def site(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("html")
