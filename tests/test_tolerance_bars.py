@@ -23,4 +23,4 @@ def test_every_bar_is_far_below_a_real_error():
     # a wrong branch, frame or unit moves a 0.2 m mechanism's points by 1e-4 m and more; angles by 1e-3 rad
     for bar in (closure(0.2, REGULAR), closure(0.2, REGULAR, 1), rounding(0.2, 2e4), residual(1.0)):
         assert bar < 1e-6 * 0.2
-    assert closure(np.pi, REGULAR, 2) < 1e-3 * 1e-3
+    assert closure(np.pi, REGULAR, 2) < 1e-2 * 1e-3  # accelerations at k = 1e2: 16 k^3 tol, 5e-6 of their size
