@@ -13,7 +13,7 @@ over the crank's turn (361 poses and the 10 targets'); its cost in microseconds 
 whole and split into the drawing and the follow, timed in interleaved rounds
 (scripts/interleave.py), medians and spread.
 
-The goal (issue 26): at most 60 s on this 2-core machine. Needs `pip install "pinmech[study]"`.
+The project's goal: at most 60 s on a 2-core machine. Needs `pip install "pinmech[study]"`.
 """
 
 from __future__ import annotations
