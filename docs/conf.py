@@ -26,13 +26,14 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.napoleon",
     "sphinxarg.ext",
+    "sphinx.ext.mathjax",  # the equations (MyST dollarmath), typeset by the reader's browser
 ]
 
 source_suffix = {".md": "markdown"}
 root_doc = "index"
 exclude_patterns = ["_build", "_generated", "Thumbs.db", ".DS_Store"]
 
-myst_enable_extensions = ["colon_fence", "deflist"]
+myst_enable_extensions = ["colon_fence", "deflist", "dollarmath", "amsmath"]  # $..$, $$..$$: equations as maths
 myst_heading_anchors = 3
 
 nitpicky = True
