@@ -26,7 +26,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from interleave import Timed, time_rounds  # noqa: E402
+from interleave import Timed, machine, time_rounds  # noqa: E402
 
 from pinmech.design.cluster import built, local_cluster, run_batches  # noqa: E402
 from pinmech.design.study.file import load_study  # noqa: E402
@@ -132,7 +132,7 @@ def main(argv: list[str] | None = None) -> None:
             cluster.close()
     print(f"tolerance study of the four-bar: {spec.samples} variants x {spec.steps} poses, batches of "
           f"{spec.batch} ({len(todo)} tasks), {args.rounds} rounds; load average (1 min) {loads[0]:.1f} before, "
-          f"{loads[1]:.1f} after, on {os.cpu_count()} CPUs")
+          f"{loads[1]:.1f} after; {machine()}")
     for name, row in rows.items():
         us = [t * 1e6 for t in row.times]
         print(f"{name:<18} median {statistics.median(us):6.3f} us a variant-pose  ({min(us):.3f} .. {max(us):.3f})")

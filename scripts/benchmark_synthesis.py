@@ -90,6 +90,10 @@ def main(argv: list[str] | None = None) -> None:
     crank = np.radians(np.arange(20.0, 300.0, 30.0))
     targets = pose(BUNDLED[None], np.ones(1), crank[None]).P[0]
     times, rates, met = [], [], 0
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from interleave import machine
+
+    print(f"the ten-point four-bar path, seeds {', '.join(map(str, args.seeds))}; {machine()}")
     for seed in args.seeds:
         run = spec.__class__(**{**spec.__dict__, "targets": targets, "seed": seed, "keep": 1,
                                 "generations": args.generations})

@@ -13,8 +13,8 @@ GENERATED = ROOT / "docs" / "_generated"
 PAGES = [ROOT / "README.md"] + sorted(p for p in (ROOT / "docs").rglob("*.md") if "_generated" not in p.parts)
 TIME = re.compile(r"(?<![\w.])(\d+(?:\.\d+)?)\s?(µs|us|ms|s|min|minutes?|seconds?|hours?)\b(?![/^])")
 #: A time in words ("about a minute"): never from a report.
-WORDS = re.compile(r"\b(?:(?:a|one|half an?) (?:minute|hour)|(?:two|three|a few|few|several) (?:minutes|seconds|hours))\b",
-                   re.I)
+WORDS = re.compile(r"\b(?:(?:a|one|half an?) (?:minute|hour)"
+                   r"|(?:two|three|a few|few|several) (?:minutes|seconds|hours))\b", re.I)
 
 #: Times that are not measurements of pinmech: (page, the words around the time), and why.
 NOT_MEASURED = {
