@@ -66,3 +66,17 @@ def test_every_generated_timing_report_names_its_machine() -> None:
                if re.search(r"\b(us|ms|wall|µs)\b", p.read_text(encoding="utf-8"))
                and not re.search(r"\bcores?\b|machine", p.read_text(encoding="utf-8"))]
     assert unnamed == []
+
+
+def test_the_design_times_report_lists_every_bundled_command() -> None:
+    """scripts/design_times.py times files that exist, and its report has a row for each
+    (measured, or marked not run)."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "scripts"))
+    import design_times
+
+    report = (GENERATED / "design_times.md").read_text(encoding="utf-8")
+    for command in design_times.COMMANDS.values():
+        assert (ROOT / command.split()[2]).is_file(), command
+        assert f"| `{command}` |" in report, command
