@@ -26,13 +26,14 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.napoleon",
     "sphinxarg.ext",
+    "sphinx.ext.mathjax",  # the equations (MyST dollarmath), typeset by the reader's browser
 ]
 
 source_suffix = {".md": "markdown"}
 root_doc = "index"
 exclude_patterns = ["_build", "_generated", "Thumbs.db", ".DS_Store"]
 
-myst_enable_extensions = ["colon_fence", "deflist"]
+myst_enable_extensions = ["colon_fence", "deflist", "dollarmath", "amsmath"]  # $..$, $$..$$: equations as maths
 myst_heading_anchors = 3
 
 nitpicky = True
@@ -66,6 +67,9 @@ def _plain_text(app, what, name, obj, options, lines) -> None:
     """Docstrings are written for `help()` in Markdown's habits: `|F|` is a magnitude, not
     an RST substitution; `code` is code, not RST's interpreted text; and a property's
     "The URDF file: ..." is a sentence, not napoleon's "type: description"."""
+    if what in ("class", "exception"):
+        lines[:] = _one_name_each(lines)
+        _LISTED[:] = _attribute_names(lines)
     for i, line in enumerate(lines):
         line = line.replace("|", "\\|")
         lines[i] = _CODE.sub(lambda m: f"``{m.group(1)}``" + ("\\ " if m.group(2) else ""), line)
@@ -75,6 +79,65 @@ def _plain_text(app, what, name, obj, options, lines) -> None:
     if what in ("property", "attribute", "data") and lines and ":" in lines[0]:
         # U+A789 (a letter that looks like a colon): napoleon then reads no type here
         lines[0] = lines[0].replace(":", "\ua789", 1)
+
+
+#: The names the class being documented lists in its "Attributes:" section: documented there
+#: (napoleon's fields), so not a second time as members (`_skip_listed`). autodoc filters a
+#: class's members right after processing the class's own docstring.
+_LISTED: list[str] = []
+
+
+def _attribute_names(lines: list[str]) -> list[str]:
+    """The names an "Attributes:" section of a Google-style docstring lists: each entry
+    starts at four spaces, and may name several ("by, on: ..."), over more than one line."""
+    entries, inside = [], False
+    for line in lines:
+        if line.strip() == "Attributes:":
+            inside = True
+        elif inside and line.strip() and not line.startswith(" "):
+            inside = False
+        elif inside and re.match(r"^ {4}\S", line):
+            entries.append(line.strip())
+        elif inside and entries and line.strip():
+            entries[-1] += " " + line.strip()
+    names = []
+    for entry in entries:
+        head = re.sub(r"\([^)]*\)", "", entry.split(": ", 1)[0] if ": " in entry else entry.rstrip(":"))
+        if re.fullmatch(r"\w+(?:,\s*\w+)*", head.strip()):
+            names += re.findall(r"\w+", head)
+    return names
+
+
+def _one_name_each(lines: list[str]) -> list[str]:
+    """An "Attributes:" entry naming several fields ("by, on: the link that exerts...,
+    the link it acts on"; a line may wrap) as one entry a field, as napoleon reads them:
+    the first carries the text, the others point to it."""
+    out, inside, i = [], False, 0
+    while i < len(lines):
+        line = lines[i]
+        if line.strip() == "Attributes:" or (inside and line.strip() and not line.startswith(" ")):
+            inside = line.strip() == "Attributes:"
+        head = line
+        while inside and re.fullmatch(r" {4}\w+(?:,\s*\w+)*,", head.rstrip()) and i + 1 < len(lines):
+            i += 1
+            head = head.rstrip() + " " + lines[i].strip()
+        names = re.match(r"^ {4}(\w+(?:,\s*\w+)+)\s*:\s(.*)$", head) if inside else None
+        if names:
+            first, *others = re.findall(r"\w+", names.group(1))
+            out.append(f"    {first}: {names.group(2)}")
+            while i + 1 < len(lines) and re.match(r"^ {5,}\S", lines[i + 1]):
+                i += 1
+                out.append(lines[i])
+            out += [f"    {other}: see ``{first}``." for other in others]
+        else:
+            out.append(head if head is not line else line)
+        i += 1
+    return out
+
+
+def _skip_listed(app, what, name, obj, skip, options):
+    """A member the class's "Attributes:" section already documents is not listed again."""
+    return True if what in ("class", "exception") and name in _LISTED else None
 
 
 def _literal_blocks(lines: list[str]) -> None:
@@ -135,6 +198,7 @@ def _optional_pages(app, docname: str, source: list[str]) -> None:
 
 def setup(app) -> None:
     app.connect("autodoc-process-docstring", _plain_text, priority=400)  # before napoleon's
+    app.connect("autodoc-skip-member", _skip_listed)
     app.connect("source-read", _optional_pages)
 
 # Commands and options in prose stay as typed: no "--set" turned into an en dash.

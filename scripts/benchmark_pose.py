@@ -1,4 +1,4 @@
-"""One pose through the public API (issue 23, item 3): `evaluate_motion` and
+"""One pose through the public API: `evaluate_motion` and
 `RateSolver.solve` on one pose, with what bounds them from below, interleaved in one
 process (scripts/interleave.py): medians and spread over the rounds, in microseconds.
 

@@ -7,7 +7,7 @@ the time spent in the compiled core's per-pose follow, and the ratio two workers
     python scripts/benchmark_study.py --samples 2000 --rounds 3
     python scripts/benchmark_study.py --full      # also the whole 100,000 x 360 study on 2 workers, once
 
-The issue's targets: 100,000 variants x 360 poses in <= 60 s on 2 cores; a variant-pose in
+The project's targets: 100,000 variants x 360 poses in <= 60 s on 2 cores; a variant-pose in
 <= 0.714 us (pylinkage-numba's time a pose); two workers >= 1.8 x one. The machine's load
 average is printed beside the numbers: other processes on the 2 cores slow the Dask rows.
 Needs `pip install "pinmech[study]"` for the Dask rows (they are skipped without it).
@@ -26,13 +26,13 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from interleave import Timed, time_rounds  # noqa: E402
+from interleave import Timed, machine, time_rounds  # noqa: E402
 
 from pinmech.design.cluster import built, local_cluster, run_batches  # noqa: E402
 from pinmech.design.study.file import load_study  # noqa: E402
 from pinmech.design.study.tolerance import batches  # noqa: E402
 
-STEPS = 360  # poses a turn, as the target
+STEPS = 360  # poses a turn
 
 
 def _spec(samples: int, batch: int):
@@ -132,7 +132,7 @@ def main(argv: list[str] | None = None) -> None:
             cluster.close()
     print(f"tolerance study of the four-bar: {spec.samples} variants x {spec.steps} poses, batches of "
           f"{spec.batch} ({len(todo)} tasks), {args.rounds} rounds; load average (1 min) {loads[0]:.1f} before, "
-          f"{loads[1]:.1f} after, on {os.cpu_count()} CPUs")
+          f"{loads[1]:.1f} after; {machine()}")
     for name, row in rows.items():
         us = [t * 1e6 for t in row.times]
         print(f"{name:<18} median {statistics.median(us):6.3f} us a variant-pose  ({min(us):.3f} .. {max(us):.3f})")

@@ -13,7 +13,7 @@ over the crank's turn (361 poses and the 10 targets'); its cost in microseconds 
 whole and split into the drawing and the follow, timed in interleaved rounds
 (scripts/interleave.py), medians and spread.
 
-The goal (issue 26): at most 60 s on this 2-core machine. Needs `pip install "pinmech[study]"`.
+The project's goal: at most 60 s on a 2-core machine. Needs `pip install "pinmech[study]"`.
 """
 
 from __future__ import annotations
@@ -90,6 +90,10 @@ def main(argv: list[str] | None = None) -> None:
     crank = np.radians(np.arange(20.0, 300.0, 30.0))
     targets = pose(BUNDLED[None], np.ones(1), crank[None]).P[0]
     times, rates, met = [], [], 0
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from interleave import machine
+
+    print(f"the ten-point four-bar path, seeds {', '.join(map(str, args.seeds))}; {machine()}")
     for seed in args.seeds:
         run = spec.__class__(**{**spec.__dict__, "targets": targets, "seed": seed, "keep": 1,
                                 "generations": args.generations})

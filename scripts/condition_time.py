@@ -26,7 +26,7 @@ import sys
 
 import numpy as np
 
-from interleave import Timed, time_rounds
+from interleave import Timed, machine, time_rounds
 
 SIZES = (1, 2, 3, 4, 8, 16, 32)
 CALLS = 500  # calls a sample
@@ -73,7 +73,8 @@ def main(argv: list[str] | None = None) -> int:
         us = [x * 1e6 for x in t.times]
         return f"{statistics.median(us):.3g}", f"{min(us):.3g} - {max(us):.3g}"
 
-    lines = [f"Condition numbers, {args.rounds} interleaved rounds of {CALLS} calls; us a call from Python.", "",
+    lines = [f"Condition numbers, {args.rounds} interleaved rounds of {CALLS} calls; us a call from Python; "
+             f"{machine()}.", "",
              "| n | spectrum | condition | core us (median) | spread | numpy SVD us (median) | spread |"
              " core's relative error vs SVD |",
              "| --- | --- | --- | --- | --- | --- | --- | --- |"]

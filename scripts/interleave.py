@@ -10,6 +10,8 @@ collection paused during a sample, as timeit does.
 from __future__ import annotations
 
 import gc
+import os
+import platform
 import time
 from dataclasses import dataclass, field
 from typing import Callable
@@ -39,3 +41,17 @@ def time_rounds(rows: list, rounds: int) -> None:
                 row.times.append((time.perf_counter() - t0) / (row.calls * row.poses))
             finally:
                 gc.enable()
+
+
+def machine() -> str:
+    """The machine a report was measured on, for its reader: the CPU's model, its cores,
+    the architecture, and the load average when the run started (a shared machine's
+    other work slows every row alike, interleaved, but not the absolute times)."""
+    model = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as info:
+            model = next((line.split(":", 1)[1].strip() for line in info if line.startswith("model name")), model)
+    except OSError:
+        pass
+    load = f", load average {os.getloadavg()[0]:.1f} at the start" if hasattr(os, "getloadavg") else ""
+    return f"{model}, {os.cpu_count()} cores, {platform.machine()}{load}"

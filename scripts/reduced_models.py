@@ -17,14 +17,19 @@ minimum-norm solution gives a joint the scene does not move (0 on the scene's mo
 Also the time example-robot-data's loader takes, which also builds the visual and
 collision geometry (meshes). Times are medians of repeats, on whatever machine runs this.
 
-Run: python scripts/reduced_models.py      (needs pip install "pinmech[robots]")
+Run: python scripts/reduced_models.py [--out FILE.md]     (needs pip install "pinmech[robots]")
 """
 
 from __future__ import annotations
 
+import argparse
 import statistics
+import sys
 import time
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from interleave import machine  # noqa: E402
 
 SCENES = Path(__file__).resolve().parents[1] / "models" / "scenes"
 ROBOT_SCENES = (("ur5.toml", "ur5"), ("panda.toml", "panda"), ("talos_left_arm.toml", "talos"))
@@ -86,26 +91,34 @@ def load_with_meshes_ms(robot: str) -> float:
     return 1e3 * _median_time(lambda: erd.load(robot), MESH_REPEATS)
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, help="also write the Markdown report to this file")
+    args = parser.parse_args(argv)
     try:
         import example_robot_data  # noqa: F401
     except ImportError:
         print('this script needs the robots extra: pip install "pinmech[robots]"')
         return
-    print(f"medians of {LOAD_REPEATS} loads, {SOLVE_REPEATS} rate solves, {MESH_REPEATS} loads with meshes")
-    print("| scene | model | nq | nv | joints | frames | load [ms] | rate solve [us] | method | "
-          "largest rate of a joint the scene holds [rad/s or m/s] |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    lines = [f"Medians of {LOAD_REPEATS} loads, {SOLVE_REPEATS} rate solves, {MESH_REPEATS} loads with meshes; "
+             f"{machine()}.", "",
+             "| scene | model | nq | nv | joints | frames | load [ms] | rate solve [us] | method | "
+             "largest rate of a joint the scene holds [rad/s or m/s] |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for scene, robot in ROBOT_SCENES:
         rows = measure(scene, robot)
         for r in rows:
-            print(f"| {scene} | {r['model']} | {r['nq']} | {r['nv']} | {r['joints']} | {r['frames']} | "
-                  f"{r['load_ms']:.1f} | {r['solve_us']:.0f} | {r['method']} | {r['held_rate']:.3g} |")
+            lines.append(f"| {scene} | {r['model']} | {r['nq']} | {r['nv']} | {r['joints']} | {r['frames']} | "
+                         f"{r['load_ms']:.1f} | {r['solve_us']:.0f} | {r['method']} | {r['held_rate']:.3g} |")
         full, reduced = rows[0], rows[-1]
-        print(f"| {scene} | ratio full / scene | | | | | {full['load_ms'] / reduced['load_ms']:.2f} | "
-              f"{full['solve_us'] / reduced['solve_us']:.2f} | | |")
-        print(f"| {scene} | example-robot-data loader, with meshes | | | | | "
-              f"{load_with_meshes_ms(robot):.0f} | | | |")
+        lines.append(f"| {scene} | ratio full / scene | | | | | {full['load_ms'] / reduced['load_ms']:.2f} | "
+                     f"{full['solve_us'] / reduced['solve_us']:.2f} | | |")
+        lines.append(f"| {scene} | example-robot-data loader, with meshes | | | | | "
+                     f"{load_with_meshes_ms(robot):.0f} | | | |")
+    text = "\n".join(lines) + "\n"
+    print(text, end="")
+    if args.out:
+        args.out.write_text(text, encoding="utf-8")
 
 
 if __name__ == "__main__":

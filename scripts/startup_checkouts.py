@@ -6,7 +6,7 @@ round, so the machine's load falls on all alike): `python -c "import pinocchio"`
 thrown away; each must exit 0). Reported: median wall time, fastest and slowest run, the
 median CPU time (user + system: what the process itself spent, less moved by other
 processes on a shared machine than its wall time), and each `solve`'s medians over
-`import pinocchio`'s (issue 23's target: at most 1.5).
+`import pinocchio`'s (the project's target: at most 1.5).
 
 Bytecode: by default every command reads its modules' bytecode from a cache in a temporary
 folder (PYTHONPYCACHEPREFIX), written by one untimed round: what an installed pinmech does

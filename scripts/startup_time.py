@@ -5,8 +5,8 @@ round, so the machine's load hits them alike): `python -c pass` (the interpreter
 `python -c "import pinocchio"` (the floor of any Pinocchio tool) and
 `pinmech solve models/scenes/r_rtr.toml` (the installed console script, output thrown
 away). Reported: the median wall time of each with its spread (fastest and slowest run),
-and the ratio of the medians of `pinmech solve` to `import pinocchio` (issue 13's
-target: at most 1.5).
+and the ratio of the medians of `pinmech solve` to `import pinocchio`. The project's
+target on that ratio (at most 1.5) is read by the exit code alone (1 over it).
 
 Where the time goes, from one more run of each kind:
 - `PYTHONPROFILEIMPORTTIME=1` (python -X importtime) on `pinmech solve`: the self time of
@@ -31,6 +31,9 @@ import tempfile
 import time
 from collections import defaultdict
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from interleave import machine  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Every child runs here, outside the checkout, so `python -c` imports the pinmech the
@@ -191,12 +194,10 @@ def report(scene: Path, runs: int, top: int) -> tuple[str, float]:
     names = list(cmds)
     medians = {n: statistics.median(t) for n, t in times.items()}
     ratio = medians[names[2]] / medians[names[1]]
-    lines = [f"{runs} runs of each command, interleaved, wall time [ms]:", "",
+    lines = [f"{runs} runs of each command, interleaved, wall time [ms]; {machine()}:", "",
              "| command | median | fastest | slowest |", "| --- | --- | --- | --- |"]
     lines += [f"| `{n}` | {_ms(medians[n])} | {_ms(min(t))} | {_ms(max(t))} |" for n, t in times.items()]
-    verdict = "met" if ratio <= 1.5 else "not met"
-    lines += ["", (f"`{names[2]}` takes {ratio:.2f} x `{names[1]}` (medians; issue 13's target: at most "
-              f"1.5 x): {verdict}."), ""]
+    lines += ["", f"`{names[2]}` takes {ratio:.2f} x `{names[1]}` (medians).", ""]
     package = measured_package()
     editable = package.resolve() == ROOT / "pinmech"
     where = "the checkout's source (an editable install)" if editable else "a regular install (in site-packages)"
@@ -240,5 +241,11 @@ def main(argv: list[str] | None = None) -> float:
     return ratio
 
 
+#: The project's target on the ratio of medians (the exit code's; the report states none).
+TARGET_RATIO = 1.5
+
 if __name__ == "__main__":
-    main()
+    _ratio = main()
+    if _ratio > TARGET_RATIO:
+        print(f"target missed: {_ratio:.2f} x import pinocchio, over {TARGET_RATIO} x", file=sys.stderr)
+    sys.exit(1 if _ratio > TARGET_RATIO else 0)

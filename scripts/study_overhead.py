@@ -1,4 +1,4 @@
-"""How much of a tolerance study's time is spent outside the per-pose solve (issue 23, item 2).
+"""How much of a tolerance study's time is spent outside the per-pose solve.
 
 The bundled four-bar tolerance study (models/studies/four_bar_tolerance.toml) with
 `--steps` poses over the crank's turn and `--samples` variants, run in this process

@@ -88,3 +88,21 @@ def test_the_home_page_lists_the_sections_and_shows_the_picture(site: Path) -> N
     for caption in ("Tutorials", "How-to guides", "Reference", "Explanation"):
         assert re.search(rf">\s*{caption}\s*<", home), caption
     assert "r_rtr.png" in home
+
+
+@pytest.mark.slow
+def test_no_field_of_a_result_is_documented_twice(site: Path) -> None:
+    """Each class of the API pages lists its fields once: in its "Variables" (the
+    docstring's "Attributes:"), not again as a member entry below it."""
+    twice = []
+    for page in sorted((site / "reference" / "api").glob("*.html")):
+        html = page.read_text(encoding="utf-8")
+        for part in re.split(r'<dl class="py (?:class|exception)">', html)[1:]:
+            name = re.search(r'id="([^"]+)"', part).group(1)
+            fields = re.search(r'<dt class="field-\w+">Variables.*?</dd>', part, re.S)
+            listed = set(re.findall(r"<strong>(\w+)</strong>", fields.group(0))) if fields else set()
+            members = [i.rsplit(".", 1)[1] for i in re.findall(r'<dt class="sig sig-object py" id="([^"]+)"', part)
+                       if i.startswith(name + ".")]
+            twice += [f"{page.name}: {name}.{m}" for m in sorted(listed & set(members))]
+            twice += [f"{page.name}: {name}.{m} (two member entries)" for m in set(members) if members.count(m) > 1]
+    assert twice == []

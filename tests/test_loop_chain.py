@@ -202,3 +202,4 @@ def test_benchmark_loops_runs(tmp_path, capsys):
     assert {(r.k, r.path) for r in rows} == {(1, "core"), (2, "core")}
     assert all(r.errors[0] <= STATED_SWEEP and len(r.times) == 1 for r in rows)
     assert "| 2 | core |" in out.read_text()
+    assert "target" not in out.read_text().lower()  # the targets are the exit code's (missed_targets)

@@ -1,1 +1,1 @@
-"""pinmech.design: design studies and synthesis; see docs/explanation/layout.md."""
+"""pinmech.design: studies, synthesis and workspace maps, and what they share."""

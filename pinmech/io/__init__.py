@@ -1,1 +1,1 @@
-"""pinmech.io: see docs/explanation/layout.md."""
+"""pinmech.io: scene and hand files read into typed objects; results as text, JSON, tables."""

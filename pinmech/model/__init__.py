@@ -1,1 +1,1 @@
-"""pinmech.model: see docs/explanation/layout.md."""
+"""pinmech.model: model files (URDF, drawn TOML, MJCF, robot.yaml) read into one Mechanism."""

@@ -1,1 +1,1 @@
-"""pinmech.solve: see docs/explanation/layout.md."""
+"""pinmech.solve: loops closed, rates, forces, sweeps and diagnostics, by the compiled core."""

@@ -1,1 +1,1 @@
-"""pinmech.design.study.run: see docs/explanation/layout.md."""
+"""pinmech.design.study: sensitivity, tolerance and grid studies of named dimensions."""

@@ -1,1 +1,1 @@
-"""pinmech.design.synthesis: see docs/explanation/layout.md."""
+"""pinmech.design.synthesis: path, motion and function synthesis of linkages."""

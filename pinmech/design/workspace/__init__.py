@@ -1,1 +1,1 @@
-"""pinmech.design.workspace.run: see docs/explanation/layout.md."""
+"""pinmech.design.workspace: workspace maps of parallel mechanisms (task and motor space)."""
