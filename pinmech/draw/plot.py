@@ -368,9 +368,12 @@ def plot_sweep(sweep: Sweep, poses: Iterable[SweepPose], path: str | Path, *,
                links: list[str] | None = None, points: list[str] | None = None) -> Path:
     """Draw a sweep's poses and save the figure (PNG, PDF, SVG)."""
     recorder = SweepPlot(sweep, links=links, points=points)
+    from pinmech.outputs import write_with
+
     for pose in poses:
         recorder.add(pose)
-    return recorder.save(path)
+    write_with(path, recorder.save)  # drawn to a temporary file, renamed whole
+    return Path(path)
 
 
 #: Agg draws a long line in pieces of this many vertices: a million-pose sweep's curves
