@@ -368,12 +368,9 @@ def plot_sweep(sweep: Sweep, poses: Iterable[SweepPose], path: str | Path, *,
                links: list[str] | None = None, points: list[str] | None = None) -> Path:
     """Draw a sweep's poses and save the figure (PNG, PDF, SVG)."""
     recorder = SweepPlot(sweep, links=links, points=points)
-    from pinmech.outputs import write_with
-
     for pose in poses:
         recorder.add(pose)
-    write_with(path, recorder.save)  # drawn to a temporary file, renamed whole
-    return Path(path)
+    return recorder.save(path)
 
 
 #: Agg draws a long line in pieces of this many vertices: a million-pose sweep's curves
@@ -383,8 +380,11 @@ AGG_CHUNK = 1000
 
 
 def _save(plt, fig, path: str | Path) -> Path:
-    path = Path(path)
-    with plt.rc_context({"agg.path.chunksize": AGG_CHUNK}):
-        fig.savefig(path, dpi=130)
-    plt.close(fig)
-    return path
+    """Every sweep figure's way to its file: whole, through outputs.write_with."""
+    from pinmech.outputs import write_with
+
+    try:
+        with plt.rc_context({"agg.path.chunksize": AGG_CHUNK}):
+            return write_with(path, lambda temporary: fig.savefig(temporary, dpi=130))
+    finally:
+        plt.close(fig)
