@@ -351,3 +351,19 @@ class SynthesisError(PinmechError):
         super().__init__(f"{path}: {message}" if path else message)
         self.path = path
         self.rejected = dict(rejected or {})
+
+
+class ClusterError(PinmechError):
+    """A Dask scheduler named by its address cannot be used: the address is not one, nothing
+    answers there within seconds, what answers is no scheduler, or the scheduler was lost
+    during the run (no output is then written).
+
+    Attributes:
+        address: the scheduler's address as given.
+    """
+
+    exit_code = 2
+
+    def __init__(self, message: str, *, address: str):
+        super().__init__(f"scheduler {address}: {message}")
+        self.address = address

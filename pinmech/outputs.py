@@ -5,6 +5,11 @@ it only when the run succeeds, so an existing file is never truncated or replace
 half-written one, and two runs writing the same path leave one complete file. When the
 run fails or is interrupted, what was written is kept as `NAME.partial` (and the
 destination is left as it was): a reader cannot take it for a complete result.
+
+A destination that is a symbolic link is replaced by the file written, as `mv` would:
+pinmech never writes through a link onto the file it points to (a link planted at an
+output's name cannot make a run overwrite another file). A link to a folder on the way
+to the destination is followed as usual.
 """
 
 from __future__ import annotations
@@ -33,7 +38,8 @@ class OutputFile:
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
-        self.target = Path(os.path.realpath(path))  # a symbolic link is written through, not replaced
+        # the link itself, if the name is one, is replaced: never written through (see above)
+        self.target = Path(os.path.realpath(self.path.parent)) / self.path.name
         self.temporary: Path | None = None
         self.stream: IO[str] | None = None
         self.direct = False  # a pipe or a device, written as the rows come
@@ -89,6 +95,8 @@ def _check_destination(option: str, path: Path) -> None:
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise PinmechError(f"{option} {path}: no such folder {folder}")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise PinmechError(f"{option} {path}: the folder {folder} is not writable")
 
 
 def _special(path: Path) -> bool:
@@ -99,11 +107,13 @@ def _special(path: Path) -> bool:
 def _mode(path: Path) -> int:
     """Permissions of the new file: the existing file's, else those the umask allows."""
     try:
-        return path.stat().st_mode & 0o777
+        if not path.is_symlink():  # a link's target's permissions are another file's
+            return path.stat().st_mode & 0o777
     except OSError:
-        umask = os.umask(0)
-        os.umask(umask)
-        return 0o666 & ~umask
+        pass
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
 
 
 def write_whole(path: str | Path, text: str) -> None:
@@ -181,6 +191,21 @@ def check_distinct(outputs: dict[str, str | Path | None], inputs: dict[str, str 
         key = os.path.realpath(path)
         if key in seen:
             raise PinmechError(f"{seen[key]} {path} would overwrite {what}: write the output elsewhere")
+
+
+def check_prefix(option: str, prefix: str | Path, endings: list[str],
+                 inputs: dict[str, str | Path] | None = None) -> None:
+    """Before computing: each file `--out PREFIX` writes (PREFIX + ending) can be made, none
+    is another's or an input (check_distinct), and PREFIX names no folder.
+
+    Raises:
+        PinmechError: naming the option, the file and what is wrong.
+    """
+    text = str(prefix)
+    if not text or text.endswith(("/", os.sep)) or Path(text).is_dir() or Path(text).name in (".", ".."):
+        raise PinmechError(f"{option} {text} is a folder: give a prefix of file names, e.g. {option} "
+                           f"{Path(text) / 'run'}")
+    check_distinct({f"{option} {text} ({ending})": beside(text, ending) for ending in endings}, inputs)
 
 
 class Outputs:

@@ -1,5 +1,6 @@
 """The one reader of the TOML files users write (scenes, hand values, drawn linkages,
-studies): a missing file or malformed TOML is one named error naming the file."""
+studies): a missing, huge, deeply nested or malformed file is one named error naming the
+file (file_limits.py); a byte-order mark and CRLF line ends are read as plain UTF-8."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from pinmech.exceptions import PinmechError
+from pinmech.file_limits import check_nesting, file_text, nested_too_deep
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -22,14 +24,17 @@ def read_toml(path: Path, what: str, error: type[PinmechError]) -> dict[str, Any
     message).
 
     Raises:
-        error: "no such <what> file", or "malformed TOML: <where>", naming the file.
+        error: "no such <what> file", a file over file_limits' size or nesting, or
+            "malformed TOML: <where>", naming the file.
     """
-    if not path.is_file():
-        raise error(f"no such {what} file", path=str(path))
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
+        tables = tomllib.loads(file_text(path, what, error))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise error(f"malformed TOML: {exc}", path=str(path)) from exc
+    except RecursionError:
+        raise nested_too_deep(what, path, error) from None
+    check_nesting(tables, what, path, error)
+    return tables
 
 
 def toml_value(text: str) -> Any:

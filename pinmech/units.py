@@ -93,6 +93,13 @@ _COMMON_UNITS: dict[str, tuple[float, str]] = {
 #: Largest magnitude of a quantity in SI units. Kinematics multiplies speeds and lengths
 #: (a = omega^2 r) and squares the results (norms), which must stay below 1.8e308.
 MAX_MAGNITUDE = 1e50
+#: Smallest magnitude of a non-zero quantity in SI units: below, its squares underflow to
+#: zero (1e-50 squared is 1e-100; 1e-300 squared is 0), so a length of "1e-300 mm" would be
+#: no length at all to the solver. The range is the one model files are held to (loop_size).
+MIN_MAGNITUDE = 1e-50
+#: Largest power of a unit written ("m^3", "kg*m^2"): pint would compute "mm**9**9**9"
+#: (a number of 369 million digits) before any check; no quantity pinmech reads needs more.
+MAX_UNIT_POWER = 4
 #: Angles written in another unit than the radian (degrees, turns) convert exactly up to
 #: this [rad]: the product's rounding (2.3e-16 of it) stays below 1e-9 rad. Beyond, the
 #: pose of "1e15 deg" would be -80.05 deg, not -80: refused, naming the same pose.
@@ -157,6 +164,9 @@ def to_si(value: Any, kind: str, *, where: str = "") -> float:
     if abs(result) > MAX_MAGNITUDE:
         raise UnitError(f"{value!r} is {result:.3g} {format_si(result, kind)}, beyond the {MAX_MAGNITUDE:g} (SI) "
                         "pinmech computes with: its squares would overflow", key=where)
+    if 0 < abs(result) < MIN_MAGNITUDE:
+        raise UnitError(f"{value!r} is {result:.3g} {format_si(result, kind)}, below the {MIN_MAGNITUDE:g} (SI) "
+                        "pinmech computes with: its squares would underflow to 0 (write 0 for none)", key=where)
     factor = result / number if number else 1.0
     if kind == "angle" and factor != 1.0 and abs(result) > MAX_CONVERTED_ANGLE:
         turn = 2 * math.pi / factor  # one turn in the unit written (360 for degrees, 1 for turns)
@@ -185,11 +195,25 @@ def _split(text: str, kind: str, where: str) -> tuple[float, str]:
                         f"'1.5 {_example(kind)}'", key=where)
     unit = match.group(2).strip().translate(_TYPOGRAPHY)
     unit = re.sub(r"\s*(\*\*|[/*^])\s*", r"\1", unit)
+    _refuse_powers(text, unit, where)
     if re.search(r"\b\d", _EXPONENT.sub("", unit)):  # a digit that starts a word; "g0" is a unit's name
         angles = " (an angle may be written 30° 20' 15\")" if kind.startswith(("angle", "angular")) else ""
         raise UnitError(f"{text!r} holds more than one number: write one number and one unit, e.g. "
                         f"'1.5 {_example(kind)}'{angles}", key=where)
     return float(match.group(1)), _ARC_MARKS.get(unit, unit)
+
+
+#: A power of a power ("mm**9**9", "m^2^3"): pint evaluates it right to left, digit by digit.
+_TOWER = re.compile(r"(\^|\*\*)[+-]?\d+(\^|\*\*)")
+
+
+def _refuse_powers(text: str, unit: str, where: str) -> None:
+    """A unit's powers are whole numbers up to MAX_UNIT_POWER, one a factor: checked before
+    pint reads the unit (which would compute "mm**9**9**9" for hours)."""
+    powers = [abs(int(p)) for p in re.findall(r"(?:\^|\*\*)\s*([+-]?\d+)", unit)]
+    if _TOWER.search(unit) or any(p > MAX_UNIT_POWER for p in powers):
+        raise UnitError(f"{text!r}: a unit's power is a whole number up to {MAX_UNIT_POWER} (as in 'kg*m^2'), "
+                        "one a factor, not a power of a power", key=where)
 
 
 #: minutes and seconds of arc written with their marks alone ("1.5 '"): pint knows no mark

@@ -189,14 +189,16 @@ def test_a_pipe_is_written_directly(r_rtr_scene, tmp_path, capsys):
     assert len(got[0].splitlines()) == 5 and _files(tmp_path) == {"pipe"}
 
 
-def test_an_output_through_a_symbolic_link_replaces_its_target(r_rtr_scene, tmp_path, capsys):
+def test_an_output_at_a_symbolic_link_replaces_the_link_never_its_target(r_rtr_scene, tmp_path, capsys):
+    """Written as `mv` would: the link becomes the file; the file it pointed to is untouched
+    (tests/test_hostile_outputs.py hunts the class over every writer)."""
     (tmp_path / "real").mkdir()
     target = tmp_path / "real" / "a.csv"
     target.write_text("old\n")
     os.symlink(target, tmp_path / "link.csv")
     assert main(["sweep", str(r_rtr_scene), "--steps", "3", "--csv", str(tmp_path / "link.csv")]) == 0
-    assert (tmp_path / "link.csv").is_symlink() and len(target.read_text().splitlines()) == 4
-    assert _files(tmp_path / "real") == {"a.csv"}
+    assert not (tmp_path / "link.csv").is_symlink() and len((tmp_path / "link.csv").read_text().splitlines()) == 4
+    assert target.read_text() == "old\n" and _files(tmp_path / "real") == {"a.csv"}
 
 
 def test_animate_refuses_more_frames_than_a_page_can_keep(r_rtr_scene, tmp_path, capsys):

@@ -168,8 +168,8 @@ def test_a_mimic_follower_has_its_columns_in_the_path_csv(tmp_path, models_dir, 
 
 
 def test_a_path_whose_step_count_never_ends_is_refused_before_any_work(scenes_dir, tmp_path, capsys):
-    """Issue 22 item 16: `step = "1e-300 s"` ran on at 300k rows a minute. 0.08 s / 1e-300 s
-    is 8e298 steps, beyond counts.MAX_POSES (10 million): exit 2 at once, naming the file,
+    """Issue 22 item 16: `step = "1e-300 s"` ran on at 300k rows a minute (now refused as a
+    quantity below units.MIN_MAGNITUDE). 0.08 s / 1e-40 s is 8e38 steps, beyond counts.MAX_POSES (10 million): exit 2 at once, naming the file,
     the key and the count; --step on the command line is named as such. The limit itself
     still passes (1 s at 1e-7 s), twice it does not."""
     import time
@@ -180,11 +180,11 @@ def test_a_path_whose_step_count_never_ends_is_refused_before_any_work(scenes_di
     scene = tmp_path / "arm.toml"
     text = (scenes_dir / "planar_arm.toml").read_text()
     assert 'step = "1 ms"' in text
-    scene.write_text(text.replace('step = "1 ms"', 'step = "1e-300 s"').replace('urdf = "../', f'urdf = "{scenes_dir.parent}/'))
+    scene.write_text(text.replace('step = "1 ms"', 'step = "1e-40 s"').replace('urdf = "../', f'urdf = "{scenes_dir.parent}/'))
     began = time.monotonic()
     assert main(["path", str(scene)]) == 2
     err = capsys.readouterr().err
-    assert "[sweep] step" in err and "arm.toml" in err and "8e+298 poses" in err and "10,000,000" in err
+    assert "[sweep] step" in err and "arm.toml" in err and "8e+38 poses" in err and "10,000,000" in err
     assert main(["path", str(scenes_dir / "planar_arm.toml"), "--step", "1e-12 s"]) == 2
     assert "--step" in capsys.readouterr().err
     assert time.monotonic() - began < 30  # refused, not run (a row takes ~0.2 ms)

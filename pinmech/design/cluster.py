@@ -17,13 +17,18 @@ starts; tests/test_cluster.py checks it).
 from __future__ import annotations
 
 import os
+import socket
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 from pinmech.design.study.file import StudySpec
 from pinmech.design.study.tolerance import Batch, BatchResult, run_batch
+from pinmech.exceptions import ClusterError, PinmechError
 
 _EXTRA = 'pip install "pinmech[study]"'
+#: Seconds a scheduler given by its address has to answer (Dask's own default waits 30 s).
+CONNECT_SECONDS = 5.0
+_SCHEMES = ("tcp", "tls", "ws", "wss")
 #: run(spec, batches, progress=None) -> results in batch order
 Runner = Callable[..., list]
 #: Dask settings of the workers pinmech starts. By default a worker samples its computing
@@ -102,11 +107,68 @@ def batch_runner(*, workers: int = 0, scheduler: str | None = None) -> Iterator[
         return
     distributed = require_dask()
     if scheduler is not None:
-        with distributed.Client(scheduler, timeout="20s") as client:
-            yield lambda spec, todo, progress=None: _gathered(client, spec, todo, progress, distributed)
+        with connected(scheduler, distributed) as client:
+            yield lambda spec, todo, progress=None: _gathered(client, spec, todo, progress, distributed, scheduler)
         return
     with local_cluster(workers) as cluster, distributed.Client(cluster) as client:
-        yield lambda spec, todo, progress=None: _gathered(client, spec, todo, progress, distributed)
+        yield lambda spec, todo, progress=None: _gathered(client, spec, todo, progress, distributed, "local")
+
+
+@contextmanager
+def connected(address: str, distributed) -> Iterator:
+    """A Client of the scheduler at `address`, in CONNECT_SECONDS or a ClusterError: the
+    address checked first (scheme://host:port), then a TCP connection tried, then Dask's
+    handshake (a server that is no scheduler fails there)."""
+    host, port = _host_port(address)
+    try:
+        socket.create_connection((host, port), timeout=CONNECT_SECONDS).close()
+    except OSError as exc:
+        raise ClusterError(f"cannot reach {host}:{port} within {CONNECT_SECONDS:g} s ({exc}): is the scheduler "
+                           "running, and is this its address?", address=address) from None
+    client = _handshake(address, distributed)
+    with client:
+        yield client
+
+
+def _handshake(address: str, distributed):
+    """Dask's Client of `address`, once the server there has said, within CONNECT_SECONDS,
+    that it is a Dask scheduler (Dask's "identity" call, on a connection of our own in an
+    event loop of our own, cancelled at the deadline): a server that answers but is no
+    scheduler (an HTTP server, a proxy) keeps Dask's own Client waiting for ever, or feeds
+    it a frame length of exabytes (numpy's MemoryError)."""
+    import asyncio
+
+    async def identity() -> object:
+        comm = await distributed.comm.connect(address, timeout=CONNECT_SECONDS)
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    try:
+        answer = asyncio.run(asyncio.wait_for(identity(), CONNECT_SECONDS))
+    except Exception as exc:  # noqa: BLE001 - Dask raises OSError, TimeoutError, ValueError, MemoryError here
+        said = " ".join(str(exc).split())[:200] or type(exc).__name__
+        raise ClusterError(f"did not answer as a Dask scheduler within {CONNECT_SECONDS:g} s ({said})",
+                           address=address) from None
+    if not isinstance(answer, dict) or answer.get("type") != "Scheduler":
+        raise ClusterError(f"answered, but not as a Dask scheduler (its identity: {str(answer)[:120]})",
+                           address=address)
+    return distributed.Client(address, timeout=f"{CONNECT_SECONDS}s")
+
+
+def _host_port(address: str) -> tuple[str, int]:
+    """(host, port) of "tcp://host:port" (or "host:port"); a ClusterError for anything else."""
+    scheme, sep, rest = address.partition("://")
+    if not sep:
+        scheme, rest = "tcp", address
+    host, _, port = rest.rpartition(":")
+    host = host.strip("[]")
+    if scheme not in _SCHEMES or not host or not port.isdigit() or not 0 < int(port) < 65536 or "/" in rest:
+        raise ClusterError(f"{address!r} is not a scheduler address: write tcp://HOST:PORT, e.g. "
+                           "tcp://127.0.0.1:8786 (schemes: " + ", ".join(_SCHEMES) + ")", address=address)
+    return host, int(port)
 
 
 def local_cluster(workers: int, **options):
@@ -134,13 +196,36 @@ def scheduler_address(option: str | None) -> str | None:
     return option or os.environ.get("DASK_SCHEDULER_ADDRESS") or None
 
 
-def _gathered(client, spec: StudySpec, batches: list[Batch], progress, distributed) -> list[BatchResult]:
-    futures = client.map(solve_batch, [spec] * len(batches), batches, pure=False)
-    index = {f.key: i for i, f in enumerate(futures)}
+def _gathered(client, spec: StudySpec, batches: list[Batch], progress, distributed,
+              address: str) -> list[BatchResult]:
+    """The batches' results in batch order; the scheduler lost on the way is a ClusterError
+    (the batches' own errors pass as they are)."""
     results: list[BatchResult | None] = [None] * len(batches)
-    for future in distributed.as_completed(futures):
-        i = index[future.key]
-        results[i] = future.result()
-        if progress:
-            progress(batches[i])
+    try:
+        futures = client.map(solve_batch, [spec] * len(batches), batches, pure=False)
+        index = {f.key: i for i, f in enumerate(futures)}
+        for future in distributed.as_completed(futures):
+            i = index[future.key]
+            results[i] = future.result()
+            if progress:
+                progress(batches[i])
+    except PinmechError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - sorted below: Dask's losses, else the batch's own error
+        if not _lost(exc):
+            raise
+        done = sum(r is not None for r in results)
+        said = " ".join(str(exc).split())[:200] or type(exc).__name__
+        raise ClusterError(f"lost during the run after {done} of {len(batches)} batches ({type(exc).__name__}: "
+                           f"{said}); nothing was written", address=address) from exc
     return results
+
+
+def _lost(error: BaseException) -> bool:
+    """Whether `error` says the scheduler or the connection to it went away (not a batch's failure)."""
+    import asyncio
+    import concurrent.futures
+
+    module = type(error).__module__
+    return (isinstance(error, (OSError, TimeoutError, asyncio.CancelledError, concurrent.futures.CancelledError))
+            or module.startswith(("distributed", "tornado")))

@@ -119,10 +119,11 @@ def write_gif(frames: Frames, path: str | Path, fps: float) -> Path:
         pictures = [image.fromarray(pixels) for pixels in renderer]
     finally:
         renderer.close()
-    path = Path(path)
-    pictures[0].save(path, save_all=True, append_images=pictures[1:], duration=round(1000 / fps), loop=0,
-                     disposal=1)
-    return path
+    from pinmech.outputs import write_with
+
+    return write_with(path, lambda temporary: pictures[0].save(
+        temporary, format="GIF", save_all=True, append_images=pictures[1:], duration=round(1000 / fps), loop=0,
+        disposal=1))
 
 
 def write_mp4(frames: Frames, path: str | Path, fps: float) -> Path:
@@ -135,10 +136,16 @@ def write_mp4(frames: Frames, path: str | Path, fps: float) -> Path:
         with tempfile.TemporaryDirectory() as folder:
             for k, pixels in enumerate(renderer):
                 image.fromarray(pixels).save(Path(folder) / f"{k:06d}.png")
-            try:
+            from pinmech.outputs import write_with
+
+            def encode(temporary: Path) -> None:
                 subprocess.run([ffmpeg, "-y", "-loglevel", "error", "-framerate", f"{fps:g}", "-i",
                                 str(Path(folder) / "%06d.png"), "-pix_fmt", "yuv420p", "-vcodec", "libx264",
-                                str(path)], check=True, capture_output=True, text=True, timeout=600)
+                                "-f", "mp4", str(temporary)], check=True, capture_output=True, text=True,
+                               timeout=600)
+
+            try:
+                write_with(path, encode)
             except subprocess.CalledProcessError as exc:
                 said = (exc.stderr or "").strip().splitlines()
                 raise PinmechError(f"--mp4 {path}: ffmpeg failed (exit {exc.returncode}): "

@@ -380,8 +380,11 @@ AGG_CHUNK = 1000
 
 
 def _save(plt, fig, path: str | Path) -> Path:
-    path = Path(path)
-    with plt.rc_context({"agg.path.chunksize": AGG_CHUNK}):
-        fig.savefig(path, dpi=130)
-    plt.close(fig)
-    return path
+    """Every sweep figure's way to its file: whole, through outputs.write_with."""
+    from pinmech.outputs import write_with
+
+    try:
+        with plt.rc_context({"agg.path.chunksize": AGG_CHUNK}):
+            return write_with(path, lambda temporary: fig.savefig(temporary, dpi=130))
+    finally:
+        plt.close(fig)

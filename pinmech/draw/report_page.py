@@ -192,8 +192,10 @@ class HtmlPage:
         self.html, self.height = page, height
 
     def save(self, path: str | Path) -> Path:
+        from pinmech.outputs import write_whole
+
         path = Path(path)
-        path.write_text(self.html, encoding="utf-8")
+        write_whole(path, self.html)  # whole or not at all; a link at `path` replaced, not written through
         return path
 
     def _repr_html_(self) -> str:

@@ -22,6 +22,7 @@ from typing import Any
 import pinocchio as pin
 
 from pinmech.exceptions import ModelError
+from pinmech.file_limits import check_nesting, file_text, nested_too_deep
 from pinmech.known_keys import unknown_keys
 from pinmech.model.frame_names import frame_named, reduced_model
 from pinmech.model.inertia_check import urdf_inertia_caveats
@@ -47,12 +48,13 @@ def read_sidecar(path: str | Path) -> dict[str, Any]:
         raise ImportError('reading robot.yaml needs PyYAML: pip install "pinmech[yaml]"') from exc
     path = Path(path)
     source = str(path)
-    if not path.is_file():
-        raise ModelError("no such sidecar file", path=source)
     try:
-        content = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
+        content = yaml.safe_load(file_text(path, "sidecar", ModelError)) or {}
     except (yaml.YAMLError, UnicodeDecodeError) as exc:
         raise ModelError(f"malformed YAML: {' '.join(str(exc).split())}", path=source) from exc
+    except RecursionError:
+        raise nested_too_deep("sidecar", path, ModelError) from None
+    check_nesting(content, "sidecar", path, ModelError)
     if not isinstance(content, dict):
         raise ModelError("expected keys closed_loop, type, name_mot", path=source)
     message = unknown_keys(content, sorted(_KEYS))

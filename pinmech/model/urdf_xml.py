@@ -16,6 +16,7 @@ import pinocchio as pin
 
 from pinmech.directions import unit_vector
 from pinmech.exceptions import ModelError
+from pinmech.file_limits import file_bytes
 from pinmech.model.closures import CUT_TYPES
 from pinmech.model.urdf_joints import mimic_joints
 
@@ -37,10 +38,9 @@ def read_xml(path: Path, root_tag: str, kind: str) -> ET.Element:
     Raises:
         ModelError: a missing file, malformed XML or another root element, naming the file.
     """
-    if not path.is_file():
-        raise ModelError(f"no such {kind} file", path=str(path))
+    data = file_bytes(path, kind, ModelError)  # missing or over file_limits' size: refused first
     try:
-        root = ET.parse(path).getroot()
+        root = ET.fromstring(data)
     except ET.ParseError as exc:
         raise ModelError(f"malformed XML: {exc}", path=str(path)) from exc
     if root.tag != root_tag:

@@ -75,16 +75,19 @@ def cmd_study(args: argparse.Namespace) -> int:
 
     from pinmech.design.cluster import scheduler_address
     from pinmech.exceptions import OptionRefused
-    from pinmech.design.study.run import study
+    from pinmech.design.study.run import load_any_study, study
     from pinmech.design.study.report import summary, text, write
 
     if args.plot and not args.out:
         raise OptionRefused("--plot writes PREFIX_*.png: give --out PREFIX too", options=["--plot"])
+    spec = load_any_study(args.study_file)
+    if args.out:
+        _check_out(args, spec)
     scheduler = scheduler_address(args.scheduler)
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
     bar = ProgressBar.on_terminal(quiet=args.quiet)
     try:
-        result = study(args.study_file, workers=workers, scheduler=scheduler, progress=bar)
+        result = study(spec, workers=workers, scheduler=scheduler, progress=bar)
     finally:
         if bar is not None:
             bar.close()
@@ -103,6 +106,18 @@ def cmd_study(args: argparse.Namespace) -> int:
                 written.append(tolerance_histograms(result, f"{args.out}_histogram.png"))
         print("wrote " + ", ".join(str(p) for p in written), file=sys.stderr)
     return 0
+
+
+def _check_out(args: argparse.Namespace, spec) -> None:
+    """Before the study runs: every file --out PREFIX (and --plot) writes can be made, and
+    none is another's, the study file or its scene."""
+    from pinmech.outputs import check_prefix
+
+    endings = [".csv", ".json", ".parquet"]
+    if args.plot:
+        endings += ["_workspace.png"] if spec.kind == "workspace" else ["_sensitivity.png", "_grid.png",
+                                                                       "_histogram.png"]
+    check_prefix("--out", args.out, endings, {"the study file": spec.path, "its scene": spec.scene})
 
 
 def _workspace_output(result, args: argparse.Namespace) -> int:

@@ -54,6 +54,7 @@ from pathlib import Path
 from typing import Any
 
 from pinmech.design.file_where import FileWhere, load_file
+from pinmech.counts import memory_refusal
 from pinmech.design.study.params import AXES, DISTRIBUTIONS, Parameter
 from pinmech.units import to_si
 
@@ -161,11 +162,41 @@ def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
     counts = {k: where.whole(raw, k, default) for k, default in
               (("steps", 73), ("samples", 200), ("seed", 0), ("batch", 64))}
     parsed = tuple(_parameter(name, table, where) for name, table in params.items())
+    _refuse_memory(kind, counts, named, len(parsed), _grid_points(raw, kind), where)
     return StudySpec(path, str(raw.get("title", path.stem)), (path.parent / scene), kind, counts["steps"],
                      counts["samples"], counts["seed"], counts["batch"], parsed, named["points"],
                      named["links"], _grid(raw, kind, parsed, where), named["sliders"], named["omega"],
                      named["transmission"], named["alpha"], named["strokes"],
                      named["torque"])
+
+
+#: Columns each output name gives (a point's x, y, z; a slider's s and s_dot; one else).
+_WIDTH = {"points": 3, "sliders": 2}
+#: Copies of the variants' outputs alive at once: the batches, their deviations from the
+#: nominal, and np.percentile's sorted copy.
+_COPIES = 3
+
+
+def _refuse_memory(kind: str, counts: dict[str, int], named: dict[str, tuple], n_par: int, points: int,
+                   where: _Where) -> None:
+    """Refuse a study whose arrays would pass counts.MAX_BYTES, from the file's counts alone:
+    variants (samples, or grid points) x steps x outputs x 8 bytes x _COPIES."""
+    outputs = sum(_WIDTH.get(k, 1) * len(v) for k, v in named.items())
+    variants, key = {"tolerance": (counts["samples"], "samples"), "grid": (points, "grid")}.get(kind, (n_par, "steps"))
+    nbytes = float(variants) * counts["steps"] * (outputs + n_par) * 8 * _COPIES
+    said = memory_refusal(nbytes, f"{variants} {'variants' if kind != 'sensitivity' else 'parameters'} x "
+                          f"{counts['steps']} poses x {outputs} outputs", f"{key} or steps")
+    if said:
+        raise where.error(key, said)
+
+
+def _grid_points(raw: dict[str, Any], kind: str) -> int:
+    """A grid study's points as the file counts them (checked by _grid); 0 otherwise."""
+    table = raw.get("grid") if kind == "grid" else None
+    if not isinstance(table, dict):
+        return 0
+    counts = [e.get("count") for e in table.values() if isinstance(e, dict)]
+    return math.prod(c for c in counts if isinstance(c, int) and not isinstance(c, bool) and c > 0)
 
 
 def _refuse_unused(raw: dict[str, Any], kind: str, where: _Where) -> None:

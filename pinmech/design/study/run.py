@@ -91,7 +91,7 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
         SweepError: the nominal's cycle fails.
         ImportError: naming `pinmech[study]`, without Dask.
     """
-    spec = path if isinstance(path, (StudySpec, WorkspaceSpec)) else _load(Path(path))
+    spec = path if isinstance(path, (StudySpec, WorkspaceSpec)) else load_any_study(Path(path))
     if spec.kind == "workspace":
         return run_workspace(spec, workers=workers, scheduler=scheduler, progress=progress)
     sm, outputs = built(spec)
@@ -119,7 +119,8 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
     return StudyResult(**common, spread=spread(sm, outputs, results), batches=tuple(results))
 
 
-def _load(path: Path) -> StudySpec | WorkspaceSpec:
-    """A study file of any kind, validated."""
+def load_any_study(path: str | Path) -> StudySpec | WorkspaceSpec:
+    """A study file of any kind, validated (SceneError naming the file and the key)."""
+    path = Path(path)
     raw = read_toml(path, "study", SceneError)
     return parse_workspace(raw, path) if is_workspace(raw) else load_study(path)

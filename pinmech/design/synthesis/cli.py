@@ -44,6 +44,12 @@ def cmd_synth(args: argparse.Namespace) -> int:
     if args.plot and not args.out:
         raise OptionRefused("--plot writes PREFIX.png: give --out PREFIX too", options=["--plot"])
     spec = load_synthesis(args.synthesis_file)
+    if args.out:
+        from pinmech.outputs import check_prefix
+
+        endings = [f"_{i}{end}" for i in range(1, spec.keep + 1) for end in (".toml", "_scene.toml")]
+        inputs = {"the synthesis file": spec.path, **({"its scene": spec.scene} if spec.scene else {})}
+        check_prefix("--out", args.out, [*endings, ".json", *([".png"] if args.plot else [])], inputs)
     result = synthesise(spec, workers=args.workers, scheduler=args.scheduler)
     if not result.linkages:
         causes = ", ".join(f"{n} {c}" for c, n in sorted(result.rejected.items())) or "none"

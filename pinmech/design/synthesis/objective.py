@@ -18,11 +18,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pinmech.design.synthesis.file import SynthesisSpec
+from pinmech.design.synthesis.file import SAMPLES, SynthesisSpec
 from pinmech.design.synthesis.kinematics import kinematics
 from pinmech.design.synthesis.motion import causes
 
-SAMPLES = 180  # crank angles over a turn for the nearest-point search (2 deg apart)
 REJECTED = 1e3  # the objective of a rejected candidate: above any accepted one's
 
 

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from pinmech.counts import memory_refusal
 from pinmech.design.file_where import load_file
 from pinmech.design.study.file import GridAxis, _Where
 from pinmech.design.workspace.measure import MAX_DEPTH
@@ -126,6 +127,7 @@ def parse_workspace(raw: dict[str, Any], path: Path) -> WorkspaceSpec:
     size = math.prod(a.count for a in axes)
     if size > _MAX_POINTS:
         raise where.error("workspace", f"{size} grid points is more than {_MAX_POINTS}: lower the counts")
+    _refuse_memory(size, len(axes), table.get("modes"), where)
     length = _length(table, where)
     unit = _unit(table["x"]["from"] if space == "task" else table.get("length", "1 mm"))
     batch = where.whole(raw, "batch", 500)
@@ -134,6 +136,22 @@ def parse_workspace(raw: dict[str, Any], path: Path) -> WorkspaceSpec:
     return WorkspaceSpec(path, str(raw.get("title", path.stem)), path.parent / scene, point, axes,
                          _modes(table.get("modes", []), where), length, batch, unit,
                          to_si(f"1 {unit}", "length", where=f"{path}, workspace.x.from"), depth, tolerance, space)
+
+
+#: Numbers a grid point keeps per mode: reached, det1, det2, sigma1, sigma2, kappa, the
+#: motors' values (up to 3), two distances, its coordinates (up to 3); the maps and the
+#: batches they come from are alive together (x 2).
+_PER_MODE = 14 * 2
+
+
+def _refuse_memory(size: int, axes: int, modes: Any, where: _Where) -> None:
+    """Refuse a map whose arrays would pass counts.MAX_BYTES: grid points x working modes
+    (those asked, else 2 per leg, a leg per axis) x _PER_MODE x 8 bytes."""
+    count = len(modes) if isinstance(modes, list) and modes else 2 ** axes
+    said = memory_refusal(float(size) * count * _PER_MODE * 8, f"{size} grid points x {count} working modes",
+                          "the counts")
+    if said:
+        raise where.error("workspace", said)
 
 
 def _actuator_axes(table: Any, where: _Where) -> tuple[GridAxis, ...]:
@@ -170,14 +188,24 @@ def _axis(name: str, entry: Any, where: _Where, key: str = "", param: int | None
 def _motor_value(entry: dict, name: str, where: str) -> float:
     """A motor's value [rad or m] as written: an angle ("30 deg"), else a length ("20 mm");
     `where` names the file and the axis's key in the error."""
-    try:
-        return to_si(entry[name], "angle", where=f"{where}.{name}")
-    except UnitError:
+    errors = []
+    for kind in ("angle", "length"):
         try:
-            return to_si(entry[name], "length", where=f"{where}.{name}")
+            return to_si(entry[name], kind, where=f"{where}.{name}")
         except UnitError as exc:
-            raise UnitError(f"{name} = {entry[name]!r} is neither an angle nor a length: give a motor's value "
-                            "as \"30 deg\" (a turn) or \"20 mm\" (a slide)", key=f"{where}.{name}") from exc
+            if _unit_is(entry[name], kind):  # "1e308 deg", "nan deg": an angle, wrong as a number
+                raise
+            errors.append(exc)
+    raise UnitError(f"{name} = {entry[name]!r} is neither an angle nor a length: give a motor's value "
+                    "as \"30 deg\" (a turn) or \"20 mm\" (a slide)", key=f"{where}.{name}") from errors[-1]
+
+
+def _unit_is(value: Any, kind: str) -> bool:
+    """Whether the unit written after the number in `value` is one of `kind`."""
+    try:
+        return to_si(f"1 {_unit(value)}", kind) > 0
+    except UnitError:
+        return False
 
 
 def _length(table: dict, where: _Where) -> float | None:
