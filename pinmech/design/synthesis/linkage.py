@@ -14,7 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
+from pinmech.angles import turn_radians
 from pinmech.design.synthesis.kinematics import kinematics
+from pinmech.design.synthesis.written import deg_text, mm_text
 from pinmech.design.synthesis.result import Linkage
 from pinmech.outputs import write_whole
 
@@ -22,11 +24,11 @@ _STEP = math.radians(1.0)  # the engine's sweep: at most this crank step between
 
 
 def _mm(v: float) -> str:
-    return f"{v * 1e3:.15g} mm"
+    return mm_text(v)
 
 
 def _deg(v: float) -> str:
-    return f"\"{math.degrees(v):.15g} deg\""
+    return f"\"{deg_text(v)}\""
 
 
 def linkage_toml(lk: Linkage, title: str, source: str) -> str:
@@ -47,7 +49,7 @@ def linkage_toml(lk: Linkage, title: str, source: str) -> str:
 
         what = what.replace("rocker", "guide").replace("coupler", "block")
         header = (f"Synthesised by `pinmech synth {source}`: {what}.\n"
-                  f"Drawn at the first target's pose (crank O2 at {math.degrees(lk.theta[0]):.6g} deg from x).")
+                  f"Drawn at the first target's pose (crank O2 at {math.degrees(motion_values(lk)[0]):.6g} deg from x).")
         return written(linkage_spec(inverted_tables(lk, title), source), header)
     if slider:
         B = p.B[0, 0]
@@ -57,9 +59,9 @@ def linkage_toml(lk: Linkage, title: str, source: str) -> str:
         raw = {"title": title, "ground": ["O2"], "joints": joints,
                "links": {"crank": ["O2", "A"], "rod": ["A", "B", "P"] if path else ["A", "B"], "piston": ["B"]},
                "sliders": {"slide": {"block": "piston", "on": "ground", "at": "B",
-                                     "along": f"{math.degrees(z[2]):.15g} deg"}}}
+                                     "along": deg_text(z[2])}}}
         header = (f"Synthesised by `pinmech synth {source}`: {what}.\n"
-                  f"Drawn at the first target's pose (crank O2 at {math.degrees(lk.theta[0]):.6g} deg from x).")
+                  f"Drawn at the first target's pose (crank O2 at {math.degrees(motion_values(lk)[0]):.6g} deg from x).")
         return written(linkage_spec(raw, source), header)
     joints = {"O2": [_mm(z[0]), _mm(z[1])], "O4": [_mm(z[2]), _mm(z[3])], "A": [_mm(A[0]), _mm(A[1])],
               "B": {"from": ["A", "O4"], "lengths": [_mm(z[5]), _mm(z[6])], "side": "left" if lk.s > 0 else "right"}}
@@ -68,14 +70,17 @@ def linkage_toml(lk: Linkage, title: str, source: str) -> str:
     raw = {"title": title, "ground": ["O2", "O4"], "joints": joints,
            "links": {"crank": ["O2", "A"], "coupler": ["A", "B", "P"] if path else ["A", "B"], "rocker": ["O4", "B"]}}
     header = (f"Synthesised by `pinmech synth {source}`: {what}.\n"
-              f"Drawn at the first target's pose (crank O2 at {math.degrees(lk.theta[0]):.6g} deg from x).")
+              f"Drawn at the first target's pose (crank O2 at {math.degrees(motion_values(lk)[0]):.6g} deg from x).")
     return written(linkage_spec(raw, source), header)
 
 
 def motion_values(lk: Linkage) -> np.ndarray:
-    """The crank's angles at the targets [rad], unwrapped along the motion (one way)."""
+    """The crank's angles at the targets [rad] along the motion: the first in [0, 2 pi)
+    (the convention of every crank angle pinmech reports), the others unwrapped from it
+    the way the crank turns (a sweep from 349.3 to 366.4 deg turns counter-clockwise
+    through 0)."""
     steps = np.mod(lk.way * np.diff(lk.theta), 2 * math.pi)
-    return lk.theta[0] + lk.way * np.concatenate(([0.0], np.cumsum(steps)))
+    return turn_radians(float(lk.theta[0])) + lk.way * np.concatenate(([0.0], np.cumsum(steps)))
 
 
 def scene_toml(lk: Linkage, linkage_file: str, title: str) -> str:
