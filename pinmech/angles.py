@@ -17,7 +17,7 @@ def turn_radians(angle: float) -> float:
     r = math.fmod(float(angle), TURN)
     if r < 0:
         r += TURN
-    return 0.0 if r >= TURN else r
+    return 0.0 if r >= TURN else r + 0.0  # + 0.0: -0.0 is 0
 
 
 def turn_degrees(angle: float) -> float:
@@ -25,4 +25,11 @@ def turn_degrees(angle: float) -> float:
     r = math.fmod(float(angle), 360.0)
     if r < 0:
         r += 360.0
-    return 0.0 if r >= 360.0 else r
+    return 0.0 if r >= 360.0 else r + 0.0
+
+
+def position_text(angle: float, spec: str = ".6g") -> str:
+    """An angle [deg] as a position, formatted with `spec`: in [0, 360), and never "360"
+    (359.9999999 rounded to 6 figures is the position 0)."""
+    text = format(turn_degrees(angle), spec)
+    return format(0.0, spec) if float(text) >= 360.0 else text

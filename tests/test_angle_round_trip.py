@@ -112,3 +112,40 @@ def test_the_built_urdf_reads_the_crank_angle_as_the_linkage_does(tmp_path, draw
                          f'[guess]\nO4 = "{math.degrees(rocker)!r} deg"\nA = "{math.degrees(bend)!r} deg"\n')
         found = analyse(Scene.load(scene)).motion.links["rocker"].angle
         assert abs(math.remainder(found - rocker, 2 * math.pi)) <= POSE_TOL / ROCKER
+
+
+def test_limit_positions_of_a_sweep_past_a_turn_are_printed_as_positions_in_0_to_360(capsys):
+    """The bundled crank-rocker (ground 100, crank 40, coupler 120, rocker 80 mm) swept from
+    300 to 700 deg: its toggles, where B lies on the crank's line at 160 mm (extended) or
+    80 mm behind O2 (folded), by the circle about O4 (80 mm), are at
+    atan2(sqrt(160^2 - 146^2), 146) = 24.1468 deg and 180 + atan2(sqrt(80^2 - 50^2), 50)
+    = 231.318 deg: printed there (6 figures), not at 384.147 and 591.318 deg, and every
+    driver position in the summary is in [0, 360)."""
+    import re
+
+    from pinmech.cli import main
+    from tests.conftest import MODELS
+
+    main(["sweep", str(MODELS / "scenes" / "four_bar_drawn.toml"), "--from", "300 deg", "--to", "700 deg",
+          "--steps", "81", "--json", "/dev/null"])
+    err = capsys.readouterr().err
+    extended = math.degrees(math.atan2(math.sqrt(160**2 - 146**2), 146))
+    folded = 180 + math.degrees(math.atan2(math.sqrt(80**2 - 50**2), 50))
+    found = {m[0]: float(m[1]) for m in re.findall(r"rocker extreme \((min|max)\) \S+ deg at O2 = (\S+) deg", err)}
+    assert found["min"] == pytest.approx(extended, abs=1e-3)  # 6 significant figures printed
+    assert found["max"] == pytest.approx(folded, abs=1e-3)
+    positions = [float(x) for x in re.findall(r"O2 = (\S+) deg", err)]
+    assert positions and all(0.0 <= x < 360.0 for x in positions)
+
+
+@pytest.mark.parametrize(("angle", "position"), [
+    (-10.69, 349.31), (349.31, 349.31), (370.0, 10.0), (-360.0, 0.0), (-0.0, 0.0), (720.0, 0.0),
+    (-180.0, 180.0), (180.0, 180.0), (-1e-300, 0.0), (1e6 + 0.5, 280.5)])
+def test_a_position_is_the_angle_less_its_whole_turns_in_0_to_360(angle, position):
+    from pinmech.angles import position_text, turn_degrees, turn_radians
+
+    # fmod is exact, so the remainder is the exact float (1e6 + 0.5 - 2777 * 360 = 280.5)
+    assert turn_degrees(angle) == position and str(turn_degrees(angle)) != "-0.0"
+    assert turn_radians(math.radians(angle)) == pytest.approx(math.radians(position), abs=1e-12)
+    assert 0.0 <= turn_radians(math.radians(angle)) < 2 * math.pi
+    assert position_text(360.0 - 1e-9) == "0" and position_text(angle) == format(position, ".6g")

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.angles import turn_degrees
+from pinmech.angles import position_text, turn_degrees
 from pinmech.design.figure_file import number_points, pyplot, save
 from pinmech.design.synthesis.kinematics import kinematics
 from pinmech.design.synthesis.linkage import motion_values
@@ -93,7 +93,7 @@ def text(result: SynthesisResult) -> str:
             f"linkage {i}: {_dimensions(lk)}; {lk['grashof']}, assembly {lk['assembly']}",
             _errors(lk),
             _met(lk),
-            f"  crank at the targets [deg]: {', '.join(f'{v:.6g}' for v in lk['crank_deg'])}",
+            f"  crank at the targets [deg]: {', '.join(position_text(v) for v in lk['crank_deg'])}",
             f"  transmission angle over the motion: {lk['transmission_deg'][0]:.4g} .. {lk['transmission_deg'][1]:.4g} deg",
         ]
         lines += [f"  {k} defect: {v}" for k, v in lk["defects"].items()]
