@@ -65,16 +65,39 @@ def test_the_written_scene_sweeps_the_engine_through_the_targets_across_the_wrap
     travel = way * np.mod(way * (theta[-1] - theta[0]), 360.0)
     assert stop - start == pytest.approx(travel, abs=1e-9)
     check = engine_check(scene, lk, targets)
-    assert check.errors.max() <= ENGINE_TOL
+    assert check.errors.max() <= ENGINE_TOL and check.drift <= ENGINE_TOL
 
 
 def test_the_drawing_carries_the_refined_values_to_the_last_bit(tmp_path):
+    """The written [params] are the search's numbers to the last bit (mm and back: one
+    rounding each way, an ulp of the size), and the drawing they make puts P where the
+    closed form does (the compass constructions' rounding: a few eps x size / sin of the
+    circles' angle, well within 1e-15 m here)."""
+    from pinmech.model.linkage import parse_linkage
+
     lk = _rocker(-0.030, [349.31, 355.0, 0.0], 1)
     linkage, _ = write_linkage(lk, tmp_path / "found", "found", "test.toml")
-    joints = tomllib.loads(linkage.read_text())["joints"]
-    P = np.array([float(v.split()[0]) for v in joints["P"]]) / 1e3
-    # mm -> m is one rounding each way: within an ulp of P's size (2.8e-17 m at 0.05 m)
-    assert np.max(np.abs(P - _P(lk, lk.theta[:1])[0])) <= 2 * np.spacing(0.05)
+    params = tomllib.loads(linkage.read_text())["params"]
+    for name, value in zip(("O2x", "O2y", "O4x", "O4y", "crank", "coupler", "rocker"), lk.z):
+        assert abs(float(params[name].split()[0]) / 1e3 - value) <= np.spacing(0.05)
+    drawn = parse_linkage(linkage).points
+    assert np.max(np.abs(drawn["P"][:2] - _P(lk, lk.theta[:1])[0])) <= 1e-15
+
+
+def test_the_written_four_bar_is_drawn_from_named_dimensions_a_user_can_edit(tmp_path):
+    """Every dimension is a [params] entry the joints use: change the crank from 40 to 45 mm
+    and A lies 45 mm from O2 at the same angle, B where the circles about the new A (the
+    coupler) and O4 (the rocker) meet."""
+    from pinmech.model.linkage import parse_linkage
+
+    lk = _rocker(-0.030, [349.31, 355.0, 0.0], 1)
+    linkage, _ = write_linkage(lk, tmp_path / "found", "found", "test.toml")
+    text = linkage.read_text()
+    assert tomllib.loads(text)["joints"]["A"] == {"from": "O2", "length": "crank", "angle": "349.31 deg"}
+    linkage.write_text(text.replace('crank = "40.0 mm"', 'crank = "45.0 mm"'))
+    A = parse_linkage(linkage).points["A"][:2]
+    assert np.allclose(A, 0.045 * np.array([math.cos(math.radians(349.31)), math.sin(math.radians(349.31))]),
+                       rtol=0, atol=1e-16)
 
 
 def _synthesis_file(tmp_path, targets: np.ndarray):

@@ -105,5 +105,9 @@ def _write_and_check(spec, lk, entry: dict, prefix: str, i: int) -> tuple[list, 
     if check.angle_errors is not None:
         entry["engine_angle_errors_deg"] = [float(e) * 180 / math.pi for e in check.angle_errors]
         also = f" and {max(entry['engine_angle_errors_deg']):.3g} deg"
+    own = ""
+    if check.drift is not None:
+        entry["engine_drift_mm"] = check.drift * 1e3
+        own = f", and within {check.drift * 1e3:.3g} mm of the synthesised linkage's own coupler point"
     return list(files), (f"linkage {i}: {files[0]}; the engine (pinmech sweep of {files[1]}) is within "
-                         f"{check.errors.max() * scale:.3g} {unit}{also} of the targets"), None
+                         f"{check.errors.max() * scale:.3g} {unit}{also} of the targets{own}"), None
