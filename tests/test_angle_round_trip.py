@@ -149,3 +149,16 @@ def test_a_position_is_the_angle_less_its_whole_turns_in_0_to_360(angle, positio
     assert turn_radians(math.radians(angle)) == pytest.approx(math.radians(position), abs=1e-12)
     assert 0.0 <= turn_radians(math.radians(angle)) < 2 * math.pi
     assert position_text(360.0 - 1e-9) == "0" and position_text(angle) == format(position, ".6g")
+
+
+@pytest.mark.parametrize("asked", [300.0, -60.0, 660.0, -420.0])
+def test_a_rocker_drawn_near_its_fold_reaches_the_scene_angle_the_only_way_it_can(tmp_path, asked):
+    """The triple rocker through 180 deg (folds at 18.57 and 341.43 deg: |A O4| = 50 - 35,
+    law of cosines) drawn at 25 deg, asked for 300 deg however written: the shorter way round
+    (back through 0 deg) meets the fold at 18.57 deg, so it is followed forward 275 deg, the
+    only way the crank can turn; B where the closed form puts it at 300 deg."""
+    linkage = _linkage(tmp_path, GROUND, 25.0)
+    scene = tmp_path / "scene.toml"
+    scene.write_text(f'linkage = "{linkage}"\n[drivers.O2]\nangle = "{asked!r} deg"\n[report]\npoints = ["B"]\n')
+    B = np.asarray(analyse(Scene.load(scene)).motion.points["B"].position[:2])
+    assert np.max(np.abs(B - _B(GROUND, math.radians(300.0)))) <= POSE_TOL

@@ -7,7 +7,6 @@ Everything here is parsed and checked once, at the edge, before anything is solv
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -20,6 +19,7 @@ from pinmech.exceptions import FrameNotFound, MobilityError, ModelError, Pinmech
 from pinmech.model.mechanism import Mechanism, urdf_joint_types, urdf_mimic_leaders
 from pinmech.solve.motion import CoincidentPoint
 from pinmech.io.scene import Scene
+from pinmech.io.scene_drawn import set_drawn_reference
 from pinmech.io.scene_tables import DriverSpec
 from pinmech.solve.loops import LoopSolver
 
@@ -267,27 +267,10 @@ def scene_solver(scene: Scene, mechanism: Mechanism, drivers: Drivers) -> LoopSo
         raise SceneError(str(exc), path=str(scene.path), key="assembly") from None
     if mechanism.reference is not None and not scene.file.guess:
         # a drawn linkage, an MJCF file at qpos0: the pose as drawn is the reference assembly
-        drawn = [mechanism.coordinate(mechanism.reference, name) for name in drivers.names]
-        solver.set_reference(drawn_on_scene_turn(mechanism, drivers.names, drawn, ref_drivers.q),
-                             mechanism.neutral(), assembly)
+        set_drawn_reference(solver, mechanism, ref_drivers.q, assembly)
     else:
         solver.set_reference(ref_drivers.q, scene_guess(scene, mechanism), assembly)
     return solver
-
-
-def drawn_on_scene_turn(mechanism: Mechanism, names: tuple[str, ...], drawn: list[float],
-                        asked: np.ndarray) -> list[float]:
-    """The drawn pose's driver values [rad or m], each angle moved by whole turns onto the
-    turn of the scene's own value (within half a turn of it): a driver angle names the
-    crank's physical angle, so the drawn pose is the scene's pose wherever the two differ
-    by whole turns (a crank drawn at -10.69 deg and a scene at 349.31 deg is no turn of
-    motion, and no fold crossed on the way)."""
-    out = []
-    for name, value, target in zip(names, drawn, np.asarray(asked, dtype=float).tolist()):
-        if mechanism.joint(name).is_angular and math.isfinite(target):
-            value += 2 * math.pi * round((target - value) / (2 * math.pi))
-        out.append(value)
-    return out
 
 
 def coincident_points(scene: Scene) -> list[CoincidentPoint]:
