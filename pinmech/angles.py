@@ -29,7 +29,7 @@ def turn_degrees(angle: float) -> float:
 
 
 def position_text(angle: float, spec: str = ".6g") -> str:
-    """An angle [deg] as a position, formatted with `spec`: in [0, 360), and never "360"
-    (359.9999999 rounded to 6 figures is the position 0)."""
-    text = format(turn_degrees(angle), spec)
-    return format(0.0, spec) if float(text) >= 360.0 else text
+    """An angle [deg] as a printed position: in [0, 360), rounded to 1e-5 deg first (a
+    located extreme 5e-7 deg past 0 is "0", not "4.8e-07" or "360"), formatted with `spec`."""
+    x = round(turn_degrees(angle), 5) + 0.0
+    return format(0.0 if x >= 360.0 else x, spec)

@@ -35,7 +35,7 @@ def implied_scene(path: Path, tables: dict[str, Any]) -> tuple[dict[str, Any], s
         SceneError: its ground pins cannot drive it (fewer tree pins on the ground than
             its mobility): the message says which scene to write.
     """
-    from pinmech.angles import position_text
+    from pinmech.angles import turn_degrees
     from pinmech.model.linkage_model import load_linkage
 
     mechanism = load_linkage(path)
@@ -51,9 +51,9 @@ def implied_scene(path: Path, tables: dict[str, Any]) -> tuple[dict[str, Any], s
     for name in drivers:
         value = mechanism.coordinate(mechanism.reference, name)
         if mechanism.joint(name).is_angular:
-            table[name] = {"angle": f"{position_text(math.degrees(value), '.15g')} deg", "speed": "1 rad/s"}
+            table[name] = {"angle": f"{_shortest(turn_degrees(math.degrees(value)))} deg", "speed": "1 rad/s"}
         else:
-            table[name] = {"position": f"{value * 1e3:.15g} mm", "velocity": "1 m/s"}
+            table[name] = {"position": f"{_shortest(value * 1e3)} mm", "velocity": "1 m/s"}
     points = [n for n in tables.get("joints", {}) if _is_frame(mechanism, n)]
     scene = {"linkage": path.name, "drivers": table, "report": {"points": points}}
     if isinstance(tables.get("title"), str):
@@ -63,6 +63,12 @@ def implied_scene(path: Path, tables: dict[str, Any]) -> tuple[dict[str, Any], s
         text += [f"[drivers.{name}]", *(f'{key} = "{quantity}"' for key, quantity in entry.items())]
     text += ["[report]", "points = [" + ", ".join(f'"{n}"' for n in points) + "]"]
     return scene, "\n".join(text)
+
+
+def _shortest(x: float) -> str:
+    """The float's shortest exact text ("0", "62.72040000000001")."""
+    text = repr(float(x))
+    return text[:-2] if text.endswith(".0") else text
 
 
 def _is_frame(mechanism, name: str) -> bool:
