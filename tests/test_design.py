@@ -352,7 +352,8 @@ def test_least_and_largest_transmission_angle_are_located_between_the_poses():
     np.testing.assert_allclose(high_at, math.pi, rtol=0, atol=DRIVER_TOL)
     np.testing.assert_allclose([low, high], [mu(0.0), mu(math.pi)], rtol=0, atol=ANGLE_TOL)
     summary = "\n".join(design.summary(2 * math.pi))
-    assert f"from {mu(0.0):.6g} deg at O2 = 360 deg to {mu(math.pi):.6g} deg at O2 = 180 deg" in summary
+    # a position is printed in [0, 360) deg: 2 pi less 1e-10 rad is "0 deg", not "360 deg"
+    assert f"from {mu(0.0):.6g} deg at O2 = 0 deg to {mu(math.pi):.6g} deg at O2 = 180 deg" in summary
 
 
 @pytest.mark.parametrize("through_folds", [False, True], ids=["stops at the fold", "through the folds"])

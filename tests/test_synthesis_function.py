@@ -60,3 +60,78 @@ def test_function_synthesis_recovers_the_bundled_four_bar(tmp_path):
     assert best.meets(1e-8)
     _, scene = write_linkage(best, tmp_path / "found", "found", "test.toml")
     assert engine_check(scene, best, pairs).errors.max() < 1e-8
+
+
+def _freudenstein_rocker(a: float, b: float, c: float, d: float, theta2: np.ndarray, open_: bool = True) -> np.ndarray:
+    """The rocker's absolute angle theta4 [rad] at crank angles theta2, both from the ground
+    line O2 -> O4: Freudenstein's closed form as Norton writes it (Design of Machinery,
+    eq. 4.10): theta4 = 2 atan2(-B -+ sqrt(B^2 - 4AC), 2A), with A = cos t2 - K1 - K2 cos t2
+    + K3, B = -2 sin t2, C = K1 - (K2 + 1) cos t2 + K3 (the open circuit takes the minus)."""
+    k1, k2, k3 = d / a, d / c, (a * a - b * b + c * c + d * d) / (2 * a * c)
+    A = np.cos(theta2) - k1 - k2 * np.cos(theta2) + k3
+    B = -2 * np.sin(theta2)
+    C = k1 - (k2 + 1) * np.cos(theta2) + k3
+    root = np.sqrt(B * B - 4 * A * C)
+    return 2 * np.arctan2(-B - root if open_ else -B + root, 2 * A)
+
+
+def test_function_synthesis_in_freudensteins_absolute_angles_recovers_the_four_bar(tmp_path):
+    # Freudenstein's setting: the pairs are the crank's and the rocker's absolute angles
+    # from the ground line (theta2 = 40 .. 120 deg, not from 0), written in the file with
+    # pair_angles = "absolute". Five exact pairs of the crank-rocker 40/120/80 on ground
+    # 100 mm fix K1, K2, K3 (three would), so the lengths come back to the refinement's
+    # rounding (1e-10 of the size) and the rocker's angles within 1e-9 rad.
+    from pinmech.design.synthesis.file import load_synthesis
+
+    theta2 = np.radians([40.0, 60.0, 80.0, 100.0, 120.0])
+    theta4 = _freudenstein_rocker(0.04, 0.12, 0.08, 0.1, theta2)
+    pairs = ", ".join(f'["{float(np.degrees(t))!r} deg", "{float(np.degrees(p))!r} deg"]' for t, p in zip(theta2, theta4))
+    path = tmp_path / "absolute.toml"
+    path.write_text(f'''title = "Freudenstein"
+task = "function"
+topology = "four-bar"
+ground = "100 mm"
+pair_angles = "absolute"
+seed = 1
+population = 10
+generations = 50
+keep = 1
+pairs = [{pairs}]
+[bounds]
+crank = ["20 mm", "200 mm"]
+coupler = ["20 mm", "200 mm"]
+rocker = ["20 mm", "200 mm"]
+''')
+    spec = load_synthesis(path)
+    # the file's degrees (shortest repr) back to radians: within an ulp or two of the angles
+    assert np.allclose(spec.start, (theta2[0], theta4[0]), rtol=0, atol=4e-16)
+    best = synthesise(spec).linkages[0]
+    assert np.allclose(best.z[4:7], [0.04, 0.12, 0.08], rtol=0, atol=1e-10)
+    assert best.errors.max() <= 1e-9
+    assert (best.theta[0], best.phi0) == spec.start  # the file's own start, not one the search moved
+    _, scene = write_linkage(best, tmp_path / "found", "found", "test.toml")
+    assert engine_check(scene, best, spec.targets).errors.max() < 1e-9
+
+
+def test_turns_stay_the_default_and_absolute_pairs_without_the_key_are_refused(tmp_path):
+    import pytest
+
+    from pinmech.design.synthesis.file import load_synthesis
+    from pinmech.exceptions import SceneError
+
+    path = tmp_path / "f.toml"
+    body = '''task = "function"
+ground = "100 mm"
+pairs = [["40 deg", "80 deg"], ["60 deg", "90 deg"], ["80 deg", "100 deg"]]
+[bounds]
+crank = ["20 mm", "200 mm"]
+coupler = ["20 mm", "200 mm"]
+rocker = ["20 mm", "200 mm"]
+'''
+    path.write_text(body)
+    with pytest.raises(SceneError, match='pair_angles = "absolute"'):
+        load_synthesis(path)
+    path.write_text('topology = "slider-crank"\npair_angles = "absolute"\n' + body.replace('ground = "100 mm"\n', "")
+                    .replace("coupler", "rod").replace("rocker", "offset"))
+    with pytest.raises(SceneError, match="for a four-bar's function"):
+        load_synthesis(path)

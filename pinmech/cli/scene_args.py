@@ -64,7 +64,19 @@ def option_or_scene(given: Any, flag: str, scene, options: dict[str, Any], key: 
     return Option(default, flag, None, scene)
 
 
+def implied_note(scene) -> None:
+    """Say on stderr which scene a drawn linkage passed as one was read as."""
+    if scene.implied is not None:
+        import sys
+
+        body = "\n".join(f"    {line}" for line in scene.implied.splitlines())
+        print(f"pinmech: {scene.path} is a drawn linkage, not a scene: solved at its drawn pose, as the scene\n"
+              f"{body}\n  (write such a scene file to drive it from other values)", file=sys.stderr)
+
+
 def scene_from_args(args: argparse.Namespace):
+    """The command's scene: its file with --set and the --angle/--speed/--acceleration
+    shortcuts applied (a drawn linkage's file: the scene it stands for, noted on stderr)."""
     from pinmech.io.scene import Scene
 
     overrides = list(args.overrides)
@@ -81,4 +93,6 @@ def scene_from_args(args: argparse.Namespace):
         spec = scene.file.drivers[name]
         keys = {"angle": spec.key_of(0), "speed": spec.key_of(1), "acceleration": "acceleration"}
         overrides += [f'drivers.{name}.{keys[k]}="{v}"' for k, v in shortcuts.items() if v]
-    return Scene.load(args.scene, overrides)
+    scene = Scene.load(args.scene, overrides)
+    implied_note(scene)
+    return scene

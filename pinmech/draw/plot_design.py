@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pinmech.angles import position_text
+
 
 @dataclass(frozen=True)
 class LeastAngle:
@@ -83,5 +85,8 @@ def mark_least(ax, least: LeastAngle, x: float, colour: str, label: str, unit: s
 
 
 def unit_x(x: float, unit: str = "°") -> str:
-    """A driver value as a figure prints it (rounded to 1e-3: 5e-7 deg is 0 deg)."""
+    """A driver value as a figure prints it (rounded to 1e-3: 5e-7 deg is 0 deg); an angle
+    as a position, in [0, 360) deg (angles.py)."""
+    if unit == "°":
+        return f"{position_text(round(x, 3) + 0.0, 'g')}{unit}"
     return f"{round(x, 3) + 0.0:g}{unit}"

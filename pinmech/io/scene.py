@@ -19,6 +19,7 @@ import msgspec
 from pinmech.arguments import file_path
 from pinmech.exceptions import PinmechError, SceneError
 from pinmech.io.scene_file import MODEL_KEYS, SceneFile
+from pinmech.io.scene_implied import implied_scene, is_drawn_linkage
 from pinmech.io.scene_tables import DRIVER_KEYS, SOLVER_RANGES, DriverSpec
 from pinmech.toml_file import TOMLDecodeError, read_toml, toml_value
 from pinmech.units import JOINT_KINDS, to_si
@@ -47,11 +48,14 @@ class Scene:
             file's own tables do not validate): their values are the reference pose that
             names the assembly (`--angle` asks for another pose of the same assembly,
             reached by continuation).
+        implied: None for a scene file; for a drawn linkage's file, the TOML of the
+            scene it was read as (its drivers at their drawn values).
     """
 
     path: Path
     file: SceneFile
     file_drivers: dict[str, DriverSpec] | None = None
+    implied: str | None = None  # a drawn linkage's file: the scene it stands for (scene_implied.py), as TOML
 
     # -------------------------------------------------------------- loading
     @classmethod
@@ -64,17 +68,20 @@ class Scene:
         """
         path = file_path(path, "the scene", SceneError)
         written = read_toml(path, "scene", SceneError)
+        implied = None
+        if is_drawn_linkage(written):  # solved at its drawn pose, as the scene it stands for
+            written, implied = implied_scene(path, written)
         tables = copy.deepcopy(written)
         for item in overrides or []:
             _override(tables, item, path)
         scene = cls.from_tables(tables, path)
         if not overrides:
-            return scene
+            return cls(path, scene.file, scene.file_drivers, implied)
         try:
             as_written = SceneFile.read(dict(tables, drivers=written.get("drivers", {})), path)
         except PinmechError:
-            return cls(path, scene.file, None)
-        return cls(path, scene.file, as_written.drivers)
+            return cls(path, scene.file, None, implied)
+        return cls(path, scene.file, as_written.drivers, implied)
 
     @classmethod
     def from_tables(cls, tables: dict[str, Any], path: str | Path) -> Scene:
@@ -132,7 +139,8 @@ class Scene:
         (a `--set guess...` picks the reference's assembly, `--angle` only the pose)."""
         if self.file_drivers is None or self.file_drivers is self.file.drivers:
             return self
-        return Scene(self.path, msgspec.structs.replace(self.file, drivers=self.file_drivers), self.file_drivers)
+        return Scene(self.path, msgspec.structs.replace(self.file, drivers=self.file_drivers), self.file_drivers,
+                     self.implied)
 
     def assembly(self) -> Any:
         """The `assembly` value as written: absent (None), "any", or a table loop -> sign."""

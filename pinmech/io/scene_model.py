@@ -19,6 +19,7 @@ from pinmech.exceptions import FrameNotFound, MobilityError, ModelError, Pinmech
 from pinmech.model.mechanism import Mechanism, urdf_joint_types, urdf_mimic_leaders
 from pinmech.solve.motion import CoincidentPoint
 from pinmech.io.scene import Scene
+from pinmech.io.scene_drawn import set_drawn_reference
 from pinmech.io.scene_tables import DriverSpec
 from pinmech.solve.loops import LoopSolver
 
@@ -266,8 +267,7 @@ def scene_solver(scene: Scene, mechanism: Mechanism, drivers: Drivers) -> LoopSo
         raise SceneError(str(exc), path=str(scene.path), key="assembly") from None
     if mechanism.reference is not None and not scene.file.guess:
         # a drawn linkage, an MJCF file at qpos0: the pose as drawn is the reference assembly
-        drawn = [mechanism.coordinate(mechanism.reference, name) for name in drivers.names]
-        solver.set_reference(drawn, mechanism.neutral(), assembly)
+        set_drawn_reference(solver, mechanism, ref_drivers.q, assembly)
     else:
         solver.set_reference(ref_drivers.q, scene_guess(scene, mechanism), assembly)
     return solver

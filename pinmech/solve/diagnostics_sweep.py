@@ -18,6 +18,7 @@ from pinmech.solve.diagnostics import advantage_unit
 from pinmech.exceptions import DiagnosticError, PinmechError
 from pinmech.extremum import Tracked
 from pinmech.solve.grashof import loop_classes
+from pinmech.angles import position_text
 from pinmech.solve.limit_positions import LimitFinder, LimitPosition, extreme_label, travel
 from pinmech.model.planar_linkage import planar_linkage
 from pinmech.solve.transmission import dyad_angles, find_dyads, find_outputs, output_rate
@@ -308,7 +309,7 @@ class DesignSweep:
         t = travel(found, span)
         fmt, lines = self._driver, []
         for x in t.limits:
-            value = f"{math.degrees(x.value):.6g} deg" if x.kind == "rocker extreme" else f"{x.value:.6g} m"
+            value = f"{position_text(math.degrees(x.value))} deg" if x.kind == "rocker extreme" else f"{x.value:.6g} m"
             lay = f", driving link and coupler {x.toggle} (toggle)" if x.toggle else ""
             lines.append(f"design: {name}: {x.kind} ({x.label}) {value} at {fmt(x.driver)}{lay}")
         if t.travel is not None:
@@ -321,7 +322,8 @@ class DesignSweep:
         return lines
 
     def _driver(self, value: float) -> str:
-        unit = f"{math.degrees(value):.6g} deg" if self.sweep.is_angular else f"{value:.6g} m"
+        """A driver position as the summary prints it: an angle in [0, 360) deg (angles.py)."""
+        unit = f"{position_text(math.degrees(value))} deg" if self.sweep.is_angular else f"{value:.6g} m"
         return f"{self.sweep.driver} = {unit}"
 
 

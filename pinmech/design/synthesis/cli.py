@@ -4,6 +4,7 @@ linkages found written as drawn linkages with their scenes and checked by the en
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 from pinmech.design.study.cli import _workers
@@ -35,7 +36,6 @@ def cmd_synth(args: argparse.Namespace) -> int:
     import json
 
     from pinmech.design.synthesis.file import load_synthesis
-    from pinmech.design.synthesis.linkage import EngineCheck, engine_check, write_linkage
     from pinmech.design.synthesis.report import figure, summary, text
     from pinmech.design.synthesis.search import synthesise
     from pinmech.exceptions import OptionRefused, SynthesisError
@@ -58,28 +58,14 @@ def cmd_synth(args: argparse.Namespace) -> int:
                              "constraints, or raise generations", path=str(spec.path), rejected=dict(result.rejected))
     report = summary(result)
     lines = [text(result)]
-    written = []
+    written, failed = [], []
     if args.out:
         for i, (lk, entry) in enumerate(zip(result.linkages, report["linkages"]), start=1):
-            if spec.scene is not None:  # a six-bar: its template redrawn, the engine's turn
-                from pinmech.design.synthesis import sixbar_output as six
-
-                files = six.write_linkage(spec, lk, f"{args.out}_{i}")
-                check = EngineCheck(None, *six.engine_check(spec, files[1], lk))
-            else:
-                files = write_linkage(lk, f"{args.out}_{i}", f"{spec.title}: linkage {i}", str(spec.path))
-                check = engine_check(files[1], lk, spec.targets, spec.angles)
-            entry["files"] = [str(p) for p in files]
-            angular = lk.task == "function" and lk.topology != "slider-crank"
-            scale, unit = (180 / 3.141592653589793, "deg") if angular else (1e3, "mm")
-            entry[f"engine_errors_{unit}"] = [float(e) * scale for e in check.errors]
-            also = ""
-            if check.angle_errors is not None:
-                entry["engine_angle_errors_deg"] = [float(e) * 180 / 3.141592653589793 for e in check.angle_errors]
-                also = f" and {max(entry['engine_angle_errors_deg']):.3g} deg"
-            lines.append(f"linkage {i}: {files[0]}; the engine (pinmech sweep of {files[1]}) meets the targets "
-                         f"within {check.errors.max() * scale:.3g} {unit}{also}")
+            files, line, error = _write_and_check(spec, lk, entry, f"{args.out}_{i}", i)
+            lines.append(line)
             written += files
+            if error is not None:
+                failed.append((i, error))
         json_path = f"{args.out}.json"
         write_whole(json_path, json.dumps(report, indent=2))
         written.append(json_path)
@@ -88,4 +74,46 @@ def cmd_synth(args: argparse.Namespace) -> int:
     print(json.dumps(report, indent=2) if args.json else "\n".join(lines))
     if written:
         print("wrote " + ", ".join(str(p) for p in written), file=sys.stderr)
+    if failed:  # every linkage listed and written; the exit code says a check failed
+        print(f"pinmech: the engine check failed for linkage(s) {', '.join(str(i) for i, _ in failed)} of "
+              f"{len(result.linkages)} (each listed above with its cause)", file=sys.stderr)
+        raise failed[0][1]
     return 0
+
+
+def _write_and_check(spec, lk, entry: dict, prefix: str, i: int) -> tuple[list, str, Exception | None]:
+    """Write linkage i and its scene, check them with the engine: the files, the listing's
+    line, and the check's error (None: passed). A failed check is reported with its
+    linkage (`engine_check` in the JSON), never in place of the others."""
+    from pinmech.design.synthesis.linkage import EngineCheck, engine_check, write_linkage
+    from pinmech.exceptions import PinmechError
+
+    if spec.scene is not None:  # a six-bar: its template redrawn, the engine's turn
+        from pinmech.design.synthesis import sixbar_output as six
+
+        files = six.write_linkage(spec, lk, prefix)
+    else:
+        files = write_linkage(lk, prefix, f"{spec.title}: linkage {i}", str(spec.path))
+    entry["files"] = [str(p) for p in files]
+    try:
+        if spec.scene is not None:
+            check = EngineCheck(None, *six.engine_check(spec, files[1], lk))
+        else:
+            check = engine_check(files[1], lk, spec.targets, spec.angles)
+    except PinmechError as exc:
+        entry["engine_check"] = f"failed: {exc}"
+        return list(files), f"linkage {i}: {files[0]}; the engine check (pinmech sweep of {files[1]}) FAILED: {exc}", exc
+    entry["engine_check"] = "passed"
+    angular = lk.task == "function" and lk.topology != "slider-crank"
+    scale, unit = (180 / math.pi, "deg") if angular else (1e3, "mm")
+    entry[f"engine_errors_{unit}"] = [float(e) * scale for e in check.errors]
+    also = ""
+    if check.angle_errors is not None:
+        entry["engine_angle_errors_deg"] = [float(e) * 180 / math.pi for e in check.angle_errors]
+        also = f" and {max(entry['engine_angle_errors_deg']):.3g} deg"
+    own = ""
+    if check.drift is not None:
+        entry["engine_drift_mm"] = check.drift * 1e3
+        own = f", and within {check.drift * 1e3:.3g} mm of the synthesised linkage's own coupler point"
+    return list(files), (f"linkage {i}: {files[0]}; the engine (pinmech sweep of {files[1]}) is within "
+                         f"{check.errors.max() * scale:.3g} {unit}{also} of the targets{own}"), None

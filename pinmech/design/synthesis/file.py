@@ -63,8 +63,13 @@ CLASSES = ("any", "grashof", "crank-rocker", "double-crank", "double-rocker", "t
 SLIDER_CLASSES = ("any", "crank", "rocker")  # grashof.slider_crank_class: the crank turns fully, or not
 DIRECTIONS = ("ccw", "cw", "either")
 _TOP = {"title", "task", "topology", "targets", "timing", "seed", "population", "generations", "keep",
-        "bounds", "constraints", "pairs", "ground", "poses", "scene", "point", "output", "link"}
-_ONLY = {"targets": "path", "timing": "path", "pairs": "function", "ground": "function", "poses": "motion"}
+        "bounds", "constraints", "pairs", "ground", "poses", "scene", "point", "output", "link", "pair_angles"}
+_ONLY = {"targets": "path", "timing": "path", "pairs": "function", "ground": "function", "poses": "motion",
+         "pair_angles": "function"}
+#: What a four-bar function's pairs hold: turns from the first pair (which is then
+#: ["0 deg", "0 deg"]), or the crank's and the rocker's absolute angles from the ground
+#: line O2 -> O4 (Freudenstein's theta and phi).
+PAIR_ANGLES = ("turns", "absolute")
 #: Each (topology, task)'s bounds: the parameters in the order of a candidate's row, each
 #: with its axes (none: a length, positive unless it is an offset); "angle" axes are angles.
 _BOUNDS = {
@@ -134,6 +139,7 @@ class SynthesisSpec:
     point: str = ""
     output: str = ""
     pins: tuple[str, ...] = ()
+    start: tuple[float, float] | None = None
 
     def __hash__(self) -> int:
         return hash((self.path, self.title, self.targets.tobytes(), self.seed))
@@ -160,8 +166,15 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
         if key in raw:
             raise w.error(key, f"{key} is for the six-bars (topology = \"watt\" or \"stephenson\")")
     slider = topology == "slider-crank"
+    start = None
     if task == "function":
-        targets, timing = _pairs(raw, w, "length" if slider else "angle"), None
+        absolute = w.choice(raw, "pair_angles", PAIR_ANGLES, "turns") == "absolute"
+        if absolute and topology != "four-bar":
+            raise w.error("pair_angles", "absolute pairs (Freudenstein's crank and rocker angles) are for a "
+                          "four-bar's function; give turns from the first pair")
+        targets, timing = _pairs(raw, w, "length" if slider else "angle", absolute), None
+        if absolute:
+            start, targets = (float(targets[0, 0]), float(targets[0, 1])), targets - targets[0]
         lower, upper = _bounds(raw, w, _BOUNDS[topology, "function"])
         ground = 0.0 if slider else w.positive_length(raw, "ground")
         if slider and "ground" in raw:
@@ -188,7 +201,7 @@ def parse_synthesis(raw: dict[str, Any], path: Path) -> SynthesisSpec:
     classes = CLASSES if topology == "four-bar" else SLIDER_CLASSES
     return SynthesisSpec(path, str(raw.get("title", path.stem)), task, topology, targets, timing, lower, upper,
                          w.choice(c, "grashof", classes, "any", "constraints"), ground,
-                         transmission, float(ratio), direction, angles=angles, **counts)
+                         transmission, float(ratio), direction, angles=angles, start=start, **counts)
 
 
 def _six_bar(raw: dict[str, Any], w: _Where, path: Path, task: str, topology: str) -> SynthesisSpec:
@@ -319,9 +332,10 @@ def _refuse_collinear(xy: np.ndarray, w: _Where, key: str, topology: str) -> Non
                       f"{FOUR_BAR_ON_A_LINE}, or a slider-crank (its slider's points move on a line)")
 
 
-def _pairs(raw: dict[str, Any], w: _Where, output: str = "angle") -> np.ndarray:
+def _pairs(raw: dict[str, Any], w: _Where, output: str = "angle", absolute: bool = False) -> np.ndarray:
     """[crank turn, output's change] from the first pair [rad, rad or m]: the output a
-    rocker's turn (angle) or a slider's travel (length)."""
+    rocker's turn (angle) or a slider's travel (length); `absolute`: the crank's and the
+    rocker's angles as the file gives them (any first pair)."""
     value = raw.get("pairs")
     what, zero = ("rocker turn", "0 deg") if output == "angle" else ("slider travel", "0 mm")
     if not isinstance(value, list) or len(value) < 3:
@@ -333,10 +347,11 @@ def _pairs(raw: dict[str, Any], w: _Where, output: str = "angle") -> np.ndarray:
             raise w.error(f"pairs[{i}]", f"{t!r} must be [crank turn, {what}] with units")
         rows.append([to_si(x, kind, where=f"{w.path}, pairs[{i}]") for x, kind in zip(t, ("angle", output))])
     out = np.array(rows)
-    if np.any(out[0] != 0):
-        raise w.error("pairs[0]", f"the first pair is the start: [\"0 deg\", \"{zero}\"]")
+    if np.any(out[0] != 0) and not absolute:
+        raise w.error("pairs[0]", f"the first pair is the start: [\"0 deg\", \"{zero}\"] (or give absolute "
+                      "angles with pair_angles = \"absolute\")")
     step = np.diff(out[:, 0])
-    if not (np.all(step > 0) or np.all(step < 0)) or abs(out[-1, 0]) >= 2 * math.pi:
+    if not (np.all(step > 0) or np.all(step < 0)) or abs(out[-1, 0] - out[0, 0]) >= 2 * math.pi:
         raise w.error("pairs", "the crank turns must grow (ccw) or fall (cw) strictly, within one turn")
     return out
 

@@ -28,8 +28,17 @@ _GRID = 24  # Freudenstein starts: theta0 and phi0 every 15 deg
 
 
 def function_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
-    """The file's bounds of crank, coupler, rocker, and the start angles over a turn."""
+    """The file's bounds of crank, coupler, rocker, and the start angles over a turn (given
+    absolute pairs: the file's start, which rows do not change)."""
+    if spec.start is not None:
+        return [*zip(spec.lower.tolist(), spec.upper.tolist()), *((a, a + 1e-9) for a in spec.start)]
     return [*zip(spec.lower.tolist(), spec.upper.tolist()), (-math.pi, math.pi), (-math.pi, math.pi)]
+
+
+def _starts(spec: SynthesisSpec, x: np.ndarray) -> np.ndarray:
+    """The crank's and the rocker's angles at the first pair (n, 2) [rad]: the rows' own,
+    or the file's absolute ones."""
+    return x[:, 3:5] if spec.start is None else np.broadcast_to(np.asarray(spec.start), (len(x), 2))
 
 
 def _linkages(spec: SynthesisSpec, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -38,7 +47,8 @@ def _linkages(spec: SynthesisSpec, x: np.ndarray) -> tuple[np.ndarray, np.ndarra
     z = np.zeros((n, 9))
     z[:, 2] = spec.ground
     z[:, 4:7] = x[:, :3]
-    return z, x[:, 3:4] + spec.targets[None, :, 0], x[:, 4:5] + spec.targets[None, :, 1]
+    start = _starts(spec, x)
+    return z, start[:, 0:1] + spec.targets[None, :, 0], start[:, 1:2] + spec.targets[None, :, 1]
 
 
 def _wrapped(angle: np.ndarray) -> np.ndarray:
@@ -65,12 +75,11 @@ def freudenstein_rows(spec: SynthesisSpec) -> np.ndarray:
     """Rows from Freudenstein's equation (least squares over the pairs) at start angles on
     a grid, within the bounds, best first."""
     rows = []
-    for theta0 in np.arange(_GRID) * 2 * math.pi / _GRID - math.pi:
-        for phi0 in np.arange(_GRID) * 2 * math.pi / _GRID - math.pi:
-            lengths = link_lengths(freudenstein_k(theta0 + spec.targets[:, 0], phi0 + spec.targets[:, 1]),
-                                   spec.ground)
-            if lengths is not None and np.all((spec.lower <= lengths) & (np.array(lengths) <= spec.upper)):
-                rows.append([*lengths, theta0, phi0])
+    grid = np.arange(_GRID) * 2 * math.pi / _GRID - math.pi
+    for theta0, phi0 in ([spec.start] if spec.start is not None else ((t, p) for t in grid for p in grid)):
+        lengths = link_lengths(freudenstein_k(theta0 + spec.targets[:, 0], phi0 + spec.targets[:, 1]), spec.ground)
+        if lengths is not None and np.all((spec.lower <= lengths) & (np.array(lengths) <= spec.upper)):
+            rows.append([*lengths, theta0, phi0])
     return np.array(rows).reshape(-1, 5)
 
 
@@ -88,7 +97,11 @@ def refined_function(spec: SynthesisSpec, s0: float, x: np.ndarray) -> Linkage |
     def jacobian(v: np.ndarray) -> np.ndarray:
         z, theta, _ = _linkages(spec, v[None])
         _, dz, dt = rocker_jacobian(z[0], s0, theta[0])
-        return np.column_stack((dz[:, 4:7], dt, -np.ones(len(dt)))) / span
+        if spec.start is not None:  # the start angles are the file's: the rows' do not count
+            dt, minus = np.zeros_like(dt), np.zeros(len(dt))
+        else:
+            minus = -np.ones(len(dt))
+        return np.column_stack((dz[:, 4:7], dt, minus)) / span
 
     lower = np.concatenate((spec.lower, [-np.inf, -np.inf]))
     upper = np.concatenate((spec.upper, [np.inf, np.inf]))
@@ -103,4 +116,4 @@ def _linkage(spec: SynthesisSpec, v: np.ndarray, s: float, errors: np.ndarray) -
     way, span = progress(theta, spec.direction)
     low, high = transmission_range(z, S, theta, way, span)
     return Linkage(z[0].copy(), s, theta[0].copy(), int(way[0]), errors, (float(low[0]), float(high[0])),
-                   grashof_label(z[0]), task="function", phi0=float(v[4]))
+                   grashof_label(z[0]), task="function", phi0=float(_starts(spec, v[None])[0, 1]))

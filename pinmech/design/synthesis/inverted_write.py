@@ -14,10 +14,11 @@ import numpy as np
 
 from pinmech.design.synthesis.inverted import guide_angle, pose
 from pinmech.design.synthesis.result import Linkage
+from pinmech.design.synthesis.written import mm_text
 
 
 def _mm(v: float) -> str:
-    return f"{v * 1e3:.15g} mm"
+    return mm_text(v)
 
 
 def inverted_tables(lk: Linkage, title: str) -> dict:

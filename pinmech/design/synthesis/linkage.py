@@ -14,7 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
+from pinmech.angles import turn_radians
 from pinmech.design.synthesis.kinematics import kinematics
+from pinmech.design.synthesis.written import deg_text, mm_text
 from pinmech.design.synthesis.result import Linkage
 from pinmech.outputs import write_whole
 
@@ -22,11 +24,11 @@ _STEP = math.radians(1.0)  # the engine's sweep: at most this crank step between
 
 
 def _mm(v: float) -> str:
-    return f"{v * 1e3:.15g} mm"
+    return mm_text(v)
 
 
 def _deg(v: float) -> str:
-    return f"\"{math.degrees(v):.15g} deg\""
+    return f"\"{deg_text(v)}\""
 
 
 def linkage_toml(lk: Linkage, title: str, source: str) -> str:
@@ -47,7 +49,7 @@ def linkage_toml(lk: Linkage, title: str, source: str) -> str:
 
         what = what.replace("rocker", "guide").replace("coupler", "block")
         header = (f"Synthesised by `pinmech synth {source}`: {what}.\n"
-                  f"Drawn at the first target's pose (crank O2 at {math.degrees(lk.theta[0]):.6g} deg from x).")
+                  f"Drawn at the first target's pose (crank O2 at {math.degrees(motion_values(lk)[0]):.6g} deg from x).")
         return written(linkage_spec(inverted_tables(lk, title), source), header)
     if slider:
         B = p.B[0, 0]
@@ -57,25 +59,42 @@ def linkage_toml(lk: Linkage, title: str, source: str) -> str:
         raw = {"title": title, "ground": ["O2"], "joints": joints,
                "links": {"crank": ["O2", "A"], "rod": ["A", "B", "P"] if path else ["A", "B"], "piston": ["B"]},
                "sliders": {"slide": {"block": "piston", "on": "ground", "at": "B",
-                                     "along": f"{math.degrees(z[2]):.15g} deg"}}}
+                                     "along": deg_text(z[2])}}}
         header = (f"Synthesised by `pinmech synth {source}`: {what}.\n"
-                  f"Drawn at the first target's pose (crank O2 at {math.degrees(lk.theta[0]):.6g} deg from x).")
+                  f"Drawn at the first target's pose (crank O2 at {math.degrees(motion_values(lk)[0]):.6g} deg from x).")
         return written(linkage_spec(raw, source), header)
-    joints = {"O2": [_mm(z[0]), _mm(z[1])], "O4": [_mm(z[2]), _mm(z[3])], "A": [_mm(A[0]), _mm(A[1])],
-              "B": {"from": ["A", "O4"], "lengths": [_mm(z[5]), _mm(z[6])], "side": "left" if lk.s > 0 else "right"}}
-    if path:
-        joints["P"] = [_mm(P[0]), _mm(P[1])]
-    raw = {"title": title, "ground": ["O2", "O4"], "joints": joints,
-           "links": {"crank": ["O2", "A"], "coupler": ["A", "B", "P"] if path else ["A", "B"], "rocker": ["O4", "B"]}}
+    raw = {"title": title, **four_bar_tables(lk, path)}
     header = (f"Synthesised by `pinmech synth {source}`: {what}.\n"
-              f"Drawn at the first target's pose (crank O2 at {math.degrees(lk.theta[0]):.6g} deg from x).")
+              f"Drawn at the first target's pose (crank O2 at {math.degrees(motion_values(lk)[0]):.6g} deg from x).")
     return written(linkage_spec(raw, source), header)
 
 
+def four_bar_tables(lk: Linkage, path: bool) -> dict:
+    """A four-bar's drawn-linkage tables with its dimensions as `[params]` (the search's
+    names: O2x, O2y, O4x, O4y, crank, coupler, rocker, and a path's or a motion's coupler
+    point P as its distances AP, BP from A and B, left or right of A -> B), drawn at the
+    first target's crank angle: edit a param and the drawing follows."""
+    z = lk.z
+    names = ("O2x", "O2y", "O4x", "O4y", "crank", "coupler", "rocker")
+    params = {n: _mm(v) for n, v in zip(names, z[:7])}
+    joints = {"O2": ["O2x", "O2y"], "O4": ["O4x", "O4y"],
+              "A": {"from": "O2", "length": "crank", "angle": deg_text(motion_values(lk)[0])},
+              "B": {"from": ["A", "O4"], "lengths": ["coupler", "rocker"], "side": "left" if lk.s > 0 else "right"}}
+    if path:
+        along, across = float(z[7]), float(z[8])
+        params["AP"], params["BP"] = _mm(math.hypot(along, across)), _mm(math.hypot(z[5] - along, across))
+        joints["P"] = {"from": ["A", "B"], "lengths": ["AP", "BP"], "side": "left" if across >= 0 else "right"}
+    return {"ground": ["O2", "O4"], "params": params, "joints": joints,
+            "links": {"crank": ["O2", "A"], "coupler": ["A", "B", "P"] if path else ["A", "B"], "rocker": ["O4", "B"]}}
+
+
 def motion_values(lk: Linkage) -> np.ndarray:
-    """The crank's angles at the targets [rad], unwrapped along the motion (one way)."""
+    """The crank's angles at the targets [rad] along the motion: the first in [0, 2 pi)
+    (the convention of every crank angle pinmech reports), the others unwrapped from it
+    the way the crank turns (a sweep from 349.3 to 366.4 deg turns counter-clockwise
+    through 0)."""
     steps = np.mod(lk.way * np.diff(lk.theta), 2 * math.pi)
-    return lk.theta[0] + lk.way * np.concatenate(([0.0], np.cumsum(steps)))
+    return turn_radians(float(lk.theta[0])) + lk.way * np.concatenate(([0.0], np.cumsum(steps)))
 
 
 def scene_toml(lk: Linkage, linkage_file: str, title: str) -> str:
@@ -130,6 +149,7 @@ class EngineCheck:
     points: np.ndarray
     errors: np.ndarray
     angle_errors: np.ndarray | None = None  # a motion's coupler angles against the poses' [rad]
+    drift: float | None = None  # path, motion: the engine's P against the synthesis's own [m], at most
 
 
 def engine_check(scene_file: str | Path, lk: Linkage, targets: np.ndarray,
@@ -153,11 +173,14 @@ def engine_check(scene_file: str | Path, lk: Linkage, targets: np.ndarray,
     poses = [p.motion for p in sweep.poses(np.asarray(dense)) if p.index in at]
     if lk.task != "function":
         P = np.array([m.points["P"].position[:2] for m in poses])
+        own = kinematics(lk.topology).pose(lk.z[None], np.array([lk.s]), lk.theta[None]).P[0]
+        drift = float(np.max(np.linalg.norm(P - own, axis=1)))
         if lk.task == "path":
-            return EngineCheck(P, np.linalg.norm(P - targets, axis=1))
+            return EngineCheck(P, np.linalg.norm(P - targets, axis=1), drift=drift)
         coupler = {"slider-crank": "rod", "inverted-slider-crank": "block"}.get(lk.topology, "coupler")
         turn = np.array([m.links[coupler].angle for m in poses]) + lk.phi0 - angles
-        return EngineCheck(P, np.linalg.norm(P - targets, axis=1), np.abs(np.mod(turn + math.pi, 2 * math.pi) - math.pi))
+        return EngineCheck(P, np.linalg.norm(P - targets, axis=1), np.abs(np.mod(turn + math.pi, 2 * math.pi) - math.pi),
+                           drift)
     if lk.topology == "slider-crank":  # the block's place along the slide from H, against the travel asked
         from pinmech.design.synthesis.slider import slide_position
 

@@ -9,11 +9,12 @@ from pathlib import Path
 
 import numpy as np
 
+from pinmech.angles import position_text, turn_degrees
 from pinmech.design.figure_file import number_points, pyplot, save
 from pinmech.design.synthesis.kinematics import kinematics
 from pinmech.design.synthesis.linkage import motion_values
 from pinmech.design.synthesis.objective import carried_angle
-from pinmech.design.synthesis.result import Linkage, SynthesisResult
+from pinmech.design.synthesis.result import MET, Linkage, SynthesisResult
 
 DEFECTS = {
     "branch": "none: every pose on one assembly (B {side}), by construction",
@@ -53,10 +54,12 @@ def linkage_summary(lk: Linkage) -> dict:
         **shape,
         "assembly": side,
         "grashof": lk.grashof,
-        "crank_deg": [round(math.degrees(v), 6) for v in motion_values(lk)],
+        "crank_deg": [turn_degrees(math.degrees(v)) for v in motion_values(lk)],
         **errors,
         **({"angle_errors_deg": [math.degrees(float(e)) for e in lk.angle_errors],
             "offset_deg": math.degrees(lk.phi0)} if lk.angle_errors is not None else {}),
+        "meets_targets": lk.meets(MET),
+        "met_within_relative": MET,
         "transmission_deg": [round(math.degrees(v), 3) for v in lk.transmission],
         "defects": {k: v.format(side=where, way=way, fold=fold) for k, v in DEFECTS.items()},
     }
@@ -89,7 +92,8 @@ def text(result: SynthesisResult) -> str:
         lines += [
             f"linkage {i}: {_dimensions(lk)}; {lk['grashof']}, assembly {lk['assembly']}",
             _errors(lk),
-            f"  crank at the targets [deg]: {', '.join(f'{v:.6g}' for v in lk['crank_deg'])}",
+            _met(lk),
+            f"  crank at the targets [deg]: {', '.join(position_text(v) for v in lk['crank_deg'])}",
             f"  transmission angle over the motion: {lk['transmission_deg'][0]:.4g} .. {lk['transmission_deg'][1]:.4g} deg",
         ]
         lines += [f"  {k} defect: {v}" for k, v in lk["defects"].items()]
@@ -113,6 +117,15 @@ def _dimensions(lk: dict) -> str:
     return (f"O2 ({d['O2x']:.6g}, {d['O2y']:.6g}) mm, O4 ({d['O4x']:.6g}, {d['O4y']:.6g}) mm, "
             f"ground {lk['ground_mm']:.6g}, crank {d['crank']:.6g}, coupler {d['coupler']:.6g}, "
             f"rocker {d['rocker']:.6g} mm, P at {d['along']:.6g} along and {d['across']:.6g} across A->B")
+
+
+def _met(lk: dict) -> str:
+    """Whether the linkage meets the targets, and what that means (the tolerance)."""
+    angular = "errors_deg" in lk and "slider_start_mm" not in lk
+    within = (f"every output angle within {lk['met_within_relative']:g} rad" if angular else
+              f"every target within {lk['met_within_relative']:g} of its size, the longest link")
+    verdict = "yes" if lk["meets_targets"] else "no: the closest this search found (errors above)"
+    return f"  meets the targets, {within}: {verdict}"
 
 
 def _carried(lk: dict) -> str:

@@ -10,6 +10,11 @@ import numpy as np
 
 from pinmech.design.synthesis.file import SynthesisSpec
 
+#: What "meets the targets" means: every target within this share of the linkage's size
+#: (its longest link; an output angle within this many radians). The search stops once
+#: a refined linkage meets it; the report says whether each linkage does.
+MET = 1e-10
+
 
 @dataclass(frozen=True)
 class Linkage:

@@ -18,12 +18,11 @@ import numpy as np
 
 from pinmech.design.synthesis.file import SIX_BARS, SynthesisSpec, load_synthesis
 from pinmech.design.synthesis.kinematics import kinematics
-from pinmech.design.synthesis.result import Linkage, SynthesisResult
+from pinmech.design.synthesis.result import MET as _MET, Linkage, SynthesisResult
 from pinmech.design.synthesis.tasks import classical_rows, evaluate, refined, search_bounds
 
 _EXTRA = 'pip install "pinmech[study]"'
 _CLOSE = 3e-2  # from a best relative rms target error below this, every 10th generation tries a refinement ...
-_MET = 1e-10  # ... and DE stops when the refined best meets every target within this share of its size
 _STRATEGY = "rand1bin"
 _STALL = 100  # generations without a 1 % better best: DE restarts with the next seed
 _SETTLED = 5  # refinements in a row (every 10th generation) landing no 1 % lower: a local optimum, restart

@@ -9,8 +9,10 @@ from pathlib import Path
 
 import numpy as np
 
+from pinmech.angles import turn_degrees
 from pinmech.design.synthesis.file import SynthesisSpec
-from pinmech.design.synthesis.result import Linkage
+from pinmech.design.synthesis.result import MET, Linkage
+from pinmech.design.synthesis.written import deg_text
 from pinmech.outputs import write_whole
 
 _STEP = math.radians(1.0)  # the engine check's sweep: at most this crank step between poses
@@ -51,7 +53,7 @@ def scene_toml(spec: SynthesisSpec, lk: Linkage, linkage_file: str) -> str:
     t = template(spec)
     driver = t.sm.sweep.driver
     shown = _shown(spec)
-    deg = [f"\"{math.degrees(v):.15g} deg\"" for v in (t.p0, t.start, t.stop)]
+    deg = [f"\"{deg_text(v)}\"" for v in (t.p0, t.start, t.stop)]
     return "\n".join([
         "# The synthesised six-bar, its crank driven from the drawn pose over the range searched:",
         "#   pinmech sweep THIS_FILE --plot fig.png",
@@ -127,10 +129,12 @@ def sixbar_summary(lk: Linkage) -> dict:
         "params_mm": {n: round(v * 1e3, 9) for n, v in lk.params.items()},
         "assembly": "as drawn (its sides)",
         "grashof": lk.grashof,
-        "crank_deg": [round(math.degrees(v), 6) for v in lk.theta],
+        "crank_deg": [turn_degrees(math.degrees(v)) for v in lk.theta],
         **errors,
         **({"angle_errors_deg": [math.degrees(float(e)) for e in lk.angle_errors],
             "offset_deg": math.degrees(lk.phi0)} if lk.angle_errors is not None else {}),
+        "meets_targets": lk.meets(MET),
+        "met_within_relative": MET,
         "transmission_deg": [round(math.degrees(v), 3) for v in lk.transmission],
         "defects": {"branch": "none: the crank's whole turn followed on the drawn assembly, no change point",
                     "circuit": "none: no fold within the crank's whole turn",
