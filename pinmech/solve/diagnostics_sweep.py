@@ -19,6 +19,7 @@ from pinmech.exceptions import DiagnosticError, PinmechError
 from pinmech.extremum import Tracked
 from pinmech.solve.grashof import loop_classes
 from pinmech.solve.limit_positions import LimitFinder, LimitPosition, extreme_label, travel
+from pinmech.solve.limit_watch import RateWatch
 from pinmech.model.planar_linkage import planar_linkage
 from pinmech.solve.transmission import dyad_angles, find_dyads, find_outputs, output_rate
 
@@ -90,8 +91,8 @@ class DesignSweep:
         self._fold_from: list[tuple[float, np.ndarray, float]] = []  # (fold, closed q, its driver value)
         self._previous_q: np.ndarray | None = None
         self.advantages = [_Extreme() for _ in self.outputs]
-        self.previous: list[tuple | None] = [None] * len(self.outputs)
-        self.brackets: list[list[tuple]] = [[] for _ in self.outputs]
+        size = sweep.mechanism.length_scale
+        self.watches = [RateWatch(1.0 if o.kind == "pin" else size) for o in self.outputs]
 
     @property
     def applicable(self) -> bool:
@@ -144,6 +145,8 @@ class DesignSweep:
         self._step = None if self._step is None else -self._step
 
     def _record(self, pose, q: np.ndarray, rates: list[float], out: dict) -> None:
+        if not self.count:
+            self._first = pose.value
         self.count += 1
         for (least, largest), pressure, (_, acute, phi) in zip(self.angles, self.pressures, out["angles"]):
             least.add(acute, pose.value, q, self._previous)
@@ -152,13 +155,13 @@ class DesignSweep:
         if self._previous is not None and "crossed a fold" not in pose.note:
             self._step = pose.value - self._previous
         self._previous, self._previous_q = pose.value, q
-        for i, (stat, value) in enumerate(zip(self.advantages, out["advantage"])):
+        for stat, value, watch, rate in zip(self.advantages, out["advantage"], self.watches, rates):
             if math.isfinite(value):
                 stat.add(abs(value), pose.value)
-            before = self.previous[i]
-            if before is not None and not pose.note and not pose.interpolated and before[2] * rates[i] < 0:
-                self.brackets[i].append((before[0], before[1], before[2], pose.value))
-            self.previous[i] = None if pose.interpolated else (pose.value, q, rates[i])
+            if pose.note or pose.interpolated:  # no limit bracketed across a fold crossed or an interpolation
+                watch.end()
+            if not pose.interpolated:
+                watch.add(pose.value, q, rate)
 
     def add(self, pose) -> None:
         """A pose of the sweep (the recorder interface of `Outputs`)."""
@@ -219,15 +222,18 @@ class DesignSweep:
         if self._limits[0] == self.count:
             return self._limits[1]
         out = []
-        for output, brackets in zip(self.outputs, self.brackets):
+        for output, watch in zip(self.outputs, self.watches):
             found = []
-            for x0, q0, r0, x1 in brackets:
+            brackets, at_poses = watch.limits()
+            for b in brackets:
                 try:
-                    x, q = self.finder.bisect(output, q0, x0, x1, r0)
+                    x, q = self.finder.bisect(output, b.q0, b.x0, b.x1, b.r0)
                 except PinmechError:  # a pose between that does not close: no limit stated there
                     continue
-                found.append((self.finder.limit(output, q, x, extreme_label(r0, x1 - x0)), q))
-            out.append(found)
+                found.append((self.finder.limit(output, q, x, extreme_label(b.r0, b.x1 - b.x0)), q))
+            found += [(self.finder.limit(output, e.q, e.x, e.label), e.q) for e in at_poses]
+            along = sorted(found, key=lambda f: abs(f[0].driver - self._first))  # in the sweep's order
+            out.append(_once_a_turn(along, self.sweep.is_angular))
         self._limits = (self.count, out)
         return out
 
@@ -323,6 +329,17 @@ class DesignSweep:
     def _driver(self, value: float) -> str:
         unit = f"{math.degrees(value):.6g} deg" if self.sweep.is_angular else f"{value:.6g} m"
         return f"{self.sweep.driver} = {unit}"
+
+
+def _once_a_turn(found: list[tuple], angular: bool) -> list[tuple]:
+    """The limits, each once: a sweep of a whole turn that begins on a limit ends on it too
+    (the same pose of the mechanism, the driver a turn on: the same limit)."""
+    out: list[tuple] = []
+    for limit, q in found:
+        if not any(angular and x.label == limit.label and abs(math.remainder(limit.driver - x.driver, 2 * math.pi))
+                   <= 1e-9 for x, _ in out):
+            out.append((limit, q))
+    return out
 
 
 def design_of(sweep) -> DesignSweep:

@@ -1,0 +1,74 @@
+"""Limit positions and extremes where a sweep begins, ends or stops: at its first pose,
+at a toggle of the driver, at a change point; checked against closed forms derived
+from the link lengths (Norton, Design of Machinery, §2.12, §4.10)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import pinmech
+from pinmech.solve.diagnostics_sweep import design_of
+from pinmech.solve.limit_positions import travel
+
+#: Limit positions at a pose of the sweep carry the pose's driver value: exact where the
+#: rate's zero is the pose (an inline slider-crank at theta = 0, 180 deg, from sin).
+#: Bisected ones are found to 1e-12 rad; 1e-9 rad leaves a margin of 1e3.
+DRIVER_TOL = 1e-9
+#: Piston places from the closed pose: rounding of the closure (1e-13 of the size).
+PLACE_TOL = 1e-12
+
+
+def slider_crank_files(tmp_path, r: float, l: float, e: float, drawn: float = 0.0):
+    """A drawn slider-crank: crank r about O (0, 0) drawn at `drawn` deg, rod l, piston on
+    y = e [mm], to the right; a scene driving O."""
+    t = math.radians(drawn)
+    ax, ay = r * math.cos(t), r * math.sin(t)
+    bx = ax + math.sqrt(l * l - (e - ay) ** 2)
+    (tmp_path / "sc.toml").write_text(f"""title = "slider-crank"
+ground = ["O"]
+[joints]
+O = ["0 mm", "0 mm"]
+A = {{ from = "O", length = "{r} mm", angle = "{drawn} deg" }}
+B = ["{bx!r} mm", "{e} mm"]
+[links]
+crank = ["O", "A"]
+rod = ["A", "B"]
+piston = ["B"]
+[sliders]
+slide = {{ block = "piston", on = "ground", at = "B", along = "0 deg" }}
+""")
+    scene = tmp_path / "sc_scene.toml"
+    scene.write_text(f'title = "sc"\nlinkage = "sc.toml"\n[drivers.O]\nangle = "{drawn} deg"\nspeed = "60 rpm"\n')
+    return scene
+
+
+def swept(scene, first_deg: float, last_deg: float, steps: int, **options):
+    sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(scene))
+    design = design_of(sweep)
+    for pose in sweep.poses(np.radians(np.linspace(first_deg, last_deg, steps)), **options):
+        design.add(pose)
+    return sweep, design
+
+
+@pytest.mark.parametrize("first", [0.0, 180.0, -180.0], ids=["from TDC", "from BDC", "from BDC backwards"])
+def test_inline_slider_crank_swept_from_a_dead_centre_names_both(tmp_path, first):
+    """Inline (e = 0): TDC at theta = 0 (crank and rod extended, x = l + r), BDC at 180 deg
+    (folded, x = l - r); stroke 2 r; Q = 1. A sweep of one turn that begins on a dead
+    centre names it once, with the other, the stroke and Q."""
+    r, l = 0.05, 0.15
+    scene = slider_crank_files(tmp_path, 50, 150, 0)
+    last = first + (360.0 if first >= 0 else -360.0)
+    _, design = swept(scene, first, last, 361)
+    (found,) = design.limits()
+    t = travel(found, 2 * math.pi)
+    by_label = {x.label: x for x in t.limits}
+    assert set(by_label) == {"max TDC", "min BDC"}, [x.label for x in found]
+    np.testing.assert_allclose(math.remainder(by_label["max TDC"].driver, 2 * math.pi), 0.0, atol=DRIVER_TOL)
+    np.testing.assert_allclose(abs(math.remainder(by_label["min BDC"].driver, 2 * math.pi)), math.pi, atol=DRIVER_TOL)
+    np.testing.assert_allclose([by_label["max TDC"].value, by_label["min BDC"].value], [l + r, l - r],
+                               rtol=0, atol=PLACE_TOL)
+    np.testing.assert_allclose(t.travel, 2 * r, rtol=0, atol=PLACE_TOL)
+    np.testing.assert_allclose(t.ratio, 1.0, rtol=0, atol=1e-9)
