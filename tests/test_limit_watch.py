@@ -72,3 +72,56 @@ def test_inline_slider_crank_swept_from_a_dead_centre_names_both(tmp_path, first
                                rtol=0, atol=PLACE_TOL)
     np.testing.assert_allclose(t.travel, 2 * r, rtol=0, atol=PLACE_TOL)
     np.testing.assert_allclose(t.ratio, 1.0, rtol=0, atol=1e-9)
+
+
+def four_bar_files(tmp_path, d, a, b, c, drawn=0.0, side="left"):
+    """A drawn four-bar O2 (0, 0), O4 (d, 0), crank a drawn at `drawn` deg, coupler b,
+    rocker c [mm], B on `side` of A -> O4; a scene driving O2 from `drawn`."""
+    (tmp_path / "fb.toml").write_text(f"""title = "four-bar"
+ground = ["O2", "O4"]
+[joints]
+O2 = ["0 mm", "0 mm"]
+O4 = ["{d} mm", "0 mm"]
+A = {{ from = "O2", length = "{a} mm", angle = "{drawn} deg" }}
+B = {{ from = ["A", "O4"], lengths = ["{b} mm", "{c} mm"], side = "{side}" }}
+[links]
+crank = ["O2", "A"]
+coupler = ["A", "B"]
+rocker = ["O4", "B"]
+""")
+    scene = tmp_path / "fb_scene.toml"
+    scene.write_text(f'title = "fb"\nlinkage = "fb.toml"\n[drivers.O2]\nangle = "{drawn} deg"\nspeed = "60 rpm"\n')
+    return scene
+
+
+def toggle_angle(a, d, reach):
+    """The crank angle [deg] where |O4 A| = reach (coupler and rocker in line), by the law
+    of cosines in the triangle O2 A O4: reach^2 = a^2 + d^2 - 2 a d cos theta."""
+    return math.degrees(math.acos((a * a + d * d - reach * reach) / (2 * a * d)))
+
+
+#: The fold is located to rounding (Newton on dx/ds = 0 with a dependent joint as the
+#: parameter): 1e-9 deg of the driver is a margin of 1e4 over what was measured; the
+#: angle there is 0 to rounding of atan2 (1e-12 deg).
+FOLD_TOL_DEG = 1e-9
+
+
+@pytest.mark.parametrize("steps", [13, 37, 361])
+@pytest.mark.parametrize("lengths, drawn, reach", [
+    ((100, 80, 40, 90), 60, "b + c"),  # Grashof double-rocker (coupler shortest): the crank rocks
+    ((100, 45, 50, 55), 0, "b + c"),  # triple rocker: s + l = 145 > p + q = 105
+], ids=["double-rocker", "triple rocker"])
+def test_least_transmission_angle_is_zero_at_the_toggle_where_the_driver_stops(tmp_path, lengths, drawn, reach,
+                                                                              steps):
+    """A crank that rocks stops where coupler and rocker fall in line (|O4 A| = b + c): the
+    acute transmission angle is 0 there and the pressure angle 90 deg, whatever the step
+    count (it was the value at the nearest pose: 21.5 deg, 7.96 or 10.11 deg by steps)."""
+    d, a, b, c = lengths
+    fold = toggle_angle(a, d, b + c)
+    scene = four_bar_files(tmp_path, d, a, b, c, drawn)
+    _, design = swept(scene, drawn, drawn + 360, steps, skip_failures=True)
+    ((x),) = design.angle_extremes()
+    np.testing.assert_allclose([x.low, x.pressure], [0.0, 90.0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose([math.degrees(x.low_at), math.degrees(x.pressure_at)], [fold, fold], rtol=0,
+                               atol=FOLD_TOL_DEG)
+    np.testing.assert_allclose(math.degrees(design.folds()[0]), fold, rtol=0, atol=FOLD_TOL_DEG)

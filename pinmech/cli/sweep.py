@@ -148,7 +148,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     interpolate = interpolating.value
     poses = sweep.poses(DriverValues(start, stop, steps), skip_failures=args.skip_failures,
                         start=mode or "predictor", batch=not args.no_batch and options.get("batch", True),
-                        interpolate=interpolate, through_folds=args.through_folds)
+                        interpolate=interpolate, through_folds=args.through_folds, to_fold=not args.through_folds)
     forces = _sweep_forces(args, scene, sweep)
     if forces is not None and interpolate and interpolate > 1:  # before any pose is computed
         raise interpolating.error(f"{interpolate}: forces need solved poses, and interpolated ones' rates miss the "
@@ -165,12 +165,16 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                 limits.check(limit_violations(sweep.mechanism, pose.motion),
                              f"at {sweep.driver} = {sweep._format(pose.value)}")
             sinks.add(pose)
+    if sweep.fold_end is not None:
+        print(f"pinmech: {sweep.driver} cannot go past {sweep._format(sweep.fold_end)} (a fold: a toggle, the end of "
+              "its range of motion on this assembly): the sweep ends at the pose before it (--through-folds goes on "
+              "onto the other branch, the driver turning back)", file=sys.stderr)
     for line in forces.summary() if forces else []:
         print(line, file=sys.stderr)
     for line in _design_summary(sweep, stop - start, args.through_folds):
         print(line, file=sys.stderr)
     limits.summary(steps)
-    if not args.through_folds:  # past a fold the driver turns back: no whole turns to speak of
+    if not args.through_folds and sweep.fold_end is None:  # past a fold the driver turns back: no whole turns
         _say_return(sweep, stop - start)
     return 0
 

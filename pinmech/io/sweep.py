@@ -131,6 +131,7 @@ class Sweep:
     last_q: np.ndarray | None = None  # configuration of the last pose, None if it failed (drawings, return_gap)
     first_q: np.ndarray | None = None  # configuration of the first pose, None if it failed
     extra_points: tuple[str, ...] = ()  # frames a figure draws beyond the reported points (need_points)
+    fold_end: float | None = None  # where a sweep `to_fold` ended: the driver's fold [rad or m]
 
     @classmethod
     def from_scene(cls, scene: Scene, driver: str | None = None) -> Sweep:
@@ -179,7 +180,8 @@ class Sweep:
 
     def poses(self, values: Iterable[float], *, skip_failures: bool = False, start: str = "predictor",
               batch: bool = True, interpolate: int = 1, warm_start: bool | None = None,
-              predictor: bool | None = None, through_folds: bool = False) -> Iterator[SweepPose]:
+              predictor: bool | None = None, through_folds: bool = False,
+              to_fold: bool = False) -> Iterator[SweepPose]:
         """Solve the poses one after the other, each from the previous one (lazy).
 
         Args:
@@ -199,6 +201,9 @@ class Sweep:
                 branch with the driver turning back, values past the fold mirrored at it
                 (a whole coupler curve of a non-Grashof linkage); the pose after it carries
                 a note. Without it, the poses past a fold fail with DriverLimitError.
+            to_fold: at a fold of the driver (without through_folds), end the sweep at the
+                last pose before it: a rocker driven to its toggle has reached the end of its
+                range of motion on this assembly, not an error (`fold_end` says where).
 
         Raises:
             SweepError: a pose where the loop cannot close or the Jacobian is singular,
@@ -212,6 +217,7 @@ class Sweep:
         if self.extra_points:  # the reported points (None: every point), then the frames a figure draws
             points = list(dict.fromkeys([*(self.mechanism.points if points is None else points), *self.extra_points]))
         coincident = coincident_points(self.scene)
+        self.fold_end = None
         for chunk in self.chunks(values, start=start, batch=batch, interpolate=interpolate,
                                  through_folds=through_folds):
             for j, value in enumerate(chunk.values.tolist()):
@@ -221,10 +227,14 @@ class Sweep:
                     self.last_q = None  # the sweep did not end on a solved pose (return_gap: NaN)
                     if index == 0:
                         self.first_q = None
+                    fold = self._fold(exc)
+                    if to_fold and fold is not None and not skip_failures and index > 0:
+                        self.fold_end = fold
+                        return
                     if not skip_failures:
                         raise SweepError(f"sweep stopped at {self.driver} = {self._format(value)}: {exc}",
                                          driver=self.driver, value=value, cause=exc) from exc
-                    yield SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}", fold=self._fold(exc))
+                    yield SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}", fold=fold)
                     continue
                 sol = chunk.solution
                 self.last_q = sol.q[j]

@@ -17,6 +17,7 @@ import numpy as np
 from pinmech.solve.diagnostics import advantage_unit
 from pinmech.exceptions import DiagnosticError, PinmechError
 from pinmech.extremum import Tracked
+from pinmech.solve.fold_pose import fold_pose
 from pinmech.solve.grashof import loop_classes
 from pinmech.solve.limit_positions import LimitFinder, LimitPosition, extreme_label, travel
 from pinmech.solve.limit_watch import RateWatch
@@ -89,6 +90,8 @@ class DesignSweep:
         self._step: float | None = None  # the driver's last step between solved poses [rad or m]
         self._folds: list[float] = []
         self._fold_from: list[tuple[float, np.ndarray, float]] = []  # (fold, closed q, its driver value)
+        self._fold_at: list[tuple[float, np.ndarray]] = []  # (fold, closed q at it), located
+        self._ended: list[float] = []  # Sweep.fold_end values counted
         self._previous_q: np.ndarray | None = None
         self.advantages = [_Extreme() for _ in self.outputs]
         size = sweep.mechanism.length_scale
@@ -132,17 +135,47 @@ class DesignSweep:
         """A fold met before this pose: the DriverLimitError's value, or, crossed with
         `--through-folds` (the driver turns back there, the values past it mirrored), the
         point p with p - x0 + p - x1 = the step (x0, x1 the driver values either side)."""
-        if pose.fold is not None and not any(abs(pose.fold - x) <= 1e-12 for x in self._folds):
-            self._folds.append(pose.fold)
-            if self._previous_q is not None:
-                self._fold_from.append((pose.fold, self._previous_q, self._previous))
+        if pose.fold is not None:
+            self._add_fold(pose.fold)
         if "crossed a fold" not in pose.note:
             return
         if self._previous is not None and self._step is not None and pose.motion is not None:
-            self._folds.append(0.5 * (self._previous + pose.value + self._step))
-            if self._previous_q is not None:
-                self._fold_from.append((self._folds[-1], self._previous_q, self._previous))
+            self._add_fold(0.5 * (self._previous + pose.value + self._step))
         self._step = None if self._step is None else -self._step
+
+    def _add_fold(self, fold: float) -> None:
+        """A fold of the driver met after the last pose (estimated at `fold`): located to
+        rounding from that pose (fold_pose.py), and its angles counted among the extremes,
+        the driver's end of travel being part of its range of motion."""
+        if any(abs(fold - x) <= 1e-9 for x in self._folds):
+            return
+        self._folds.append(fold)
+        if self._previous_q is None:
+            return
+        try:
+            x, q = fold_pose(self.solver, self.k, self.finder.x, self._previous_q, self._previous, fold)
+        except PinmechError:  # not located better than the engine's estimate: no pose at it
+            self._fold_from.append((fold, self._previous_q, self._previous))
+            return
+        if self.sweep.is_angular:
+            x = fold + math.remainder(x - fold, 2 * math.pi)
+        self._folds[-1] = x
+        self._fold_at.append((x, q))
+        self._fold_from.append((x, self._previous_q, self._previous))
+        self.linkage.place(q)
+        origin = (self._previous, self._previous_q)
+        for (least, largest), pressure, dyad in zip(self.angles, self.pressures, self.dyads):
+            a = dyad_angles(self.linkage, dyad)
+            least.add(a.mu_acute, x, q, self._previous, origin)
+            largest.add(a.mu_acute, x, q, self._previous, origin)
+            pressure.add(a.pressure, x, q, self._previous, origin)
+
+    def _end_fold(self) -> None:
+        """The sweep ended at a fold of the driver (`Sweep.fold_end`): counted once."""
+        end = getattr(self.sweep, "fold_end", None)
+        if self.applicable and end is not None and end not in self._ended:
+            self._ended.append(end)
+            self._add_fold(end)
 
     def _record(self, pose, q: np.ndarray, rates: list[float], out: dict) -> None:
         if not self.count:
@@ -241,8 +274,9 @@ class DesignSweep:
         """Each dyad's least and largest acute transmission angle and largest pressure angle
         [deg], located between the poses (to extremum.TOL of the driver); where a trial pose
         cannot close (a fold beside it) the value over the poses stands, `refined` False."""
-        if self._extremes[0] != self.count:
-            self._extremes = (self.count, [self._dyad_extremes(*x) for x in
+        self._end_fold()
+        if self._extremes[0] != self.count + len(self._ended):
+            self._extremes = (self.count + len(self._ended), [self._dyad_extremes(*x) for x in
                                            zip(self.dyads, self.angles, self.pressures)])
         return self._extremes[1]
 
@@ -259,20 +293,26 @@ class DesignSweep:
 
     def _angle(self, dyad, tracked: Tracked, x: float, what: str) -> float:
         """An angle of the dyad [deg] at driver value x, the pose followed from the tracked one."""
-        self.linkage.place(self.finder.pose(tracked.q, tracked.at, x))
+        at, q = tracked.follow_from()
+        self.linkage.place(self.finder.pose(q, at, x))
         return getattr(dyad_angles(self.linkage, dyad), what)
 
     def folds(self) -> list[float]:
         """The driver values of the folds the sweep met [rad or m]: where it stopped
         (DriverLimitError) or, with `--through-folds`, where the driver turned back."""
+        self._end_fold()
         return list(self._folds)
 
     def fold_poses(self) -> list[tuple[float, np.ndarray]]:
         """(driver value [rad or m], closed q) at each fold, followed from the last pose
         before it; where the step onto the fold itself does not close (the loop's Jacobian
         is singular there), the nearest of 1e-12 .. 1e-6 of the step short of it."""
-        out = []
+        self._end_fold()
+        located = {x for x, _ in self._fold_at}
+        out = list(self._fold_at)
         for fold, q0, x0 in self._fold_from:
+            if fold in located:
+                continue
             for short in (0.0, 1e-12, 1e-9, 1e-6):
                 try:
                     out.append((fold, self.finder.pose(q0, x0, fold - short * (fold - x0))))
