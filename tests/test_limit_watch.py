@@ -113,15 +113,35 @@ FOLD_TOL_DEG = 1e-9
 ], ids=["double-rocker", "triple rocker"])
 def test_least_transmission_angle_is_zero_at_the_toggle_where_the_driver_stops(tmp_path, lengths, drawn, reach,
                                                                               steps):
-    """A crank that rocks stops where coupler and rocker fall in line (|O4 A| = b + c): the
-    acute transmission angle is 0 there and the pressure angle 90 deg, whatever the step
-    count (it was the value at the nearest pose: 21.5 deg, 7.96 or 10.11 deg by steps)."""
+    """A crank that rocks stops where coupler and rocker fall in line, extended (|O4 A| =
+    b + c): the transmission angle ABO is 180 deg there (acute 0) and the pressure angle
+    90 deg, whatever the step count (it was the value at the nearest pose: 21.5 deg,
+    7.96 or 10.11 deg by steps)."""
     d, a, b, c = lengths
     fold = toggle_angle(a, d, b + c)
     scene = four_bar_files(tmp_path, d, a, b, c, drawn)
     _, design = swept(scene, drawn, drawn + 360, steps, skip_failures=True)
     ((x),) = design.angle_extremes()
-    np.testing.assert_allclose([x.low, x.pressure], [0.0, 90.0], rtol=0, atol=1e-12)
-    np.testing.assert_allclose([math.degrees(x.low_at), math.degrees(x.pressure_at)], [fold, fold], rtol=0,
+    np.testing.assert_allclose([x.high, x.acute_low, x.pressure], [180.0, 0.0, 90.0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose([math.degrees(x.high_at), math.degrees(x.pressure_at)], [fold, fold], rtol=0,
                                atol=FOLD_TOL_DEG)
     np.testing.assert_allclose(math.degrees(design.folds()[0]), fold, rtol=0, atol=FOLD_TOL_DEG)
+
+
+#: Where coupler and output fall in line at a change point the pose itself is singular:
+#: bisection on their side of the line stops where trial poses stop closing (condition
+#: number 1e10: within ~1e-10 rad of it), so the driver value is good to 1e-9 rad.
+CHANGE_TOL = 1e-9
+
+
+def test_parallelogram_transmission_angle_reaches_0_and_180_at_its_change_points(tmp_path):
+    """Parallelogram a = c = 50, b = d = 100 mm: the coupler stays parallel to the ground,
+    the rocker to the crank, so the angle ABO is the crank angle theta folded on [0, 180]:
+    0 at theta = 0, 180 deg at theta = 180 deg, the change points where all four pins fall in
+    line (it was 1 deg at the pose beside the change point, 'located between the poses')."""
+    scene = four_bar_files(tmp_path, 100, 50, 100, 50, 270, side="right")
+    _, design = swept(scene, 270, 630, 361, skip_failures=True)
+    (x,) = design.angle_extremes()
+    np.testing.assert_allclose([x.low, x.high, x.pressure], [0.0, 180.0, 90.0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose([x.low_at, x.high_at], [2 * math.pi, 3 * math.pi], rtol=0, atol=CHANGE_TOL)
+    np.testing.assert_allclose(x.in_line, [2 * math.pi, 3 * math.pi], rtol=0, atol=CHANGE_TOL)

@@ -16,7 +16,7 @@ import numpy as np
 
 from pinmech.solve.diagnostics import advantage_unit
 from pinmech.exceptions import DiagnosticError, PinmechError
-from pinmech.extremum import Tracked
+from pinmech.solve.angle_watch import AngleExtremes, AngleWatch
 from pinmech.solve.fold_pose import fold_pose
 from pinmech.solve.grashof import loop_classes
 from pinmech.solve.limit_positions import LimitFinder, LimitPosition, extreme_label, travel
@@ -39,22 +39,6 @@ class _Extreme:
             self.low, self.low_at = value, at
         if value > self.high:
             self.high, self.high_at = value, at
-
-
-@dataclass(frozen=True)
-class AngleExtremes:
-    """A dyad's (named by its pin B) least and largest acute transmission angle and largest
-    pressure angle [deg], each with its driver value [rad or m]; `refined` False where
-    one is the value over the poses only (a fold beside it)."""
-
-    name: str
-    low: float
-    low_at: float
-    high: float
-    high_at: float
-    pressure: float
-    pressure_at: float
-    refined: bool
 
 
 class DesignSweep:
@@ -84,8 +68,7 @@ class DesignSweep:
         self.solver = LoopSolver(sweep.mechanism, names, **sweep.scene.solver_options())
         self.finder = LimitFinder(self.solver, self.linkage, self.k, sweep.drivers.q, self.dyads)
         self.unit = np.eye(len(names))[self.k]
-        self.angles = [(Tracked(1.0), Tracked(-1.0)) for _ in self.dyads]  # least, largest acute mu [deg]
-        self.pressures = [Tracked(-1.0) for _ in self.dyads]  # largest pressure angle [deg]
+        self.angles = AngleWatch(self.linkage, self.dyads, self._place_at)
         self._previous: float | None = None  # the last solved pose's driver value
         self._step: float | None = None  # the driver's last step between solved poses [rad or m]
         self._folds: list[float] = []
@@ -120,7 +103,7 @@ class DesignSweep:
             angles = [dyad_angles(self.linkage, d) for d in self.dyads]
             out = {"angles": [(a.mu, a.mu_acute, a.pressure) for a in angles],
                    "advantage": [math.inf if r == 0 else 1.0 / r for r in rates]}
-            self._record(pose, q, rates, out)
+            self._record(pose, q, rates, angles, out)
         self._cache = (pose.index, out)
         return out
 
@@ -137,6 +120,7 @@ class DesignSweep:
         point p with p - x0 + p - x1 = the step (x0, x1 the driver values either side)."""
         if pose.fold is not None:
             self._add_fold(pose.fold)
+            self.angles.cut()
         if "crossed a fold" not in pose.note:
             return
         if self._previous is not None and self._step is not None and pose.motion is not None:
@@ -163,12 +147,8 @@ class DesignSweep:
         self._fold_at.append((x, q))
         self._fold_from.append((x, self._previous_q, self._previous))
         self.linkage.place(q)
-        origin = (self._previous, self._previous_q)
-        for (least, largest), pressure, dyad in zip(self.angles, self.pressures, self.dyads):
-            a = dyad_angles(self.linkage, dyad)
-            least.add(a.mu_acute, x, q, self._previous, origin)
-            largest.add(a.mu_acute, x, q, self._previous, origin)
-            pressure.add(a.pressure, x, q, self._previous, origin)
+        self.angles.add(x, q, self._previous, [dyad_angles(self.linkage, d) for d in self.dyads],
+                        origin=(self._previous, self._previous_q))
 
     def _end_fold(self) -> None:
         """The sweep ended at a fold of the driver (`Sweep.fold_end`): counted once."""
@@ -177,14 +157,13 @@ class DesignSweep:
             self._ended.append(end)
             self._add_fold(end)
 
-    def _record(self, pose, q: np.ndarray, rates: list[float], out: dict) -> None:
+    def _record(self, pose, q: np.ndarray, rates: list[float], angles: list, out: dict) -> None:
         if not self.count:
             self._first = pose.value
         self.count += 1
-        for (least, largest), pressure, (_, acute, phi) in zip(self.angles, self.pressures, out["angles"]):
-            least.add(acute, pose.value, q, self._previous)
-            largest.add(acute, pose.value, q, self._previous)
-            pressure.add(phi, pose.value, q, self._previous)
+        if "crossed a fold" in pose.note:
+            self.angles.cut()
+        self.angles.add(pose.value, q, self._previous, angles, bracket=not pose.interpolated)
         if self._previous is not None and "crossed a fold" not in pose.note:
             self._step = pose.value - self._previous
         self._previous, self._previous_q = pose.value, q
@@ -271,31 +250,16 @@ class DesignSweep:
         return out
 
     def angle_extremes(self) -> list[AngleExtremes]:
-        """Each dyad's least and largest acute transmission angle and largest pressure angle
-        [deg], located between the poses (to extremum.TOL of the driver); where a trial pose
-        cannot close (a fold beside it) the value over the poses stands, `refined` False."""
+        """Each dyad's least and largest transmission angle [0, 180] deg and largest pressure
+        angle over the sweep's range, toggles, change points and folds included (angle_watch.py)."""
         self._end_fold()
         if self._extremes[0] != self.count + len(self._ended):
-            self._extremes = (self.count + len(self._ended), [self._dyad_extremes(*x) for x in
-                                           zip(self.dyads, self.angles, self.pressures)])
+            self._extremes = (self.count + len(self._ended), self.angles.extremes())
         return self._extremes[1]
 
-    def _dyad_extremes(self, dyad, angles: tuple[Tracked, Tracked], pressure: Tracked) -> AngleExtremes:
-        found, refined = [], True
-        for tracked, what in ((angles[0], "mu_acute"), (angles[1], "mu_acute"), (pressure, "pressure")):
-            try:
-                found.append(tracked.refine(lambda x, t=tracked, w=what: self._angle(dyad, t, x, w)))
-            except PinmechError:  # a trial pose beside a fold: the value over the poses stands
-                found.append((tracked.at, tracked.value))
-                refined = False
-        (low_at, low), (high_at, high), (p_at, p) = found
-        return AngleExtremes(dyad.joint.name, low, low_at, high, high_at, p, p_at, refined)
-
-    def _angle(self, dyad, tracked: Tracked, x: float, what: str) -> float:
-        """An angle of the dyad [deg] at driver value x, the pose followed from the tracked one."""
-        at, q = tracked.follow_from()
-        self.linkage.place(self.finder.pose(q, at, x))
-        return getattr(dyad_angles(self.linkage, dyad), what)
+    def _place_at(self, q0: np.ndarray, x0: float, x: float) -> None:
+        """The linkage at driver value x, the pose followed from the closed q0 at x0."""
+        self.linkage.place(self.finder.pose(q0, x0, x))
 
     def folds(self) -> list[float]:
         """The driver values of the folds the sweep met [rad or m]: where it stopped
@@ -332,11 +296,14 @@ class DesignSweep:
                  for x in loop_classes(self.linkage)]
         fmt = self._driver
         for d, x in zip(self.dyads, self.angle_extremes()):
-            what = "transmission angle (acute)" if d.kind == "pin" else "transmission angle (90 deg - pressure angle)"
+            what = "transmission angle mu" if d.kind == "pin" else "transmission angle mu = 90 deg - pressure angle"
             where = "located between" if x.refined else "over"
             lines.append(f"design: {d.name(self.linkage)}: {what} from {x.low:.6g} deg at {fmt(x.low_at)} to "
-                         f"{x.high:.6g} deg at {fmt(x.high_at)}; pressure angle up to {x.pressure:.6g} deg at "
-                         f"{fmt(x.pressure_at)} ({where} the {self.count} poses)")
+                         f"{x.high:.6g} deg at {fmt(x.high_at)}; pressure angle |90 deg - mu| up to {x.pressure:.6g} "
+                         f"deg at {fmt(x.pressure_at)} (acute mu least {x.acute_low:.6g} deg) ({where} the "
+                         f"{self.count} poses)")
+            lines += [f"design: {d.name(self.linkage)}: coupler and output in line (mu = 0 or 180 deg) at {fmt(y)}"
+                      for y in x.in_line]
         lines += [f"design: {self.sweep.driver}: fold (limit position of the driver) at {fmt(x)}"
                   for x in self.folds()]
         for output, found, stat in zip(self.outputs, self.limits(), self.advantages):
