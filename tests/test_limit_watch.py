@@ -145,3 +145,65 @@ def test_parallelogram_transmission_angle_reaches_0_and_180_at_its_change_points
     np.testing.assert_allclose([x.low, x.high, x.pressure], [0.0, 180.0, 90.0], rtol=0, atol=1e-12)
     np.testing.assert_allclose([x.low_at, x.high_at], [2 * math.pi, 3 * math.pi], rtol=0, atol=CHANGE_TOL)
     np.testing.assert_allclose(x.in_line, [2 * math.pi, 3 * math.pi], rtol=0, atol=CHANGE_TOL)
+
+
+def test_summary_json_carries_the_crank_rockers_design_at_full_precision(tmp_path, capsys):
+    """The bundled crank-rocker (a 40, b 120, c 80, d 100 mm), one turn: Barker I-2 GCRR
+    (s + l = 140 < p + q = 180, the input the shortest); the rocker's extremes where crank
+    and coupler are in line, |O2 B| = b + a and b - a, B from the circles (O2, b +- a) and
+    (O4, c); Q = alpha / beta of the crank angles between them; mu from the law of cosines
+    at theta = 0 and 180 deg (Norton §4.10) — each to 1e-9, from the JSON file."""
+    import json
+
+    from pinmech.cli import main
+
+    from .conftest import SCENES
+
+    a, b, c, d = 0.04, 0.12, 0.08, 0.10
+    out = tmp_path / "summary.json"
+    assert main(["sweep", str(SCENES / "four_bar.toml"), "--steps", "37", "--csv", str(tmp_path / "s.csv"),
+                 "--summary-json", str(out)]) == 0
+    summary = json.loads(out.read_text())
+    (loop,) = summary["loops"]
+    assert (loop["class"], loop["barker"]) == ("crank-rocker", "I-2 GCRR")
+    crank, rocker = [], []
+    for reach, flip in ((b + a, 0.0), (b - a, math.pi)):
+        x = (reach**2 - c**2 + d**2) / (2 * d)
+        B = np.array([x, math.sqrt(reach**2 - x**2)])
+        crank.append((math.atan2(B[1], B[0]) + flip) % (2 * math.pi))
+        rocker.append(math.atan2(B[1], B[0] - d))
+    (output,) = summary["outputs"]
+    np.testing.assert_allclose(sorted(x["driver_wrapped"] for x in output["limits"]), sorted(crank), rtol=0, atol=1e-9)
+    np.testing.assert_allclose(output["swing"], abs(rocker[1] - rocker[0]), rtol=0, atol=1e-9)
+    alpha = (crank[1] - crank[0]) % (2 * math.pi)
+    np.testing.assert_allclose(output["time_ratio"], max(alpha, 2 * math.pi - alpha) / min(alpha, 2 * math.pi - alpha),
+                               rtol=1e-9)
+    (dyad,) = summary["dyads"]
+    mu = [math.acos((b * b + c * c - a * a - d * d + 2 * a * d * math.cos(t)) / (2 * b * c)) for t in (0, math.pi)]
+    np.testing.assert_allclose([dyad["transmission_angle_least"], dyad["transmission_angle_largest"]], mu,
+                               rtol=0, atol=1e-12)  # flat extremes: the value to rounding
+    np.testing.assert_allclose(dyad["pressure_angle_largest"], math.pi / 2 - mu[0], rtol=0, atol=1e-12)
+    assert "Barker I-2 GCRR (input crank)" in capsys.readouterr().err
+
+
+def test_json_lines_carry_the_instant_centres(tmp_path):
+    """I13 (ground, coupler) of a four-bar is where the lines O2 A and O4 B meet (Kennedy),
+    O2, A, B, O4 from the closed form (scripts/closed_form.py) at each pose's crank angle."""
+    import json
+
+    from closed_form import four_bar
+
+    from pinmech.cli import main
+
+    from .conftest import SCENES
+
+    lines = tmp_path / "s.jsonl"
+    assert main(["sweep", str(SCENES / "four_bar.toml"), "--steps", "7", "--json", str(lines)]) == 0
+    for row in map(json.loads, lines.read_text().splitlines()):
+        fb = four_bar(row["O2"], 1.0, 0.0, 0.04, 0.12, 0.08, 0.10)
+        A, B, O4 = np.asarray(fb.A), np.asarray(fb.B), np.array([0.10, 0.0])
+        t = np.linalg.solve(np.column_stack([A, -(B - O4)]), O4)  # t A = O4 + s (B - O4)
+        centres = {tuple(x["links"]): x for x in row["design"]["instant_centres"]}
+        assert len(centres) == 6
+        # Kennedy's intersection against the closed form's: rounding over the lines' angle, 1e-9 relative
+        np.testing.assert_allclose(centres["ground", "coupler"]["position"][:2], t[0] * A, rtol=1e-9)

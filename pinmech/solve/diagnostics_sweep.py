@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pinmech.solve.diagnostics import advantage_unit
+from pinmech.solve.diagnostics import _centre_dict, advantage_unit, barker_words
 from pinmech.exceptions import DiagnosticError, PinmechError
 from pinmech.solve.angle_watch import AngleExtremes, AngleWatch
 from pinmech.solve.fold_pose import fold_pose
@@ -22,7 +22,8 @@ from pinmech.solve.grashof import loop_classes
 from pinmech.solve.limit_positions import LimitFinder, LimitPosition, extreme_label, travel
 from pinmech.solve.limit_watch import RateWatch
 from pinmech.model.planar_linkage import planar_linkage
-from pinmech.solve.transmission import dyad_angles, find_dyads, find_outputs, output_rate
+from pinmech.solve.instant_centres import instant_centres
+from pinmech.solve.transmission import dyad_angles, find_dyads, find_outputs, input_links, output_rate
 
 
 @dataclass
@@ -65,6 +66,8 @@ class DesignSweep:
         self.dyads = find_dyads(self.linkage, names)
         self.outputs = find_outputs(self.linkage, names)
         self.k = names.index(sweep.driver)
+        inputs = input_links(self.linkage, [sweep.driver])
+        self.input_link = self.linkage.names[inputs[0]] if inputs else None
         self.solver = LoopSolver(sweep.mechanism, names, **sweep.scene.solver_options())
         self.finder = LimitFinder(self.solver, self.linkage, self.k, sweep.drivers.q, self.dyads)
         self.unit = np.eye(len(names))[self.k]
@@ -102,7 +105,7 @@ class DesignSweep:
             rates = [output_rate(self.linkage, o) for o in self.outputs]
             angles = [dyad_angles(self.linkage, d) for d in self.dyads]
             out = {"angles": [(a.mu, a.mu_acute, a.pressure) for a in angles],
-                   "advantage": [math.inf if r == 0 else 1.0 / r for r in rates]}
+                   "advantage": [math.inf if r == 0 else 1.0 / r for r in rates], "qv": (q, v)}
             self._record(pose, q, rates, angles, out)
         self._cache = (pose.index, out)
         return out
@@ -207,12 +210,16 @@ class DesignSweep:
         return cells + [x if math.isfinite(x) else "inf" for x in out["advantage"]]
 
     def entry(self, pose) -> dict | None:
-        """The pose's `design` object of the JSON lines (SI: angles [rad])."""
+        """The pose's `design` object of the JSON lines (SI: angles [rad], places [m]): the
+        dyads' angles, the outputs' mechanical advantage, every instant centre."""
         out = self.evaluate(pose)
         if not out:
             return None
         names = self.linkage.names
+        self.linkage.place(*out["qv"])  # rates per unit driver rate: the centres do not depend on the speed
+        centres = instant_centres(self.linkage, velocities=True).values()
         return {
+            "instant_centres": [_centre_dict(self.linkage, c) for c in centres],
             "dyads": {d.joint.name: {"transmission_angle": math.radians(mu), "transmission_angle_acute":
                                      math.radians(acute), "pressure_angle": math.radians(phi)}
                       for d, (mu, acute, phi) in zip(self.dyads, out["angles"])},
@@ -292,8 +299,8 @@ class DesignSweep:
             return [f"design: planar diagnostics: not applicable ({self.reason})"]
         if not self.count:
             return []
-        lines = [f"design: loop {'-'.join(x.links)}: {x.kind}, {x.label} ({x.condition})"
-                 for x in loop_classes(self.linkage)]
+        lines = [f"design: loop {'-'.join(x.links)}: {x.kind}, {x.label}{barker_words(x, self.input_link)} "
+                 f"({x.condition})" for x in loop_classes(self.linkage)]
         fmt = self._driver
         for d, x in zip(self.dyads, self.angle_extremes()):
             what = "transmission angle mu" if d.kind == "pin" else "transmission angle mu = 90 deg - pressure angle"
