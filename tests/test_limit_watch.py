@@ -207,3 +207,28 @@ def test_json_lines_carry_the_instant_centres(tmp_path):
         assert len(centres) == 6
         # Kennedy's intersection against the closed form's: rounding over the lines' angle, 1e-9 relative
         np.testing.assert_allclose(centres["ground", "coupler"]["position"][:2], t[0] * A, rtol=1e-9)
+
+
+def test_a_parallelogram_that_changes_branch_at_its_change_point_says_so(tmp_path):
+    """Parallelogram a = c = 50, b = d = 100 mm drawn at 270 deg on its antiparallelogram
+    branch (B right of A -> O4), swept a turn, failing poses skipped: where it goes on as the
+    parallelogram (O2 A = O4 B: the rocker's joint angle equal to the crank's) the sweep
+    names the change point and both branches (it passed in silence at O2 = 540 deg)."""
+    scene = four_bar_files(tmp_path, 100, 50, 100, 50, 270, side="left")
+    sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(scene))
+    design = design_of(sweep)
+    was, changes = None, []
+    for pose in sweep.poses(np.radians(np.linspace(270, 630, 361)), skip_failures=True):
+        design.add(pose)
+        if pose.motion is None:
+            continue
+        joints = pose.motion.joints
+        parallel = abs(math.remainder(joints["O4"].q - joints["O2"].q, 2 * math.pi)) <= 1e-9  # O2 A = O4 B
+        if was is not None and parallel != was:
+            changes.append((pose.index, parallel))
+        was = parallel
+    notes = design.branch_notes
+    assert len(notes) == len(changes) >= 1
+    for note, (_, parallel) in zip(notes, changes):
+        now = "parallelogram" if parallel else "antiparallelogram"
+        assert f"now on its {now} branch" in note

@@ -112,6 +112,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from pinmech.solve.limits import limit_violations
     from pinmech.io.scene_model import limit_mode
     from pinmech.io.sweep import DriverValues, Sweep, sweep_options
+    from pinmech.solve.diagnostics_sweep import design_of
 
     from pinmech.io.unused_options import refuse_sweep_options
 
@@ -168,6 +169,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                 limits.check(limit_violations(sweep.mechanism, pose.motion),
                              f"at {sweep.driver} = {sweep._format(pose.value)}")
             sinks.add(pose)
+            for note in design_of(sweep).notes(pose) if design_of(sweep).applicable else []:
+                print(f"pinmech: at pose {pose.index}: {note}", file=sys.stderr)
     if sweep.fold_end is not None:
         print(f"pinmech: {sweep.driver} cannot go past {sweep._format(sweep.fold_end)} (a fold: a toggle, the end of "
               "its range of motion on this assembly): the sweep ends at the pose before it (--through-folds goes on "

@@ -234,7 +234,8 @@ class Sweep:
                     if not skip_failures:
                         raise SweepError(f"sweep stopped at {self.driver} = {self._format(value)}: {exc}",
                                          driver=self.driver, value=value, cause=exc) from exc
-                    yield SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}", fold=fold)
+                    yield SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}", fold=fold,
+                                    note=chunk.notes.get(j, ""))  # a change point passed on the way
                     continue
                 sol = chunk.solution
                 self.last_q = sol.q[j]

@@ -17,6 +17,7 @@ import numpy as np
 from pinmech.solve.diagnostics import _centre_dict, advantage_unit, barker_words
 from pinmech.exceptions import DiagnosticError, PinmechError
 from pinmech.solve.angle_watch import AngleExtremes, AngleWatch
+from pinmech.solve.change_points import BranchWatch
 from pinmech.solve.fold_pose import fold_pose
 from pinmech.solve.grashof import loop_classes
 from pinmech.solve.limit_positions import LimitFinder, LimitPosition, extreme_label, travel
@@ -72,6 +73,8 @@ class DesignSweep:
         self.finder = LimitFinder(self.solver, self.linkage, self.k, sweep.drivers.q, self.dyads)
         self.unit = np.eye(len(names))[self.k]
         self.angles = AngleWatch(self.linkage, self.dyads, self._place_at)
+        self.branches = BranchWatch(self.linkage)
+        self.branch_notes: list[str] = []  # every change of branch the sweep made, in order
         self._previous: float | None = None  # the last solved pose's driver value
         self._step: float | None = None  # the driver's last step between solved poses [rad or m]
         self._folds: list[float] = []
@@ -107,6 +110,12 @@ class DesignSweep:
             out = {"angles": [(a.mu, a.mu_acute, a.pressure) for a in angles],
                    "advantage": [math.inf if r == 0 else 1.0 / r for r in rates], "qv": (q, v)}
             self._record(pose, q, rates, angles, out)
+            self.linkage.place(q)
+            changes = self.branches.add(self._driver(pose.value))
+            self.branch_notes += changes
+            out["notes"] = changes
+            if "passed a change point" in pose.note:  # the engine's note: name the branch it kept
+                out["notes"] += [f"loop {n} after the change point: on its {f} branch" for n, f in self.branches.forms()]
         self._cache = (pose.index, out)
         return out
 
@@ -225,7 +234,12 @@ class DesignSweep:
                       for d, (mu, acute, phi) in zip(self.dyads, out["angles"])},
             "mechanical_advantage": {names[o.output]: (x if math.isfinite(x) else None)
                                      for o, x in zip(self.outputs, out["advantage"])},
+            "notes": out["notes"],
         }
+
+    def notes(self, pose) -> list[str]:
+        """What the pose's diagnostics noticed: a change of branch at a change point."""
+        return self.evaluate(pose).get("notes", [])
 
     def _unit(self, output) -> str:
         return advantage_unit(self.sweep.is_angular, output)
@@ -313,6 +327,7 @@ class DesignSweep:
                       for y in x.in_line]
         lines += [f"design: {self.sweep.driver}: fold (limit position of the driver) at {fmt(x)}"
                   for x in self.folds()]
+        lines += [f"design: {note}" for note in self.branch_notes]
         for output, found, stat in zip(self.outputs, self.limits(), self.advantages):
             name = self.linkage.names[output.output]
             lines += self._travel_lines(name, found, span)
