@@ -232,3 +232,22 @@ def test_a_parallelogram_that_changes_branch_at_its_change_point_says_so(tmp_pat
     for note, (_, parallel) in zip(notes, changes):
         now = "parallelogram" if parallel else "antiparallelogram"
         assert f"now on its {now} branch" in note
+
+
+def test_mechanical_advantage_at_a_dead_centre_is_infinite_not_rounding_noise(tmp_path):
+    """Inline slider-crank r 50, l 150 mm: x = r cos theta + sqrt(l^2 - r^2 sin^2 theta), so
+    dx/dtheta = -r sin theta (1 + r cos theta / sqrt(l^2 - r^2 sin^2 theta)): zero at theta =
+    0 and 180 deg (the advantage infinite: it was 2.4e17 at 180 deg, 1 / rounding), -r at
+    90 deg (advantage -1/r = -20 1/m)."""
+    r, l = 0.05, 0.15
+    scene = slider_crank_files(tmp_path, 50, 150, 0)
+    sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(scene))
+    design = design_of(sweep)
+    found = {}
+    for pose in sweep.poses(np.radians([0.0, 90.0, 180.0, 360.0])):
+        design.add(pose)
+        found[round(math.degrees(pose.value))] = design.evaluate(pose)["advantage"][0]
+    assert found[0] == found[180] == found[360] == math.inf
+    slope = -r * (1 + 0.0)  # at 90 deg, cos theta = 0
+    np.testing.assert_allclose(found[90], 1 / slope, rtol=1e-12)  # rates to rounding x condition (~10)
+    assert l > r

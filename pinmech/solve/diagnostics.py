@@ -19,6 +19,7 @@ import numpy as np
 from pinmech.exceptions import DiagnosticError
 from pinmech.solve.grashof import LoopClass, loop_classes
 from pinmech.solve.instant_centres import InstantCentre, instant_centres
+from pinmech.solve.limit_watch import ZERO_RATE
 from pinmech.model.planar_linkage import PlanarLinkage, planar_linkage
 from pinmech.solve.transmission import (
     Dyad,
@@ -65,8 +66,15 @@ def mechanical_advantage(linkage: PlanarLinkage, output: Output, unit_rates: np.
     """Driver rate over the output's rate at q, from the joint rates per unit driver rate
     `unit_rates` (inf where the output stops: a limit position)."""
     linkage.place(q, unit_rates)
-    rate = output_rate(linkage, output)
-    return math.inf if rate == 0 else 1.0 / rate
+    return advantage_of(output_rate(linkage, output), output, linkage.mechanism.length_scale)
+
+
+def advantage_of(rate: float, output: Output, size: float) -> float:
+    """1 / the output's rate per unit driver rate; inf where that rate is zero to rounding
+    (limit_watch.ZERO_RATE of its scale: 1 for a rocker, the mechanism's size `size` [m]
+    for a piston), a limit position: not 1 / rounding noise (2.4e17 at a dead centre)."""
+    scale = 1.0 if output.kind == "pin" else size
+    return math.inf if abs(rate) <= ZERO_RATE * scale else 1.0 / rate
 
 
 def design_at(mechanism, drivers: list[str], q: np.ndarray, v: np.ndarray, unit_rates: np.ndarray | None,

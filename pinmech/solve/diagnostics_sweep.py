@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pinmech.solve.diagnostics import _centre_dict, advantage_unit, barker_words
+from pinmech.solve.diagnostics import _centre_dict, advantage_of, advantage_unit, barker_words
 from pinmech.exceptions import DiagnosticError, PinmechError
 from pinmech.solve.angle_watch import AngleExtremes, AngleWatch
 from pinmech.solve.change_points import BranchWatch
@@ -108,7 +108,7 @@ class DesignSweep:
             rates = [output_rate(self.linkage, o) for o in self.outputs]
             angles = [dyad_angles(self.linkage, d) for d in self.dyads]
             out = {"angles": [(a.mu, a.mu_acute, a.pressure) for a in angles],
-                   "advantage": [math.inf if r == 0 else 1.0 / r for r in rates], "qv": (q, v)}
+                   "advantage": [advantage_of(r, o, self.sweep.mechanism.length_scale) for r, o in zip(rates, self.outputs)], "qv": (q, v)}
             self._record(pose, q, rates, angles, out)
             self.linkage.place(q)
             changes = self.branches.add(self._driver(pose.value))
