@@ -251,3 +251,13 @@ def test_mechanical_advantage_at_a_dead_centre_is_infinite_not_rounding_noise(tm
     slope = -r * (1 + 0.0)  # at 90 deg, cos theta = 0
     np.testing.assert_allclose(found[90], 1 / slope, rtol=1e-12)  # rates to rounding x condition (~10)
     assert l > r
+
+
+@pytest.mark.parametrize("e, label", [(99.0, "crank"), (100.0, "change point"), (101.0, "rocker")])
+def test_slider_crank_class_at_the_edge_r_plus_e_equals_l(e, label):
+    """r 50, l 150 mm: the rod reaches the slide's line from every crank pin iff r + |e| <= l;
+    at r + |e| = l it is normal to the slide at theta = -90 deg, a singular pose the crank
+    cannot be driven through: a change point, not a crank (it was called 'crank')."""
+    from pinmech.solve.grashof import slider_crank_class
+
+    assert slider_crank_class(0.05, 0.15, e / 1000)[0] == label

@@ -98,9 +98,13 @@ def four_bar_class(d: float, a: float, b: float, c: float) -> tuple[str, str, tu
 
 
 def slider_crank_class(r: float, l: float, e: float) -> tuple[str, str]:
-    """Whether a slider-crank's crank turns fully: r + |e| <= l. Lengths [m]."""
+    """Whether a slider-crank's crank turns fully: r + |e| < l; at r + |e| = l (within
+    EQUAL) the rod falls normal to the slide once a turn, a singular pose the crank cannot
+    be driven through (a change point). Lengths [m]."""
     reach = r + abs(e)
-    if reach <= l * (1 + EQUAL):
+    if abs(reach - l) <= EQUAL * (r + l + abs(e)):
+        return "change point", f"r + |e| = {reach:.6g} m = l = {l:.6g} m"
+    if reach < l:
         return "crank", f"r + |e| = {reach:.6g} m <= l = {l:.6g} m"
     return "rocker", f"r + |e| = {reach:.6g} m > l = {l:.6g} m"
 
