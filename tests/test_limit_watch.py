@@ -261,3 +261,21 @@ def test_slider_crank_class_at_the_edge_r_plus_e_equals_l(e, label):
     from pinmech.solve.grashof import slider_crank_class
 
     assert slider_crank_class(0.05, 0.15, e / 1000)[0] == label
+
+
+def test_a_pose_exactly_on_a_change_point_does_not_stop_the_sweep(tmp_path):
+    """The parallelogram a = c = 50, b = d = 100 mm on its parallelogram branch, swept a turn
+    from 270 deg in 1 deg steps, has poses exactly on its change points, theta = 360 and
+    540 deg (all pins in line: the crossing of the two branches, its rates undefined). They
+    are failed rows, named, and the sweep goes on (it stopped there, exit 7); every other
+    pose is the parallelogram, O2 A = O4 B: the rocker's joint angle equal to the crank's."""
+    scene = four_bar_files(tmp_path, 100, 50, 100, 50, 270, side="right")
+    sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(scene))
+    poses = list(sweep.poses(np.radians(np.linspace(270, 630, 361))))
+    failed = [round(math.degrees(p.value)) for p in poses if p.motion is None]
+    assert failed == [360, 540]
+    assert all("change point" in p.note for p in poses if p.motion is None)
+    for p in poses:
+        if p.motion is not None:
+            gap = math.remainder(p.motion.joints["O4"].q - p.motion.joints["O2"].q, 2 * math.pi)
+            assert abs(gap) <= 1e-9, (math.degrees(p.value), gap)  # closure to 1e-13, conditioned ~1e3 near

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from pinmech.arguments import instance_of, real_number
-from pinmech.exceptions import DriverLimitError, ModelError, SceneError, SweepError
+from pinmech.exceptions import AssemblyError, DriverLimitError, ModelError, SceneError, SingularPoseError, SweepError
 from pinmech.model.mechanism import Mechanism
 from pinmech.solve.motion import Motion, evaluate_motion
 from pinmech.solve.results import Accuracy
@@ -34,6 +34,10 @@ from pinmech.io.scene_model import (
 )
 from pinmech.solve.cycle import RangeChunk, solve_range
 from pinmech.solve.loops import LoopSolver
+
+_SINGULAR_PASSED = ("a singular pose the sweep went on past (a change point: the crossing of two branches, where "
+                    "no assembly can be told and the rates are undefined): written as a failed row")
+
 
 @dataclass(frozen=True)
 class SweepPose:
@@ -218,10 +222,14 @@ class Sweep:
             points = list(dict.fromkeys([*(self.mechanism.points if points is None else points), *self.extra_points]))
         coincident = coincident_points(self.scene)
         self.fold_end = None
+        held: tuple[SweepPose, SweepError] | None = None  # a singular pose, written if the sweep goes on past it
         for chunk in self.chunks(values, start=start, batch=batch, interpolate=interpolate,
                                  through_folds=through_folds):
             for j, value in enumerate(chunk.values.tolist()):
                 index = chunk.start + j
+                if held is not None and j not in chunk.errors:
+                    yield held[0]
+                    held = None
                 if j in chunk.errors:
                     exc = chunk.errors[j]
                     self.last_q = None  # the sweep did not end on a solved pose (return_gap: NaN)
@@ -231,9 +239,15 @@ class Sweep:
                     if to_fold and fold is not None and not skip_failures and index > 0:
                         self.fold_end = fold
                         return
+                    stop = SweepError(f"sweep stopped at {self.driver} = {self._format(value)}: {exc}",
+                                      driver=self.driver, value=value, cause=exc)
+                    if not skip_failures and held is None and index > 0 and fold is None \
+                            and isinstance(exc, (SingularPoseError, AssemblyError)):  # a change point's own pose: kept if the next one closes
+                        held = (SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}",
+                                          note=_SINGULAR_PASSED), stop)
+                        continue
                     if not skip_failures:
-                        raise SweepError(f"sweep stopped at {self.driver} = {self._format(value)}: {exc}",
-                                         driver=self.driver, value=value, cause=exc) from exc
+                        raise held[1] if held is not None else stop from exc
                     yield SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}", fold=fold,
                                     note=chunk.notes.get(j, ""))  # a change point passed on the way
                     continue
@@ -246,6 +260,8 @@ class Sweep:
                                              points=points, links=links, coincident=coincident)
                 yield SweepPose(index, value, motion, sol.accuracy(j), interpolated=bool(chunk.interpolated[j]),
                                 note=chunk.notes.get(j, ""))
+        if held is not None:
+            raise held[1]
 
     def need_points(self, names) -> None:
         """Evaluate these frames (a drawn linkage's pins, by name) at every pose as well, for a
