@@ -69,11 +69,13 @@ def test_a_singular_pose_the_sweep_goes_past_is_a_failed_row_naming_its_angle(tm
     change point of the inverted slider-crank, r = d). The pose is a failed row saying so
     and the sweep goes on past it; a singular pose it cannot go past (the last) stops it."""
     sweep = Sweep.from_scene(_singular_scene(tmp_path, models_dir))
-    poses = list(sweep.poses(np.radians([-20.0, -10.0, 0.0, 10.0])))
+    with pytest.raises(SweepError, match=r"sweep stopped at A = 0 deg"):  # any failure stops a sweep by default
+        list(sweep.poses(np.radians([-20.0, -10.0, 0.0, 10.0])))
+    poses = list(sweep.poses(np.radians([-20.0, -10.0, 0.0, 10.0]), past_change_points=True))
     assert [p.motion is None for p in poses] == [False, False, True, False]
     assert "A = 0 deg" in poses[2].error and "change point" in poses[2].note
     with pytest.raises(SweepError, match=r"sweep stopped at A = 0 deg") as info:
-        list(sweep.poses(np.radians([-20.0, -10.0, 0.0])))
+        list(sweep.poses(np.radians([-20.0, -10.0, 0.0]), past_change_points=True))
     assert info.value.value == 0.0 and info.value.exit_code == 7
 
 

@@ -152,7 +152,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     interpolate = interpolating.value
     poses = sweep.poses(DriverValues(start, stop, steps), skip_failures=args.skip_failures,
                         start=mode or "predictor", batch=not args.no_batch and options.get("batch", True),
-                        interpolate=interpolate, through_folds=args.through_folds, to_fold=not args.through_folds)
+                        interpolate=interpolate, through_folds=args.through_folds, to_fold=not args.through_folds,
+                        past_change_points=True)
     forces = _sweep_forces(args, scene, sweep)
     if forces is not None and interpolate and interpolate > 1:  # before any pose is computed
         raise interpolating.error(f"{interpolate}: forces need solved poses, and interpolated ones' rates miss the "

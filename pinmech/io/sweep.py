@@ -185,7 +185,7 @@ class Sweep:
     def poses(self, values: Iterable[float], *, skip_failures: bool = False, start: str = "predictor",
               batch: bool = True, interpolate: int = 1, warm_start: bool | None = None,
               predictor: bool | None = None, through_folds: bool = False,
-              to_fold: bool = False) -> Iterator[SweepPose]:
+              to_fold: bool = False, past_change_points: bool = False) -> Iterator[SweepPose]:
         """Solve the poses one after the other, each from the previous one (lazy).
 
         Args:
@@ -208,6 +208,9 @@ class Sweep:
             to_fold: at a fold of the driver (without through_folds), end the sweep at the
                 last pose before it: a rocker driven to its toggle has reached the end of its
                 range of motion on this assembly, not an error (`fold_end` says where).
+            past_change_points: a pose exactly on a change point (singular, or on both
+                assemblies at once) becomes a failed row with a note when the pose after it
+                closes, and the sweep goes on (without: it stops the sweep, as any failure).
 
         Raises:
             SweepError: a pose where the loop cannot close or the Jacobian is singular,
@@ -241,7 +244,7 @@ class Sweep:
                         return
                     stop = SweepError(f"sweep stopped at {self.driver} = {self._format(value)}: {exc}",
                                       driver=self.driver, value=value, cause=exc)
-                    if not skip_failures and held is None and index > 0 and fold is None \
+                    if past_change_points and not skip_failures and held is None and index > 0 and fold is None \
                             and isinstance(exc, (SingularPoseError, AssemblyError)):  # a change point's own pose: kept if the next one closes
                         held = (SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}",
                                           note=_SINGULAR_PASSED), stop)
