@@ -279,3 +279,27 @@ def test_a_pose_exactly_on_a_change_point_does_not_stop_the_sweep(tmp_path):
         if p.motion is not None:
             gap = math.remainder(p.motion.joints["O4"].q - p.motion.joints["O2"].q, 2 * math.pi)
             assert abs(gap) <= 1e-9, (math.degrees(p.value), gap)  # closure to 1e-13, conditioned ~1e3 near
+
+
+# Barker's table (Norton table 2-4) read off the lengths (d ground, a input, b coupler, c output):
+# Grashof (s + l < p + q) by the shortest link, non-Grashof by the longest, special Grashof
+# (s + l = p + q) by the shortest, or two equal pairs (S2X).
+BARKER = [
+    ((40, 90, 110, 100), "O2", "I-1 GCCC"),  # 40 + 110 < 190, the ground shortest
+    ((100, 40, 120, 80), "O2", "I-2 GCRR"),  # 40 + 120 < 180, the input shortest
+    ((100, 80, 40, 90), "O2", "I-3 GRCR"),  # 40 + 100 < 170, the coupler shortest
+    ((100, 40, 120, 80), "O4", "I-4 GRRC"),  # the crank-rocker driven at its rocker: the output shortest
+    ((100, 45, 50, 55), "O2", "II-1 RRR1"),  # 45 + 100 > 105, the ground longest
+    ((100, 40, 120, 60), "O2", "III-2 SCRR"),  # 40 + 120 = 160 = 100 + 60, the input shortest
+    ((100, 50, 100, 50), "O2", "III-5 S2X"),  # two equal pairs
+]
+
+
+@pytest.mark.parametrize("lengths, driver, code", BARKER, ids=[b[2] for b in BARKER])
+def test_barker_type_from_the_link_lengths_with_the_driver_as_link_2(tmp_path, lengths, driver, code):
+    from pinmech.solve.grashof import loop_classes
+    from pinmech.model.planar_linkage import planar_linkage
+
+    four_bar_files(tmp_path, *lengths, 60)
+    (loop,) = loop_classes(planar_linkage(pinmech.load_linkage(tmp_path / "fb.toml")))
+    assert loop.barker({"O2": "crank", "O4": "rocker"}[driver]) == code
