@@ -343,7 +343,9 @@ class DesignSweep:
         t = travel(found, span)
         fmt, lines = self._driver, []
         for x in t.limits:
-            value = f"{math.degrees(x.value):.6g} deg" if x.kind == "rocker extreme" else f"{x.value:.6g} m"
+            value = f"{math.degrees(x.value):.6g} deg" if x.kind == "rocker extreme" else f"{x.value:.6g} m along the slide"
+            if x.slide is not None:
+                value += f" (slide coordinate s = {x.slide:.6g} m, as the CSV)"
             lay = f", driving link and coupler {x.toggle} (toggle)" if x.toggle else ""
             lines.append(f"design: {name}: {x.kind} ({x.label}) {value} at {fmt(x.driver)}{lay}")
         if t.travel is not None:
