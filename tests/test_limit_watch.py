@@ -303,3 +303,19 @@ def test_barker_type_from_the_link_lengths_with_the_driver_as_link_2(tmp_path, l
     four_bar_files(tmp_path, *lengths, 60)
     (loop,) = loop_classes(planar_linkage(pinmech.load_linkage(tmp_path / "fb.toml")))
     assert loop.barker({"O2": "crank", "O4": "rocker"}[driver]) == code
+
+
+def test_a_crank_rocker_driven_at_its_rocker_stops_where_crank_and_coupler_fold(tmp_path):
+    """The crank-rocker a 40, b 120, c 80, d 100 mm driven at its rocker (Barker GRRC): the
+    rocker cannot pass the toggle where crank and coupler fold, |O2 B| = b - a; its angle
+    there from the triangle O2 O4 B, 180 deg - acos((c^2 + d^2 - (b - a)^2) / (2 c d)) =
+    128.682 deg. The dyad coupler-crank at A has mu = 0 there (folded), pressure angle 90."""
+    a, b, c, d = 40, 120, 80, 100
+    fold = 180 - math.degrees(math.acos((c * c + d * d - (b - a) ** 2) / (2 * c * d)))
+    four_bar_files(tmp_path, d, a, b, c, 0)
+    scene = tmp_path / "rocker_scene.toml"
+    scene.write_text('title = "fb"\nlinkage = "fb.toml"\n[drivers.O4]\nangle = "97 deg"\nspeed = "60 rpm"\n')
+    _, design = swept(scene, 97, 457, 73, skip_failures=True)
+    (x,) = design.angle_extremes()
+    np.testing.assert_allclose([x.low, x.pressure], [0.0, 90.0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(math.degrees(x.low_at), fold, rtol=0, atol=FOLD_TOL_DEG)
