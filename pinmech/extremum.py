@@ -28,16 +28,25 @@ class Tracked:
     q: np.ndarray | None = None
     before: float | None = None
     after: float | None = None
+    origin: tuple[float, np.ndarray] | None = None  # where poses near `at` are followed from, if not (at, q)
 
     def __post_init__(self) -> None:
         self.value = self.sign * math.inf  # worse than any value
 
-    def add(self, value: float, at: float, q: np.ndarray, previous: float | None) -> None:
-        """A solved pose (driver value `at`, the previous solved pose's `previous`)."""
+    def add(self, value: float, at: float, q: np.ndarray, previous: float | None,
+            origin: tuple[float, np.ndarray] | None = None) -> None:
+        """A solved pose (driver value `at`, the previous solved pose's `previous`); `origin`
+        (driver value, closed q): where to follow poses near it from, for a pose no path
+        leaves (a fold: the driver's end of travel)."""
         if self.q is not None and self.after is None and previous is not None and self.at == previous:
             self.after = at
         if self.sign * value < self.sign * self.value:
             self.value, self.at, self.q, self.before, self.after = value, at, q.copy(), previous, None
+            self.origin = origin
+
+    def follow_from(self) -> tuple[float, np.ndarray]:
+        """(driver value, closed q) that trial poses near the extreme are followed from."""
+        return self.origin if self.origin is not None else (self.at, self.q)
 
     def refine(self, f: Callable[[float], float]) -> tuple[float, float]:
         """(driver value, value) of the extreme of f between the poses around it, by golden

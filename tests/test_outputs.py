@@ -49,7 +49,7 @@ def test_a_sweep_failing_at_its_first_pose_leaves_an_existing_csv_as_it_was(sing
 def test_a_sweep_failing_midway_keeps_its_rows_as_partial_files_that_agree(singular_at_zero, tmp_path, capsys):
     out, lines = tmp_path / "a.csv", tmp_path / "a.jsonl"
     out.write_text("old\n")
-    code = main(["sweep", str(singular_at_zero), "--from", "-20 deg", "--to", "10 deg", "--steps", "7",
+    code = main(["sweep", str(singular_at_zero), "--from", "-20 deg", "--to", "0 deg", "--steps", "5",
                  "--csv", str(out), "--json", str(lines)])
     assert code == 7
     err = capsys.readouterr().err
@@ -214,7 +214,7 @@ def test_a_figure_that_cannot_be_a_file_is_refused_in_one_line(singular_at_zero,
 
 
 def test_rows_sent_to_standard_output_end_with_a_mark_when_the_run_stops(singular_at_zero, capsys):
-    assert main(["sweep", str(singular_at_zero), "--from", "-20 deg", "--to", "10 deg", "--steps", "7"]) == 7
+    assert main(["sweep", str(singular_at_zero), "--from", "-20 deg", "--to", "0 deg", "--steps", "5"]) == 7
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == 1 + 4 + 1  # header, the 4 poses before 0 deg, the mark
     assert lines[-1].startswith("INCOMPLETE: pinmech stopped before the last row (sweep stopped at A = 0 deg")

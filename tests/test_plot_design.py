@@ -40,13 +40,12 @@ def _panel(fig, start: str):
 
 
 def _four_bar_mu(theta_deg: np.ndarray, a, b, c, d) -> np.ndarray:
-    """Norton §4.10: cos mu = (b² + c² - a² - d² + 2 a d cos theta) / (2 b c), acute form [deg]."""
+    """Norton §4.10: cos mu = (b² + c² - a² - d² + 2 a d cos theta) / (2 b c), mu on [0, 180] deg."""
     cos_mu = (b**2 + c**2 - a**2 - d**2 + 2 * a * d * np.cos(np.radians(theta_deg))) / (2 * b * c)
-    mu = np.degrees(np.arccos(cos_mu))
-    return np.minimum(mu, 180 - mu)
+    return np.degrees(np.arccos(cos_mu))
 
 
-# (d, a, b, c) [mm] and the crank angle where the acute angle is least: the diagonal O4 A
+# (d, a, b, c) [mm] and the crank angle where mu is farthest from 90 deg: the diagonal O4 A
 # is shortest (theta 0) or longest (theta 180), and mu is farthest from 90 deg at one of them.
 FOUR_BARS = [((100, 40, 120, 80), "crank-rocker"), ((40, 90, 110, 100), "double-crank")]
 
@@ -65,7 +64,7 @@ def test_least_transmission_angle_is_marked_where_the_law_of_cosines_puts_it(fig
     (least,) = [line for line in ax.get_lines() if line.get_gid() == "least transmission angle"]
     (at,), (mu,) = least.get_data()
     extremes = np.array([0.0, 180.0])
-    where = extremes[np.argmin(_four_bar_mu(extremes, a, b, c, d))]
+    where = extremes[np.argmax(abs(90.0 - _four_bar_mu(extremes, a, b, c, d)))]
     assert abs((at - where + 180) % 360 - 180) < LEAST_AT_TOL_DEG
     np.testing.assert_allclose(mu, _four_bar_mu(np.array([where]), a, b, c, d)[0], rtol=0, atol=ANGLE_TOL_DEG)
     assert any(f"μ = {mu:.1f}°" in t.get_text() for t in ax.get_legend().get_texts())

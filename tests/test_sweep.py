@@ -65,11 +65,18 @@ def _singular_scene(tmp_path, models_dir):
     return Scene.load(scene)
 
 
-def test_a_singular_pose_stops_the_sweep_naming_its_angle(tmp_path, models_dir):
-    """AB = AC: at phi = 0 the block sits on C and the guide's direction is undefined."""
+def test_a_singular_pose_the_sweep_goes_past_is_a_failed_row_naming_its_angle(tmp_path, models_dir):
+    """AB = AC: at phi = 0 the block sits on C and the guide's direction is undefined (a
+    change point of the inverted slider-crank, r = d). The pose is a failed row saying so
+    and the sweep goes on past it; a singular pose it cannot go past (the last) stops it."""
     sweep = Sweep.from_scene(_singular_scene(tmp_path, models_dir))
-    with pytest.raises(SweepError, match=r"sweep stopped at A = 0 deg") as info:
+    with pytest.raises(SweepError, match=r"sweep stopped at A = 0 deg"):  # any failure stops a sweep by default
         list(sweep.poses(np.radians([-20.0, -10.0, 0.0, 10.0])))
+    poses = list(sweep.poses(np.radians([-20.0, -10.0, 0.0, 10.0]), past_change_points=True))
+    assert [p.motion is None for p in poses] == [False, False, True, False]
+    assert "A = 0 deg" in poses[2].error and "change point" in poses[2].note
+    with pytest.raises(SweepError, match=r"sweep stopped at A = 0 deg") as info:
+        list(sweep.poses(np.radians([-20.0, -10.0, 0.0]), past_change_points=True))
     assert info.value.value == 0.0 and info.value.exit_code == 7
 
 
@@ -116,7 +123,7 @@ def test_cli_range_in_users_units(r_rtr_scene, capsys):
 
 def test_cli_failure_exit_code_names_the_angle(tmp_path, models_dir, capsys):
     scene = _singular_scene(tmp_path, models_dir)
-    assert main(["sweep", str(scene.path), "--from", "-20 deg", "--to", "20 deg", "--steps", "5"]) == 7
+    assert main(["sweep", str(scene.path), "--from", "-20 deg", "--to", "0 deg", "--steps", "5"]) == 7
     assert "sweep stopped at A = 0 deg" in capsys.readouterr().err
 
 

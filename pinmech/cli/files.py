@@ -20,7 +20,8 @@ def check_outputs(args: argparse.Namespace, scene) -> Path | None:
     torque = getattr(args, "torque_plot", None)
     check_distinct({"--csv": args.csv_path, "--json": args.json_path, "--plot": figure,
                     "--paths": getattr(args, "paths_path", None),
-                    "--torque-plot": plot_path(torque, "--torque-plot") if torque else None},
+                    "--torque-plot": plot_path(torque, "--torque-plot") if torque else None,
+                    "--summary-json": getattr(args, "summary_json", None)},
                    inputs_of(scene))
     return figure
 

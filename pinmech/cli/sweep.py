@@ -50,6 +50,9 @@ def add_parser(sub) -> None:
     sweep.add_argument("--path-plane", choices=("xy", "yz", "zx", "3d"),
                        help="a spatial mechanism's paths projected on this world plane (default xy), or 3d")
     add_limits_argument(sweep)
+    sweep.add_argument("--summary-json", dest="summary_json", metavar="FILE",
+                       help="also write the design summary (Grashof and Barker class, transmission and pressure "
+                       "angle extremes, folds, limit positions, swing or stroke, Q) here as JSON, SI, full precision")
     sweep.add_argument("--skip-failures", action="store_true",
                        help="report a pose that cannot close as a row with its error instead of stopping")
     sweep.add_argument("--start", dest="start_mode", choices=("predictor", "warm", "cold"),
@@ -109,6 +112,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from pinmech.solve.limits import limit_violations
     from pinmech.io.scene_model import limit_mode
     from pinmech.io.sweep import DriverValues, Sweep, sweep_options
+    from pinmech.solve.diagnostics_sweep import design_of
 
     from pinmech.io.unused_options import refuse_sweep_options
 
@@ -148,7 +152,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     interpolate = interpolating.value
     poses = sweep.poses(DriverValues(start, stop, steps), skip_failures=args.skip_failures,
                         start=mode or "predictor", batch=not args.no_batch and options.get("batch", True),
-                        interpolate=interpolate, through_folds=args.through_folds)
+                        interpolate=interpolate, through_folds=args.through_folds, to_fold=not args.through_folds,
+                        past_change_points=True)
     forces = _sweep_forces(args, scene, sweep)
     if forces is not None and interpolate and interpolate > 1:  # before any pose is computed
         raise interpolating.error(f"{interpolate}: forces need solved poses, and interpolated ones' rates miss the "
@@ -165,12 +170,20 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                 limits.check(limit_violations(sweep.mechanism, pose.motion),
                              f"at {sweep.driver} = {sweep._format(pose.value)}")
             sinks.add(pose)
+            for note in design_of(sweep).notes(pose) if design_of(sweep).applicable else []:
+                print(f"pinmech: at pose {pose.index}: {note}", file=sys.stderr)
+    if sweep.fold_end is not None:
+        print(f"pinmech: {sweep.driver} cannot go past {sweep._format(sweep.fold_end)} (a fold: a toggle, the end of "
+              "its range of motion on this assembly): the sweep ends at the pose before it (--through-folds goes on "
+              "onto the other branch, the driver turning back)", file=sys.stderr)
     for line in forces.summary() if forces else []:
         print(line, file=sys.stderr)
     for line in _design_summary(sweep, stop - start, args.through_folds):
         print(line, file=sys.stderr)
+    if args.summary_json:
+        _write_summary(args.summary_json, sweep, stop - start, args.through_folds)
     limits.summary(steps)
-    if not args.through_folds:  # past a fold the driver turns back: no whole turns to speak of
+    if not args.through_folds and sweep.fold_end is None:  # past a fold the driver turns back: no whole turns
         _say_return(sweep, stop - start)
     return 0
 
@@ -188,12 +201,28 @@ def _timing_step(args: argparse.Namespace, scene, kind: str) -> float | None:
 def _design_summary(sweep, span: float, through_folds: bool) -> list[str]:
     """The sweep's design diagnostics (docs/howto/diagnostics.md); the time ratio when the
     driver made exactly one turn."""
-    import math
-
     from pinmech.solve.diagnostics_sweep import design_of
 
-    turn = sweep.is_angular and not through_folds and abs(abs(span) - 2 * math.pi) <= 1e-9
-    return design_of(sweep).summary(2 * math.pi if turn else None)
+    return design_of(sweep).summary(_one_turn(sweep, span, through_folds))
+
+
+def _one_turn(sweep, span: float, through_folds: bool) -> float | None:
+    """2 pi when the sweep was one whole turn of an angular driver (then Q), else None."""
+    import math
+
+    turn = sweep.is_angular and not through_folds and sweep.fold_end is None and abs(abs(span) - 2 * math.pi) <= 1e-9
+    return 2 * math.pi if turn else None
+
+
+def _write_summary(path: str, sweep, span: float, through_folds: bool) -> None:
+    """--summary-json: the design summary, whole (design_summary.py)."""
+    import json
+
+    from pinmech.cli.files import write_text
+    from pinmech.solve.design_summary import design_summary
+
+    text = json.dumps(design_summary(sweep, _one_turn(sweep, span, through_folds)), indent=1, allow_nan=False)
+    write_text(path, text + "\n", "design summary")
 
 
 def _say_return(sweep, span: float) -> None:

@@ -35,7 +35,7 @@ if TYPE_CHECKING:
     from pinmech.io.sweep import Sweep, SweepPose
 
 MAX_POINTS = 20_000
-#: The panel of Norton's transmission angles (acute, 90 deg best) of a planar linkage's dyads.
+#: The panel of the transmission angles (0..180 deg, 90 best) of a planar linkage's dyads.
 TRANSMISSION = "transmission angle, μ [deg]"
 
 

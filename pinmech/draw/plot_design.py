@@ -1,9 +1,9 @@
 """What the sweep figures draw of the design diagnostics (pinmech.solve.diagnostics_sweep): each dyad's
-transmission angle (Norton's acute mu [deg]) with its least value marked, and the limit
+transmission angle (mu on [0, 180] deg, 90 best) with its value farthest from 90 deg marked, and the limit
 positions of the outputs (rocker extremes, dead centres, the toggles at them) as vertical
 lines in every panel and as ghost outlines of the mechanism in the paths figure.
 
-The least angle is the design summary's (`DesignSweep.angle_extremes`: refined by golden
+The marked angle is the design summary's (`DesignSweep.angle_extremes`: refined by golden
 section between the poses on either side of it, to extremum.TOL); where a trial pose cannot
 close (a fold beside it) the least over the poses stands and the figure says so.
 """
@@ -20,8 +20,8 @@ from pinmech.angles import position_text
 
 @dataclass(frozen=True)
 class LeastAngle:
-    """A dyad's least transmission angle: `mu` [deg] at driver value `at` [rad or m];
-    `refined` False where it is the least over the poses only."""
+    """A dyad's transmission angle farthest from 90 deg (its worst): `mu` [deg, 0..180] at
+    driver value `at` [rad or m]; `refined` False where it is the worst over the poses only."""
 
     name: str
     mu: float
@@ -48,11 +48,11 @@ class DesignTrace:
         return [d.joint.name for d in self.dyads]
 
     def add(self, pose, q: np.ndarray | None) -> list[float]:
-        """The acute transmission angle of each dyad at a pose [deg] (NaN where it failed)."""
+        """The transmission angle of each dyad at a pose [deg, 0..180] (NaN where it failed)."""
         out = self.design.evaluate(pose)
         if not out or q is None:
             return [math.nan] * len(self.dyads)
-        return [acute for _, acute, _ in out["angles"]]
+        return [mu for mu, _, _ in out["angles"]]
 
     def least(self) -> list[LeastAngle]:
         """Each dyad's least transmission angle, located between the poses around it by the
@@ -60,7 +60,8 @@ class DesignTrace:
         does not change (a slot through its lever's pivot: mu = 90 deg throughout)."""
         if not self.dyads or not self.design.count:
             return []
-        return [LeastAngle(x.name, x.low, x.low_at, x.refined) for x in self.design.angle_extremes()
+        return [LeastAngle(x.name, *((x.low, x.low_at) if 90.0 - x.low >= x.high - 90.0 else (x.high, x.high_at)),
+                           x.refined) for x in self.design.angle_extremes()
                 if x.high - x.low > 1e-9 * 180.0]  # below: rounding about a constant
 
     def limits(self) -> list[tuple[str, float, np.ndarray]]:
@@ -79,7 +80,7 @@ class DesignTrace:
 def mark_least(ax, least: LeastAngle, x: float, colour: str, label: str, unit: str = "°") -> None:
     """The least transmission angle on its panel: a triangle and a legend entry (x as
     drawn, in `unit`)."""
-    word = "least" if least.refined else "least over the poses"
+    word = "farthest from 90°" if least.refined else "farthest from 90° over the poses"
     ax.plot([x], [least.mu], "v", color=colour, markersize=8, markeredgecolor="0.1", zorder=6, clip_on=False,
             gid="least transmission angle", label=f"{label}: {word} μ = {least.mu:.1f}° at {unit_x(x, unit)}")
 

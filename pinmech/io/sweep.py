@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from pinmech.arguments import instance_of, real_number
-from pinmech.exceptions import DriverLimitError, ModelError, SceneError, SweepError
+from pinmech.exceptions import AssemblyError, DriverLimitError, ModelError, SceneError, SingularPoseError, SweepError
 from pinmech.model.mechanism import Mechanism
 from pinmech.solve.motion import Motion, evaluate_motion
 from pinmech.solve.results import Accuracy
@@ -34,6 +34,10 @@ from pinmech.io.scene_model import (
 )
 from pinmech.solve.cycle import RangeChunk, solve_range
 from pinmech.solve.loops import LoopSolver
+
+_SINGULAR_PASSED = ("a singular pose the sweep went on past (a change point: the crossing of two branches, where "
+                    "no assembly can be told and the rates are undefined): written as a failed row")
+
 
 @dataclass(frozen=True)
 class SweepPose:
@@ -131,6 +135,7 @@ class Sweep:
     last_q: np.ndarray | None = None  # configuration of the last pose, None if it failed (drawings, return_gap)
     first_q: np.ndarray | None = None  # configuration of the first pose, None if it failed
     extra_points: tuple[str, ...] = ()  # frames a figure draws beyond the reported points (need_points)
+    fold_end: float | None = None  # where a sweep `to_fold` ended: the driver's fold [rad or m]
 
     @classmethod
     def from_scene(cls, scene: Scene, driver: str | None = None) -> Sweep:
@@ -179,7 +184,8 @@ class Sweep:
 
     def poses(self, values: Iterable[float], *, skip_failures: bool = False, start: str = "predictor",
               batch: bool = True, interpolate: int = 1, warm_start: bool | None = None,
-              predictor: bool | None = None, through_folds: bool = False) -> Iterator[SweepPose]:
+              predictor: bool | None = None, through_folds: bool = False,
+              to_fold: bool = False, past_change_points: bool = False) -> Iterator[SweepPose]:
         """Solve the poses one after the other, each from the previous one (lazy).
 
         Args:
@@ -199,6 +205,12 @@ class Sweep:
                 branch with the driver turning back, values past the fold mirrored at it
                 (a whole coupler curve of a non-Grashof linkage); the pose after it carries
                 a note. Without it, the poses past a fold fail with DriverLimitError.
+            to_fold: at a fold of the driver (without through_folds), end the sweep at the
+                last pose before it: a rocker driven to its toggle has reached the end of its
+                range of motion on this assembly, not an error (`fold_end` says where).
+            past_change_points: a pose exactly on a change point (singular, or on both
+                assemblies at once) becomes a failed row with a note when the pose after it
+                closes, and the sweep goes on (without: it stops the sweep, as any failure).
 
         Raises:
             SweepError: a pose where the loop cannot close or the Jacobian is singular,
@@ -212,19 +224,35 @@ class Sweep:
         if self.extra_points:  # the reported points (None: every point), then the frames a figure draws
             points = list(dict.fromkeys([*(self.mechanism.points if points is None else points), *self.extra_points]))
         coincident = coincident_points(self.scene)
+        self.fold_end = None
+        held: tuple[SweepPose, SweepError] | None = None  # a singular pose, written if the sweep goes on past it
         for chunk in self.chunks(values, start=start, batch=batch, interpolate=interpolate,
                                  through_folds=through_folds):
             for j, value in enumerate(chunk.values.tolist()):
                 index = chunk.start + j
+                if held is not None and j not in chunk.errors:
+                    yield held[0]
+                    held = None
                 if j in chunk.errors:
                     exc = chunk.errors[j]
                     self.last_q = None  # the sweep did not end on a solved pose (return_gap: NaN)
                     if index == 0:
                         self.first_q = None
+                    fold = self._fold(exc)
+                    if to_fold and fold is not None and not skip_failures and index > 0:
+                        self.fold_end = fold
+                        return
+                    stop = SweepError(f"sweep stopped at {self.driver} = {self._format(value)}: {exc}",
+                                      driver=self.driver, value=value, cause=exc)
+                    if past_change_points and not skip_failures and held is None and index > 0 and fold is None \
+                            and isinstance(exc, (SingularPoseError, AssemblyError)):  # a change point's own pose: kept if the next one closes
+                        held = (SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}",
+                                          note=_SINGULAR_PASSED), stop)
+                        continue
                     if not skip_failures:
-                        raise SweepError(f"sweep stopped at {self.driver} = {self._format(value)}: {exc}",
-                                         driver=self.driver, value=value, cause=exc) from exc
-                    yield SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}", fold=self._fold(exc))
+                        raise held[1] if held is not None else stop from exc
+                    yield SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}", fold=fold,
+                                    note=chunk.notes.get(j, ""))  # a change point passed on the way
                     continue
                 sol = chunk.solution
                 self.last_q = sol.q[j]
@@ -235,6 +263,8 @@ class Sweep:
                                              points=points, links=links, coincident=coincident)
                 yield SweepPose(index, value, motion, sol.accuracy(j), interpolated=bool(chunk.interpolated[j]),
                                 note=chunk.notes.get(j, ""))
+        if held is not None:
+            raise held[1]
 
     def need_points(self, names) -> None:
         """Evaluate these frames (a drawn linkage's pins, by name) at every pose as well, for a

@@ -19,8 +19,18 @@ import numpy as np
 from pinmech.exceptions import DiagnosticError
 from pinmech.solve.grashof import LoopClass, loop_classes
 from pinmech.solve.instant_centres import InstantCentre, instant_centres
+from pinmech.solve.limit_watch import ZERO_RATE
 from pinmech.model.planar_linkage import PlanarLinkage, planar_linkage
-from pinmech.solve.transmission import Dyad, DyadAngles, Output, dyad_angles, find_dyads, find_outputs, output_rate
+from pinmech.solve.transmission import (
+    Dyad,
+    DyadAngles,
+    Output,
+    dyad_angles,
+    find_dyads,
+    find_outputs,
+    input_links,
+    output_rate,
+)
 
 
 @dataclass
@@ -43,6 +53,7 @@ class Design:
     dyads: list[tuple[Dyad, DyadAngles]] = field(default_factory=list)
     advantage: dict[str, tuple[float, str]] = field(default_factory=dict)
     centres: list[InstantCentre] = field(default_factory=list)
+    input_link: str | None = None  # the first driver's link: Barker's link 2
 
 
 def advantage_unit(driver_angular: bool, output: Output) -> str:
@@ -55,8 +66,15 @@ def mechanical_advantage(linkage: PlanarLinkage, output: Output, unit_rates: np.
     """Driver rate over the output's rate at q, from the joint rates per unit driver rate
     `unit_rates` (inf where the output stops: a limit position)."""
     linkage.place(q, unit_rates)
-    rate = output_rate(linkage, output)
-    return math.inf if rate == 0 else 1.0 / rate
+    return advantage_of(output_rate(linkage, output), output, linkage.mechanism.length_scale)
+
+
+def advantage_of(rate: float, output: Output, size: float) -> float:
+    """1 / the output's rate per unit driver rate; inf where that rate is zero to rounding
+    (limit_watch.ZERO_RATE of its scale: 1 for a rocker, the mechanism's size `size` [m]
+    for a piston), a limit position: not 1 / rounding noise (2.4e17 at a dead centre)."""
+    scale = 1.0 if output.kind == "pin" else size
+    return math.inf if abs(rate) <= ZERO_RATE * scale else 1.0 / rate
 
 
 def design_at(mechanism, drivers: list[str], q: np.ndarray, v: np.ndarray, unit_rates: np.ndarray | None,
@@ -68,7 +86,9 @@ def design_at(mechanism, drivers: list[str], q: np.ndarray, v: np.ndarray, unit_
         linkage = planar_linkage(mechanism)
     except DiagnosticError as exc:
         return Design(False, reason=str(exc).split(": ", 1)[-1])
-    design = Design(True, linkage=linkage, loops=loop_classes(linkage))
+    inputs = input_links(linkage, drivers[:1])
+    design = Design(True, linkage=linkage, loops=loop_classes(linkage),
+                    input_link=linkage.names[inputs[0]] if inputs else None)
     linkage.place(q, v)
     design.centres = list(instant_centres(linkage, velocities=bool(np.any(v))).values())
     design.dyads = [(d, dyad_angles(linkage, d)) for d in find_dyads(linkage, drivers)]
@@ -95,7 +115,7 @@ def design_dict(design: Design) -> dict:
     linkage = design.linkage
     return {
         "planar": True,
-        "loops": [x.as_dict() for x in design.loops],
+        "loops": [x.as_dict(design.input_link) for x in design.loops],
         "dyads": [{"name": d.name(linkage), "kind": d.kind, "pin": d.joint.name,
                    "coupler": linkage.names[d.coupler], "output": linkage.names[d.output],
                    "transmission_angle": math.radians(a.mu), "transmission_angle_acute": math.radians(a.mu_acute),
@@ -123,8 +143,8 @@ def design_lines(design: Design) -> list[str]:
         return lines + [f"  planar diagnostics: not applicable ({design.reason})"]
     for loop in design.loops:
         turns = ", ".join(loop.cranks) or "none"
-        lines.append(f"  loop {'-'.join(loop.links):<28} {loop.kind}: {loop.label} ({loop.condition}); "
-                     f"turning fully: {turns}")
+        lines.append(f"  loop {'-'.join(loop.links):<28} {loop.kind}: {loop.label}{barker_words(loop, design.input_link)} "
+                     f"({loop.condition}); turning fully: {turns}")
     for d, a in design.dyads:
         if d.kind == "pin":
             lines.append(f"  {d.name(design.linkage):<33} transmission angle mu = {a.mu:.6g} deg "
@@ -139,6 +159,12 @@ def design_lines(design: Design) -> list[str]:
         lines += [f"  instant centres{plane} (* primary: pins, slides; the others by Kennedy's theorem):"]
         lines += [f"    {_centre_text(c)}" for c in design.centres]
     return lines
+
+
+def barker_words(loop: LoopClass, input_link: str | None) -> str:
+    """', Barker I-2 GCRR (input crank)' for a four-bar, else ''."""
+    code = loop.barker(input_link)
+    return f", Barker {code} (input {input_link or loop.links[1]})" if code else ""
 
 
 def _centre_text(c: InstantCentre) -> str:

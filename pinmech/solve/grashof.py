@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pinmech.model.planar_linkage import Pair, PlanarLinkage
+from pinmech.solve.barker import barker_class
 
 #: Lengths are equal (a change point) within this share of the loop's perimeter.
 EQUAL = 1e-9
@@ -52,9 +53,23 @@ class LoopClass:
     label: str
     cranks: tuple[str, ...]
 
-    def as_dict(self) -> dict:
-        return {"kind": self.kind, "links": list(self.links), "lengths": self.lengths, "condition": self.condition,
-                "class": self.label, "cranks": list(self.cranks)}
+    def as_dict(self, input_link: str | None = None) -> dict:
+        out = {"kind": self.kind, "links": list(self.links), "lengths": self.lengths, "condition": self.condition,
+               "class": self.label, "cranks": list(self.cranks)}
+        if self.kind == "four-bar":
+            out["barker"] = self.barker(input_link)
+        return out
+
+    def barker(self, input_link: str | None = None) -> str:
+        """Barker's type of a four-bar ("I-2 GCRR"), its links numbered from the ground with
+        `input_link` (one of the two pivoted on it; default the first) as link 2; "" for
+        another loop."""
+        if self.kind != "four-bar":
+            return ""
+        ground, a, b, c = self.links
+        order = (ground, c, b, a) if input_link == c else (ground, a, b, c)
+        found = barker_class(*(self.lengths[n] for n in order))
+        return f"{found.name} {found.code}"
 
 
 def four_bar_class(d: float, a: float, b: float, c: float) -> tuple[str, str, tuple[bool, bool]]:
@@ -83,9 +98,13 @@ def four_bar_class(d: float, a: float, b: float, c: float) -> tuple[str, str, tu
 
 
 def slider_crank_class(r: float, l: float, e: float) -> tuple[str, str]:
-    """Whether a slider-crank's crank turns fully: r + |e| <= l. Lengths [m]."""
+    """Whether a slider-crank's crank turns fully: r + |e| < l; at r + |e| = l (within
+    EQUAL) the rod falls normal to the slide once a turn, a singular pose the crank cannot
+    be driven through (a change point). Lengths [m]."""
     reach = r + abs(e)
-    if reach <= l * (1 + EQUAL):
+    if abs(reach - l) <= EQUAL * (r + l + abs(e)):
+        return "change point", f"r + |e| = {reach:.6g} m = l = {l:.6g} m"
+    if reach < l:
         return "crank", f"r + |e| = {reach:.6g} m <= l = {l:.6g} m"
     return "rocker", f"r + |e| = {reach:.6g} m > l = {l:.6g} m"
 

@@ -44,6 +44,9 @@ class LimitPosition:
         value: the output's angle [rad] or place along its slide [m] there.
         toggle: "extended" or "folded" when the driving link and the coupler are in line
             there, else "".
+        slide: a dead centre's slide coordinate s [m] (the slide joint's, as the CSV's
+            `NAME.s` and the figures give it: from the drawn pose), None for a rocker or a
+            slide closed by a loop cut.
     """
 
     output: str
@@ -52,10 +55,11 @@ class LimitPosition:
     driver: float
     value: float
     toggle: str
+    slide: float | None = None
 
     def as_dict(self) -> dict:
         return {"output": self.output, "kind": self.kind, "label": self.label, "driver": self.driver,
-                "value": self.value, "toggle": self.toggle}
+                "value": self.value, "toggle": self.toggle, "slide_coordinate": self.slide}
 
 
 @dataclass(frozen=True)
@@ -151,7 +155,14 @@ class LimitFinder:
         kind = "rocker extreme" if output.kind == "pin" else "dead centre"
         dyad = next((d for d in self.dyads if d.output == output.output), None)
         lay = toggle(self.linkage, dyad) if dyad is not None else ""
-        return LimitPosition(name, kind, label, x, output_position(self.linkage, output), lay)
+        return LimitPosition(name, kind, label, x, output_position(self.linkage, output), lay, self._slide(output, q))
+
+    def _slide(self, output: Output, q: np.ndarray) -> float | None:
+        """The slide joint's coordinate s at q [m], if the output's slide is a joint of the tree."""
+        mech = self.linkage.mechanism
+        if output.kind != "slide" or output.ground.name not in mech.joints:
+            return None
+        return mech.coordinate(q, output.ground.name)
 
 
 def extreme_label(rate: float, step: float) -> str:
@@ -186,5 +197,5 @@ def _dead_centres(limits: list[LimitPosition]) -> list[LimitPosition]:
     if limits[0].kind != "dead centre":
         return limits
     word = {"extended": " TDC", "folded": " BDC"}
-    return [LimitPosition(x.output, x.kind, x.label + word.get(x.toggle, ""), x.driver, x.value, x.toggle)
+    return [LimitPosition(x.output, x.kind, x.label + word.get(x.toggle, ""), x.driver, x.value, x.toggle, x.slide)
             for x in limits]

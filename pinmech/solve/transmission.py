@@ -205,6 +205,23 @@ def dyad_angles(linkage: PlanarLinkage, dyad: Dyad) -> DyadAngles:
     return DyadAngles(90.0 - phi, 90.0 - phi, phi)
 
 
+def dyad_side(linkage: PlanarLinkage, dyad: Dyad) -> float:
+    """A number whose sign changes exactly where the dyad's acute transmission angle passes
+    through 0 (the coupler and the output in line: a toggle, a change point) [m^2]: of a pin
+    dyad the cross product (A - B) x (O - B) (mu through 0 or 180 deg); of a slider dyad
+    the rod's component along the slide times |rod| (the rod normal to the slide); of a
+    slot dyad the slot's direction along O P times |OP| (the slot normal to O P)."""
+    A = linkage.point(dyad.coupler, _end(dyad.near, dyad.coupler))
+    O = linkage.point(0, _end(dyad.ground, 0)) if dyad.kind != "slide" else None
+    if dyad.kind == "slot":
+        return float(linkage.direction(dyad.joint.links[0], dyad.joint.axis) @ (A - O))
+    B = linkage.point(dyad.coupler, _end(dyad.joint, dyad.coupler))
+    if dyad.kind == "slide":
+        return float(linkage.direction(dyad.ground.links[0], dyad.ground.axis) @ (A - B))
+    u, w = A - B, O - B
+    return float(u[0] * w[1] - u[1] * w[0])
+
+
 def _slot_angles(linkage: PlanarLinkage, dyad: Dyad, P: np.ndarray) -> DyadAngles:
     """A slot dyad's angles with the block's pin at P: phi between the slot and OP."""
     O = linkage.point(0, _end(dyad.ground, 0))
