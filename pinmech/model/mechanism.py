@@ -74,6 +74,9 @@ class Mechanism:
         massless_links: links without mass by construction (a drawn slot's hidden block, a
             ball's gimbal links): no mass is missing there.
         mass_source: where a file gives a link's mass, for the message naming links without.
+        written_frames: ("point", name) or ("cut", name, side) -> the placement in its joint
+            of the frame a file wrote it in, where the model's own frames lost it (an MJCF
+            site or anchor on a jointless body, moved onto the moving body).
     """
 
     model: pin.Model
@@ -94,6 +97,7 @@ class Mechanism:
     force_caveats: tuple[str, ...] = ()
     massless_links: tuple[str, ...] = ()
     mass_source: str = "<inertial> mass"
+    written_frames: dict = field(default_factory=dict)
 
     # ---------------------------------------------------------------- construction
     @classmethod
