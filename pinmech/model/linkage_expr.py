@@ -50,6 +50,17 @@ def check_param_name(name: str, source: str) -> None:
                          path=source, element=f"[params] {name}")
 
 
+def is_angle(value: Any) -> bool:
+    """Whether a `[params]` value is one quantity with an angle's unit ("25 deg", "0.4 rad")."""
+    if not isinstance(value, str):
+        return False
+    try:
+        to_si(value, "angle")
+    except UnitError:
+        return False
+    return True
+
+
 def length(value: Any, params: dict[str, float], source: str, where: str) -> float:
     """A length [m]: a quantity with its unit, or an expression over `params` [m].
 

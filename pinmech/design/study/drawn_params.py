@@ -1,5 +1,8 @@
 """A drawn linkage's `[params]` as study parameters (`param = "crank"` in a study file).
 
+A param written with an angle's unit ("25 deg": a bearing construction's angle) is an
+angle parameter: its values in rad, its sensitivities per rad.
+
 A variant is the linkage's points redrawn with the changed lengths (`linkage_from_spec`
 with the values: the compass and polar constructions move other drawn points and turn the
 frames built from them) and its joint and frame placements, rotations included, computed
@@ -31,7 +34,7 @@ class Drawing:
     placements each set of values draws."""
 
     def __init__(self, scene, mechanism, where: str) -> None:
-        from pinmech.model.linkage_expr import length
+        from pinmech.model.linkage import linkage_params, param_kinds
         from pinmech.model.linkage_spec import read_linkage_spec
 
         if scene.model_kind != "linkage":
@@ -39,9 +42,8 @@ class Drawing:
                              f"'{scene.model_kind}'", path=where, key="params")
         self.spec, self.source = read_linkage_spec(scene.model_file("linkage"))
         self.model, self.urdf_path = mechanism.model, getattr(mechanism, "urdf_path", None)
-        self.values: dict[str, float] = {}
-        for name, value in self.spec.params.items():  # in the order written: expressions use earlier ones
-            self.values[name] = length(value, self.values, self.source, f"[params] {name}")
+        self.values: dict[str, float] = linkage_params(self.spec, self.source)  # [m], angles [rad]
+        self.kinds = param_kinds(self.spec)
         self._drawn: dict[tuple, list] = {}
         self._placed = None  # the placements' rules (model/linkage_placements.py), at the first drawing
 
@@ -90,10 +92,16 @@ class DrawnPlacement:
     drawn = True
     written_in = 0  # no translation of its own (rate_sensitivity.py reads it, with u = 0)
 
-    def __init__(self, drawing: Drawing, name: str, where: str) -> None:
+    def __init__(self, drawing: Drawing, param, where: str) -> None:
+        name = param.element
         if name not in drawing.values:
             raise FrameNotFound("param (a drawn linkage's [params])", name, list(drawing.values), path=where)
-        self.drawing, self.name = drawing, name
+        self.drawing, self.name, self.kind = drawing, name, drawing.kinds[name]
+        given = param.nominal is not None or param.spread > 0 or np.isfinite([param.lower, param.upper]).any()
+        if given and param.kind != self.kind:
+            unit = "deg" if self.kind == "angle" else "mm"
+            raise SceneError(f"the linkage's {name} is {'an' if self.kind == 'angle' else 'a'} {self.kind}, and this "
+                             f"parameter's values are {param.kind}s: give them in {unit}", path=where, key="params")
 
     def read(self) -> float:
         return float(self.drawing.values[self.name])

@@ -27,6 +27,10 @@
     [params.crank_drawn]                 # a drawn linkage's [params] entry (a scene with linkage = ...):
     param = "crank"                      # the linkage is redrawn for each variant; no component
 
+    [params.gamma]                       # a drawn angle param (gamma = "26.57 deg" in the linkage):
+    param = "gamma"                      # its values in deg
+    tolerance = "0.5 deg"
+
     [outputs]
     points = ["P"]                       # world x, y, z of these points [m]
     links = ["rocker"]                   # angle of these links about the plane normal [rad]
@@ -43,6 +47,9 @@
     to = "70 mm"
     count = 11
 
+A component is read and written in the frame the file writes it in (a URDF origin in its
+parent link's, an MJCF pos in its body's), whatever frames Pinocchio merged it into.
+
 Every mistake is a SceneError naming the study file, the key and the value as written.
 """
 
@@ -55,6 +62,7 @@ from typing import Any
 
 from pinmech.design.file_where import FileWhere, load_file
 from pinmech.design.study.params import AXES, DISTRIBUTIONS, Parameter
+from pinmech.model.linkage_expr import is_angle
 from pinmech.units import to_si
 
 
@@ -194,15 +202,15 @@ def _grid(raw: dict[str, Any], kind: str, params: tuple[Parameter, ...], where: 
     names = [p.name for p in params]
     if not 1 <= len(table) <= 3:
         raise where.error("grid", f"give 1 to 3 [grid.NAME] tables, got {len(table)}")
-    axes = tuple(_axis(name, entry, names, where) for name, entry in table.items())
+    axes = tuple(_axis(name, entry, params, where) for name, entry in table.items())
     points = math.prod(a.count for a in axes)
     if points > _GRID_MAX:
         raise where.error("grid", f"{points} grid points is more than {_GRID_MAX}: lower the counts")
     return axes
 
 
-def _axis(name: str, entry: Any, names: list[str], where: _Where) -> GridAxis:
-    key = f"grid.{name}"
+def _axis(name: str, entry: Any, params: tuple[Parameter, ...], where: _Where) -> GridAxis:
+    key, names = f"grid.{name}", [p.name for p in params]
     if name not in names:
         raise where.error(key, f"'{name}' is not a parameter (the [params] tables: {', '.join(names)})")
     where.known(entry, _GRID_KEYS, key)
@@ -212,7 +220,8 @@ def _axis(name: str, entry: Any, names: list[str], where: _Where) -> GridAxis:
     count = entry["count"]
     if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= _GRID_MAX:
         raise where.error(f"{key}.count", f"count = {count!r} must be a whole number from 1 to {_GRID_MAX}")
-    start, stop = where.length(entry, "from", key), where.length(entry, "to", key)
+    along = _Where(where.path, params[names.index(name)].kind)
+    start, stop = along.length(entry, "from", key), along.length(entry, "to", key)
     if count > 1 and not start < stop:
         raise where.error(key, f"from {entry['from']} is not below to {entry['to']} (count {count})")
     if count == 1 and start != stop:
@@ -243,11 +252,21 @@ def _parameter(name: str, table: Any, where: _Where) -> Parameter:
         raise where.error(f"{key}.component", "a drawn linkage's param is a length of its own: it has no component")
     if component not in AXES:
         raise where.error(f"{key}.component", f"component = {component!r} must be \"x\", \"y\" or \"z\"")
+    kind = _kind(table) if target == "param" else "length"
+    where = _Where(where.path, kind)
     nominal = where.length(table, "nominal", key) if "nominal" in table else None
     lower, upper = _bounds(table, key, where, nominal)
     distribution, spread = _distribution(table, key, where)
     return Parameter(name, target, str(table[target]), side, AXES[component], nominal, lower, upper,
-                     distribution, spread)
+                     distribution, spread, kind)
+
+
+def _kind(table: dict) -> str:
+    """A drawn param's kind, by the unit of its first value given: "angle" for "0.5 deg",
+    else "length" (values of the other kind are then refused by name)."""
+    given = [table[k] for k in ("nominal", "tolerance", "sigma") if k in table]
+    given += list(table["bounds"]) if isinstance(table.get("bounds"), list) else []
+    return "angle" if given and is_angle(given[0]) else "length"
 
 
 def _bounds(table: dict, key: str, where: _Where, nominal: float | None) -> tuple[float, float]:
@@ -256,7 +275,7 @@ def _bounds(table: dict, key: str, where: _Where, nominal: float | None) -> tupl
     bounds = table["bounds"]
     if not isinstance(bounds, list) or len(bounds) != 2:
         raise where.error(f"{key}.bounds", f"bounds = {bounds!r} must be [lower, upper], e.g. [\"119 mm\", \"121 mm\"]")
-    lower, upper = (to_si(b, "length", where=f"{where.path}, {key}.bounds") for b in bounds)
+    lower, upper = (to_si(b, where.kind, where=f"{where.path}, {key}.bounds") for b in bounds)
     if not lower < upper:
         raise where.error(f"{key}.bounds", f"lower {bounds[0]} is not below upper {bounds[1]}")
     if nominal is not None and not lower <= nominal <= upper:
@@ -302,15 +321,20 @@ def _names(value: Any, where: _Where, key: str) -> tuple[str, ...]:
 
 
 class _Where(FileWhere):
-    """The study file, for errors naming it and the key."""
+    """The study file, for errors naming it and the key; `kind`: the quantity its values are
+    ("length", or "angle" for a drawn angle param)."""
 
     limits = _LIMITS
 
+    def __init__(self, path: Path, kind: str = "length") -> None:
+        super().__init__(path)
+        self.kind = kind
+
     def length(self, table: dict, name: str, key: str) -> float:
-        return to_si(table[name], "length", where=f"{self.path}, {key}.{name}")
+        return to_si(table[name], self.kind, where=f"{self.path}, {key}.{name}")
 
     def positive(self, table: dict, name: str, key: str) -> float:
         value = self.length(table, name, key)
         if not value > 0:
-            raise self.error(f"{key}.{name}", f"{name} = {table[name]!r} must be a positive length")
+            raise self.error(f"{key}.{name}", f"{name} = {table[name]!r} must be a positive {self.kind}")
         return value

@@ -44,6 +44,8 @@ class Parameter:
         lower, upper: bounds [m] (a sampled value outside is a failed variant).
         distribution: "normal", "uniform" or "fixed".
         spread: the standard deviation [m] (normal) or the half width [m] (uniform).
+        kind: "length", or "angle" for a drawn linkage's param written in deg (then every
+            value above is in rad).
     """
 
     name: str
@@ -56,6 +58,7 @@ class Parameter:
     upper: float = math.inf
     distribution: str = "fixed"
     spread: float = 0.0
+    kind: str = "length"  # or "angle": a drawn linkage's angle param (values in rad)
 
     @property
     def sigma(self) -> float:
@@ -93,6 +96,7 @@ class Placement:
     """
 
     drawn = False  # a translation component (drawn_params.DrawnPlacement: a drawn length)
+    kind = "length"
 
     def __init__(self, model: pin.Model, joint: int, frames: tuple[int, ...], component: int,
                  writing: pin.SE3 | None = None) -> None:
@@ -171,7 +175,7 @@ def placements(mechanism, params: tuple[Parameter, ...], path: str, scene=None) 
             from pinmech.design.study.drawn_params import Drawing, DrawnPlacement
 
             drawing = drawing or Drawing(scene, mechanism, where)
-            out.append(DrawnPlacement(drawing, p.element, where))
+            out.append(DrawnPlacement(drawing, p, where))
         else:
             out.append(_placement(mechanism, p, where))
     return out

@@ -27,6 +27,11 @@ def _unit(kind: str) -> tuple[float, str]:
     return _SCALE[kind]
 
 
+def _per(result: StudyResult, k: int) -> tuple[float, str]:
+    """Parameter k's users' unit: (SI per unit, "mm" or "deg")."""
+    return (1e-3, "mm") if result.param_kind(k) == "length" else (math.pi / 180, "deg")
+
+
 def summary(result: StudyResult) -> dict:
     """The JSON summary: per output, the largest |dy/dp| over the cycle for each parameter,
     and for a tolerance study the spread beside the linear estimate and the failures."""
@@ -34,14 +39,17 @@ def summary(result: StudyResult) -> dict:
     out = {"study": str(spec.path), "title": spec.title, "kind": spec.kind, "driver": result.driver,
            "poses": len(result.values), "parameters": {}, "outputs": {}}
     for k, p in enumerate(spec.params):
-        out["parameters"][p.name] = {"nominal_mm": result.nominal_p[k] * 1e3, "distribution": p.distribution,
-                                     "sigma_mm": p.sigma * 1e3}
+        size, per = _per(result, k)
+        out["parameters"][p.name] = {f"nominal_{per}": result.nominal_p[k] / size, "distribution": p.distribution,
+                                     f"sigma_{per}": p.sigma / size}
     for j, name in enumerate(result.outputs):
         scale, unit = _unit(result.kinds[j])
         entry = {"unit": unit, "nominal_min": float(result.nominal[:, j].min() * scale),
-                 "nominal_max": float(result.nominal[:, j].max() * scale),
-                 f"max_abs_sensitivity_{unit}_per_mm": {p: float(np.abs(result.sensitivity[:, j, k]).max() * scale / 1e3)
-                                                       for k, p in enumerate(result.params)}}
+                 "nominal_max": float(result.nominal[:, j].max() * scale)}
+        for k, p in enumerate(result.params):
+            size, per = _per(result, k)
+            entry.setdefault(f"max_abs_sensitivity_{unit}_per_{per}", {})[p] = float(
+                np.abs(result.sensitivity[:, j, k]).max() * scale * size)
         if result.spread is not None:
             s = result.spread
             entry.update(sigma_max=_finite(s.sigma[:, j].max() * scale),
@@ -80,13 +88,11 @@ def text(result: StudyResult) -> str:
     s = summary(result)
     lines = [f"{s['title']} ({s['kind']}, {s['poses']} poses of {s['driver']}"
              + (f", {s['samples']} variants, seed {s['seed']})" if "samples" in s else ")")]
-    lines.append("parameters: " + ", ".join(f"{n} {p['nominal_mm']:.6g} mm"
-                                            + (f" (sigma {p['sigma_mm']:.3g} mm, {p['distribution']})"
-                                               if p["distribution"] != "fixed" else "")
-                                            for n, p in s["parameters"].items()))
+    lines.append("parameters: " + ", ".join(_said_param(n, p) for n, p in s["parameters"].items()))
     lines.append("largest |dy/dp| over the cycle: " + "; ".join(
-        f"{o}: " + ", ".join(f"{p} {v:.4g}" for p, v in e[f"max_abs_sensitivity_{e['unit']}_per_mm"].items())
-        + f" {e['unit']}/mm" for o, e in s["outputs"].items()))
+        f"{o}: " + ", ".join(f"{p} {v:.4g} {e['unit']}/{per}" for per in ("mm", "deg")
+                             for p, v in e.get(f"max_abs_sensitivity_{e['unit']}_per_{per}", {}).items())
+        for o, e in s["outputs"].items()))
     if "samples" in s:
         lines.append(f"{'output':<16}{'sigma max':>12}{'linear':>12}{'worst':>12}{'linear':>12}")
         for o, e in s["outputs"].items():
@@ -104,6 +110,12 @@ def text(result: StudyResult) -> str:
     return "\n".join(lines)
 
 
+def _said_param(name: str, p: dict) -> str:
+    per = "mm" if "nominal_mm" in p else "deg"
+    spread = f" (sigma {p[f'sigma_{per}']:.3g} {per}, {p['distribution']})" if p["distribution"] != "fixed" else ""
+    return f"{name} {p[f'nominal_{per}']:.6g} {per}{spread}"
+
+
 def table(result: StudyResult) -> dict[str, list]:
     """The study's table as columns: one row a pose and output (sensitivity), one row a
     variant (tolerance: its parameters, its cause, its largest deviation of each output), or
@@ -113,19 +125,20 @@ def table(result: StudyResult) -> dict[str, list]:
         return grid_table(result)
     if result.spread is None:
         rows: dict[str, list] = {f"{result.driver} [deg]": [], "output": [], "unit": [], "value": []}
-        rows.update({f"d/d {p} [per mm]": [] for p in result.params})
+        columns = [f"d/d {p} [per {_per(result, k)[1]}]" for k, p in enumerate(result.params)]
+        rows.update({c: [] for c in columns})
         for i, x in enumerate(result.values):
             for j, name in enumerate(result.outputs):
                 scale, unit = _unit(result.kinds[j])
                 rows[f"{result.driver} [deg]"].append(math.degrees(x))
                 rows["output"].append(name), rows["unit"].append(unit)
                 rows["value"].append(result.nominal[i, j] * scale)
-                for k, p in enumerate(result.params):
-                    rows[f"d/d {p} [per mm]"].append(result.sensitivity[i, j, k] * scale / 1e3)
+                for k, c in enumerate(columns):
+                    rows[c].append(result.sensitivity[i, j, k] * scale * _per(result, k)[0])
         return rows
     p, y, causes = result.variants
     rows = {"variant": list(range(len(causes)))}
-    rows.update({f"{name} [mm]": (p[:, k] * 1e3).tolist() for k, name in enumerate(result.params)})
+    rows.update(_param_columns(result, p))
     rows["cause"] = list(causes)
     dev = np.abs(deviation(y, result.nominal, result.kinds)).max(axis=1)
     for j, name in enumerate(result.outputs):
@@ -140,7 +153,7 @@ def grid_table(result: StudyResult) -> dict[str, list]:
     the least transmission angle over the cycle for a planar linkage with dyads."""
     p, y, causes = result.variants
     rows: dict[str, list] = {"point": list(range(len(causes)))}
-    rows.update({f"{name} [mm]": (p[:, k] * 1e3).tolist() for k, name in enumerate(result.params)})
+    rows.update(_param_columns(result, p))
     rows["cause"] = list(causes)
     lo, hi = cycle_range(y, result.kinds)
     for j, name in enumerate(result.outputs):
@@ -150,6 +163,15 @@ def grid_table(result: StudyResult) -> dict[str, list]:
     if result.transmission is not None:
         rows["least transmission angle [deg]"] = np.degrees(result.transmission).tolist()
     return rows
+
+
+def _param_columns(result: StudyResult, p: np.ndarray) -> dict[str, list]:
+    """The variants' parameters (N, n_par) [m or rad] as columns in mm or deg."""
+    out = {}
+    for k, name in enumerate(result.params):
+        size, per = _per(result, k)
+        out[f"{name} [{per}]"] = (p[:, k] / size).tolist()
+    return out
 
 
 def write(result: StudyResult, prefix: str | Path, *, parquet: bool = True) -> list[Path]:

@@ -54,6 +54,11 @@ class StudyResult:
     sensitivity: np.ndarray
     spread: Spread | None = None
     batches: tuple[BatchResult, ...] = ()
+    param_kinds: tuple[str, ...] = ()  # "length" or "angle" each (a drawn angle param) ; () all lengths
+
+    def param_kind(self, k: int) -> str:
+        """Parameter k's kind: "length" [m] or "angle" [rad]."""
+        return self.param_kinds[k] if self.param_kinds else "length"
 
     @property
     def variants(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
@@ -103,7 +108,8 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
                          driver=sm.sweep.driver, value=float("nan"), cause=cycle.error) from cycle.error
     y0, dy = cycle_sensitivity(sm, outputs, cycle)
     common = dict(spec=spec, driver=sm.sweep.driver, values=sm.values, outputs=outputs.names, kinds=outputs.kinds,
-                  params=[p.name for p in spec.params], nominal_p=sm.nominal.copy(), nominal=y0, sensitivity=dy)
+                  params=[p.name for p in spec.params], nominal_p=sm.nominal.copy(), nominal=y0, sensitivity=dy,
+                  param_kinds=tuple(place.kind for place in sm.placements))
     if spec.kind == "sensitivity":
         return StudyResult(**common)
     todo = batches(grid_size(spec) if spec.kind == "grid" else spec.samples, spec.batch)
