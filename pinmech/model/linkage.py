@@ -27,14 +27,13 @@ from typing import Any
 
 import numpy as np
 
-from pinmech.exceptions import ModelError, UnitError
+from pinmech.exceptions import ModelError
 from pinmech.model.compass import compass
-from pinmech.model.linkage_expr import is_angle, length
+from pinmech.model.linkage_expr import is_angle, length, quantity_si
 from pinmech.model.linkage_masses import LinkMass, parse_masses
 from pinmech.directions import unit_vector
 from pinmech.model.linkage_entries import Bearing
 from pinmech.model.linkage_spec import GROUND, Compass, LinkageSpec, Polar, Slot, read_linkage_spec
-from pinmech.units import to_si
 
 
 @dataclass(frozen=True)
@@ -193,10 +192,7 @@ class _Reader:
         """An angle [rad]: "30 deg", or the name of an angle parameter ("gamma")."""
         if isinstance(value, str) and value.strip() in self.angles:
             return self.angles[value.strip()]
-        try:
-            return to_si(value, "angle", where=where)
-        except UnitError as exc:
-            raise ModelError(str(exc), path=self.source) from exc
+        return quantity_si(value, "angle", self.source, where)
 
     def points(self, joints: dict[str, tuple | Polar | Compass | Bearing]) -> dict[str, np.ndarray]:
         """World positions of `[joints]`, in the order written (constructions use earlier ones)."""

@@ -65,6 +65,8 @@ class DrawnPlacements:
                        for link, link_edge in self.tree.parent.items() if model.existJointName(link_edge[0].name)]
         self.frames = self._frame_roles(linkage)
         self.slides = self._slides(linkage)
+        self._bodies = {link: self.model.frames[self.model.getFrameId(link, pin.FrameType.BODY)].placement
+                        for _, link, _, _ in self.frames}  # each frame's link's body frame (fixed)
         self._check(linkage)
 
     def _frame_roles(self, linkage: Linkage) -> list[tuple[int, str, str, bool]]:
@@ -117,8 +119,10 @@ class DrawnPlacements:
         for i, link, (kind, name), world in self.frames:
             o, R = frames[link]
             x = edges[name].at if kind == "cut" else linkage.points[name]
-            body = self.model.frames[self.model.getFrameId(link, pin.FrameType.BODY)].placement
-            out.append(("frame", i, body * pin.SE3(R.T if world else np.eye(3), R.T @ (_at(x) - o))))
+            body = self._bodies[link]
+            local = R.T @ (_at(x) - o)
+            out.append(("frame", i, body * pin.SE3(R.T, local) if world else
+                        pin.SE3(body.rotation, body.translation + body.rotation @ local)))
         return out
 
     def _check(self, linkage: Linkage) -> None:

@@ -62,6 +62,12 @@ class Drawing:
         self.apply(self._draw(values))
         self.values = dict(values)
 
+    def set(self, changed: dict[str, float]) -> None:
+        """Write these params' values [m or rad] (the others kept): one redrawing, none if
+        nothing changed."""
+        if any(self.values[n] != v for n, v in changed.items()):
+            self.write({**self.values, **changed})
+
     def apply(self, placements: list[tuple[str, int, pin.SE3]]) -> None:
         for kind, i, M in placements:
             if kind == "joint":
@@ -107,8 +113,7 @@ class DrawnPlacement:
         return float(self.drawing.values[self.name])
 
     def write(self, value: float) -> None:
-        if value != self.drawing.values[self.name]:
-            self.drawing.write({**self.drawing.values, self.name: float(value)})
+        self.drawing.set({self.name: float(value)})
 
     def direction(self, data: pin.Data) -> np.ndarray:
         """No translation of its own (the study's exact rows take `column` instead)."""
