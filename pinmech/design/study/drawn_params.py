@@ -47,9 +47,9 @@ class Drawing:
         self._drawn: dict[tuple, list] = {}
         self._placed = None  # the placements' rules (model/linkage_placements.py), at the first drawing
 
-    def placements(self, values: dict[str, float]) -> list[tuple[str, int, pin.SE3]]:
+    def placements(self, values: dict[str, float]) -> list[tuple[str, int, np.ndarray, np.ndarray]]:
         """The placements the linkage draws with these params: (kind, index in the study's
-        model, SE3) for each joint and frame it has (kept per set of values)."""
+        model, rotation, translation [m]) for each joint and frame it has (kept per set of values)."""
         key = tuple(sorted(values.items()))
         if key not in self._drawn:
             if len(self._drawn) > 64:  # a tolerance study's nominals do not repeat: keep the cache small
@@ -68,14 +68,11 @@ class Drawing:
         if any(self.values[n] != v for n, v in changed.items()):
             self.write({**self.values, **changed})
 
-    def apply(self, placements: list[tuple[str, int, pin.SE3]]) -> None:
-        for kind, i, M in placements:
-            if kind == "joint":
-                self.model.jointPlacements[i] = M
-            else:
-                self.model.frames[i].placement = M
+    def apply(self, placements: list[tuple[str, int, np.ndarray, np.ndarray]]) -> None:
+        """Write drawn placements (DrawnPlacements.placements) into the study's model in place."""
+        self._placed.write(placements)
 
-    def _draw(self, values: dict[str, float]) -> list[tuple[str, int, pin.SE3]]:
+    def _draw(self, values: dict[str, float]) -> list[tuple[str, int, np.ndarray, np.ndarray]]:
         from pinmech.model.linkage import linkage_from_spec
 
         try:  # every value given: the spec holds the file's, not the last drawing's
