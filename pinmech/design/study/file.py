@@ -31,6 +31,10 @@
     param = "gamma"                      # its values in deg
     tolerance = "0.5 deg"
 
+    [spec]                               # tolerance: limits on an output's deviation from the nominal
+    "P.y" = "0.3 mm"                     # +-0.3 mm (or { lower = "-0.2 mm", upper = "0.3 mm" }):
+                                         # Cp, Cpk and parts per million out (capability.py)
+
     [outputs]
     points = ["P"]                       # world x, y, z of these points [m]
     links = ["rocker"]                   # angle of these links about the plane normal [rad]
@@ -67,7 +71,7 @@ from pinmech.units import to_si
 
 
 KINDS = ("sensitivity", "tolerance", "grid", "workspace")
-_TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs", "batch", "grid"}
+_TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs", "batch", "grid", "spec"}
 _GRID_KEYS = {"from", "to", "count"}
 _GRID_MAX = 1_000_000  # grid points in all
 _TARGETS = ("joint", "cut", "point", "body", "param")
@@ -76,7 +80,8 @@ _OUTPUT_KEYS = {"points", "links", "sliders", "omega", "transmission", "alpha", 
 _LIMITS = {"steps": (1, 100_000), "samples": (1, 10_000_000), "seed": (0, 2**63 - 1), "batch": (1, 1_000_000)}
 #: Keys only some kinds use: any other kind refuses them (a key read by nobody would be a
 #: silent no-op). Top-level keys, then [params.NAME] keys.
-_TOP_USED_BY = {"samples": ("tolerance",), "seed": ("tolerance",), "batch": ("tolerance", "grid")}
+_TOP_USED_BY = {"samples": ("tolerance",), "seed": ("tolerance",), "batch": ("tolerance", "grid"),
+                "spec": ("tolerance",)}
 _PARAM_USED_BY = {k: ("tolerance",) for k in ("tolerance", "sigma", "k", "distribution")}
 
 
@@ -117,6 +122,9 @@ class StudySpec:
         transmission: dyads by their middle pin, for their transmission angle.
         alpha: links' angular accelerations; strokes: prismatic joints' max - min of s.
         torque: drivers whose torque (force) the scene's masses and loads need.
+        limits: a tolerance study's `[spec]`: (output name, "0.3 mm" or ((lower, text),
+            (upper, text))) as written (read in the output's own quantity by
+            capability.limits once the outputs are known).
         grid: a grid study's axes (1 to 3), in the [grid] table's order; () otherwise.
     """
 
@@ -138,6 +146,7 @@ class StudySpec:
     alpha: tuple[str, ...] = ()
     strokes: tuple[str, ...] = ()
     torque: tuple[str, ...] = ()
+    limits: tuple = ()
 
 
 def load_study(path: str | Path) -> StudySpec:
@@ -173,7 +182,18 @@ def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
                      counts["samples"], counts["seed"], counts["batch"], parsed, named["points"],
                      named["links"], _grid(raw, kind, parsed, where), named["sliders"], named["omega"],
                      named["transmission"], named["alpha"], named["strokes"],
-                     named["torque"])
+                     named["torque"], _spec_table(raw, where))
+
+
+def _spec_table(raw: dict[str, Any], where: _Where) -> tuple:
+    """The `[spec]` table: output name -> "0.3 mm" (+-) or {lower, upper}, as written."""
+    table = raw.get("spec", {})
+    if not isinstance(table, dict):
+        raise where.error("spec", 'give [spec] as a table: "P.y" = "0.3 mm" or { lower = "-0.2 mm", upper = "0.3 mm" }')
+    for name, value in table.items():
+        if not isinstance(value, (str, dict)):
+            raise where.error(f"spec.{name}", f"{value!r} must be a +- quantity (\"0.3 mm\") or {{ lower, upper }}")
+    return tuple((name, tuple(value.items()) if isinstance(value, dict) else value) for name, value in table.items())
 
 
 def _refuse_unused(raw: dict[str, Any], kind: str, where: _Where) -> None:

@@ -9,12 +9,10 @@ from pathlib import Path
 import numpy as np
 
 from pinmech.design.figure_file import pyplot, save
+from pinmech.design.study.outputs import USER_UNITS as _SCALE
 from pinmech.design.study.run import StudyResult
 from pinmech.design.study.tolerance import deviation
 
-_SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "speed": (1e3, "mm/s"),
-          "angular speed": (180 / math.pi, "deg/s"), "angular acceleration": (180 / math.pi, "deg/s^2"),
-          "torque": (1.0, "N m"), "force": (1.0, "N")}
 
 
 def sensitivity_bars(result: StudyResult, path: str | Path) -> Path:

@@ -14,13 +14,12 @@ from pathlib import Path
 import numpy as np
 
 from pinmech.design.study.grid import cycle_range, failures
+from pinmech.design.study.outputs import USER_UNITS as _SCALE
 from pinmech.design.study.run import StudyResult
 from pinmech.design.study.tolerance import PERCENTILES, deviation
+from pinmech.design.study.tolerance_report import pose_table, tolerance_lines, tolerance_summary
 from pinmech.outputs import beside, write_whole, write_with
 
-_SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "speed": (1e3, "mm/s"),
-          "angular speed": (180 / math.pi, "deg/s"), "angular acceleration": (180 / math.pi, "deg/s^2"),
-          "torque": (1.0, "N m"), "force": (1.0, "N")}
 
 
 def _unit(kind: str) -> tuple[float, str]:
@@ -64,6 +63,7 @@ def summary(result: StudyResult) -> dict:
     if result.spread is not None:
         out.update(samples=spec.samples, seed=spec.seed, solved=result.spread.solved,
                    failures=dict(result.spread.failures))
+        out.update(tolerance_summary(result))
     return out
 
 
@@ -94,13 +94,15 @@ def text(result: StudyResult) -> str:
                              for p, v in e.get(f"max_abs_sensitivity_{e['unit']}_per_{per}", {}).items())
         for o, e in s["outputs"].items()))
     if "samples" in s:
-        lines.append(f"{'output':<16}{'sigma max':>12}{'linear':>12}{'worst':>12}{'linear':>12}")
+        lines.append(f"{'output':<16}{'sigma max':>12}{'linear':>12}{'worst':>12}{'linear':>12}"
+                     "   (largest over the cycle: Monte Carlo, linear)")
         for o, e in s["outputs"].items():
             lines.append(f"{o + ' [' + e['unit'] + ']':<16}" + "".join(
                 f"{v:>12.4g}" if v is not None else f"{'-':>12}"
                 for v in (e["sigma_max"], e["sigma_linear_max"], e["worst"], e["worst_linear"])))
         failed = ", ".join(f"{c}: {n}" for c, n in s["failures"].items()) or "none"
         lines.append(f"solved {s['solved']} of {s['samples']} variants; failed: {failed}")
+        lines += tolerance_lines(s, s["driver"])
     if "points" in s:
         axes = " x ".join(f"{n} {g['from_mm']:.6g}..{g['to_mm']:.6g} mm ({g['count']})" for n, g in s["grid"].items())
         failed = ", ".join(f"{c}: {n}" for c, n in s["failures"].items()) or "none"
@@ -175,18 +177,28 @@ def _param_columns(result: StudyResult, p: np.ndarray) -> dict[str, list]:
 
 
 def write(result: StudyResult, prefix: str | Path, *, parquet: bool = True) -> list[Path]:
-    """PREFIX.csv, PREFIX.json and (with pyarrow) PREFIX.parquet; the paths written."""
-    return write_tables(table(result), summary(result), prefix, parquet=parquet)
+    """PREFIX.csv, PREFIX.json and (with pyarrow) PREFIX.parquet, and for a tolerance study
+    PREFIX_poses.csv (every pose's stack-up: tolerance_report.pose_table); the paths written."""
+    paths = write_tables(table(result), summary(result), prefix, parquet=parquet)
+    if result.spread is not None:
+        paths.append(write_csv(pose_table(result), Path(f"{prefix}_poses.csv")))
+    return paths
+
+
+def write_csv(columns: dict[str, list], path: Path) -> Path:
+    """Columns to a CSV file (written whole)."""
+    text = io.StringIO(newline="")
+    writer = csv.writer(text)
+    writer.writerow(columns)
+    writer.writerows(zip(*columns.values()))
+    write_whole(path, text.getvalue())
+    return path
 
 
 def write_tables(columns: dict[str, list], summary_: dict, prefix: str | Path, *, parquet: bool = True) -> list[Path]:
     """Columns to PREFIX.csv (and PREFIX.parquet with pyarrow), a summary to PREFIX.json."""
     paths = [beside(prefix, ".csv"), beside(prefix, ".json")]
-    text = io.StringIO(newline="")
-    writer = csv.writer(text)
-    writer.writerow(columns)
-    writer.writerows(zip(*columns.values()))
-    write_whole(paths[0], text.getvalue())
+    write_csv(columns, paths[0])
     write_whole(paths[1], json.dumps(summary_, indent=2) + "\n")
     if parquet:
         try:
