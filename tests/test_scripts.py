@@ -20,6 +20,7 @@ import pytest
         ("singular_accuracy", []),
         ("condition_time", ["--sizes", "1", "5", "--rounds", "1"]),
         ("benchmark_study", ["--samples", "40", "--rounds", "1"]),
+        ("benchmark_drawn_study", ["--samples", "10", "--steps", "13", "--rounds", "1"]),
         ("benchmark_synthesis", ["--six-bar", "--rounds", "1"]),
     ],
 )
