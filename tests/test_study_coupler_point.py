@@ -77,3 +77,17 @@ def test_an_angle_param_takes_its_tolerance_in_degrees():
     raw["params"]["gamma"] = {"param": "gamma", "tolerance": "0.5 mm"}
     with pytest.raises(SceneError, match=r"gamma is an angle.*give them in deg"):
         StudyMechanism(parse_study(raw, STUDIES / "inline.toml"))
+
+
+@pytest.mark.parametrize("unit, error", [("deg", None), ("mm", r"gamma is an angle: give from and to in deg")])
+def test_a_grid_over_an_angle_param_is_in_degrees(unit, error):
+    """gamma from 20 to 30 deg in 3 points: P at each is the bearing's; in mm: refused."""
+    raw = {**_raw(), "kind": "grid", "steps": 5, "params": {"gamma": {"param": "gamma"}},
+           "grid": {"gamma": {"from": f"20 {unit}", "to": f"30 {unit}", "count": 3}}}
+    spec = parse_study(raw, STUDIES / "inline.toml")
+    if error:
+        with pytest.raises(SceneError, match=error):
+            StudyMechanism(spec)
+        return
+    np.testing.assert_allclose(spec.grid[0].values, np.radians([20.0, 25.0, 30.0]), rtol=1e-15)
+    assert spec.grid[0].kind == "angle"

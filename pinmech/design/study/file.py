@@ -95,6 +95,7 @@ class GridAxis:
     start: float
     stop: float
     count: int
+    kind: str = "length"  # the parameter's: "angle" for a drawn angle param (values in rad)
 
     @property
     def values(self) -> tuple[float, ...]:
@@ -240,13 +241,13 @@ def _axis(name: str, entry: Any, params: tuple[Parameter, ...], where: _Where) -
     count = entry["count"]
     if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= _GRID_MAX:
         raise where.error(f"{key}.count", f"count = {count!r} must be a whole number from 1 to {_GRID_MAX}")
-    along = _Where(where.path, params[names.index(name)].kind)
+    along = _Where(where.path, "angle" if is_angle(entry["from"]) else params[names.index(name)].kind)
     start, stop = along.length(entry, "from", key), along.length(entry, "to", key)
     if count > 1 and not start < stop:
         raise where.error(key, f"from {entry['from']} is not below to {entry['to']} (count {count})")
     if count == 1 and start != stop:
         raise where.error(key, f"count = 1 is the one value from = {entry['from']}: give to = from, or a count above 1")
-    return GridAxis(name, names.index(name), start, stop, count)
+    return GridAxis(name, names.index(name), start, stop, count, along.kind)
 
 
 def _parameter(name: str, table: Any, where: _Where) -> Parameter:

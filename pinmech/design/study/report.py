@@ -70,7 +70,9 @@ def summary(result: StudyResult) -> dict:
 def _grid_summary(result: StudyResult) -> dict:
     """A grid study's axes [mm], its points that solved, and the failures by cause."""
     _, _, causes = result.variants
-    out = {"grid": {a.name: {"from_mm": a.start * 1e3, "to_mm": a.stop * 1e3, "count": a.count}
+    units = {a.name: _per(result, a.param) for a in result.spec.grid}
+    out = {"grid": {a.name: {f"from_{units[a.name][1]}": a.start / units[a.name][0],
+                             f"to_{units[a.name][1]}": a.stop / units[a.name][0], "count": a.count}
                     for a in result.spec.grid},
            "points": len(causes), "solved": sum(not c for c in causes), "failures": failures(causes)}
     mu = result.transmission
@@ -104,7 +106,8 @@ def text(result: StudyResult) -> str:
         lines.append(f"solved {s['solved']} of {s['samples']} variants; failed: {failed}")
         lines += tolerance_lines(s, s["driver"])
     if "points" in s:
-        axes = " x ".join(f"{n} {g['from_mm']:.6g}..{g['to_mm']:.6g} mm ({g['count']})" for n, g in s["grid"].items())
+        axes = " x ".join(f"{n} {g[f'from_{u}']:.6g}..{g[f'to_{u}']:.6g} {u} ({g['count']})"
+                          for n, g in s["grid"].items() for u in ("mm" if "from_mm" in g else "deg",))
         failed = ", ".join(f"{c}: {n}" for c, n in s["failures"].items()) or "none"
         lines.append(f"grid {axes}: solved {s['solved']} of {s['points']} points; failed: {failed}")
         if "least_transmission_angle_deg" in s:

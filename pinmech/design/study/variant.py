@@ -63,6 +63,12 @@ class StudyMechanism:
         self.model = self.mechanism.model
         self.placements: list[Placement] = placements(self.mechanism, spec.params, str(spec.path), scene)
         self._drawing = next((place.drawing for place in self.placements if place.drawn), None)
+        for axis in spec.grid:  # a grid's values are in its parameter's own quantity
+            if axis.kind != self.placements[axis.param].kind:
+                kind = self.placements[axis.param].kind
+                raise SceneError(f"grid.{axis.name} is given as {axis.kind}s, but {axis.name} is "
+                                 f"{'an' if kind == 'angle' else 'a'} {kind}: give from and to in "
+                                 f"{'deg' if kind == 'angle' else 'mm'}", path=str(spec.path), key=f"grid.{axis.name}")
         for p, place in zip(spec.params, self.placements):
             if p.nominal is not None:
                 place.write(p.nominal)
