@@ -46,11 +46,7 @@ def test_watt_redrawn_in_place_closes_at_the_compass_points():
     placed = DrawnPlacements(linkage_from_spec(spec, source, params), model)
     rng = np.random.default_rng(3)
     p = {n: v * (1 + 0.05 * rng.uniform(-1, 1)) for n, v in params.items()}
-    for kind, i, M in placed.placements(linkage_from_spec(spec, source, p)):
-        if kind == "joint":
-            model.jointPlacements[i] = M
-        else:
-            model.frames[i].placement = M
+    placed.write(placed.placements(linkage_from_spec(spec, source, p)))
     fresh = linkage_mechanism(linkage_from_spec(spec.with_params(**p), source))
     for j in range(1, model.njoints):
         assert np.allclose(model.jointPlacements[j].homogeneous, fresh.model.jointPlacements[j].homogeneous,

@@ -21,6 +21,7 @@ from tests.tolerance import STATED_SWEEP, rounding
         ("singular_accuracy", []),
         ("condition_time", ["--sizes", "1", "5", "--rounds", "1"]),
         ("benchmark_study", ["--samples", "40", "--rounds", "1"]),
+        ("benchmark_drawn_study", ["--samples", "10", "--steps", "13", "--rounds", "1"]),
         ("benchmark_synthesis", ["--six-bar", "--rounds", "1"]),
     ],
 )

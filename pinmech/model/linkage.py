@@ -27,13 +27,13 @@ from typing import Any
 
 import numpy as np
 
-from pinmech.exceptions import ModelError, UnitError
+from pinmech.exceptions import ModelError
 from pinmech.model.compass import compass
-from pinmech.model.linkage_expr import length
+from pinmech.model.linkage_expr import is_angle, length, quantity_si
 from pinmech.model.linkage_masses import LinkMass, parse_masses
 from pinmech.directions import unit_vector
+from pinmech.model.linkage_entries import Bearing
 from pinmech.model.linkage_spec import GROUND, Compass, LinkageSpec, Polar, Slot, read_linkage_spec
-from pinmech.units import to_si
 
 
 @dataclass(frozen=True)
@@ -134,12 +134,20 @@ def linkage_from_spec(spec: LinkageSpec, source: str = "<linkage>", values: dict
 
 
 def linkage_params(spec: LinkageSpec, source: str = "<linkage>") -> dict[str, float]:
-    """The spec's parameters as lengths [m], in the order written (a study's named dimensions).
+    """The spec's parameters in SI, in the order written (a study's named dimensions): lengths
+    [m], and angles [rad] for those written with an angle's unit (`param_kinds`).
 
     Raises:
-        ModelError: a parameter that is no length (naming `[params] NAME`).
+        ModelError: a parameter that is no length nor angle (naming `[params] NAME`).
     """
-    return dict(_Reader(source, spec.params).params)
+    reader = _Reader(source, spec.params)
+    return {name: reader.params.get(name, reader.angles.get(name)) for name in spec.params}
+
+
+def param_kinds(spec: LinkageSpec) -> dict[str, str]:
+    """Each parameter's kind: "angle" where written as one quantity with an angle's unit
+    ("25 deg"), else "length"."""
+    return {name: "angle" if is_angle(value) else "length" for name, value in spec.params.items()}
 
 
 def _masses(linkage: Linkage, reader: _Reader, spec: LinkageSpec) -> None:
@@ -156,30 +164,37 @@ def _masses(linkage: Linkage, reader: _Reader, spec: LinkageSpec) -> None:
 
 
 class _Reader:
-    """Lengths and angles of one file: quantities with units, or names of `[params]`."""
+    """Lengths and angles of one file: quantities with units, or names of `[params]`
+    (lengths, and angles: a parameter written with an angle's unit, used by its name)."""
 
     def __init__(self, source: str, params: dict[str, Any], values: dict[str, float] | None = None):
         self.source = source
-        self.params: dict[str, float] = {}
-        if values is not None:  # already lengths [m], one for every parameter
-            self.params = {name: float(values[name]) for name in params}
-            return
+        self.params: dict[str, float] = {}  # the length parameters [m]
+        self.angles: dict[str, float] = {}  # the angle parameters [rad]
         for name, value in params.items():  # in the order written: a parameter may use earlier ones
-            self.params[name] = self.length(value, f"[params] {name}")
+            angle = is_angle(value)
+            if values is not None:  # already in SI, one for every parameter
+                (self.angles if angle else self.params)[name] = float(values[name])
+            elif angle:
+                self.angles[name] = self.angle(value, f"[params] {name}")
+            else:
+                self.params[name] = self.length(value, f"[params] {name}")
 
     def length(self, value: Any, where: str) -> float:
         """A length [m]: "15 mm", a parameter name "crank", or an expression "-a", "2*a + b"
         (see `pinmech.model.linkage_expr`)."""
+        if isinstance(value, str) and value.strip() in self.angles:
+            raise ModelError(f"'{value.strip()}' is an angle parameter ({self.angles[value.strip()] * 180 / math.pi:.6g}"
+                             " deg) where a length is needed", path=self.source, element=where)
         return length(value, self.params, self.source, where)
 
     def angle(self, value: Any, where: str) -> float:
-        """An angle [rad]: "30 deg"."""
-        try:
-            return to_si(value, "angle", where=where)
-        except UnitError as exc:
-            raise ModelError(str(exc), path=self.source) from exc
+        """An angle [rad]: "30 deg", or the name of an angle parameter ("gamma")."""
+        if isinstance(value, str) and value.strip() in self.angles:
+            return self.angles[value.strip()]
+        return quantity_si(value, "angle", self.source, where)
 
-    def points(self, joints: dict[str, tuple | Polar | Compass]) -> dict[str, np.ndarray]:
+    def points(self, joints: dict[str, tuple | Polar | Compass | Bearing]) -> dict[str, np.ndarray]:
         """World positions of `[joints]`, in the order written (constructions use earlier ones)."""
         out: dict[str, np.ndarray] = {}
         for name, spec in joints.items():
@@ -193,11 +208,28 @@ class _Reader:
                 a, b = _level(out[spec.bases[0]], out[spec.bases[1]], list(spec.bases), self.source, where)
                 point = _compass(a[:2], b[:2], r1, r2, spec.side == "left", f"{self.source}, {where}")
                 out[name] = np.append(point, a[2]) if a.size == 3 else point
+            elif isinstance(spec, Bearing):
+                out[name] = self._bearing(spec, out, where)
             else:
                 out[name] = np.array([self.length(v, f"{where} {c}") for v, c in zip(spec, "xyz")])
         return out
 
-def _level(a: np.ndarray, b: np.ndarray, names: list[str], source: str, where: str) -> tuple[np.ndarray, np.ndarray]:
+    def _bearing(self, spec: Bearing, out: dict[str, np.ndarray], where: str) -> np.ndarray:
+        """At `length` from A, turned `angle` from A -> B (seen from +z, in the plane z = z_A) [m]."""
+        r, gamma = self.length(spec.length, f"{where} length"), self.angle(spec.angle, f"{where} angle")
+        a, b = _level(out[spec.bases[0]], out[spec.bases[1]], list(spec.bases), self.source, where, "bearing")
+        d = float(np.linalg.norm(b[:2] - a[:2]))
+        if d == 0:
+            raise ModelError(f"cannot be drawn: {spec.bases[0]} and {spec.bases[1]} are at one place, so the line "
+                             "the angle is measured from has no direction", path=self.source, element=where)
+        u = (b[:2] - a[:2]) / d
+        c, s = math.cos(gamma), math.sin(gamma)
+        point = a[:2] + r * np.array([c * u[0] - s * u[1], s * u[0] + c * u[1]])
+        return np.append(point, a[2]) if a.size == 3 else point
+
+
+def _level(a: np.ndarray, b: np.ndarray, names: list[str], source: str, where: str, kind: str = "compass"
+           ) -> tuple[np.ndarray, np.ndarray]:
     """The two bases of a compass construction, both 2-D or both 3-D at one z [m]: left and
     right of A -> B are seen from +z, so the circles are drawn in the plane z = z_A.
 
@@ -208,7 +240,7 @@ def _level(a: np.ndarray, b: np.ndarray, names: list[str], source: str, where: s
         return a, b
     a, b = (np.append(p, 0.0) if p.size == 2 else p for p in (a, b))
     if abs(a[2] - b[2]) > 1e-12 * max(float(np.linalg.norm(b - a)), float(np.max(np.abs(a))), 1e-300):
-        raise ModelError(f"a compass construction draws in a plane z = constant, but {names[0]} is at z = "
+        raise ModelError(f"a {kind} construction draws in a plane z = constant, but {names[0]} is at z = "
                          f"{a[2]:.6g} m and {names[1]} at z = {b[2]:.6g} m: give this joint's [x, y, z]",
                          path=source, element=where)
     return a, b

@@ -38,6 +38,16 @@ class Compass(_Entry):
     side: Literal["left", "right"]
 
 
+class Bearing(_Entry):
+    """`{from = ["A", "B"], length = "p", angle = "gamma"}`: at `length` from A, `angle` from
+    the line A -> B (counter-clockwise seen from +z): a coupler point by its distance from
+    A and its angle to the coupler's line (Norton's R_PA and delta_3)."""
+
+    bases: tuple[str, str] = msgspec.field(name="from")
+    length: Written
+    angle: Written
+
+
 class Slider(_Entry):
     """`{block = LINK, on = LINK, at = JOINT, along = ANGLE or [P, Q]}`: a prismatic pair."""
 
@@ -68,15 +78,20 @@ Coordinates = tuple[Written, ...]
 
 
 #: A joint's place at the drawn pose: coordinates as written, or a construction.
-Joint = Union[Coordinates, Polar, Compass]
+Joint = Union[Coordinates, Polar, Compass, Bearing]
+#: The constructions: their type, and the keys each is written with.
+CONSTRUCTIONS = {Polar: ("from", "length", "angle"), Compass: ("from", "lengths", "side"),
+                 Bearing: ("from", "length", "angle")}
 
 
 def joint_type(entry: object) -> type:
     """The type a `[joints]` entry takes (its shape is checked before: `linkage_spec._joint`)."""
-    if isinstance(entry, (Polar, Compass)):
+    if isinstance(entry, (Polar, Compass, Bearing)):
         return type(entry)
     if isinstance(entry, dict):
-        return Polar if isinstance(entry.get("from"), str) else Compass
+        if isinstance(entry.get("from"), str):
+            return Polar
+        return Compass if "lengths" in entry or "side" in entry else Bearing
     return Coordinates
 
 

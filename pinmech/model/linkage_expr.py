@@ -18,6 +18,7 @@ length or not finite, or a magnitude beyond `units.MAX_MAGNITUDE`.
 from __future__ import annotations
 
 import ast
+import functools
 import keyword
 import math
 import re
@@ -50,6 +51,20 @@ def check_param_name(name: str, source: str) -> None:
                          path=source, element=f"[params] {name}")
 
 
+@functools.lru_cache(maxsize=4096)
+def _is_angle_text(value: str) -> bool:
+    try:
+        to_si(value, "angle")
+    except UnitError:
+        return False
+    return True
+
+
+def is_angle(value: Any) -> bool:
+    """Whether a `[params]` value is one quantity with an angle's unit ("25 deg", "0.4 rad")."""
+    return isinstance(value, str) and _is_angle_text(value)
+
+
 def length(value: Any, params: dict[str, float], source: str, where: str) -> float:
     """A length [m]: a quantity with its unit, or an expression over `params` [m].
 
@@ -59,8 +74,8 @@ def length(value: Any, params: dict[str, float], source: str, where: str) -> flo
     if not isinstance(value, str):
         return _quantity(value, source, where)
     text = value.strip().replace("\u2212", "-")  # a typographic minus sign is a minus sign
-    tree = _parse(text)
-    if tree is None or not any(isinstance(n, ast.Name) for n in ast.walk(tree)):
+    tree, named = _parse(text)
+    if not named:
         _refuse_unit_named_as_param(text, params, source, where)
         try:
             return _quantity(value, source, where)
@@ -84,23 +99,48 @@ def length(value: Any, params: dict[str, float], source: str, where: str) -> flo
     return result
 
 
-def _parse(text: str) -> ast.Expression | None:
-    """The expression's tree, or None when the text is no expression (a quantity "15 mm")."""
+@functools.lru_cache(maxsize=4096)
+def _parse(text: str) -> tuple[ast.Expression | None, bool]:
+    """The expression's tree, or None when the text is no expression (a quantity "15 mm"),
+    and whether it names anything (a parameter). Kept per text: a study redraws a linkage
+    for every variant, and the trees are only read."""
     if len(text) > MAX_TEXT:
-        return None
+        return None, False
     try:
         with warnings.catch_warnings():  # "15mm": Python's SyntaxWarning, on stderr, is no message of ours
             warnings.simplefilter("ignore", SyntaxWarning)
-            return ast.parse(text, mode="eval")
+            tree = ast.parse(text, mode="eval")
     except (SyntaxError, ValueError, RecursionError, MemoryError):
-        return None
+        return None, False
+    return tree, any(isinstance(n, ast.Name) for n in ast.walk(tree))
+
+
+def quantity_si(value: Any, kind: str, source: str, where: str) -> float:
+    """A quantity as written ("15 mm", "30 deg") in SI: `units.to_si`, kept per text (a
+    redrawing reads the same texts again).
+
+    Raises:
+        ModelError: naming the file and the key.
+    """
+    try:
+        if isinstance(value, (str, int, float)) and not isinstance(value, bool):
+            return _si(value, kind)
+        return to_si(value, kind, where=where)
+    except UnitError:
+        try:
+            to_si(value, kind, where=where)  # the message, with the key it was written under
+        except UnitError as exc:
+            raise ModelError(str(exc), path=source) from exc
+        raise
+
+
+@functools.lru_cache(maxsize=4096)
+def _si(value: str | int | float, kind: str) -> float:
+    return to_si(value, kind)
 
 
 def _quantity(value: Any, source: str, where: str) -> float:
-    try:
-        return to_si(value, "length", where=where)
-    except UnitError as exc:
-        raise ModelError(str(exc), path=source) from exc
+    return quantity_si(value, "length", source, where)
 
 
 def _refuse_unit_named_as_param(text: str, params: dict[str, float], source: str, where: str) -> None:

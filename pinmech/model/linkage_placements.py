@@ -22,6 +22,8 @@ a placement) is refused by name.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pinocchio as pin
 
@@ -42,12 +44,17 @@ def _link_frames(linkage: Linkage, tree: Tree) -> dict[str, tuple[np.ndarray, np
         for link in tree.order[1:]:
             out[link] = (np.asarray(tree.parent[link][0].at, dtype=float), np.eye(3))
         return out
-    return {link: (np.append(f.origin, 0.0), pin.rpy.rpyToMatrix(0.0, 0.0, f.phi))
-            for link, f in _frames(linkage, tree).items()}
+    return {link: (_at(f.origin), _turn(f.phi)) for link, f in _frames(linkage, tree).items()}
+
+
+def _turn(phi: float) -> np.ndarray:
+    """The rotation about z by phi [rad] (3, 3)."""
+    c, s = math.cos(phi), math.sin(phi)
+    return np.array(((c, -s, 0.0), (s, c, 0.0), (0.0, 0.0, 1.0)))
 
 
 def _at(p: np.ndarray) -> np.ndarray:
-    return np.append(p, 0.0) if p.size == 2 else np.asarray(p, dtype=float)
+    return np.array((p[0], p[1], 0.0)) if p.size == 2 else np.asarray(p, dtype=float)
 
 
 class DrawnPlacements:
@@ -65,6 +72,10 @@ class DrawnPlacements:
                        for link, link_edge in self.tree.parent.items() if model.existJointName(link_edge[0].name)]
         self.frames = self._frame_roles(linkage)
         self.slides = self._slides(linkage)
+        bodies = {link: self.model.frames[self.model.getFrameId(link, pin.FrameType.BODY)].placement
+                  for _, link, _, _ in self.frames}  # each frame's link's body frame (fixed)
+        self._bodies = {link: (np.array(M.rotation), np.array(M.translation)) for link, M in bodies.items()}
+        self._joint_placements, self._model_frames = model.jointPlacements, model.frames  # Pinocchio's own vectors
         self._check(linkage)
 
     def _frame_roles(self, linkage: Linkage) -> list[tuple[int, str, str, bool]]:
@@ -92,15 +103,16 @@ class DrawnPlacements:
         """Each slide's direction [-] (world, drawn pose): an axis, not a placement."""
         return {e.name: np.asarray(e.direction, dtype=float) for e in linkage.edges if e.kind == "prismatic"}
 
-    def placements(self, linkage: Linkage) -> list[tuple[str, int, pin.SE3]]:
-        """(kind, index, SE3) of every joint and frame the redrawn `linkage` places.
+    def placements(self, linkage: Linkage) -> list[tuple[str, int, np.ndarray, np.ndarray]]:
+        """(kind, index, rotation (3, 3), translation (3,) [m]) of every joint and frame the
+        redrawn `linkage` places, in its parent joint's frame.
 
         Raises:
             ModelError: the redrawing turns a slide (its direction changes: the joint's or
                 the cut's axis, which no placement holds).
         """
         for name, d in self._slides(linkage).items():
-            if float(np.max(np.abs(d - self.slides[name]))) > 1e-12:
+            if max(abs(float(x) - float(y)) for x, y in zip(d, self.slides[name])) > 1e-12:
                 raise ModelError(f"redrawn, the slide {name} turns (direction {np.round(d, 9).tolist()} against "
                                  f"{np.round(self.slides[name], 9).tolist()} drawn): a slide's axis cannot be "
                                  "written in place; keep its direction fixed", path=self.source)
@@ -108,27 +120,36 @@ class DrawnPlacements:
         tree = Tree(self.tree.order, {link: (edges[e.name], parent) for link, (e, parent) in self.tree.parent.items()},
                     [edges[c.name] for c in self.tree.cuts])  # the template's tree, the new drawing's points
         frames = _link_frames(linkage, tree)
-        out = []
+        out, identity = [], np.eye(3)
         for j, child, template_edge, parent in self.joints:
             edge = edges[template_edge.name]
             o_p, R_p = frames[parent]
-            R = R_p.T @ frames[child][1] if edge.kind == "prismatic" and not linkage.spatial else np.eye(3)
-            out.append(("joint", j, pin.SE3(R, R_p.T @ (_at(edge.at) - o_p))))
+            R = R_p.T @ frames[child][1] if edge.kind == "prismatic" and not linkage.spatial else identity
+            out.append(("joint", j, R, R_p.T @ (_at(edge.at) - o_p)))
         for i, link, (kind, name), world in self.frames:
             o, R = frames[link]
             x = edges[name].at if kind == "cut" else linkage.points[name]
-            body = self.model.frames[self.model.getFrameId(link, pin.FrameType.BODY)].placement
-            out.append(("frame", i, body * pin.SE3(R.T if world else np.eye(3), R.T @ (_at(x) - o))))
+            body_R, body_t = self._bodies[link]
+            local = body_t + body_R @ (R.T @ (_at(x) - o))
+            out.append(("frame", i, body_R @ R.T if world else body_R, local))
         return out
+
+    def write(self, placements: list[tuple[str, int, np.ndarray, np.ndarray]]) -> None:
+        """Write `placements` into the model in place (through Pinocchio's views: no SE3 made)."""
+        joints, frames = self._joint_placements, self._model_frames
+        for kind, i, R, t in placements:
+            M = joints[i] if kind == "joint" else frames[i].placement
+            M.translation[:] = t
+            M.rotation[:] = R
 
     def _check(self, linkage: Linkage) -> None:
         """The rules give the loaded model's own placements (else: refused by name)."""
         pts = np.array([_at(p) for p in linkage.points.values()])
         tol = _MATCH * max(float(np.ptp(pts, axis=0).max()), 1e-300)
-        for kind, i, M in self.placements(linkage):
+        for kind, i, R, t in self.placements(linkage):
             have = self.model.jointPlacements[i] if kind == "joint" else self.model.frames[i].placement
-            gap = float(np.max(np.abs(have.translation - M.translation)))
-            turn = float(np.max(np.abs(have.rotation - M.rotation)))
+            gap = float(np.max(np.abs(have.translation - t)))
+            turn = float(np.max(np.abs(have.rotation - R)))
             if gap > tol or turn > _MATCH:
                 what = self.model.names[i] if kind == "joint" else self.model.frames[i].name
                 raise ModelError(f"the {kind} {what}'s placement is not the drawing's (off by {gap:.3g} m, {turn:.3g} in its rotation): "

@@ -22,9 +22,9 @@ from msgspec import structs
 from pinmech.directions import unit_vector, written
 from pinmech.exceptions import ModelError
 from pinmech.known_keys import unknown_keys
-from pinmech.model.linkage_entries import (TABLES as _TABLES, Compass, Joint, MassSpec, Polar, Slider, Slot, Written,
+from pinmech.model.linkage_entries import (TABLES as _TABLES, Bearing, Compass, Joint, MassSpec, Polar, Slider, Slot, Written,
                                            as_model_error as _as_model_error, joint_type)
-from pinmech.model.linkage_expr import check_param_name
+from pinmech.model.linkage_expr import check_param_name, is_angle
 from pinmech.typed_values import WrongType, typed
 
 GROUND = "ground"
@@ -43,7 +43,7 @@ class LinkageSpec(msgspec.Struct, frozen=True, forbid_unknown_fields=True, kw_on
         title: the linkage's title (None: the file's stem).
         ground: the joints on the ground.
         params: parameter name -> a length as written; coordinates may use them.
-        joints: joint name -> `[x, y]` / `[x, y, z]` as written, or a `Polar` or `Compass`
+        joints: joint name -> `[x, y]` / `[x, y, z]` as written, or a `Polar`, `Compass` or `Bearing`
             construction from joints above it.
         links: link name -> the joints it carries, in order.
         sliders, slots: name -> `Slider` / `Slot`.
@@ -93,7 +93,8 @@ class LinkageSpec(msgspec.Struct, frozen=True, forbid_unknown_fields=True, kw_on
         return tuple(name for name, n in count.items() if n >= 2)
 
     def with_params(self, **lengths_m: float) -> LinkageSpec:
-        """This linkage with parameters set to lengths [m] (written "<value> m"), validated again.
+        """This linkage with parameters set to lengths [m] (written "<value> m"; an angle
+        parameter's value [rad] written "<value> rad"), validated again.
 
         Raises:
             ModelError: a name that is not one of `params`.
@@ -102,7 +103,8 @@ class LinkageSpec(msgspec.Struct, frozen=True, forbid_unknown_fields=True, kw_on
             if name not in self.params:
                 raise ModelError(f"'{name}' is not a parameter (params: {', '.join(self.params) or 'none'})",
                                  element="[params]")
-        params = {**self.params, **{n: f"{float(v)!r} m" for n, v in lengths_m.items()}}
+        unit = {n: "rad" if is_angle(self.params[n]) else "m" for n in lengths_m}
+        params = {**self.params, **{n: f"{float(v)!r} {unit[n]}" for n, v in lengths_m.items()}}
         return linkage_spec({**msgspec.to_builtins(self), "params": params})
 
 
@@ -168,9 +170,17 @@ def _names(value: Any, where: str, source: str) -> list[str]:
     return list(value)
 
 
+_SAY = {"polar": 'a polar construction has from = "JOINT", length, angle (from the x axis)',
+        "compass": 'a compass construction has from = ["A", "B"], lengths = [|A..|, |B..|], side = "left" or '
+                   '"right" (of the line A -> B)',
+        "bearing": 'a bearing construction has from = ["A", "B"], length (from A), angle (from the line A -> B)'}
+_KEYS_OF = {"polar": ("from", "length", "angle"), "compass": ("from", "lengths", "side"),
+            "bearing": ("from", "length", "angle")}
+
+
 def _joint(spec: Any, where: str, source: str) -> Any:
-    """A joint's entry checked for shape: coordinates, or a polar or compass construction."""
-    if isinstance(spec, (Polar, Compass)):  # built in code, typed already
+    """A joint's entry checked for shape: coordinates, or a polar, compass or bearing construction."""
+    if isinstance(spec, (Polar, Compass, Bearing)):  # built in code, typed already
         return spec
     if isinstance(spec, (list, tuple)):
         if len(spec) not in (2, 3):
@@ -183,19 +193,29 @@ def _joint(spec: Any, where: str, source: str) -> Any:
     bases = [origin] if isinstance(origin, str) else origin
     if not isinstance(bases, (list, tuple)) or not all(isinstance(b, str) for b in bases):
         raise ModelError("a construction needs from = \"JOINT\" (with length, angle) or from = [\"A\", \"B\"] "
-                         "(with lengths, side)", path=source, element=where)
-    if isinstance(origin, str):
-        if set(spec) != {"from", "length", "angle"}:
-            raise ModelError("a polar construction has exactly from, length, angle", path=source, element=where)
-        return spec
-    if len(bases) != 2 or set(spec) != {"from", "lengths", "side"}:
-        raise ModelError("a compass construction has exactly from = [\"A\", \"B\"], lengths = [|A..|, |B..|], "
-                         "side = \"left\" or \"right\" (of the line A -> B)", path=source, element=where)
-    if not isinstance(spec["lengths"], (list, tuple)) or len(spec["lengths"]) != 2:
-        raise ModelError(f"lengths must be two lengths, got {spec['lengths']!r}", path=source, element=where)
-    if spec["side"] not in ("left", "right"):
-        raise ModelError(f"side must be \"left\" or \"right\", got {spec['side']!r}", path=source, element=where)
+                         "(with lengths, side; or with length, angle from the line A -> B)", path=source, element=where)
+    kind = _construction(spec)
+    message = unknown_keys(spec, _KEYS_OF[kind], hint=_SAY[kind])
+    missing = [k for k in _KEYS_OF[kind] if k not in spec]
+    if message or missing:
+        raise ModelError(message or f"missing {', '.join(missing)}: {_SAY[kind]}", path=source, element=where)
+    if kind != "polar" and len(bases) != 2:
+        raise ModelError(f"from names {len(bases)} joints: {_SAY[kind]}", path=source, element=where)
+    if kind == "compass":
+        if not isinstance(spec["lengths"], (list, tuple)) or len(spec["lengths"]) != 2:
+            raise ModelError(f"lengths must be two lengths, got {spec['lengths']!r}", path=source, element=where)
+        if spec["side"] not in ("left", "right"):
+            raise ModelError(f"side must be \"left\" or \"right\", got {spec['side']!r}", path=source, element=where)
     return spec
+
+
+def _construction(spec: dict) -> str:
+    """Which construction a table is: polar (from one joint), else compass or bearing (from
+    two), whichever of their keys it writes more of (a misspelt key then named as unknown)."""
+    if isinstance(spec.get("from"), str):
+        return "polar"
+    score = {k: len(set(spec) & set(_KEYS_OF[k])) for k in ("compass", "bearing")}
+    return "bearing" if score["bearing"] > score["compass"] else "compass"
 
 
 def read_linkage_spec(path: Any) -> tuple[LinkageSpec, str]:
@@ -235,16 +255,18 @@ def _check_references(spec: LinkageSpec, source: str) -> None:
     """Every name an entry uses is given where it must be (joints, links, earlier joints)."""
     joints = list(spec.joints)
     for name, entry in spec.joints.items():
-        bases = [entry.base] if isinstance(entry, Polar) else list(entry.bases) if isinstance(entry, Compass) else []
+        bases = [entry.base] if isinstance(entry, Polar) else list(entry.bases) if isinstance(entry, (Compass, Bearing)) else []
         for base in bases:
             if base not in joints[: joints.index(name)]:
-                raise ModelError(f"from names '{base}', which is not given above it", path=source,
-                                 element=f"[joints] {name}")
+                above = ", ".join(joints[: joints.index(name)]) or "none"
+                later = " (it is given below: a construction uses joints above it)" if base in joints else ""
+                raise ModelError(f"from names '{base}', which is not given above it{later}; joints above: {above}",
+                                 path=source, element=f"[joints] {name}")
     for link, names in {GROUND: spec.ground, **spec.links}.items():
         for name in names:
             if name not in spec.joints:
-                raise ModelError(f"names joint '{name}', which [joints] does not give", path=source,
-                                 element=f"[links] {link}" if link != GROUND else "ground")
+                raise ModelError(f"names joint '{name}', which [joints] does not give (joints: {', '.join(joints)})",
+                                 path=source, element=f"[links] {link}" if link != GROUND else "ground")
     if not spec.links:
         raise ModelError("no link: list the moving links under [links]", path=source)
     for where, names in ((f"[axes] {n}", [n]) for n in spec.axes):
@@ -263,7 +285,8 @@ def _check_references(spec: LinkageSpec, source: str) -> None:
 def _joints_given(names: list[str], spec: LinkageSpec, source: str, where: str) -> None:
     for name in names:
         if name not in spec.joints:
-            raise ModelError(f"'{name}' is not a joint of [joints]", path=source, element=where)
+            raise ModelError(f"'{name}' is not a joint of [joints] (joints: {', '.join(spec.joints)})", path=source,
+                             element=where)
 
 
 def _link(value: Any, links: list[str], key: str, source: str, where: str) -> str:
@@ -276,7 +299,8 @@ def _check_along(along: Any, spec: LinkageSpec, source: str, where: str) -> None
     if along is None:
         raise ModelError("has no line: give along = \"ANGLE\" or along = [\"P\", \"Q\"]", path=source, element=where)
     if isinstance(along, tuple) and (len(along) != 2 or not all(n in spec.joints for n in along)):
-        raise ModelError(f"along = {list(along)!r} must name two joints of [joints]", path=source, element=where)
+        raise ModelError(f"along = {list(along)!r} must name two joints of [joints] (joints: {', '.join(spec.joints)})",
+                         path=source, element=where)
 
 
 def _check_slider(name: str, slider: Slider, spec: LinkageSpec, links: list[str], source: str) -> None:
@@ -286,7 +310,9 @@ def _check_slider(name: str, slider: Slider, spec: LinkageSpec, links: list[str]
     if block == on:
         raise ModelError(f"block and on are the same link '{block}'", path=source, element=where)
     if slider.at not in ({GROUND: spec.ground, **spec.links}.get(block) or ()):
-        raise ModelError(f"at = {slider.at!r} must be a joint the block '{block}' lists", path=source, element=where)
+        listed = ", ".join({GROUND: spec.ground, **spec.links}.get(block) or ()) or "none"
+        raise ModelError(f"at = {slider.at!r} must be a joint the block '{block}' lists ({listed})", path=source,
+                         element=where)
     _check_along(slider.along, spec, source, where)
 
 
@@ -295,7 +321,8 @@ def _check_slot(name: str, slot: Slot, spec: LinkageSpec, links: list[str], sour
     pin_link = _link(slot.pin, links, "pin", source, where)
     _link(slot.slot, links, "slot", source, where)
     if name not in spec.joints:
-        raise ModelError(f"the slot's pin '{name}' is not given in [joints]", path=source, element=where)
+        raise ModelError(f"the slot's pin '{name}' is not given in [joints] (joints: {', '.join(spec.joints)})",
+                         path=source, element=where)
     if name not in ({GROUND: spec.ground, **spec.links}.get(pin_link) or ()):
         raise ModelError(f"the pin '{name}' must be listed by its link '{pin_link}'", path=source, element=where)
     if f"{name}_block" in spec.links:  # it would be replaced by the block, in silence
@@ -309,8 +336,8 @@ def _check_mass(link: str, mass: MassSpec, spec: LinkageSpec, source: str) -> No
     if link not in spec.links:
         raise ModelError(f"names no moving link (links: {', '.join(spec.links)})", path=source, element=where)
     if isinstance(mass.at, str) and mass.at not in spec.joints:
-        raise ModelError(f"at = {mass.at!r} is not a joint of [joints] (give its name or coordinates)",
-                         path=source, element=where)
+        raise ModelError(f"at = {mass.at!r} is not a joint of [joints] (give its name or coordinates; joints: "
+                         f"{', '.join(spec.joints)})", path=source, element=where)
     if not isinstance(mass.at, (str, tuple)) or (isinstance(mass.at, tuple) and len(mass.at) not in (2, 3)):
         raise ModelError(f"at = {mass.at!r}: the centre of mass is a joint's name or [x, y] (or [x, y, z]) "
                          "with units", path=source, element=where)

@@ -124,6 +124,7 @@ def _num(x: float) -> str:
 def _frames(linkage: Linkage, tree: Tree) -> dict[str, _Frame]:
     """Each link's frame: on its parent joint, x from its first listed point to the next (a block: its slide)."""
     frames = {GROUND: _Frame(np.zeros(2), 0.0)}
+    small = 1e-9 * _size(linkage)
     for link in tree.order[1:]:
         edge, _ = tree.parent[link]
         origin = edge.at
@@ -136,7 +137,7 @@ def _frames(linkage: Linkage, tree: Tree) -> dict[str, _Frame]:
             phi = 0.0
             for name in names[1:]:
                 vector = linkage.points[name] - first
-                if np.linalg.norm(vector) > 1e-9 * _size(linkage):
+                if math.hypot(vector[0], vector[1]) > small:
                     phi = math.atan2(vector[1], vector[0])
                     break
         frames[link] = _Frame(origin, phi)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import re
 
-from pinmech.model.linkage_entries import Compass, MassSpec, Polar, Slider, Slot
+from pinmech.model.linkage_entries import Bearing, Compass, MassSpec, Polar, Slider, Slot
 from pinmech.model.linkage_spec import LinkageSpec
 from pinmech.typed_values import given_fields
 
@@ -46,13 +46,13 @@ def linkage_toml(spec: LinkageSpec, header: str = "") -> str:
     return "\n".join(lines) + "\n"
 
 
-def _joint(joint: tuple | Polar | Compass) -> str:
-    if isinstance(joint, (Polar, Compass)):
+def _joint(joint: tuple | Polar | Compass | Bearing) -> str:
+    if isinstance(joint, (Polar, Compass, Bearing)):
         return _entry(joint)
     return _array(joint)
 
 
-def _entry(entry: Polar | Compass | Slider | Slot | MassSpec) -> str:
+def _entry(entry: Polar | Compass | Bearing | Slider | Slot | MassSpec) -> str:
     """An inline table of the entry's given fields, by their file names (`from`)."""
     fields = given_fields(entry)
     return "{ " + ", ".join(f"{_key(k)} = {_value(v)}" for k, v in fields.items()) + " }"

@@ -74,6 +74,9 @@ class Mechanism:
         massless_links: links without mass by construction (a drawn slot's hidden block, a
             ball's gimbal links): no mass is missing there.
         mass_source: where a file gives a link's mass, for the message naming links without.
+        written_frames: ("point", name) or ("cut", name, side) -> the placement in its joint
+            of the frame a file wrote it in, where the model's own frames lost it (an MJCF
+            site or anchor on a jointless body, moved onto the moving body).
     """
 
     model: pin.Model
@@ -94,6 +97,7 @@ class Mechanism:
     force_caveats: tuple[str, ...] = ()
     massless_links: tuple[str, ...] = ()
     mass_source: str = "<inertial> mass"
+    written_frames: dict = field(default_factory=dict)
 
     # ---------------------------------------------------------------- construction
     @classmethod
@@ -256,8 +260,7 @@ class Mechanism:
     def frame_id(self, name: str) -> int:
         """Frame id of a point, a link, or any other frame of the model, by name."""
         if not isinstance(name, str):
-            raise FrameNotFound("point or frame", f"{name!r:.40}", list(self.points) + list(self.links),
-                                path=self.source)
+            raise FrameNotFound("point or frame", f"{name!r:.40}", self.place_names, path=self.source)
         if name in self.points:
             return self.points[name]
         if name in self.links:
@@ -265,8 +268,17 @@ class Mechanism:
         fid = frame_named(self.model, name, source=self.source)
         if fid is not None:
             return fid
-        known = list(self.points) + list(self.links)
-        raise FrameNotFound("point or frame", name, known, path=self.source)
+        raise FrameNotFound("point or frame", name, self.place_names, path=self.source)
+
+    @property
+    def place_names(self) -> list[str]:
+        """Every name `frame_id` finds: the points, the links, then the pins and joints (a
+        drawn linkage's pins, a URDF's joints and fixed joints), without pinmech's own
+        frames (a loop cut's sides) and the world."""
+        own = {f"{c.name}__{side}" for c in self.closures for side in ("parent", "child")} | {"universe"}
+        names = list(dict.fromkeys([*self.points, *self.links]))
+        kinds = (pin.FrameType.OP_FRAME, pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT)
+        return names + sorted({f.name for f in self.model.frames if f.type in kinds} - set(names) - own)
 
     def link_of_frame(self, frame: int) -> str:
         """Name of the link a frame is attached to (the body of its parent joint)."""

@@ -214,8 +214,9 @@ def _equalities(root: ET.Element, source: str) -> tuple[list[str], list[str], li
     return connects, welds, elements
 
 
-def _wrapped(root: ET.Element, source: str) -> Path:
-    """The file with every top-level body under one fixed wrapper body at the origin (cached)."""
+def _wrapped(root: ET.Element, source: str) -> tuple[Path, dict]:
+    """The file with every top-level body under one fixed wrapper body at the origin (cached),
+    and what was moved off jointless bodies (mjcf_frames.hoist_to_moving_bodies)."""
     world = root.find("worldbody")
     if world is None:
         raise ModelError("no <worldbody>", path=source)
@@ -245,8 +246,8 @@ def _wrapped(root: ET.Element, source: str) -> Path:
                 for key in ("body1", "body2"):
                     if el.get(key) in (None, "world"):
                         el.set(key, WRAPPER)
-    hoist_to_moving_bodies(root, wrapper, source)
-    return cached_text("mjcf", ".xml", ET.tostring(root, encoding="unicode"))  # read back only if it is ours
+    written_on = hoist_to_moving_bodies(root, wrapper, source)
+    return cached_text("mjcf", ".xml", ET.tostring(root, encoding="unicode")), written_on  # read back only if ours
 
 
 def _build(path: Path, source: str) -> tuple[pin.Model, list, list]:
@@ -271,7 +272,7 @@ def load_mjcf(path: str | Path, *, locked: dict[str, float] | None = None) -> Me
         raise ModelError("Pinocchio's parser drops a <frame> with every body in it: write those bodies without "
                          "the <frame> (its pos and orientation composed into theirs)", path=source,
                          element="<worldbody> <frame>")
-    wrapped = _wrapped(root, source)
+    wrapped, written_on = _wrapped(root, source)
     model, points, frames = _build(wrapped, source)
     _check_everything_read(root, model, source)
     place_composites_as_mujoco(model, points + frames, root, source)
@@ -287,9 +288,24 @@ def load_mjcf(path: str | Path, *, locked: dict[str, float] | None = None) -> Me
     if locked:  # checked as drawn; then the joints the scene holds are locked out
         mech = Mechanism.from_model(model, points + frames, names=connects + welds, source=source,
                                     reference=qpos0, urdf_path=str(wrapped), locked=locked)
+    mech.written_frames = _written_frames(mech, written_on, elements, connects + welds)
     mech.force_caveats = mech.force_caveats + _force_caveats(root)
     mech.limits = {n: lu for n, lu in mjcf_limits(root, source).items() if n in mech.joints or n in mech.locked}
     return mech
+
+
+def _written_frames(mech: Mechanism, written_on: dict, elements: list[ET.Element], names: list[str]) -> dict:
+    """("point", site) or ("cut", name, side) -> the placement [m] in its joint of the
+    jointless body a site or an anchor was written on (before it was moved onto a moving one)."""
+    connects = [el for el in elements if el.tag == "connect"]
+    name_of = {id(el): name for el, name in zip(connects + [el for el in elements if el.tag == "weld"], names)}
+    out = {}
+    for key, (carrier, pos, rotation) in written_on.items():
+        if carrier not in mech.links:
+            continue
+        placement = mech.model.frames[mech.links[carrier]].placement * pin.SE3(rotation, pos)
+        out[("point", key[1]) if key[0] == "site" else ("cut", name_of[id(key[0])], key[1])] = placement
+    return out
 
 
 _DOFS = {"hinge": 1, "slide": 1, "ball": 3}

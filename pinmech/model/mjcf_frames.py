@@ -241,13 +241,19 @@ def _carrier(body: ET.Element, top: ET.Element, parent_of: dict, source: str):
     return body, pos, quat
 
 
-def hoist_to_moving_bodies(root: ET.Element, top: ET.Element, source: str) -> None:
+def hoist_to_moving_bodies(root: ET.Element, top: ET.Element, source: str) -> dict:
     """Sites, and the bodies a connect or weld names, moved from bodies without joints onto
     the nearest body that moves (or `top`, the world's wrapper), their placements composed:
     Pinocchio's parser places a site two or more jointless bodies below a joint, and a
-    connect anchor on any jointless body, as if the bodies between had no offset."""
+    connect anchor on any jointless body, as if the bodies between had no offset.
+
+    Returns: what was written on a jointless body, by ("site", name) or (equality element,
+    "parent" or "child": the side its anchor is on): (the moving body's name, the jointless
+    body's pos [m] and rotation (3, 3) in it), the frame a study reads the site's or the
+    anchor's pos in."""
     parent_of = {child: parent for parent in root.iter() for child in parent}
     bodies = {b.get("name"): b for b in root.iter("body") if b.get("name")}
+    written_on = {}
     for site in [s for s in root.iter("site")]:
         body = parent_of[site]
         carrier, pos, quat = _carrier(body, top, parent_of, source)
@@ -258,6 +264,7 @@ def hoist_to_moving_bodies(root: ET.Element, top: ET.Element, source: str) -> No
         site.set("quat", _text(_product(quat, r)))
         body.remove(site)
         carrier.append(site)
+        written_on[("site", site.get("name"))] = (carrier.get("name"), pos, _rotation(quat))
     for equality in root.findall("equality"):
         for el in equality:
             for key in ("body1", "body2"):
@@ -270,7 +277,10 @@ def hoist_to_moving_bodies(root: ET.Element, top: ET.Element, source: str) -> No
                 if (el.tag, key) in (("connect", "body1"), ("weld", "body2")):  # the anchor is in this body's frame
                     anchor = numbers(el, "anchor", 3, source) if el.get("anchor") is not None else np.zeros(3)
                     el.set("anchor", _text(pos + _rotation(quat) @ anchor))
+                    side = "parent" if key == "body1" else "child"
+                    written_on[(el, side)] = (carrier.get("name"), pos, _rotation(quat))
                 el.set(key, carrier.get("name"))
+    return written_on
 
 
 def sites_on(top: ET.Element, source: str) -> list[tuple[str, np.ndarray, np.ndarray]]:

@@ -61,7 +61,8 @@ def add_parser(sub) -> None:
     study.add_argument("--out", default=None, metavar="PREFIX",
                        help="write PREFIX.csv, PREFIX.parquet (pyarrow) and PREFIX.json")
     study.add_argument("--plot", action="store_true",
-                       help="with --out: PREFIX_sensitivity.png, and PREFIX_histogram.png for a tolerance study, "
+                       help="with --out: PREFIX_sensitivity.png; for a tolerance study PREFIX_histogram.png, PREFIX_sigma.png "
+                            "(spread against the driver), PREFIX_pareto.png, PREFIX_ellipses.png (point outputs); "
                             "PREFIX_grid.png for a 1-D or 2-D grid study, PREFIX_workspace.png for a workspace study")
     study.add_argument("--json", action="store_true", help="print the JSON summary instead of the text one")
     study.add_argument("--quiet", action="store_true",
@@ -103,7 +104,13 @@ def cmd_study(args: argparse.Namespace) -> int:
             if result.spec.kind == "grid":
                 written.append(grid_figure(result, f"{args.out}_grid.png"))
             if result.spread is not None:
+                from pinmech.design.study.plot_tolerance import ellipse_curves, pareto, point_pairs, sigma_curves
+
                 written.append(tolerance_histograms(result, f"{args.out}_histogram.png"))
+                written.append(sigma_curves(result, f"{args.out}_sigma.png"))
+                written.append(pareto(result, f"{args.out}_pareto.png"))
+                if point_pairs(result.outputs):
+                    written.append(ellipse_curves(result, f"{args.out}_ellipses.png"))
         print("wrote " + ", ".join(str(p) for p in written), file=sys.stderr)
     return 0
 

@@ -1,5 +1,8 @@
 """A drawn linkage's `[params]` as study parameters (`param = "crank"` in a study file).
 
+A param written with an angle's unit ("25 deg": a bearing construction's angle) is an
+angle parameter: its values in rad, its sensitivities per rad.
+
 A variant is the linkage's points redrawn with the changed lengths (`linkage_from_spec`
 with the values: the compass and polar constructions move other drawn points and turn the
 frames built from them) and its joint and frame placements, rotations included, computed
@@ -31,7 +34,7 @@ class Drawing:
     placements each set of values draws."""
 
     def __init__(self, scene, mechanism, where: str) -> None:
-        from pinmech.model.linkage_expr import length
+        from pinmech.model.linkage import linkage_params, param_kinds
         from pinmech.model.linkage_spec import read_linkage_spec
 
         if scene.model_kind != "linkage":
@@ -39,15 +42,14 @@ class Drawing:
                              f"'{scene.model_kind}'", path=where, key="params")
         self.spec, self.source = read_linkage_spec(scene.model_file("linkage"))
         self.model, self.urdf_path = mechanism.model, getattr(mechanism, "urdf_path", None)
-        self.values: dict[str, float] = {}
-        for name, value in self.spec.params.items():  # in the order written: expressions use earlier ones
-            self.values[name] = length(value, self.values, self.source, f"[params] {name}")
+        self.values: dict[str, float] = linkage_params(self.spec, self.source)  # [m], angles [rad]
+        self.kinds = param_kinds(self.spec)
         self._drawn: dict[tuple, list] = {}
         self._placed = None  # the placements' rules (model/linkage_placements.py), at the first drawing
 
-    def placements(self, values: dict[str, float]) -> list[tuple[str, int, pin.SE3]]:
+    def placements(self, values: dict[str, float]) -> list[tuple[str, int, np.ndarray, np.ndarray]]:
         """The placements the linkage draws with these params: (kind, index in the study's
-        model, SE3) for each joint and frame it has (kept per set of values)."""
+        model, rotation, translation [m]) for each joint and frame it has (kept per set of values)."""
         key = tuple(sorted(values.items()))
         if key not in self._drawn:
             if len(self._drawn) > 64:  # a tolerance study's nominals do not repeat: keep the cache small
@@ -60,14 +62,17 @@ class Drawing:
         self.apply(self._draw(values))
         self.values = dict(values)
 
-    def apply(self, placements: list[tuple[str, int, pin.SE3]]) -> None:
-        for kind, i, M in placements:
-            if kind == "joint":
-                self.model.jointPlacements[i] = M
-            else:
-                self.model.frames[i].placement = M
+    def set(self, changed: dict[str, float]) -> None:
+        """Write these params' values [m or rad] (the others kept): one redrawing, none if
+        nothing changed."""
+        if any(self.values[n] != v for n, v in changed.items()):
+            self.write({**self.values, **changed})
 
-    def _draw(self, values: dict[str, float]) -> list[tuple[str, int, pin.SE3]]:
+    def apply(self, placements: list[tuple[str, int, np.ndarray, np.ndarray]]) -> None:
+        """Write drawn placements (DrawnPlacements.placements) into the study's model in place."""
+        self._placed.write(placements)
+
+    def _draw(self, values: dict[str, float]) -> list[tuple[str, int, np.ndarray, np.ndarray]]:
         from pinmech.model.linkage import linkage_from_spec
 
         try:  # every value given: the spec holds the file's, not the last drawing's
@@ -90,17 +95,22 @@ class DrawnPlacement:
     drawn = True
     written_in = 0  # no translation of its own (rate_sensitivity.py reads it, with u = 0)
 
-    def __init__(self, drawing: Drawing, name: str, where: str) -> None:
+    def __init__(self, drawing: Drawing, param, where: str) -> None:
+        name = param.element
         if name not in drawing.values:
             raise FrameNotFound("param (a drawn linkage's [params])", name, list(drawing.values), path=where)
-        self.drawing, self.name = drawing, name
+        self.drawing, self.name, self.kind = drawing, name, drawing.kinds[name]
+        given = param.nominal is not None or param.spread > 0 or np.isfinite([param.lower, param.upper]).any()
+        if given and param.kind != self.kind:
+            unit = "deg" if self.kind == "angle" else "mm"
+            raise SceneError(f"the linkage's {name} is {'an' if self.kind == 'angle' else 'a'} {self.kind}, and this "
+                             f"parameter's values are {param.kind}s: give them in {unit}", path=where, key="params")
 
     def read(self) -> float:
         return float(self.drawing.values[self.name])
 
     def write(self, value: float) -> None:
-        if value != self.drawing.values[self.name]:
-            self.drawing.write({**self.drawing.values, self.name: float(value)})
+        self.drawing.set({self.name: float(value)})
 
     def direction(self, data: pin.Data) -> np.ndarray:
         """No translation of its own (the study's exact rows take `column` instead)."""

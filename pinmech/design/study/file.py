@@ -27,6 +27,14 @@
     [params.crank_drawn]                 # a drawn linkage's [params] entry (a scene with linkage = ...):
     param = "crank"                      # the linkage is redrawn for each variant; no component
 
+    [params.gamma]                       # a drawn angle param (gamma = "26.57 deg" in the linkage):
+    param = "gamma"                      # its values in deg
+    tolerance = "0.5 deg"
+
+    [spec]                               # tolerance: limits on an output's deviation from the nominal
+    "P.y" = "0.3 mm"                     # +-0.3 mm (or { lower = "-0.2 mm", upper = "0.3 mm" }):
+                                         # Cp, Cpk and parts per million out (capability.py)
+
     [outputs]
     points = ["P"]                       # world x, y, z of these points [m]
     links = ["rocker"]                   # angle of these links about the plane normal [rad]
@@ -43,6 +51,9 @@
     to = "70 mm"
     count = 11
 
+A component is read and written in the frame the file writes it in (a URDF origin in its
+parent link's, an MJCF pos in its body's), whatever frames Pinocchio merged it into.
+
 Every mistake is a SceneError naming the study file, the key and the value as written.
 """
 
@@ -56,11 +67,12 @@ from typing import Any
 from pinmech.design.file_where import FileWhere, load_file
 from pinmech.counts import memory_refusal
 from pinmech.design.study.params import AXES, DISTRIBUTIONS, Parameter
+from pinmech.model.linkage_expr import is_angle
 from pinmech.units import to_si
 
 
 KINDS = ("sensitivity", "tolerance", "grid", "workspace")
-_TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs", "batch", "grid"}
+_TOP = {"title", "scene", "kind", "steps", "samples", "seed", "params", "outputs", "batch", "grid", "spec"}
 _GRID_KEYS = {"from", "to", "count"}
 _GRID_MAX = 1_000_000  # grid points in all
 _TARGETS = ("joint", "cut", "point", "body", "param")
@@ -69,7 +81,8 @@ _OUTPUT_KEYS = {"points", "links", "sliders", "omega", "transmission", "alpha", 
 _LIMITS = {"steps": (1, 100_000), "samples": (1, 10_000_000), "seed": (0, 2**63 - 1), "batch": (1, 1_000_000)}
 #: Keys only some kinds use: any other kind refuses them (a key read by nobody would be a
 #: silent no-op). Top-level keys, then [params.NAME] keys.
-_TOP_USED_BY = {"samples": ("tolerance",), "seed": ("tolerance",), "batch": ("tolerance", "grid")}
+_TOP_USED_BY = {"samples": ("tolerance",), "seed": ("tolerance",), "batch": ("tolerance", "grid"),
+                "spec": ("tolerance",)}
 _PARAM_USED_BY = {k: ("tolerance",) for k in ("tolerance", "sigma", "k", "distribution")}
 
 
@@ -83,6 +96,7 @@ class GridAxis:
     start: float
     stop: float
     count: int
+    kind: str = "length"  # the parameter's: "angle" for a drawn angle param (values in rad)
 
     @property
     def values(self) -> tuple[float, ...]:
@@ -110,6 +124,9 @@ class StudySpec:
         transmission: dyads by their middle pin, for their transmission angle.
         alpha: links' angular accelerations; strokes: prismatic joints' max - min of s.
         torque: drivers whose torque (force) the scene's masses and loads need.
+        limits: a tolerance study's `[spec]`: (output name, "0.3 mm" or ((lower, text),
+            (upper, text))) as written (read in the output's own quantity by
+            capability.limits once the outputs are known).
         grid: a grid study's axes (1 to 3), in the [grid] table's order; () otherwise.
     """
 
@@ -131,6 +148,7 @@ class StudySpec:
     alpha: tuple[str, ...] = ()
     strokes: tuple[str, ...] = ()
     torque: tuple[str, ...] = ()
+    limits: tuple = ()
 
 
 def load_study(path: str | Path) -> StudySpec:
@@ -167,7 +185,18 @@ def parse_study(raw: dict[str, Any], path: Path) -> StudySpec:
                      counts["samples"], counts["seed"], counts["batch"], parsed, named["points"],
                      named["links"], _grid(raw, kind, parsed, where), named["sliders"], named["omega"],
                      named["transmission"], named["alpha"], named["strokes"],
-                     named["torque"])
+                     named["torque"], _spec_table(raw, where))
+
+
+def _spec_table(raw: dict[str, Any], where: _Where) -> tuple:
+    """The `[spec]` table: output name -> "0.3 mm" (+-) or {lower, upper}, as written."""
+    table = raw.get("spec", {})
+    if not isinstance(table, dict):
+        raise where.error("spec", 'give [spec] as a table: "P.y" = "0.3 mm" or { lower = "-0.2 mm", upper = "0.3 mm" }')
+    for name, value in table.items():
+        if not isinstance(value, (str, dict)):
+            raise where.error(f"spec.{name}", f"{value!r} must be a +- quantity (\"0.3 mm\") or {{ lower, upper }}")
+    return tuple((name, tuple(value.items()) if isinstance(value, dict) else value) for name, value in table.items())
 
 
 #: Columns each output name gives (a point's x, y, z; a slider's s and s_dot; one else).
@@ -225,15 +254,15 @@ def _grid(raw: dict[str, Any], kind: str, params: tuple[Parameter, ...], where: 
     names = [p.name for p in params]
     if not 1 <= len(table) <= 3:
         raise where.error("grid", f"give 1 to 3 [grid.NAME] tables, got {len(table)}")
-    axes = tuple(_axis(name, entry, names, where) for name, entry in table.items())
+    axes = tuple(_axis(name, entry, params, where) for name, entry in table.items())
     points = math.prod(a.count for a in axes)
     if points > _GRID_MAX:
         raise where.error("grid", f"{points} grid points is more than {_GRID_MAX}: lower the counts")
     return axes
 
 
-def _axis(name: str, entry: Any, names: list[str], where: _Where) -> GridAxis:
-    key = f"grid.{name}"
+def _axis(name: str, entry: Any, params: tuple[Parameter, ...], where: _Where) -> GridAxis:
+    key, names = f"grid.{name}", [p.name for p in params]
     if name not in names:
         raise where.error(key, f"'{name}' is not a parameter (the [params] tables: {', '.join(names)})")
     where.known(entry, _GRID_KEYS, key)
@@ -243,12 +272,13 @@ def _axis(name: str, entry: Any, names: list[str], where: _Where) -> GridAxis:
     count = entry["count"]
     if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= _GRID_MAX:
         raise where.error(f"{key}.count", f"count = {count!r} must be a whole number from 1 to {_GRID_MAX}")
-    start, stop = where.length(entry, "from", key), where.length(entry, "to", key)
+    along = _Where(where.path, "angle" if is_angle(entry["from"]) else params[names.index(name)].kind)
+    start, stop = along.length(entry, "from", key), along.length(entry, "to", key)
     if count > 1 and not start < stop:
         raise where.error(key, f"from {entry['from']} is not below to {entry['to']} (count {count})")
     if count == 1 and start != stop:
         raise where.error(key, f"count = 1 is the one value from = {entry['from']}: give to = from, or a count above 1")
-    return GridAxis(name, names.index(name), start, stop, count)
+    return GridAxis(name, names.index(name), start, stop, count, along.kind)
 
 
 def _parameter(name: str, table: Any, where: _Where) -> Parameter:
@@ -274,11 +304,21 @@ def _parameter(name: str, table: Any, where: _Where) -> Parameter:
         raise where.error(f"{key}.component", "a drawn linkage's param is a length of its own: it has no component")
     if component not in AXES:
         raise where.error(f"{key}.component", f"component = {component!r} must be \"x\", \"y\" or \"z\"")
+    kind = _kind(table) if target == "param" else "length"
+    where = _Where(where.path, kind)
     nominal = where.length(table, "nominal", key) if "nominal" in table else None
     lower, upper = _bounds(table, key, where, nominal)
     distribution, spread = _distribution(table, key, where)
     return Parameter(name, target, str(table[target]), side, AXES[component], nominal, lower, upper,
-                     distribution, spread)
+                     distribution, spread, kind)
+
+
+def _kind(table: dict) -> str:
+    """A drawn param's kind, by the unit of its first value given: "angle" for "0.5 deg",
+    else "length" (values of the other kind are then refused by name)."""
+    given = [table[k] for k in ("nominal", "tolerance", "sigma") if k in table]
+    given += list(table["bounds"]) if isinstance(table.get("bounds"), list) else []
+    return "angle" if given and is_angle(given[0]) else "length"
 
 
 def _bounds(table: dict, key: str, where: _Where, nominal: float | None) -> tuple[float, float]:
@@ -287,7 +327,7 @@ def _bounds(table: dict, key: str, where: _Where, nominal: float | None) -> tupl
     bounds = table["bounds"]
     if not isinstance(bounds, list) or len(bounds) != 2:
         raise where.error(f"{key}.bounds", f"bounds = {bounds!r} must be [lower, upper], e.g. [\"119 mm\", \"121 mm\"]")
-    lower, upper = (to_si(b, "length", where=f"{where.path}, {key}.bounds") for b in bounds)
+    lower, upper = (to_si(b, where.kind, where=f"{where.path}, {key}.bounds") for b in bounds)
     if not lower < upper:
         raise where.error(f"{key}.bounds", f"lower {bounds[0]} is not below upper {bounds[1]}")
     if nominal is not None and not lower <= nominal <= upper:
@@ -333,15 +373,20 @@ def _names(value: Any, where: _Where, key: str) -> tuple[str, ...]:
 
 
 class _Where(FileWhere):
-    """The study file, for errors naming it and the key."""
+    """The study file, for errors naming it and the key; `kind`: the quantity its values are
+    ("length", or "angle" for a drawn angle param)."""
 
     limits = _LIMITS
 
+    def __init__(self, path: Path, kind: str = "length") -> None:
+        super().__init__(path)
+        self.kind = kind
+
     def length(self, table: dict, name: str, key: str) -> float:
-        return to_si(table[name], "length", where=f"{self.path}, {key}.{name}")
+        return to_si(table[name], self.kind, where=f"{self.path}, {key}.{name}")
 
     def positive(self, table: dict, name: str, key: str) -> float:
         value = self.length(table, name, key)
         if not value > 0:
-            raise self.error(f"{key}.{name}", f"{name} = {table[name]!r} must be a positive length")
+            raise self.error(f"{key}.{name}", f"{name} = {table[name]!r} must be a positive {self.kind}")
         return value

@@ -28,6 +28,11 @@ import pinocchio as pin
 
 from pinmech.exceptions import SceneError
 from pinmech.design.study.stroke import Stroke
+
+#: An output's kind -> (users' units per SI unit, the users' unit): lengths in mm, angles in deg.
+USER_UNITS = {"length": (1e3, "mm"), "angle": (180 / np.pi, "deg"), "speed": (1e3, "mm/s"),
+              "angular speed": (180 / np.pi, "deg/s"), "angular acceleration": (180 / np.pi, "deg/s^2"),
+              "torque": (1.0, "N m"), "force": (1.0, "N")}
 from pinmech.design.study.torque import DriverTorques
 from pinmech.design.study.transmission import dyad_pins, transmission_row, transmission_values
 from pinmech.solve.core import _core

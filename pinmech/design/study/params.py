@@ -44,6 +44,8 @@ class Parameter:
         lower, upper: bounds [m] (a sampled value outside is a failed variant).
         distribution: "normal", "uniform" or "fixed".
         spread: the standard deviation [m] (normal) or the half width [m] (uniform).
+        kind: "length", or "angle" for a drawn linkage's param written in deg (then every
+            value above is in rad).
     """
 
     name: str
@@ -56,6 +58,7 @@ class Parameter:
     upper: float = math.inf
     distribution: str = "fixed"
     spread: float = 0.0
+    kind: str = "length"  # or "angle": a drawn linkage's angle param (values in rad)
 
     @property
     def sigma(self) -> float:
@@ -77,45 +80,65 @@ class Placement:
     """Where a Parameter sits in a model: read and write its value, and the world
     direction a unit change moves its frames (for the closure's parameter Jacobian).
 
+    Pinocchio stores a placement in its carrying joint's frame, composed with the frames
+    it hangs from (a URDF fixed link turned on another, an MJCF jointless body with its
+    quat, a joint's `pos`); the value is read and written in the frame the file writes
+    it in: `value = axes^T (t - origin)`, t the stored translation.
+
     Attributes:
         joint: the joint whose subtree moves rigidly when a joint origin changes, or the
             joint carrying the frames (then only those frames move).
         frames: the frames moved together (a cut frame; a named point with the frames
             built at it: a fixed link's, a sidecar cut's, those hung below it), or () for
             a joint origin.
+        written_in: the joint whose body carries what moves (rate_sensitivity.py).
+        axes, origin: the writing frame's axes (3, 3) and origin (3,) [m] in written_in's frame.
     """
 
     drawn = False  # a translation component (drawn_params.DrawnPlacement: a drawn length)
+    kind = "length"
 
-    def __init__(self, model: pin.Model, joint: int, frames: tuple[int, ...], component: int) -> None:
+    def __init__(self, model: pin.Model, joint: int, frames: tuple[int, ...], component: int,
+                 writing: pin.SE3 | None = None) -> None:
         self.model, self.joint, self.frames, self.component = model, joint, tuple(frames), component
         # the model's own vectors (Boost.Python views, indexed afresh at each write: a frame
         # added to the model later moves their elements, not them)
         self._joint_placements, self._model_frames = model.jointPlacements, model.frames
         self.written_in = model.parents[joint] if not self.frames else joint  # whose axes the component is in
+        writing = pin.SE3.Identity() if writing is None else writing
+        self.axes, self.origin = np.array(writing.rotation), np.array(writing.translation)
 
     def read(self) -> float:
-        """The placement's component now [m] (the first frame's, for frames)."""
-        return float(self._se3(self.frames[0] if self.frames else -1).translation[self.component])
+        """The placement's component now [m], in the frame it is written in (the first
+        frame's, for frames)."""
+        t = self._se3(self.frames[0] if self.frames else -1).translation
+        return float(self.axes[:, self.component] @ (np.asarray(t) - self.origin))
 
     def write(self, value: float) -> None:
         """Write the component [m] into the model in place (frames: each moved by the same
-        amount). Pinocchio 4's bindings hand `translation` as a view of the model's own SE3,
-        so one component is written with no SE3 copied (tests/test_study_variant_writes.py)."""
+        amount, along the writing frame's axis). Pinocchio 4's bindings hand `translation`
+        as a view of the model's own SE3, so it is written with no SE3 copied
+        (tests/test_study_variant_writes.py)."""
+        k, axis = self.component, self.axes[:, self.component]
         if not self.frames:
-            self._joint_placements[self.joint].translation[self.component] = value
+            views = [self._joint_placements[self.joint].translation]
+        else:
+            views = [self._model_frames[f].placement.translation for f in self.frames]
+        if axis[k] == 1.0:  # written in axes parallel to the stored ones: the component itself, exactly
+            shift = float(self.origin[k]) + value - float(views[0][k])
+            for t in views:
+                t[k] = float(t[k]) + shift
+            views[0][k] = float(self.origin[k]) + value
             return
-        k = self.component
-        views = [self._model_frames[f].placement.translation for f in self.frames]
-        shift = value - float(views[0][k])
+        shift = (value - self.read()) * axis
         for t in views:
-            t[k] = float(t[k]) + shift
+            for i in np.flatnonzero(shift):
+                t[i] = float(t[i]) + float(shift[i])
 
     def direction(self, data: pin.Data) -> np.ndarray:
         """World direction [m/m] a unit change moves what it moves (`data.oMi` up to date):
-        the axis of the frame the origin is written in (the parent joint's, or the
-        frames' joint)."""
-        return np.array(data.oMi[self.written_in].rotation[:, self.component])
+        the writing frame's axis, carried by the joint whose body holds it."""
+        return np.array(data.oMi[self.written_in].rotation @ self.axes[:, self.component])
 
     def moves_frame(self, frame: int, subtree: dict[int, set[int]]) -> bool:
         """Whether a unit change translates `frame` (its joint in the moved subtree, or one
@@ -152,7 +175,7 @@ def placements(mechanism, params: tuple[Parameter, ...], path: str, scene=None) 
             from pinmech.design.study.drawn_params import Drawing, DrawnPlacement
 
             drawing = drawing or Drawing(scene, mechanism, where)
-            out.append(DrawnPlacement(drawing, p.element, where))
+            out.append(DrawnPlacement(drawing, p, where))
         else:
             out.append(_placement(mechanism, p, where))
     return out
@@ -167,22 +190,65 @@ def _placement(mechanism, p: Parameter, where: str) -> Placement:
         if len(joints) != 1:
             bodies = sorted({j.child_link for j in mechanism.joints.values() if j.kind != "other"})
             raise FrameNotFound("body with one joint", p.element, bodies, path=where)
-        return Placement(model, joints[0].id, (), p.component)
+        return _joint_origin(model, joints[0].id, p.component, body=p.element)
     if p.target == "joint":
         if p.element not in mechanism.joints:
             raise FrameNotFound("joint", p.element, list(mechanism.joints), path=where)
-        return Placement(model, mechanism.joint(p.element).id, (), p.component)
+        return _joint_origin(model, mechanism.joint(p.element).id, p.component)
     if p.target == "point":
         if p.element not in mechanism.points:
             raise FrameNotFound("point", p.element, list(mechanism.points), path=where)
         frame = mechanism.points[p.element]
-        return Placement(model, model.frames[frame].parentJoint, _frames_at(mechanism, frame), p.component)
+        frames = _frames_at(mechanism, frame)
+        writing = mechanism.written_frames.get(("point", p.element)) or _writing_frame(model, _top_of(model, frame, frames))
+        return Placement(model, model.frames[frame].parentJoint, frames, p.component, writing)
     cuts = {c.name: c for c in mechanism.closures}
     if p.element not in cuts:
         raise FrameNotFound("cut", p.element, list(cuts), path=where)
     cut = cuts[p.element]
     frame = cut.parent_frame if p.side == "parent" else cut.child_frame
-    return Placement(model, model.frames[frame].parentJoint, (frame,), p.component)
+    writing = mechanism.written_frames.get(("cut", p.element, p.side)) or _writing_frame(model, frame)
+    return Placement(model, model.frames[frame].parentJoint, (frame,), p.component, writing)
+
+
+def _joint_origin(model: pin.Model, joint: int, component: int, body: str = "") -> Placement:
+    """A joint origin's Placement, written in its parent link's frame (the link the joint
+    hangs from, which Pinocchio may have merged into the parent joint with a turn: a URDF
+    fixed link, an MJCF jointless body or a joint's `pos`). For an MJCF `body`, the value
+    is the body's pos: its frame's origin, which a joint `pos` sets off from the joint's."""
+    frame = model.getFrameId(model.names[joint], pin.FrameType.JOINT)
+    writing = _writing_frame(model, frame) if frame < model.nframes else pin.SE3.Identity()
+    if body:
+        own = next((f for f in model.frames if f.name == body and f.type == pin.FrameType.BODY
+                    and f.parentJoint == joint), None)
+        if own is not None:  # origin shifted by the body frame's offset on its joint [m]
+            offset = model.jointPlacements[joint].rotation @ own.placement.translation
+            writing = pin.SE3(writing.rotation, writing.translation - offset)
+    return Placement(model, joint, (), component, writing)
+
+
+def _writing_frame(model: pin.Model, frame: int) -> pin.SE3:
+    """The placement [m] in `frame`'s joint of the frame it is written in: its parent frame,
+    when that is on the same joint (a link's frame, a fixed link's turned one), else the
+    joint's own (identity)."""
+    parent = model.frames[frame].parentFrame
+    if parent == frame or model.frames[parent].parentJoint != _carrier(model, frame):
+        return pin.SE3.Identity()
+    return pin.SE3(model.frames[parent].placement)
+
+
+def _carrier(model: pin.Model, frame: int) -> int:
+    """The joint a frame's placement is stored in: a JOINT frame's is its parent joint's."""
+    f = model.frames[frame]
+    return model.parents[f.parentJoint] if f.type == pin.FrameType.JOINT else f.parentJoint
+
+
+def _top_of(model: pin.Model, frame: int, same: tuple[int, ...]) -> int:
+    """The highest of a point's frames built at the same place (the fixed joint that made
+    it): the one whose parent frame is not among them."""
+    while model.frames[frame].parentFrame in same and model.frames[frame].parentFrame != frame:
+        frame = model.frames[frame].parentFrame
+    return frame
 
 
 def _frames_at(mechanism, frame: int) -> tuple[int, ...]:

@@ -9,12 +9,10 @@ from pathlib import Path
 import numpy as np
 
 from pinmech.design.figure_file import pyplot, save
+from pinmech.design.study.outputs import USER_UNITS as _SCALE
 from pinmech.design.study.run import StudyResult
 from pinmech.design.study.tolerance import deviation
 
-_SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "speed": (1e3, "mm/s"),
-          "angular speed": (180 / math.pi, "deg/s"), "angular acceleration": (180 / math.pi, "deg/s^2"),
-          "torque": (1.0, "N m"), "force": (1.0, "N")}
 
 
 def sensitivity_bars(result: StudyResult, path: str | Path) -> Path:
@@ -105,21 +103,22 @@ def _grid_panels(result: StudyResult) -> list[tuple[str, str, np.ndarray, np.nda
 
 
 def _grid_line(ax, axis, lo: np.ndarray, hi: np.ndarray, failed: np.ndarray, unit: str) -> None:
-    x = np.asarray(axis.values) * 1e3
+    size, unit = _axis_unit(axis)
+    x = np.asarray(axis.values) / size
     if hi is not lo:
         ax.plot(x, hi, "o-", color="tab:red", ms=3, label="max over the cycle")
     ax.plot(x, lo, "o-", color="tab:blue", ms=3, label="min over the cycle" if hi is not lo else "least over the cycle")
     if failed.any():
         ax.plot(x[failed], np.zeros(int(failed.sum())), "kx", transform=ax.get_xaxis_transform(), clip_on=False,
                 label="failed (see table)")
-    ax.set_xlabel(f"{axis.name} [mm]")
+    ax.set_xlabel(f"{axis.name} [{unit}]")
     ax.set_ylabel(f"[{unit}]")
     ax.legend(fontsize=7)
 
 
 def _grid_map(fig, ax, axes_g, value: np.ndarray, failed: np.ndarray, label: str) -> None:
     shape = (axes_g[0].count, axes_g[1].count)
-    x, y = (np.asarray(a.values) * 1e3 for a in axes_g)
+    x, y = (np.asarray(a.values) / _axis_unit(a)[0] for a in axes_g)
     mesh = ax.pcolormesh(y, x, np.ma.masked_array(value.reshape(shape), failed.reshape(shape)), shading="nearest")
     fig.colorbar(mesh, ax=ax, label=label)
     from matplotlib.patches import Rectangle
@@ -130,8 +129,13 @@ def _grid_map(fig, ax, axes_g, value: np.ndarray, failed: np.ndarray, label: str
                                hatch="xx", lw=0.0, label="failed (see table)" if not ax.patches else None))
     if failed.any():
         ax.legend(fontsize=7, loc="lower right")
-    ax.set_xlabel(f"{axes_g[1].name} [mm]")
-    ax.set_ylabel(f"{axes_g[0].name} [mm]")
+    ax.set_xlabel(f"{axes_g[1].name} [{_axis_unit(axes_g[1])[1]}]")
+    ax.set_ylabel(f"{axes_g[0].name} [{_axis_unit(axes_g[0])[1]}]")
+
+
+def _axis_unit(axis) -> tuple[float, str]:
+    """A grid axis's users' unit: (SI per unit, "mm" or "deg") by its parameter's kind."""
+    return (math.pi / 180, "deg") if axis.kind == "angle" else (1e-3, "mm")
 
 
 def _half(centres: np.ndarray) -> float:

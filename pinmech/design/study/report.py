@@ -14,17 +14,21 @@ from pathlib import Path
 import numpy as np
 
 from pinmech.design.study.grid import cycle_range, failures
+from pinmech.design.study.outputs import USER_UNITS as _SCALE
 from pinmech.design.study.run import StudyResult
 from pinmech.design.study.tolerance import PERCENTILES, deviation
+from pinmech.design.study.tolerance_report import pose_table, tolerance_lines, tolerance_summary
 from pinmech.outputs import beside, write_whole, write_with
 
-_SCALE = {"length": (1e3, "mm"), "angle": (180 / math.pi, "deg"), "speed": (1e3, "mm/s"),
-          "angular speed": (180 / math.pi, "deg/s"), "angular acceleration": (180 / math.pi, "deg/s^2"),
-          "torque": (1.0, "N m"), "force": (1.0, "N")}
 
 
 def _unit(kind: str) -> tuple[float, str]:
     return _SCALE[kind]
+
+
+def _per(result: StudyResult, k: int) -> tuple[float, str]:
+    """Parameter k's users' unit: (SI per unit, "mm" or "deg")."""
+    return (1e-3, "mm") if result.param_kind(k) == "length" else (math.pi / 180, "deg")
 
 
 def summary(result: StudyResult) -> dict:
@@ -34,14 +38,17 @@ def summary(result: StudyResult) -> dict:
     out = {"study": str(spec.path), "title": spec.title, "kind": spec.kind, "driver": result.driver,
            "poses": len(result.values), "parameters": {}, "outputs": {}}
     for k, p in enumerate(spec.params):
-        out["parameters"][p.name] = {"nominal_mm": result.nominal_p[k] * 1e3, "distribution": p.distribution,
-                                     "sigma_mm": p.sigma * 1e3}
+        size, per = _per(result, k)
+        out["parameters"][p.name] = {f"nominal_{per}": result.nominal_p[k] / size, "distribution": p.distribution,
+                                     f"sigma_{per}": p.sigma / size}
     for j, name in enumerate(result.outputs):
         scale, unit = _unit(result.kinds[j])
         entry = {"unit": unit, "nominal_min": float(result.nominal[:, j].min() * scale),
-                 "nominal_max": float(result.nominal[:, j].max() * scale),
-                 f"max_abs_sensitivity_{unit}_per_mm": {p: float(np.abs(result.sensitivity[:, j, k]).max() * scale / 1e3)
-                                                       for k, p in enumerate(result.params)}}
+                 "nominal_max": float(result.nominal[:, j].max() * scale)}
+        for k, p in enumerate(result.params):
+            size, per = _per(result, k)
+            entry.setdefault(f"max_abs_sensitivity_{unit}_per_{per}", {})[p] = float(
+                np.abs(result.sensitivity[:, j, k]).max() * scale * size)
         if result.spread is not None:
             s = result.spread
             entry.update(sigma_max=_finite(s.sigma[:, j].max() * scale),
@@ -56,13 +63,16 @@ def summary(result: StudyResult) -> dict:
     if result.spread is not None:
         out.update(samples=spec.samples, seed=spec.seed, solved=result.spread.solved,
                    failures=dict(result.spread.failures))
+        out.update(tolerance_summary(result))
     return out
 
 
 def _grid_summary(result: StudyResult) -> dict:
     """A grid study's axes [mm], its points that solved, and the failures by cause."""
     _, _, causes = result.variants
-    out = {"grid": {a.name: {"from_mm": a.start * 1e3, "to_mm": a.stop * 1e3, "count": a.count}
+    units = {a.name: _per(result, a.param) for a in result.spec.grid}
+    out = {"grid": {a.name: {f"from_{units[a.name][1]}": a.start / units[a.name][0],
+                             f"to_{units[a.name][1]}": a.stop / units[a.name][0], "count": a.count}
                     for a in result.spec.grid},
            "points": len(causes), "solved": sum(not c for c in causes), "failures": failures(causes)}
     mu = result.transmission
@@ -80,28 +90,35 @@ def text(result: StudyResult) -> str:
     s = summary(result)
     lines = [f"{s['title']} ({s['kind']}, {s['poses']} poses of {s['driver']}"
              + (f", {s['samples']} variants, seed {s['seed']})" if "samples" in s else ")")]
-    lines.append("parameters: " + ", ".join(f"{n} {p['nominal_mm']:.6g} mm"
-                                            + (f" (sigma {p['sigma_mm']:.3g} mm, {p['distribution']})"
-                                               if p["distribution"] != "fixed" else "")
-                                            for n, p in s["parameters"].items()))
+    lines.append("parameters: " + ", ".join(_said_param(n, p) for n, p in s["parameters"].items()))
     lines.append("largest |dy/dp| over the cycle: " + "; ".join(
-        f"{o}: " + ", ".join(f"{p} {v:.4g}" for p, v in e[f"max_abs_sensitivity_{e['unit']}_per_mm"].items())
-        + f" {e['unit']}/mm" for o, e in s["outputs"].items()))
+        f"{o}: " + ", ".join(f"{p} {v:.4g} {e['unit']}/{per}" for per in ("mm", "deg")
+                             for p, v in e.get(f"max_abs_sensitivity_{e['unit']}_per_{per}", {}).items())
+        for o, e in s["outputs"].items()))
     if "samples" in s:
-        lines.append(f"{'output':<16}{'sigma max':>12}{'linear':>12}{'worst':>12}{'linear':>12}")
+        lines.append(f"{'output':<16}{'sigma max':>12}{'linear':>12}{'worst':>12}{'linear':>12}"
+                     "   (largest over the cycle: Monte Carlo, linear)")
         for o, e in s["outputs"].items():
             lines.append(f"{o + ' [' + e['unit'] + ']':<16}" + "".join(
                 f"{v:>12.4g}" if v is not None else f"{'-':>12}"
                 for v in (e["sigma_max"], e["sigma_linear_max"], e["worst"], e["worst_linear"])))
         failed = ", ".join(f"{c}: {n}" for c, n in s["failures"].items()) or "none"
         lines.append(f"solved {s['solved']} of {s['samples']} variants; failed: {failed}")
+        lines += tolerance_lines(s, s["driver"])
     if "points" in s:
-        axes = " x ".join(f"{n} {g['from_mm']:.6g}..{g['to_mm']:.6g} mm ({g['count']})" for n, g in s["grid"].items())
+        axes = " x ".join(f"{n} {g[f'from_{u}']:.6g}..{g[f'to_{u}']:.6g} {u} ({g['count']})"
+                          for n, g in s["grid"].items() for u in ("mm" if "from_mm" in g else "deg",))
         failed = ", ".join(f"{c}: {n}" for c, n in s["failures"].items()) or "none"
         lines.append(f"grid {axes}: solved {s['solved']} of {s['points']} points; failed: {failed}")
         if "least_transmission_angle_deg" in s:
             lines.append(f"least transmission angle over the grid: {s['least_transmission_angle_deg']:.4g} deg")
     return "\n".join(lines)
+
+
+def _said_param(name: str, p: dict) -> str:
+    per = "mm" if "nominal_mm" in p else "deg"
+    spread = f" (sigma {p[f'sigma_{per}']:.3g} {per}, {p['distribution']})" if p["distribution"] != "fixed" else ""
+    return f"{name} {p[f'nominal_{per}']:.6g} {per}{spread}"
 
 
 def table(result: StudyResult) -> dict[str, list]:
@@ -113,19 +130,20 @@ def table(result: StudyResult) -> dict[str, list]:
         return grid_table(result)
     if result.spread is None:
         rows: dict[str, list] = {f"{result.driver} [deg]": [], "output": [], "unit": [], "value": []}
-        rows.update({f"d/d {p} [per mm]": [] for p in result.params})
+        columns = [f"d/d {p} [per {_per(result, k)[1]}]" for k, p in enumerate(result.params)]
+        rows.update({c: [] for c in columns})
         for i, x in enumerate(result.values):
             for j, name in enumerate(result.outputs):
                 scale, unit = _unit(result.kinds[j])
                 rows[f"{result.driver} [deg]"].append(math.degrees(x))
                 rows["output"].append(name), rows["unit"].append(unit)
                 rows["value"].append(result.nominal[i, j] * scale)
-                for k, p in enumerate(result.params):
-                    rows[f"d/d {p} [per mm]"].append(result.sensitivity[i, j, k] * scale / 1e3)
+                for k, c in enumerate(columns):
+                    rows[c].append(result.sensitivity[i, j, k] * scale * _per(result, k)[0])
         return rows
     p, y, causes = result.variants
     rows = {"variant": list(range(len(causes)))}
-    rows.update({f"{name} [mm]": (p[:, k] * 1e3).tolist() for k, name in enumerate(result.params)})
+    rows.update(_param_columns(result, p))
     rows["cause"] = list(causes)
     dev = np.abs(deviation(y, result.nominal, result.kinds)).max(axis=1)
     for j, name in enumerate(result.outputs):
@@ -140,7 +158,7 @@ def grid_table(result: StudyResult) -> dict[str, list]:
     the least transmission angle over the cycle for a planar linkage with dyads."""
     p, y, causes = result.variants
     rows: dict[str, list] = {"point": list(range(len(causes)))}
-    rows.update({f"{name} [mm]": (p[:, k] * 1e3).tolist() for k, name in enumerate(result.params)})
+    rows.update(_param_columns(result, p))
     rows["cause"] = list(causes)
     lo, hi = cycle_range(y, result.kinds)
     for j, name in enumerate(result.outputs):
@@ -152,19 +170,38 @@ def grid_table(result: StudyResult) -> dict[str, list]:
     return rows
 
 
+def _param_columns(result: StudyResult, p: np.ndarray) -> dict[str, list]:
+    """The variants' parameters (N, n_par) [m or rad] as columns in mm or deg."""
+    out = {}
+    for k, name in enumerate(result.params):
+        size, per = _per(result, k)
+        out[f"{name} [{per}]"] = (p[:, k] / size).tolist()
+    return out
+
+
 def write(result: StudyResult, prefix: str | Path, *, parquet: bool = True) -> list[Path]:
-    """PREFIX.csv, PREFIX.json and (with pyarrow) PREFIX.parquet; the paths written."""
-    return write_tables(table(result), summary(result), prefix, parquet=parquet)
+    """PREFIX.csv, PREFIX.json and (with pyarrow) PREFIX.parquet, and for a tolerance study
+    PREFIX_poses.csv (every pose's stack-up: tolerance_report.pose_table); the paths written."""
+    paths = write_tables(table(result), summary(result), prefix, parquet=parquet)
+    if result.spread is not None:
+        paths.append(write_csv(pose_table(result), Path(f"{prefix}_poses.csv")))
+    return paths
+
+
+def write_csv(columns: dict[str, list], path: Path) -> Path:
+    """Columns to a CSV file (written whole)."""
+    text = io.StringIO(newline="")
+    writer = csv.writer(text)
+    writer.writerow(columns)
+    writer.writerows(zip(*columns.values()))
+    write_whole(path, text.getvalue())
+    return path
 
 
 def write_tables(columns: dict[str, list], summary_: dict, prefix: str | Path, *, parquet: bool = True) -> list[Path]:
     """Columns to PREFIX.csv (and PREFIX.parquet with pyarrow), a summary to PREFIX.json."""
     paths = [beside(prefix, ".csv"), beside(prefix, ".json")]
-    text = io.StringIO(newline="")
-    writer = csv.writer(text)
-    writer.writerow(columns)
-    writer.writerows(zip(*columns.values()))
-    write_whole(paths[0], text.getvalue())
+    write_csv(columns, paths[0])
     write_whole(paths[1], json.dumps(summary_, indent=2) + "\n")
     if parquet:
         try:

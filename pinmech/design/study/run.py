@@ -12,6 +12,7 @@ singularity loci and conditioning, workspace.py), run in batches here or on Dask
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from pinmech.design.cluster import built, run_batches
+from pinmech.design.study.capability import limits as capability_limits
 from pinmech.design.study.grid import grid_size
 from pinmech.design.study.sensitivity import cycle_sensitivity
 from pinmech.design.study.file import StudySpec, load_study
@@ -54,6 +56,12 @@ class StudyResult:
     sensitivity: np.ndarray
     spread: Spread | None = None
     batches: tuple[BatchResult, ...] = ()
+    param_kinds: tuple[str, ...] = ()  # "length" or "angle" each (a drawn angle param) ; () all lengths
+    limits: dict = dataclasses.field(default_factory=dict)  # output -> (lower, upper) of its deviation [SI]
+
+    def param_kind(self, k: int) -> str:
+        """Parameter k's kind: "length" [m] or "angle" [rad]."""
+        return self.param_kinds[k] if self.param_kinds else "length"
 
     @property
     def variants(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
@@ -95,6 +103,7 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
     if spec.kind == "workspace":
         return run_workspace(spec, workers=workers, scheduler=scheduler, progress=progress)
     sm, outputs = built(spec)
+    limits = capability_limits(spec.limits, outputs.names, outputs.kinds, str(spec.path))
     cycle = sm.cycle(sm.nominal)
     if cycle.cause:
         from pinmech.exceptions import SweepError
@@ -103,7 +112,8 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
                          driver=sm.sweep.driver, value=float("nan"), cause=cycle.error) from cycle.error
     y0, dy = cycle_sensitivity(sm, outputs, cycle)
     common = dict(spec=spec, driver=sm.sweep.driver, values=sm.values, outputs=outputs.names, kinds=outputs.kinds,
-                  params=[p.name for p in spec.params], nominal_p=sm.nominal.copy(), nominal=y0, sensitivity=dy)
+                  params=[p.name for p in spec.params], nominal_p=sm.nominal.copy(), nominal=y0, sensitivity=dy,
+                  param_kinds=tuple(place.kind for place in sm.placements))
     if spec.kind == "sensitivity":
         return StudyResult(**common)
     todo = batches(grid_size(spec) if spec.kind == "grid" else spec.samples, spec.batch)
@@ -116,7 +126,7 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
     results = run_batches(spec, todo, workers=workers, scheduler=scheduler, progress=tick if progress else None)
     if spec.kind == "grid":
         return StudyResult(**common, batches=tuple(results))
-    return StudyResult(**common, spread=spread(sm, outputs, results), batches=tuple(results))
+    return StudyResult(**common, spread=spread(sm, outputs, results), batches=tuple(results), limits=limits)
 
 
 def load_any_study(path: str | Path) -> StudySpec | WorkspaceSpec:

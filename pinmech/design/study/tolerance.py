@@ -118,8 +118,7 @@ def spread(sm: StudyMechanism, outputs: StudyOutputs, results: list[BatchResult]
     ok = np.array([not c for c in causes], dtype=bool)
     dev = deviation(y[ok], y0, outputs.kinds)
     sig = np.array([param.sigma for param in sm.spec.params])
-    half = np.array([param.spread if param.distribution == "uniform" else 3.0 * param.sigma
-                     for param in sm.spec.params])
+    half = half_widths(sm.spec.params)
     failures: dict[str, int] = {}
     for c in causes:
         if c:
@@ -133,6 +132,11 @@ def spread(sm: StudyMechanism, outputs: StudyOutputs, results: list[BatchResult]
         (np.abs(dy) @ half).max(axis=0),
         np.full((len(PERCENTILES), *y0.shape), math.nan) if empty else np.percentile(dev, PERCENTILES, axis=0),
         failures, int(ok.sum()))
+
+
+def half_widths(params) -> np.ndarray:
+    """Each parameter's tolerance t [m or rad]: a uniform's half width, else 3 sigma."""
+    return np.array([p.spread if p.distribution == "uniform" else 3.0 * p.sigma for p in params])
 
 
 def deviation(y: np.ndarray, y0: np.ndarray, kinds: list[str]) -> np.ndarray:

@@ -62,6 +62,13 @@ class StudyMechanism:
         self.mechanism, self.solver = self.sweep.mechanism, self.sweep.solver
         self.model = self.mechanism.model
         self.placements: list[Placement] = placements(self.mechanism, spec.params, str(spec.path), scene)
+        self._drawing = next((place.drawing for place in self.placements if place.drawn), None)
+        for axis in spec.grid:  # a grid's values are in its parameter's own quantity
+            if axis.kind != self.placements[axis.param].kind:
+                kind = self.placements[axis.param].kind
+                raise SceneError(f"grid.{axis.name} is given as {axis.kind}s, but {axis.name} is "
+                                 f"{'an' if kind == 'angle' else 'a'} {kind}: give from and to in "
+                                 f"{'deg' if kind == 'angle' else 'mm'}", path=str(spec.path), key=f"grid.{axis.name}")
         for p, place in zip(spec.params, self.placements):
             if p.nominal is not None:
                 place.write(p.nominal)
@@ -81,9 +88,16 @@ class StudyMechanism:
         self.core = CoreCycle(self.solver, self.sweep.drivers, self.sweep.driver, self.values, self.reference)
 
     def write(self, p: np.ndarray) -> None:
-        """Write the parameter values p [m] into the model in place."""
+        """Write the parameter values p [m] into the model in place (a drawn linkage's params
+        all at once: one redrawing a variant)."""
+        drawn = {}
         for place, value in zip(self.placements, p):
-            place.write(float(value))
+            if place.drawn:
+                drawn[place.name] = float(value)
+            else:
+                place.write(float(value))
+        if drawn:
+            self._drawing.set(drawn)
 
     def outside(self, p: np.ndarray) -> np.ndarray:
         """Whether the values p (..., n_par) [m] lie outside a parameter's bounds (...,) bool;
