@@ -19,13 +19,11 @@ from pinmech.solve.limit_positions import travel
 
 def turn_diagnostics(turn) -> dict:
     """The panel's data for a solved turn (`frame.Turn`): JSON-ready."""
-    from pinmech.solve.diagnostics_sweep import DesignSweep
-
-    design = DesignSweep(turn.sweep)
+    design = _design_sweep(turn.sweep)
     if not design.applicable:
         return {"applicable": False, "reason": design.reason}
     mu = [np.full(len(turn.values), np.nan) for _ in design.dyads]
-    for pose in turn.poses:
+    for pose in sweep_poses(turn):
         out = design.evaluate(pose)
         for series, angles in zip(mu, out.get("angles", ())):
             series[pose.index] = angles[1]
@@ -37,6 +35,32 @@ def turn_diagnostics(turn) -> dict:
         "outputs": [_output(design, o, found, turn) for o, found in zip(design.outputs, design.limit_poses())],
         "folds": [{"driver": x, "points": ghost_points(turn, q)} for x, q in design.fold_poses()],
     }
+
+
+def _design_sweep(sweep):
+    """The sweep's diagnostics (`DesignSweep`), fed poses whose motion is their configuration."""
+    from pinmech.solve.diagnostics_sweep import DesignSweep
+
+    class ArrayDesign(DesignSweep):
+        def _q(self, motion) -> np.ndarray:  # the turn's q row, carried as the pose's motion
+            return motion
+
+    return ArrayDesign(sweep)
+
+
+def sweep_poses(turn) -> list:
+    """The turn's poses as `pinmech sweep` yields them to its diagnostics (`SweepPose`), each
+    carrying its configuration q in place of its motion (None where it failed)."""
+    from pinmech.io.sweep import SweepPose
+
+    out = []
+    for i, value in enumerate(turn.values.tolist()):
+        error = turn.errors.get(i)
+        if error is not None:  # the turn stopped here: the poses after it were not solved
+            out.append(SweepPose(i, value, None, None, f"{type(error).__name__}: {error}", fold=turn.folds.get(i)))
+            break
+        out.append(SweepPose(i, value, turn.q[i], None, note=turn.notes.get(i, "")))
+    return out
 
 
 def _loop_classes(linkage) -> list:
@@ -86,14 +110,12 @@ def _output(design, output, found: list, turn) -> dict:
 
 def ghost_points(turn, q: np.ndarray) -> dict[str, list[float]]:
     """Every drawn point's place [m] at a closed configuration q (a ghost of the linkage)."""
-    from pinmech.solve.motion import evaluate_motion
+    from pinmech.solve.sweep_frames import frame_paths
 
-    sweep = turn.sweep
-    zero = np.zeros(sweep.mechanism.model.nv)
-    names = list(turn.paths)
+    mech = turn.sweep.mechanism
+    zero = np.zeros((1, mech.model.nv))
     try:
-        with sweep.solver.lock:
-            motion = evaluate_motion(sweep.mechanism, sweep.solver.data, q, zero, zero, points=names, links=[])
+        paths = frame_paths(mech, turn.names, np.asarray(q, dtype=float)[None, :], zero, zero)
     except PinmechError:
         return {}
-    return {n: [float(x) for x in motion.points[n].position[:2]] for n in names}
+    return {n: paths.position[0, i, :2].tolist() for i, n in enumerate(turn.names)}

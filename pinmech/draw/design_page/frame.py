@@ -1,15 +1,16 @@
 """One turn of a drawn linkage, solved as `pinmech sweep` solves it: the data a page draws.
 
-The spec is written to a private folder with a scene beside it (its driver at the drawn
-pose's value, so the sweep starts on the drawn assembly), and `Sweep.from_scene` solves
-it: the page's curves are the rows `pinmech sweep` prints for the same two files. A pose
-that cannot close (a fold, a branch end) is a gap in the curves, its driver value kept.
+The spec is drawn (`linkage_from_spec`, `linkage_mechanism`) and given a scene (its driver
+at the drawn pose's value, so the sweep starts on the drawn assembly; the one `save.py`
+writes), and `Sweep.from_scene` solves it, its poses taken as arrays (`Sweep.chunks`) and its points read by one compiled call
+(`frame_paths`, the numbers `evaluate_motion` gives `pinmech sweep`'s rows): the page's
+curves are the rows `pinmech sweep` prints for the same two files. A pose that cannot
+close (a fold, a branch end) is a gap in the curves, its error and fold kept.
 """
 
 from __future__ import annotations
 
 import math
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -18,10 +19,12 @@ import numpy as np
 from pinmech.exceptions import ModelError
 from pinmech.model.linkage import Linkage, linkage_from_spec
 from pinmech.model.linkage_spec import LinkageSpec
-from pinmech.model.linkage_write import linkage_toml
 
 #: Poses of one turn, both ends included (as `pinmech sweep`'s default).
 STEPS = 361
+#: Poses solved at a time: past a fold every pose fails, slowly, and the turn stops at the
+#: first chunk that fails (the poses solved before the fold are all kept).
+STOP_CHUNK = 16
 
 
 @dataclass
@@ -32,31 +35,41 @@ class Turn:
         linkage: the drawing (SI, drawn pose).
         sweep: the `Sweep` that solved it (its mechanism, solver, driver).
         values: the driver's values [rad or m], STEPS of them.
-        paths: point name -> (STEPS, 2) world positions [m], NaN where the pose failed.
-        poses: the `SweepPose` of every value (motion None where it failed).
-        errors: pose index -> why it failed (the named error's text).
-        folds: driver values [rad or m] of the folds the turn met.
+        names: the drawn points, in the order of the arrays' axis 1.
+        q: (STEPS, nq) configurations, NaN rows where a pose failed.
+        position, velocity, acceleration: (STEPS, len(names), 2) world x, y [m, m/s, m/s^2].
+        errors: pose index -> the error of a pose that failed (the turn stops at the first:
+            the poses after it are not solved, their rows NaN).
+        notes: pose index -> what the path passed on its way there.
+        folds: pose index -> the driver's fold value [rad or m] its DriverLimitError names.
     """
 
     linkage: Linkage
     sweep: object
     values: np.ndarray
-    paths: dict[str, np.ndarray]
-    poses: list
-    errors: dict[int, str] = field(default_factory=dict)
-    folds: list[float] = field(default_factory=list)
+    names: list[str]
+    q: np.ndarray
+    position: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    errors: dict[int, Exception] = field(default_factory=dict)
+    notes: dict[int, str] = field(default_factory=dict)
+    folds: dict[int, float] = field(default_factory=dict)
+
+    def path(self, name: str) -> np.ndarray:
+        """(STEPS, 2) positions of a drawn point [m], NaN where the pose failed."""
+        return self.position[:, self.names.index(name)]
 
 
 class TurnSolver:
-    """Solves turns of changed specs in one private folder (the files of the last one kept)."""
+    """Solves turns of changed specs, driven at `driver` (default: the tree's first joint)
+    at `speed` (text, e.g. "60 rpm")."""
 
     def __init__(self, driver: str | None = None, speed: str = "60 rpm") -> None:
-        self._folder = tempfile.TemporaryDirectory(prefix="pinmech-design-")
-        self.folder = Path(self._folder.name)
         self.driver, self.speed = driver, speed
 
     def close(self) -> None:
-        self._folder.cleanup()
+        return None
 
     def solve(self, spec: LinkageSpec, source: str) -> Turn:
         """Draw `spec`, then sweep its driver over one turn from the drawn pose.
@@ -67,25 +80,24 @@ class TurnSolver:
         """
         from pinmech.io.scene import Scene
         from pinmech.io.sweep import Sweep
+        from pinmech.model.linkage_model import linkage_mechanism
 
         linkage = linkage_from_spec(spec, source)
         if linkage.spatial:
             raise ModelError("the design page draws planar linkages only", path=source)
-        (self.folder / "linkage.toml").write_text(linkage_toml(spec), encoding="utf-8")
-        tables = scene_tables(linkage, "linkage.toml", self._driver(spec, source), self.speed)
-        sweep = Sweep.from_scene(Scene.from_tables(tables, self.folder / "scene.toml"))
-        values = np.asarray(sweep.default_values(STEPS))
-        return _turn(linkage, sweep, values)
+        mechanism = linkage_mechanism(linkage)
+        tables = scene_tables(linkage, Path(source).name, self._driver(mechanism, source), self.speed)
+        scene = Scene.from_tables(tables, Path(source).with_name("scene.toml"))
+        sweep = Sweep.from_scene(scene, mechanism=mechanism)  # the scene's linkage, drawn from `spec`
+        return _turn(linkage, sweep, np.asarray(sweep.default_values(STEPS)))
 
-    def _driver(self, spec: LinkageSpec, source: str) -> tuple[str, float]:
-        """The driver's name and its value at the drawn pose [rad or m]."""
-        from pinmech.model.linkage_model import linkage_mechanism
-
-        mech = linkage_mechanism(linkage_from_spec(spec, source))
-        name = self.driver or next(iter(mech.joints))
-        if name not in mech.joints:
-            raise ModelError(f"'{name}' is not a joint of the linkage's tree ({', '.join(mech.joints)})", path=source)
-        return name, mech.joint(name).coordinate(mech.reference)
+    def _driver(self, mechanism, source: str) -> tuple[str, float]:
+        """The driver's name and its value at the drawn pose [rad or m] (the reference)."""
+        name = self.driver or next(iter(mechanism.joints))
+        if name not in mechanism.joints:
+            raise ModelError(f"'{name}' is not a joint of the linkage's tree ({', '.join(mechanism.joints)})",
+                             path=source)
+        return name, float(mechanism.joint(name).coordinate(mechanism.reference))
 
 
 def drawn_points(linkage: Linkage) -> list[str]:
@@ -104,19 +116,41 @@ def scene_tables(linkage: Linkage, linkage_file: str, driver: tuple[str, float],
 
 
 def _turn(linkage: Linkage, sweep, values: np.ndarray) -> Turn:
+    """The turn's poses as arrays, every drawn point's place, rate and acceleration."""
+    from pinmech.solve.sweep_frames import frame_paths
+
     names = drawn_points(linkage)
-    paths = {n: np.full((len(values), 2), np.nan) for n in names}
-    poses, errors, folds = [], {}, []
-    for pose in sweep.poses(values, skip_failures=True):
-        poses.append(pose)
-        if pose.motion is None:
-            errors[pose.index] = pose.error
-            if pose.fold is not None and not any(abs(pose.fold - f) <= 1e-12 for f in folds):
-                folds.append(pose.fold)
-            continue
-        for n in names:
-            paths[n][pose.index] = pose.motion.points[n].position[:2]
-    return Turn(linkage, sweep, values, paths, poses, errors, folds)
+    nq, nv = sweep.mechanism.model.nq, sweep.mechanism.model.nv
+    q, v, a = np.full((len(values), nq), np.nan), np.zeros((len(values), nv)), np.zeros((len(values), nv))
+    errors, notes, folds = {}, {}, {}
+    for chunk in _chunks(sweep, values):
+        rows = slice(chunk.start, chunk.start + len(chunk))
+        q[rows], v[rows], a[rows] = chunk.solution.q, chunk.solution.v, chunk.solution.a
+        for j, exc in chunk.errors.items():
+            errors[chunk.start + j] = exc
+            fold = sweep._fold(exc)
+            if fold is not None:
+                folds[chunk.start + j] = fold
+        notes.update({chunk.start + j: note for j, note in chunk.notes.items()})
+        if chunk.errors:  # the turn stops there, as `pinmech sweep` stops
+            break
+    solved = ~np.isnan(q).any(axis=1)
+    position, velocity, acceleration = (np.full((len(values), len(names), 2), np.nan) for _ in range(3))
+    if solved.any():
+        paths = frame_paths(sweep.mechanism, names, q[solved], np.nan_to_num(v[solved]), np.nan_to_num(a[solved]))
+        position[solved], velocity[solved] = paths.position[..., :2], paths.velocity[..., :2]
+        acceleration[solved] = paths.acceleration[..., :2]
+    return Turn(linkage, sweep, values, names, q, position, velocity, acceleration, errors, notes, folds)
+
+
+def _chunks(sweep, values: np.ndarray):
+    """The sweep's poses in chunks of STOP_CHUNK (`Sweep.chunks`'s solve, chunked finer: the
+    poses are the same however chunked), so that a turn that stops at a fold stops soon."""
+    from pinmech.solve.cycle import solve_range
+
+    d = sweep.drivers
+    return solve_range(sweep.solver, sweep.driver, values, driver_q=d.q, driver_v=d.v, driver_a=d.a,
+                       chunk=STOP_CHUNK)
 
 
 def angle_text(value: float, angular: bool) -> str:

@@ -40,6 +40,8 @@ def make_app(session, saving, token: str):
 
     from pinmech.draw.design_page.messages import answer
 
+    from starlette.websockets import WebSocketDisconnect
+
     lock = threading.Lock()
 
     def allowed(params) -> bool:
@@ -50,30 +52,63 @@ def make_app(session, saving, token: str):
             return PlainTextResponse("403: this page needs the token of its address", status_code=403)
         return HTMLResponse(page_html(session.turn.linkage.title), headers={"Cache-Control": "no-store"})
 
-    def locked_answer(message: dict) -> dict:
-        with lock:
-            return answer(session, saving, message)
-
     async def socket_(websocket):
         if not allowed(websocket.query_params):
             await websocket.close(code=POLICY_VIOLATION)
             return
         await websocket.accept()
-        await websocket.send_text(json.dumps(finite(session.first), allow_nan=False, default=_plain))
-        from starlette.websockets import WebSocketDisconnect
-
+        await _send(websocket, session.first)
+        waiting: asyncio.Queue = asyncio.Queue()
+        reader = asyncio.ensure_future(_read(websocket, waiting))
         try:
+            await _send(websocket, await run_in_threadpool(locked, session.diagnostics))
             while True:
-                message = json.loads(await websocket.receive_text())
-                reply = await run_in_threadpool(locked_answer, message)
-                await websocket.send_text(json.dumps(finite(reply), allow_nan=False, default=_plain))
-        except (WebSocketDisconnect, asyncio.CancelledError):
+                message = await waiting.get()
+                if message is None:
+                    return
+                reply = await run_in_threadpool(locked, answer, session, saving, message)
+                await _send(websocket, reply)
+                if reply.get("type") == "frame" and reply.get("ok") and waiting.empty():
+                    await _send(websocket, await run_in_threadpool(locked, session.diagnostics))
+        except (WebSocketDisconnect, asyncio.CancelledError, RuntimeError):
             return
+        finally:
+            reader.cancel()
+
+    def locked(function, *args):
+        with lock:
+            return function(*args)
 
     async def refused(request):
         return PlainTextResponse("403: this page needs the token of its address", status_code=403)
 
     return Starlette(routes=[Route("/", page), WebSocketRoute("/ws", socket_), Route("/{rest:path}", refused)])
+
+
+async def _read(websocket, waiting: asyncio.Queue) -> None:
+    """Put the page's messages on `waiting` as they come (None when it goes); a message
+    that is no JSON object is answered as an error."""
+    try:
+        while True:
+            text = await websocket.receive_text()
+            try:
+                waiting.put_nowait(json.loads(text))
+            except json.JSONDecodeError:
+                waiting.put_nowait({"type": "malformed"})
+    except Exception:  # the page went (WebSocketDisconnect), or the server stops
+        waiting.put_nowait(None)
+
+
+async def _send(websocket, reply: dict) -> None:
+    await websocket.send_text(as_json(reply))
+
+
+def as_json(reply: dict) -> str:
+    """The reply as JSON, NaN and infinities as null (JSON has neither)."""
+    try:
+        return json.dumps(reply, allow_nan=False, default=_plain)
+    except ValueError:
+        return json.dumps(finite(reply), allow_nan=False, default=_plain)
 
 
 def finite(value):

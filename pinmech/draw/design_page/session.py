@@ -17,7 +17,7 @@ from pinmech.model.linkage import linkage_params
 from pinmech.model.linkage_entries import Compass, Polar
 from pinmech.model.linkage_spec import GROUND, LinkageSpec
 from pinmech.draw.design_page.edits import move_joint, set_param
-from pinmech.draw.design_page.frame import Turn, TurnSolver, drawn_points
+from pinmech.draw.design_page.frame import Turn, TurnSolver
 
 
 class Session:
@@ -34,6 +34,7 @@ class Session:
         self.source, self.solver = source, TurnSolver(driver, speed)
         self.spec: LinkageSpec = spec
         self.turn: Turn | None = None
+        self.count, self._diagnostics = 0, None
         self.first = self.solve(spec)
         if not self.first["ok"]:
             raise PinmechError(self.first["error"])
@@ -50,9 +51,24 @@ class Session:
             frame = turn_frame(turn, spec)
         except PinmechError as exc:
             return {"type": "frame", "ok": False, "error": f"{type(exc).__name__}: {exc}"}
-        self.spec, self.turn = spec, turn
-        frame["ms"] = 1e3 * (time.perf_counter() - started)
+        self.spec, self.turn, self._diagnostics = spec, turn, None
+        self.count += 1
+        frame["id"], frame["ms"] = self.count, 1e3 * (time.perf_counter() - started)
         return frame
+
+    def diagnostics(self) -> dict:
+        """The diagnostics of the current turn (computed once per turn), tagged with its frame's id."""
+        from pinmech.draw.design_page.diagnostics import turn_diagnostics
+
+        if self._diagnostics is None:
+            started = time.perf_counter()
+            try:
+                found = turn_diagnostics(self.turn)
+            except PinmechError as exc:
+                found = {"applicable": False, "reason": f"{type(exc).__name__}: {exc}"}
+            self._diagnostics = {"type": "diagnostics", "id": self.count, "diagnostics": found,
+                                 "ms": 1e3 * (time.perf_counter() - started)}
+        return self._diagnostics
 
     def drag(self, joint: str, x: float, y: float) -> dict:
         """Joint `joint` dragged to (x, y) [m]."""
@@ -73,50 +89,43 @@ class Session:
     # ------------------------------------------------------------------ one pose
     def motion(self, index: int, point: str) -> dict:
         """Velocity [m/s] and classical acceleration [m/s^2] of a drawn point at pose `index`."""
-        pose = self._pose(index)
-        if pose is None or point not in pose.motion.points:
+        turn = self.turn
+        if not self._solved(index) or point not in turn.names:
             return {"type": "motion", "ok": False, "index": index, "point": point}
-        p = pose.motion.points[point]
+        k = turn.names.index(point)
         return {"type": "motion", "ok": True, "index": index, "point": point,
-                "position": p.position[:2].tolist(), "velocity": p.velocity[:2].tolist(),
-                "acceleration": p.acceleration[:2].tolist()}
+                "position": turn.position[index, k].tolist(), "velocity": turn.velocity[index, k].tolist(),
+                "acceleration": turn.acceleration[index, k].tolist()}
 
     def centres(self, index: int) -> dict:
         """Every instant centre at pose `index` (world [m], or a direction at infinity)."""
         from pinmech.solve.diagnostics import design_at, design_dict
 
-        pose = self._pose(index)
-        if pose is None:
+        if not self._solved(index):
             return {"type": "centres", "ok": False, "index": index}
         sweep = self.turn.sweep
-        q, v = pose_q(sweep.mechanism, pose.motion)
-        design = design_at(sweep.mechanism, list(sweep.drivers.names), q, v, None, sweep.is_angular)
+        design = design_at(sweep.mechanism, list(sweep.drivers.names), self.turn.q[index],
+                           self._rates(index), None, sweep.is_angular)
         found = design_dict(design).get("instant_centres", []) if design.applicable else []
         return {"type": "centres", "ok": True, "index": index, "centres": found}
 
-    def _pose(self, index: int):
-        poses = self.turn.poses if self.turn else []
-        pose = poses[index] if isinstance(index, int) and 0 <= index < len(poses) else None
-        return pose if pose is not None and pose.motion is not None else None
+    def _solved(self, index: int) -> bool:
+        turn = self.turn
+        return turn is not None and 0 <= index < len(turn.values) and index not in turn.errors
 
-
-def pose_q(mech, motion) -> tuple[np.ndarray, np.ndarray]:
-    """The configuration q and joint rates v of a pose's motion (its joints' coordinates)."""
-    q, v = mech.neutral(), np.zeros(mech.model.nv)
-    for name, joint in motion.joints.items():
-        mech.set_coordinate(q, name, joint.q)
-        info = mech.joint(name)
-        if info.nv == 1:
-            v[info.idx_v] = joint.v
-    return q, v
+    def _rates(self, index: int) -> np.ndarray:
+        """Joint rates at pose `index` for unit driver speed (the centres' velocities)."""
+        sweep = self.turn.sweep
+        k = list(sweep.drivers.names).index(sweep.driver)
+        v, _, _ = sweep.solver.rates(self.turn.q[index], np.eye(len(sweep.drivers.names))[k],
+                                     np.zeros(len(sweep.drivers.names)))
+        return v
 
 
 def turn_frame(turn: Turn, spec: LinkageSpec) -> dict:
     """What the page draws of a solved turn: JSON-ready, lengths [m], angles [rad]."""
-    from pinmech.draw.design_page.diagnostics import turn_diagnostics
-
     linkage, sweep = turn.linkage, turn.sweep
-    names = drawn_points(linkage)
+    names = turn.names
     ground = set(linkage.links.get(GROUND, ()))
     kinds = {n: "compass" if isinstance(e, Compass) else "polar" if isinstance(e, Polar) else "point"
              for n, e in spec.joints.items()}
@@ -129,12 +138,16 @@ def turn_frame(turn: Turn, spec: LinkageSpec) -> dict:
         "links": [{"name": k, "points": [n for n in v if n in names], "ground": k == GROUND}
                   for k, v in linkage.links.items() if k not in linkage.hidden],
         "slides": _slides(linkage),
-        "paths": {n: [None if math.isnan(p[0]) else p.tolist() for p in turn.paths[n]] for n in names},
-        "stopped": None if first_error is None else {"index": first_error, "why": turn.errors[first_error]},
-        "folds": turn.folds,
+        "solved": (~np.isnan(turn.q).any(axis=1)).tolist(),
+        "paths": {n: np.nan_to_num(turn.path(n)).ravel().tolist() for n in names},
+        "stopped": None if first_error is None else {"index": first_error, "why": _said(turn.errors[first_error])},
+        "folds": list(turn.folds.values()),
         "params": {n: v for n, v in linkage_params(spec, linkage.source).items()},
-        "diagnostics": turn_diagnostics(turn),
     }
+
+
+def _said(exc: Exception) -> str:
+    return f"{type(exc).__name__}: {exc}"
 
 
 def _slides(linkage) -> list[dict]:

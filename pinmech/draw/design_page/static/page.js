@@ -34,7 +34,8 @@
       state.pending = false;
       if (m.ok) takeFrame(m); else showError(m.error);
       if (state.queued) { const next = state.queued; state.queued = null; send(next); }
-    } else if (m.type === "motion") { state.motion = m.ok ? m : null; draw(); }
+    } else if (m.type === "diagnostics") { takeDiagnostics(m); }
+    else if (m.type === "motion") { state.motion = m.ok ? m : null; draw(); }
     else if (m.type === "centres") { state.centres = m.ok ? m : null; draw(); }
     else if (m.type === "saved") { state.saved = m; showSaved(m); }
     else if (m.type === "synthesis") { takeSynthesis(m); }
@@ -48,8 +49,19 @@
     if (first || !state.dragging) state.view = fitView(f);
     message(f.stopped ? stoppedText(f) : "", f.stopped ? "note" : "");
     status(`solved ${f.driver.values.length} poses in ${f.ms.toFixed(0)} ms`);
-    if (first) { buildParams(f); buildPointChoice(f); }
-    drawDiagnostics(f); draw(); requestDetails();
+    const names = f.joints.map((j) => j.name).join(" ");
+    if (first || names !== state.names) { buildParams(f); buildPointChoice(f); state.names = names; }
+    $("diagnostics").classList.add("stale");
+    draw(); requestDetails();
+  }
+
+  function takeDiagnostics(m) {
+    if (!state.frame || m.id !== state.frame.id) return;  // of a drawing already replaced
+    state.frame.diagnostics = m.diagnostics;
+    state.diagnosticsMs = m.ms;
+    $("diagnostics").classList.remove("stale");
+    drawDiagnostics(state.frame); draw();
+    status(`solved ${state.frame.driver.values.length} poses in ${state.frame.ms.toFixed(0)} ms, diagnostics in ${m.ms.toFixed(0)} ms`);
   }
 
   function showError(text) {
@@ -75,14 +87,19 @@
     const at = driverText(f, f.driver.values[f.stopped.index]);
     return `the turn stops before ${f.driver.name} = ${at}: ${f.stopped.why}`;
   }
-  function pointAt(f, name, index) { const p = f.paths[name]; return p ? p[index] : null; }
+  // paths come flat, x0 y0 x1 y1 ..., with `solved` saying which poses closed
+  function pointAt(f, name, index) {
+    const p = f.paths[name];
+    return p && f.solved[index] ? [p[2 * index], p[2 * index + 1]] : null;
+  }
+  function pathPoints(f, name) { return f.solved.map((ok, i) => pointAt(f, name, i)); }
 
   function fitView(f) {
     let lo = [Infinity, Infinity], hi = [-Infinity, -Infinity];
     const add = (p) => { if (!p) return; const q = mm(p);
       lo = [Math.min(lo[0], q[0]), Math.min(lo[1], q[1])]; hi = [Math.max(hi[0], q[0]), Math.max(hi[1], q[1])]; };
     for (const j of f.joints) add(j.at);
-    for (const n in f.paths) f.paths[n].forEach(add);
+    for (const n in f.paths) pathPoints(f, n).forEach(add);
     const w = Math.max(hi[0] - lo[0], 1), h = Math.max(hi[1] - lo[1], 1), pad = 0.15 * Math.max(w, h);
     return [lo[0] - pad, lo[1] - pad, w + 2 * pad, h + 2 * pad];
   }
@@ -98,7 +115,7 @@
     const unit = Math.max(w, h) / 600;  // one screen pixel, about [mm]
     defs(unit);
     const index = state.dragging ? 0 : state.index;
-    if ($("show-ghosts").checked) drawGhosts(f, unit);
+    if ($("show-ghosts").checked && f.diagnostics) drawGhosts(f, unit);
     drawPaths(f);
     drawSlides(f, w + h);
     drawLinks(f, index);
@@ -138,7 +155,7 @@
   function drawPaths(f) {
     for (const j of f.joints) {
       if (j.ground) continue;
-      for (const seg of segments(f.paths[j.name])) polyline(seg, j.pin ? "path-pin" : "path-point");
+      for (const seg of segments(pathPoints(f, j.name))) polyline(seg, j.pin ? "path-pin" : "path-point");
     }
   }
 
@@ -159,6 +176,7 @@
     const d = f.diagnostics || {};
     const ghosts = [];
     for (const o of d.outputs || []) for (const l of o.limits) ghosts.push([`${o.name} ${l.label}`, l.points]);
+    for (const x of d.folds || []) ghosts.push([`fold at ${driverText(f, x.driver)}`, x.points]);
     for (const g of ghosts) {
       for (const link of f.links) {
         if (link.ground) continue;
@@ -241,6 +259,7 @@
   // ------------------------------------------------------------------ diagnostics
   function drawDiagnostics(f) {
     const d = f.diagnostics, box = $("diagnostics");
+    if (!d) return;
     box.innerHTML = "";
     const row = (html) => { const r = document.createElement("div"); r.className = "diag-row"; r.innerHTML = html; box.appendChild(r); };
     const deg = (x) => (x * 180 / Math.PI).toFixed(2);
@@ -265,6 +284,7 @@
     const chart = $("mu-chart");
     while (chart.firstChild) chart.removeChild(chart.firstChild);
     const d = f.diagnostics;
+    if (!d) return;
     if (!d || !d.applicable || !d.dyads.length) return;
     const n = f.driver.values.length, X = (i) => 25 + 270 * i / (n - 1), Y = (mu) => 110 - mu;  // mu in [0, 90] deg
     el("text", { x: 2, y: 14 }, chart).textContent = "90";
@@ -324,7 +344,7 @@
     if (!state.playing || !state.frame) return;
     const n = state.frame.driver.values.length;
     state.index = (state.index + 1) % n;
-    if (state.frame.paths[state.frame.joints[0].name][state.index] === null) state.index = 0;
+    if (!state.frame.solved[state.index]) state.index = 0;
     draw(); requestDetails();
     requestAnimationFrame(step);
   }
