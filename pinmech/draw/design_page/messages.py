@@ -6,6 +6,8 @@
     {"type": "motion", "index": 10, "point": "P"}            -> velocity, acceleration
     {"type": "centres", "index": 10}                         -> the instant centres
     {"type": "save", "svg": "<svg...", "png": "data:..."}    -> the files written
+    {"type": "synthesise", "kind": "four-bar", "targets": [[x, y], ...], "max_crank": 0.2}
+    {"type": "synthesis"} (how far), {"type": "cancel"}, {"type": "adopt", "answer": 0} -> a frame
 Positions in metres, world frame; `index` a pose of the turn (0: the drawn pose).
 """
 
@@ -56,7 +58,7 @@ def answer(session, saving: Saving, message: dict) -> dict:
             return session.centres(int(message["index"]))
         if kind == "save":
             return saving.save(session, message)
-        if kind in ("synthesise", "cancel", "adopt"):
+        if kind in ("synthesise", "synthesis", "cancel", "adopt"):
             from pinmech.draw.design_page.synthesis import synthesis_answer
 
             return synthesis_answer(session, message)

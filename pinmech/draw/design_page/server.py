@@ -1,6 +1,6 @@
 """The design page's web server: Starlette on uvicorn, on 127.0.0.1 only, every request
 refused without the random token of the page's address (HTTP 403; a websocket closed
-with code 1008 before it opens). One websocket per page; each message is answered in a
+before it is accepted, which its handshake answers with HTTP 403). One websocket per page; each message is answered in a
 worker thread (`messages.answer`), one at a time, so a drag never waits behind a queue:
 the page sends its next drag when the last one's frame has come back.
 """

@@ -39,6 +39,7 @@
     else if (m.type === "centres") { state.centres = m.ok ? m : null; draw(); }
     else if (m.type === "saved") { state.saved = m; showSaved(m); }
     else if (m.type === "synthesis") { takeSynthesis(m); }
+    if (m.type === "frame" && m.ok && state.answers.length && state.adopting) { state.adopting = false; state.chosen = -1; state.targets = []; draw(); }
     else if (m.type === "error") { showError(m.error); }
   }
 
@@ -46,7 +47,7 @@
     const first = state.frame === null;
     state.frame = f; state.frames += 1; state.error = ""; state.phantom = null;
     state.centres = null; state.motion = null; state.arrowScale = null;
-    if (first || !state.dragging) state.view = fitView(f);
+    if (first || !state.dragging || !state.view) state.view = fitView(f);
     message(f.stopped ? stoppedText(f) : "", f.stopped ? "note" : "");
     status(`solved ${f.driver.values.length} poses in ${f.ms.toFixed(0)} ms`);
     const names = f.joints.map((j) => j.name).join(" ");
@@ -250,6 +251,7 @@
     const a = state.answers[state.chosen];
     if (!a) return;
     for (const seg of segments(a.path)) polyline(seg, "answer-path");
+    for (const n in a.points) { const p = mm(a.points[n]); el("circle", { class: "target", cx: p[0], cy: p[1], r: 3 }, svg); }
     for (const link of a.links) {
       const pts = link.map((n) => a.points[n]).filter((p) => p).map(mm);
       if (pts.length >= 2) polyline(pts, "ghost");
@@ -411,15 +413,17 @@
   function takeSynthesis(m) {
     $("synth-progress").textContent = m.progress || m.error || "";
     if (m.error) message(m.error, "error");
+    state.synthRunning = !!m.running;
+    if (m.running) setTimeout(() => ws.send(JSON.stringify({ type: "synthesis" })), 500);
     if (!m.answers) return;
     state.answers = m.answers;
     const list = $("answers"); list.innerHTML = "";
     m.answers.forEach((a, i) => {
       const li = document.createElement("li"); li.textContent = a.summary;
       li.addEventListener("click", () => { state.chosen = i; [...list.children].forEach((c, k) => c.className = k === i ? "chosen" : ""); draw(); });
-      li.addEventListener("dblclick", () => ws.send(JSON.stringify({ type: "adopt", answer: i })));
       const adopt = document.createElement("button"); adopt.textContent = "adopt"; adopt.type = "button";
-      adopt.addEventListener("click", (e) => { e.stopPropagation(); ws.send(JSON.stringify({ type: "adopt", answer: i })); });
+      adopt.addEventListener("click", (e) => { e.stopPropagation(); state.adopting = true; state.view = null;
+        ws.send(JSON.stringify({ type: "adopt", answer: i })); });
       li.appendChild(adopt); list.appendChild(li);
     });
   }
