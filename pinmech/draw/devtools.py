@@ -39,7 +39,8 @@ class DevToolsPage:
             [chromium, *FLAGS, f"--window-size={window[0]},{window[1]}", "--remote-debugging-port=0",
              f"--user-data-dir={self._profile.name}", "about:blank"],
             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-        self._socket = connect(self._browser_address(), max_size=2**26, open_timeout=START_TIMEOUT_S)
+        self._connection = connect(self._browser_address(), max_size=2**26, open_timeout=START_TIMEOUT_S)
+        self._socket = self._connection.__enter__()
         self._next = 0
         target = self._call("Target.createTarget", {"url": "about:blank"})["targetId"]
         self._session = self._call("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
@@ -100,7 +101,10 @@ class DevToolsPage:
         """
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
-            value = self.evaluate(expression)
+            try:
+                value = self.evaluate(expression)
+            except PinmechError:  # not there yet (the page still loading)
+                value = None
             if value:
                 return value
             time.sleep(every)
@@ -134,8 +138,8 @@ class DevToolsPage:
 
     def close(self) -> None:
         try:
-            if getattr(self, "_socket", None) is not None:
-                self._socket.close()
+            if getattr(self, "_connection", None) is not None:
+                self._connection.__exit__(None, None, None)
         finally:
             self.process.terminate()
             try:

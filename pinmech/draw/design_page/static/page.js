@@ -52,6 +52,7 @@
     status(`solved ${f.driver.values.length} poses in ${f.ms.toFixed(0)} ms`);
     const names = f.joints.map((j) => j.name).join(" ");
     if (first || names !== state.names) { buildParams(f); buildPointChoice(f); state.names = names; }
+    else showParams(f);
     $("diagnostics").classList.add("stale");
     draw(); requestDetails();
   }
@@ -311,7 +312,7 @@
     event.preventDefault();
     state.dragging = name; state.index = 0; stopPlay();
   }
-  svg.addEventListener("mousemove", (event) => {
+  window.addEventListener("mousemove", (event) => {  // the window's: a drag may leave the drawing
     if (!state.dragging) return;
     const p = toWorld(event);
     state.phantom = state.error ? p : null;
@@ -358,11 +359,20 @@
     for (const name of names) {
       const v = f.params[name] * 1000;
       const label = document.createElement("label");
+      label.dataset.name = name;
       label.innerHTML = `${name} <input type="range" min="${(v * 0.2).toFixed(3)}" max="${(v * 2).toFixed(3)}" step="${(v / 200).toPrecision(3)}" value="${v}"> <span>${v.toFixed(3)} mm</span>`;
       const input = label.querySelector("input"), text = label.querySelector("span");
       input.addEventListener("input", () => { text.textContent = `${Number(input.value).toFixed(3)} mm`;
         send({ type: "param", name, value: Number(input.value) / 1000 }); });
       box.appendChild(label);
+    }
+  }
+  function showParams(f) {  // the values a drag gave the parameters (the slider being moved left alone)
+    for (const label of $("params").querySelectorAll("label")) {
+      const input = label.querySelector("input"), name = label.dataset.name;
+      if (!input || document.activeElement === input || !(name in f.params)) continue;
+      input.value = f.params[name] * 1000;
+      label.querySelector("span").textContent = `${(f.params[name] * 1000).toFixed(3)} mm`;
     }
   }
   function buildPointChoice(f) {
