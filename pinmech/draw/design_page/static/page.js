@@ -123,7 +123,7 @@
     drawLinks(f, index);
     drawFolds(f, unit);
     drawTargets(unit);
-    drawAnswer(f);
+    drawAnswer(unit);
     if ($("show-centres").checked && state.centres && state.centres.index === index) drawCentres(unit);
     if ($("show-arrows").checked && state.motion && state.motion.index === index) drawArrows(unit, w + h);
     drawJoints(f, index, unit);
@@ -248,11 +248,11 @@
       el("circle", { class: "target", cx: p[0], cy: p[1], r: 6 * unit, "vector-effect": "non-scaling-stroke" }, svg);
     }
   }
-  function drawAnswer() {
+  function drawAnswer(unit) {
     const a = state.answers[state.chosen];
     if (!a) return;
     for (const seg of segments(a.path)) polyline(seg, "answer-path");
-    for (const n in a.points) { const p = mm(a.points[n]); el("circle", { class: "target", cx: p[0], cy: p[1], r: 3 }, svg); }
+    for (const n in a.points) { const p = mm(a.points[n]); el("circle", { class: "target", cx: p[0], cy: p[1], r: 3 * unit }, svg); }
     for (const link of a.links) {
       const pts = link.map((n) => a.points[n]).filter((p) => p).map(mm);
       if (pts.length >= 2) polyline(pts, "ghost");
@@ -309,6 +309,7 @@
     return [p.x, p.y];
   }
   function startDrag(event, name) {
+    if ($("targets-on").checked) return;  // placing targets: a click on a joint is a target too
     event.preventDefault();
     state.dragging = name; state.index = 0; stopPlay();
   }
