@@ -179,16 +179,16 @@
     const ghosts = [];
     for (const o of d.outputs || []) for (const l of o.limits) ghosts.push([`${o.name} ${l.label}`, l.points]);
     for (const x of d.folds || []) ghosts.push([`fold at ${driverText(f, x.driver)}`, x.points]);
-    for (const g of ghosts) {
+    ghosts.forEach((g, k) => {
       for (const link of f.links) {
         if (link.ground) continue;
         const pts = link.points.map((n) => g[1][n]).filter((p) => p).map(mm);
         if (pts.length >= 2) polyline(pts.length > 2 ? pts.concat([pts[0]]) : pts, "ghost");
       }
       const anyPoint = Object.values(g[1])[Object.keys(g[1]).length - 1];
-      if (anyPoint) { const p = mm(anyPoint); el("text", { class: "ghost-label", x: p[0] + 6 * unit, y: p[1] - 6 * unit,
-        "font-size": 11 * unit }, svg).textContent = g[0]; }
-    }
+      if (anyPoint) { const p = mm(anyPoint); el("text", { class: "ghost-label", x: p[0] + 6 * unit,
+        y: p[1] - 6 * unit - 13 * unit * k, "font-size": 11 * unit }, svg).textContent = g[0]; }  // stacked: one line each
+    });
   }
   function drawSlides(f, size) {
     for (const s of f.slides) {
