@@ -181,3 +181,16 @@ def test_each_kind_of_linkage_opens_drags_and_is_diagnosed(file, joint, loop):
     assert np.linalg.norm(moved - (at + [0.002, 0.001])) < DRAG_TOL
     panel = session.diagnostics()["diagnostics"]
     assert panel["applicable"] and loop in [x["kind"] for x in panel["loops"]]
+
+
+# ---------------------------------------------------------------- the command
+@pytest.mark.parametrize("file, said", [
+    ("models/linkages/rsur.toml", "planar linkages only"),
+    ("models/linkages/no_such_linkage.toml", "no_such_linkage.toml"),
+])
+def test_design_command_refuses_what_it_cannot_draw_in_one_line(file, said, capsys):
+    from pinmech.cli import main
+
+    assert main(["design", str(ROOT / file), "--no-browser"]) != 0
+    err = capsys.readouterr().err
+    assert said in err and "Traceback" not in err and len(err.strip().splitlines()) == 1

@@ -77,7 +77,11 @@ def make_app(session, saving, token: str):
 
     def locked(function, *args):
         with lock:
-            return function(*args)
+            try:
+                return function(*args)
+            except Exception as exc:  # a bug of pinmech's, said on the page rather than a dead socket
+                return {"type": "error", "error": f"pinmech failed unexpectedly ({type(exc).__name__}: {exc}); "
+                                                  "please report it"}
 
     async def refused(request):
         return PlainTextResponse("403: this page needs the token of its address", status_code=403)

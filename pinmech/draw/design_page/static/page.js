@@ -40,7 +40,10 @@
     else if (m.type === "saved") { state.saved = m; showSaved(m); }
     else if (m.type === "synthesis") { takeSynthesis(m); }
     if (m.type === "frame" && m.ok && state.answers.length && state.adopting) { state.adopting = false; state.chosen = -1; state.targets = []; draw(); }
-    else if (m.type === "error") { showError(m.error); }
+    else if (m.type === "error") {
+      state.pending = false; showError(m.error);
+      if (state.queued) { const next = state.queued; state.queued = null; send(next); }
+    }
   }
 
   function takeFrame(f) {
