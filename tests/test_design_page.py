@@ -194,3 +194,25 @@ def test_design_command_refuses_what_it_cannot_draw_in_one_line(file, said, caps
     assert main(["design", str(ROOT / file), "--no-browser"]) != 0
     err = capsys.readouterr().err
     assert said in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.slow
+def test_a_synthesis_file_opens_on_its_best_answer_with_the_others_listed(tmp_path):
+    from pinmech.draw.design_page.synthesis import adopt_run, open_synthesis, synthesis_answer
+
+    text = (ROOT / "models" / "synthesis" / "four_bar_path.toml").read_text()
+    file = tmp_path / "path.toml"
+    file.write_text(text.replace("generations = 400", "generations = 60"))
+    run, answer = open_synthesis(file)
+    try:
+        assert answer["answers"] and len(run.specs) == len(answer["answers"])
+        session = Session(run.specs[0], str(tmp_path / "path_design.toml"))
+        adopt_run(session, run)
+        listed = synthesis_answer(session, {"type": "synthesis"})
+        assert [a["summary"] for a in listed["answers"]] == [a["summary"] for a in answer["answers"]]
+        # the answer the page opens passes the file's first target (pinmech synth met it within 1e-4 m)
+        first = np.array([0.102112, 0.032029])
+        curve = session.turn.path("P")
+        assert np.nanmin(np.linalg.norm(curve - first, axis=1)) < 1e-4
+    finally:
+        run.close()

@@ -159,6 +159,16 @@ def _slides(linkage) -> list[dict]:
     return out
 
 
+def is_synthesis_file(path: str | Path) -> bool:
+    """Whether a TOML file is a synthesis file (it states a `task`)."""
+    import tomllib
+
+    try:
+        return "task" in tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return False
+
+
 def read_design_file(path: str | Path) -> tuple[LinkageSpec, str, str | None, str]:
     """A linkage file, or a scene that names one: (spec, the linkage file, the driver, its speed).
 
@@ -174,6 +184,10 @@ def read_design_file(path: str | Path) -> tuple[LinkageSpec, str, str | None, st
         tables = tomllib.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
         tables = {}
+    if "task" in tables and "topology" in tables or "task" in tables and "targets" in tables:
+        from pinmech.exceptions import SceneError
+
+        raise SceneError("is a synthesis file: open it with open_synthesis", path=str(path))
     if "linkage" in tables and isinstance(tables["linkage"], str):
         from pinmech.io.scene import Scene
 

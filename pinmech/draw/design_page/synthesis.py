@@ -50,15 +50,23 @@ def synthesis_toml(kind: str, targets: np.ndarray, max_crank: float) -> str:
 
 
 class SynthesisRun:
-    """One `pinmech synth` child process and its folder."""
+    """One `pinmech synth` child process and the private folder of its answers.
 
-    def __init__(self, kind: str, targets: np.ndarray, max_crank: float) -> None:
+    Args:
+        text: the synthesis file's text (written in the folder), or None with `file`.
+        file: a user's synthesis file, run where it is (its relative paths kept).
+    """
+
+    def __init__(self, text: str | None = None, file: Path | None = None) -> None:
         self._folder = tempfile.TemporaryDirectory(prefix="pinmech-page-synth-")
         self.folder = Path(self._folder.name)
-        (self.folder / "targets.toml").write_text(synthesis_toml(kind, targets, max_crank), encoding="utf-8")
+        if file is None:
+            file = self.folder / "targets.toml"
+            file.write_text(text, encoding="utf-8")
         self.started = time.monotonic()
-        self.process = subprocess.Popen([sys.executable, "-m", "pinmech", "synth", "targets.toml", "--out", "answer"],
-                                        cwd=self.folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "pinmech", "synth", str(Path(file).resolve()), "--out", str(self.folder / "answer")],
+            cwd=Path(file).resolve().parent, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         self.answers: list[dict] | None = None
         self.specs: list = []
 
@@ -77,6 +85,8 @@ def synthesis_answer(session, message: dict) -> dict:
     kind, run = message["type"], _RUNS.get(id(session))
     if kind == "synthesise":
         return _start(session, message, run)
+    if run is None and kind == "synthesis":  # the page asks on opening: nothing yet
+        return {"type": "synthesis", "running": False, "progress": ""}
     if run is None:
         return {"type": "synthesis", "error": "no synthesis has been run on this page"}
     if kind == "cancel":
@@ -102,7 +112,7 @@ def _start(session, message: dict, run: SynthesisRun | None) -> dict:
         return {"type": "synthesis", "error": f"the crank's limit must be positive, got {max_crank} m"}
     if run is not None:
         run.close()
-    _RUNS[id(session)] = SynthesisRun(choice, targets, max_crank)
+    _RUNS[id(session)] = SynthesisRun(synthesis_toml(choice, targets, max_crank))
     return {"type": "synthesis", "progress": f"searching ({len(targets)} targets)...", "running": True}
 
 
@@ -119,6 +129,29 @@ def _progress(session, run: SynthesisRun) -> dict:
                 "error": f"pinmech synth: {said[-1] if said else f'exit code {code}'}"}
     return {"type": "synthesis", "running": False, "answers": run.answers,
             "progress": f"{len(run.answers)} answer(s) in {elapsed:.0f} s"}
+
+
+def open_synthesis(file: Path) -> tuple[SynthesisRun, list[dict]]:
+    """`pinmech design SYNTHESIS.toml`: the file's search run to its end (the terminal told
+    how long it took), and its answers; the first one is the page's linkage.
+
+    Raises:
+        PinmechError: the search failed or found no linkage (pinmech synth's last line quoted).
+    """
+    from pinmech.exceptions import PinmechError
+
+    run = SynthesisRun(file=file)
+    run.process.wait()
+    answer = _progress(None, run)
+    if not run.specs:
+        run.close()
+        raise PinmechError(answer.get("error") or f"{file}: the synthesis found no linkage to open")
+    return run, answer
+
+
+def adopt_run(session, run: SynthesisRun) -> None:
+    """Make `run` the session's synthesis (its answers listed on the page)."""
+    _RUNS[id(session)] = run
 
 
 def _answers(session, run: SynthesisRun, code: int) -> list[dict]:

@@ -16,7 +16,7 @@
 
   // ------------------------------------------------------------------ connection
   const ws = new WebSocket(`ws://${location.host}/ws?token=${encodeURIComponent(token)}`);
-  ws.onopen = () => status("connected");
+  ws.onopen = () => { status("connected"); ws.send(JSON.stringify({ type: "synthesis" })); };  // answers already found
   ws.onclose = (e) => status(`disconnected (${e.code})`);
   ws.onmessage = (event) => receive(JSON.parse(event.data));
 
