@@ -21,6 +21,7 @@ import pytest
         ("condition_time", ["--sizes", "1", "5", "--rounds", "1"]),
         ("benchmark_study", ["--samples", "40", "--rounds", "1"]),
         ("benchmark_synthesis", ["--six-bar", "--rounds", "1"]),
+        ("benchmark_design_page", ["--drags", "1"]),
     ],
 )
 def test_script_runs(name, argv, capsys):
