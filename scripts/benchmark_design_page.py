@@ -6,9 +6,10 @@ server, as the browser sends them; timed from sending the drag to receiving
 
     frame:        the curves of every point over the turn, the drawing, folds (what the page
                   redraws at once), as JSON;
-    + diagnostics: then the diagnostics panel's data (Grashof/Barker class, transmission
-                  angle over the turn and its least value, limit positions as ghosts, swing
-                  or stroke, Q), computed from the same turn and sent next.
+    + diagnostics: plus the time the server takes to compute the diagnostics panel's data
+                  (Grashof/Barker class, transmission angle over the turn and its least
+                  value, limit positions as ghosts, swing or stroke, Q) from the same turn,
+                  sent next (after a pause of server.PAUSE_S for a next drag, not counted).
 
 Printed: the median and the spread (fastest, slowest) of each, against the page's targets
 (one update <= 30 ms for a four-bar, <= 100 ms for a Watt or Stephenson six-bar). The
@@ -59,10 +60,10 @@ def measure(file: str, joint: str, drags: int) -> tuple[list[float], list[float]
                 at_frame = time.perf_counter()
                 if not frame["ok"]:
                     raise SystemExit(f"{file}: the drag failed: {frame['error']}")
-                _until(ws, "diagnostics")
-                if i >= 3:
-                    frames.append(1e3 * (at_frame - started))
-                    totals.append(1e3 * (time.perf_counter() - started))
+                diagnostics = _until(ws, "diagnostics")
+                if i >= 3:  # the work of one update: the frame as received, plus the diagnostics'
+                    frames.append(1e3 * (at_frame - started))  # computation (the server waits PAUSE_S
+                    totals.append(frames[-1] + diagnostics["ms"])  # for a next drag before it, not counted)
     finally:
         server.stop()
         session.close()

@@ -16,6 +16,9 @@ import threading
 from importlib import resources
 
 HOST = "127.0.0.1"
+#: After a frame, the diagnostics wait this long for the page's next drag [s]: while the
+#: mouse moves, frames follow each other at once; when it pauses, the diagnostics come.
+PAUSE_S = 0.03
 #: WebSocket close code for a refused token (RFC 6455: policy violation).
 POLICY_VIOLATION = 1008
 
@@ -68,8 +71,10 @@ def make_app(session, saving, token: str):
                     return
                 reply = await run_in_threadpool(locked, answer, session, saving, message)
                 await _send(websocket, reply)
-                if reply.get("type") == "frame" and reply.get("ok") and waiting.empty():
-                    await _send(websocket, await run_in_threadpool(locked, session.diagnostics))
+                if reply.get("type") == "frame" and reply.get("ok"):
+                    await asyncio.sleep(PAUSE_S)  # a drag still moving sends its next place by then
+                    if waiting.empty():
+                        await _send(websocket, await run_in_threadpool(locked, session.diagnostics))
         except (WebSocketDisconnect, asyncio.CancelledError, RuntimeError):
             return
         finally:
