@@ -40,6 +40,10 @@ class Session:
             raise PinmechError(self.first["error"])
 
     def close(self) -> None:
+        """Stop the page's synthesis, if one runs (its files removed)."""
+        from pinmech.draw.design_page.synthesis import close_run
+
+        close_run(self)
         self.solver.close()
 
     # ------------------------------------------------------------------ changes

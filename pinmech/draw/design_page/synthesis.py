@@ -149,6 +149,13 @@ def open_synthesis(file: Path) -> tuple[SynthesisRun, list[dict]]:
     return run, answer
 
 
+def close_run(session) -> None:
+    """Stop the session's search, if any, and remove its folder."""
+    run = _RUNS.pop(id(session), None)
+    if run is not None:
+        run.close()
+
+
 def adopt_run(session, run: SynthesisRun) -> None:
     """Make `run` the session's synthesis (its answers listed on the page)."""
     _RUNS[id(session)] = run
