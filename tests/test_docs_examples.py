@@ -44,6 +44,7 @@ NOT_RUN = {
     "python -m sphinx": "tests/test_docs_build.py builds the site",
     "python -m http.server": "a server that runs until stopped",
     "pinmech view": "a live meshcat server that runs until stopped (tests/test_view_server.py)",
+    "pinmech design": "a page's server that runs until stopped (tests/test_design_page*.py)",
     "python scripts/": "benchmarks and picture scripts: minutes each (tests/test_scripts.py runs the quick ones)",
     ".venv/bin/python scripts/": "benchmarks: minutes each (tests/test_scripts.py runs the quick ones)",
     "dask": "a cluster's processes",

@@ -48,4 +48,5 @@ SUBCOMMANDS = {
     "check": "pinmech.cli.check",
     "study": "pinmech.design.study.cli",
     "synth": "pinmech.design.synthesis.cli",
+    "design": "pinmech.cli.design",
 }

@@ -138,8 +138,11 @@ class Sweep:
     fold_end: float | None = None  # where a sweep `to_fold` ended: the driver's fold [rad or m]
 
     @classmethod
-    def from_scene(cls, scene: Scene, driver: str | None = None) -> Sweep:
+    def from_scene(cls, scene: Scene, driver: str | None = None, *, mechanism: Mechanism | None = None) -> Sweep:
         """The sweep of a scene's driver (its only one unless `driver` names one).
+
+        `mechanism`: the scene's model, loaded already (`load_mechanism(scene)`, or the
+        drawn linkage it names, `linkage_mechanism`); default: loaded here.
 
         Raises:
             SceneError: a scene without drivers (a task scene is followed in time by
@@ -150,7 +153,7 @@ class Sweep:
             raise SceneError("has no [drivers] to sweep; a task scene ([[task]]) is followed in time: "
                              "pinmech path SCENE --duration ... (pinmech animate SCENE --duration ... "
                              "animates it)", path=str(scene.path), key="drivers")
-        mechanism = load_mechanism(scene)
+        mechanism = load_mechanism(scene) if mechanism is None else mechanism
         if not scene.file.drivers:
             raise SceneError(_no_drivers(mechanism, bool(scene.file.pose)), path=str(scene.path), key="drivers")
         drivers = scene_drivers(scene, mechanism)

@@ -1,0 +1,91 @@
+"""What the page saves: the linkage as a drawn-linkage TOML file (the file's leading
+comments kept as its header), a scene that sweeps it from the drawn pose, and the figures
+of what is on screen (SVG as the page draws it, PNG as the browser rasterised it). Every
+file is written whole, through a temporary file renamed when complete.
+"""
+
+from __future__ import annotations
+
+import base64
+from pathlib import Path
+
+from pinmech.exceptions import PinmechError
+from pinmech.model.linkage_spec import LinkageSpec
+from pinmech.model.linkage_write import linkage_toml
+from pinmech.outputs import write_whole, write_with
+
+
+def leading_comments(path: Path) -> str:
+    """The comment lines a file opens with, without their "# " (the header written back)."""
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError):
+        return ""
+    header = []
+    for line in lines:
+        if not line.startswith("#"):
+            break
+        header.append(line[1:].removeprefix(" "))
+    return "\n".join(header)
+
+
+def save_linkage(spec: LinkageSpec, path: Path, header: str) -> Path:
+    """Write the linkage whole to `path` (its header comment lines first)."""
+    write_whole(path, linkage_toml(spec, header))
+    return path
+
+
+def save_scene(tables: dict, linkage_path: Path, path: Path) -> Path:
+    """Write the scene of `tables` (`frame.scene_tables`) to `path`, naming the linkage by a
+    path relative to the scene's folder."""
+    import os
+
+    tables = dict(tables, linkage=os.path.relpath(linkage_path.resolve(), path.resolve().parent))
+    (name, driver), = tables["drivers"].items()
+    lines = [
+        f"# A scene of {linkage_path.name}, written by pinmech design: its driver at the drawn pose.",
+        f"# pinmech sweep {path.name}",
+        f"title = {_string(tables['title'])}",
+        f"linkage = {_string(tables['linkage'])}",
+        "",
+        f"[drivers.{name}]",
+        f"angle = {_string(driver['angle'])}",
+        f"speed = {_string(driver['speed'])}",
+        "",
+        "[report]",
+        "points = [" + ", ".join(_string(p) for p in tables["report"]["points"]) + "]",
+    ]
+    write_whole(path, "\n".join(lines) + "\n")
+    return path
+
+
+def save_figure(svg: str | None, png_data_url: str | None, stem: Path) -> list[Path]:
+    """The page's figure as `stem`.svg and `stem`.png (either may be absent).
+
+    Raises:
+        PinmechError: a PNG that is not a base64 data URL of a PNG.
+    """
+    written = []
+    if svg:
+        written.append(_write_text(stem.with_suffix(".svg"), svg))
+    if png_data_url:
+        prefix = "data:image/png;base64,"
+        if not png_data_url.startswith(prefix):
+            raise PinmechError("the page sent a PNG that is not a data:image/png;base64 URL")
+        data = base64.b64decode(png_data_url[len(prefix):], validate=True)
+        if not data.startswith(b"\x89PNG"):
+            raise PinmechError("the page sent a PNG whose data is not a PNG")
+        written.append(write_with(stem.with_suffix(".png"), lambda tmp: Path(tmp).write_bytes(data)))
+    return written
+
+
+def _write_text(path: Path, text: str) -> Path:
+    write_whole(path, text)
+    return path
+
+
+def _string(text: str) -> str:
+    """A TOML basic string (JSON's escapes are TOML's: \\", \\\\, \\uXXXX)."""
+    import json
+
+    return json.dumps(text)
