@@ -199,3 +199,20 @@ def test_the_cache_rebuilds_a_kernel_it_did_not_write(models_dir):
         assert not third.cached and not os.path.islink(third.path)
     finally:
         target.unlink(missing_ok=True)
+
+
+@needs_kernels
+def test_the_arm_of_text_17_110_on_the_kernel_meets_cramers_rule(scenes_dir):
+    """tests/test_planar_arm.py's check (rtol 1e-10) with [solver] kernel = "generated": the
+    rate solve (RateSolver) runs its passes on the kernel."""
+    from pinmech import analyse, to_dict
+
+    deg = np.pi / 180
+    analysis = analyse(pinmech.Scene.load(scenes_dir / "planar_arm.toml", ['solver.kernel="generated"']))
+    links = to_dict(analysis)["links"]
+    cramer = closed_form.planar_arm_rates(50 * deg, -15 * deg, -90 * deg, 0.3, 0.3, 0.17, np.array([1.0, 0.0]),
+                                          np.zeros(2))
+    np.testing.assert_allclose([links[n]["angular_velocity"][2] for n in ("AB", "BC")],
+                               [cramer.omega_AB, cramer.omega_BC], rtol=1e-10)
+    np.testing.assert_allclose([links[n]["angular_acceleration"][2] for n in ("AB", "BC")],
+                               [cramer.alpha_AB, cramer.alpha_BC], rtol=1e-10)
