@@ -70,27 +70,32 @@ def build_kernel(model: pin.Model) -> KernelBuild:
     cc = _compiler("CC", ("cc", "gcc", "clang"))
     key = hashlib.sha256("\0".join([text, cc, _compiler_version(cc), " ".join(KERNEL_FLAGS),
                                     _generator_source()]).encode()).hexdigest()
-    times: dict[str, float] = {}
+    made: list[tuple[float, float, int, int]] = []
+    path, cached = cached_build("kernel", key, ".so", lambda out: made.append(make_kernel(model, out, text, cc)))
+    generate, compile_, c_bytes, _ = made[0] if made else (0.0, 0.0, 0, 0)
+    return KernelBuild(path, cached, generate, compile_, path.stat().st_size, c_bytes)
 
-    def make(out: Path) -> None:
-        generator = generator_path()
-        model_file, c_file = out.with_suffix(".model"), out.with_suffix(".c")
-        try:
-            model_file.write_text(text)
-            start = time.perf_counter()
-            _run([str(generator), str(model_file), str(c_file)], "the kernel generator")
-            times["generate"] = time.perf_counter() - start
-            times["c_bytes"] = c_file.stat().st_size
-            start = time.perf_counter()
-            _run([cc, *KERNEL_FLAGS, "-o", str(out), str(c_file)], "the C compiler")
-            times["compile"] = time.perf_counter() - start
-        finally:
-            for leftover in (model_file, c_file):
-                leftover.unlink(missing_ok=True)
 
-    path, cached = cached_build("kernel", key, ".so", make)
-    return KernelBuild(path, cached, times.get("generate", 0.0), times.get("compile", 0.0), path.stat().st_size,
-                       int(times.get("c_bytes", 0)))
+def make_kernel(model: pin.Model, out: Path, text: str | None = None,
+                cc: str | None = None) -> tuple[float, float, int, int]:
+    """Generate `model`'s kernel as C and compile it to `out` (no cache); returns the
+    seconds to write the C, the seconds to compile it, the C's and the library's sizes [bytes]."""
+    text = _structure(model) if text is None else text
+    cc = cc or _compiler("CC", ("cc", "gcc", "clang"))
+    generator = generator_path()
+    model_file, c_file = out.with_suffix(".model"), out.with_suffix(".c")
+    try:
+        model_file.write_text(text)
+        start = time.perf_counter()
+        _run([str(generator), str(model_file), str(c_file)], "the kernel generator")
+        generate = time.perf_counter() - start
+        c_bytes = c_file.stat().st_size
+        start = time.perf_counter()
+        _run([cc, *KERNEL_FLAGS, "-o", str(out), str(c_file)], "the C compiler")
+        return generate, time.perf_counter() - start, c_bytes, out.stat().st_size
+    finally:
+        for leftover in (model_file, c_file):
+            leftover.unlink(missing_ok=True)
 
 
 def generator_path() -> Path:
