@@ -17,7 +17,6 @@ and the generic passes run).
 from __future__ import annotations
 
 import hashlib
-import json
 import os
 import shutil
 import subprocess
@@ -203,8 +202,3 @@ def describe(build: KernelBuild) -> str:
         return f"generated kernel {build.path.name} ({build.bytes / 1024:.0f} kB, cached)"
     return (f"generated kernel {build.path.name}: C written in {build.generate_seconds:.2f} s "
             f"({build.c_bytes / 1024:.0f} kB), compiled in {build.compile_seconds:.2f} s ({build.bytes / 1024:.0f} kB)")
-
-
-def summary(build: KernelBuild) -> str:
-    return json.dumps({"path": str(build.path), "cached": build.cached, "generate_seconds": build.generate_seconds,
-                       "compile_seconds": build.compile_seconds, "bytes": build.bytes, "c_bytes": build.c_bytes})
