@@ -10,6 +10,11 @@ shared temporary folder is open to every local user, so a file there is used onl
     holds exactly that text when read back; otherwise it is written anew;
   * it is written through `tempfile.mkstemp` (an unpredictable name, created exclusively)
     and renamed into place whole.
+
+A built file (a compiled kernel, the kernel generator: `cached_build`) is named by the
+SHA-256 of everything it is built from, and used only where it and its record, a file
+beside it holding the SHA-256 of its bytes, are regular files of this user's and the
+bytes read back match the record; otherwise it is built anew.
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ import shutil
 import stat
 import tempfile
 from pathlib import Path
+from typing import Callable
 
 _fallback: Path | None = None
 
@@ -39,6 +45,51 @@ def cached_text(kind: str, suffix: str, text: str) -> Path:
     if not _holds(path, data):
         _write(folder, path, data)
     return path
+
+
+def cached_build(kind: str, key: str, suffix: str, build: Callable[[Path], None]) -> tuple[Path, bool]:
+    """A built file in this user's private cache folder, and whether it was there already.
+
+    Args:
+        kind: the file name's prefix ("kernel", "kernelgen").
+        key: the SHA-256 (hex) of everything the file is built from.
+        suffix: its extension (".so", "").
+        build: writes the file at the path it is given (in the same folder).
+    """
+    folder = private_folder()
+    path = folder / f"{kind}-{key}{suffix}"
+    record = folder / f"{kind}-{key}{suffix}.sha256"
+    digest = _digest(path)
+    if digest is not None and _holds(record, digest.encode("ascii")):
+        return path, True
+    handle, name = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(handle)
+    try:
+        build(Path(name))
+        os.chmod(name, 0o700)
+        digest = _digest(Path(name))
+        if digest is None:
+            raise OSError(f"{name}: the build wrote no file")
+        os.replace(name, path)
+    except BaseException:
+        Path(name).unlink(missing_ok=True)
+        raise
+    _write(folder, record, digest.encode("ascii"))
+    return path, False
+
+
+def _digest(path: Path) -> str | None:
+    """The SHA-256 of a regular file of this user's (read without following links), or None."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+    except OSError:
+        return None
+    with os.fdopen(fd, "rb") as handle:
+        info = os.fstat(handle.fileno())
+        if not stat.S_ISREG(info.st_mode) or (_uid() is not None and info.st_uid != _uid()):
+            return None
+        return hashlib.file_digest(handle, "sha256").hexdigest() if hasattr(hashlib, "file_digest") else \
+            hashlib.sha256(handle.read()).hexdigest()
 
 
 def private_folder() -> Path:

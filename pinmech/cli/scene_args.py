@@ -80,6 +80,8 @@ def scene_from_args(args: argparse.Namespace):
     from pinmech.io.scene import Scene
 
     overrides = list(args.overrides)
+    if getattr(args, "kernel", None):
+        overrides.append(f'solver.kernel="{args.kernel}"')
     shortcuts = {"angle": args.angle, "speed": args.speed, "acceleration": args.acceleration}
     for key, value in shortcuts.items():
         given_text(value, f"--{key}")

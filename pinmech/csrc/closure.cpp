@@ -129,8 +129,8 @@ VectorXd Core::residual(const VectorXd& q) {
 // pass where `jacobians` (a Jacobian will be taken here), else at the first jacobian_into
 // (most residuals are the last of a Newton solve: no Jacobian is taken there).
 void Core::residual_into(const VectorXd& q, VectorXd& r, bool jacobians) {
-  if (jacobians) pin::computeJointJacobians(model_, data_, q);
-  else pin::forwardKinematics(model_, data_, q);
+  if (jacobians) joint_jacobians_at(&q);
+  else kinematics_at(q);
   joint_jacobians_ = jacobians;
   for (size_t c = 0; c < cuts_.size(); ++c) {
     const Cut& cut = cuts_[c];
@@ -160,7 +160,7 @@ MatrixXd Core::jacobian(bool newton) {
 // residual_into; data_ then has the joint Jacobians at q too.
 void Core::jacobian_into(bool newton) {
   if (!joint_jacobians_) {
-    pin::computeJointJacobians(model_, data_);  // from the placements residual_into left
+    joint_jacobians_at(nullptr);  // at the q residual_into left
     joint_jacobians_ = true;
   }
   for (const Cut& cut : cuts_) relative_jacobian(cut, newton);
@@ -187,7 +187,7 @@ VectorXd Core::drift(const VectorXd& q, const VectorXd& v) {
 }
 
 void Core::drift_into(const VectorXd& q, const VectorXd& v, VectorXd& out) {
-  pin::forwardKinematics(model_, data_, q, v, zero_);
+  motion_at(q, v, zero_);
   joint_jacobians_ = false;  // data_.J is computed again from these placements where asked
   for (const Cut& cut : cuts_) {
     pin::updateFramePlacement(model_, data_, cut.parent);  // at this q, whatever the last call's was

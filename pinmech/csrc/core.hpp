@@ -23,6 +23,7 @@
 #include <nanobind/nanobind.h>
 #include <nanobind/eigen/dense.h>
 #include <nanobind/stl/pair.h>
+#include <nanobind/stl/string.h>
 #include <nanobind/stl/tuple.h>
 #include <nanobind/stl/vector.h>
 
@@ -30,7 +31,9 @@
 
 #include <cmath>
 #include <complex>
+#include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "buffer.hpp"
@@ -259,6 +262,21 @@ struct PathResult {
   std::vector<int> signs_a, signs_b;
 };
 
+// A generated kernel loaded into a core (kernel.cpp): Pinocchio's kinematic passes
+// specialised to the model, C functions of x = [q | v | a | joint placements] writing y
+// (pinmech/kernelgen/generator.cpp documents the layout).
+struct Kernel {
+  using Pass = void (*)(const double*, double*);
+  void* handle = nullptr;  // dlopen's
+  Pass placements = nullptr, jacobians = nullptr, motion = nullptr;
+  VectorXd x, y;
+  std::string path;
+  Kernel() = default;
+  Kernel(const Kernel&) = delete;
+  Kernel& operator=(const Kernel&) = delete;
+  ~Kernel();
+};
+
 class Core {
  public:
   // `model`: a pin.Model, kept alive and read at every call (a joint or frame placement
@@ -356,6 +374,13 @@ class Core {
   // Throws (a ValueError in Python) where the model's joints or frames changed.
   void check_structure() const;
 
+  // ------------------------------------------------------------ kernel.cpp
+  // The kinematic passes from the generated kernel at `path` (checked: made for this
+  // model's sizes), or Pinocchio's generic algorithms again (clear_kernel).
+  void set_kernel(const std::string& path);
+  void clear_kernel();
+  std::string kernel_path() const;  // "" where the passes are generic
+
  private:
   Vector6d error6(const Cut& cut) const;
   FrameMotion<double> frame_motion(pin::FrameIndex frame, bool ground) const;
@@ -388,6 +413,13 @@ class Core {
   void locate_fold(CurvePoint a, CurvePoint b, const PathSpec& path, CurvePoint& out);
   void task_jacobian_into(const VectorXd& q, MatrixXd& J);
   void task_drift_into(const VectorXd& q, const VectorXd& v, VectorXd& drift);
+  // The passes (kernel.cpp): forwardKinematics(q); computeJointJacobians(q) (q null: at
+  // the last pass's q); forwardKinematics(q, v, a). Generated where a kernel is set.
+  void kinematics_at(const VectorXd& q);
+  void joint_jacobians_at(const VectorXd* q);
+  void motion_at(const VectorXd& q, const VectorXd& v, const VectorXd& a);
+  void kernel_inputs(const VectorXd& q, const VectorXd* v, const VectorXd* a);
+  const double* kernel_placements_out();
 
   nb::object model_object_;  // the Python pin.Model: alive as long as this core
   const pin::Model& model_;
@@ -429,6 +461,7 @@ class Core {
   VectorXd rate_row_scale_, rate_v_scale_;
   int rate_method_ = 0;
   double rate_damping_ = 1e-3, rate_max_condition_ = 1e8;
+  std::unique_ptr<Kernel> kernel_;  // null: Pinocchio's generic passes
 };
 
 }  // namespace pinmech

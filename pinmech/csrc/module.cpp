@@ -108,5 +108,8 @@ NB_MODULE(_core, m) {
       .def("set_rate_options", &Core::set_rate_options)
       .def_prop_ro("rate_columns", &Core::rate_columns)
       .def("stacked_jacobian", &Core::stacked_jacobian)
-      .def("pinocchio_passes", &Core::pinocchio_passes);
+      .def("pinocchio_passes", &Core::pinocchio_passes)
+      .def("set_kernel", &Core::set_kernel, "set_kernel(path): the kinematic passes from a generated kernel (kernel.cpp)")
+      .def("clear_kernel", &Core::clear_kernel, "clear_kernel(): Pinocchio's generic passes again")
+      .def_prop_ro("kernel_path", &Core::kernel_path);
 }

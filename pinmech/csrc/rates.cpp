@@ -150,7 +150,7 @@ void Core::task_jacobian_into(const VectorXd& q, MatrixXd& J) {
     jacobian_into(false);
     J.topRows(rows_) = J_;
   } else {
-    pin::computeJointJacobians(model_, data_, q);
+    joint_jacobians_at(&q);
   }
   Index row = rows_;
   for (size_t t = 0; t < task_frames_.size(); ++t) {
@@ -175,7 +175,7 @@ void Core::task_drift_into(const VectorXd& q, const VectorXd& v, VectorXd& drift
     drift_into(q, v, drift_);
     drift.head(rows_) = drift_;
   } else {
-    pin::forwardKinematics(model_, data_, q, v, zero_);
+    motion_at(q, v, zero_);
   }
   Index row = rows_;
   for (size_t t = 0; t < task_frames_.size(); ++t) {
@@ -353,8 +353,8 @@ RowMatrix Core::pinocchio_passes(const Eigen::Ref<const RowMatrix>& Q, const Eig
     for (Index i = 0; i < n; ++i) {
       q = Q.row(i).transpose();
       v = V.row(i).transpose();
-      for (int k = 0; k < jacobians; ++k) pin::computeJointJacobians(model_, data_, q);
-      pin::forwardKinematics(model_, data_, q, v, zero_);
+      for (int k = 0; k < jacobians; ++k) joint_jacobians_at(&q);
+      motion_at(q, v, zero_);
       out.block<1, 3>(i, 0) = data_.oMi[last].translation().transpose();
       out.block<1, 3>(i, 3) = (data_.oMi[last].rotation() * data_.a[last].linear()).transpose();
     }

@@ -91,7 +91,8 @@ def analyse_task(scene: Scene) -> Analysis:
     _check_frames(scene, mechanism, tasks)
     check_scene_names(scene, mechanism)
     rates = RateSolver(mechanism, tasks, **scene.file.rates.options(),
-                       tol=scene.solver_options().get("tol", DEFAULT_TOL))  # the q closed above, to this tol
+                       tol=scene.solver_options().get("tol", DEFAULT_TOL),  # the q closed above, to this tol
+                       kernel=scene.solver_options().get("kernel", "generic"))
     rs = rates.solve(q)
     accuracy = Accuracy(residual, iterations, rs.condition, rs.sigma_min,
                         max(rs.closure_velocity_residual, rs.velocity_error),

@@ -109,24 +109,32 @@ class ReportSpec(Table):
 
 
 class SolverSpec(Table):
-    """`[solver]`: closure tolerance, Newton iteration cap, singular limit (only those given)."""
+    """`[solver]`: closure tolerance, Newton iteration cap, singular limit, kinematic passes
+    (kernel: "generic" or "generated"; only those given)."""
 
     tol: Any = None
     max_iterations: Any = None
     max_condition: Any = None
+    kernel: Any = None
 
     @classmethod
     def _known_keys(cls, data: Any) -> Any:
         if not isinstance(data, dict):
             raise Refused(f"[solver] must be a table, got {data!r}")
         for key in data:
-            if key not in SOLVER_RANGES:
-                raise Refused(f"unknown solver option {key}; known: {', '.join(SOLVER_RANGES)}", at=(key,))
+            if key not in SOLVER_RANGES and key != "kernel":
+                raise Refused(f"unknown solver option {key}; known: {', '.join(SOLVER_RANGES)}, kernel", at=(key,))
         return data
 
     @classmethod
     def _field(cls, name: str, value: Any) -> Any:
         key = f"solver.{name}"
+        if name == "kernel":
+            from pinmech.solve.kernels import KERNELS
+
+            if value not in KERNELS:
+                raise Refused(f"{key} = {value!r} must be one of {', '.join(KERNELS)}")
+            return value
         number = positive_number(value, key, *SOLVER_RANGES[name])
         if name == "max_iterations":
             if number != int(number):  # 2.7 was cut to 2 in silence
@@ -136,7 +144,7 @@ class SolverSpec(Table):
 
     def options(self) -> dict[str, float | int]:
         """The settings given, as LoopSolver's keyword arguments."""
-        return {key: getattr(self, key) for key in SOLVER_RANGES if getattr(self, key) is not None}
+        return {key: getattr(self, key) for key in (*SOLVER_RANGES, "kernel") if getattr(self, key) is not None}
 
 
 class RatesSpec(Table):

@@ -33,6 +33,7 @@ from pinmech.solve.closure_check import (  # noqa: F401  (importers of these nam
     not_closed_error,
     open_loops_error,
 )
+from pinmech.solve.kernels import checked_kernel
 from pinmech.solve.driver_values import check_mobility, index_view, one_coordinate, ordered_values, turn_remainder
 from pinmech.solve.results import Accuracy, LoopSolution
 from pinmech.solve.solver_options import (  # noqa: F401  (names users and other modules import from here)
@@ -63,6 +64,9 @@ class LoopSolver(SolverOptions):
         tol: closure tolerance, relative to each loop's size (SOLVER_RANGES: 1e-16 to 1e-3).
         max_iterations: Newton iteration cap (1 to 1000).
         max_condition: a constraint Jacobian worse conditioned than this is singular (>= 1).
+        kernel: the kinematic passes: "generic" (Pinocchio's algorithms) or "generated"
+            (the same algorithms specialised to the model, compiled once and cached;
+            needs a compiler and `pinmech[fast]`, else one line says so and "generic" runs).
 
     After `solve`, `data` holds the joint placements and Jacobians at the solution and
     the placements of the cut frames (call `pin.updateFramePlacements` for the others).
@@ -86,8 +90,10 @@ class LoopSolver(SolverOptions):
         tol: float = DEFAULT_TOL,
         max_iterations: int = 50,
         max_condition: float = DEFAULT_MAX_CONDITION,
+        kernel: str = "generic",
     ) -> None:
         self.mechanism = mechanism
+        self.kernel = checked_kernel(kernel)
         self.model = mechanism.model
         self.data = self.model.createData()
         self.drivers = names(drivers, "drivers")

@@ -38,6 +38,7 @@ from pinmech.model.mechanism import Mechanism
 from pinmech.seeded import Seeded
 from pinmech.solve import core
 from pinmech.solve.core import _core
+from pinmech.solve.kernels import attach, checked_kernel
 from pinmech.solve.results import RateSolution, frozen
 from pinmech.solve.loops import (
     DEFAULT_MAX_CONDITION,
@@ -143,6 +144,7 @@ class RateSolver:
             (SingularPoseError) unless the method is "damped".
         tol: how closed the loops of a q must be (dimensionless, as `LoopSolver`'s tol,
             which closed it): a q whose loops are open beyond it is a LoopClosureError.
+        kernel: the kinematic passes, as `LoopSolver`'s ("generic" or "generated").
 
     Raises:
         TaskError: unknown method, no task, or a damping out of DAMPING_RANGE.
@@ -152,7 +154,7 @@ class RateSolver:
 
     def __init__(self, mechanism: Mechanism, tasks: Sequence[Task], *, method: str = "exact",
                  damping: float = 1e-3, max_condition: float = DEFAULT_MAX_CONDITION,
-                 tol: float = DEFAULT_TOL) -> None:
+                 tol: float = DEFAULT_TOL, kernel: str = "generic") -> None:
         if method not in METHODS:
             raise TaskError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
         if not isinstance(tasks, (list, tuple)) or not all(isinstance(t, Task) for t in tasks):
@@ -174,6 +176,7 @@ class RateSolver:
         self.damping = float(damping)
         self.max_condition = checked_option("max_condition", max_condition)  # NaN would turn the check off
         self.tol = checked_option("tol", tol)
+        self.kernel = checked_kernel(kernel)
         self.x_dot = np.concatenate([t.velocity for t in self.tasks])
         self.x_ddot = np.concatenate([t.acceleration for t in self.tasks])
         self.row_names = [f"{t.frame}.{c}" for t in self.tasks for c in t.components]
@@ -303,6 +306,9 @@ class RateSolver:
             cached = (compiled, None)
             nv = self.model.nv
             self._columns = (nv, 2 * nv + _core.RATE_NUMBERS, self.x_dot.size)
+        if self.__dict__.get("_kernel_set") != (id(cached[0]), self.kernel):
+            attach(cached[0], self.model, self.kernel)
+            self.__dict__["_kernel_set"] = (id(cached[0]), self.kernel)
         if cached[1] != options:
             rows, columns = self._scales(self._closure_rows)
             cached[0].set_rate_options(rows, columns, _ASKED[self.method], self.damping, self.max_condition)

@@ -1,0 +1,218 @@
+"""Generated kernels (pinmech/solve/kernels.py, kernel_build.py, csrc/kernel.cpp): the
+kinematic passes as Pinocchio's algorithms specialised to the model, compiled and cached.
+
+Checks, each against something that is not the kernel:
+- every joint kind the core takes: with the kernel on, the closure rows are Pinocchio's own
+  frame placements R_P^T (p_C - p_P) (1e-15, as tests/test_core.py's), the Jacobian their
+  central difference (h = 1e-6: truncation h^2 ~ 1e-12, rounding eps / h ~ 1e-10; 1e-8);
+- every bundled scene with loops: the kernel's closure residual, Jacobian and drift equal
+  the generic passes' to 1e-13 of their size. The two run the same operations on the same
+  numbers in another order: each output is a sum of at most a few hundred products of
+  numbers of the model's size (lengths to 1 m, rotations to 1, rates to 10), so the two
+  differ by a few hundred ulps of that size at most (300 x 2.2e-16 ~ 7e-14 < 1e-13);
+- the closed forms of tests/test_bundled_models.py (four-bar, slider-crank) with the kernel on;
+- a changed dimension is used at the next call with no new kernel;
+- no compiler: one line names it, the generic passes run; the cache refuses what it did not write.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import closed_form
+import pinmech
+import pinmech.solve.core as core
+from pinmech.io.sweep import Sweep
+from pinmech.solve import kernel_build, kernels
+from pinmech.solve.loops import LoopSolver
+from tests.test_core import LOOP_SCENES, _relative_position, _two_chains
+
+try:
+    kernel_build.generator_path()
+    REASON = ""
+except kernel_build.KernelUnavailable as why:
+    REASON = str(why)
+needs_kernels = pytest.mark.skipif(bool(REASON), reason=f"no generated kernels here: {REASON}")
+
+KINDS = ["helical", "helical_z", "universal", "ellipsoid", "spherical_zyx", "spherical", "planar", "free_flyer",
+         "translation", "prismatic_unaligned", "composite", "mimic"]
+
+
+def _with_kernel(compiled, model):
+    path = kernels.attach(compiled, model, "generated")
+    assert path is not None and compiled.kernel_path == path
+    return compiled
+
+
+@needs_kernels
+@pytest.mark.parametrize("kind", KINDS)
+def test_every_joint_kind_on_the_kernel_meets_pinocchio_and_finite_differences(kind):
+    """The joint kinds of tests/test_core.py's test_the_core_serves_every_joint_kind, with the
+    kernel on: closure rows against Pinocchio's own frame placements, Jacobian against their
+    central difference (the module's docstring gives the tolerances)."""
+    model, closure = _two_chains(kind)
+    compiled = _with_kernel(core.compile_loops(model, [closure], np.ones(model.nv))[0], model)
+    rng, h = np.random.default_rng(11), 1e-6
+    for _ in range(3):
+        q = pin.integrate(model, pin.neutral(model), rng.uniform(-1.0, 1.0, model.nv))
+        np.testing.assert_allclose(compiled.residual(q), _relative_position(model, closure, q), rtol=0, atol=1e-15)
+        J = compiled.jacobian(False)
+        for k in range(model.nv):
+            e = np.zeros(model.nv)
+            e[k] = h
+            fd = (_relative_position(model, closure, pin.integrate(model, q, e))
+                  - _relative_position(model, closure, pin.integrate(model, q, -e))) / (2 * h)
+            np.testing.assert_allclose(J[:, k], fd, rtol=0, atol=1e-8, err_msg=f"column {k}")
+
+
+@needs_kernels
+@pytest.mark.parametrize("kind", KINDS)
+def test_every_joint_kind_on_the_kernel_equals_the_generic_passes(kind):
+    """Residual, Jacobian and drift with and without the kernel, at seeded poses and rates:
+    equal to 1e-13 of their size (the module's docstring derives the bound)."""
+    model, closure = _two_chains(kind)
+    generic = core.compile_loops(model, [closure], np.ones(model.nv))[0]
+    generated = _with_kernel(core.compile_loops(model, [closure], np.ones(model.nv))[0], model)
+    _same_passes(model, generic, generated, np.random.default_rng(5))
+
+
+def _same_passes(model, generic, generated, rng, poses=3):
+    for _ in range(poses):
+        q = pin.integrate(model, pin.neutral(model), rng.uniform(-1.0, 1.0, model.nv))
+        v = rng.normal(size=model.nv)
+        for name, a, b in (("residual", generic.residual(q), generated.residual(q)),
+                           ("jacobian", generic.jacobian(True), generated.jacobian(True)),
+                           ("drift", generic.drift(q, v), generated.drift(q, v))):
+            size = max(1.0, float(np.max(np.abs(a))))
+            np.testing.assert_allclose(b, a, rtol=0, atol=1e-13 * size, err_msg=name)
+
+
+@needs_kernels
+@pytest.mark.parametrize("scene", LOOP_SCENES)
+def test_every_bundled_model_on_the_kernel_equals_the_generic_passes(scenes_dir, scene):
+    """Every bundled scene with loops: the kernel's passes give the generic residual,
+    Jacobian and drift to 1e-13 of their size, at poses near the scene's own."""
+    path = scenes_dir / scene
+    if not path.is_file():
+        pytest.skip(f"{scene} is not bundled")
+    solver = Sweep.from_scene(pinmech.Scene.load(path)).solver
+    generic = core.core_for(solver)
+    generated = _with_kernel(core.compile_loops(solver.model, solver.mechanism.closures,
+                                                solver.mechanism.velocity_scale(), drv_v=solver._drv_v,
+                                                dep_v=solver._dep_v, drv_q=solver._drv_q,
+                                                blocks=solver.structure.blocks)[0], solver.model)
+    _same_passes(solver.model, generic, generated, np.random.default_rng(3))
+
+
+@needs_kernels
+def test_the_four_bar_on_the_kernel_meets_its_closed_form(scenes_dir):
+    """tests/test_bundled_models.py's four-bar check, with [solver] kernel = "generated"."""
+    sweep = Sweep.from_scene(pinmech.Scene.load(scenes_dir / "four_bar.toml", ['solver.kernel="generated"']))
+    assert sweep.solver.kernel == "generated"
+    values = sweep.default_values(91)
+    poses = list(sweep.poses(values))
+    assert core.core_for(sweep.solver).kernel_path
+    cf = closed_form.four_bar(values, 4 * np.pi, 0.0, 0.04, 0.12, 0.08, 0.10, branch=1)
+    links = [p.motion.links for p in poses]
+    _close([m["rocker"].angular_velocity[2] for m in links], cf.omega4)
+    _close([m["rocker"].angular_acceleration[2] for m in links], cf.alpha4)
+    _close([p.motion.points["B_pin"].acceleration[:2] for p in poses], cf.aB)
+
+
+@needs_kernels
+def test_the_slider_crank_on_the_kernel_meets_its_closed_form(scenes_dir):
+    sweep = Sweep.from_scene(pinmech.Scene.load(scenes_dir / "slider_crank.toml", ['solver.kernel="generated"']))
+    values = sweep.default_values(91)
+    poses = list(sweep.poses(values))
+    assert core.core_for(sweep.solver).kernel_path
+    cf = closed_form.slider_crank(values, 100 * np.pi, 0.0, 0.05, 0.15, 0.01, branch=1)
+    _close([p.motion.joints["slide"].q for p in poses], cf.x_B)
+    _close([p.motion.joints["slide"].v for p in poses], cf.v_B)
+    _close([p.motion.joints["slide"].a for p in poses], cf.a_B)
+
+
+def _close(ours, theirs):
+    """tests/test_bundled_models.py's bound: 1e-10 of the quantity's largest magnitude."""
+    theirs = np.asarray(theirs, dtype=float)
+    np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-10 * np.abs(theirs).max())
+
+
+@needs_kernels
+def test_a_changed_dimension_is_used_with_the_same_kernel(models_dir):
+    """A joint placement changed in the model (a study's variant) is read at the next call:
+    the residual is Pinocchio's frame placements for the new length, and no kernel is built."""
+    mech = pinmech.Mechanism.from_urdf(models_dir / "four_bar.urdf")
+    closure = mech.closures[0]
+    model = mech.model
+    compiled = _with_kernel(core.compile_loops(model, [closure], np.ones(model.nv))[0], model)
+    first = compiled.kernel_path
+    q = pin.integrate(model, pin.neutral(model), np.array([0.3, -0.2, 0.5]))
+    j = model.frames[closure.child_frame].parentJoint
+    model.jointPlacements[j] = pin.SE3(np.eye(3), model.jointPlacements[j].translation + np.array([0.013, 0, 0]))
+    before = kernel_build.build_kernel(model)
+    assert before.cached and str(before.path) == first
+    np.testing.assert_allclose(compiled.errors6(q)[0, :3], _relative_position(model, closure, q), rtol=0, atol=1e-15)
+
+
+def test_the_scene_and_api_refuse_an_unknown_kernel(scenes_dir):
+    with pytest.raises(pinmech.SceneError, match="kernel"):
+        Sweep.from_scene(pinmech.Scene.load(scenes_dir / "four_bar.toml", ['solver.kernel="fast"']))
+    mech = pinmech.Mechanism.from_urdf(scenes_dir.parent / "four_bar.urdf")
+    with pytest.raises(pinmech.OptionError, match="generic, generated"):
+        LoopSolver(mech, ["O2"], kernel="fast")
+
+
+def test_no_compiler_is_one_line_and_the_generic_passes(models_dir, monkeypatch, capsys):
+    """CC naming no compiler: one line on stderr says so, the core keeps the generic passes."""
+    monkeypatch.setenv("CC", "/nonexistent/cc")
+    monkeypatch.setattr(kernels, "_said", set())
+    mech = pinmech.Mechanism.from_urdf(models_dir / "four_bar.urdf")
+    compiled = core.compile_loops(mech.model, mech.closures, np.ones(mech.model.nv))[0]
+    assert kernels.attach(compiled, mech.model, "generated") is None
+    assert compiled.kernel_path == ""
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no compiler found ($CC=/nonexistent/cc)" in err[0] and "generic" in err[0]
+
+
+@needs_kernels
+def test_the_cache_rebuilds_a_kernel_it_did_not_write(models_dir):
+    """A cached kernel whose bytes no longer match its record, or that is a link, is built
+    anew; the folder is the user's alone (0700)."""
+    mech = pinmech.Mechanism.from_urdf(models_dir / "four_bar.urdf")
+    build = kernel_build.build_kernel(mech.model)
+    assert stat.S_IMODE(os.stat(build.path.parent).st_mode) == 0o700
+    assert kernel_build.build_kernel(mech.model).cached
+    with open(build.path, "ab") as f:
+        f.write(b"\0")
+    again = kernel_build.build_kernel(mech.model)
+    assert not again.cached and again.path == build.path
+    target = build.path.with_name("elsewhere.so")
+    os.replace(build.path, target)
+    os.symlink(target, build.path)
+    try:
+        third = kernel_build.build_kernel(mech.model)
+        assert not third.cached and not os.path.islink(third.path)
+    finally:
+        target.unlink(missing_ok=True)
+
+
+@needs_kernels
+def test_the_arm_of_text_17_110_on_the_kernel_meets_cramers_rule(scenes_dir):
+    """tests/test_planar_arm.py's check (rtol 1e-10) with [solver] kernel = "generated": the
+    rate solve (RateSolver) runs its passes on the kernel."""
+    from pinmech import analyse, to_dict
+
+    deg = np.pi / 180
+    analysis = analyse(pinmech.Scene.load(scenes_dir / "planar_arm.toml", ['solver.kernel="generated"']))
+    links = to_dict(analysis)["links"]
+    cramer = closed_form.planar_arm_rates(50 * deg, -15 * deg, -90 * deg, 0.3, 0.3, 0.17, np.array([1.0, 0.0]),
+                                          np.zeros(2))
+    np.testing.assert_allclose([links[n]["angular_velocity"][2] for n in ("AB", "BC")],
+                               [cramer.omega_AB, cramer.omega_BC], rtol=1e-10)
+    np.testing.assert_allclose([links[n]["angular_acceleration"][2] for n in ("AB", "BC")],
+                               [cramer.alpha_AB, cramer.alpha_BC], rtol=1e-10)
