@@ -67,14 +67,19 @@ void Core::node_at(Node& node, const VectorXd& d, const VectorXd* a_drv) {
   for (const ColumnBlock& b : dep_blocks_)  // J_dep times dep_scale_'s diagonal, where not structurally zero
     scaled_.block(b.offset, b.dep, b.rows, 1) = Jdep_.block(b.offset, b.dep, b.rows, 1) * dep_scale_(b.dep);
   square_.factor(scaled_);
-  // The condition number of J_dep, with its rows and columns in block order where it has
-  // several blocks (a permutation: the same singular values), where a chain of loops is a
-  // band matrix.
-  auto [condition, sigma_min] =
-      condition_of(scaled_, square_.singular(), condition_work_, band_ ? &*band_ : nullptr);
-  node.condition = condition;
-  node.sigma_min = sigma_min;
-  signs_into(Jdep_, node.signs);
+  if (certify_now_) {
+    // The condition number of J_dep, with its rows and columns in block order where it has
+    // several blocks (a permutation: the same singular values), where a chain of loops is a
+    // band matrix.
+    auto [condition, sigma_min] =
+        condition_of(scaled_, square_.singular(), condition_work_, band_ ? &*band_ : nullptr);
+    node.condition = condition;
+    node.sigma_min = sigma_min;
+    signs_into(Jdep_, node.signs);
+  } else {  // left uncertified: the caller keeps the last certified signature
+    node.condition = NAN;
+    node.sigma_min = NAN;
+  }
   VectorXd &v = node.d1, &a = node.d2;
   v.setZero(model_.nv);
   a.setZero(model_.nv);
@@ -116,6 +121,11 @@ int Core::step(const Node& from, double p, const VectorXd& x0, const VectorXd& d
   out.p = p;
   out.residual = residual_left;
   node_at(out, d);
+  if (!certify_now_) {  // residuals, trust region and turn only; the signature carried on
+    out.signs = from.signs;
+    if (square_.singular() || !out.d1.allFinite() || !out.d2.allFinite()) return 3;
+    return turn_between(from, out, unit) > MAX_TURN ? 4 : 0;
+  }
   for (int s : out.signs)
     if (s == 0) return 3;
   if (!(out.condition <= SINGULAR_NODE)) return 3;
@@ -150,19 +160,46 @@ nb::tuple Core::follow(double p0, const VectorXd& q0, const VectorXd& d1, const 
     nb::gil_scoped_release release;
     PathSpec path = make_path(x0, d, unit, false, pivots_);
     Node node = start_node(p0, q0, d1, d2, signs0, condition0);
-    for (; done < n && stop == DONE; ++done) {
+    // The dial: poses left uncertified between certified ones. Where a step among them is
+    // refused, or a certified pose finds another signature or a condition number over
+    // max_condition, the range is followed again from the last certified pose with every
+    // pose certified up to that one, so it stops, names and locates as at every pose.
+    Node certified = node;
+    Index certified_done = 0, full_until = -1;
+    struct Restore {  // the pose mode certifies every pose, whatever ends this loop
+      Core& core;
+      ~Restore() { core.certify_all_ = core.landing_due_ = core.certify_now_ = true; }
+    } restore{*this};
+    while (done < n && stop == DONE) {
+      certify_all_ = certify_every_ == CERTIFY_EVERY_POSE || done <= full_until;
+      landing_due_ = certify_all_ || certify_due(certify_every_, done, n);
       PathResult out;
       follow_path(node, targets(done), path, out);
+      const bool uncertified_run = !certify_all_;
+      if (out.status == PATH_REFUSED) {
+        full_until = done;
+        node = certified;
+        done = certified_done;
+        continue;
+      }
       if (out.status != PATH_DONE || !out.change_points.empty() || !out.folds.empty()) {
         stop = out.status == PATH_DONE ? SIGNATURE_CHANGED : NEEDS_PIVOT;
         break;
       }
       std::swap(node, out.node);
-      if (node.condition > max_condition) {
+      const bool bad_condition = node.condition > max_condition;
+      const bool not_finite = !node.d1.allFinite() || !node.d2.allFinite();
+      if (uncertified_run && (bad_condition || not_finite)) {
+        full_until = done;
+        node = certified;
+        done = certified_done;
+        continue;
+      }
+      if (bad_condition) {
         stop = CONDITION;
         break;
       }
-      if (!node.d1.allFinite() || !node.d2.allFinite()) {
+      if (not_finite) {
         stop = NOT_FINITE;
         break;
       }
@@ -171,10 +208,20 @@ nb::tuple Core::follow(double p0, const VectorXd& q0, const VectorXd& d1, const 
       D2.row(done) = node.d2.transpose();
       acc.row(done) << node.residual, double(out.iterations), node.condition, node.sigma_min, node.velocity_residual,
           node.acceleration_residual, double(out.steps);
+      ++done;
+      if (landing_due_) {
+        certified = node;
+        certified_done = done;
+      }
     }
   }
   return nb::make_tuple(done, stop, Q.topRows(done).eval(), D1.topRows(done).eval(), D2.topRows(done).eval(),
                         acc.topRows(done).eval());
+}
+
+void Core::set_certify_every(int every) {
+  if (every < CERTIFY_NONE) throw std::invalid_argument("certify_every: -1 (none), 0 (ends), 1 (every pose) or k >= 2");
+  certify_every_ = every;
 }
 
 void Core::set_pivots(const std::vector<int>& scalar) {

@@ -248,7 +248,22 @@ inline Node start_node(double p, const VectorXd& q, const VectorXd& d1, const Ve
 }
 
 // How Path.follow ended (pivot.cpp). Python builds the named error from it.
-enum PathStatus { PATH_DONE = 0, PATH_STUCK = 1, PATH_FOLD = 2, PATH_SINGULAR = 3 };
+// PATH_REFUSED: a step left uncertified (the dial below) was refused; the range mode then
+// follows again from its last certified pose, certifying every pose.
+enum PathStatus { PATH_DONE = 0, PATH_STUCK = 1, PATH_FOLD = 2, PATH_SINGULAR = 3, PATH_REFUSED = 4 };
+
+// The certification dial (Core::certify_every): which poses of a range get the exact
+// condition number and the assembly signature. Every pose gets its residuals (closure,
+// velocity, acceleration), the trust region and the tangent's turn limit.
+constexpr int CERTIFY_EVERY_POSE = 1;  // k >= 2: every k-th pose and a range's last
+constexpr int CERTIFY_ENDS = 0;        // a range's last pose (its first is certified already)
+constexpr int CERTIFY_NONE = -1;       // no pose: residual tolerances only
+// Whether the pose `i` of `n` is certified at level `every`.
+inline bool certify_due(int every, long i, long n) {
+  if (every == CERTIFY_EVERY_POSE) return true;
+  if (every == CERTIFY_NONE) return false;
+  return i == n - 1 || (every >= 2 && (i + 1) % every == 0);
+}
 // Why a path is stuck (continuation.py words them): 1-5 the last failed step's reason
 // (Core::step's codes; 5 the assembly changed: signs_a -> signs_b), then
 enum StuckWhy { NO_PIVOT = 6, ANOTHER_ASSEMBLY_NEAR = 7, TARGET_NOT_CLOSED = 8, TARGET_ON_ANOTHER = 9 };
@@ -364,6 +379,10 @@ class Core {
 
   double tol() const { return tol_; }
   void set_tol(double tol) { tol_ = tol; }
+  // The certification dial of the range and rate modes (CERTIFY_* above); the pose mode
+  // (close, node, rates_at, follow_path) certifies every pose whatever it is.
+  int certify_every() const { return certify_every_; }
+  void set_certify_every(int every);
   int iterations() const { return iterations_; }
   // Diagonal blocks the dependent solves go through (0: the whole matrix at once).
   int solve_blocks() const { return int(square_.blocks()); }
@@ -449,6 +468,10 @@ class Core {
   std::vector<Vector6d, Eigen::aligned_allocator<Vector6d>> errors_;  // each cut's error6 there
   int iterations_ = 0;
   double moved_ = 0.0;
+  int certify_every_ = CERTIFY_EVERY_POSE;
+  bool certify_all_ = true;  // follow_path certifies every step (false: only a due landing)
+  bool landing_due_ = true;  // ... and the step that lands on its target
+  bool certify_now_ = true;  // node_at computes the condition number and the signature
   std::vector<int> pivots_;
   Node next_;  // follow_path's step buffer
   long attempts_ = 0;  // steps tried since the last look at Python's signal handlers

@@ -58,6 +58,9 @@ NB_MODULE(_core, m) {
       "lower, upper: the structural band (every entry beyond it exactly zero), else found by a scan");
   m.attr("KINEMATICS_COLUMNS") = KINEMATICS_COLUMNS;
   m.attr("RATE_NUMBERS") = RATE_NUMBERS;
+  m.attr("CERTIFY_EVERY_POSE") = CERTIFY_EVERY_POSE;
+  m.attr("CERTIFY_ENDS") = CERTIFY_ENDS;
+  m.attr("CERTIFY_NONE") = CERTIFY_NONE;
   m.def("frames_at", &frames_at,
         "frames_at(model, data, q, v, a, frames, joints, out): forwardKinematics(q, v, a) in the user's data, "
         "then a row per frame and joint asked into out (kinematics.cpp)");
@@ -79,6 +82,9 @@ NB_MODULE(_core, m) {
       .def_prop_ro("idx_q", &Core::idx_q)
       .def_prop_ro("idx_v", &Core::idx_v)
       .def_prop_rw("tol", &Core::tol, &Core::set_tol)
+      .def_prop_rw("certify_every", &Core::certify_every, &Core::set_certify_every,
+                   "the certification dial of the range and rate modes: 1 every pose, k >= 2 every k-th pose and "
+                   "a range's last, 0 a range's last, -1 none (residuals only)")
       .def_prop_ro("iterations", &Core::iterations)
       .def_prop_ro("solve_blocks", &Core::solve_blocks)
       .def_prop_ro("moved", &Core::moved)

@@ -116,8 +116,15 @@ void Core::follow_path(Node& node, double p_target, PathSpec& path, PathResult& 
     const double remaining = p_target - node.p;
     h = std::copysign(std::min(std::abs(h), std::abs(remaining)), remaining);
     bool change = false;
-    const int code = step(node, std::abs(h) < std::abs(remaining) ? node.p + h : p_target, path.x0, path.d, unit,
-                          next, change);
+    const bool lands = !(std::abs(h) < std::abs(remaining));
+    certify_now_ = certify_all_ || (landing_due_ && lands);
+    const int code = step(node, lands ? p_target : node.p + h, path.x0, path.d, unit, next, change);
+    certify_now_ = true;
+    if (code != 0 && !certify_all_) {  // refused among uncertified poses: the range mode follows again
+      out.status = PATH_REFUSED;
+      out.why = code;
+      return;
+    }
     if (code == 0 || (code == 5 && change)) {
       if (next.signs != node.signs) out.change_points.push_back(0.5 * (node.p + next.p));
       std::swap(node, next);
