@@ -213,7 +213,9 @@ class Sweep:
                 range of motion on this assembly, not an error (`fold_end` says where).
             past_change_points: a pose exactly on a change point (singular, or on both
                 assemblies at once) becomes a failed row with a note when the pose after it
-                closes, and the sweep goes on (without: it stops the sweep, as any failure).
+                closes, and the sweep goes on (without: it stops the sweep, as any failure); along
+                the continuation only (`start="predictor"`): a cold or warm start's failure is
+                never taken for a change point.
 
         Raises:
             SweepError: a pose where the loop cannot close or the Jacobian is singular,
@@ -247,8 +249,10 @@ class Sweep:
                         return
                     stop = SweepError(f"sweep stopped at {self.driver} = {self._format(value)}: {exc}",
                                       driver=self.driver, value=value, cause=exc)
+                    # a change point's own pose, kept if the next one closes: only along the
+                    # continuation (a cold or warm start's other assembly is no change point)
                     if past_change_points and not skip_failures and held is None and index > 0 and fold is None \
-                            and isinstance(exc, (SingularPoseError, AssemblyError)):  # a change point's own pose: kept if the next one closes
+                            and start == "predictor" and isinstance(exc, (SingularPoseError, AssemblyError)):
                         held = (SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}",
                                           note=_SINGULAR_PASSED), stop)
                         continue
