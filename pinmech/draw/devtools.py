@@ -19,6 +19,7 @@ from pathlib import Path
 
 from pinmech.draw.browser import FLAGS
 from pinmech.exceptions import PinmechError
+from pinmech.outputs import write_with
 
 #: How long chromium may take to say where its DevTools listen [s].
 START_TIMEOUT_S = 30.0
@@ -133,7 +134,8 @@ class DevToolsPage:
     def screenshot(self, png: Path) -> Path:
         """The page as it is drawn now, written to `png`."""
         data = self.call("Page.captureScreenshot", {"format": "png"})["data"]
-        Path(png).write_bytes(base64.b64decode(data))
+        picture = base64.b64decode(data)
+        write_with(png, lambda temporary: Path(temporary).write_bytes(picture))
         return Path(png)
 
     def close(self) -> None:

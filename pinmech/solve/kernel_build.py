@@ -82,18 +82,18 @@ def make_kernel(model: pin.Model, out: Path, text: str | None = None,
     text = _structure(model) if text is None else text
     cc = cc or _compiler("CC", ("cc", "gcc", "clang"))
     generator = generator_path()
-    model_file, c_file = out.with_suffix(".model"), out.with_suffix(".c")
+    temporary_model, c_file = out.with_suffix(".model"), out.with_suffix(".c")  # beside the cache's temporary
     try:
-        model_file.write_text(text)
+        temporary_model.write_text(text)
         start = time.perf_counter()
-        _run([str(generator), str(model_file), str(c_file)], "the kernel generator")
+        _run([str(generator), str(temporary_model), str(c_file)], "the kernel generator")
         generate = time.perf_counter() - start
         c_bytes = c_file.stat().st_size
         start = time.perf_counter()
         _run([cc, *KERNEL_FLAGS, "-o", str(out), str(c_file)], "the C compiler")
         return generate, time.perf_counter() - start, c_bytes, out.stat().st_size
     finally:
-        for leftover in (model_file, c_file):
+        for leftover in (temporary_model, c_file):
             leftover.unlink(missing_ok=True)
 
 

@@ -75,7 +75,7 @@ def save_figure(svg: str | None, png_data_url: str | None, stem: Path) -> list[P
         data = base64.b64decode(png_data_url[len(prefix):], validate=True)
         if not data.startswith(b"\x89PNG"):
             raise PinmechError("the page sent a PNG whose data is not a PNG")
-        written.append(write_with(stem.with_suffix(".png"), lambda tmp: Path(tmp).write_bytes(data)))
+        written.append(write_with(stem.with_suffix(".png"), lambda temporary: Path(temporary).write_bytes(data)))
     return written
 
 

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from pinmech.draw.design_page.edits import millimetres
+from pinmech.outputs import write_whole
 
 KINDS = ("four-bar", "slider-crank")
 GENERATIONS = 120  # at most, on each assembly: a page's search answers in seconds
@@ -62,7 +63,7 @@ class SynthesisRun:
         self.folder = Path(self._folder.name)
         if file is None:
             file = self.folder / "targets.toml"
-            file.write_text(text, encoding="utf-8")
+            write_whole(file, text)
         self.started = time.monotonic()
         self.process = subprocess.Popen(
             [sys.executable, "-m", "pinmech", "synth", str(Path(file).resolve()), "--out", str(self.folder / "answer")],
