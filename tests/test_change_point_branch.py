@@ -115,3 +115,75 @@ def test_pinmech_sweep_of_the_antiparallelogram_names_no_change_of_branch(tmp_pa
     assert "now on its parallelogram branch" not in err
     assert err.count("after the change point: on its antiparallelogram branch") == 4
     assert "back where it began" in err
+
+
+def scrr_scene(tmp_path):
+    """Barker III-2 SCRR: ground 100, crank 40, coupler 120, rocker 60 mm (s + l = 160 =
+    p + q): a change point at theta = 0, where |O4 A| = d - a = 60 = b - c puts B, O4 and A
+    in line. Drawn at 90 deg."""
+    (tmp_path / "scrr.toml").write_text("""title = "SCRR four-bar"
+ground = ["O2", "O4"]
+[joints]
+O2 = ["0 mm", "0 mm"]
+O4 = ["100 mm", "0 mm"]
+A = { from = "O2", length = "40 mm", angle = "90 deg" }
+B = { from = ["A", "O4"], lengths = ["120 mm", "60 mm"], side = "left" }
+[links]
+crank = ["O2", "A"]
+coupler = ["A", "B"]
+rocker = ["O4", "B"]
+""")
+    scene = tmp_path / "scrr_scene.toml"
+    scene.write_text('title = "scrr"\nlinkage = "scrr.toml"\n[drivers.O2]\nangle = "90 deg"\nspeed = "60 rpm"\n')
+    return scene
+
+
+ENDS = [(0.0, 360.0), (360.0, 0.0), (90.0, 360.0), (-90.0, 0.0), (0.0, -360.0), (360.0, 720.0)]
+
+
+@pytest.mark.parametrize("first, last", ENDS, ids=[f"{a:g} to {b:g}" for a, b in ENDS])
+@pytest.mark.parametrize("steps", [361, 37])
+def test_a_change_point_at_a_sweeps_first_or_last_pose_is_a_row_not_a_failure(tmp_path, capsys, first, last, steps):
+    """The SCRR's change point at theta = 0 (mod 360) as the first or the last pose of a
+    sweep, either way round: `pinmech sweep` writes it as a failed row saying so and exits
+    0 (it stopped there with exit 7, or 10); every other pose is solved."""
+    lines = tmp_path / "s.jsonl"
+    assert main(["sweep", str(scrr_scene(tmp_path)), "--from", f"{first} deg", "--to", f"{last} deg", "--steps",
+                 str(steps), "--csv", str(tmp_path / "s.csv"), "--json", str(lines)]) == 0
+    err = capsys.readouterr().err
+    rows = [json.loads(line) for line in lines.read_text().splitlines()]
+    assert len(rows) == steps
+    on_change_point = [i for i, value in enumerate((first, last)) if math.remainder(value, 360.0) == 0.0]
+    failed = [row["index"] for row in rows if row["pose"] != "solved"]
+    assert failed == [(0, steps - 1)[i] for i in on_change_point]
+    for which in ("first", "last"):
+        assert (f"the sweep's {which} pose is a change point" in err) == ((0 if which == "first" else 1) in on_change_point)
+
+
+@pytest.mark.parametrize("last", [450.5, -269.5], ids=["forwards", "backwards"])
+@pytest.mark.parametrize("steps", [361, 100, 37])
+def test_an_scrr_swept_off_the_grid_passes_its_change_point_either_way(tmp_path, capsys, last, steps):
+    """From 90.5 deg a turn either way: no pose on the change point; every pose solved, the
+    change point passed named once (it failed one way round)."""
+    assert main(["sweep", str(scrr_scene(tmp_path)), "--from", "90.5 deg", "--to", f"{last} deg", "--steps",
+                 str(steps), "--csv", str(tmp_path / "s.csv")]) == 0
+    assert capsys.readouterr().err.count("passed a change point near O2 = ") == 1
+
+
+@pytest.mark.parametrize("branch", ["antiparallelogram", "parallelogram"])
+@pytest.mark.parametrize("first, last", [(0.0, 720.0), (720.0, 0.0), (180.0, 540.0), (90.5, 540.0)],
+                         ids=["0 to 720", "720 to 0", "180 to 540", "90.5 to 540"])
+def test_a_parallelogram_swept_between_change_points_names_its_branch_at_both_ends(tmp_path, capsys, branch,
+                                                                                    first, last):
+    """Two turns between change points: the end poses on them are rows, the branch named
+    there (the one drawn), every pose solved on it to the closed form."""
+    lines = tmp_path / "s.jsonl"
+    assert main(["sweep", str(scene_files(tmp_path, branch)), "--from", f"{first} deg", "--to", f"{last} deg",
+                 "--steps", "361", "--csv", str(tmp_path / "s.csv"), "--json", str(lines)]) == 0
+    err = capsys.readouterr().err
+    for row in map(json.loads, lines.read_text().splitlines()):
+        if row["pose"] == "solved":
+            assert off_branch(branch, row["O2"], row["links"]["rocker"]["angle"]) <= ANGLE_TOL
+    assert f"ends on its change point, arriving on its {branch} branch" in err
+    other = "parallelogram" if branch == "antiparallelogram" else "antiparallelogram"
+    assert f"on its {other} branch" not in err.replace(f"on its {branch} branch", "")
