@@ -39,6 +39,8 @@ from pinmech.solve.loops import LoopSolver
 
 _SINGULAR_PASSED = ("a singular pose the sweep went on past (a change point: the crossing of two branches, where "
                     "no assembly can be told and the rates are undefined): written as a failed row")
+_SINGULAR_OTHER = ("a singular pose the sweep went on past (not a change point: the rates undefined there, the "
+                   "pose after it closing on the sweep's assembly): written as a failed row")
 _CHANGE_POINT_END = ("the sweep's {which} pose is a change point (the crossing of two branches: the pins in line, "
                      "the rates undefined): written as a failed row; {how}")
 _FIRST_HOW = "the poses after it are on the branch continuation reaches from the drawn pose"
@@ -264,7 +266,7 @@ class Sweep:
                             continue
                         if index > 0:
                             held = (SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}",
-                                              note=_SINGULAR_PASSED), stop, crossing)
+                                              note=_SINGULAR_PASSED if crossing else _SINGULAR_OTHER), stop, crossing)
                             continue
                     if not skip_failures:
                         raise held[1] if held is not None else stop from exc
