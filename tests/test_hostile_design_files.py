@@ -121,13 +121,45 @@ def test_a_hostile_synthesis_file_is_one_line_before_any_work(base, old, new, ke
     _refused(["synth", str(path)], path, key, word, capsys)
 
 
-@pytest.mark.skip(reason="the edit leaves an unknown key: to be rewritten")
-def test_six_collinear_targets_a_four_bar_can_meet_are_not_refused_by_the_reader(tmp_path):
-    """A sextic meets a line in six points: six collinear targets are a search's business."""
+def _with_targets(tmp_path, points: list[tuple[float, float]]) -> Path:
+    """The bundled four-bar path file with its whole target list replaced by `points` [mm]."""
+    source = SYNTHESES / "four_bar_path.toml"
+    text = source.read_text(encoding="utf-8")
+    old = re.search(r"targets = \[.*?\n\]", text, re.S).group(0)
+    return _edited(source, old, "targets = [" + ", ".join(f'["{x!r} mm", "{y!r} mm"]' for x, y in points) + "]",
+                   tmp_path)
+
+
+def _on_a_line(n: int, slope: float, off: float = 0.0) -> list[tuple[float, float]]:
+    """n targets 5 mm apart along y = 20 + slope (x - 20) [mm], the k-th moved off it by
+    off k (k - n + 1) mm (a parabola through the first and last: no three on one line)."""
+    return [(20.0 + 5 * k, 20.0 + slope * 5 * k + off * k * (k - n + 1)) for k in range(n)]
+
+
+@pytest.mark.parametrize("n, slope", [(6, 0.0), (6, 1e6), (5, 0.3)])
+def test_up_to_six_collinear_targets_a_four_bar_can_meet_are_not_refused_by_the_reader(tmp_path, n, slope):
+    """A four-bar's coupler curve is a sextic, which meets a line in six points: six
+    collinear targets or fewer are the search's business."""
     from pinmech.design.synthesis.file import load_synthesis
 
-    six = "targets = [" + ", ".join(f'["20 mm", "{20 + 5 * i} mm"]' for i in range(6)) + "]\nunused = ["
-    assert len(load_synthesis(_edited(SYNTHESES / "four_bar_path.toml", "targets = [", six, tmp_path)).targets) == 6
+    assert len(load_synthesis(_with_targets(tmp_path, _on_a_line(n, slope))).targets) == n
+
+
+@pytest.mark.parametrize("n, slope, off", [(7, 0.0, 0.0), (7, 1e6, 0.0), (10, -0.3, 0.0), (8, 2.0, 1e-13)],
+                         ids=["seven on y = 20", "seven near vertical", "ten sloping", "eight 1e-13 mm off"])
+def test_more_than_six_collinear_targets_for_a_four_bar_are_one_line_before_any_work(tmp_path, capsys, n, slope, off):
+    """Seven or more targets on one line (to 1e-9 of their extent: rounding of the file's
+    numbers) are more than a sextic meets: refused before the search, the count said."""
+    path = _with_targets(tmp_path, _on_a_line(n, slope, off))
+    _refused(["synth", str(path)], path, "targets", f"the {n} targets lie on one line", capsys)
+
+
+def test_seven_targets_off_a_line_by_more_than_rounding_are_the_searchs_business(tmp_path):
+    """Seven targets on a parabola 1e-4 mm off their chord at most (1e-7 of their 30 mm
+    extent, above the 1e-9 collinear share): not one line, so not refused."""
+    from pinmech.design.synthesis.file import load_synthesis
+
+    assert len(load_synthesis(_with_targets(tmp_path, _on_a_line(7, 0.0, 1e-5))).targets) == 7
 
 
 def test_collinear_targets_of_a_slider_crank_are_its_slider_s_line(tmp_path):
