@@ -7,6 +7,7 @@ attacks ran past a minute, or to tens of GiB, before).
 
 from __future__ import annotations
 
+import math
 import re
 import time
 from pathlib import Path
@@ -170,3 +171,43 @@ def test_collinear_targets_of_a_slider_crank_are_its_slider_s_line(tmp_path):
     old = text[start:text.index("]\n", text.index("\n", start) + 1) + 1]
     path = _edited(SYNTHESES / "slider_crank_path.toml", old, _ON_A_LINE, tmp_path)
     assert len(load_synthesis(path).targets) == 7
+
+
+def test_a_linkage_with_a_link_of_no_length_is_refused_naming_the_link(tmp_path, capsys):
+    """crank = "0 mm" draws A on O2: the crank has no length and its two joints coincide
+    (another linkage). Refused in one line naming the link, both pins and the gap (it swept,
+    exit 0, a mechanism without its crank)."""
+    text = (ROOT / "models" / "linkages" / "four_bar.toml").read_text(encoding="utf-8")
+    assert 'crank = "40 mm"' in text
+    (tmp_path / "fb.toml").write_text(text.replace('crank = "40 mm"', 'crank = "0 mm"'), encoding="utf-8")
+    scene = tmp_path / "scene.toml"
+    scene.write_text('title = "s"\nlinkage = "fb.toml"\n[drivers.O2]\nangle = "0 deg"\nspeed = "60 rpm"\n')
+    assert main(["sweep", str(scene), "--steps", "5", "--csv", str(tmp_path / "s.csv")]) == 3
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "[links] crank: its pins O2 and A are drawn 0 mm apart" in err, err
+
+
+@pytest.mark.parametrize("base", ["four_bar_drawn_tolerance", "four_bar_drawn_sensitivity"])
+def test_a_study_param_that_draws_a_link_of_no_length_is_refused_before_the_run(tmp_path, capsys, base):
+    """A study's nominal crank = 0 mm over a drawn linkage: refused in one line naming the
+    param's value and the link (it ran, and reported σ of a linkage without its crank)."""
+    path = _edited(STUDIES / f"{base}.toml", 'param = "crank"', 'param = "crank"\nnominal = "0 mm"', tmp_path)
+    began = time.monotonic()
+    assert main(["study", str(path), "--workers", "0", "--quiet"]) == 3
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "crank = 0 mm" in err and "[links] crank" in err, err
+    assert time.monotonic() - began < 5
+
+
+def test_an_angle_param_in_a_drawing_that_fails_is_named_in_degrees():
+    """The message naming the values a drawing failed with shows an angle param (gamma, a
+    polar construction's angle) in deg, not its radians times 1000 as 'mm'."""
+    from pinmech.design.study.drawn_params import Drawing
+    from pinmech.exceptions import ModelError
+    from pinmech.io.scene import Scene
+    from pinmech.io.scene_model import load_mechanism
+
+    scene = Scene.load(ROOT / "models" / "scenes" / "four_bar_coupler_point.toml")
+    drawing = Drawing(scene, load_mechanism(scene), "test")
+    with pytest.raises(ModelError, match=r"coupler = 300 mm, gamma = 30 deg"):
+        drawing.write({**drawing.values, "coupler": 0.3, "gamma": math.radians(30.0)})
