@@ -190,12 +190,14 @@ def test_a_linkage_with_a_link_of_no_length_is_refused_naming_the_link(tmp_path,
 @pytest.mark.parametrize("base", ["four_bar_drawn_tolerance", "four_bar_drawn_sensitivity"])
 def test_a_study_param_that_draws_a_link_of_no_length_is_refused_before_the_run(tmp_path, capsys, base):
     """A study's nominal crank = 0 mm over a drawn linkage: refused in one line naming the
-    param's value and the link (it ran, and reported σ of a linkage without its crank)."""
+    study file, the param, its value and the link (exit 4: the study file's value; it ran,
+    and reported σ of a linkage without its crank)."""
     path = _edited(STUDIES / f"{base}.toml", 'param = "crank"', 'param = "crank"\nnominal = "0 mm"', tmp_path)
     began = time.monotonic()
-    assert main(["study", str(path), "--workers", "0", "--quiet"]) == 3
+    assert main(["study", str(path), "--workers", "0", "--quiet"]) == 4
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "crank = 0 mm" in err and "[links] crank" in err, err
+    assert len(err.splitlines()) == 1 and f"{path}, params.crank.nominal:" in err, err
+    assert "crank = 0 mm" in err and "[links] crank" in err, err
     assert time.monotonic() - began < 5
 
 
@@ -211,3 +213,28 @@ def test_an_angle_param_in_a_drawing_that_fails_is_named_in_degrees():
     drawing = Drawing(scene, load_mechanism(scene), "test")
     with pytest.raises(ModelError, match=r"coupler = 300 mm, gamma = 30 deg"):
         drawing.write({**drawing.values, "coupler": 0.3, "gamma": math.radians(30.0)})
+
+
+def test_a_study_nominal_whose_compass_circles_do_not_meet_is_refused_before_the_run(tmp_path, capsys):
+    """coupler = 300 mm with rocker 80 mm: |A O4| = 60 mm < 300 - 80, the circles about A and
+    O4 do not meet, B cannot be drawn. One line naming the study file, the param, the joint
+    and the radii (exit 4)."""
+    path = _edited(STUDIES / "four_bar_drawn_tolerance.toml", 'param = "coupler"',
+                   'param = "coupler"\nnominal = "300 mm"', tmp_path)
+    assert main(["study", str(path), "--workers", "0", "--quiet"]) == 4
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"{path}, params.coupler.nominal:" in err, err
+    assert "[joints] B" in err and "0.3 m and 0.08 m" in err, err
+
+
+def test_tolerance_variants_that_cannot_be_drawn_are_counted_not_fatal(tmp_path, capsys):
+    """A crank tolerance of 150 mm over a 40 mm crank: many variants draw B from circles
+    that do not meet (|A O4| beyond coupler + rocker). Each is a failed variant, "cannot
+    assemble", and sigma is over the survivors, counted (the first such variant ended the
+    study, exit 3)."""
+    path = _edited(STUDIES / "four_bar_drawn_tolerance.toml", 'tolerance = "0.1 mm"', 'tolerance = "150 mm"', tmp_path)
+    path.write_text(path.read_text(encoding="utf-8").replace("samples = 2000", "samples = 100"), encoding="utf-8")
+    assert main(["study", str(path), "--workers", "0", "--quiet"]) == 0
+    out = capsys.readouterr()
+    text = out.out + out.err
+    assert "failed: cannot assemble:" in text and "variants that solved" in text, text[-2000:]
