@@ -98,7 +98,7 @@ def test_least_transmission_angle_matches_the_law_of_cosines(crank_grid):
     # 1e-6 deg: the loops close to ~1e-10 m (~1e-7 deg on 80 mm links).
     np.testing.assert_allclose(np.degrees(mu[ok]), least, rtol=0, atol=1e-6)
     assert np.isnan(mu[~ok]).all()
-    np.testing.assert_allclose(grid_table(crank_grid)["least transmission angle [deg]"][0], least[0], atol=1e-6)
+    np.testing.assert_allclose(grid_table(crank_grid)["least acute transmission angle [deg]"][0], least[0], atol=1e-6)
 
 
 def test_least_transmission_angle_over_a_ground_grid_uses_each_points_pivot():
@@ -204,3 +204,16 @@ def test_a_key_the_kind_would_ignore_is_refused_by_name(kind, change, key):
     with pytest.raises(SceneError) as err:
         parse_study(raw, STUDIES / "inline.toml")
     assert key in str(err.value) and "inline.toml" in str(err.value)
+
+
+def test_the_grids_transmission_extreme_is_named_as_sweeps_acute_least(crank_grid):
+    """One convention with `sweep`: mu on [0, 180] deg, its extreme folded on [0, 90] named
+    acute (the grid called it the 'least transmission angle', which sweep's summary gives
+    for mu on [0, 180])."""
+    from pinmech.design.study.report import grid_table, summary
+
+    table = grid_table(crank_grid)
+    assert "least acute transmission angle [deg]" in table and "least transmission angle [deg]" not in table
+    found = summary(crank_grid)
+    assert "transmission_angle_acute_least_deg" in found and "least_transmission_angle_deg" not in found
+    assert found["transmission_angle_acute_least_deg"] == pytest.approx(np.nanmin(table["least acute transmission angle [deg]"]))

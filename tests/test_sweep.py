@@ -68,7 +68,8 @@ def _singular_scene(tmp_path, models_dir):
 def test_a_singular_pose_the_sweep_goes_past_is_a_failed_row_naming_its_angle(tmp_path, models_dir):
     """AB = AC: at phi = 0 the block sits on C and the guide's direction is undefined (a
     change point of the inverted slider-crank, r = d). The pose is a failed row saying so
-    and the sweep goes on past it; a singular pose it cannot go past (the last) stops it."""
+    and the sweep goes on past it; as the last pose it is a row saying so, the sweep ending
+    on it (it stopped the sweep, exit 7)."""
     sweep = Sweep.from_scene(_singular_scene(tmp_path, models_dir))
     with pytest.raises(SweepError, match=r"sweep stopped at A = 0 deg"):  # any failure stops a sweep by default
         list(sweep.poses(np.radians([-20.0, -10.0, 0.0, 10.0])))
@@ -76,8 +77,10 @@ def test_a_singular_pose_the_sweep_goes_past_is_a_failed_row_naming_its_angle(tm
     assert [p.motion is None for p in poses] == [False, False, True, False]
     assert "A = 0 deg" in poses[2].error and "change point" in poses[2].note
     with pytest.raises(SweepError, match=r"sweep stopped at A = 0 deg") as info:
-        list(sweep.poses(np.radians([-20.0, -10.0, 0.0]), past_change_points=True))
+        list(sweep.poses(np.radians([-20.0, -10.0, 0.0])))
     assert info.value.value == 0.0 and info.value.exit_code == 7
+    *_, last = sweep.poses(np.radians([-20.0, -10.0, 0.0]), past_change_points=True)
+    assert last.motion is None and "A = 0 deg" in last.error and "last pose is a change point" in last.note
 
 
 def test_skip_failures_reports_the_pose_with_its_error(tmp_path, models_dir):
@@ -121,10 +124,14 @@ def test_cli_range_in_users_units(r_rtr_scene, capsys):
     assert [float(r[0]) for r in rows[1:]] == pytest.approx([0, 30, 60, 90])
 
 
-def test_cli_failure_exit_code_names_the_angle(tmp_path, models_dir, capsys):
+def test_cli_sweep_ending_on_a_change_point_names_the_angle_and_succeeds(tmp_path, models_dir, capsys):
+    """The inverted slider-crank's change point as the last pose: a failed row naming the
+    angle, exit 0 (it was exit 7: a sweep's end on a change point is not a failure)."""
     scene = _singular_scene(tmp_path, models_dir)
-    assert main(["sweep", str(scene.path), "--from", "-20 deg", "--to", "0 deg", "--steps", "5"]) == 7
-    assert "sweep stopped at A = 0 deg" in capsys.readouterr().err
+    assert main(["sweep", str(scene.path), "--from", "-20 deg", "--to", "0 deg", "--steps", "5"]) == 0
+    captured = capsys.readouterr()
+    assert "at pose 4: the sweep's last pose is a change point" in captured.err
+    assert "A = 0 deg" in captured.out.splitlines()[-1]
 
 
 def test_start_options_agree_on_the_exact_solution(sweep):

@@ -128,7 +128,7 @@ int Core::step(const Node& from, double p, const VectorXd& x0, const VectorXd& d
   }
   for (int s : out.signs)
     if (s == 0) return 3;
-  if (!(out.condition <= SINGULAR_NODE)) return 3;
+  if (!(out.condition <= SINGULAR_NODE) || within_reach_of_singular(out.residual, out.sigma_min)) return 3;
   const double turn = turn_between(from, out, unit);
   if (turn > MAX_TURN) return 4;
   if (out.signs != from.signs) {

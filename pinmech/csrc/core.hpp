@@ -67,6 +67,17 @@ constexpr double MAX_TURN = 30.0 * M_PI / 180.0;
 constexpr double PIVOT_BELOW = 1e-4;
 constexpr int CORRECTOR_ITERATIONS = 8;
 constexpr double SINGULAR_NODE = 1e10;
+// A closed pose is a root of one branch, its tangent that branch's, only outside Newton's
+// reach of a singular pose (Kantorovich: residual x curvature / sigma_min^2 small; the
+// dimensionless closure's curvature is of order 1). The tangent is then good to about that
+// ratio (rad), against the 3 deg a change point's turn may take. A corrector that lands on
+// a change point (a crossing of two branches) stalls where the ratio is of order 1 (0.5 to
+// 1.5 measured on a parallelogram four-bar), with a tangent between the branches' from
+// which the next step can take either: such a landing is refused, as a singular pose.
+constexpr double NEWTON_REACH = 1e-3;
+inline bool within_reach_of_singular(double residual, double sigma_min) {
+  return !(residual <= NEWTON_REACH * sigma_min * sigma_min);
+}
 constexpr int LINE_SEARCH_HALVINGS = 30;
 
 // The constants of the pivot-parametrized curve through folds (pivot.cpp; continuation.py's).

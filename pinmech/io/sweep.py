@@ -18,7 +18,8 @@ from typing import Any
 import numpy as np
 
 from pinmech.arguments import instance_of, real_number
-from pinmech.exceptions import AssemblyError, DriverLimitError, ModelError, SceneError, SingularPoseError, SweepError
+from pinmech.exceptions import (AssemblyError, DriverLimitError, ModelError, PinmechError, SceneError, SingularPoseError,
+                                SweepError)
 from pinmech.model.mechanism import Mechanism
 from pinmech.solve.motion import Motion, evaluate_motion
 from pinmech.solve.results import Accuracy
@@ -32,11 +33,18 @@ from pinmech.io.scene_model import (
     scene_drivers,
     scene_solver,
 )
+from pinmech.solve.crossing import is_change_point
 from pinmech.solve.cycle import RangeChunk, solve_range
 from pinmech.solve.loops import LoopSolver
 
 _SINGULAR_PASSED = ("a singular pose the sweep went on past (a change point: the crossing of two branches, where "
                     "no assembly can be told and the rates are undefined): written as a failed row")
+_SINGULAR_OTHER = ("a singular pose the sweep went on past (not a change point: the rates undefined there, the "
+                   "pose after it closing on the sweep's assembly): written as a failed row")
+_CHANGE_POINT_END = ("the sweep's {which} pose is a change point (the crossing of two branches: the pins in line, "
+                     "the rates undefined): written as a failed row; {how}")
+_FIRST_HOW = "the poses after it are on the branch continuation reaches from the drawn pose"
+_LAST_HOW = "the sweep ends on it, on the branch it arrived on"
 
 
 @dataclass(frozen=True)
@@ -230,7 +238,8 @@ class Sweep:
             points = list(dict.fromkeys([*(self.mechanism.points if points is None else points), *self.extra_points]))
         coincident = coincident_points(self.scene)
         self.fold_end = None
-        held: tuple[SweepPose, SweepError] | None = None  # a singular pose, written if the sweep goes on past it
+        held: tuple[SweepPose, SweepError, bool] | None = None  # a singular pose, written if the sweep goes on past it
+        before = None  # the last pose solved [q]
         for chunk in self.chunks(values, start=start, batch=batch, interpolate=interpolate,
                                  through_folds=through_folds):
             for j, value in enumerate(chunk.values.tolist()):
@@ -240,6 +249,7 @@ class Sweep:
                     held = None
                 if j in chunk.errors:
                     exc = chunk.errors[j]
+                    before = self.last_q if self.last_q is not None else before
                     self.last_q = None  # the sweep did not end on a solved pose (return_gap: NaN)
                     if index == 0:
                         self.first_q = None
@@ -251,11 +261,17 @@ class Sweep:
                                       driver=self.driver, value=value, cause=exc)
                     # a change point's own pose, kept if the next one closes: only along the
                     # continuation (a cold or warm start's other assembly is no change point)
-                    if past_change_points and not skip_failures and held is None and index > 0 and fold is None \
+                    if past_change_points and not skip_failures and held is None and fold is None \
                             and start == "predictor" and isinstance(exc, (SingularPoseError, AssemblyError)):
-                        held = (SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}",
-                                          note=_SINGULAR_PASSED), stop)
-                        continue
+                        crossing = self._crossing(exc, value, before)
+                        if index == 0 and crossing:  # the sweep begins on it: it goes on from the drawn pose
+                            yield SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}",
+                                            note=_CHANGE_POINT_END.format(which="first", how=_FIRST_HOW))
+                            continue
+                        if index > 0:
+                            held = (SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}",
+                                              note=_SINGULAR_PASSED if crossing else _SINGULAR_OTHER), stop, crossing)
+                            continue
                     if not skip_failures:
                         raise held[1] if held is not None else stop from exc
                     yield SweepPose(index, value, None, None, f"{type(exc).__name__}: {exc}", fold=fold,
@@ -270,8 +286,28 @@ class Sweep:
                                              points=points, links=links, coincident=coincident)
                 yield SweepPose(index, value, motion, sol.accuracy(j), interpolated=bool(chunk.interpolated[j]),
                                 note=chunk.notes.get(j, ""))
-        if held is not None:
+        if held is not None and not held[2]:
             raise held[1]
+        if held is not None:  # the sweep ends on a change point: a row, not a failure
+            yield SweepPose(held[0].index, held[0].value, None, None, held[0].error,
+                            note=_CHANGE_POINT_END.format(which="last", how=_LAST_HOW))
+
+    def _crossing(self, exc: Exception, value: float, before) -> bool:
+        """Whether a singular (or unkept) pose at the swept `value` is a change point: the
+        closed pose the error carries, else the pose Newton closes there from the last
+        solved one, is a crossing of two branches (crossing.py)."""
+        q = getattr(exc, "partial", None)
+        if q is None and before is not None:
+            row = np.array(self.drivers.q, dtype=float)
+            row[self.drivers.names.index(self.driver)] = value
+            try:
+                q, _, _ = self.solver.close(before, row)
+            except PinmechError:
+                return False
+        if q is None:
+            return False
+        with self.solver.lock:
+            return is_change_point(self.solver, q, self.driver)
 
     def need_points(self, names) -> None:
         """Evaluate these frames (a drawn linkage's pins, by name) at every pose as well, for a

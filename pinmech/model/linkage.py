@@ -121,6 +121,7 @@ def linkage_from_spec(spec: LinkageSpec, source: str = "<linkage>", values: dict
     linkage = Linkage(source, title, points, links, [], {})
     _spatial(linkage, spec)
     _pins(linkage)
+    _distinct_pins(linkage)
     for name, slider in spec.sliders.items():
         edge = Edge(name, "prismatic", (slider.on, slider.block), linkage.points[slider.at],
                     _direction(linkage, reader, slider.along, linkage.points[slider.at], f"[sliders] {name}"))
@@ -296,6 +297,37 @@ def _pins(linkage: Linkage) -> None:
             label = name if len(on) == 2 else f"{name}_{other}"
             linkage.edges.append(Edge(label, kind, (on[0], other), linkage.points[name],
                                       axis=linkage.axes.get(name) if linkage.spatial else None))
+
+
+#: Two pins of one link closer than this share of the drawing's extent are one place: the
+#: link between them has no length and the joints it would join coincide (another
+#: linkage, e.g. a crank drawn with crank = "0 mm"). Rounding of a drawing is 1e-15 of it.
+COINCIDENT_PINS = 1e-9
+
+
+def _distinct_pins(linkage: Linkage) -> None:
+    """Refuse a link two of whose pins are drawn at one place (ModelError naming both)."""
+    xyz = np.array(list(linkage.points.values()), dtype=float)
+    size = float(np.max(np.ptp(xyz, axis=0))) if len(xyz) > 1 else 0.0
+    for link, names in linkage.links.items():
+        pins = [n for n in dict.fromkeys(names) if n not in linkage.point_links]
+        for i, a in enumerate(pins):
+            for b in pins[i + 1:]:
+                gap = float(np.linalg.norm(linkage.points[a] - linkage.points[b]))
+                if gap <= COINCIDENT_PINS * size and not _crossed_axes(linkage, a, b):
+                    raise ModelError(f"[links] {link}: its pins {a} and {b} are drawn {gap * 1e3:.3g} mm apart, at one "
+                                     f"place (a link of no length: the joints it joins would coincide); draw them apart",
+                                     path=linkage.source)
+
+
+def _crossed_axes(linkage: Linkage, a: str, b: str) -> bool:
+    """Two pins at one place whose axes are not parallel: a universal joint's cross, drawn
+    so in a spatial linkage (its two revolutes meet at the cross's centre)."""
+    u, w = linkage.axes.get(a), linkage.axes.get(b)
+    if u is None or w is None:
+        return False
+    u, w = np.asarray(u, dtype=float), np.asarray(w, dtype=float)
+    return float(np.linalg.norm(np.cross(u, w))) > 1e-9 * float(np.linalg.norm(u) * np.linalg.norm(w))
 
 
 def _direction(linkage: Linkage, reader: _Reader, along: Any, at: np.ndarray, where: str) -> np.ndarray:

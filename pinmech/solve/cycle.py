@@ -330,24 +330,26 @@ class _Cycle(Interpolation):
             self._note(route)
             return node
         guess = ref.q if self.start == "warm" else self._cold_guess()
-        x_ref = self.q_drv.copy()
-        self.q_drv[self.k] = p
-        q, self._iterations, _ = solver.close(guess, self.q_drv)
+        x_ref = path.drivers(ref.p)  # the last pose solved: a failed pose leaves it the reference
+        x = path.drivers(p)
+        q, self._iterations, _ = solver.close(guess, x)
         try:
             new = path.node(p, q, at_q=True) if solver._cuts else path.node(p, q)
         except _Singular:  # a dead centre: no assembly to name (it escaped as a traceback)
             raise AssemblyError(
-                f"{solver.mechanism.source}: a {self.start} start at {solver.describe_drivers(self.q_drv)} lands on "
+                f"{solver.mechanism.source}: a {self.start} start at {solver.describe_drivers(x)} lands on "
                 "a singular pose (a dead centre, where no assembly can be told): use the predictor start",
-                expected=ref.signs, found=(), drivers=solver.drivers, value=tuple(self.q_drv.tolist())) from None
-        if ref.signs and new.signs != ref.signs:
+                expected=ref.signs, found=(), drivers=solver.drivers, value=tuple(x.tolist())) from None
+        route = Route((ref.p,))
+        if solver._cuts and solver.reference is not None and solver.reference.keep:  # as one sign may not tell
+            route = check_guessed_pose(solver, q, x, start=(ref.q, x_ref))  # a change point passed: named
+        if ref.signs and new.signs != ref.signs and not route.change_points:
             raise AssemblyError(
-                f"{solver.mechanism.source}: a {self.start} start at {solver.describe_drivers(self.q_drv)} "
+                f"{solver.mechanism.source}: a {self.start} start at {solver.describe_drivers(x)} "
                 f"lands on {solver.structure.change(ref.signs, new.signs, solver.data, whose=_SWEEPS)}: use the "
                 "predictor start",
-                expected=ref.signs, found=new.signs, drivers=solver.drivers, value=tuple(self.q_drv.tolist()))
-        if solver._cuts and solver.reference is not None and solver.reference.keep:  # as one sign may not tell
-            check_guessed_pose(solver, q, self.q_drv.copy(), start=(ref.q, x_ref))
+                expected=ref.signs, found=new.signs, drivers=solver.drivers, value=tuple(x.tolist()))
+        self._note(route)
         return new
 
     def _first(self, p: float) -> Node:

@@ -76,6 +76,7 @@ class DesignSweep:
         self.angles = AngleWatch(self.linkage, self.dyads, self._place_at)
         self.branches = BranchWatch(self.linkage)
         self.branch_notes: list[str] = []  # every change of branch the sweep made, in order
+        self._branch_due = False  # name the branch at the next pose solved (after a change point's own pose)
         self._previous: float | None = None  # the last solved pose's driver value
         self._step: float | None = None  # the driver's last step between solved poses [rad or m]
         self._folds: list[float] = []
@@ -102,6 +103,10 @@ class DesignSweep:
             self._fold(pose)
         if self.applicable and pose.motion is None:
             self._previous, self._previous_q = None, None
+            if "is a change point" in pose.note:  # a sweep's first or last pose: name the branch
+                self._branch_due = True
+                out["notes"] = [f"loop {n} ends on its change point, arriving on its {f} branch"
+                                for (n, *_), f in zip(self.branches.loops, self.branches.last) if f is not None]
         if self.applicable and pose.motion is not None:
             q = self._q(pose.motion)
             v, _, _ = self.solver.rates(q, self.unit, np.zeros(len(self.unit)), closed=not pose.interpolated)
@@ -115,7 +120,8 @@ class DesignSweep:
             changes = self.branches.add(self._driver(pose.value))
             self.branch_notes += changes
             out["notes"] = changes
-            if "passed a change point" in pose.note:  # the engine's note: name the branch it kept
+            if "passed a change point" in pose.note or self._branch_due:  # the engine's note: name the branch it kept
+                self._branch_due = False
                 out["notes"] += [f"loop {n} after the change point: on its {f} branch" for n, f in self.branches.forms()]
         self._cache = (pose.index, out)
         return out

@@ -84,7 +84,8 @@ class Drawing:
             return self._placed.placements(linkage)
         except ModelError as exc:
             changed = {n: v for n, v in values.items() if v != self.values.get(n)} or values
-            shown = ", ".join(f"{n} = {v * 1e3:.6g} mm" for n, v in changed.items())
+            shown = ", ".join(f"{n} = {np.degrees(v):.6g} deg" if self.kinds.get(n) == "angle" else
+                              f"{n} = {v * 1e3:.6g} mm" for n, v in changed.items())
             raise ModelError(f"the linkage cannot be drawn with {shown}: {exc}", path=self.source) from exc
 
 

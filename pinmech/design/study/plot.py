@@ -98,7 +98,7 @@ def _grid_panels(result: StudyResult) -> list[tuple[str, str, np.ndarray, np.nda
         panels.append((name, unit, lo[:, j] * scale, hi[:, j] * scale))
     if result.transmission is not None:
         mu = np.degrees(result.transmission)
-        panels.append(("least transmission angle", "deg", mu, mu))
+        panels.append(("least acute transmission angle", "deg", mu, mu))
     return panels
 
 

@@ -77,7 +77,7 @@ def _grid_summary(result: StudyResult) -> dict:
            "points": len(causes), "solved": sum(not c for c in causes), "failures": failures(causes)}
     mu = result.transmission
     if mu is not None and not np.isnan(mu).all():
-        out["least_transmission_angle_deg"] = float(np.degrees(np.nanmin(mu)))
+        out["transmission_angle_acute_least_deg"] = float(np.degrees(np.nanmin(mu)))  # as sweep's summary
     return out
 
 
@@ -110,8 +110,9 @@ def text(result: StudyResult) -> str:
                           for n, g in s["grid"].items() for u in ("mm" if "from_mm" in g else "deg",))
         failed = ", ".join(f"{c}: {n}" for c, n in s["failures"].items()) or "none"
         lines.append(f"grid {axes}: solved {s['solved']} of {s['points']} points; failed: {failed}")
-        if "least_transmission_angle_deg" in s:
-            lines.append(f"least transmission angle over the grid: {s['least_transmission_angle_deg']:.4g} deg")
+        if "transmission_angle_acute_least_deg" in s:
+            lines.append(f"least acute transmission angle (mu folded on 0-90 deg) over the grid: "
+                         f"{s['transmission_angle_acute_least_deg']:.4g} deg")
     return "\n".join(lines)
 
 
@@ -155,7 +156,8 @@ def table(result: StudyResult) -> dict[str, list]:
 def grid_table(result: StudyResult) -> dict[str, list]:
     """One row a grid point: its index, parameters [mm], cause ("" if it solved) and each
     output's min and max over the cycle (NaN where the point failed; angles unwrapped), and
-    the least transmission angle over the cycle for a planar linkage with dyads."""
+    the least acute transmission angle over the cycle (mu folded on 0-90 deg, as sweep's
+    `transmission_angle_acute_least`) for a planar linkage with dyads."""
     p, y, causes = result.variants
     rows: dict[str, list] = {"point": list(range(len(causes)))}
     rows.update(_param_columns(result, p))
@@ -166,7 +168,7 @@ def grid_table(result: StudyResult) -> dict[str, list]:
         rows[f"min {name} [{unit}]"] = (lo[:, j] * scale).tolist()
         rows[f"max {name} [{unit}]"] = (hi[:, j] * scale).tolist()
     if result.transmission is not None:
-        rows["least transmission angle [deg]"] = np.degrees(result.transmission).tolist()
+        rows["least acute transmission angle [deg]"] = np.degrees(result.transmission).tolist()
     return rows
 
 

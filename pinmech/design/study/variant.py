@@ -19,6 +19,7 @@ from pinmech.exceptions import (
     AssemblyError,
     DriverLimitError,
     LoopClosureError,
+    ModelError,
     PinmechError,
     SceneError,
     SingularPoseError,
@@ -71,7 +72,11 @@ class StudyMechanism:
                                  f"{'deg' if kind == 'angle' else 'mm'}", path=str(spec.path), key=f"grid.{axis.name}")
         for p, place in zip(spec.params, self.placements):
             if p.nominal is not None:
-                place.write(p.nominal)
+                try:
+                    place.write(p.nominal)
+                except ModelError as exc:  # a drawing the nominal cannot make: the study file's value
+                    raise SceneError(f"the nominal cannot be drawn: {exc}", path=str(spec.path),
+                                     key=f"params.{p.name}.nominal") from exc
         self.nominal = np.array([place.read() for place in self.placements])
         outside = _outside(spec, self.nominal)
         if outside:
@@ -116,8 +121,12 @@ class StudyMechanism:
         """The variant with parameters p [m] (within their bounds: `outside` checked) over
         the cycle; the model keeps p afterwards. The compiled core follows it in one call
         (variant_core.py); where it hands the variant back, the scene's sweep solves it and
-        names what failed."""
-        self.write(p)
+        names what failed. A drawn linkage's variant that cannot be drawn (a compass whose
+        circles do not meet, a link of no length) cannot be assembled."""
+        try:
+            self.write(p)
+        except ModelError as exc:
+            return VariantCycle(self.values, None, "cannot assemble", str(exc), exc)
         fast = self.core.follow()
         if fast is not None:
             return VariantCycle(self.values, fast[0], v=fast[1], a=fast[2])
