@@ -20,6 +20,7 @@ from pinmech.cli.progress import LimitWatch, progress
 from pinmech.cli.scene_args import given_text, option_or_scene, scene_from_args
 from pinmech.counts import checked_count
 from pinmech.exceptions import PinmechError
+from pinmech.solve.certify import dial_note
 
 if TYPE_CHECKING:
     from pinmech.outputs import Outputs
@@ -172,6 +173,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             sinks.add(pose)
             for note in design_of(sweep).notes(pose) if design_of(sweep).applicable else []:
                 print(f"pinmech: at pose {pose.index}: {note}", file=sys.stderr)
+    dial = dial_note(sweep.solver.certify)
+    if dial:
+        print(f"pinmech: {dial}", file=sys.stderr)
     if sweep.fold_end is not None:
         print(f"pinmech: {sweep.driver} cannot go past {sweep._format(sweep.fold_end)} (a fold: a toggle, the end of "
               "its range of motion on this assembly): the sweep ends at the pose before it (--through-folds goes on "
