@@ -80,6 +80,15 @@ def dial_note(certify: str) -> str | None:
             "closure, velocity and acceleration residuals at every pose")
 
 
+def dial_caption(certify: str) -> str | None:
+    """A figure's short line for the level (None at every pose)."""
+    if certify == EVERY_POSE:
+        return None
+    if certify == "none":
+        return "condition number and assembly not checked (residual tolerances only)"
+    return f"condition number and assembly checked at {certified_text(certify)} only"
+
+
 def condition_words(condition: float, digits: int = 3) -> str:
     """A condition number for a report: the number, or NOT_CERTIFIED where it is NaN (a pose
     the dial left uncertified)."""
