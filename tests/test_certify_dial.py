@@ -270,3 +270,34 @@ def test_a_sweep_at_every_pose_writes_what_it_wrote_before(r_rtr_scene, tmp_path
     assert main(["sweep", str(r_rtr_scene), "--steps", "5", "--csv", str(csv_path)]) == 0
     assert "certified" not in capsys.readouterr().err
     assert csv_path.read_text().startswith("A.q [deg],")
+
+
+# ------------------------------------------------------------------ the rate solver (P2, the arm of 17.110)
+@pytest.mark.parametrize("level", LEVELS)
+def test_the_arms_rates_meet_the_closed_form_at_every_level(level):
+    """RateSolver.solve_many at 360 poses of the planar arm of text 17.110 against its
+    closed form (closed_form.planar_arm_rates): the rates are exact at every level; the
+    condition number is NaN at the poses left uncertified, the ones certified keep it. The
+    bar: rounding of rates up to 149 rad/s^2 at the arm's condition number (under 50 on these
+    poses: 26 at most at every pose)."""
+    from tests.conftest import MODELS
+    from tests.test_rates_many import R1, R2, R3, TH_CD, _poses
+    import pinmech
+
+    mechanism = pinmech.Mechanism.from_urdf(MODELS / "planar_arm.urdf")
+    solver = pinmech.RateSolver(mechanism, [
+        pinmech.Task("D", ("x", "y"), np.array([1.0, 0.0]), np.zeros(2)),
+        pinmech.Task("CD", ("wz",), np.zeros(1), np.zeros(1))], certify=level)
+    Q, th1, th2 = _poses(mechanism)
+    batch = solver.solve_many(Q)
+    ref = closed_form.planar_arm_rates(th1, th2, TH_CD, R1, R2, R3, np.array([1.0, 0.0]), np.zeros(2))
+    ia, ib = mechanism.joint("A").idx_v, mechanism.joint("B").idx_v
+    got = np.column_stack([batch.v[:, ia], batch.v[:, ia] + batch.v[:, ib], batch.a[:, ia],
+                           batch.a[:, ia] + batch.a[:, ib]])
+    want = np.column_stack([ref.omega_AB, ref.omega_BC, ref.alpha_AB, ref.alpha_BC])
+    from tests.tolerance import rounding
+
+    assert np.abs(got - want).max() < rounding(np.abs(want).max(), 50.0)
+    certified = ~np.isnan(batch.condition)
+    expected = {"every-pose": 360, "every-10": 36, "every-3": 120, "ends": 1, "none": 0}[level]
+    assert certified.sum() == expected and np.all(batch.condition[certified] < 50.0)
