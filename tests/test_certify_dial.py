@@ -301,3 +301,19 @@ def test_the_arms_rates_meet_the_closed_form_at_every_level(level):
     certified = ~np.isnan(batch.condition)
     expected = {"every-pose": 360, "every-10": 36, "every-3": 120, "ends": 1, "none": 0}[level]
     assert certified.sum() == expected and np.all(batch.condition[certified] < 50.0)
+
+
+def test_a_study_run_every_10_poses_says_so_and_a_workspace_study_refuses_it(tmp_path, capsys):
+    """The study's JSON summary, text and CSV comment name the level; a workspace study
+    (each grid point solved on its own, certified) refuses a level it cannot honour."""
+    from tests.conftest import MODELS
+
+    studies = MODELS / "studies"
+    out = tmp_path / "st"
+    assert main(["study", str(studies / "four_bar_sensitivity.toml"), "--workers", "0", "--certify", "every-10",
+                 "--out", str(out)]) == 0
+    assert "each variant's cycle: condition number and assembly certified at every 10 poses" in capsys.readouterr().out
+    assert json.loads((tmp_path / "st.json").read_text())["certified"] == "every 10 poses"
+    assert (tmp_path / "st.csv").read_text().startswith("# condition number and assembly certified at every 10")
+    assert main(["study", str(studies / "five_bar_workspace.toml"), "--workers", "0", "--certify", "ends"]) == 2
+    assert "workspace study solves each grid point on its own" in capsys.readouterr().err

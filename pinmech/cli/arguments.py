@@ -19,10 +19,10 @@ def add_scene_arguments(parser: argparse.ArgumentParser) -> None:
                         help="kinematic passes: Pinocchio's generic algorithms, or the same algorithms generated "
                         "for the model, compiled once and cached (needs a compiler and pinmech[fast]; "
                         "[solver] kernel)")
-    add_certify_argument(parser)
 
 
 def add_certify_argument(parser: argparse.ArgumentParser) -> None:
+    """--certify, for the commands that follow ranges of poses (a single pose is always certified)."""
     parser.add_argument("--certify", metavar="LEVEL",
                         help="poses of a range given the exact condition number and assembly check: every-pose "
                         "(default), every-K (e.g. every-10: every K-th pose and a range's last), ends, or none "

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from pinmech.cli.arguments import (
+    add_certify_argument,
     add_force_arguments,
     add_limits_argument,
     add_output_arguments,
@@ -30,6 +31,7 @@ def add_parser(sub) -> None:
     sweep = sub.add_parser("sweep", help="sweep a driver through a cycle (or follow an arm's task in time): "
                            "CSV, JSON lines and a figure")
     add_scene_arguments(sweep)
+    add_certify_argument(sweep)
     sweep.add_argument("--driver", help="the driver to sweep (default: the scene's first)")
     sweep.add_argument("--from", dest="first", help="first value, e.g. '0 deg' (default: the scene's)")
     sweep.add_argument("--to", dest="last", help="last value, e.g. '360 deg' (default: one turn on)")
