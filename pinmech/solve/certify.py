@@ -21,7 +21,7 @@ import math
 import re
 
 from pinmech.exceptions import OptionError
-from pinmech.solve.core import _core
+from pinmech.model.closure_core import _core
 
 #: The level every pose is certified at (the default).
 EVERY_POSE = "every-pose"
