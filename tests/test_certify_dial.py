@@ -317,3 +317,21 @@ def test_a_study_run_every_10_poses_says_so_and_a_workspace_study_refuses_it(tmp
     assert (tmp_path / "st.csv").read_text().startswith("# condition number and assembly certified at every 10")
     assert main(["study", str(studies / "five_bar_workspace.toml"), "--workers", "0", "--certify", "ends"]) == 2
     assert "workspace study solves each grid point on its own" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("level", ["every-10", "none"])
+def test_a_single_pose_is_certified_at_every_level(level):
+    """`RateSolver.solve` (one pose) and `LoopSolver.solve` give the condition number at
+    every level: the dial skips it between the poses of a range only."""
+    from tests.conftest import MODELS
+    import pinmech
+
+    arm = pinmech.Mechanism.from_urdf(MODELS / "planar_arm.urdf")
+    rates = pinmech.RateSolver(arm, [pinmech.Task("D", ("x", "y"), np.array([1.0, 0.0]), np.zeros(2)),
+                                     pinmech.Task("CD", ("wz",), np.zeros(1), np.zeros(1))], certify=level)
+    q = arm.neutral()
+    q[arm.joint("B").idx_q] = 0.5
+    assert 1.0 <= rates.solve(q).condition < 50.0
+    solver = LoopSolver(Mechanism.from_urdf(write_r_rtr()), ["A"], certify=level)
+    sol = solver.solve([0.5], guess=solver.mechanism.neutral())
+    assert sol.accuracy.certified and 1.0 <= sol.accuracy.condition < R_RTR_COND
