@@ -335,3 +335,18 @@ def test_a_single_pose_is_certified_at_every_level(level):
     solver = LoopSolver(Mechanism.from_urdf(write_r_rtr()), ["A"], certify=level)
     sol = solver.solve([0.5], guess=solver.mechanism.neutral())
     assert sol.accuracy.certified and 1.0 <= sol.accuracy.condition < R_RTR_COND
+
+
+def test_the_dial_benchmark_runs_and_every_level_meets_the_references(tmp_path, capsys):
+    """scripts/benchmark_dial.py at small counts: its exit code is 0 when every level's
+    largest error on P1, P2 and the chain is within 1e-9 of the closed forms."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
+    import benchmark_dial
+
+    out = tmp_path / "dial.md"
+    assert benchmark_dial.main(["--poses", "36", "--rounds", "1", "--samples", "4", "--out", str(out)]) == 0
+    text = out.read_text()
+    assert text.count("| P1 R-RTR") == 6 and "| five-bar workspace grid | any | any |" in text
