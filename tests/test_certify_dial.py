@@ -9,11 +9,11 @@ a non-Grashof four-bar's limit angle from the law of cosines (|A - O4| = b - c);
 parallelogram's change point where its crank lies along the ground (t2 = 0).
 
 What each level keeps: every pose has its closure, velocity and acceleration residuals
-(so every pose meets the same closed form, to the bound of a closed pose at the cycle's
-condition number); certified poses (every pose, every K-th and a range's last, a range's
-last) have their condition number and assembly signature, the others NaN. A MUTANT test
-shows the due-pose check at work: the same assertion on the change point fails when the
-due poses are not certified (level "none": every-K with its due checks skipped).
+and its assembly signature (so every pose meets the same closed form, to the bound of a
+closed pose at the cycle's condition number, and every change point is named); certified poses (every pose, every K-th and a range's last, a range's
+last) have their condition number, the others NaN. A MUTANT test
+shows the due-pose check at work: the same assertion on a pose over max_condition fails when
+the due poses are not certified (level "none": every-K with its due checks skipped).
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ import pytest
 
 from pinmech import LoopSolver, Mechanism, OptionError, Scene
 from pinmech.cli import main
-from pinmech.exceptions import DriverLimitError
+from pinmech.exceptions import DriverLimitError, SingularPoseError
 from pinmech.io.sweep import Sweep
 from pinmech.solve.cycle import solve_range
 from tests._mechanisms import four_bar_urdf, write
@@ -126,50 +126,76 @@ def test_a_crank_rocker_over_a_turn_meets_freudenstein_at_every_level(tmp_path, 
 
 
 # ------------------------------------------------------------------ a change point between certified poses
-def _parallelogram(tmp_path, level: str) -> LoopSolver:
+def _parallelogram(tmp_path, level: str, max_condition: float = 1e4) -> LoopSolver:
     """The parallelogram a = c = 50 mm, b = d = 100 mm on its parallelogram branch at crank
-    angle 1 rad (rocker = crank, coupler along the ground): its branches cross at t2 = 0."""
+    angle 1 rad (rocker = crank, coupler along the ground): its branches cross where the
+    crank lies along the ground (t2 = 0, pi)."""
     mech = Mechanism.from_urdf(write(tmp_path, "pg.urdf", four_bar_urdf(0.05, 0.1, 0.05, 0.1)))
     q = mech.neutral()
     for name, value in (("O2", 1.0), ("A", -1.0), ("O4", 1.0)):
         mech.set_coordinate(q, name, value)
-    solver = LoopSolver(mech, ["O2"], certify=level)
+    solver = LoopSolver(mech, ["O2"], certify=level, max_condition=max_condition)
     solver.set_reference([1.0], q)
     return solver
 
 
-def _assert_the_change_point_is_named(tmp_path, level: str) -> None:
-    """100 crank angles from 1 to -1 rad, none on the crossing: the sweep notes the change
-    point it passed, where the closed form puts it (t2 = 0, to the 1e-6 rad a sweep locates
-    a crossing between poses 0.02 rad apart), and stays on the branch of continuous tangent
-    (the parallelogram's: rocker = crank)."""
+@pytest.mark.parametrize("level", LEVELS)
+@pytest.mark.parametrize("turn, crossings, located", [(False, [0.0], 1e-6), (True, [np.pi, 2 * np.pi], 1e-3)])
+def test_change_points_between_certified_poses_are_named_as_at_every_pose(tmp_path, level, turn, crossings, located):
+    """From 1 rad down through 0 (100 crank angles, none on the crossing), or a whole turn
+    up (25 angles: two crossings, at pi and 2 pi, the signature back as it was at the end):
+    each change point is noted where the closed form puts it (the middle of the continuation
+    step that passed it: 1e-6 rad on the fine range, 1e-3 rad on the coarse turn, whose
+    steps are 0.26 rad) and the sweep keeps the branch of continuous tangent (rocker =
+    crank). Every pose keeps its assembly signature whatever the level: an uncertified step
+    that finds another one is refused, and the range followed again with every pose
+    certified, so the notes are the ones every pose gives."""
     solver = _parallelogram(tmp_path, level)
-    values = np.linspace(1.0, -1.0, 100)
+    values = np.linspace(1.0, 1.0 + 2 * np.pi, 25) if turn else np.linspace(1.0, -1.0, 100)
     chunks = _range(solver, values)
     notes = {ch.start + j: n for ch in chunks for j, n in ch.notes.items()}
-    assert list(notes) == [50], notes  # the first pose past t2 = 0
-    where = float(notes[50].split("O2 = ")[1].split(" deg")[0])
-    assert abs(math.radians(where)) < 1e-6
+    where = [math.radians(float(n.split("O2 = ")[1].split(" deg")[0])) for n in notes.values()]
+    assert len(where) == len(crossings) and np.all(np.abs(np.array(where) - crossings) < located), notes
+    for i, at in zip(notes, crossings):  # each note on the first pose past its crossing
+        assert values[i - 1] < at < values[i] or values[i] < at < values[i - 1]
     qs = np.concatenate([ch.solution.q for ch in chunks])
     rocker = np.array([solver.mechanism.coordinate(qi, "O4") for qi in qs])
     np.testing.assert_allclose(_wrapped(rocker - values), 0.0, atol=closure(np.pi, 1e3))
 
 
+# ------------------------------------------------------------------ a pose over max_condition at a due pose
+def _assert_the_ill_conditioned_pose_is_named(tmp_path, level: str) -> None:
+    """The parallelogram driven from 1 rad toward its crossing (100 angles down to 1 mrad)
+    with max_condition = 100: its condition number grows about as 1/t2 (from the closed
+    form: the coupler and the crank become collinear), so the poses from t2 = 1.2 deg on
+    are singular poses, named as such (SingularPoseError) by a sweep at every pose; the
+    range's last pose is a due pose at every-K and ends."""
+    solver = _parallelogram(tmp_path, level, max_condition=100.0)
+    values = np.linspace(1.0, 0.001, 100)
+    chunks = _range(solver, values)
+    errors = {ch.start + j: e for ch in chunks for j, e in ch.errors.items()}
+    assert sorted(errors) == [97, 98, 99], sorted(errors)
+    assert all(isinstance(e, SingularPoseError) and e.condition > 100.0 for e in errors.values())
+
+
 @pytest.mark.parametrize("level", ["every-pose", "every-10", "every-3", "ends"])
-def test_a_change_point_between_certified_poses_is_named_as_at_every_pose(tmp_path, level):
-    """The poses around the crossing are left uncertified at every-10, every-3 and ends: the
-    next certified pose finds the other signature, the core goes back to the last certified
-    pose and certifies every pose up to it, and the note is the one every pose gives."""
-    _assert_the_change_point_is_named(tmp_path, level)
+def test_a_due_pose_over_max_condition_names_the_first_singular_pose_as_at_every_pose(tmp_path, level):
+    """The poses before the range's last are left uncertified at every-10, every-3 and ends:
+    the last, certified, is over max_condition, the core goes back to the last certified
+    pose and certifies every pose up to it, and the first singular pose is named as at
+    every pose."""
+    _assert_the_ill_conditioned_pose_is_named(tmp_path, level)
 
 
-def test_mutant_the_change_point_check_fails_without_the_due_pose_certification(tmp_path):
-    """The MUTANT: every-K with its due-pose certification skipped is level "none" (no pose
-    certified): the uncertified steps carry the old signature through the crossing and
-    nothing compares it again, so the note above is missing and the same assertion fails.
-    This is what the due-pose check of every-K catches (the test above)."""
+def test_mutant_the_check_fails_without_the_due_pose_certification(tmp_path):
+    """The MUTANT: every-K with its due-pose certification skipped is level "none" (no
+    condition number anywhere): nothing compares a condition number with max_condition, the
+    singular poses come back as answers (flagged "not certified") and the same assertion
+    fails. This is what the due-pose check of every-K catches (the test above). A core built
+    with the due landing left uncertified (pivot.cpp: certify_now_ = certify_all_) fails the
+    test above the same way, at every-10, every-3 and ends."""
     with pytest.raises(AssertionError):
-        _assert_the_change_point_is_named(tmp_path, "none")
+        _assert_the_ill_conditioned_pose_is_named(tmp_path, "none")
 
 
 # ------------------------------------------------------------------ a fold

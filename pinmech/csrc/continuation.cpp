@@ -75,11 +75,11 @@ void Core::node_at(Node& node, const VectorXd& d, const VectorXd* a_drv) {
         condition_of(scaled_, square_.singular(), condition_work_, band_ ? &*band_ : nullptr);
     node.condition = condition;
     node.sigma_min = sigma_min;
-    signs_into(Jdep_, node.signs);
-  } else {  // left uncertified: the caller keeps the last certified signature
+  } else {  // left uncertified (the dial): no condition number; the signature below all the same
     node.condition = NAN;
     node.sigma_min = NAN;
   }
+  signs_into(Jdep_, node.signs);  // a determinant's sign a block: every pose keeps its assembly check
   VectorXd &v = node.d1, &a = node.d2;
   v.setZero(model_.nv);
   a.setZero(model_.nv);
@@ -121,10 +121,12 @@ int Core::step(const Node& from, double p, const VectorXd& x0, const VectorXd& d
   out.p = p;
   out.residual = residual_left;
   node_at(out, d);
-  if (!certify_now_) {  // residuals, trust region and turn only; the signature carried on
-    out.signs = from.signs;
+  if (!certify_now_) {  // residuals, trust region, turn and signature: all but the condition number
+    for (int s : out.signs)
+      if (s == 0) return 3;
     if (square_.singular() || !out.d1.allFinite() || !out.d2.allFinite()) return 3;
-    return turn_between(from, out, unit) > MAX_TURN ? 4 : 0;
+    if (turn_between(from, out, unit) > MAX_TURN) return 4;
+    return out.signs != from.signs ? 5 : 0;  // refused: followed again, every pose certified
   }
   for (int s : out.signs)
     if (s == 0) return 3;
