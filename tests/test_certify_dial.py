@@ -274,7 +274,7 @@ def test_a_sweep_certified_every_10_poses_says_so_in_csv_json_and_text(r_rtr_sce
                  "--json", str(json_path)]) == 0
     assert "certified at every 10 poses" in capsys.readouterr().err
     text = csv_path.read_text()
-    assert text.startswith("# condition number and assembly certified at every 10 poses")
+    assert text.startswith("# condition number (and the error bounds it gives) certified at every 10 poses")
     rows = list(csv.DictReader(io.StringIO(text.split("\n", 1)[1])))
     cells = [r["condition_number [1]"] for r in rows]
     assert "nan" not in (c.lower() for c in cells)
@@ -338,9 +338,10 @@ def test_a_study_run_every_10_poses_says_so_and_a_workspace_study_refuses_it(tmp
     out = tmp_path / "st"
     assert main(["study", str(studies / "four_bar_sensitivity.toml"), "--workers", "0", "--certify", "every-10",
                  "--out", str(out)]) == 0
-    assert "each variant's cycle: condition number and assembly certified at every 10 poses" in capsys.readouterr().out
+    assert "each variant's cycle: condition number (and the error bounds it gives) certified at every 10 poses" \
+        in capsys.readouterr().out
     assert json.loads((tmp_path / "st.json").read_text())["certified"] == "every 10 poses"
-    assert (tmp_path / "st.csv").read_text().startswith("# condition number and assembly certified at every 10")
+    assert (tmp_path / "st.csv").read_text().startswith("# condition number (and the error bounds it gives) certified at")
     assert main(["study", str(studies / "five_bar_workspace.toml"), "--workers", "0", "--certify", "ends"]) == 2
     assert "workspace study solves each grid point on its own" in capsys.readouterr().err
 

@@ -24,9 +24,9 @@ def add_scene_arguments(parser: argparse.ArgumentParser) -> None:
 def add_certify_argument(parser: argparse.ArgumentParser) -> None:
     """--certify, for the commands that follow ranges of poses (a single pose is always certified)."""
     parser.add_argument("--certify", metavar="LEVEL",
-                        help="poses of a range given the exact condition number and assembly check: every-pose "
+                        help="poses of a range given the exact condition number: every-pose "
                         "(default), every-K (e.g. every-10: every K-th pose and a range's last), ends, or none "
-                        "(residuals only); every pose keeps its residual checks ([solver] certify)")
+                        "(no condition number); every pose keeps its residual and assembly checks ([solver] certify)")
 
 
 def add_output_arguments(parser: argparse.ArgumentParser) -> None:

@@ -1,18 +1,19 @@
-"""The certification dial: which poses of a range get the exact condition number and the
-assembly signature (the compiled core's `certify_every`).
+"""The certification dial: which poses of a range get the exact condition number (and the
+error bounds it gives; the compiled core's `certify_every`).
 
-Every pose gets its closure, velocity and acceleration residuals, the trust region and the
-tangent's turn limit, whatever the level. The levels, as a user writes them:
+Every pose gets its closure, velocity and acceleration residuals, the trust region, the
+tangent's turn limit and its assembly signature, whatever the level. The levels, as a user
+writes them:
 
 - "every-pose" (the default): every pose certified.
 - "every-K" (K >= 2, e.g. "every-10"): every K-th pose of a range and its last.
 - "ends": the last pose of each range (its first is certified already).
-- "none": no pose: residual tolerances only (the assembly is not checked).
+- "none": no pose: residual tolerances and the assembly check only.
 
-Where a step between certified poses is refused (singular, not finite, turning too fast),
-or a certified pose finds another signature or a condition number over max_condition,
-the core goes back to the last certified pose and certifies every pose up to that one:
-it stops, names and locates what it met as at every pose.
+Where a step between certified poses is refused (singular, not finite, turning too fast,
+another signature), or a certified pose finds a condition number over max_condition, the
+core goes back to the last certified pose and certifies every pose up to that one: it
+stops, names and locates what it met as at every pose.
 """
 
 from __future__ import annotations
@@ -61,13 +62,13 @@ def core_level(certify: str) -> int:
 
 def certified_text(certify: str) -> str:
     """The level in words, for outputs: "every pose", "every 10 poses", "the last pose of each
-    range", "no pose (residual tolerances only)"."""
+    range", "no pose"."""
     if certify == EVERY_POSE:
         return "every pose"
     if certify == "ends":
         return "the last pose of each range"
     if certify == "none":
-        return "no pose (residual tolerances only; the assembly not checked)"
+        return "no pose"
     return f"every {certify.split('-', 1)[1]} poses"
 
 
@@ -76,8 +77,8 @@ def dial_note(certify: str) -> str | None:
     certified (None at every pose)."""
     if certify == EVERY_POSE:
         return None
-    return (f"condition number and assembly certified at {certified_text(certify)} (certify = \"{certify}\"); "
-            "closure, velocity and acceleration residuals at every pose")
+    return (f"condition number (and the error bounds it gives) certified at {certified_text(certify)} "
+            f"(certify = \"{certify}\"); closure, velocity and acceleration residuals and the assembly at every pose")
 
 
 def dial_caption(certify: str) -> str | None:
@@ -85,8 +86,8 @@ def dial_caption(certify: str) -> str | None:
     if certify == EVERY_POSE:
         return None
     if certify == "none":
-        return "condition number and assembly not checked (residual tolerances only)"
-    return f"condition number and assembly checked at {certified_text(certify)} only"
+        return "no condition number (residuals and assembly checked at every pose)"
+    return f"condition number at {certified_text(certify)} only (residuals and assembly at every pose)"
 
 
 def condition_words(condition: float, digits: int = 3) -> str:

@@ -67,10 +67,10 @@ class LoopSolver(SolverOptions):
         kernel: the kinematic passes: "generic" (Pinocchio's algorithms) or "generated"
             (the same algorithms specialised to the model, compiled once and cached;
             needs a compiler and `pinmech[fast]`, else one line says so and "generic" runs).
-        certify: which poses of a range get the exact condition number and the assembly
-            signature: "every-pose" (default), "every-K" (e.g. "every-10": every K-th pose
-            and a range's last), "ends" (a range's last), "none" (residuals only); every
-            pose gets its residuals whatever the level (certify.py). A single `solve`
+        certify: which poses of a range get the exact condition number (and the error
+            bounds it gives): "every-pose" (default), "every-K" (e.g. "every-10": every K-th pose
+            and a range's last), "ends" (a range's last), "none"; every pose gets its
+            residuals and its assembly check whatever the level (certify.py). A single `solve`
             certifies its pose at every level.
 
     After `solve`, `data` holds the joint placements and Jacobians at the solution and

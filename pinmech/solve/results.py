@@ -56,8 +56,8 @@ class Accuracy:
 
     @property
     def certified(self) -> bool:
-        """Whether this pose has its exact condition number (and its assembly checked): False
-        at a pose the certification dial (`certify`, certify.py) left to its residuals."""
+        """Whether this pose has its exact condition number: False at a pose the certification
+        dial (`certify`, certify.py) left to its residuals and assembly check."""
         return self.condition == self.condition  # not NaN
 
     @property

@@ -66,9 +66,9 @@ def add_parser(sub) -> None:
                             "PREFIX_grid.png for a 1-D or 2-D grid study, PREFIX_workspace.png for a workspace study")
     study.add_argument("--json", action="store_true", help="print the JSON summary instead of the text one")
     study.add_argument("--certify", metavar="LEVEL",
-                       help="poses of each variant's cycle given the exact condition number and assembly check: "
+                       help="poses of each variant's cycle given the exact condition number: "
                        "every-pose, every-K (e.g. every-10), ends or none (default: the scene's [solver] certify, "
-                       "else every-pose); every pose keeps its residual checks")
+                       "else every-pose); every pose keeps its residual and assembly checks")
     study.add_argument("--quiet", action="store_true",
                        help="no progress bar (there is none either when stderr is not a terminal)")
     study.set_defaults(func=cmd_study)
