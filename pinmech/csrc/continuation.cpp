@@ -162,10 +162,11 @@ nb::tuple Core::follow(double p0, const VectorXd& q0, const VectorXd& d1, const 
     nb::gil_scoped_release release;
     PathSpec path = make_path(x0, d, unit, false, pivots_);
     Node node = start_node(p0, q0, d1, d2, signs0, condition0);
-    // The dial: poses left uncertified between certified ones. Where a step among them is
-    // refused, or a certified pose finds another signature or a condition number over
-    // max_condition, the range is followed again from the last certified pose with every
-    // pose certified up to that one, so it stops, names and locates as at every pose.
+    // The dial: poses left without their condition number between certified ones. Where a
+    // step among them is refused (singular, not finite, turning, another signature), or a
+    // certified pose finds a condition number over max_condition, the range is followed
+    // again from the last certified pose with every pose certified up to that one, so it
+    // stops, names and locates as at every pose.
     Node certified = node;
     Index certified_done = 0, full_until = -1;
     struct Restore {  // the pose mode certifies every pose, whatever ends this loop
