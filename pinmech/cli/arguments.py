@@ -21,6 +21,14 @@ def add_scene_arguments(parser: argparse.ArgumentParser) -> None:
                         "[solver] kernel)")
 
 
+def add_certify_argument(parser: argparse.ArgumentParser) -> None:
+    """--certify, for the commands that follow ranges of poses (a single pose is always certified)."""
+    parser.add_argument("--certify", metavar="LEVEL",
+                        help="poses of a range given the exact condition number: every-pose "
+                        "(default), every-K (e.g. every-10: every K-th pose and a range's last), ends, or none "
+                        "(no condition number); every pose keeps its residual and assembly checks ([solver] certify)")
+
+
 def add_output_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--csv", dest="csv_path", help="write the CSV here (default: standard output)")
     parser.add_argument("--json", dest="json_path", help="also write the rows as JSON lines here")

@@ -74,6 +74,17 @@ def implied_note(scene) -> None:
               f"{body}\n  (write such a scene file to drive it from other values)", file=sys.stderr)
 
 
+def certify_argument(value: str) -> str:
+    """--certify's value checked (certify.py's levels), else an OptionRefused naming it."""
+    from pinmech.exceptions import OptionError, OptionRefused
+    from pinmech.solve.certify import checked_certify
+
+    try:
+        return checked_certify(value)
+    except OptionError as exc:
+        raise OptionRefused(f"--{exc}", options=["--certify"]) from None
+
+
 def scene_from_args(args: argparse.Namespace):
     """The command's scene: its file with --set and the --angle/--speed/--acceleration
     shortcuts applied (a drawn linkage's file: the scene it stands for, noted on stderr)."""
@@ -82,6 +93,8 @@ def scene_from_args(args: argparse.Namespace):
     overrides = list(args.overrides)
     if getattr(args, "kernel", None):
         overrides.append(f'solver.kernel="{args.kernel}"')
+    if getattr(args, "certify", None):
+        overrides.append(f'solver.certify="{certify_argument(args.certify)}"')
     shortcuts = {"angle": args.angle, "speed": args.speed, "acceleration": args.acceleration}
     for key, value in shortcuts.items():
         given_text(value, f"--{key}")

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from pinmech.cli.arguments import (
+    add_certify_argument,
     add_force_arguments,
     add_limits_argument,
     add_output_arguments,
@@ -20,6 +21,7 @@ from pinmech.cli.progress import LimitWatch, progress
 from pinmech.cli.scene_args import given_text, option_or_scene, scene_from_args
 from pinmech.counts import checked_count
 from pinmech.exceptions import PinmechError
+from pinmech.solve.certify import dial_note
 
 if TYPE_CHECKING:
     from pinmech.outputs import Outputs
@@ -29,6 +31,7 @@ def add_parser(sub) -> None:
     sweep = sub.add_parser("sweep", help="sweep a driver through a cycle (or follow an arm's task in time): "
                            "CSV, JSON lines and a figure")
     add_scene_arguments(sweep)
+    add_certify_argument(sweep)
     sweep.add_argument("--driver", help="the driver to sweep (default: the scene's first)")
     sweep.add_argument("--from", dest="first", help="first value, e.g. '0 deg' (default: the scene's)")
     sweep.add_argument("--to", dest="last", help="last value, e.g. '360 deg' (default: one turn on)")
@@ -172,6 +175,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             sinks.add(pose)
             for note in design_of(sweep).notes(pose) if design_of(sweep).applicable else []:
                 print(f"pinmech: at pose {pose.index}: {note}", file=sys.stderr)
+    dial = dial_note(sweep.solver.certify)
+    if dial:
+        print(f"pinmech: {dial}", file=sys.stderr)
     if sweep.fold_end is not None:
         print(f"pinmech: {sweep.driver} cannot go past {sweep._format(sweep.fold_end)} (a fold: a toggle, the end of "
               "its range of motion on this assembly): the sweep ends at the pose before it (--through-folds goes on "

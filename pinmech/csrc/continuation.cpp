@@ -75,11 +75,11 @@ void Core::node_at(Node& node, const VectorXd& d, const VectorXd* a_drv) {
         condition_of(scaled_, square_.singular(), condition_work_, band_ ? &*band_ : nullptr);
     node.condition = condition;
     node.sigma_min = sigma_min;
-    signs_into(Jdep_, node.signs);
-  } else {  // left uncertified: the caller keeps the last certified signature
+  } else {  // left uncertified (the dial): no condition number; the signature below all the same
     node.condition = NAN;
     node.sigma_min = NAN;
   }
+  signs_into(Jdep_, node.signs);  // a determinant's sign a block: every pose keeps its assembly check
   VectorXd &v = node.d1, &a = node.d2;
   v.setZero(model_.nv);
   a.setZero(model_.nv);
@@ -121,10 +121,12 @@ int Core::step(const Node& from, double p, const VectorXd& x0, const VectorXd& d
   out.p = p;
   out.residual = residual_left;
   node_at(out, d);
-  if (!certify_now_) {  // residuals, trust region and turn only; the signature carried on
-    out.signs = from.signs;
+  if (!certify_now_) {  // residuals, trust region, turn and signature: all but the condition number
+    for (int s : out.signs)
+      if (s == 0) return 3;
     if (square_.singular() || !out.d1.allFinite() || !out.d2.allFinite()) return 3;
-    return turn_between(from, out, unit) > MAX_TURN ? 4 : 0;
+    if (turn_between(from, out, unit) > MAX_TURN) return 4;
+    return out.signs != from.signs ? 5 : 0;  // refused: followed again, every pose certified
   }
   for (int s : out.signs)
     if (s == 0) return 3;
@@ -160,10 +162,11 @@ nb::tuple Core::follow(double p0, const VectorXd& q0, const VectorXd& d1, const 
     nb::gil_scoped_release release;
     PathSpec path = make_path(x0, d, unit, false, pivots_);
     Node node = start_node(p0, q0, d1, d2, signs0, condition0);
-    // The dial: poses left uncertified between certified ones. Where a step among them is
-    // refused, or a certified pose finds another signature or a condition number over
-    // max_condition, the range is followed again from the last certified pose with every
-    // pose certified up to that one, so it stops, names and locates as at every pose.
+    // The dial: poses left without their condition number between certified ones. Where a
+    // step among them is refused (singular, not finite, turning, another signature), or a
+    // certified pose finds a condition number over max_condition, the range is followed
+    // again from the last certified pose with every pose certified up to that one, so it
+    // stops, names and locates as at every pose.
     Node certified = node;
     Index certified_done = 0, full_until = -1;
     struct Restore {  // the pose mode certifies every pose, whatever ends this loop

@@ -264,8 +264,9 @@ inline Node start_node(double p, const VectorXd& q, const VectorXd& d1, const Ve
 enum PathStatus { PATH_DONE = 0, PATH_STUCK = 1, PATH_FOLD = 2, PATH_SINGULAR = 3, PATH_REFUSED = 4 };
 
 // The certification dial (Core::certify_every): which poses of a range get the exact
-// condition number and the assembly signature. Every pose gets its residuals (closure,
-// velocity, acceleration), the trust region and the tangent's turn limit.
+// condition number. Every pose gets its residuals (closure, velocity, acceleration), the
+// trust region, the tangent's turn limit and its assembly signature (a sign a block: where
+// it changes between certified poses, the range is followed again, every pose certified).
 constexpr int CERTIFY_EVERY_POSE = 1;  // k >= 2: every k-th pose and a range's last
 constexpr int CERTIFY_ENDS = 0;        // a range's last pose (its first is certified already)
 constexpr int CERTIFY_NONE = -1;       // no pose: residual tolerances only
@@ -482,7 +483,7 @@ class Core {
   int certify_every_ = CERTIFY_EVERY_POSE;
   bool certify_all_ = true;  // follow_path certifies every step (false: only a due landing)
   bool landing_due_ = true;  // ... and the step that lands on its target
-  bool certify_now_ = true;  // node_at computes the condition number and the signature
+  bool certify_now_ = true;  // node_at computes the condition number
   std::vector<int> pivots_;
   Node next_;  // follow_path's step buffer
   long attempts_ = 0;  // steps tried since the last look at Python's signal handlers

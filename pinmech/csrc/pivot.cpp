@@ -120,7 +120,11 @@ void Core::follow_path(Node& node, double p_target, PathSpec& path, PathResult& 
     certify_now_ = certify_all_ || (landing_due_ && lands);
     const int code = step(node, lands ? p_target : node.p + h, path.x0, path.d, unit, next, change);
     certify_now_ = true;
-    if (code != 0 && !certify_all_) {  // refused among uncertified poses: the range mode follows again
+    // Refused among uncertified poses: singular, not finite, turning, another signature, or
+    // a step that would need the pivot. The range mode follows again from its
+    // last certified pose, certifying every pose. A corrector or trust-region refusal (1, 2)
+    // halves the step as at every pose: step control, not certification.
+    if (code != 0 && !certify_all_ && (code >= 3 || std::abs(h) * unit <= PIVOT_BELOW)) {
       out.status = PATH_REFUSED;
       out.why = code;
       return;

@@ -256,8 +256,10 @@ void Core::rates(nb::handle Q_object, nb::handle x_dot_object, nb::handle x_ddot
         w.lu_ready = true;
         const bool singular = w.lu.singular();
         double c = INFINITY, s = 0.0;
-        if (!singular && !certify_due(certify_every_, long(i), long(n))) {
-          c = s = NAN;  // left uncertified (the dial): exact where it is regular, no condition number
+        if (!singular && n > 1 && !certify_due(certify_every_, long(i), long(n))) {
+          // left uncertified (the dial): exact where it is regular, no condition number; a
+          // single pose (RateSolver.solve) is certified at every level, as the pose mode
+          c = s = NAN;
           condition = c;
           sigma_min = s;
           settled = true;

@@ -10,6 +10,7 @@ import numpy as np
 
 from pinmech.draw.plot_curves import BRANCH_STYLES, angles as _angles, branch_pieces, legend_beside
 from pinmech.draw.plot_curves import nearest as _nearest, spike_limits
+from pinmech.solve.certify import dial_caption
 
 
 class SweepPanels:
@@ -82,8 +83,9 @@ class SweepPanels:
         note = f"dashed: the scene's pose, {mark_x:.4g} {unit}" if marked else ""
         if self.failed:
             note += ("; " if note else "") + f"{len(self.failed)} pose(s) failed (red x)"
+        dial = dial_caption(sweep.solver.certify)
         driven = f"driver {sweep.driver} at {rate} {speed}, acceleration {acceleration}"
-        return f"{sweep.scene.title}: {driven}" + (f"\n({note})" if note else "")
+        return f"{sweep.scene.title}: {driven}" + (f"\n({note})" if note else "") + (f"\n{dial}" if dial else "")
 
     def _summary(self, mark_x: float, unit: str) -> str:
         lines = [f"At the scene's pose, {self.sweep.driver} = {mark_x:.4g} {unit}:", ""]

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from pinmech.arguments import instance_of
+from pinmech.solve.certify import NOT_CERTIFIED
 from pinmech.solve.limits import limit_violations
 from pinmech.solve.motion import Motion
 from pinmech.io.analysis_result import Analysis
@@ -245,6 +246,8 @@ def _accuracy_line(analysis: Analysis) -> str:
                    f"{analysis.mechanism.length_scale:.4g} m), {acc.iterations} Newton iterations, ")
     else:
         closure = "an open chain (no loop to close: the pose is the scene's), "
+    if not acc.certified:
+        return f"  {closure}condition number {NOT_CERTIFIED} (its residuals checked; no error bound stated)"
     bounds = (max(b, 1e-16) for b in acc.error_bounds)
     return (f"  {closure}condition number {acc.condition:.4g} "
             "(worst-case relative error about {:.0e} in positions, {:.0e} in velocities, {:.0e} in "

@@ -108,22 +108,28 @@ class ReportSpec(Table):
         return value
 
 
+_NAMED_OPTIONS = ("kernel", "certify")  # [solver] keys named by a word, not a number
+
+
 class SolverSpec(Table):
     """`[solver]`: closure tolerance, Newton iteration cap, singular limit, kinematic passes
-    (kernel: "generic" or "generated"; only those given)."""
+    (kernel: "generic" or "generated"), certification dial (certify: "every-pose",
+    "every-K", "ends" or "none"; only those given)."""
 
     tol: Any = None
     max_iterations: Any = None
     max_condition: Any = None
     kernel: Any = None
+    certify: Any = None
 
     @classmethod
     def _known_keys(cls, data: Any) -> Any:
         if not isinstance(data, dict):
             raise Refused(f"[solver] must be a table, got {data!r}")
         for key in data:
-            if key not in SOLVER_RANGES and key != "kernel":
-                raise Refused(f"unknown solver option {key}; known: {', '.join(SOLVER_RANGES)}, kernel", at=(key,))
+            if key not in SOLVER_RANGES and key not in _NAMED_OPTIONS:
+                raise Refused(f"unknown solver option {key}; known: {', '.join((*SOLVER_RANGES, *_NAMED_OPTIONS))}",
+                              at=(key,))
         return data
 
     @classmethod
@@ -135,6 +141,14 @@ class SolverSpec(Table):
             if value not in KERNELS:
                 raise Refused(f"{key} = {value!r} must be one of {', '.join(KERNELS)}")
             return value
+        if name == "certify":
+            from pinmech.exceptions import OptionError
+            from pinmech.solve.certify import checked_certify
+
+            try:
+                return checked_certify(value)
+            except OptionError as exc:
+                raise Refused(f"solver.{exc}") from None
         number = positive_number(value, key, *SOLVER_RANGES[name])
         if name == "max_iterations":
             if number != int(number):  # 2.7 was cut to 2 in silence
@@ -144,7 +158,7 @@ class SolverSpec(Table):
 
     def options(self) -> dict[str, float | int]:
         """The settings given, as LoopSolver's keyword arguments."""
-        return {key: getattr(self, key) for key in (*SOLVER_RANGES, "kernel") if getattr(self, key) is not None}
+        return {key: getattr(self, key) for key in (*SOLVER_RANGES, *_NAMED_OPTIONS) if getattr(self, key) is not None}
 
 
 class RatesSpec(Table):

@@ -15,6 +15,7 @@ from typing import IO, TYPE_CHECKING
 
 import numpy as np
 
+from pinmech.solve.certify import EVERY_POSE, certified_text, dial_note
 from pinmech.solve.diagnostics_sweep import design_of
 from pinmech.solve.limits import limit_violations
 from pinmech.solve.motion import Motion
@@ -24,6 +25,16 @@ if TYPE_CHECKING:
     from pinmech.model.mechanism import Mechanism
     from pinmech.solve.path import PathPoint
     from pinmech.io.sweep import Sweep, SweepPose
+
+
+#: A CSV cell of the condition-number column at a pose the certification dial left uncertified.
+NOT_CERTIFIED_CELL = "not certified"
+
+
+def sweep_dial_note(sweep: Sweep) -> str | None:
+    """The line a sweep's outputs carry where its solver certified fewer poses than all
+    (certify.py), else None."""
+    return dial_note(sweep.solver.certify)
 
 
 def columns(sweep: Sweep, first: Motion) -> list[str]:
@@ -69,7 +80,8 @@ def row(sweep: Sweep, pose: SweepPose, width: int) -> list[object]:
     out += design_of(sweep).cells(pose)
     acc = pose.accuracy
     beyond = " ".join(v.joint for v in limit_violations(sweep.mechanism, m))
-    return out + [acc.residual, acc.condition, acc.iterations, beyond, "interpolated" if pose.interpolated else "solved",
+    condition = acc.condition if acc.certified else NOT_CERTIFIED_CELL
+    return out + [acc.residual, condition, acc.iterations, beyond, "interpolated" if pose.interpolated else "solved",
                   ""]
 
 
@@ -77,7 +89,8 @@ class SweepCsv:
     """Writes a sweep's poses as CSV rows as they come (`add`), then `close`."""
 
     def __init__(self, sweep: Sweep, stream: IO[str]) -> None:
-        self.sweep, self.writer = sweep, csv.writer(stream)
+        self.sweep, self.stream, self.writer = sweep, stream, csv.writer(stream)
+        self.commented = False
         self.header: list[str] | None = None
         self.pending: list[SweepPose] = []  # failures before the first solved pose
         self.count = 0
@@ -88,11 +101,19 @@ class SweepCsv:
                 self.pending.append(pose)  # the header waits for the first solved pose
                 return
             self.header = self._columns(pose)
+            self._comment()
             self.writer.writerow(self.header)
             for failed in self.pending:
                 self._write(failed)
             self.pending = []
         self._write(pose)
+
+    def _comment(self) -> None:
+        """A `# ` line before the header where the sweep certified fewer poses than all."""
+        note = sweep_dial_note(self.sweep)
+        if note and not self.commented:
+            self.stream.write(f"# {note}; {NOT_CERTIFIED_CELL}: a pose left to its residuals\n")
+            self.commented = True
 
     def _columns(self, pose: SweepPose) -> list[str]:
         """The header, from the first solved pose (subclasses add columns)."""
@@ -109,6 +130,7 @@ class SweepCsv:
     def close(self) -> int:
         """Finish (a sweep where every pose failed gets a short table); the row count."""
         if self.header is None:
+            self._comment()
             unit = "deg" if self.sweep.is_angular else "m"
             self.writer.writerow([f"{self.sweep.driver}.q [{unit}]", "pose", "error"])
             for failed in self.pending:
@@ -140,6 +162,9 @@ class SweepJsonLines:
         """The pose's JSON object (subclasses add keys)."""
         entry = {"index": pose.index, self.sweep.driver: pose.value, "error": pose.error,
                  "pose": "failed" if pose.motion is None else "interpolated" if pose.interpolated else "solved"}
+        certified = self.sweep.solver.certify
+        if certified != EVERY_POSE:  # the dial: which poses have their condition number and assembly checked
+            entry["certified"] = certified_text(certified)
         if pose.note:  # a change point passed or a fold crossed on the way to this pose
             entry["note"] = pose.note
         if pose.motion is not None:

@@ -22,7 +22,7 @@ import pinocchio as pin
 from pinmech.model.closure_core import CUT_CODES, DEFAULT_TOL, CompiledModel, _core, check_pinocchio, compile_loops
 
 __all__ = ["CUT_CODES", "DEFAULT_TOL", "CompiledModel", "ModelShape", "_core", "check_pinocchio", "compile_loops",
-           "core_for"]
+           "core_for", "set_certify"]
 
 
 class ModelShape:
@@ -51,6 +51,8 @@ def core_for(solver) -> _core.Core | None:
     compiled = cached[1]
     if compiled is not None and compiled.tol != solver.tol:
         compiled.tol = solver.tol
+    if compiled is not None:
+        set_certify(compiled, getattr(solver, "certify", "every-pose"))
     kernel = getattr(solver, "kernel", "generic")
     if compiled is not None and solver.__dict__.get("_kernel_set") != (id(compiled), kernel):
         from pinmech.solve.kernels import attach
@@ -58,6 +60,15 @@ def core_for(solver) -> _core.Core | None:
         attach(compiled, solver.model, kernel)
         solver.__dict__["_kernel_set"] = (id(compiled), kernel)
     return compiled
+
+
+def set_certify(compiled: _core.Core, certify: str) -> None:
+    """Set a checked certification level (certify.py) on a compiled core."""
+    from pinmech.solve.certify import core_level
+
+    level = core_level(certify)
+    if compiled.certify_every != level:
+        compiled.certify_every = level
 
 
 def _build(solver) -> _core.Core | None:

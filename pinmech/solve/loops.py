@@ -67,6 +67,11 @@ class LoopSolver(SolverOptions):
         kernel: the kinematic passes: "generic" (Pinocchio's algorithms) or "generated"
             (the same algorithms specialised to the model, compiled once and cached;
             needs a compiler and `pinmech[fast]`, else one line says so and "generic" runs).
+        certify: which poses of a range get the exact condition number (and the error
+            bounds it gives): "every-pose" (default), "every-K" (e.g. "every-10": every K-th pose
+            and a range's last), "ends" (a range's last), "none"; every pose gets its
+            residuals and its assembly check whatever the level (certify.py). A single `solve`
+            certifies its pose at every level.
 
     After `solve`, `data` holds the joint placements and Jacobians at the solution and
     the placements of the cut frames (call `pin.updateFramePlacements` for the others).
@@ -77,8 +82,8 @@ class LoopSolver(SolverOptions):
 
     Raises:
         FrameNotFound: a driver that is not a joint of the model.
-        OptionError: tol, max_iterations or max_condition out of SOLVER_RANGES (also when
-            set later).
+        OptionError: tol, max_iterations or max_condition out of SOLVER_RANGES, or a certify
+            level not one of certify.LEVELS (also when set later).
         MobilityError: more or fewer drivers than the mechanism's mobility.
     """
 
@@ -91,9 +96,11 @@ class LoopSolver(SolverOptions):
         max_iterations: int = 50,
         max_condition: float = DEFAULT_MAX_CONDITION,
         kernel: str = "generic",
+        certify: str = "every-pose",
     ) -> None:
         self.mechanism = mechanism
         self.kernel = checked_kernel(kernel)
+        self.certify = certify
         self.model = mechanism.model
         self.data = self.model.createData()
         self.drivers = names(drivers, "drivers")

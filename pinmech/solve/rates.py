@@ -38,6 +38,7 @@ from pinmech.model.mechanism import Mechanism
 from pinmech.seeded import Seeded
 from pinmech.solve import core
 from pinmech.solve.core import _core
+from pinmech.solve.certify import checked_certify
 from pinmech.solve.kernels import attach, checked_kernel
 from pinmech.solve.results import RateSolution, frozen
 from pinmech.solve.loops import (
@@ -145,6 +146,9 @@ class RateSolver:
         tol: how closed the loops of a q must be (dimensionless, as `LoopSolver`'s tol,
             which closed it): a q whose loops are open beyond it is a LoopClosureError.
         kernel: the kinematic passes, as `LoopSolver`'s ("generic" or "generated").
+        certify: the certification dial, as `LoopSolver`'s: of the poses of one `solve_many`
+            call, which get the exact condition number (the others, regular by their
+            factorization, report NaN); certify.py.
 
     Raises:
         TaskError: unknown method, no task, or a damping out of DAMPING_RANGE.
@@ -154,7 +158,7 @@ class RateSolver:
 
     def __init__(self, mechanism: Mechanism, tasks: Sequence[Task], *, method: str = "exact",
                  damping: float = 1e-3, max_condition: float = DEFAULT_MAX_CONDITION,
-                 tol: float = DEFAULT_TOL, kernel: str = "generic") -> None:
+                 tol: float = DEFAULT_TOL, kernel: str = "generic", certify: str = "every-pose") -> None:
         if method not in METHODS:
             raise TaskError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
         if not isinstance(tasks, (list, tuple)) or not all(isinstance(t, Task) for t in tasks):
@@ -177,6 +181,7 @@ class RateSolver:
         self.max_condition = checked_option("max_condition", max_condition)  # NaN would turn the check off
         self.tol = checked_option("tol", tol)
         self.kernel = checked_kernel(kernel)
+        self.certify = checked_certify(certify)
         self.x_dot = np.concatenate([t.velocity for t in self.tasks])
         self.x_ddot = np.concatenate([t.acceleration for t in self.tasks])
         self.row_names = [f"{t.frame}.{c}" for t in self.tasks for c in t.components]
@@ -309,6 +314,7 @@ class RateSolver:
         if self.__dict__.get("_kernel_set") != (id(cached[0]), self.kernel):
             attach(cached[0], self.model, self.kernel)
             self.__dict__["_kernel_set"] = (id(cached[0]), self.kernel)
+        core.set_certify(cached[0], self.certify)
         if cached[1] != options:
             rows, columns = self._scales(self._closure_rows)
             cached[0].set_rate_options(rows, columns, _ASKED[self.method], self.damping, self.max_condition)

@@ -34,8 +34,10 @@ class Accuracy:
         residual: largest closure (or task) position error, dimensionless: position rows
             are divided by the mechanism's length scale [m], orientation rows are [rad].
         iterations: Newton iterations spent on the position (0 when none were needed).
-        condition: 2-norm condition number of the Jacobian solved for the rates.
-        sigma_min: smallest singular value of that Jacobian (dimensionless rows).
+        condition: 2-norm condition number of the Jacobian solved for the rates; NaN at a
+            pose the certification dial left uncertified (`certified` False: certify.py).
+        sigma_min: smallest singular value of that Jacobian (dimensionless rows); NaN
+            where `condition` is.
         velocity_residual: max |J q_dot| of the velocity equations, per second.
         acceleration_residual: max |J q_ddot + Jdot q_dot| of the acceleration equations.
         interpolation: for a pose interpolated between solved ones (a sweep's
@@ -53,6 +55,12 @@ class Accuracy:
     interpolation: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     @property
+    def certified(self) -> bool:
+        """Whether this pose has its exact condition number: False at a pose the certification
+        dial (`certify`, certify.py) left to its residuals and assembly check."""
+        return self.condition == self.condition  # not NaN
+
+    @property
     def error_bounds(self) -> tuple[float, float, float]:
         """Relative errors to expect of positions, velocities and accelerations.
 
@@ -66,7 +74,8 @@ class Accuracy:
         factors are margins of 2 to 5 over the worst ratios measured against
         extended-precision closed forms (tests/test_singular.py, scripts/singular_accuracy.py):
         k depends on how lengths are made dimensionless (by the loops' sizes), which no law
-        fixes to better than a small factor.
+        fixes to better than a small factor. NaN at a pose not `certified`: without its
+        condition number no bound is stated.
         """
         m = max(self.residual, EPS)
         k = self.condition
@@ -79,21 +88,28 @@ class Accuracy:
         return self.error_bounds[2]
 
     def is_accurate(self, tol: float = 1e-9, max_condition: float = 1e8) -> bool:
-        """True when the position residual is below `tol` and the Jacobian is well conditioned."""
+        """True when the position residual is below `tol` and the Jacobian is well conditioned
+        (False at a pose not `certified`: its conditioning is not known)."""
         return self.residual <= tol and self.condition <= max_condition
 
-    def as_dict(self) -> dict[str, float | int]:
+    def as_dict(self) -> dict[str, float | int | bool | None]:
+        """The numbers by name, for JSON; at a pose not `certified` the condition number,
+        sigma_min and the bounds that need them are None (never NaN: JSON has none) and
+        "certified" is False."""
+        certified = self.certified
+        bounds = self.error_bounds if certified else (None, None, None)
         return {
             "closure_residual": self.residual,
             "newton_iterations": self.iterations,
-            "condition_number": self.condition,
-            "sigma_min": self.sigma_min,
+            "certified": certified,
+            "condition_number": self.condition if certified else None,
+            "sigma_min": self.sigma_min if certified else None,
             "velocity_residual": self.velocity_residual,
             "acceleration_residual": self.acceleration_residual,
-            "estimated_relative_error": self.error_estimate,
-            "relative_error_bound_position": self.error_bounds[0],
-            "relative_error_bound_velocity": self.error_bounds[1],
-            "relative_error_bound_acceleration": self.error_bounds[2],
+            "estimated_relative_error": bounds[2],
+            "relative_error_bound_position": bounds[0],
+            "relative_error_bound_velocity": bounds[1],
+            "relative_error_bound_acceleration": bounds[2],
         }
 
 

@@ -119,3 +119,14 @@ class SolverOptions:
     @max_condition.setter
     def max_condition(self, value: float) -> None:
         self._max_condition = checked_option("max_condition", value)
+
+    @property
+    def certify(self) -> str:
+        """The certification dial (certify.py): "every-pose", "every-K", "ends" or "none"."""
+        return self._certify
+
+    @certify.setter
+    def certify(self, value: str) -> None:
+        from pinmech.solve.certify import checked_certify
+
+        self._certify = checked_certify(value)

@@ -65,6 +65,10 @@ def add_parser(sub) -> None:
                             "(spread against the driver), PREFIX_pareto.png, PREFIX_ellipses.png (point outputs); "
                             "PREFIX_grid.png for a 1-D or 2-D grid study, PREFIX_workspace.png for a workspace study")
     study.add_argument("--json", action="store_true", help="print the JSON summary instead of the text one")
+    study.add_argument("--certify", metavar="LEVEL",
+                       help="poses of each variant's cycle given the exact condition number: "
+                       "every-pose, every-K (e.g. every-10), ends or none (default: the scene's [solver] certify, "
+                       "else every-pose); every pose keeps its residual and assembly checks")
     study.add_argument("--quiet", action="store_true",
                        help="no progress bar (there is none either when stderr is not a terminal)")
     study.set_defaults(func=cmd_study)
@@ -88,7 +92,7 @@ def cmd_study(args: argparse.Namespace) -> int:
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
     bar = ProgressBar.on_terminal(quiet=args.quiet)
     try:
-        result = study(spec, workers=workers, scheduler=scheduler, progress=bar)
+        result = study(spec, workers=workers, scheduler=scheduler, progress=bar, certify=_certify(args))
     finally:
         if bar is not None:
             bar.close()
@@ -113,6 +117,15 @@ def cmd_study(args: argparse.Namespace) -> int:
                     written.append(ellipse_curves(result, f"{args.out}_ellipses.png"))
         print("wrote " + ", ".join(str(p) for p in written), file=sys.stderr)
     return 0
+
+
+def _certify(args: argparse.Namespace) -> str | None:
+    """--certify checked (an OptionRefused naming it), or None."""
+    if args.certify is None:
+        return None
+    from pinmech.cli.scene_args import certify_argument
+
+    return certify_argument(args.certify)
 
 
 def _check_out(args: argparse.Namespace, spec) -> None:

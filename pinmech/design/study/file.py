@@ -149,6 +149,7 @@ class StudySpec:
     strokes: tuple[str, ...] = ()
     torque: tuple[str, ...] = ()
     limits: tuple = ()
+    certify: str | None = None  # the certification dial asked for the run (None: the scene's [solver])
 
 
 def load_study(path: str | Path) -> StudySpec:

@@ -12,7 +12,15 @@ from pinmech.design.figure_file import pyplot, save
 from pinmech.design.study.outputs import USER_UNITS as _SCALE
 from pinmech.design.study.run import StudyResult
 from pinmech.design.study.tolerance import deviation
+from pinmech.solve.certify import dial_caption
 
+
+
+def titled(result: StudyResult) -> str:
+    """The study's title for a figure, with the certification dial where fewer poses than
+    all were certified (certify.py)."""
+    caption = dial_caption(result.certify)
+    return result.spec.title if caption is None else f"{result.spec.title} ({caption})"
 
 
 def sensitivity_bars(result: StudyResult, path: str | Path) -> Path:
@@ -27,7 +35,7 @@ def sensitivity_bars(result: StudyResult, path: str | Path) -> Path:
         ax.invert_yaxis()
         ax.set_title(result.outputs[j])
         ax.set_xlabel(f"max |d/dp| over the cycle [{unit}/mm]")
-    fig.suptitle(f"{result.spec.title}: sensitivities over the cycle of {result.driver}")
+    fig.suptitle(f"{titled(result)}: sensitivities over the cycle of {result.driver}")
     return save(plt, fig, path)
 
 
@@ -56,7 +64,7 @@ def tolerance_histograms(result: StudyResult, path: str | Path) -> Path:
         ax.set_xlabel(f"deviation from nominal [{unit}]")
         ax.legend(fontsize=7)
     failed = len(causes) - int(ok.sum())
-    fig.suptitle(f"{result.spec.title}: {len(causes)} variants, {failed} failed (counted by cause)")
+    fig.suptitle(f"{titled(result)}: {len(causes)} variants, {failed} failed (counted by cause)")
     return save(plt, fig, path)
 
 
@@ -82,7 +90,7 @@ def grid_figure(result: StudyResult, path: str | Path) -> Path:
             _grid_map(fig, ax, axes_g, hi - lo if hi is not lo else lo, failed,
                       f"max - min over the cycle [{unit}]" if hi is not lo else f"least over the cycle [{unit}]")
         ax.set_title(title)
-    fig.suptitle(f"{result.spec.title}: {len(failed)} points, {int(failed.sum())} failed (marked)")
+    fig.suptitle(f"{titled(result)}: {len(failed)} points, {int(failed.sum())} failed (marked)")
     return save(plt, fig, path)
 
 

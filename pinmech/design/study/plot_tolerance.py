@@ -14,6 +14,7 @@ import numpy as np
 from pinmech.design.figure_file import pyplot, save
 from pinmech.design.study.outputs import USER_UNITS
 from pinmech.design.study.stackup import covariances, ellipse, point_pairs, stackup
+from pinmech.design.study.plot import titled
 
 _NICE = (1.0, 2.0, 5.0)
 
@@ -51,7 +52,7 @@ def sigma_curves(result, path: str | Path) -> Path:
         ax.set_title(result.outputs[j])
         ax.grid(alpha=0.3)
     axes[0][0].legend(fontsize=7, loc="best")
-    fig.suptitle(f"{result.spec.title}\n{_over(st)}; t: a uniform's half width, else 3 sigma", fontsize=10)
+    fig.suptitle(f"{titled(result)}\n{_over(st)}; t: a uniform's half width, else 3 sigma", fontsize=10)
     return save(plt, fig, path, tight=False)
 
 
@@ -93,7 +94,7 @@ def ellipse_curves(result, path: str | Path, every: int | None = None) -> Path:
         ax.set_title(f"{name}: 3-sigma ellipses, drawn x{k:g}", fontsize=10)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="best")
-    fig.suptitle(f"{result.spec.title}\n{_over(st)}; every {step} poses", fontsize=10)
+    fig.suptitle(f"{titled(result)}\n{_over(st)}; every {step} poses", fontsize=10)
     return save(plt, fig, path, tight=False)
 
 
@@ -120,7 +121,7 @@ def pareto(result, path: str | Path) -> Path:
         scale, unit = USER_UNITS[result.kinds[j]]
         ax.set_title(f"{result.outputs[j]} at {result.driver} = {math.degrees(result.values[i]) % 360:.0f} deg\n"
                      f"(sigma linear {st.sigma_linear[i, j] * scale:.3g} {unit})", fontsize=9)
-    fig.suptitle(f"{result.spec.title}: shares (S_i sigma_i)^2 / sigma^2", fontsize=10)
+    fig.suptitle(f"{titled(result)}: shares (S_i sigma_i)^2 / sigma^2", fontsize=10)
     return save(plt, fig, path, tight=False)
 
 

@@ -16,6 +16,7 @@ import numpy as np
 from pinmech.design.study.grid import cycle_range, failures
 from pinmech.design.study.outputs import USER_UNITS as _SCALE
 from pinmech.design.study.run import StudyResult
+from pinmech.solve.certify import EVERY_POSE, certified_text, dial_note
 from pinmech.design.study.tolerance import PERCENTILES, deviation
 from pinmech.design.study.tolerance_report import pose_table, tolerance_lines, tolerance_summary
 from pinmech.outputs import beside, write_whole, write_with
@@ -37,6 +38,8 @@ def summary(result: StudyResult) -> dict:
     spec = result.spec
     out = {"study": str(spec.path), "title": spec.title, "kind": spec.kind, "driver": result.driver,
            "poses": len(result.values), "parameters": {}, "outputs": {}}
+    if result.certify != EVERY_POSE:  # each variant's cycle followed with fewer poses certified
+        out["certified"] = certified_text(result.certify)
     for k, p in enumerate(spec.params):
         size, per = _per(result, k)
         out["parameters"][p.name] = {f"nominal_{per}": result.nominal_p[k] / size, "distribution": p.distribution,
@@ -91,6 +94,9 @@ def text(result: StudyResult) -> str:
     lines = [f"{s['title']} ({s['kind']}, {s['poses']} poses of {s['driver']}"
              + (f", {s['samples']} variants, seed {s['seed']})" if "samples" in s else ")")]
     lines.append("parameters: " + ", ".join(_said_param(n, p) for n, p in s["parameters"].items()))
+    note = dial_note(result.certify)
+    if note:
+        lines.append(f"each variant's cycle: {note}")
     lines.append("largest |dy/dp| over the cycle: " + "; ".join(
         f"{o}: " + ", ".join(f"{p} {v:.4g} {e['unit']}/{per}" for per in ("mm", "deg")
                              for p, v in e.get(f"max_abs_sensitivity_{e['unit']}_per_{per}", {}).items())
@@ -184,15 +190,18 @@ def _param_columns(result: StudyResult, p: np.ndarray) -> dict[str, list]:
 def write(result: StudyResult, prefix: str | Path, *, parquet: bool = True) -> list[Path]:
     """PREFIX.csv, PREFIX.json and (with pyarrow) PREFIX.parquet, and for a tolerance study
     PREFIX_poses.csv (every pose's stack-up: tolerance_report.pose_table); the paths written."""
-    paths = write_tables(table(result), summary(result), prefix, parquet=parquet)
+    comment = dial_note(result.certify)
+    paths = write_tables(table(result), summary(result), prefix, parquet=parquet, comment=comment)
     if result.spread is not None:
-        paths.append(write_csv(pose_table(result), Path(f"{prefix}_poses.csv")))
+        paths.append(write_csv(pose_table(result), Path(f"{prefix}_poses.csv"), comment))
     return paths
 
 
-def write_csv(columns: dict[str, list], path: Path) -> Path:
-    """Columns to a CSV file (written whole)."""
+def write_csv(columns: dict[str, list], path: Path, comment: str | None = None) -> Path:
+    """Columns to a CSV file (written whole), after a `# comment` line where one is given."""
     text = io.StringIO(newline="")
+    if comment:
+        text.write(f"# {comment}\n")
     writer = csv.writer(text)
     writer.writerow(columns)
     writer.writerows(zip(*columns.values()))
@@ -200,10 +209,12 @@ def write_csv(columns: dict[str, list], path: Path) -> Path:
     return path
 
 
-def write_tables(columns: dict[str, list], summary_: dict, prefix: str | Path, *, parquet: bool = True) -> list[Path]:
-    """Columns to PREFIX.csv (and PREFIX.parquet with pyarrow), a summary to PREFIX.json."""
+def write_tables(columns: dict[str, list], summary_: dict, prefix: str | Path, *, parquet: bool = True,
+                 comment: str | None = None) -> list[Path]:
+    """Columns to PREFIX.csv (after a `# comment` line where one is given; and PREFIX.parquet
+    with pyarrow), a summary to PREFIX.json."""
     paths = [beside(prefix, ".csv"), beside(prefix, ".json")]
-    write_csv(columns, paths[0])
+    write_csv(columns, paths[0], comment)
     write_whole(paths[1], json.dumps(summary_, indent=2) + "\n")
     if parquet:
         try:

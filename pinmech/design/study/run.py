@@ -58,6 +58,7 @@ class StudyResult:
     batches: tuple[BatchResult, ...] = ()
     param_kinds: tuple[str, ...] = ()  # "length" or "angle" each (a drawn angle param) ; () all lengths
     limits: dict = dataclasses.field(default_factory=dict)  # output -> (lower, upper) of its deviation [SI]
+    certify: str = "every-pose"  # the certification dial the variants were followed with (certify.py)
 
     def param_kind(self, k: int) -> str:
         """Parameter k's kind: "length" [m] or "angle" [rad]."""
@@ -81,7 +82,8 @@ class StudyResult:
 
 
 def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, scheduler: str | None = None,
-          progress: Callable[[int, int], None] | None = None) -> StudyResult | WorkspaceResult:
+          progress: Callable[[int, int], None] | None = None,
+          certify: str | None = None) -> StudyResult | WorkspaceResult:
     """Run a study file.
 
     Args:
@@ -90,6 +92,9 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
             processes; scheduler: a running Dask scheduler's address instead.
         progress: called with (variants done, variants) as each batch of a tolerance or grid
             study finishes.
+        certify: the certification dial of each variant's cycle ("every-pose", "every-K",
+            "ends", "none"; certify.py); None: the scene's `[solver] certify`. A workspace
+            study solves each grid point on its own, certified, and refuses another level.
 
     Raises:
         SceneError: a bad study file (FrameNotFound: a name the model lacks); the scene's
@@ -100,6 +105,8 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
         ImportError: naming `pinmech[study]`, without Dask.
     """
     spec = path if isinstance(path, (StudySpec, WorkspaceSpec)) else load_any_study(Path(path))
+    if certify is not None:
+        spec = _with_certify(spec, certify)
     if spec.kind == "workspace":
         return run_workspace(spec, workers=workers, scheduler=scheduler, progress=progress)
     sm, outputs = built(spec)
@@ -113,7 +120,7 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
     y0, dy = cycle_sensitivity(sm, outputs, cycle)
     common = dict(spec=spec, driver=sm.sweep.driver, values=sm.values, outputs=outputs.names, kinds=outputs.kinds,
                   params=[p.name for p in spec.params], nominal_p=sm.nominal.copy(), nominal=y0, sensitivity=dy,
-                  param_kinds=tuple(place.kind for place in sm.placements))
+                  param_kinds=tuple(place.kind for place in sm.placements), certify=sm.solver.certify)
     if spec.kind == "sensitivity":
         return StudyResult(**common)
     todo = batches(grid_size(spec) if spec.kind == "grid" else spec.samples, spec.batch)
@@ -127,6 +134,22 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
     if spec.kind == "grid":
         return StudyResult(**common, batches=tuple(results))
     return StudyResult(**common, spread=spread(sm, outputs, results), batches=tuple(results), limits=limits)
+
+
+def _with_certify(spec: StudySpec | WorkspaceSpec, certify: str) -> StudySpec | WorkspaceSpec:
+    """The spec with the run's certification level (checked: OptionError naming the levels)."""
+    from pinmech.solve.certify import EVERY_POSE, checked_certify
+
+    level = checked_certify(certify)
+    if spec.kind == "workspace":
+        if level != EVERY_POSE:
+            from pinmech.exceptions import OptionError
+
+            raise OptionError(f"{spec.path}: certify = {certify!r}: a workspace study solves each grid point on its "
+                              "own, every one certified (no range to certify fewer poses of)", option="certify",
+                              value=certify)
+        return spec
+    return dataclasses.replace(spec, certify=level)
 
 
 def load_any_study(path: str | Path) -> StudySpec | WorkspaceSpec:

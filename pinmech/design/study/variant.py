@@ -61,6 +61,8 @@ class StudyMechanism:
         self.scene = scene = Scene.load(spec.scene)
         self.sweep = Sweep.from_scene(scene)
         self.mechanism, self.solver = self.sweep.mechanism, self.sweep.solver
+        if spec.certify is not None:  # the run's dial over the scene's [solver] certify
+            self.solver.certify = spec.certify
         self.model = self.mechanism.model
         self.placements: list[Placement] = placements(self.mechanism, spec.params, str(spec.path), scene)
         self._drawing = next((place.drawing for place in self.placements if place.drawn), None)
