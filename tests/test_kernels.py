@@ -17,8 +17,12 @@ Checks, each against something that is not the kernel:
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 import stat
+import sys
+import tempfile
+import time
 
 import numpy as np
 import pinocchio as pin
@@ -30,14 +34,28 @@ import pinmech.solve.core as core
 from pinmech.io.sweep import Sweep
 from pinmech.solve import kernel_build, kernels
 from pinmech.solve.loops import LoopSolver
+from tests.conftest import MODELS
 from tests.test_core import LOOP_SCENES, _relative_position, _two_chains
 
-try:
-    kernel_build.generator_path()
-    REASON = ""
-except kernel_build.KernelUnavailable as why:
-    REASON = str(why)
-needs_kernels = pytest.mark.skipif(bool(REASON), reason=f"no generated kernels here: {REASON}")
+
+
+@pytest.fixture(scope="session")
+def kernels_here():
+    """The kernel generator, built once per test session (and once per machine: the user
+    cache keeps it; workers of `pytest -n` that ask at once wait on its lock, one builds);
+    the test is skipped, with the one-line reason, where it cannot be built here."""
+    start = time.perf_counter()
+    try:
+        path = kernel_build.generator_path()
+    except kernel_build.KernelUnavailable as why:
+        pytest.skip(f"no generated kernels here: {why}")
+    seconds = time.perf_counter() - start
+    if seconds > 1.0:
+        print(f"\nthe kernel generator was built in {seconds:.0f} s", file=sys.stderr)
+    return path
+
+
+needs_kernels = pytest.mark.usefixtures("kernels_here")
 
 KINDS = ["helical", "helical_z", "universal", "ellipsoid", "spherical_zyx", "spherical", "planar", "free_flyer",
          "translation", "prismatic_unaligned", "composite", "mimic"]
@@ -184,6 +202,9 @@ def test_the_cache_rebuilds_a_kernel_it_did_not_write(models_dir):
     """A cached kernel whose bytes no longer match its record, or that is a link, is built
     anew; the folder is the user's alone (0700)."""
     mech = pinmech.Mechanism.from_urdf(models_dir / "four_bar.urdf")
+    # a frame of its own makes this kernel this test's alone: the other tests' four-bar
+    # kernel, which `pytest -n` workers may be reading now, is left whole
+    mech.model.addFrame(pin.Frame("only_the_cache_test", 0, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME))
     build = kernel_build.build_kernel(mech.model)
     assert stat.S_IMODE(os.stat(build.path.parent).st_mode) == 0o700
     assert kernel_build.build_kernel(mech.model).cached
@@ -216,3 +237,114 @@ def test_the_arm_of_text_17_110_on_the_kernel_meets_cramers_rule(scenes_dir):
                                [cramer.omega_AB, cramer.omega_BC], rtol=1e-10)
     np.testing.assert_allclose([links[n]["angular_acceleration"][2] for n in ("AB", "BC")],
                                [cramer.alpha_AB, cramer.alpha_BC], rtol=1e-10)
+
+
+def _swap_kind(model: pin.Model, j: int) -> None:
+    """Joint `j` changed in place, with its indexes: a revolute about x, y or z becomes the
+    prismatic along that axis, a prismatic the revolute, a continuous joint (nq 2) the prismatic."""
+    was = model.joints[j]
+    axis = was.shortname()[-1]
+    other = {"R": "P", "P": "R", "U": "P"}[was.shortname()[len("JointModel")]]
+    swapped = getattr(pin, f"JointModel{other}{axis}")()
+    swapped.setIndexes(j, was.idx_q, was.idx_v, was.idx_vExtended)
+    model.joints[j] = swapped
+
+
+@needs_kernels
+def test_a_joint_changed_in_place_never_runs_the_old_kernel(models_dir):
+    """The slider-crank's slide changed in place from prismatic to revolute (same sizes, same
+    tree): a core still holding the old kernel refuses to run it (a named ValueError), and the
+    solver's next call runs a fresh kernel whose closure rows are Pinocchio's frame
+    placements of the changed model (1e-15, as above)."""
+    mech = pinmech.Mechanism.from_urdf(models_dir / "slider_crank.urdf")
+    model, closure = mech.model, mech.closures[0]
+    solver = LoopSolver(mech, ["O"], kernel="generated")
+    compiled = core.core_for(solver)
+    old = compiled.kernel_path
+    assert old and not compiled.kernel_stale
+    q = pin.integrate(model, pin.neutral(model), np.array([0.3, -0.2, 0.05]))
+    _swap_kind(model, model.getJointId("slide"))
+    assert compiled.kernel_stale
+    with pytest.raises(ValueError, match="joints changed since its generated kernel"):
+        compiled.residual(q)
+    fresh = core.core_for(solver)
+    assert fresh.kernel_path not in ("", old) and not fresh.kernel_stale
+    np.testing.assert_allclose(fresh.errors6(q)[0, :3], _relative_position(model, closure, q), rtol=0, atol=1e-15)
+
+
+@needs_kernels
+def test_a_revolute_made_prismatic_in_place_is_refused_by_the_old_core(models_dir):
+    """The four-bar's continuous rocker pivot (nq 2) made prismatic in place (nq 1; Pinocchio
+    leaves the model's own nq as it was): the core holding the old kernel refuses every call,
+    naming the change."""
+    mech = pinmech.Mechanism.from_urdf(models_dir / "four_bar.urdf")
+    compiled = core.core_for(LoopSolver(mech, ["O2"], kernel="generated"))
+    q = pin.neutral(mech.model)
+    _swap_kind(mech.model, mech.model.getJointId("O4"))
+    with pytest.raises(ValueError, match="joints changed since its generated kernel"):
+        compiled.residual(q)
+
+
+@pytest.mark.parametrize("change", ["prismatic", "axis", "pitch", "mimic ratio"])
+def test_the_kernel_key_covers_what_the_kernel_is_specialised_on(kernels_here, change):
+    """A kernel is named by everything the generated code is specialised on: each change of
+    a joint's type, axis, helical pitch or mimic ratio names another kernel; a changed joint
+    placement (a dimension, an input of the kernel) names the same one."""
+    def key(model):
+        return kernel_build.kernel_key(kernel_build._structure(model))
+
+    kind = {"prismatic": "translation", "axis": "prismatic_unaligned", "pitch": "helical", "mimic ratio": "mimic"}
+    model, _ = _two_chains(kind[change])
+    before = key(model)
+    moved = model.copy()
+    moved.jointPlacements[1] = pin.SE3(np.eye(3), np.array([0.3, 0.1, 0.0]))
+    assert key(moved) == before
+    changed = model.copy()
+    j = 1
+    if change == "prismatic":
+        changed = pinmech.Mechanism.from_urdf(MODELS / "slider_crank.urdf").model
+        before = key(changed)
+        _swap_kind(changed, changed.getJointId("slide"))
+    elif change == "axis":
+        changed.joints[j] = _indexed(pin.JointModelPrismaticUnaligned(np.array([0.0, 0.6, 0.8])), model.joints[j])
+    elif change == "pitch":
+        changed.joints[j] = _indexed(pin.JointModelHelicalUnaligned(np.array([0.0, 0.0, 1.0]), 0.031), model.joints[j])
+    else:
+        changed.joints[3] = _indexed(pin.JointModelMimic(changed.joints[1], -1.25, 0.0), model.joints[3])
+    assert key(changed) != before
+
+
+def _indexed(joint, like):
+    joint.setIndexes(like.id, like.idx_q, like.idx_v, like.idx_vExtended)
+    return joint
+
+
+def _build_slowly(out, counter):
+    with open(counter, "a") as f:
+        f.write("built\n")
+    time.sleep(0.5)
+    out.write_bytes(b"the same bytes")
+
+
+def _ask(folder, counter, results):
+    tempfile.tempdir = str(folder)
+    from pinmech.user_cache import cached_build
+
+    results.put(cached_build("thing", "0" * 64, "", lambda out: _build_slowly(out, counter))[1])
+
+
+def test_processes_asking_at_once_build_a_cached_file_once(tmp_path):
+    """Three processes ask the user cache for the same file at once (as `pytest -n` workers
+    and a study's workers do): one builds it, the other two wait and find it built."""
+    context = multiprocessing.get_context("fork")
+    results = context.Queue()
+    counter = tmp_path / "builds"
+    workers = [context.Process(target=_ask, args=(tmp_path, counter, results)) for _ in range(3)]
+    for w in workers:
+        w.start()
+    for w in workers:
+        w.join(30)
+    cached = sorted(results.get(timeout=5) for _ in workers)
+    assert counter.read_text().count("built") == 1
+    assert cached == [False, True, True]
+

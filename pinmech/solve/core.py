@@ -51,12 +51,10 @@ def core_for(solver) -> _core.Core | None:
     compiled = cached[1]
     if compiled is not None and compiled.tol != solver.tol:
         compiled.tol = solver.tol
-    kernel = getattr(solver, "kernel", "generic")
-    if compiled is not None and solver.__dict__.get("_kernel_set") != (id(compiled), kernel):
-        from pinmech.solve.kernels import attach
+    if compiled is not None:
+        from pinmech.solve.kernels import kept
 
-        attach(compiled, solver.model, kernel)
-        solver.__dict__["_kernel_set"] = (id(compiled), kernel)
+        kept(solver.__dict__, compiled, solver.model, getattr(solver, "kernel", "generic"))
     return compiled
 
 

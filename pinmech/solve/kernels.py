@@ -31,6 +31,15 @@ def checked_kernel(kernel: object) -> str:
     return str(kernel)
 
 
+def kept(owner: dict, core, model: pin.Model, kernel: str) -> None:
+    """Set the passes `kernel` asks on `core` once per core and choice (`owner`: the solver's
+    __dict__, which remembers it), and again where the model's joints changed in place since
+    its kernel was made (a joint's type or axis: the old kernel would answer for the old joints)."""
+    if owner.get("_kernel_set") != (id(core), kernel) or core.kernel_stale:
+        attach(core, model, kernel)
+        owner["_kernel_set"] = (id(core), kernel)
+
+
 def attach(core, model: pin.Model, kernel: str) -> str | None:
     """Set the passes `kernel` asks on `core` (a compiled Core of `model`): the generated
     kernel's path, or None where the generic passes run (asked, or no kernel could be built)."""
