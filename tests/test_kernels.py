@@ -348,3 +348,50 @@ def test_processes_asking_at_once_build_a_cached_file_once(tmp_path):
     assert counter.read_text().count("built") == 1
     assert cached == [False, True, True]
 
+
+
+@pytest.fixture
+def counted_generations(monkeypatch):
+    """Kernels made in this test: each kernel's name salted with the test's own word, so the
+    first use generates one (whatever the cache holds) and every later one is counted."""
+    made = []
+    salted = kernel_build.kernel_key
+    monkeypatch.setattr(kernel_build, "kernel_key", lambda text: salted(text + f"\0{os.getpid()}-{id(made)}"))
+    real = kernel_build.make_kernel
+    monkeypatch.setattr(kernel_build, "make_kernel", lambda *a, **k: made.append(1) or real(*a, **k))
+    return made
+
+
+@needs_kernels
+@pytest.mark.parametrize("file, changes", [("four_bar_tolerance.toml", {"samples": 30, "batch": 10, "steps": 13}),
+                                           ("four_bar_drawn_tolerance.toml", {"samples": 20, "batch": 10, "steps": 13}),
+                                           ("four_bar_grid.toml", {"steps": 13}),
+                                           ("five_bar_workspace.toml", {})])
+def test_a_study_over_lengths_generates_one_kernel(models_dir, counted_generations, file, changes):
+    """A tolerance study (of joint placements, and of a drawn linkage's lengths), a grid over
+    lengths and a workspace grid with kernel="generated": the variants' lengths are the
+    kernel's inputs, so the whole run makes one kernel."""
+    import dataclasses
+
+    from pinmech.design.study.run import load_any_study, study
+
+    spec = dataclasses.replace(load_any_study(models_dir / "studies" / file), **changes)
+    if spec.kind == "grid":
+        spec = dataclasses.replace(spec, grid=tuple(dataclasses.replace(a, count=3) for a in spec.grid))
+    if spec.kind == "workspace":
+        spec = dataclasses.replace(spec, axes=tuple(dataclasses.replace(a, count=4) for a in spec.axes))
+    study(spec, kernel="generated")
+    assert len(counted_generations) == 1
+
+
+@needs_kernels
+def test_a_six_bar_synthesis_search_generates_one_kernel(models_dir, counted_generations):
+    """A drawn six-bar's search with kernel="generated": every candidate's lengths are
+    written into the one model, so the whole search makes one kernel."""
+    import dataclasses
+
+    from pinmech.design.synthesis.search import load_synthesis, synthesise
+
+    spec = load_synthesis(models_dir / "synthesis" / "stephenson_function.toml")
+    synthesise(dataclasses.replace(spec, generations=3, population=2, keep=1), kernel="generated")
+    assert len(counted_generations) == 1

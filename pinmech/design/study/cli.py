@@ -65,6 +65,9 @@ def add_parser(sub) -> None:
                             "(spread against the driver), PREFIX_pareto.png, PREFIX_ellipses.png (point outputs); "
                             "PREFIX_grid.png for a 1-D or 2-D grid study, PREFIX_workspace.png for a workspace study")
     study.add_argument("--json", action="store_true", help="print the JSON summary instead of the text one")
+    study.add_argument("--kernel", choices=("generic", "generated"), default=None,
+                       help="kinematic passes of every variant (default: the scene's [solver] kernel); "
+                       "generated: one kernel for the whole study, the lengths are its inputs")
     study.add_argument("--quiet", action="store_true",
                        help="no progress bar (there is none either when stderr is not a terminal)")
     study.set_defaults(func=cmd_study)
@@ -88,7 +91,7 @@ def cmd_study(args: argparse.Namespace) -> int:
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
     bar = ProgressBar.on_terminal(quiet=args.quiet)
     try:
-        result = study(spec, workers=workers, scheduler=scheduler, progress=bar)
+        result = study(spec, workers=workers, scheduler=scheduler, progress=bar, kernel=args.kernel)
     finally:
         if bar is not None:
             bar.close()

@@ -28,6 +28,7 @@ from pinmech.design.study.tolerance import Batch, BatchResult, Spread, batches, 
 from pinmech.design.workspace.run import WorkspaceResult, run_workspace
 from pinmech.design.workspace.file import WorkspaceSpec, is_workspace, parse_workspace
 from pinmech.exceptions import SceneError
+from pinmech.solve.kernels import checked_kernel
 from pinmech.toml_file import read_toml
 
 
@@ -81,7 +82,7 @@ class StudyResult:
 
 
 def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, scheduler: str | None = None,
-          progress: Callable[[int, int], None] | None = None) -> StudyResult | WorkspaceResult:
+          progress: Callable[[int, int], None] | None = None, kernel: str | None = None) -> StudyResult | WorkspaceResult:
     """Run a study file.
 
     Args:
@@ -90,6 +91,8 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
             processes; scheduler: a running Dask scheduler's address instead.
         progress: called with (variants done, variants) as each batch of a tolerance or grid
             study finishes.
+        kernel: the kinematic passes every variant runs, "generic" or "generated" (one
+            kernel for every variant: the lengths are its inputs); None: the scene's [solver] kernel.
 
     Raises:
         SceneError: a bad study file (FrameNotFound: a name the model lacks); the scene's
@@ -100,6 +103,8 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
         ImportError: naming `pinmech[study]`, without Dask.
     """
     spec = path if isinstance(path, (StudySpec, WorkspaceSpec)) else load_any_study(Path(path))
+    if kernel is not None:
+        spec = dataclasses.replace(spec, kernel=checked_kernel(kernel))
     if spec.kind == "workspace":
         return run_workspace(spec, workers=workers, scheduler=scheduler, progress=progress)
     sm, outputs = built(spec)

@@ -24,7 +24,7 @@ from pinmech.exceptions import (
     SingularPoseError,
 )
 from pinmech.io.scene import Scene
-from pinmech.design.study.file import StudySpec
+from pinmech.design.study.file import StudySpec, spec_scene
 from pinmech.design.study.params import Placement, placements, subtrees
 from pinmech.design.study.variant_core import CoreCycle
 from pinmech.io.sweep import Sweep, sweep_options
@@ -57,7 +57,7 @@ class StudyMechanism:
 
     def __init__(self, spec: StudySpec) -> None:
         self.spec = spec
-        self.scene = scene = Scene.load(spec.scene)
+        self.scene = scene = spec_scene(spec)
         self.sweep = Sweep.from_scene(scene)
         self.mechanism, self.solver = self.sweep.mechanism, self.sweep.solver
         self.model = self.mechanism.model

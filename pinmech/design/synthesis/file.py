@@ -140,6 +140,7 @@ class SynthesisSpec:
     output: str = ""
     pins: tuple[str, ...] = ()
     start: tuple[float, float] | None = None
+    kernel: str | None = None  # the engine's kinematic passes asked by the API (None: the template scene's)
 
     def __hash__(self) -> int:
         return hash((self.path, self.title, self.targets.tobytes(), self.seed))
