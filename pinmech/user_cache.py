@@ -85,6 +85,14 @@ def cached_build(kind: str, key: str, suffix: str, build: Callable[[Path], None]
     return path, False
 
 
+def cached_path(kind: str, key: str, suffix: str) -> Path | None:
+    """The built file `cached_build` keeps for (kind, key, suffix), where it is there and
+    verified; None where it is not (nothing is built)."""
+    folder = private_folder()
+    path = folder / f"{kind}-{key}{suffix}"
+    return path if _verified(path, folder / f"{kind}-{key}{suffix}.sha256") else None
+
+
 def _verified(path: Path, record: Path) -> bool:
     """`path` is a regular file of this user's whose SHA-256 its `record` holds."""
     digest = _digest(path)

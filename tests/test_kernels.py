@@ -395,3 +395,48 @@ def test_a_six_bar_synthesis_search_generates_one_kernel(models_dir, counted_gen
     spec = load_synthesis(models_dir / "synthesis" / "stephenson_function.toml")
     synthesise(dataclasses.replace(spec, generations=3, population=2, keep=1), kernel="generated")
     assert len(counted_generations) == 1
+
+
+@needs_kernels
+@pytest.mark.parametrize("poses, generator, expected", [(kernels.AUTO_POSES, True, "generated"),
+                                                        (kernels.AUTO_POSES - 1, True, "generic"),
+                                                        (kernels.AUTO_POSES, False, "generic")])
+def test_auto_takes_the_kernel_for_a_long_run_where_the_generator_is_built(models_dir, monkeypatch, poses,
+                                                                           generator, expected):
+    """kernel = "auto" in a study's scene: the generated kernel for a run of AUTO_POSES poses
+    or more where the generator is built here, the generic passes for a shorter run or where
+    it is not (auto never starts the generator's one-time build)."""
+    from pinmech.design.study.file import load_study
+    from pinmech.design.study.variant import StudyMechanism
+
+    if not generator:
+        monkeypatch.setattr(kernel_build, "generator_built", lambda: False)
+    import dataclasses
+
+    spec = dataclasses.replace(load_study(models_dir / "studies" / "four_bar_tolerance.toml"), kernel="auto")
+    sm = StudyMechanism(spec, poses=poses)
+    assert sm.solver.kernel == expected
+    assert bool(core.core_for(sm.solver).kernel_path) == (expected == "generated")
+
+
+def test_auto_is_generic_for_one_sweep(models_dir):
+    """A sweep's length is not known to the solver: "auto" there runs the generic passes."""
+    mech = pinmech.Mechanism.from_urdf(models_dir / "four_bar.urdf")
+    solver = LoopSolver(mech, ["O2"], kernel="auto")
+    assert core.core_for(solver).kernel_path == ""
+
+
+def test_no_compiler_on_the_path_is_one_line_and_the_generic_passes(models_dir, monkeypatch, capsys):
+    """PATH holding no compiler and CXX naming none: one line on stderr, the generic passes,
+    and "auto" never takes the kernel."""
+    monkeypatch.setenv("PATH", "")
+    monkeypatch.delenv("CC", raising=False)
+    monkeypatch.setenv("CXX", "/nonexistent/c++")
+    monkeypatch.setattr(kernels, "_said", set())
+    mech = pinmech.Mechanism.from_urdf(models_dir / "four_bar.urdf")
+    compiled = core.compile_loops(mech.model, mech.closures, np.ones(mech.model.nv))[0]
+    assert kernels.attach(compiled, mech.model, "generated") is None
+    assert compiled.kernel_path == ""
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no compiler found (cc or gcc or clang)" in err[0] and "generic" in err[0]
+    assert kernels.resolved("auto", 10 ** 9) == "generic"

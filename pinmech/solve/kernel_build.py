@@ -29,7 +29,7 @@ from pathlib import Path
 
 import pinocchio as pin
 
-from pinmech.user_cache import cached_build
+from pinmech.user_cache import cached_build, cached_path
 
 #: Versions that go into the generator's build (its cache key).
 _VERSIONED = ("libpinocchio", "cmeel-boost", "cmeel-eigen", "cmeel-cppad", "cmeel-cppadcodegen")
@@ -120,6 +120,15 @@ def generator_path() -> Path:
         _run([cxx, *flags, str(source), "-o", str(out), *libs], "the C++ compiler (building the kernel generator)")
 
     return cached_build("kernelgen", key, "", make)[0]
+
+
+def generator_built() -> bool:
+    """The kernel generator is built for this machine and versions already (nothing is built now)."""
+    try:
+        key = generator_recipe()[3]
+    except KernelUnavailable:
+        return False
+    return cached_path("kernelgen", key, "") is not None
 
 
 def generator_recipe() -> tuple[str, list[str], str, str]:

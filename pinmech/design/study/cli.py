@@ -6,6 +6,8 @@ import argparse
 import os
 import sys
 
+from pinmech.solve.kernels import KERNELS
+
 
 def _workers(text: str) -> int:
     """--workers: a whole number >= 0 (argparse type)."""
@@ -65,7 +67,7 @@ def add_parser(sub) -> None:
                             "(spread against the driver), PREFIX_pareto.png, PREFIX_ellipses.png (point outputs); "
                             "PREFIX_grid.png for a 1-D or 2-D grid study, PREFIX_workspace.png for a workspace study")
     study.add_argument("--json", action="store_true", help="print the JSON summary instead of the text one")
-    study.add_argument("--kernel", choices=("generic", "generated"), default=None,
+    study.add_argument("--kernel", choices=KERNELS, default=None,
                        help="kinematic passes of every variant (default: the scene's [solver] kernel); "
                        "generated: one kernel for the whole study, the lengths are its inputs")
     study.add_argument("--quiet", action="store_true",

@@ -8,6 +8,7 @@ import math
 import sys
 
 from pinmech.design.study.cli import _workers
+from pinmech.solve.kernels import KERNELS
 
 
 def add_parser(sub) -> None:
@@ -28,7 +29,7 @@ def add_parser(sub) -> None:
                             "PREFIX.json, and check each one with the engine")
     synth.add_argument("--plot", action="store_true", help="with --out: PREFIX.png, the targets over the coupler curves")
     synth.add_argument("--json", action="store_true", help="print the JSON summary instead of the text one")
-    synth.add_argument("--kernel", choices=("generic", "generated"), default=None,
+    synth.add_argument("--kernel", choices=KERNELS, default=None,
                        help="kinematic passes of a drawn six-bar's candidates (default: the template scene's "
                        "[solver] kernel); four-bars and slider-cranks are solved in closed form")
     synth.set_defaults(func=cmd_synth)

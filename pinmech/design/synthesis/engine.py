@@ -58,7 +58,8 @@ class EngineTemplate:
         raw = {"scene": str(spec.scene.resolve()), "kind": "sensitivity", "steps": 2,
                "params": {name: {"param": name} for name in spec.free}, "outputs": shown}
         self.spec = spec
-        self.sm = StudyMechanism(dataclasses.replace(parse_study(raw, spec.path), kernel=spec.kernel))
+        searched = spec.population * len(spec.free) * spec.generations * (GRID + 1)  # poses, for kernel "auto"
+        self.sm = StudyMechanism(dataclasses.replace(parse_study(raw, spec.path), kernel=spec.kernel), poses=searched)
         self.outputs = StudyOutputs(self.sm)
         self.drawing = self.sm.placements[0].drawing
         self.template = dict(self.drawing.values)

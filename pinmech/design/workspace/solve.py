@@ -20,6 +20,7 @@ motor's column of J by L, so every matrix is dimensionless.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from itertools import product
 
@@ -33,7 +34,7 @@ from pinmech.exceptions import SceneError
 from pinmech.io.scene import Scene
 from pinmech.io.scene_model import load_mechanism, scene_drivers
 from pinmech.model.closure_core import closure_rows
-from pinmech.solve.kernels import attach
+from pinmech.solve.kernels import attach, resolved
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 TOL = 1e-10  # Newton's convergence on the dimensionless residual (closure rows / loop size, end rows / L)
@@ -70,7 +71,8 @@ class WorkspaceMechanism:
         self.mechanism = m = load_mechanism(scene)
         self.model, self.data = m.model, m.model.createData()
         if m.closures:  # the closure rows' core runs the passes the scene (or the API) asks
-            attach(closure_rows(m).core, m.model, scene.solver_options().get("kernel", "generic"))
+            points = math.prod(axis.count for axis in spec.axes)  # each a Newton solve: poses, for "auto"
+            attach(closure_rows(m).core, m.model, resolved(scene.solver_options().get("kernel", "generic"), points))
         where = str(spec.path)
         self.motors = tuple(scene_drivers(scene, m).names)
         self.legs = find_legs(m, self.motors, where)
