@@ -57,6 +57,11 @@ def kernels_here():
 
 needs_kernels = pytest.mark.usefixtures("kernels_here")
 
+#: Every bundled scene (models/scenes); LOOPS: those with loops and drivers (a sweep; the delta has none).
+SCENES = sorted(p.name for p in (MODELS / "scenes").glob("*.toml") if not p.name.endswith(".hand.toml"))
+LOOPS = sorted(set(LOOP_SCENES) | {"crank_shaper.toml", "four_bar_coupler_point.toml", "jansen_leg.toml",
+                                   "leg_mjcf.toml", "stephenson_params.toml", "watt_params.toml"})
+
 KINDS = ["helical", "helical_z", "universal", "ellipsoid", "spherical_zyx", "spherical", "planar", "free_flyer",
          "translation", "prismatic_unaligned", "composite", "mimic"]
 
@@ -111,7 +116,7 @@ def _same_passes(model, generic, generated, rng, poses=3):
 
 
 @needs_kernels
-@pytest.mark.parametrize("scene", LOOP_SCENES)
+@pytest.mark.parametrize("scene", LOOPS)
 def test_every_bundled_model_on_the_kernel_equals_the_generic_passes(scenes_dir, scene):
     """Every bundled scene with loops: the kernel's passes give the generic residual,
     Jacobian and drift to 1e-13 of their size, at poses near the scene's own."""
@@ -379,7 +384,7 @@ def test_a_study_over_lengths_generates_one_kernel(models_dir, counted_generatio
     if spec.kind == "grid":
         spec = dataclasses.replace(spec, grid=tuple(dataclasses.replace(a, count=3) for a in spec.grid))
     if spec.kind == "workspace":
-        spec = dataclasses.replace(spec, axes=tuple(dataclasses.replace(a, count=4) for a in spec.axes))
+        spec = dataclasses.replace(spec, axes=tuple(dataclasses.replace(a, count=4) for a in spec.axes), refine_depth=0)
     study(spec, kernel="generated")
     assert len(counted_generations) == 1
 
@@ -440,3 +445,40 @@ def test_no_compiler_on_the_path_is_one_line_and_the_generic_passes(models_dir, 
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "no compiler found (cc or gcc or clang)" in err[0] and "generic" in err[0]
     assert kernels.resolved("auto", 10 ** 9) == "generic"
+
+
+def _numbers(tree, out: dict, key: str = "") -> dict:
+    """Every number of a nested dict / list (to_dict's), by its path."""
+    if isinstance(tree, dict):
+        for k, v in tree.items():
+            _numbers(v, out, f"{key}.{k}")
+    elif isinstance(tree, (list, tuple)):
+        for i, v in enumerate(tree):
+            _numbers(v, out, f"{key}[{i}]")
+    elif isinstance(tree, (int, float)) and not isinstance(tree, bool):
+        out[key] = float(tree)
+    return out
+
+
+@needs_kernels
+@pytest.mark.parametrize("scene", SCENES)
+def test_every_bundled_scene_answers_the_same_on_the_kernel(scenes_dir, scene, monkeypatch):
+    """Every bundled scene's analysis (pose, rates, forces where asked) with kernel = "generated":
+    the kernel runs, and every number equals the generic one to 1e-13 of its size (the
+    module's docstring derives the bound; a Newton solve on either stops within its tolerance
+    of the same root, so the poses agree to rounding too)."""
+    from pinmech import analyse, to_dict
+
+    ran = []
+    attach = kernels.attach
+    monkeypatch.setattr(kernels, "attach", lambda *a: ran.append(attach(*a)) or ran[-1])
+    try:
+        generic = _numbers(to_dict(analyse(pinmech.Scene.load(scenes_dir / scene))), {})
+    except ImportError as missing:  # the robots' scenes need pinmech[robots]
+        pytest.skip(str(missing))
+    generated = _numbers(to_dict(analyse(pinmech.Scene.load(scenes_dir / scene, ['solver.kernel="generated"']))), {})
+    assert any(ran), "the kernel did not run"
+    assert generated.keys() == generic.keys()
+    for key, a in generic.items():
+        if np.isfinite(a):
+            assert abs(generated[key] - a) <= 1e-13 * max(1.0, abs(a)), key
