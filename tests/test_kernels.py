@@ -11,8 +11,15 @@ Checks, each against something that is not the kernel:
   numbers of the model's size (lengths to 1 m, rotations to 1, rates to 10), so the two
   differ by a few hundred ulps of that size at most (300 x 2.2e-16 ~ 7e-14 < 1e-13);
 - the closed forms of tests/test_bundled_models.py (four-bar, slider-crank) with the kernel on;
-- a changed dimension is used at the next call with no new kernel;
-- no compiler: one line names it, the generic passes run; the cache refuses what it did not write.
+- a changed dimension is used at the next call with no new kernel; a study, a grid, a
+  workspace grid and a six-bar search make one kernel in all (generations counted);
+- a joint changed in place (prismatic to revolute) never runs the old kernel: the core
+  refuses it, the solver's next call makes a fresh one, checked against Pinocchio;
+- the kernel's name changes with each joint type, axis, pitch, mimic ratio, not with a length;
+- "auto": the kernel for a long run where the generator is built, else the generic passes;
+- no compiler: one line names it, the generic passes run; the cache refuses what it did not
+  write, and processes asking at once build a file once (its lock);
+- every bundled scene's analysis on the kernel equals the generic one to 1e-13 of its size.
 """
 
 from __future__ import annotations

@@ -1,13 +1,15 @@
 """Which kinematic passes a solver's compiled core runs: Pinocchio's generic algorithms
 (`kernel="generic"`, the default) or a kernel generated from the same algorithms for the
-model (`kernel="generated"`: kernel_build.py makes it, the core loads it).
+model (`kernel="generated"`: kernel_build.py makes it, the core loads it), or for a long
+design run "auto" (`resolved`: generated where it pays, measured).
 
 The generated kernel writes the same numbers the generic passes write (the joints' world
 placements, their Jacobians, velocities and accelerations), summed in another order: the
 answers agree to rounding (tests/test_kernels.py), and the core's checks of every pose
 (residual, condition number, assembly signature) run on them unchanged. Where no kernel
 can be built (no compiler, no `pinmech[fast]`), one line on stderr says why and the
-generic passes run.
+generic passes run. A kernel made for other joints never runs: the core refuses it
+(`Core.kernel_stale`) and `kept` sets the kernel of the joints the model has now.
 """
 
 from __future__ import annotations
