@@ -197,18 +197,6 @@ def test_the_scene_and_api_refuse_an_unknown_kernel(scenes_dir):
         LoopSolver(mech, ["O2"], kernel="fast")
 
 
-def test_no_compiler_is_one_line_and_the_generic_passes(models_dir, monkeypatch, capsys):
-    """CC naming no compiler: one line on stderr says so, the core keeps the generic passes."""
-    monkeypatch.setenv("CC", "/nonexistent/cc")
-    monkeypatch.setattr(kernels, "_said", set())
-    mech = pinmech.Mechanism.from_urdf(models_dir / "four_bar.urdf")
-    compiled = core.compile_loops(mech.model, mech.closures, np.ones(mech.model.nv))[0]
-    assert kernels.attach(compiled, mech.model, "generated") is None
-    assert compiled.kernel_path == ""
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "no compiler found ($CC=/nonexistent/cc)" in err[0] and "generic" in err[0]
-
-
 @needs_kernels
 def test_the_cache_rebuilds_a_kernel_it_did_not_write(models_dir):
     """A cached kernel whose bytes no longer match its record, or that is a link, is built
@@ -438,19 +426,24 @@ def test_auto_is_generic_for_one_sweep(models_dir):
     assert core.core_for(solver).kernel_path == ""
 
 
-def test_no_compiler_on_the_path_is_one_line_and_the_generic_passes(models_dir, monkeypatch, capsys):
-    """PATH holding no compiler and CXX naming none: one line on stderr, the generic passes,
-    and "auto" never takes the kernel."""
-    monkeypatch.setenv("PATH", "")
-    monkeypatch.delenv("CC", raising=False)
-    monkeypatch.setenv("CXX", "/nonexistent/c++")
+@pytest.mark.parametrize("env, said", [({"CC": "/nonexistent/cc"}, "no compiler found ($CC=/nonexistent/cc)"),
+                                       ({"PATH": "", "CC": None, "CXX": "/nonexistent/c++"},
+                                        "no compiler found (cc or gcc or clang)")])
+def test_no_compiler_is_one_line_and_the_generic_passes(models_dir, monkeypatch, capsys, env, said):
+    """CC naming no compiler, or PATH holding none (and CXX naming none): one line on stderr
+    says so, the core keeps the generic passes, and "auto" never takes the kernel."""
+    for name, value in env.items():
+        if value is None:
+            monkeypatch.delenv(name, raising=False)
+        else:
+            monkeypatch.setenv(name, value)
     monkeypatch.setattr(kernels, "_said", set())
     mech = pinmech.Mechanism.from_urdf(models_dir / "four_bar.urdf")
     compiled = core.compile_loops(mech.model, mech.closures, np.ones(mech.model.nv))[0]
     assert kernels.attach(compiled, mech.model, "generated") is None
     assert compiled.kernel_path == ""
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "no compiler found (cc or gcc or clang)" in err[0] and "generic" in err[0]
+    assert len(err) == 1 and said in err[0] and "generic" in err[0]
     assert kernels.resolved("auto", 10 ** 9) == "generic"
 
 

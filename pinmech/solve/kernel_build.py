@@ -123,8 +123,10 @@ def generator_path() -> Path:
 
 
 def generator_built() -> bool:
-    """The kernel generator is built for this machine and versions already (nothing is built now)."""
+    """The kernel generator is built for this machine and versions already, and the C compiler
+    a kernel needs is here (nothing is built now)."""
     try:
+        _compiler("CC", ("cc", "gcc", "clang"))
         key = generator_recipe()[3]
     except KernelUnavailable:
         return False
