@@ -25,8 +25,9 @@ import os
 import shutil
 import stat
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterator
 
 _fallback: Path | None = None
 
@@ -50,6 +51,10 @@ def cached_text(kind: str, suffix: str, text: str) -> Path:
 def cached_build(kind: str, key: str, suffix: str, build: Callable[[Path], None]) -> tuple[Path, bool]:
     """A built file in this user's private cache folder, and whether it was there already.
 
+    Processes that ask for the same file at once (test workers, a study's workers) build it
+    once: the first takes the file's lock and builds, the others wait on the lock and then
+    find it built.
+
     Args:
         kind: the file name's prefix ("kernel", "kernelgen").
         key: the SHA-256 (hex) of everything the file is built from.
@@ -59,23 +64,56 @@ def cached_build(kind: str, key: str, suffix: str, build: Callable[[Path], None]
     folder = private_folder()
     path = folder / f"{kind}-{key}{suffix}"
     record = folder / f"{kind}-{key}{suffix}.sha256"
-    digest = _digest(path)
-    if digest is not None and _holds(record, digest.encode("ascii")):
+    if _verified(path, record):
         return path, True
-    handle, name = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(handle)
-    try:
-        build(Path(name))
-        os.chmod(name, 0o700)
-        digest = _digest(Path(name))
-        if digest is None:
-            raise OSError(f"{name}: the build wrote no file")
-        os.replace(name, path)
-    except BaseException:
-        Path(name).unlink(missing_ok=True)
-        raise
-    _write(folder, record, digest.encode("ascii"))
+    with _locked(folder / f".{path.name}.lock"):
+        if _verified(path, record):  # built by another process while this one waited
+            return path, True
+        handle, name = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
+        os.close(handle)
+        try:
+            build(Path(name))
+            os.chmod(name, 0o700)
+            digest = _digest(Path(name))
+            if digest is None:
+                raise OSError(f"{name}: the build wrote no file")
+            _write(folder, record, digest.encode("ascii"))
+            os.replace(name, path)
+        except BaseException:
+            Path(name).unlink(missing_ok=True)
+            raise
     return path, False
+
+
+def cached_path(kind: str, key: str, suffix: str) -> Path | None:
+    """The built file `cached_build` keeps for (kind, key, suffix), where it is there and
+    verified; None where it is not (nothing is built)."""
+    folder = private_folder()
+    path = folder / f"{kind}-{key}{suffix}"
+    return path if _verified(path, folder / f"{kind}-{key}{suffix}.sha256") else None
+
+
+def _verified(path: Path, record: Path) -> bool:
+    """`path` is a regular file of this user's whose SHA-256 its `record` holds."""
+    digest = _digest(path)
+    return digest is not None and _holds(record, digest.encode("ascii"))
+
+
+@contextmanager
+def _locked(lock: Path) -> Iterator[None]:
+    """An exclusive lock on `lock` (made 0600 if absent) for the block; none where the
+    system has no `fcntl` (Windows: two processes may then build the same file twice)."""
+    try:
+        import fcntl
+    except ImportError:
+        yield
+        return
+    fd = os.open(lock, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o600)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # releases the lock
 
 
 def _digest(path: Path) -> str | None:

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import argparse
 
+from pinmech.solve.kernels import KERNELS
+
 
 def add_scene_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", help="scene file (TOML), e.g. models/scenes/r_rtr.toml")
@@ -15,7 +17,7 @@ def add_scene_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--angle", help="shortcut: the (single) driver's angle or position, e.g. '45 deg'")
     parser.add_argument("--speed", help="shortcut: the driver's speed, e.g. '-50 rpm' or '2 rad/s'")
     parser.add_argument("--acceleration", help="shortcut: the driver's acceleration, e.g. '1 rad/s^2'")
-    parser.add_argument("--kernel", choices=("generic", "generated"),
+    parser.add_argument("--kernel", choices=KERNELS,
                         help="kinematic passes: Pinocchio's generic algorithms, or the same algorithms generated "
                         "for the model, compiled once and cached (needs a compiler and pinmech[fast]; "
                         "[solver] kernel)")

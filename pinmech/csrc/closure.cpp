@@ -114,6 +114,10 @@ void Core::check_structure() const {
                                 std::to_string(parents_.size() - 1) + " joints, " + std::to_string(nframes_) +
                                 " frames then; " + std::to_string(model_.njoints - 1) + " joints, " +
                                 std::to_string(model_.frames.size()) + " frames now)");
+  if (kernel_stale())
+    throw std::invalid_argument("the model's joints changed since its generated kernel " + kernel_->path +
+                                " was loaded (a joint's type, axis, pitch or mimic ratio): it would give the old "
+                                "joints' answers; set the kernel again (pinmech makes one for the new joints)");
 }
 
 // ---------------------------------------------------------------- pieces (also for tests)

@@ -298,6 +298,7 @@ struct Kernel {
   Pass placements = nullptr, jacobians = nullptr, motion = nullptr;
   VectorXd x, y;
   std::string path;
+  pin::Model::JointModelVector joints;  // the joints it was generated for (types, axes, pitches...)
   Kernel() = default;
   Kernel(const Kernel&) = delete;
   Kernel& operator=(const Kernel&) = delete;
@@ -411,6 +412,9 @@ class Core {
   void set_kernel(const std::string& path);
   void clear_kernel();
   std::string kernel_path() const;  // "" where the passes are generic
+  // A kernel is set and the model's joints are no longer those it was made for (a joint's
+  // type, axis, pitch or mimic ratio changed in place): check_structure refuses to run it.
+  bool kernel_stale() const;
 
  private:
   Vector6d error6(const Cut& cut) const;

@@ -33,7 +33,7 @@ Kernel::~Kernel() {
 }
 
 void Core::set_kernel(const std::string& path) {
-  check_structure();
+  if (!same_structure()) check_structure();  // a stale kernel is what this replaces
   auto kernel = std::make_unique<Kernel>();
   kernel->handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (kernel->handle == nullptr) throw std::invalid_argument("cannot load the kernel " + path + ": " + dlerror());
@@ -52,6 +52,7 @@ void Core::set_kernel(const std::string& path) {
   kernel->x = VectorXd::Zero(model_.nq + 2 * model_.nv + 12 * nj);
   kernel->y = VectorXd::Zero(12 * nj + std::max<Index>(6 * model_.nvExtended, 12 * nj));
   kernel->path = path;
+  kernel->joints = model_.joints;
   kernel_ = std::move(kernel);
   joint_jacobians_ = false;
 }
@@ -62,6 +63,8 @@ void Core::clear_kernel() {
 }
 
 std::string Core::kernel_path() const { return kernel_ ? kernel_->path : std::string(); }
+
+bool Core::kernel_stale() const { return kernel_ && !(model_.joints == kernel_->joints); }
 
 // The kernel's input: q, v, a and the model's joint placements as they are now (a
 // dimension changed in the model is used at the next call).

@@ -117,5 +117,6 @@ NB_MODULE(_core, m) {
       .def("pinocchio_passes", &Core::pinocchio_passes)
       .def("set_kernel", &Core::set_kernel, "set_kernel(path): the kinematic passes from a generated kernel (kernel.cpp)")
       .def("clear_kernel", &Core::clear_kernel, "clear_kernel(): Pinocchio's generic passes again")
-      .def_prop_ro("kernel_path", &Core::kernel_path);
+      .def_prop_ro("kernel_path", &Core::kernel_path)
+      .def_prop_ro("kernel_stale", &Core::kernel_stale);
 }

@@ -53,12 +53,9 @@ def core_for(solver) -> _core.Core | None:
         compiled.tol = solver.tol
     if compiled is not None:
         set_certify(compiled, getattr(solver, "certify", "every-pose"))
-    kernel = getattr(solver, "kernel", "generic")
-    if compiled is not None and solver.__dict__.get("_kernel_set") != (id(compiled), kernel):
-        from pinmech.solve.kernels import attach
+        from pinmech.solve.kernels import kept
 
-        attach(compiled, solver.model, kernel)
-        solver.__dict__["_kernel_set"] = (id(compiled), kernel)
+        kept(solver.__dict__, compiled, solver.model, getattr(solver, "kernel", "generic"))
     return compiled
 
 

@@ -47,7 +47,7 @@ def fold_pose(solver, k: int, driver_q: np.ndarray, q0: np.ndarray, x0: float, e
     pivot = _pivot(solver, solver._rates(q0, unit, np.zeros(len(unit)), limit=math.inf)[0])  # ill-conditioned there
     names = [n for i, n in enumerate(solver.drivers) if i != k] + [pivot]
     by_pivot = LoopSolver(mech, names, tol=solver.tol, max_iterations=solver.max_iterations,
-                          max_condition=solver.max_condition)
+                          max_condition=solver.max_condition, kernel=solver.kernel)
     held = [float(x) for i, x in enumerate(driver_q) if i != k]
     v_in = np.zeros(len(names))
     v_in[-1] = 1.0

@@ -16,6 +16,7 @@ and the generic passes run).
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import shutil
@@ -28,7 +29,7 @@ from pathlib import Path
 
 import pinocchio as pin
 
-from pinmech.user_cache import cached_build
+from pinmech.user_cache import cached_build, cached_path
 
 #: Versions that go into the generator's build (its cache key).
 _VERSIONED = ("libpinocchio", "cmeel-boost", "cmeel-eigen", "cmeel-cppad", "cmeel-cppadcodegen")
@@ -66,13 +67,22 @@ class KernelBuild:
 def build_kernel(model: pin.Model) -> KernelBuild:
     """The kernel of `model`'s joints and tree, from the cache or generated and compiled now."""
     text = _structure(model)
+    key = kernel_key(text)
     cc = _compiler("CC", ("cc", "gcc", "clang"))
-    key = hashlib.sha256("\0".join([text, cc, _compiler_version(cc), " ".join(KERNEL_FLAGS),
-                                    _generator_source()]).encode()).hexdigest()
     made: list[tuple[float, float, int, int]] = []
     path, cached = cached_build("kernel", key, ".so", lambda out: made.append(make_kernel(model, out, text, cc)))
     generate, compile_, c_bytes, _ = made[0] if made else (0.0, 0.0, 0, 0)
     return KernelBuild(path, cached, generate, compile_, path.stat().st_size, c_bytes)
+
+
+def kernel_key(text: str) -> str:
+    """The SHA-256 of everything a kernel is made from: the model's structure (`text`: its
+    joints with their types, axes, pitches and mimic ratios, its tree and frames), the C
+    compiler, its version and flags, and the generator's own key (generator.cpp, the
+    Pinocchio, Boost, Eigen and CppAD versions, the C++ compiler and its version)."""
+    cc = _compiler("CC", ("cc", "gcc", "clang"))
+    return hashlib.sha256("\0".join([text, cc, _compiler_version(cc), " ".join(KERNEL_FLAGS),
+                                     generator_recipe()[3]]).encode()).hexdigest()
 
 
 def make_kernel(model: pin.Model, out: Path, text: str | None = None,
@@ -110,6 +120,17 @@ def generator_path() -> Path:
         _run([cxx, *flags, str(source), "-o", str(out), *libs], "the C++ compiler (building the kernel generator)")
 
     return cached_build("kernelgen", key, "", make)[0]
+
+
+def generator_built() -> bool:
+    """The kernel generator is built for this machine and versions already, and the C compiler
+    a kernel needs is here (nothing is built now)."""
+    try:
+        _compiler("CC", ("cc", "gcc", "clang"))
+        key = generator_recipe()[3]
+    except KernelUnavailable:
+        return False
+    return cached_path("kernelgen", key, "") is not None
 
 
 def generator_recipe() -> tuple[str, list[str], str, str]:
@@ -156,6 +177,7 @@ def _compiler(variable: str, names: tuple[str, ...]) -> str:
     raise KernelUnavailable(f"no compiler found ({said}); generated kernels need one at run time")
 
 
+@functools.lru_cache(maxsize=8)
 def _compiler_version(path: str) -> str:
     done = subprocess.run([path, "--version"], capture_output=True, text=True)
     return done.stdout.splitlines()[0] if done.returncode == 0 and done.stdout else path

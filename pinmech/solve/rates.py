@@ -39,7 +39,7 @@ from pinmech.seeded import Seeded
 from pinmech.solve import core
 from pinmech.solve.core import _core
 from pinmech.solve.certify import checked_certify
-from pinmech.solve.kernels import attach, checked_kernel
+from pinmech.solve.kernels import checked_kernel, kept
 from pinmech.solve.results import RateSolution, frozen
 from pinmech.solve.loops import (
     DEFAULT_MAX_CONDITION,
@@ -311,9 +311,7 @@ class RateSolver:
             cached = (compiled, None)
             nv = self.model.nv
             self._columns = (nv, 2 * nv + _core.RATE_NUMBERS, self.x_dot.size)
-        if self.__dict__.get("_kernel_set") != (id(cached[0]), self.kernel):
-            attach(cached[0], self.model, self.kernel)
-            self.__dict__["_kernel_set"] = (id(cached[0]), self.kernel)
+        kept(self.__dict__, cached[0], self.model, self.kernel)
         core.set_certify(cached[0], self.certify)
         if cached[1] != options:
             rows, columns = self._scales(self._closure_rows)

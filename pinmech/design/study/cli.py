@@ -6,6 +6,8 @@ import argparse
 import os
 import sys
 
+from pinmech.solve.kernels import KERNELS
+
 
 def _workers(text: str) -> int:
     """--workers: a whole number >= 0 (argparse type)."""
@@ -69,6 +71,9 @@ def add_parser(sub) -> None:
                        help="poses of each variant's cycle given the exact condition number: "
                        "every-pose, every-K (e.g. every-10), ends or none (default: the scene's [solver] certify, "
                        "else every-pose); every pose keeps its residual and assembly checks")
+    study.add_argument("--kernel", choices=KERNELS, default=None,
+                       help="kinematic passes of every variant (default: the scene's [solver] kernel); "
+                       "generated: one kernel for the whole study, the lengths are its inputs")
     study.add_argument("--quiet", action="store_true",
                        help="no progress bar (there is none either when stderr is not a terminal)")
     study.set_defaults(func=cmd_study)
@@ -92,7 +97,8 @@ def cmd_study(args: argparse.Namespace) -> int:
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
     bar = ProgressBar.on_terminal(quiet=args.quiet)
     try:
-        result = study(spec, workers=workers, scheduler=scheduler, progress=bar, certify=_certify(args))
+        result = study(spec, workers=workers, scheduler=scheduler, progress=bar, certify=_certify(args),
+                       kernel=args.kernel)
     finally:
         if bar is not None:
             bar.close()

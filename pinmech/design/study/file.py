@@ -67,6 +67,7 @@ from typing import Any
 from pinmech.design.file_where import FileWhere, load_file
 from pinmech.counts import memory_refusal
 from pinmech.design.study.params import AXES, DISTRIBUTIONS, Parameter
+from pinmech.io.scene import Scene
 from pinmech.model.linkage_expr import is_angle
 from pinmech.units import to_si
 
@@ -150,6 +151,14 @@ class StudySpec:
     torque: tuple[str, ...] = ()
     limits: tuple = ()
     certify: str | None = None  # the certification dial asked for the run (None: the scene's [solver])
+    kernel: str | None = None  # the kinematic passes asked by the API (None: the scene's [solver] kernel)
+
+
+def spec_scene(spec) -> Scene:
+    """The scene a study or workspace file names, with the kernel the API asked (`spec.kernel`)
+    in place of its [solver] kernel where one was asked."""
+    asked = getattr(spec, "kernel", None)
+    return Scene.load(spec.scene, [f'solver.kernel="{asked}"'] if asked else None)
 
 
 def load_study(path: str | Path) -> StudySpec:

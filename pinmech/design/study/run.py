@@ -28,6 +28,7 @@ from pinmech.design.study.tolerance import Batch, BatchResult, Spread, batches, 
 from pinmech.design.workspace.run import WorkspaceResult, run_workspace
 from pinmech.design.workspace.file import WorkspaceSpec, is_workspace, parse_workspace
 from pinmech.exceptions import SceneError
+from pinmech.solve.kernels import checked_kernel
 from pinmech.toml_file import read_toml
 
 
@@ -82,8 +83,8 @@ class StudyResult:
 
 
 def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, scheduler: str | None = None,
-          progress: Callable[[int, int], None] | None = None,
-          certify: str | None = None) -> StudyResult | WorkspaceResult:
+          progress: Callable[[int, int], None] | None = None, certify: str | None = None,
+          kernel: str | None = None) -> StudyResult | WorkspaceResult:
     """Run a study file.
 
     Args:
@@ -95,6 +96,8 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
         certify: the certification dial of each variant's cycle ("every-pose", "every-K",
             "ends", "none"; certify.py); None: the scene's `[solver] certify`. A workspace
             study solves each grid point on its own, certified, and refuses another level.
+        kernel: the kinematic passes every variant runs, "generic" or "generated" (one
+            kernel for every variant: the lengths are its inputs); None: the scene's [solver] kernel.
 
     Raises:
         SceneError: a bad study file (FrameNotFound: a name the model lacks); the scene's
@@ -107,6 +110,8 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
     spec = path if isinstance(path, (StudySpec, WorkspaceSpec)) else load_any_study(Path(path))
     if certify is not None:
         spec = _with_certify(spec, certify)
+    if kernel is not None:
+        spec = dataclasses.replace(spec, kernel=checked_kernel(kernel))
     if spec.kind == "workspace":
         return run_workspace(spec, workers=workers, scheduler=scheduler, progress=progress)
     sm, outputs = built(spec)

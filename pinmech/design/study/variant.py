@@ -10,6 +10,8 @@ point where its assembly changes ("changes assembly"), or has a value outside it
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,10 +27,11 @@ from pinmech.exceptions import (
     SingularPoseError,
 )
 from pinmech.io.scene import Scene
-from pinmech.design.study.file import StudySpec
+from pinmech.design.study.file import StudySpec, spec_scene
 from pinmech.design.study.params import Placement, placements, subtrees
 from pinmech.design.study.variant_core import CoreCycle
 from pinmech.io.sweep import Sweep, sweep_options
+from pinmech.solve.kernels import resolved
 
 CAUSES = ("cannot assemble", "other assembly", "fold within the range", "changes assembly", "singular pose",
           "outside bounds")
@@ -56,13 +59,16 @@ class StudyMechanism:
     sweep's driver values [rad or m], and the nominal reference (q and its signs).
     """
 
-    def __init__(self, spec: StudySpec) -> None:
+    def __init__(self, spec: StudySpec, poses: int | None = None) -> None:
+        """`poses`: about how many poses the run solves (default: the study's variants times
+        its steps), for the scene's kernel = "auto" (solve/kernels.py's `resolved`)."""
         self.spec = spec
-        self.scene = scene = Scene.load(spec.scene)
+        self.scene = scene = spec_scene(spec)
         self.sweep = Sweep.from_scene(scene)
         self.mechanism, self.solver = self.sweep.mechanism, self.sweep.solver
         if spec.certify is not None:  # the run's dial over the scene's [solver] certify
             self.solver.certify = spec.certify
+        self.solver.kernel = resolved(self.solver.kernel, _run_poses(spec) if poses is None else poses)
         self.model = self.mechanism.model
         self.placements: list[Placement] = placements(self.mechanism, spec.params, str(spec.path), scene)
         self._drawing = next((place.drawing for place in self.placements if place.drawn), None)
@@ -162,6 +168,13 @@ class StudyMechanism:
         pin.computeJointJacobians(self.model, self.data, q)
         pin.updateFramePlacements(self.model, self.data)
         return self.data
+
+
+def _run_poses(spec: StudySpec) -> int:
+    """The poses a study solves: its variants (samples, grid points, or the nominal and two
+    a parameter for its slopes) times its steps."""
+    variants = {"tolerance": spec.samples, "grid": math.prod(a.count for a in spec.grid)}
+    return variants.get(spec.kind, 2 * len(spec.params) + 1) * spec.steps
 
 
 def _cycle_values(scene: Scene, sweep: Sweep, steps: int) -> np.ndarray:

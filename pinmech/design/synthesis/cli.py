@@ -8,6 +8,7 @@ import math
 import sys
 
 from pinmech.design.study.cli import _workers
+from pinmech.solve.kernels import KERNELS
 
 
 def add_parser(sub) -> None:
@@ -28,6 +29,9 @@ def add_parser(sub) -> None:
                             "PREFIX.json, and check each one with the engine")
     synth.add_argument("--plot", action="store_true", help="with --out: PREFIX.png, the targets over the coupler curves")
     synth.add_argument("--json", action="store_true", help="print the JSON summary instead of the text one")
+    synth.add_argument("--kernel", choices=KERNELS, default=None,
+                       help="kinematic passes of a drawn six-bar's candidates (default: the template scene's "
+                       "[solver] kernel); four-bars and slider-cranks are solved in closed form")
     synth.set_defaults(func=cmd_synth)
 
 
@@ -50,7 +54,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
         endings = [f"_{i}{end}" for i in range(1, spec.keep + 1) for end in (".toml", "_scene.toml")]
         inputs = {"the synthesis file": spec.path, **({"its scene": spec.scene} if spec.scene else {})}
         check_prefix("--out", args.out, [*endings, ".json", *([".png"] if args.plot else [])], inputs)
-    result = synthesise(spec, workers=args.workers, scheduler=args.scheduler)
+    result = synthesise(spec, workers=args.workers, scheduler=args.scheduler, kernel=args.kernel)
     if not result.linkages:
         causes = ", ".join(f"{n} {c}" for c, n in sorted(result.rejected.items())) or "none"
         raise SynthesisError(f"no linkage meets the targets without a defect and within the constraints "

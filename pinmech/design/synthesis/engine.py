@@ -18,6 +18,7 @@ One template per process (Pinocchio's models do not pickle: a Dask worker builds
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -57,7 +58,8 @@ class EngineTemplate:
         raw = {"scene": str(spec.scene.resolve()), "kind": "sensitivity", "steps": 2,
                "params": {name: {"param": name} for name in spec.free}, "outputs": shown}
         self.spec = spec
-        self.sm = StudyMechanism(parse_study(raw, spec.path))
+        searched = spec.population * len(spec.free) * spec.generations * (GRID + 1)  # poses, for kernel "auto"
+        self.sm = StudyMechanism(dataclasses.replace(parse_study(raw, spec.path), kernel=spec.kernel), poses=searched)
         self.outputs = StudyOutputs(self.sm)
         self.drawing = self.sm.placements[0].drawing
         self.template = dict(self.drawing.values)

@@ -101,8 +101,7 @@ class SynthesisSpec:
         timing: (N,) the crank's turn from the first target to each [rad], or None
             (then the crank angles are free, their order checked).
         lower, upper: (9,) bounds of (O2x, O2y, O4x, O4y, crank, coupler, rocker, along,
-            across) [m] (fourbar.NAMES); for a function (3,) of crank, coupler,
-            rocker [m].
+            across) [m] (fourbar.NAMES); for a function (3,) of crank, coupler, rocker [m].
         ground: a function generator's ground O2 -> O4 along x [m] (0 for a path).
         angles: (N,) the coupler's angles at the poses of a motion task [rad] (its
             positions are `targets`), else None.
@@ -114,7 +113,7 @@ class SynthesisSpec:
             params the search varies (lower, upper: their bounds [m]); point: the coupler
             point of a path or a motion; output: the link whose turns a function gives, or
             the link a motion's poses carry (the file's `link`); pins: the dyads' middle
-            pins whose transmission angle is bounded.
+            pins whose transmission angle is bounded. kernel: the engine's passes (None: the scene's).
     """
 
     path: Path
@@ -141,6 +140,7 @@ class SynthesisSpec:
     output: str = ""
     pins: tuple[str, ...] = ()
     start: tuple[float, float] | None = None
+    kernel: str | None = None
 
     def __hash__(self) -> int:
         return hash((self.path, self.title, self.targets.tobytes(), self.seed))

@@ -11,6 +11,7 @@ in the same arithmetic and gathered in order, and DE updates it once per generat
 
 from __future__ import annotations
 
+import dataclasses
 from collections import Counter
 from pathlib import Path
 
@@ -20,6 +21,7 @@ from pinmech.design.synthesis.file import SIX_BARS, SynthesisSpec, load_synthesi
 from pinmech.design.synthesis.kinematics import kinematics
 from pinmech.design.synthesis.result import MET as _MET, Linkage, SynthesisResult
 from pinmech.design.synthesis.tasks import classical_rows, evaluate, refined, search_bounds
+from pinmech.solve.kernels import checked_kernel
 
 _EXTRA = 'pip install "pinmech[study]"'
 _CLOSE = 3e-2  # from a best relative rms target error below this, every 10th generation tries a refinement ...
@@ -56,16 +58,22 @@ class PopulationMap:
         return values
 
 
-def synthesise(spec: SynthesisSpec | str | Path, *, workers: int = 0, scheduler: str | None = None) -> SynthesisResult:
+def synthesise(spec: SynthesisSpec | str | Path, *, workers: int = 0, scheduler: str | None = None,
+               kernel: str | None = None) -> SynthesisResult:
     """The best distinct linkages (up to spec.keep) that meet the targets without defects.
 
     Args:
         spec: a synthesis file's spec, or the file (read with load_synthesis).
         workers: 0 evaluates in this process; n > 0 on a LocalCluster of n worker
             processes (unless a scheduler address is given).
+        kernel: the engine's kinematic passes for a drawn six-bar's candidates ("generic" or
+            "generated": one kernel for the whole search); None: the template scene's. The
+            four-bar and slider-crank topologies are solved in closed form and run no passes.
     """
     if not isinstance(spec, SynthesisSpec):
         spec = load_synthesis(spec)
+    if kernel is not None:
+        spec = dataclasses.replace(spec, kernel=checked_kernel(kernel))
     if scheduler is None and workers == 0:
         return _run(spec, PopulationMap(spec))
     from pinmech.design.cluster import require_dask

@@ -78,6 +78,7 @@ class WorkspaceSpec:
     space: str = "task"
     kind: str = "workspace"
     seed: int = 0
+    kernel: str | None = None  # the kinematic passes asked by the API (None: the scene's [solver] kernel)
 
     @property
     def task_rows(self) -> tuple[int, ...]:

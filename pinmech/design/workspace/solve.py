@@ -20,18 +20,21 @@ motor's column of J by L, so every matrix is dimensionless.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from itertools import product
 
 import numpy as np
 import pinocchio as pin
 
+from pinmech.design.study.file import spec_scene
 from pinmech.design.workspace.file import WorkspaceSpec
 from pinmech.design.workspace.legs import Leg, angles, find_legs, mode_sign, passive_conditioning, set_angles
 from pinmech.exceptions import SceneError
 from pinmech.io.scene import Scene
 from pinmech.io.scene_model import load_mechanism, scene_drivers
 from pinmech.model.closure_core import closure_rows
+from pinmech.solve.kernels import attach, resolved
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 TOL = 1e-10  # Newton's convergence on the dimensionless residual (closure rows / loop size, end rows / L)
@@ -64,9 +67,12 @@ class WorkspaceMechanism:
     """The study's mechanism, its legs, end point and seed tables: built once per process."""
 
     def __init__(self, spec: WorkspaceSpec) -> None:
-        scene = Scene.load(spec.scene)
+        scene = spec_scene(spec)
         self.mechanism = m = load_mechanism(scene)
         self.model, self.data = m.model, m.model.createData()
+        if m.closures:  # the closure rows' core runs the passes the scene (or the API) asks
+            points = math.prod(axis.count for axis in spec.axes)  # each a Newton solve: poses, for "auto"
+            attach(closure_rows(m).core, m.model, resolved(scene.solver_options().get("kernel", "generic"), points))
         where = str(spec.path)
         self.motors = tuple(scene_drivers(scene, m).names)
         self.legs = find_legs(m, self.motors, where)
