@@ -27,7 +27,7 @@ from pinmech.model.display import colour_of, display_names, hex_colour
 from pinmech.draw.plot_centrodes import CentrodeTrace
 from pinmech.draw.plot_curves import driver_axis as _driver_axis
 from pinmech.draw.plot_curves import draw_markers, legend_beside, length_unit
-from pinmech.draw.plot_design import DesignTrace, mark_least
+from pinmech.draw.plot_design import DesignTrace, mark_least, transmission_band
 from pinmech.draw.plot_paths import PathRecorder
 from pinmech.draw.sweep_panels import SweepPanels
 
@@ -169,7 +169,12 @@ class SweepPlot(SweepPanels):
             self.points = [n for n, p in motion.points.items()
                            if p.link in mech.links and model.frames[mech.links[p.link]].parentJoint != 0]
         self.sliders = list(motion.sliders)
-        self.colours = {n: hex_colour(colour_of(mech, n)) for n in [*self.links, *self.points]}
+        from pinmech.draw.figure_style import point_styles
+
+        self.colours = {n: hex_colour(colour_of(mech, n)) for n in self.links}
+        styles = point_styles(self.points)  # each point its own colour and marker (figure_style.py)
+        self.colours.update({n: colour for n, (colour, _) in styles.items()})
+        self.point_markers = {n: marker for n, (_, marker) in styles.items()}
         # a slider in the colour of its moving side (a tree joint's child, a loop cut's child link)
         self.colours.update({n: hex_colour(colour_of(mech, s.child)) for n, s in motion.sliders.items()})
         for dyad, name in zip(self.design.dyads, self.design.names):  # a dyad in its output's colour
@@ -248,7 +253,8 @@ class SweepPlot(SweepPanels):
         for ax, (title, series) in zip(axes.flat, panels):
             self._panel(ax, title, series, x, order, mark_x if marked else None)
             if title == TRANSMISSION:
-                self._mark_least(ax, turn)
+                transmission_band(ax)
+                self._mark_least(ax, turn)  # its legend names the band and the least angle
             ax.set_xlim(lo, hi)
             if turn:
                 ax.set_xticks(np.arange(0, 361, 60))
@@ -373,18 +379,17 @@ def plot_sweep(sweep: Sweep, poses: Iterable[SweepPose], path: str | Path, *,
     return recorder.save(path)
 
 
-#: Agg draws a long line in pieces of this many vertices: a million-pose sweep's curves
-#: (20,000 kept points, dense zigzags) took 278 MB to draw in one piece, 163 MB in these
-#: (scripts/sweep_memory.py).
-AGG_CHUNK = 1000
-
 
 def _save(plt, fig, path: str | Path) -> Path:
     """Every sweep figure's way to its file: whole, through outputs.write_with."""
+    from pinmech.draw.figure_style import FIGURE_RC
+    from pinmech.draw.label_place import settle
     from pinmech.outputs import write_with
 
     try:
-        with plt.rc_context({"agg.path.chunksize": AGG_CHUNK}):
-            return write_with(path, lambda temporary: fig.savefig(temporary, dpi=130))
+        with plt.rc_context(FIGURE_RC):
+            settle(fig)  # labels placed apart once the layout is final
+            return write_with(path, lambda temporary: fig.savefig(temporary, dpi=130, bbox_inches="tight",
+                                                                  pad_inches=0.08))
     finally:
         plt.close(fig)

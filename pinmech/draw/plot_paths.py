@@ -14,8 +14,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from pinmech.exceptions import FrameNotFound, PinmechError
-from pinmech.model.display import colour_of, display_names, hex_colour, joint_colours
+from pinmech.draw.label_place import defer
+from pinmech.exceptions import PinmechError
+from pinmech.model.display import display_names, joint_colours
 from pinmech.model.link_nodes import sketch_links, world_nodes
 from pinmech.solve.motion import _plane_reference
 
@@ -89,7 +90,8 @@ class PathRecorder:
         for k, (name, (u, v)) in enumerate(self.uv.items()):
             u, v = np.array(u) * scale, np.array(v) * scale
             (line,) = ax.plot(u, v, linewidth=1.6, color=self._colour(name), linestyle=("-", "--", "-.", ":")[k % 4],
-                              label=f"path of {self.labels.get(name, name)}", zorder=4)
+                              marker=self._marker(name), markevery=[0], markersize=7, markeredgecolor="0.1",
+                              label=f"path of {self.labels.get(name, name)}", zorder=4)  # marked where it begins
             _arrows(ax, u[::-1], v[::-1], line.get_color()) if backwards else _arrows(ax, u, v, line.get_color())
         if timing is not None:
             self._timing(ax, timing, scale)
@@ -110,20 +112,27 @@ class PathRecorder:
         for name in timing.points:
             uv = np.array([self.axes @ timing.marks[k][name] for k in keys]).reshape(-1, 2) * scale
             colour = self._colour(name)
-            ax.plot(uv[:, 0], uv[:, 1], "o", markersize=4, markerfacecolor="white", markeredgecolor=colour,
+            ax.plot(uv[:, 0], uv[:, 1], self._marker(name), markersize=4.5, markerfacecolor=colour, markeredgecolor=colour,
                     zorder=5, gid=f"timing {name}", label=f"{self.labels.get(name, name)} every "
                     f"{timing.label(timing.step if not timing.sweep.is_angular else np.degrees(timing.step))} "
                     "of the driver")
+            middle = np.nanmean(uv, axis=0)
             for text, p in _merged([timing.label(k) for k in keys], uv, 1e-6 * max(self._size() * scale, 1e-300)):
-                ax.annotate(text, p, xytext=(4, 4), textcoords="offset points", fontsize=6.5,
-                            color=colour, zorder=6, gid=f"timing {name}")
+                defer(ax, text, p, middle, fontsize=6.5, color=colour, zorder=6, gid=f"timing {name}")
 
     def _colour(self, name: str) -> str:
-        """A point's path in its link's colour (pinmech.model.display); black for a point not on a link."""
-        try:
-            return hex_colour(colour_of(self.mechanism, name))
-        except FrameNotFound:
-            return "#111111"
+        """A point's own colour (figure_style.py), by its place among the recorded points."""
+        return self._style(name)[0]
+
+    def _marker(self, name: str) -> str:
+        """A point's own marker (figure_style.py)."""
+        return self._style(name)[1]
+
+    def _style(self, name: str) -> tuple[str, str]:
+        from pinmech.draw.figure_style import point_style
+
+        names = list(self.xyz)
+        return point_style(names.index(name) if name in names else len(names))
 
     def _draw_3d(self, ax, q: np.ndarray | None, travel: str, backwards: bool = False) -> None:
         scale, unit = self._unit()

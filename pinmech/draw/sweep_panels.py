@@ -12,6 +12,11 @@ from pinmech.draw.plot_curves import BRANCH_STYLES, angles as _angles, branch_pi
 from pinmech.draw.plot_curves import nearest as _nearest, spike_limits
 
 
+#: A speed's or acceleration's panel switches from mm to m where its largest value would
+#: reach this many mm/s or mm/s² (five digits: 9,999 mm/s² is drawn, 10,000 is 10 m/s²).
+RATE_LIMIT = 1e4
+
+
 class SweepPanels:
     """The panel drawing of `SweepPlot` (its recorded `series`, `branch`, `colours`, `names`,
     `length`, `angles`, `mark` and `sweep`)."""
@@ -22,7 +27,7 @@ class SweepPanels:
         style a branch), constant ones said in the legend, a fold's spike clipped."""
         quantity, label = title.split(", ")
         symbol, dim = label.split(" [")
-        scale, dim = self._length_dim(dim.rstrip("]"))
+        scale, dim = self._length_dim(dim.rstrip("]"), series.values())
         label, dim = f"{symbol} [{dim}]", dim + "]"
         angle = title.startswith("angle")
         curves = {name: _angles(np.array(v)[order], self.angles) if angle else scale * np.array(v)[order]
@@ -58,20 +63,30 @@ class SweepPanels:
         ax.grid(True, alpha=0.35)
         legend_beside(ax)
 
-    def _length_dim(self, dim: str) -> tuple[float, str]:
+    def _length_dim(self, dim: str, values=()) -> tuple[float, str]:
         """(factor, unit) a quantity in SI `dim` is drawn in: the figure's length unit for
-        lengths, speeds and accelerations ("m/s" -> "mm/s"), else as it is."""
-        if dim in ("m", "m/s", "m/s²"):
-            return self.length[0], self.length[1] + dim[1:]
-        return 1.0, dim
+        lengths, and for speeds and accelerations too unless their largest value (`values`,
+        the panel's series [SI]) would reach 10,000 in it: then m/s, m/s² (never 150,000 mm/s²)."""
+        if dim not in ("m", "m/s", "m/s²"):
+            return 1.0, dim
+        scale, unit = self.length
+        if dim != "m" and scale != 1.0:
+            largest = max((float(np.nanmax(np.abs(np.asarray(v, float)))) for v in values
+                           if len(v) and np.any(np.isfinite(np.asarray(v, float)))), default=0.0)
+            if scale * largest >= RATE_LIMIT:
+                return 1.0, dim
+        return scale, unit + dim[1:]
 
     def _curve(self, ax, name: str, x: np.ndarray, y: np.ndarray, branch: np.ndarray) -> None:
-        """One name's curve, in its link's colour, one line style for each branch."""
+        """One name's curve, in its link's colour (a point's in its own colour, with its own
+        marker every so often), one line style for each branch."""
         colour = self.colours.get(name, "k")
+        marker = getattr(self, "point_markers", {}).get(name)
+        extra = {"marker": marker, "markevery": max(1, len(x) // 9), "markersize": 5} if marker else {}
         for b, mask in branch_pieces(branch):
             label = self.names.get(name, name) + (f", assembly {b + 1}" if self._folded else "")
             ax.plot(x, np.where(mask, y, np.nan), linewidth=1.6, color=colour,
-                    linestyle=BRANCH_STYLES[b % len(BRANCH_STYLES)], label=label)
+                    linestyle=BRANCH_STYLES[b % len(BRANCH_STYLES)], label=label, **extra)
 
     def _title(self, marked: bool, mark_x: float, unit: str) -> str:
         sweep = self.sweep
@@ -89,7 +104,7 @@ class SweepPanels:
         lines = [f"At the scene's pose, {self.sweep.driver} = {mark_x:.4g} {unit}:", ""]
         for title, values in self.mark[1].items():
             symbol, dim = title.split(", ")[1].split(" [")
-            scale, dim = self._length_dim(dim.rstrip("]"))
+            scale, dim = self._length_dim(dim.rstrip("]"), self.series.get(title, {}).values())
             for name, value in values.items():
                 lines.append(f"  {self.names.get(name, name) + ' ' + symbol:<18} {scale * value: .5g} {dim}")
         return "\n".join(lines)
