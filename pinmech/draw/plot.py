@@ -324,6 +324,9 @@ class SweepPlot(SweepPanels):
         fig = plt.figure(figsize=(8, 6.5))
         ax = fig.add_subplot(projection="3d" if self.paths.is_3d else None)
         self._draw_paths(ax)
+        if not self.paths.is_3d:  # the figure as tall as the drawing needs: no empty band above it
+            aspect = np.diff(ax.get_ylim())[0] / np.diff(ax.get_xlim())[0]
+            fig.set_figheight(min(6.5, max(3.6, 5.6 * aspect + 1.4)))
         fig.suptitle(f"{self.sweep.scene.title}: paths over the sweep", fontsize=11)
         fig.tight_layout()
         return _save(plt, fig, path)

@@ -85,17 +85,17 @@ class PathRecorder:
         for k, fold in enumerate(folds):
             draw_ghost(ax, self.mechanism, fold, self.axes, scale, "outlines: folds (the driver's limits)" if k == 0
                        else None, style=(0, (1, 1.5)), gid="fold")
-        if q is not None:
-            draw_linkage(ax, self.mechanism, q, self.axes, scale)
         for k, (name, (u, v)) in enumerate(self.uv.items()):
             u, v = np.array(u) * scale, np.array(v) * scale
             (line,) = ax.plot(u, v, linewidth=1.6, color=self._colour(name), linestyle=("-", "--", "-.", ":")[k % 4],
                               marker=self._marker(name), markevery=[0], markersize=7, markeredgecolor="0.1",
                               label=f"path of {self.labels.get(name, name)}", zorder=4)  # marked where it begins
             _arrows(ax, u[::-1], v[::-1], line.get_color()) if backwards else _arrows(ax, u, v, line.get_color())
+        if q is not None:  # after the paths: its guides span the strokes drawn
+            draw_linkage(ax, self.mechanism, q, self.axes, scale)
         if timing is not None:
             self._timing(ax, timing, scale)
-        ax.set_aspect("equal", adjustable="datalim")
+        frame(ax)
         ax.set_xlabel(f"{self.names[0]} [{unit}]", fontsize=9)
         ax.set_ylabel(f"{self.names[1]} [{unit}]", fontsize=9)
         self._finish(ax, travel)
@@ -209,11 +209,12 @@ def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scal
     size = scale * max(spans, default=mechanism.length_scale)
     colours = joint_colours(mechanism)  # as in every figure (pinmech.model.display)
     _labels(ax, mechanism, sketches, data, axes, scale, size)
+    drawn = np.vstack([(world_nodes(s, data) @ axes.T) * scale for s in sketches.values()] + [_data_corners(ax)])
     for link in sketches.values():
         uv = (world_nodes(link, data) @ axes.T) * scale
         colour = colours[link.joint]
         if link.is_ground:
-            _ground(ax, link, uv, size, axes, scale)
+            _ground(ax, link, uv, size, axes, scale, drawn)
             continue
         if link.is_plate and len(_hull(uv)) >= 3:
             ax.add_patch(Polygon(_hull(uv), closed=True, facecolor=colour, alpha=0.3, edgecolor=colour, lw=2,
@@ -313,8 +314,37 @@ def draw_linkage_3d(ax, mechanism: Mechanism, q: np.ndarray, scale: float = 1.0)
         ax.plot(*ring.T, color=colour, linewidth=3.5)
 
 
-def _ground(ax, link, uv: np.ndarray, size: float, axes: np.ndarray, scale: float) -> None:
-    """Triangles under the fixed pivots, a dashed line along each guide."""
+#: The drawing's margin round what it holds, a share of its larger side; its least height to width.
+MARGIN, LEAST_ASPECT = 0.06, 0.5
+
+
+def frame(ax) -> float:
+    """Axes limits from what the axes hold (the mechanism, paths, outlines), a margin round
+    it, to equal scales, the axes' box fitted to them (no empty bands); the height-to-width
+    ratio drawn, at least LEAST_ASPECT (a flat slider-crank is not drawn as a strip)."""
+    (x0, y0), (x1, y1) = ax.dataLim.get_points()
+    width, height = x1 - x0, y1 - y0
+    pad = MARGIN * max(width, height)
+    width, height = width + 2 * pad, height + 2 * pad
+    grow = max(LEAST_ASPECT * width - height, 0.0) / 2
+    ax.set_xlim(x0 - pad, x1 + pad)
+    ax.set_ylim(y0 - pad - grow, y1 + pad + grow)
+    ax.set_aspect("equal", adjustable="box")
+    return (height + 2 * grow) / width
+
+
+def _data_corners(ax) -> np.ndarray:
+    """The corners of what the axes hold so far (paths, outlines), shape (k, 2); none if empty."""
+    if not ax.has_data() or not np.all(np.isfinite(ax.dataLim.get_points())):
+        return np.zeros((0, 2))
+    (x0, y0), (x1, y1) = ax.dataLim.get_points()
+    return np.array([[x0, y0], [x0, y1], [x1, y0], [x1, y1]])
+
+
+def _ground(ax, link, uv: np.ndarray, size: float, axes: np.ndarray, scale: float, drawn: np.ndarray) -> None:
+    """Triangles under the fixed pivots, a dashed line along each guide: over what is drawn
+    along it (the mechanism, and the paths and outlines drawn before it: the slider's stroke),
+    and a margin, never farther (a long guide would shrink the mechanism in its figure)."""
     from matplotlib.patches import Polygon
 
     h = 0.08 * size
@@ -325,7 +355,10 @@ def _ground(ax, link, uv: np.ndarray, size: float, axes: np.ndarray, scale: floa
             ax.plot([p[0] - h, p[0] + h], [p[1] - h] * 2, color="0.3", linewidth=1.5, zorder=1)
     for origin, axis in link.guides:
         p, d = axes @ origin * scale, axes @ axis
-        ends = np.array([p - 0.3 * size * d, p + 1.5 * size * d])
+        d = d / max(float(np.linalg.norm(d)), 1e-300)
+        along = (drawn - p) @ d
+        margin = 0.08 * size
+        ends = np.array([p + (along.min() - margin) * d, p + (along.max() + margin) * d])
         ax.plot(ends[:, 0], ends[:, 1], color="0.45", linestyle="--", linewidth=1.2, zorder=1)
 
 
