@@ -359,7 +359,7 @@ def _ground(ax, link, uv: np.ndarray, size: float, axes: np.ndarray, scale: floa
         along = (drawn - p) @ d
         margin = 0.08 * size
         ends = np.array([p + (along.min() - margin) * d, p + (along.max() + margin) * d])
-        ax.plot(ends[:, 0], ends[:, 1], color="0.45", linestyle="--", linewidth=1.2, zorder=1)
+        ax.plot(ends[:, 0], ends[:, 1], color="0.45", linestyle="--", linewidth=1.2, zorder=1, gid="guide")
 
 
 def _block(ax, centre: np.ndarray, axis: np.ndarray, size: float, colour: str) -> None:
