@@ -27,6 +27,7 @@ from pinmech.model.display import colour_of, display_names, hex_colour
 from pinmech.draw.plot_centrodes import CentrodeTrace
 from pinmech.draw.plot_curves import driver_axis as _driver_axis
 from pinmech.draw.plot_curves import draw_markers, legend_beside, length_unit
+from pinmech.draw.label_place import settle
 from pinmech.draw.plot_design import DesignTrace, mark_least, transmission_band
 from pinmech.draw.plot_paths import PathRecorder
 from pinmech.draw.sweep_panels import SweepPanels
@@ -282,6 +283,7 @@ class SweepPlot(SweepPanels):
                           fontsize=8.5, transform=spare[0].transAxes)
         fig.suptitle(self._title(marked, mark_x, unit), fontsize=11)
         fig.tight_layout()
+        settle(fig)  # labels placed apart once the layout is final
         return _save(plt, fig, path)
 
     def _driver_label(self) -> str:
@@ -329,6 +331,7 @@ class SweepPlot(SweepPanels):
             fig.set_figheight(min(6.5, max(3.6, 5.6 * aspect + 1.4)))
         fig.suptitle(f"{self.sweep.scene.title}: paths over the sweep", fontsize=11)
         fig.tight_layout()
+        settle(fig)  # labels placed apart once the layout is final
         return _save(plt, fig, path)
 
     def _draw_paths(self, ax) -> None:
@@ -386,7 +389,6 @@ def plot_sweep(sweep: Sweep, poses: Iterable[SweepPose], path: str | Path, *,
 def _save(plt, fig, path: str | Path) -> Path:
     """Every sweep figure's way to its file: whole, through outputs.write_with."""
     from pinmech.draw.figure_style import FIGURE_RC
-    from pinmech.draw.label_place import settle
     from pinmech.outputs import write_with
 
     try:

@@ -27,7 +27,7 @@ class SweepPanels:
         style a branch), constant ones said in the legend, a fold's spike clipped."""
         quantity, label = title.split(", ")
         symbol, dim = label.split(" [")
-        scale, dim = self._length_dim(dim.rstrip("]"), series.values())
+        scale, dim = self._length_dim(dim.rstrip("]"))
         label, dim = f"{symbol} [{dim}]", dim + "]"
         angle = title.startswith("angle")
         curves = {name: _angles(np.array(v)[order], self.angles) if angle else scale * np.array(v)[order]
@@ -63,19 +63,28 @@ class SweepPanels:
         ax.grid(True, alpha=0.35)
         legend_beside(ax)
 
-    def _length_dim(self, dim: str, values=()) -> tuple[float, str]:
+    def _length_dim(self, dim: str) -> tuple[float, str]:
         """(factor, unit) a quantity in SI `dim` is drawn in: the figure's length unit for
-        lengths, and for speeds and accelerations too unless their largest value (`values`,
-        the panel's series [SI]) would reach 10,000 in it: then m/s, m/s² (never 150,000 mm/s²)."""
+        lengths, and for speeds and accelerations too unless the largest of that kind in the
+        figure (every panel in `dim`) would reach 10,000 in it: then m/s or m/s², one unit a
+        kind in the figure (never 150,000 mm/s²)."""
         if dim not in ("m", "m/s", "m/s²"):
             return 1.0, dim
         scale, unit = self.length
-        if dim != "m" and scale != 1.0:
-            largest = max((float(np.nanmax(np.abs(np.asarray(v, float)))) for v in values
-                           if len(v) and np.any(np.isfinite(np.asarray(v, float)))), default=0.0)
-            if scale * largest >= RATE_LIMIT:
-                return 1.0, dim
+        if dim != "m" and scale != 1.0 and scale * self._largest(dim) >= RATE_LIMIT:
+            return 1.0, dim
         return scale, unit + dim[1:]
+
+    def _largest(self, dim: str) -> float:
+        """The largest |value| [SI] of the figure's panels in `dim`."""
+        out = 0.0
+        for title, series in self.series.items():
+            if title.endswith(f"[{dim}]"):
+                for values in series.values():
+                    y = np.abs(np.asarray(values, float))
+                    if np.any(np.isfinite(y)):
+                        out = max(out, float(np.nanmax(y)))
+        return out
 
     def _curve(self, ax, name: str, x: np.ndarray, y: np.ndarray, branch: np.ndarray) -> None:
         """One name's curve, in its link's colour (a point's in its own colour, with its own
@@ -104,7 +113,7 @@ class SweepPanels:
         lines = [f"At the scene's pose, {self.sweep.driver} = {mark_x:.4g} {unit}:", ""]
         for title, values in self.mark[1].items():
             symbol, dim = title.split(", ")[1].split(" [")
-            scale, dim = self._length_dim(dim.rstrip("]"), self.series.get(title, {}).values())
+            scale, dim = self._length_dim(dim.rstrip("]"))
             for name, value in values.items():
                 lines.append(f"  {self.names.get(name, name) + ' ' + symbol:<18} {scale * value: .5g} {dim}")
         return "\n".join(lines)
