@@ -340,7 +340,7 @@ class SweepPlot(SweepPanels):
         ghosts = [(q, label) for label, _, q in self.design.limits()]
         folds = [q for _, q in self.design.design.fold_poses()] if self.design.design.applicable else []
         self.paths.draw(ax, self.mark_q, self._travel(), backwards=self._backwards(), ghosts=ghosts, folds=folds,
-                        timing=self.timing)
+                        timing=self.timing, targets=self.sweep.scene.file.sweep.targets)
         if self.centrodes is not None and not self.paths.is_3d:
             self.centrodes.draw(ax, self.paths.axes, self.paths._unit()[0], self.mark_q)
             legend_beside(ax)

@@ -70,13 +70,15 @@ class PathRecorder:
         return {name: tuple(self.axes @ np.array(xyz)) for name, xyz in self.xyz.items()}
 
     def draw(self, ax, q: np.ndarray | None, travel: str, *, backwards: bool = False,
-             ghosts: list[tuple[np.ndarray, str]] = (), folds: list[np.ndarray] = (), timing=None) -> None:
+             ghosts: list[tuple[np.ndarray, str]] = (), folds: list[np.ndarray] = (), timing=None,
+             targets: dict[str, list[tuple[float, float]]] | None = None) -> None:
         """Paths, the mechanism at q (if given) and arrows of travel, on matplotlib axes
         (3-D axes when the recorder is 3-D); `backwards`: the points move against the order
         they were recorded in (a driver turning at a negative speed), and the arrows say so;
         `ghosts`: (q, label) of poses outlined thinly (limit positions); `folds`: q at the
         driver's own limits, outlined dotted; `timing`: a
-        `plot_timing.TimingMarks` whose marks are drawn on the paths."""
+        `plot_timing.TimingMarks` whose marks are drawn on the paths; `targets`: point ->
+        places (world x, y [m]) drawn on its path, numbered (a synthesis's targets)."""
         if self.is_3d:
             return self._draw_3d(ax, q, travel, backwards)
         scale, unit = self._unit()
@@ -91,6 +93,8 @@ class PathRecorder:
                               marker=self._marker(name), markevery=[0], markersize=7, markeredgecolor="0.1",
                               label=f"path of {self.labels.get(name, name)}", zorder=4)  # marked where it begins
             _arrows(ax, u[::-1], v[::-1], line.get_color()) if backwards else _arrows(ax, u, v, line.get_color())
+        for name, places in (targets or {}).items():
+            self._targets(ax, name, places, scale)
         if q is not None:  # after the paths: its guides span the strokes drawn
             draw_linkage(ax, self.mechanism, q, self.axes, scale)
         if timing is not None:
@@ -119,6 +123,17 @@ class PathRecorder:
             middle = np.nanmean(uv, axis=0)
             for text, p in _merged([timing.label(k) for k in keys], uv, 1e-6 * max(self._size() * scale, 1e-300)):
                 defer(ax, text, p, middle, fontsize=6.5, color=colour, zorder=6, gid=f"timing {name}")
+
+    def _targets(self, ax, name: str, places: list[tuple[float, float]], scale: float) -> None:
+        """A point's target places as crosses in its colour, numbered 1, 2, ... (labels apart)."""
+        xyz = np.column_stack([np.asarray(places, float), np.zeros(len(places))])
+        uv = (xyz @ self.axes.T) * scale
+        colour = self._colour(name)
+        ax.plot(uv[:, 0], uv[:, 1], "x", color=colour, markersize=8, markeredgewidth=2, zorder=6,
+                gid=f"targets {name}", label=f"targets of {self.labels.get(name, name)}")
+        middle = uv.mean(axis=0)
+        for k, p in enumerate(uv, start=1):
+            defer(ax, str(k), p, middle, fontsize=8, color=colour, zorder=7, gid=f"targets {name}")
 
     def _colour(self, name: str) -> str:
         """A point's own colour (figure_style.py), by its place among the recorded points."""
