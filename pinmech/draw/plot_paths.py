@@ -213,8 +213,10 @@ def _arrows(ax, u: np.ndarray, v: np.ndarray, colour: str, count: int = 4) -> No
                     arrowprops={"arrowstyle": "-|>", "color": colour, "lw": 1.4, "mutation_scale": 14})
 
 
-def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scale: float = 1.0) -> None:
-    """The mechanism at q on matplotlib axes, in the plane spanned by `axes` (2 x 3) [m x scale]."""
+def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scale: float = 1.0,
+                 labels: bool = True) -> None:
+    """The mechanism at q on matplotlib axes, in the plane spanned by `axes` (2 x 3) [m x scale];
+    `labels` False: its joints and points not named (a small drawing over a map)."""
     from matplotlib.patches import Polygon
 
     data = mechanism.model.createData()
@@ -223,7 +225,8 @@ def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scal
     spans = [np.linalg.norm(a.position - b.position) for s in sketches.values() for a in s.nodes for b in s.nodes]
     size = scale * max(spans, default=mechanism.length_scale)
     colours = joint_colours(mechanism)  # as in every figure (pinmech.model.display)
-    _labels(ax, mechanism, sketches, data, axes, scale, size)
+    if labels:
+        _labels(ax, mechanism, sketches, data, axes, scale, size)
     drawn = np.vstack([(world_nodes(s, data) @ axes.T) * scale for s in sketches.values()] + [_data_corners(ax)])
     for link in sketches.values():
         uv = (world_nodes(link, data) @ axes.T) * scale
