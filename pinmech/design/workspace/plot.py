@@ -72,13 +72,36 @@ def _loci(ax, result: WorkspaceResult, k: int, index, here: np.ndarray, x: np.nd
     det1 does and along the reached region's edge (black); det2 < 0 hatched (an assembly mode)."""
     det1, det2 = (np.ma.masked_invalid(result.values[f][..., k][index]).T for f in ("det1", "det2"))
     if here.any() and not here.all():
-        ax.contour(x, y, here.T.astype(float), levels=[0.5], colors="black", linewidths=1.2)
+        ax.contour(x, y, _edge_field(here, result.values["det1"][..., k][index]).T, levels=[0.0], colors="black",
+                   linewidths=1.2)
     for det, colour in ((det1, "black"), (det2, "red")):
         if det.count() >= 4 and det.min() < 0 < det.max():
             ax.contour(x, y, det, levels=[0.0], colors=colour, linewidths=1.2)
     if det2.count() >= 4 and det2.min() < 0:
         ax.contourf(x, y, det2, levels=[det2.min() - 1.0, 0.0], colors="none", hatches=["//"])
 
+
+
+def _edge_field(here: np.ndarray, det1: np.ndarray) -> np.ma.MaskedArray:
+    """A field whose zero is the reached region's edge, between the grid's points: det1^2
+    inside (a leg's sine squared, which falls off linearly to 0 where the leg stretches or
+    folds), carried one step outside by linear extrapolation from the two points inside
+    (so the edge is drawn where det1^2 reaches 0, a circle as a circle, not the grid's
+    staircase); where that fails (a point with no two inside), a step's half: -f inside."""
+    f = np.where(here, np.nan_to_num(det1) ** 2, np.nan)
+    out = np.full(f.shape, np.nan)
+    out[here] = f[here]
+    for axis in range(f.ndim):
+        for step in (1, -1):
+            inner, inner2 = np.roll(f, -step, axis), np.roll(f, -2 * step, axis)
+            edge = np.ones(f.shape, bool)
+            index = [slice(None)] * f.ndim
+            index[axis] = slice(-2, None) if step == 1 else slice(0, 2)
+            edge[tuple(index)] = False  # no wrapping round the grid
+            guess = np.where(np.isfinite(inner2), 2 * inner - inner2, -inner)
+            take = ~here & edge & np.isfinite(inner) & np.isfinite(guess)
+            out[take] = np.fmin(np.nan_to_num(out[take], nan=np.inf), np.minimum(guess[take], -1e-300))
+    return np.ma.masked_invalid(out)
 
 
 def _legend() -> list:
