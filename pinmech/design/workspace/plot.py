@@ -62,14 +62,15 @@ def workspace_figure(result: WorkspaceResult, path: str | Path) -> Path:
                        spacing="proportional",
                        ticks=ticks)
     bar.ax.set_yticklabels([f"{t:g}" for t in ticks])
-    fig.legend(handles=_legend(), loc="outside lower center", ncol=4, fontsize=7, frameon=False)
+    fig.legend(handles=_legend(robot is not None), loc="outside lower center", ncol=4, fontsize=7, frameon=False)
     fig.suptitle(f"{result.spec.title}: workspace of '{result.spec.point}'", fontsize=10)
     return save(plt, fig, path, tight=False)
 
 
 def _loci(ax, result: WorkspaceResult, k: int, index, here: np.ndarray, x: np.ndarray, y: np.ndarray) -> None:
     """The singularity loci as curves: type II where det2 changes sign (red), type I where
-    det1 does and along the reached region's edge (black); det2 < 0 hatched (an assembly mode)."""
+    det1 does and along the reached region's edge (black); det2 < 0 hatched where the panel
+    holds both assembly modes."""
     det1, det2 = (np.ma.masked_invalid(result.values[f][..., k][index]).T for f in ("det1", "det2"))
     if here.any() and not here.all():
         ax.contour(x, y, _edge_field(here, result.values["det1"][..., k][index]).T, levels=[0.0], colors="black",
@@ -77,7 +78,7 @@ def _loci(ax, result: WorkspaceResult, k: int, index, here: np.ndarray, x: np.nd
     for det, colour in ((det1, "black"), (det2, "red")):
         if det.count() >= 4 and det.min() < 0 < det.max():
             ax.contour(x, y, det, levels=[0.0], colors=colour, linewidths=1.2)
-    if det2.count() >= 4 and det2.min() < 0:
+    if det2.count() >= 4 and det2.min() < 0 < det2.max():  # two assembly modes on the panel
         ax.contourf(x, y, det2, levels=[det2.min() - 1.0, 0.0], colors="none", hatches=["//"])
 
 
@@ -104,14 +105,15 @@ def _edge_field(here: np.ndarray, det1: np.ndarray) -> np.ma.MaskedArray:
     return np.ma.masked_invalid(out)
 
 
-def _legend() -> list:
+def _legend(robot: bool) -> list:
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
     return [Line2D([], [], color="black", lw=1.2, label="type I locus (the edge: a leg stretched or folded)"),
             Line2D([], [], color="red", lw=1.2, label="type II locus"),
             Patch(facecolor="none", edgecolor="0.2", hatch="//", label="assembly mode det Φp < 0"),
-            Line2D([], [], color="0.4", marker="^", ls="none", label="motors; the robot at its scene's pose")]
+            *([Line2D([], [], color="0.4", marker="^", ls="none", label="motors; the robot at its scene's pose")]
+              if robot else [])]
 
 
 def _robot(result: WorkspaceResult):
