@@ -73,7 +73,7 @@ def _loci(ax, result: WorkspaceResult, k: int, index, here: np.ndarray, x: np.nd
     holds both assembly modes."""
     det1, det2 = (np.ma.masked_invalid(result.values[f][..., k][index]).T for f in ("det1", "det2"))
     if here.any() and not here.all():
-        ax.contour(x, y, _edge_field(here, result.values["det1"][..., k][index]).T, levels=[0.0], colors="black",
+        ax.contour(x, y, edge_field(here, result.values["det1"][..., k][index]).T, levels=[0.0], colors="black",
                    linewidths=1.2)
     for det, colour in ((det1, "black"), (det2, "red")):
         if det.count() >= 4 and det.min() < 0 < det.max():
@@ -83,7 +83,7 @@ def _loci(ax, result: WorkspaceResult, k: int, index, here: np.ndarray, x: np.nd
 
 
 
-def _edge_field(here: np.ndarray, det1: np.ndarray) -> np.ma.MaskedArray:
+def edge_field(here: np.ndarray, det1: np.ndarray) -> np.ma.MaskedArray:
     """A field whose zero is the reached region's edge, between the grid's points: det1^2
     inside (a leg's sine squared, which falls off linearly to 0 where the leg stretches or
     folds), carried one step outside by linear extrapolation from the two points inside
