@@ -14,7 +14,7 @@ from pinmech.design.figure_file import pyplot, save
 from pinmech.design.workspace.actuator import ActuatorResult
 from pinmech.design.workspace.actuator_batch import ASSEMBLIES
 from pinmech.design.workspace.actuator_report import _scales
-from pinmech.design.workspace.plot import edge_field
+from pinmech.design.workspace.plot import edge_field, kappa_bar
 
 
 def actuator_figure(result: ActuatorResult, path: str | Path) -> Path:
@@ -51,10 +51,7 @@ def actuator_figure(result: ActuatorResult, path: str | Path) -> Path:
         image_ax.set_title(f"assembly {assembly}: end point '{result.spec.point}' (task-space image)", fontsize=8)
         image_ax.set_xlabel(f"x [{unit}]")
         image_ax.set_ylabel(f"{'z' if across == 2 else 'y'} [{unit}]")
-    ticks = [t for t in (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000) if norm.vmin <= t <= norm.vmax]
-    bar = fig.colorbar(image, ax=axs, label=f"kappa (J over L = {result.length / u:.4g} {unit})", shrink=0.6,
-                       spacing="proportional", ticks=ticks)
-    bar.ax.set_yticklabels([f"{t:g}" for t in ticks])
+    kappa_bar(fig, image, axs, norm, f"kappa (J over L = {result.length / u:.4g} {unit})")
     fig.legend(handles=[Line2D([], [], color="black", lw=1.2, label="type I locus"),
                         Line2D([], [], color="red", lw=1.2, label="type II locus (the assembly ends)")],
                loc="outside lower center", ncol=2, fontsize=7, frameon=False)

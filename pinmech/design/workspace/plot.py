@@ -57,11 +57,7 @@ def workspace_figure(result: WorkspaceResult, path: str | Path) -> Path:
         ax.set_aspect("equal")
         ax.set_xlabel(f"x [{unit}]")
         ax.set_ylabel(f"y [{unit}]")
-    ticks = [t for t in (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000) if norm.vmin <= t <= norm.vmax]
-    bar = fig.colorbar(image, ax=axs, label=f"kappa (J over L = {result.length / u:.4g} {unit})", shrink=0.6,
-                       spacing="proportional",
-                       ticks=ticks)
-    bar.ax.set_yticklabels([f"{t:g}" for t in ticks])
+    kappa_bar(fig, image, axs, norm, f"kappa (J over L = {result.length / u:.4g} {unit})")
     fig.legend(handles=_legend(robot is not None), loc="outside lower center", ncol=4, fontsize=7, frameon=False)
     fig.suptitle(f"{result.spec.title}: workspace of '{result.spec.point}'", fontsize=10)
     return save(plt, fig, path, tight=False)
@@ -81,6 +77,13 @@ def _loci(ax, result: WorkspaceResult, k: int, index, here: np.ndarray, x: np.nd
     if det2.count() >= 4 and det2.min() < 0 < det2.max():  # two assembly modes on the panel
         ax.contourf(x, y, det2, levels=[det2.min() - 1.0, 0.0], colors="none", hatches=["//"])
 
+
+
+def kappa_bar(fig, image, axs, norm, label: str) -> None:
+    """kappa's colour bar beside the maps, on its log scale, ticked 1, 2, 5, 10, ... in plain numbers."""
+    ticks = [t for t in (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000) if norm.vmin <= t <= norm.vmax]
+    bar = fig.colorbar(image, ax=axs, label=label, shrink=0.6, spacing="proportional", ticks=ticks)
+    bar.ax.set_yticklabels([f"{t:g}" for t in ticks])
 
 
 def edge_field(here: np.ndarray, det1: np.ndarray) -> np.ma.MaskedArray:
