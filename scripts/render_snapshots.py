@@ -147,7 +147,7 @@ def cli_pictures(chromium: str, tmp: Path) -> None:
 
 
 def report_picture(chromium: str, tmp: Path) -> None:
-    """The first page of the R-RTR's report as it prints (A4 PDF, then a PNG of page 1)."""
+    """The R-RTR's report as it prints (one A4 page, PDF, then a PNG of it)."""
     import shutil
     import subprocess
 
@@ -162,13 +162,15 @@ def report_picture(chromium: str, tmp: Path) -> None:
     here = os.getcwd()
     os.chdir(ROOT)  # the page names the scene as a user types it: models/scenes/r_rtr.toml
     try:
-        pinmech(["report", "models/scenes/r_rtr.toml", "-o", str(page), "--steps", "0"])
+        pinmech(["report", "models/scenes/r_rtr.toml", "-o", str(page)])
+        page.write_text(page.read_text(encoding="utf-8").replace("</style>", "@page {size: A4}</style>", 1),
+                        encoding="utf-8")  # the reader's paper
     finally:
         os.chdir(here)
     subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
                     f"--user-data-dir={tmp / 'profile'}", f"--print-to-pdf={pdf}", page.resolve().as_uri()],
                    check=True, capture_output=True, timeout=120)
-    subprocess.run(["pdftoppm", "-png", "-r", "80", "-f", "1", "-l", "1", "-singlefile", str(pdf),
+    subprocess.run(["pdftoppm", "-png", "-r", "90", "-f", "1", "-l", "1", "-singlefile", str(pdf),
                     str(IMAGES / "report_r_rtr_page1")], check=True)
 
 

@@ -103,11 +103,16 @@ def _hues(pixels: np.ndarray, value: np.ndarray, spread: np.ndarray) -> np.ndarr
     return (hue / 6.0) % 1.0
 
 
-def print_pdf(html_file: Path, pdf: Path) -> Path:
-    """The page printed to PDF by headless chromium (as a reader's "print to PDF")."""
+def print_pdf(html_file: Path, pdf: Path, paper: str | None = None) -> Path:
+    """The page printed to PDF by headless chromium (as a reader's "print to PDF"); `paper`
+    ("A4", "letter"): the paper chosen in the print dialog (else chromium's default, Letter)."""
     import subprocess
     import tempfile
 
+    if paper is not None:  # as a reader picks a paper size: a copy of the page asks for it
+        text = Path(html_file).read_text(encoding="utf-8")
+        html_file = Path(pdf).with_suffix(".html")
+        html_file.write_text(text.replace("</style>", f"@page {{size: {paper}}}</style>", 1), encoding="utf-8")
     with tempfile.TemporaryDirectory() as profile:
         subprocess.run([require_browser(), "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
                         f"--user-data-dir={profile}", f"--print-to-pdf={pdf}", Path(html_file).resolve().as_uri()],
@@ -128,3 +133,17 @@ def page_dom(html_file: Path, *, fragment: str = "") -> str:
         done = subprocess.run([*command[:-1], "--dump-dom", command[-1]], capture_output=True, text=True,
                               timeout=90, check=True)
     return done.stdout
+
+
+def pdf_pages(pdf: Path) -> int:
+    """The number of pages of a PDF file (`pdfinfo`, poppler-utils)."""
+    import re
+    import shutil
+    import subprocess
+
+    if shutil.which("pdfinfo") is None:
+        if os.environ.get("PINMECH_REQUIRE_BROWSER"):
+            pytest.fail("PINMECH_REQUIRE_BROWSER is set but pdfinfo is not installed (apt-get install poppler-utils)")
+        pytest.skip("pdfinfo is not installed (apt-get install poppler-utils)")
+    out = subprocess.run(["pdfinfo", str(pdf)], check=True, capture_output=True, text=True).stdout
+    return int(re.search(r"^Pages:\s+(\d+)", out, re.MULTILINE).group(1))

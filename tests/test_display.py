@@ -42,9 +42,9 @@ def test_a_pin_point_is_named_as_the_textbook_letters_it():
 
 
 def test_the_four_bar_has_one_colour_a_link_in_the_curves_the_paths_and_its_urdf(figures, tmp_path):
-    """The URDF paints the crank red, the coupler blue, the rocker green: the sweep curves, the
-    path of the coupler point P and the sketched links take the same colours (to the 8-bit
-    rounding of a hex colour, 1/255)."""
+    """The URDF paints the crank red, the coupler blue, the rocker green: the links' sweep
+    curves and the sketched links take the same colours (to the 8-bit rounding of a hex
+    colour, 1/255); the points B and P each take a colour of their own."""
     urdf = _urdf_colours(MODELS / "four_bar.urdf")
     assert main(["sweep", str(SCENES / "four_bar.toml"), "--steps", "19", "--plot", str(tmp_path / "f.png"),
                  "--links", "crank", "coupler", "rocker", "--points", "P", "B_pin"]) == 0
@@ -56,9 +56,13 @@ def test_the_four_bar_has_one_colour_a_link_in_the_curves_the_paths_and_its_urdf
     paths = fig.axes[-1] if fig.axes[-1].get_title().startswith("paths") else \
         next(ax for ax in fig.axes if ax.get_title().startswith("paths"))
     (p,) = [x for x in paths.get_lines() if x.get_label() == "path of P"]
-    np.testing.assert_allclose(_rgb(p.get_color()), urdf["coupler"], atol=1 / 255)
     speed = next(ax for ax in fig.axes if ax.get_title().startswith("speed"))
     assert {x.get_label() for x in speed.get_lines()} >= {"B", "P"}  # B_pin is the textbook's B
+    # a point has a colour of its own (not its link's: B and P were both drawn the coupler's
+    # or the rocker's), the same in the panels and the paths
+    by_name = {x.get_label(): _rgb(x.get_color()) for x in speed.get_lines() if x.get_label() in ("B", "P")}
+    np.testing.assert_allclose(_rgb(p.get_color()), by_name["P"], atol=1 / 255)
+    assert np.max(np.abs(np.subtract(by_name["B"], by_name["P"]))) > 0.2
     labels = {t.get_text() for t in paths.texts}
     assert {"O2", "A", "B", "O4", "P"} <= labels  # every joint and named point, once
 

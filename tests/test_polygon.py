@@ -150,12 +150,28 @@ def test_cli_writes_the_svg_and_a_failed_write_leaves_nothing(tmp_path, capsys):
     assert "no_such_folder" in capsys.readouterr().err
 
 
-def test_a_polygon_of_fixed_points_only_is_a_named_error(capsys, tmp_path):
-    """Only the fixed pivots reported: nothing moves, nothing to draw, one line and exit 9."""
+def test_a_polygon_of_fixed_points_only_draws_the_pins(tmp_path):
+    """Only the fixed pivots reported: the polygon draws the moving pin B anyway (every pin,
+    as the graphical method does), with o->b = v_B of the R-RTR's closed form."""
+    import closed_form as cf
+
     text = (SCENES / "r_rtr.toml").read_text(encoding="utf-8").replace("../", str(SCENES.parent) + "/")
     text = re.sub(r"\[points\.B3\][^\[]*", "", text).replace('"A", "B", "B3", "C", "D"', '"A", "C"')
-    scene, out = tmp_path / "fixed.toml", tmp_path / "v.svg"
+    scene = tmp_path / "fixed.toml"
     scene.write_text(text, encoding="utf-8")
+    polygon = velocity_polygon(analyse(Scene.load(scene)))
+    v_B = cf.r_rtr(math.radians(30.0), -50.0 * math.pi / 30.0, 0.0).vB
+    from tests.tolerance import REGULAR, closure
+
+    # a pose closed to the solver's tolerance at a regular pose (tests/tolerance.py)
+    assert np.linalg.norm(polygon.images["b"] - v_B) <= closure(np.linalg.norm(v_B), REGULAR, 1)
+
+
+def test_a_polygon_of_a_mechanism_at_rest_is_a_named_error(capsys, tmp_path):
+    """The driver at rest: nothing moves, nothing to draw, one line and exit 9."""
+    text = (SCENES / "r_rtr.toml").read_text(encoding="utf-8").replace("../", str(SCENES.parent) + "/")
+    scene, out = tmp_path / "rest.toml", tmp_path / "v.svg"
+    scene.write_text(text.replace('speed = "-50 rpm"', 'speed = "0 rpm"'), encoding="utf-8")
     assert main(["polygon", str(scene), "-o", str(out)]) == 9
     assert "nothing to draw" in capsys.readouterr().err and not out.exists()
 
@@ -360,3 +376,27 @@ def test_the_space_diagram_is_drawn_to_its_scale_beside_the_polygon():
     assert len(grounds) == 2
     names = {t.text for t in space.iter(f"{SVG}text") if t.get("class") == "place"}
     assert {"O2", "O4", "A", "B", "P"} <= names
+
+
+def test_a_polygon_draws_every_pin_the_scene_does_not_report():
+    """The drawn four-bar's scene reports only the coupler point P; its polygons still draw
+    the pins A and B, as the graphical method does: o->a is v_A and o->b is v_B (o'->a',
+    o'->b' the accelerations) of Norton's closed form (scripts/closed_form.py), crank 40,
+    coupler 120, rocker 80, ground 100 mm, crank at 60 deg turning at 120 rpm, B above O2-O4.
+    Before, the polygon had only o, p and the fixed pivots. Tolerance: a pose closed to the
+    solver's tolerance at a regular pose (tests/tolerance.py)."""
+    from tests.tolerance import REGULAR, closure
+
+    analysis = analyse(Scene.load(SCENES / "four_bar_drawn.toml"))
+    assert list(analysis.motion.points) == ["P"]
+    fb = next(f for f in (cf.four_bar(math.radians(60.0), 4 * math.pi, 0.0, 0.04, 0.12, 0.08, 0.10, branch)
+                          for branch in (1, -1)) if f.B[1] > 0)
+    for polygon, a, b, order in ((velocity_polygon(analysis), fb.vA, fb.vB, 1),
+                                 (acceleration_polygon(analysis), fb.aA, fb.aB, 2)):
+        prime = "'" if order == 2 else ""
+        assert {"a" + prime, "b" + prime} <= set(polygon.images)
+        for label, expected in (("a" + prime, a), ("b" + prime, b)):
+            np.testing.assert_allclose(polygon.images[label], expected, rtol=0,
+                                       atol=closure(np.linalg.norm(expected), REGULAR, order))
+        drawn = {v.label for v in polygon.vectors if v.kind == "absolute"}
+        assert {f"{polygon.quantity[0]}_A", f"{polygon.quantity[0]}_B"} <= drawn

@@ -90,9 +90,11 @@ def test_the_report_page_draws_offline(tmp_path):
     pixels = screenshot(out, tmp_path / "page.png", window=(1000, 1400))
     assert span_share(pixels) > 0.8
     crank, guide = (colour_mask(pixels, rgb) for rgb in (CRANK_RED, GUIDE_GREEN))
-    assert crank.sum() > 1000 and guide.sum() > 1000  # the R-RTR's crank and guide, drawn in the frame
+    # the R-RTR's crank and guide, drawn in the space diagram (half the page's width: the design
+    # table beside it; the crank alone is about 900 pixels there)
+    assert crank.sum() > 500 and guide.sum() > 500
     rows = np.nonzero(crank | guide)[0]
-    assert rows.max() - rows.min() > 0.5 * FRAME_HEIGHT  # framed: the mechanism fills its frame
+    assert rows.max() - rows.min() > 0.5 * FRAME_HEIGHT  # the mechanism fills its drawing
 
 
 def test_the_report_page_of_a_bare_model(tmp_path):
@@ -232,12 +234,12 @@ def _pdf_words(pdf) -> tuple[list[tuple[float, float, str]], float]:
 
 
 @pytest.mark.browser
-def test_the_report_prints_the_drawing_and_whole_tables(tmp_path):
+def test_the_report_prints_the_drawing_and_the_polygons(tmp_path):
     """Printed to PDF by chromium: the pose is on paper (the WebGL view printed blank: the
-    R-RTR's red crank and green guide are found in the first page's pixels), every word lies
-    on the page (a table cut at the right edge loses its last column), and the points
-    table's last column is there: |a_D| of the closed form (scripts/closed_form.py) at the
-    6 significant digits printed."""
+    R-RTR's red crank and green guide are found in the page's pixels), every word lies on the
+    page, and the acceleration polygon's a_D is |a_D| of the closed form (scripts/closed_form.py)
+    at the 4 significant digits the polygon writes. The motion tables stay on the screen
+    (the sheet is one page: tests/test_report_sheet.py)."""
     import subprocess
 
     import closed_form as cf
@@ -251,8 +253,8 @@ def test_the_report_prints_the_drawing_and_whole_tables(tmp_path):
     assert words and max(right for _, right, _ in words) <= width
     text = " ".join(w for *_, w in words)
     a_D = np.linalg.norm(cf.r_rtr(math.radians(30.0), -50.0 * math.pi / 30.0, 0.0).aD)
-    assert f"{a_D:.6g}" in text and "|a|" in text
-    for part in ("Given", "Figure 1.", "Figure 2.", "Figure 3.", "pinmech 0.", "r_rtr.toml"):
+    assert f"= {a_D:.4g} m/s²" in text
+    for part in ("Given", "Design", "Figure 1.", "Figure 2.", "Figure 3.", "pinmech 0.", "r_rtr.toml", "motion tables"):
         assert part in text
     subprocess.run(["pdftoppm", "-png", "-r", "60", "-f", "1", "-l", "1", str(pdf), str(tmp_path / "p")], check=True)
     pixels = read_png(next(tmp_path.glob("p*.png")))
@@ -260,7 +262,7 @@ def test_the_report_prints_the_drawing_and_whole_tables(tmp_path):
 
 
 def test_the_page_is_a_lab_report(tmp_path):
-    """Given first, then figures numbered 1, 2, ... each once with a caption (the pose, the two
+    """Given first, then figures numbered 1, 2, ... each once with a caption, the design table (the pose, the two
     polygons, the sweep, the paths), the full text folded under <details>, and the version,
     the date and the scene file on top."""
     import datetime
@@ -272,7 +274,7 @@ def test_the_page_is_a_lab_report(tmp_path):
     page = out.read_text(encoding="utf-8")
     numbers = [int(n) for n in re.findall(r"<b>Figure (\d+)\.</b>", page)]
     assert numbers == list(range(1, 6))  # pose, velocity, acceleration, sweep, paths
-    assert page.index("<h2>Given</h2>") < page.index("<h2>Figures</h2>") < page.index("<h2>Results</h2>")
+    assert page.index("<h2>Given</h2>") < page.index("<h2>Design</h2>") < page.index("<h2>Results</h2>")
     assert page.count('data-quantity="velocity"') == 1 and page.count('data-quantity="acceleration"') == 1
     assert page.count('class="pose"') == 1 and page.count('class="space-diagram"') == 1  # the mechanism once
     assert re.search(r"<details><summary>[^<]*<code>pinmech solve</code>[^<]*</summary><pre>", page)

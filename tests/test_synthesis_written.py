@@ -156,3 +156,44 @@ def test_met_means_within_the_printed_share_of_the_size(tmp_path, monkeypatch, c
     assert "meets the targets" in first and first.split("meets the targets")[1].split("\n")[0].endswith(
         "no: the closest this search found (errors above)")
     assert second.split("meets the targets")[1].split("\n")[0].endswith(": yes")
+
+
+def test_the_written_scene_carries_the_targets_and_the_paths_figure_draws_them(tmp_path, monkeypatch):
+    """A path task's scene writes its targets (`[sweep] targets`, mm to 12 significant
+    figures) and `pinmech sweep SCENE --paths` draws them as crosses numbered 1, 2, ... on P's
+    path: read back, each cross is the closed form's P at its crank angle, to the 12 figures
+    written (1e-9 of the 0.05 m size; the figure draws in mm)."""
+    import matplotlib.pyplot as plt
+
+    from pinmech.io.scene import Scene
+
+    O4x, theta, way = CASES["ccw through 0, held in [0, 360)"]
+    lk = _rocker(O4x, theta, way)
+    assert lk.task == "path"
+    targets = _P(lk, lk.theta)
+    _, scene = write_linkage(lk, tmp_path / "found", "found", "test.toml", targets)
+    read = np.array(Scene.load(scene).file.sweep.targets["P"])
+    np.testing.assert_allclose(read, targets, rtol=0, atol=1e-9 * 0.05)
+    kept = []
+    monkeypatch.setattr(plt, "close", lambda fig=None: kept.append(fig))
+    assert main(["sweep", str(scene), "--paths", str(tmp_path / "p.png")]) == 0
+    ax = kept[0].axes[0]
+    (crosses,) = [x for x in ax.get_lines() if x.get_gid() == "targets P"]
+    np.testing.assert_allclose(np.asarray(crosses.get_xydata(), float), 1e3 * targets, rtol=0, atol=1e-9 * 50.0)
+    numbers = sorted(int(t.get_text()) for t in ax.texts if t.get_gid() == "targets P")
+    assert numbers == list(range(1, len(targets) + 1))
+
+
+@pytest.mark.parametrize("places, said", [('[["1 mm"]]', "list of [x, y] places"), ('[["1 mm", "nan mm"]]', "finite"),
+                                          ('[["1 mm", "2 deg"]]', "length"), ('"P"', "list of [x, y] places")])
+def test_bad_targets_in_a_scene_are_named(tmp_path, capsys, places, said):
+    """A scene's `[sweep] targets` that are not places: one line naming the file, the key
+    and the value, no traceback."""
+    from tests.conftest import SCENES
+
+    text = (SCENES / "four_bar_drawn.toml").read_text(encoding="utf-8").replace("../", str(SCENES.parent) + "/")
+    scene = tmp_path / "bad.toml"
+    scene.write_text(text + f"\n[sweep]\ntargets = {{P = {places}}}\n", encoding="utf-8")
+    assert main(["solve", str(scene)]) != 0
+    err = capsys.readouterr().err
+    assert "sweep.targets" in err and said in err and "Traceback" not in err

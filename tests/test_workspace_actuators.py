@@ -206,3 +206,30 @@ def test_task_axes_beside_actuator_axes_are_refused(tmp_path):
                           'x = { from = "0 mm", to = "1 mm", count = 2 }')
     with pytest.raises(SceneError, match=r"workspace.x: an actuator-space grid .* takes no x"):
         load_workspace(path)
+
+
+def test_the_actuator_map_draws_the_assemblys_end_as_a_curve_near_the_closed_form(tmp_path, monkeypatch):
+    """The figure, read back: no dots; the type II locus (red) is a contour line whose
+    vertices lie where the distal links fold collinear, |B1B2| = 2 l2, to well within a grid
+    step h: |B1B2| - 2 l2 changes by at most |d|B1B2|/dq| h, 2 l1 h over a step, and the drawn
+    curve is within a quarter of that at 90 % of its vertices (the grid's staircase, which the
+    map drew before, sits h/2 off)."""
+    import matplotlib
+    import matplotlib.pyplot as plt
+
+    matplotlib.use("Agg")
+    kept = []
+    monkeypatch.setattr(plt, "close", lambda fig=None: kept.append(fig))
+    path = _actuator_file(tmp_path, "five_bar.toml", "closedloop1_A", {"mot1": (-180, 180, 37), "mot2": (-180, 180, 37)})
+    assert main(["study", str(path), "--workers", "0", "--quiet", "--out", str(tmp_path / "act"), "--plot"]) == 0
+    maps = [a for a in kept[0].axes if a.get_xlabel().startswith("mot1")]
+    assert len(maps) == 2
+    h = math.radians(10.0)
+    for ax in maps:
+        assert not [x for x in ax.get_lines() if x.get_marker() == "."]
+        red = [c for c in ax.collections if hasattr(c, "get_paths") and c.get_edgecolor().size
+               and np.allclose(c.get_edgecolor()[0][:3], matplotlib.colors.to_rgb("red"))]
+        q = np.radians(np.vstack([p.vertices for c in red for p in c.get_paths() if len(p.vertices)]))
+        assert len(q) > 20
+        off = np.array([abs(np.linalg.norm(np.subtract(*five_bar_elbows(v)[::-1])) - 2 * L2) for v in q])
+        assert np.percentile(off, 90) <= 0.25 * 2 * L1 * h

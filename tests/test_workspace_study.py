@@ -429,3 +429,52 @@ def test_bad_refinement_keys_are_named_with_their_values(tmp_path, line, message
     with pytest.raises(SceneError, match=message) as info:
         load_workspace(path)
     assert str(path) in str(info.value) and "\n" not in str(info.value)
+
+
+def test_the_map_draws_the_type_two_locus_as_a_curve_within_a_grid_step_of_the_closed_form(tmp_path, monkeypatch):
+    """The figure, read back: the type II locus is a contour line (red), not scattered dots,
+    and each of its vertices lies within one grid step of the closed form's locus (the distal
+    links collinear: their sine changes sign within one step h of the vertex); the edge of
+    the workspace is a curve on the annuli's circles (round holes, not the grid's octagons);
+    no panel draws dots; the robot's links and its motors' triangles are on every panel."""
+    import matplotlib
+    import matplotlib.pyplot as plt
+
+    matplotlib.use("Agg")
+    kept = []
+    monkeypatch.setattr(plt, "close", lambda fig=None: kept.append(fig))
+    path = _five_bar(tmp_path, '{ from = "-50 mm", to = "150 mm", count = 21 }',
+                     '{ from = "-140 mm", to = "140 mm", count = 29 }', 'modes = ["+-"]')
+    assert main(["study", str(path), "--workers", "0", "--quiet", "--out", str(tmp_path / "ws"), "--plot"]) == 0
+    (ax,) = [a for a in kept[0].axes if a.get_title().startswith("mode")]
+    assert not [x for x in ax.get_lines() if x.get_marker() == "."]  # no dots
+    red = [c for c in ax.collections if hasattr(c, "get_paths") and c.get_edgecolor().size
+           and np.allclose(c.get_edgecolor()[0][:3], matplotlib.colors.to_rgb("red"))]
+    vertices = np.vstack([p.vertices for c in red for p in c.get_paths() if len(p.vertices)]) / 1000.0
+    assert len(vertices) > 20
+    h = 0.01
+    around = h * np.array([[math.cos(a), math.sin(a)] for a in np.linspace(0, 2 * math.pi, 16, endpoint=False)])
+    checked = 0
+    for v in vertices:
+        ring = v + around
+        if near_circle(v, 2 * h) or np.any([np.linalg.norm(ring - a, axis=1).min() < L2 - L1 + 1e-6 for a in A]):
+            continue  # beside a leg's stretched or folded circle: no elbow there to compare
+        try:
+            here, signs = collinearity(v, "+-"), [collinearity(p, "+-") for p in ring]
+        except ValueError:  # a ring point out of reach
+            continue
+        assert abs(here) < 1e-12 or min(here * s for s in signs) < 0, v
+        checked += 1
+    assert checked > 10
+    # the edge (type I, black): on the annuli's circles |P - A_i| = l2 - l1 or l1 + l2, most of
+    # it well inside a grid step (a drawn staircase of the grid sat h/2 off everywhere; where
+    # two circles meet, a corner, the curve cuts across by up to about h/2)
+    black = [c for c in ax.collections if hasattr(c, "get_paths") and c.get_edgecolor().size
+             and np.allclose(c.get_edgecolor()[0][:3], 0.0)]
+    edge = np.vstack([p.vertices for c in black for p in c.get_paths() if len(p.vertices)]) / 1000.0
+    off = np.min([np.minimum(np.abs(np.linalg.norm(edge - a, axis=1) - (L2 - L1)),
+                             np.abs(np.linalg.norm(edge - a, axis=1) - (L1 + L2))) for a in A], axis=0)
+    assert np.median(off) <= 0.15 * h and np.percentile(off, 90) <= 0.35 * h and off.max() <= 0.6 * h
+    robot = [x for x in ax.get_lines() if x.get_linewidth() == 4]
+    assert len(robot) >= 4  # two proximal and two distal links
+    assert sum(type(p).__name__ == "Polygon" for p in ax.patches) >= 2  # the motors' triangles

@@ -57,10 +57,15 @@ def number_points(ax, points, color: str = "tab:red") -> None:
 def save(plt, fig, path: str | Path, *, tight: bool = True) -> Path:
     """Lay the figure out (unless `tight` is False: a figure with a colour bar over several
     axes), write it whole (format from the suffix, 110 dpi; see `write_with`) and close it."""
+    from pinmech.draw.figure_style import FIGURE_RC
+    from pinmech.draw.label_place import settle
+
     if tight:
         fig.tight_layout()
     try:
-        write_with(path, lambda temporary: fig.savefig(temporary, dpi=110))
+        with plt.rc_context(FIGURE_RC):
+            settle(fig)  # labels placed apart once the layout is final
+            write_with(path, lambda temporary: fig.savefig(temporary, dpi=110, bbox_inches="tight", pad_inches=0.08))
     finally:
         plt.close(fig)
     return Path(path)

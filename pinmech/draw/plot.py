@@ -27,7 +27,8 @@ from pinmech.model.display import colour_of, display_names, hex_colour
 from pinmech.draw.plot_centrodes import CentrodeTrace
 from pinmech.draw.plot_curves import driver_axis as _driver_axis
 from pinmech.draw.plot_curves import draw_markers, legend_beside, length_unit
-from pinmech.draw.plot_design import DesignTrace, mark_least
+from pinmech.draw.label_place import settle
+from pinmech.draw.plot_design import DesignTrace, mark_least, transmission_band
 from pinmech.draw.plot_paths import PathRecorder
 from pinmech.draw.sweep_panels import SweepPanels
 
@@ -169,7 +170,12 @@ class SweepPlot(SweepPanels):
             self.points = [n for n, p in motion.points.items()
                            if p.link in mech.links and model.frames[mech.links[p.link]].parentJoint != 0]
         self.sliders = list(motion.sliders)
-        self.colours = {n: hex_colour(colour_of(mech, n)) for n in [*self.links, *self.points]}
+        from pinmech.draw.figure_style import point_styles
+
+        self.colours = {n: hex_colour(colour_of(mech, n)) for n in self.links}
+        styles = point_styles(self.points)  # each point its own colour and marker (figure_style.py)
+        self.colours.update({n: colour for n, (colour, _) in styles.items()})
+        self.point_markers = {n: marker for n, (_, marker) in styles.items()}
         # a slider in the colour of its moving side (a tree joint's child, a loop cut's child link)
         self.colours.update({n: hex_colour(colour_of(mech, s.child)) for n, s in motion.sliders.items()})
         for dyad, name in zip(self.design.dyads, self.design.names):  # a dyad in its output's colour
@@ -248,7 +254,8 @@ class SweepPlot(SweepPanels):
         for ax, (title, series) in zip(axes.flat, panels):
             self._panel(ax, title, series, x, order, mark_x if marked else None)
             if title == TRANSMISSION:
-                self._mark_least(ax, turn)
+                transmission_band(ax)
+                self._mark_least(ax, turn)  # its legend names the band and the least angle
             ax.set_xlim(lo, hi)
             if turn:
                 ax.set_xticks(np.arange(0, 361, 60))
@@ -276,6 +283,7 @@ class SweepPlot(SweepPanels):
                           fontsize=8.5, transform=spare[0].transAxes)
         fig.suptitle(self._title(marked, mark_x, unit), fontsize=11)
         fig.tight_layout()
+        settle(fig)  # labels placed apart once the layout is final
         return _save(plt, fig, path)
 
     def _driver_label(self) -> str:
@@ -318,8 +326,12 @@ class SweepPlot(SweepPanels):
         fig = plt.figure(figsize=(8, 6.5))
         ax = fig.add_subplot(projection="3d" if self.paths.is_3d else None)
         self._draw_paths(ax)
+        if not self.paths.is_3d:  # the figure as tall as the drawing needs: no empty band above it
+            aspect = np.diff(ax.get_ylim())[0] / np.diff(ax.get_xlim())[0]
+            fig.set_figheight(min(6.5, max(3.6, 5.6 * aspect + 1.4)))
         fig.suptitle(f"{self.sweep.scene.title}: paths over the sweep", fontsize=11)
         fig.tight_layout()
+        settle(fig)  # labels placed apart once the layout is final
         return _save(plt, fig, path)
 
     def _draw_paths(self, ax) -> None:
@@ -328,7 +340,7 @@ class SweepPlot(SweepPanels):
         ghosts = [(q, label) for label, _, q in self.design.limits()]
         folds = [q for _, q in self.design.design.fold_poses()] if self.design.design.applicable else []
         self.paths.draw(ax, self.mark_q, self._travel(), backwards=self._backwards(), ghosts=ghosts, folds=folds,
-                        timing=self.timing)
+                        timing=self.timing, targets=self.sweep.scene.file.sweep.targets)
         if self.centrodes is not None and not self.paths.is_3d:
             self.centrodes.draw(ax, self.paths.axes, self.paths._unit()[0], self.mark_q)
             legend_beside(ax)
@@ -373,18 +385,16 @@ def plot_sweep(sweep: Sweep, poses: Iterable[SweepPose], path: str | Path, *,
     return recorder.save(path)
 
 
-#: Agg draws a long line in pieces of this many vertices: a million-pose sweep's curves
-#: (20,000 kept points, dense zigzags) took 278 MB to draw in one piece, 163 MB in these
-#: (scripts/sweep_memory.py).
-AGG_CHUNK = 1000
-
 
 def _save(plt, fig, path: str | Path) -> Path:
     """Every sweep figure's way to its file: whole, through outputs.write_with."""
+    from pinmech.draw.figure_style import FIGURE_RC
     from pinmech.outputs import write_with
 
     try:
-        with plt.rc_context({"agg.path.chunksize": AGG_CHUNK}):
-            return write_with(path, lambda temporary: fig.savefig(temporary, dpi=130))
+        with plt.rc_context(FIGURE_RC):
+            settle(fig)  # labels placed apart once the layout is final
+            return write_with(path, lambda temporary: fig.savefig(temporary, dpi=130, bbox_inches="tight",
+                                                                  pad_inches=0.08))
     finally:
         plt.close(fig)

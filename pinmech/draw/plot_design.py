@@ -91,3 +91,18 @@ def unit_x(x: float, unit: str = "°") -> str:
     if unit == "°":
         return f"{position_text(round(x, 3) + 0.0, 'g')}{unit}"
     return f"{round(x, 3) + 0.0:g}{unit}"
+
+
+#: The transmission angles a designer keeps to (Norton, Design of Machinery, sec. 3.3: mu
+#: within 40 to 140 deg for a linkage that runs smoothly) [deg].
+BAND = (40.0, 140.0)
+
+
+def transmission_band(ax) -> None:
+    """The transmission angle's panel on its whole range, 0 to 180 deg (mu is computed on it:
+    no angle folded about 90 deg), with the 40-140 deg band shaded and 90 deg drawn."""
+    ax.axhspan(*BAND, color="#2ca02c", alpha=0.08, zorder=0, gid="transmission band",
+               label=f"{BAND[0]:g}°–{BAND[1]:g}°: the usual working band")
+    ax.axhline(90.0, color="0.5", linewidth=0.7, linestyle=":", zorder=0)
+    ax.set_ylim(0.0, 180.0)
+    ax.set_yticks(np.arange(0.0, 181.0, 30.0))

@@ -14,8 +14,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from pinmech.exceptions import FrameNotFound, PinmechError
-from pinmech.model.display import colour_of, display_names, hex_colour, joint_colours
+from pinmech.draw.label_place import defer
+from pinmech.exceptions import PinmechError
+from pinmech.model.display import display_names, joint_colours
 from pinmech.model.link_nodes import sketch_links, world_nodes
 from pinmech.solve.motion import _plane_reference
 
@@ -69,13 +70,15 @@ class PathRecorder:
         return {name: tuple(self.axes @ np.array(xyz)) for name, xyz in self.xyz.items()}
 
     def draw(self, ax, q: np.ndarray | None, travel: str, *, backwards: bool = False,
-             ghosts: list[tuple[np.ndarray, str]] = (), folds: list[np.ndarray] = (), timing=None) -> None:
+             ghosts: list[tuple[np.ndarray, str]] = (), folds: list[np.ndarray] = (), timing=None,
+             targets: dict[str, list[tuple[float, float]]] | None = None) -> None:
         """Paths, the mechanism at q (if given) and arrows of travel, on matplotlib axes
         (3-D axes when the recorder is 3-D); `backwards`: the points move against the order
         they were recorded in (a driver turning at a negative speed), and the arrows say so;
         `ghosts`: (q, label) of poses outlined thinly (limit positions); `folds`: q at the
         driver's own limits, outlined dotted; `timing`: a
-        `plot_timing.TimingMarks` whose marks are drawn on the paths."""
+        `plot_timing.TimingMarks` whose marks are drawn on the paths; `targets`: point ->
+        places (world x, y [m]) drawn on its path, numbered (a synthesis's targets)."""
         if self.is_3d:
             return self._draw_3d(ax, q, travel, backwards)
         scale, unit = self._unit()
@@ -84,16 +87,19 @@ class PathRecorder:
         for k, fold in enumerate(folds):
             draw_ghost(ax, self.mechanism, fold, self.axes, scale, "outlines: folds (the driver's limits)" if k == 0
                        else None, style=(0, (1, 1.5)), gid="fold")
-        if q is not None:
-            draw_linkage(ax, self.mechanism, q, self.axes, scale)
         for k, (name, (u, v)) in enumerate(self.uv.items()):
             u, v = np.array(u) * scale, np.array(v) * scale
             (line,) = ax.plot(u, v, linewidth=1.6, color=self._colour(name), linestyle=("-", "--", "-.", ":")[k % 4],
-                              label=f"path of {self.labels.get(name, name)}", zorder=4)
+                              marker=self._marker(name), markevery=[0], markersize=7, markeredgecolor="0.1",
+                              label=f"path of {self.labels.get(name, name)}", zorder=4)  # marked where it begins
             _arrows(ax, u[::-1], v[::-1], line.get_color()) if backwards else _arrows(ax, u, v, line.get_color())
+        for name, places in (targets or {}).items():
+            self._targets(ax, name, places, scale)
+        if q is not None:  # after the paths: its guides span the strokes drawn
+            draw_linkage(ax, self.mechanism, q, self.axes, scale)
         if timing is not None:
             self._timing(ax, timing, scale)
-        ax.set_aspect("equal", adjustable="datalim")
+        frame(ax)
         ax.set_xlabel(f"{self.names[0]} [{unit}]", fontsize=9)
         ax.set_ylabel(f"{self.names[1]} [{unit}]", fontsize=9)
         self._finish(ax, travel)
@@ -110,20 +116,38 @@ class PathRecorder:
         for name in timing.points:
             uv = np.array([self.axes @ timing.marks[k][name] for k in keys]).reshape(-1, 2) * scale
             colour = self._colour(name)
-            ax.plot(uv[:, 0], uv[:, 1], "o", markersize=4, markerfacecolor="white", markeredgecolor=colour,
+            ax.plot(uv[:, 0], uv[:, 1], self._marker(name), markersize=4.5, markerfacecolor=colour, markeredgecolor=colour,
                     zorder=5, gid=f"timing {name}", label=f"{self.labels.get(name, name)} every "
                     f"{timing.label(timing.step if not timing.sweep.is_angular else np.degrees(timing.step))} "
                     "of the driver")
+            middle = np.nanmean(uv, axis=0)
             for text, p in _merged([timing.label(k) for k in keys], uv, 1e-6 * max(self._size() * scale, 1e-300)):
-                ax.annotate(text, p, xytext=(4, 4), textcoords="offset points", fontsize=6.5,
-                            color=colour, zorder=6, gid=f"timing {name}")
+                defer(ax, text, p, middle, fontsize=6.5, color=colour, zorder=6, gid=f"timing {name}")
+
+    def _targets(self, ax, name: str, places: list[tuple[float, float]], scale: float) -> None:
+        """A point's target places as crosses in its colour, numbered 1, 2, ... (labels apart)."""
+        xyz = np.column_stack([np.asarray(places, float), np.zeros(len(places))])
+        uv = (xyz @ self.axes.T) * scale
+        colour = self._colour(name)
+        ax.plot(uv[:, 0], uv[:, 1], "x", color=colour, markersize=8, markeredgewidth=2, zorder=6,
+                gid=f"targets {name}", label=f"targets of {self.labels.get(name, name)}")
+        middle = uv.mean(axis=0)
+        for k, p in enumerate(uv, start=1):
+            defer(ax, str(k), p, middle, fontsize=8, color=colour, zorder=7, gid=f"targets {name}")
 
     def _colour(self, name: str) -> str:
-        """A point's path in its link's colour (pinmech.model.display); black for a point not on a link."""
-        try:
-            return hex_colour(colour_of(self.mechanism, name))
-        except FrameNotFound:
-            return "#111111"
+        """A point's own colour (figure_style.py), by its place among the recorded points."""
+        return self._style(name)[0]
+
+    def _marker(self, name: str) -> str:
+        """A point's own marker (figure_style.py)."""
+        return self._style(name)[1]
+
+    def _style(self, name: str) -> tuple[str, str]:
+        from pinmech.draw.figure_style import point_style
+
+        names = list(self.xyz)
+        return point_style(names.index(name) if name in names else len(names))
 
     def _draw_3d(self, ax, q: np.ndarray | None, travel: str, backwards: bool = False) -> None:
         scale, unit = self._unit()
@@ -189,8 +213,10 @@ def _arrows(ax, u: np.ndarray, v: np.ndarray, colour: str, count: int = 4) -> No
                     arrowprops={"arrowstyle": "-|>", "color": colour, "lw": 1.4, "mutation_scale": 14})
 
 
-def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scale: float = 1.0) -> None:
-    """The mechanism at q on matplotlib axes, in the plane spanned by `axes` (2 x 3) [m x scale]."""
+def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scale: float = 1.0,
+                 labels: bool = True) -> None:
+    """The mechanism at q on matplotlib axes, in the plane spanned by `axes` (2 x 3) [m x scale];
+    `labels` False: its joints and points not named (a small drawing over a map)."""
     from matplotlib.patches import Polygon
 
     data = mechanism.model.createData()
@@ -199,12 +225,14 @@ def draw_linkage(ax, mechanism: Mechanism, q: np.ndarray, axes: np.ndarray, scal
     spans = [np.linalg.norm(a.position - b.position) for s in sketches.values() for a in s.nodes for b in s.nodes]
     size = scale * max(spans, default=mechanism.length_scale)
     colours = joint_colours(mechanism)  # as in every figure (pinmech.model.display)
-    _labels(ax, mechanism, sketches, data, axes, scale, size)
+    if labels:
+        _labels(ax, mechanism, sketches, data, axes, scale, size)
+    drawn = np.vstack([(world_nodes(s, data) @ axes.T) * scale for s in sketches.values()] + [_data_corners(ax)])
     for link in sketches.values():
         uv = (world_nodes(link, data) @ axes.T) * scale
         colour = colours[link.joint]
         if link.is_ground:
-            _ground(ax, link, uv, size, axes, scale)
+            _ground(ax, link, uv, size, axes, scale, drawn)
             continue
         if link.is_plate and len(_hull(uv)) >= 3:
             ax.add_patch(Polygon(_hull(uv), closed=True, facecolor=colour, alpha=0.3, edgecolor=colour, lw=2,
@@ -304,8 +332,37 @@ def draw_linkage_3d(ax, mechanism: Mechanism, q: np.ndarray, scale: float = 1.0)
         ax.plot(*ring.T, color=colour, linewidth=3.5)
 
 
-def _ground(ax, link, uv: np.ndarray, size: float, axes: np.ndarray, scale: float) -> None:
-    """Triangles under the fixed pivots, a dashed line along each guide."""
+#: The drawing's margin round what it holds, a share of its larger side; its least height to width.
+MARGIN, LEAST_ASPECT = 0.06, 0.5
+
+
+def frame(ax) -> float:
+    """Axes limits from what the axes hold (the mechanism, paths, outlines), a margin round
+    it, to equal scales, the axes' box fitted to them (no empty bands); the height-to-width
+    ratio drawn, at least LEAST_ASPECT (a flat slider-crank is not drawn as a strip)."""
+    (x0, y0), (x1, y1) = ax.dataLim.get_points()
+    width, height = x1 - x0, y1 - y0
+    pad = MARGIN * max(width, height)
+    width, height = width + 2 * pad, height + 2 * pad
+    grow = max(LEAST_ASPECT * width - height, 0.0) / 2
+    ax.set_xlim(x0 - pad, x1 + pad)
+    ax.set_ylim(y0 - pad - grow, y1 + pad + grow)
+    ax.set_aspect("equal", adjustable="box")
+    return (height + 2 * grow) / width
+
+
+def _data_corners(ax) -> np.ndarray:
+    """The corners of what the axes hold so far (paths, outlines), shape (k, 2); none if empty."""
+    if not ax.has_data() or not np.all(np.isfinite(ax.dataLim.get_points())):
+        return np.zeros((0, 2))
+    (x0, y0), (x1, y1) = ax.dataLim.get_points()
+    return np.array([[x0, y0], [x0, y1], [x1, y0], [x1, y1]])
+
+
+def _ground(ax, link, uv: np.ndarray, size: float, axes: np.ndarray, scale: float, drawn: np.ndarray) -> None:
+    """Triangles under the fixed pivots, a dashed line along each guide: over what is drawn
+    along it (the mechanism, and the paths and outlines drawn before it: the slider's stroke),
+    and a margin, never farther (a long guide would shrink the mechanism in its figure)."""
     from matplotlib.patches import Polygon
 
     h = 0.08 * size
@@ -316,8 +373,11 @@ def _ground(ax, link, uv: np.ndarray, size: float, axes: np.ndarray, scale: floa
             ax.plot([p[0] - h, p[0] + h], [p[1] - h] * 2, color="0.3", linewidth=1.5, zorder=1)
     for origin, axis in link.guides:
         p, d = axes @ origin * scale, axes @ axis
-        ends = np.array([p - 0.3 * size * d, p + 1.5 * size * d])
-        ax.plot(ends[:, 0], ends[:, 1], color="0.45", linestyle="--", linewidth=1.2, zorder=1)
+        d = d / max(float(np.linalg.norm(d)), 1e-300)
+        along = (drawn - p) @ d
+        margin = 0.08 * size
+        ends = np.array([p + (along.min() - margin) * d, p + (along.max() + margin) * d])
+        ax.plot(ends[:, 0], ends[:, 1], color="0.45", linestyle="--", linewidth=1.2, zorder=1, gid="guide")
 
 
 def _block(ax, centre: np.ndarray, axis: np.ndarray, size: float, colour: str) -> None:

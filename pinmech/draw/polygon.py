@@ -125,7 +125,7 @@ def _polygon(analysis: Analysis, quantity: str) -> Polygon:
         images[labels[name]] = axes @ (place.acceleration if acc else place.velocity)
     vectors = [PolygonVector("absolute", np.zeros(2), images[labels[n]], "o" + prime, labels[n],
                              f"{quantity[0]}_{shown.get(n, n)}")
-               for n in analysis.motion.points if np.linalg.norm(images[labels[n]]) > 0]
+               for n in places if np.linalg.norm(images[labels[n]]) > 0]
     coincident = [c for c in coincident_points(analysis.scene) if c.name in labels and c.at in labels]
     rates = _link_rates(analysis, [*members, *(c.link for c in coincident)])
     for link, names in members.items():
@@ -165,8 +165,8 @@ def _drawn(vectors: list[PolygonVector], images: dict[str, np.ndarray]) -> list[
 
 
 def _places_and_links(analysis: Analysis) -> tuple[dict[str, PointMotion], dict[str, list[str]]]:
-    """The reported points and the fixed pivots of the moving links (at rest, image at the
-    pole), and moving link -> the places on it (a pin's on both links), fixed ones first,
+    """The reported points, the pins the report leaves out and the fixed pivots of the moving
+    links (at rest, image at the pole), and moving link -> the places on it (a pin's on both links), fixed ones first,
     then in the report's order. The fixed pivots let a point at the end of a rocker be
     reached by both routes of the graphical method: about the coupler's pin and about the
     rocker's pivot."""
@@ -178,6 +178,7 @@ def _places_and_links(analysis: Analysis) -> tuple[dict[str, PointMotion], dict[
     joint_of = {name: sketch.joint for name, sketch in sketches.items()}
     places = dict(motion.points)
     places.update(_fixed_pivots(sketches, data, places, mech.length_scale))
+    places.update(_moving_pins(analysis, sketches, data, places))
     members: dict[str, list[str]] = {}
     for name, p in places.items():
         on = {p.link} if name in coincident else {p.link, *pin_links(sketches, data, p.position, mech.length_scale)}
@@ -201,6 +202,29 @@ def _fixed_pivots(sketches: dict, data: pin.Data, reported: dict[str, PointMotio
         if node.kind == "revolute" and not taken and node.name not in reported:
             out[node.name] = PointMotion(p, np.zeros(3), np.zeros(3), ground.name)
     return out
+
+
+def _moving_pins(analysis: Analysis, sketches: dict, data: pin.Data,
+                 shown: dict[str, PointMotion]) -> dict[str, PointMotion]:
+    """The pins between moving links that no reported point marks (a polygon draws every
+    pin, as the graphical method does, whatever the scene reports), read off the solved pose
+    at the pin joint's frame."""
+    mech, scale = analysis.mechanism, analysis.mechanism.length_scale
+    found: dict[str, np.ndarray] = {}
+    for sketch in sketches.values():
+        if sketch.is_ground:
+            continue
+        for node, p in zip(sketch.nodes, world_nodes(sketch, data)):
+            taken = any(np.linalg.norm(p - q.position) <= 1e-6 * scale for q in shown.values()) or any(
+                np.linalg.norm(p - q) <= 1e-6 * scale for q in found.values())
+            if node.kind == "revolute" and not taken and node.name not in shown and mech.model.existFrame(node.name):
+                found[node.name] = p
+    if not found:
+        return {}
+    sol = analysis.solution
+    motion = evaluate_motion(mech, mech.model.createData(), sol.q, sol.v, sol.a, points=list(found), links=[])
+    return {name: m for name, m in motion.points.items()
+            if np.linalg.norm(m.position - found[name]) <= 1e-6 * scale}  # the frame is at the pin
 
 
 def _link_rates(analysis: Analysis, links: list[str]) -> dict[str, tuple[float, float]]:

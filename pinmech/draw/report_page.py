@@ -26,7 +26,9 @@ from pinmech.io.html_tables import motion_table_html
 
 
 def report_html(analysis: Analysis, *, steps: int = 121, hand_text: str | None = None) -> str:
-    """The whole page.
+    """The whole page: a sheet that prints on one page (A4 or Letter) -- the given data, the
+    drawing beside the design table, the polygons, the sweep and the paths -- then, on screen
+    only, the motion tables, the hand check and the full text report.
 
     Args:
         analysis: the solved scene (`pinmech.analyse`).
@@ -35,16 +37,60 @@ def report_html(analysis: Analysis, *, steps: int = 121, hand_text: str | None =
     """
     from pinmech.io.report import to_text
 
-    figures = _figures(analysis, steps)
-    sections = [("Given", _given(analysis)),
-                ("Figures", "\n".join(_figure(n, body, caption) for n, (body, caption) in enumerate(figures, 1))),
-                ("Results", _caption(_CAPTIONS["motion"]) + motion_table_html(analysis.motion, analysis.mechanism.plane_normal))]
+    sweep_figures, summary = _sweep(analysis, steps) if steps and not analysis.scene.is_task else ([], None)
+    drawing, polygons = _drawing(analysis), _polygons(analysis) if analysis.mechanism.plane_normal is not None else []
+    numbered = [drawing, *polygons, *sweep_figures]
+    figure = {id(f): _figure(n, *f) for n, f in enumerate(numbered, 1)}
+    rows = [row for row in (polygons, sweep_figures) if row]
+    sheet_fit = _fit(analysis, summary, len(rows))
+    sheet = [_section("Given", _given(analysis)),
+             f'<div class="pair">{figure[id(drawing)]}{_design_section(analysis, summary, steps)}</div>']
+    sheet += [f'<div class="pair{"" if sheet_fit.sweep_printed or row is not sweep_figures else " off-paper"}">'
+              f'{"".join(figure[id(f)] for f in row)}</div>' for row in rows]
+    style = f"--figure: {sheet_fit.figure_mm:g}mm; --pose: {sheet_fit.pose_mm:g}mm"
+    more = [("Results", _caption(_CAPTIONS["motion"]) + motion_table_html(analysis.motion, analysis.mechanism.plane_normal))]
     if hand_text is not None:
-        sections.append(("Hand calculation checked", _caption(_CAPTIONS["hand"]) + _pre(hand_text)))
-    sections.append(("Full text report", '<details><summary>As <code>pinmech solve</code> prints it (click to '
-                     f'open)</summary>{_pre(to_text(analysis))}</details>'))
-    body = "\n".join(f"<section><h2>{html.escape(t)}</h2>\n{content}</section>" for t, content in sections)
+        more.append(("Hand calculation checked", _caption(_CAPTIONS["hand"]) + _pre(hand_text)))
+    more.append(("Full text report", '<details><summary>As <code>pinmech solve</code> prints it (click to '
+                 f'open)</summary>{_pre(to_text(analysis))}</details>'))
+    rest = "\n".join(_section(t, content) for t, content in more)
+    off = "" if sheet_fit.sweep_printed or not sweep_figures else " the sweep and paths figures (Figures 4-5),"
+    body = (f'<div class="sheet" style="{style}">{"".join(sheet)}</div>\n'
+            f'<p class="print-only rest">{_REST.format(off=off)}</p>\n'
+            f'<div class="screen-only">{rest}</div>')
     return _PAGE.format(title=html.escape(analysis.scene.title), meta=_meta(analysis), body=body)
+
+
+_REST = ("On the HTML page, not printed:{off} the points' and links' motion tables, the hand check and the full "
+         "text report.")
+
+
+def _fit(analysis: Analysis, summary: dict | None, rows_of_figures: int):
+    """The figures' printed heights that keep the sheet on one page (report_fit.py)."""
+    from pinmech.draw.report_design import design_rows
+    from pinmech.draw.report_fit import fit
+    from pinmech.io.report_given import given
+
+    design = design_rows(summary) if summary and summary.get("planar") else []
+    return fit(given(analysis), design, rows_of_figures=rows_of_figures)
+
+
+def _section(title: str, content: str) -> str:
+    return f"<section><h2>{html.escape(title)}</h2>\n{content}</section>"
+
+
+def _design_section(analysis: Analysis, summary: dict | None, steps: int) -> str:
+    """The design table of the page's sweep, or a line saying why there is none."""
+    from pinmech.draw.report_design import design_table
+
+    if summary is None:
+        why = ("a task scene is followed in time (pinmech path)" if analysis.scene.is_task
+               else "no sweep (--steps 0)" if not steps else "no pose of the sweep closed")
+        return f'<section class="design"><h2>Design</h2><p class="design-none">No design table: {why}.</p></section>'
+    driver = analysis.motion.joints.get(summary["driver"])
+    sense = 1.0 if driver is None or driver.v >= 0 else -1.0
+    return (f'<section class="design"><h2>Design</h2>{design_table(summary, sense)}'
+            f'{_caption(_CAPTIONS["design"].format(poses=summary.get("poses", 0)))}</section>')
 
 
 def _meta(analysis: Analysis) -> str:
@@ -65,19 +111,13 @@ def _given(analysis: Analysis) -> str:
     return f'<table class="given">{rows}</table>'
 
 
-def _figures(analysis: Analysis, steps: int) -> list[tuple[str, str]]:
-    """(figure body, caption) in order: each figure once."""
-    out = []
+def _drawing(analysis: Analysis) -> tuple[str, str]:
+    """Figure 1: the space diagram (planar), or the interactive view (spatial)."""
     if analysis.mechanism.plane_normal is not None:
         from pinmech.draw.space_svg import pose_svg
 
-        out.append((pose_svg(analysis) + _interactive(analysis, "Interactive 3-D view"), _CAPTIONS["pose"]))
-        out += [(svg, caption) for svg, caption in _polygons(analysis)]
-    else:
-        out.append((_interactive(analysis, None), _CAPTIONS["drawing"]))
-    if steps and not analysis.scene.is_task:
-        out += _sweep(analysis, steps)
-    return out
+        return pose_svg(analysis) + _interactive(analysis, "Interactive 3-D view"), _CAPTIONS["pose"]
+    return _interactive(analysis, None), _CAPTIONS["drawing"]
 
 
 def _figure(number: int, body: str, caption: str) -> str:
@@ -105,23 +145,33 @@ def _polygons(analysis: Analysis) -> list[tuple[str, str]]:
             ((velocity_polygon, "velocity"), (acceleration_polygon, "acceleration"))]
 
 
-def _sweep(analysis: Analysis, steps: int) -> list[tuple[str, str]]:
+def _sweep(analysis: Analysis, steps: int) -> tuple[list[tuple[str, str]], dict | None]:
+    """The sweep and paths figures over one turn of the first driver (up to a fold, where the
+    driver cannot turn on), and the sweep's design summary (`pinmech.design_summary`)."""
+    import math
+
     from pinmech.draw.plot import SweepPlot
     from pinmech.io.sweep import Sweep
+    from pinmech.solve.design_summary import design_summary
+    from pinmech.solve.diagnostics_sweep import design_of
 
     sweep = Sweep.from_scene(analysis.scene)
-    recorder = SweepPlot(sweep, total=steps)
-    for pose in sweep.poses(sweep.default_values(steps), skip_failures=True):
+    recorder, design = SweepPlot(sweep, total=steps), design_of(sweep)
+    values = sweep.default_values(steps)
+    for pose in sweep.poses(values, skip_failures=True, to_fold=True, past_change_points=True):
         recorder.add(pose)
+        design.add(pose)
+    turn = sweep.is_angular and sweep.fold_end is None
+    summary = design_summary(sweep, 2 * math.pi if turn else None) if design.count or not design.applicable else None
     with tempfile.TemporaryDirectory() as folder:
         try:
             figures = [recorder.save(Path(folder) / "sweep.png")]
             if recorder.points:
                 figures.append(recorder.save_paths(Path(folder) / "paths.png"))
         except PinmechError as exc:  # every pose failed: the page says so, the rest stands
-            return [(f"<p>No sweep figure: {html.escape(str(exc))}</p>", _CAPTIONS["sweep"])]
+            return [(f"<p>No sweep figure: {html.escape(str(exc))}</p>", _CAPTIONS["sweep"])], summary
         return [(f'<img alt="{p.stem}" src="data:image/png;base64,{base64.b64encode(p.read_bytes()).decode()}">',
-                 _CAPTIONS[p.stem]) for p in figures]
+                 _CAPTIONS[p.stem]) for p in figures], summary
 
 
 _CAPTIONS = {
@@ -135,6 +185,9 @@ _CAPTIONS = {
                     "relative accelerations as their normal and tangential parts, a slider's as its Coriolis and "
                     "sliding parts; a point on two links reached by both routes. Scale written on the drawing.",
     "sweep": "Every quantity against the driver over one turn (the scene's pose dashed).",
+    "design": "From the design summary of the sweep's {poses} poses (pinmech sweep --summary-json gives it at full "
+              "precision): extremes located between the poses, at toggles and change points included; driver "
+              "positions on [0, 360) deg.",
     "paths": "The paths of the named points over one turn, with the mechanism at the scene's pose.",
     "motion": "Table 1: the points; Table 2: the links. World frame, SI units; φ, ω, α about the plane's normal "
               "for a planar mechanism.",
@@ -154,32 +207,37 @@ _PAGE = """<!DOCTYPE html>
 <html><head><meta charset="utf-8"><title>{title}</title>
 <style>
 body {{font: 14px sans-serif; margin: 16px auto; max-width: 1100px; color: #222; padding: 0 8px}}
-h1 {{font-size: 20px; margin-bottom: 2px}} h2 {{font-size: 16px; border-bottom: 1px solid #ccc}}
+h1 {{font-size: 20px; margin-bottom: 2px}} h2 {{font-size: 16px; border-bottom: 1px solid #ccc; margin: 10px 0 4px}}
 .meta {{color: #666; font-size: 12px; margin-top: 0}}
 iframe.drawing {{width: 100%; height: 520px; border: 1px solid #ccc}}
 .caption {{color: #555; margin: 4px 0 8px}}
 pre {{font-size: 12px; background: #f7f7f7; padding: 8px; overflow-x: auto}}
-figure {{margin: 12px 0}} figcaption {{color: #444; font-size: 13px; margin-top: 4px; max-width: 760px}}
-figure svg, figure img {{display: block; max-width: 100%; height: auto}} figure svg.pose {{max-width: 640px}}
-img[alt="paths"] {{max-width: 760px}} figure > svg:not(.pose) {{max-width: 760px}}
+.pair {{display: flex; gap: 16px; align-items: flex-start}} .pair > * {{flex: 1 1 0; min-width: 0}}
+figure {{margin: 12px 0}} figcaption {{color: #444; font-size: 13px; margin-top: 4px}}
+figure svg, figure img {{display: block; max-width: 100%; height: auto}} figure svg.pose {{max-height: 460px}}
 table {{border-collapse: collapse; margin: 6px 0; max-width: 100%}}
 td, th {{border: 1px solid #ccc; padding: 2px 6px; overflow-wrap: anywhere; vertical-align: top}}
-table.given th {{text-align: left; white-space: nowrap; background: #f4f4f4}}
+table.given th, table.design th {{text-align: left; background: #f4f4f4}} table.given th {{white-space: nowrap}}
+table.design th {{width: 32%}}
 .print-only {{display: none}}
-@page {{size: A4; margin: 12mm}}
+@page {{margin: 9mm}}
 @media print {{
-  body {{max-width: none; margin: 0; padding: 0; font-size: 10pt}}
-  .screen-only {{display: none}} .print-only {{display: block}}
-  figure {{break-inside: avoid}} h2 {{break-after: avoid}} tr {{break-inside: avoid}}
-  figure svg, figure img {{width: 100%; max-width: 170mm}} figure svg.pose {{max-width: 130mm}}
-  table {{width: 100%; font-size: 8pt; table-layout: auto}}
-  pre {{white-space: pre-wrap; font-size: 7.5pt}}
+  body {{max-width: none; margin: 0; padding: 0; font-size: 7.5pt}}
+  h1 {{font-size: 12pt; margin: 0}} .meta {{font-size: 6.5pt; margin: 0 0 1mm}}
+  h2 {{font-size: 9pt; margin: 1.5mm 0 1mm}}
+  .screen-only {{display: none}} .print-only {{display: block}} .rest {{font-size: 6.5pt; color: #666; margin: 1mm 0 0}}
+  .sheet {{break-after: avoid}} .pair {{gap: 4mm}}
+  figure {{margin: 1.5mm 0; break-inside: avoid}} figcaption {{font-size: 6.5pt; margin-top: 0.5mm; line-height: 1.2}}
+  figure svg, figure img {{max-width: 100%; width: auto; max-height: var(--figure, 52mm); margin: 0 auto}}
+  figure svg.pose {{max-height: var(--pose, 60mm)}} .off-paper {{display: none}}
+  .caption {{font-size: 6.5pt; margin: 1mm 0}}
+  table {{width: 100%; font-size: 7pt}} td, th {{padding: 0.3mm 1.2mm; line-height: 1.2}}
 }}
 </style></head>
 <body><h1>{title}</h1>
 <p class="meta">{meta}</p>
 {body}
-<p style="color:#777">Written by pinmech; offline: everything is on this page.</p>
+<p class="screen-only" style="color:#777">Written by pinmech; offline: everything is on this page.</p>
 </body></html>
 """
 

@@ -13,6 +13,11 @@ from pinmech.draw.plot_curves import nearest as _nearest, spike_limits
 from pinmech.solve.certify import dial_caption
 
 
+#: A speed's or acceleration's panel switches from mm to m where its largest value would
+#: reach this many mm/s or mm/s² (five digits: 9,999 mm/s² is drawn, 10,000 is 10 m/s²).
+RATE_LIMIT = 1e4
+
+
 class SweepPanels:
     """The panel drawing of `SweepPlot` (its recorded `series`, `branch`, `colours`, `names`,
     `length`, `angles`, `mark` and `sweep`)."""
@@ -61,18 +66,37 @@ class SweepPanels:
 
     def _length_dim(self, dim: str) -> tuple[float, str]:
         """(factor, unit) a quantity in SI `dim` is drawn in: the figure's length unit for
-        lengths, speeds and accelerations ("m/s" -> "mm/s"), else as it is."""
-        if dim in ("m", "m/s", "m/s²"):
-            return self.length[0], self.length[1] + dim[1:]
-        return 1.0, dim
+        lengths, and for speeds and accelerations too unless the largest of that kind in the
+        figure (every panel in `dim`) would reach 10,000 in it: then m/s or m/s², one unit a
+        kind in the figure (never 150,000 mm/s²)."""
+        if dim not in ("m", "m/s", "m/s²"):
+            return 1.0, dim
+        scale, unit = self.length
+        if dim != "m" and scale != 1.0 and scale * self._largest(dim) >= RATE_LIMIT:
+            return 1.0, dim
+        return scale, unit + dim[1:]
+
+    def _largest(self, dim: str) -> float:
+        """The largest |value| [SI] of the figure's panels in `dim`."""
+        out = 0.0
+        for title, series in self.series.items():
+            if title.endswith(f"[{dim}]"):
+                for values in series.values():
+                    y = np.abs(np.asarray(values, float))
+                    if np.any(np.isfinite(y)):
+                        out = max(out, float(np.nanmax(y)))
+        return out
 
     def _curve(self, ax, name: str, x: np.ndarray, y: np.ndarray, branch: np.ndarray) -> None:
-        """One name's curve, in its link's colour, one line style for each branch."""
+        """One name's curve, in its link's colour (a point's in its own colour, with its own
+        marker every so often), one line style for each branch."""
         colour = self.colours.get(name, "k")
+        marker = getattr(self, "point_markers", {}).get(name)
+        extra = {"marker": marker, "markevery": max(1, len(x) // 9), "markersize": 5} if marker else {}
         for b, mask in branch_pieces(branch):
             label = self.names.get(name, name) + (f", assembly {b + 1}" if self._folded else "")
             ax.plot(x, np.where(mask, y, np.nan), linewidth=1.6, color=colour,
-                    linestyle=BRANCH_STYLES[b % len(BRANCH_STYLES)], label=label)
+                    linestyle=BRANCH_STYLES[b % len(BRANCH_STYLES)], label=label, **extra)
 
     def _title(self, marked: bool, mark_x: float, unit: str) -> str:
         sweep = self.sweep

@@ -14,6 +14,8 @@
     step = "1 ms"             # its time step,
     scheme = "taylor"         # its integration scheme (euler, taylor, rk4)
     gain = 0                  # and its feedback on the drift [1/s]
+    targets = {P = [["20 mm", "20 mm"], ["20 mm", "25 mm"]]}   # places drawn on P's path
+                              # (a synthesis writes its task's targets here), world x, y
 """
 
 from __future__ import annotations
@@ -23,12 +25,15 @@ from typing import Any
 
 import msgspec
 
-from pinmech.io.scene_fields import Refused, Table, names, positive_quantity, written_value
+from pinmech.io.scene_fields import Refused, Table, names, positive_quantity, quantity, written_value
 from pinmech.typed_values import given_fields
 
 #: The `[sweep]` keys and their types.
 SWEEP_KEYS = {"links": list, "points": list, "steps": int, "from": str, "to": str, "start": str,
-              "batch": bool, "interpolate": int, "duration": str, "step": str, "scheme": str, "gain": (int, float)}
+              "batch": bool, "interpolate": int, "duration": str, "step": str, "scheme": str, "gain": (int, float),
+              "targets": dict}
+#: The most target places a scene may draw (a synthesis has a few dozen at most).
+MAX_TARGETS = 10_000
 #: The `[sweep]` numbers' ranges: the least value, and what it counts.
 _LEAST = {"steps": (2, "poses, both ends included"), "interpolate": (1, "(1: every pose solved)")}
 
@@ -50,6 +55,7 @@ class SweepSpec(Table):
     step: str | None = None
     scheme: str | None = None
     gain: float | None = None
+    targets: dict[str, list[tuple[float, float]]] | None = None  # point -> places (x, y) [m]
 
     @classmethod
     def _known_keys(cls, data: Any) -> Any:
@@ -78,6 +84,8 @@ class SweepSpec(Table):
             return written_value(value)
         if name in ("duration", "step"):
             positive_quantity(value, "time", "a positive time")
+        if name == "targets":
+            return _targets(value)
         return value
 
     @staticmethod
@@ -93,3 +101,18 @@ class SweepSpec(Table):
     def given(self) -> dict[str, Any]:
         """The keys the scene gives, by their names in the file ("from", "steps", ...)."""
         return given_fields(self)
+
+
+def _targets(value: dict) -> dict[str, list[tuple[float, float]]]:
+    """`targets = {P = [["x", "y"], ...]}`: each point's places, lengths, in SI."""
+    out, count = {}, 0
+    for point, places in value.items():
+        if not isinstance(places, list) or not all(isinstance(p, list) and len(p) == 2 for p in places):
+            raise Refused(f"must be a list of [x, y] places such as [\"20 mm\", \"45 mm\"], got {places!r}",
+                          at=(point,))
+        count += len(places)
+        if count > MAX_TARGETS:
+            raise Refused(f"more than {MAX_TARGETS} target places", at=(point,))
+        out[point] = [tuple(quantity(c, "length", at=(point, k)).si for c in p)
+                      for k, p in enumerate(places)]
+    return out

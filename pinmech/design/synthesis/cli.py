@@ -97,7 +97,8 @@ def _write_and_check(spec, lk, entry: dict, prefix: str, i: int) -> tuple[list, 
 
         files = six.write_linkage(spec, lk, prefix)
     else:
-        files = write_linkage(lk, prefix, f"{spec.title}: linkage {i}", str(spec.path))
+        files = write_linkage(lk, prefix, f"{spec.title}: linkage {i}", str(spec.path),
+                              spec.targets[:, :2] if lk.task in ("path", "motion") else None)
     entry["files"] = [str(p) for p in files]
     try:
         if spec.scene is not None:

@@ -16,7 +16,7 @@ import numpy as np
 
 from pinmech.angles import turn_radians
 from pinmech.design.synthesis.kinematics import kinematics
-from pinmech.design.synthesis.written import deg_text, mm_text
+from pinmech.design.synthesis.written import deg_text, mm_text, targets_text
 from pinmech.design.synthesis.result import Linkage
 from pinmech.outputs import write_whole
 
@@ -97,9 +97,10 @@ def motion_values(lk: Linkage) -> np.ndarray:
     return turn_radians(float(lk.theta[0])) + lk.way * np.concatenate(([0.0], np.cumsum(steps)))
 
 
-def scene_toml(lk: Linkage, linkage_file: str, title: str) -> str:
+def scene_toml(lk: Linkage, linkage_file: str, title: str, targets=None) -> str:
     """A scene of the linkage: the crank O2 driven from the first target's angle, its
-    sweep over the motion to the last target."""
+    sweep over the motion to the last target; a path's or motion's target places [m] (N, 2)
+    written beside it, for the paths figure (`[sweep] targets`)."""
     values = motion_values(lk)
     steps = int(math.ceil(abs(values[-1] - values[0]) / _STEP)) + 1
     shown = {"path": "points = [\"P\"]", "motion": "points = [\"P\"]\nlinks = [\"coupler\"]",
@@ -124,6 +125,7 @@ def scene_toml(lk: Linkage, linkage_file: str, title: str) -> str:
         f"to = {_deg(values[-1])}",
         f"steps = {steps}",
         shown,
+        *([targets_text("P", targets)] if targets is not None and lk.task in ("path", "motion") else []),
         "",
         "[report]",
         shown,
@@ -131,12 +133,13 @@ def scene_toml(lk: Linkage, linkage_file: str, title: str) -> str:
     ])
 
 
-def write_linkage(lk: Linkage, prefix: str | Path, title: str, source: str) -> tuple[Path, Path]:
-    """PREFIX.toml (the drawn linkage) and PREFIX_scene.toml (its sweep); their paths."""
+def write_linkage(lk: Linkage, prefix: str | Path, title: str, source: str, targets=None) -> tuple[Path, Path]:
+    """PREFIX.toml (the drawn linkage) and PREFIX_scene.toml (its sweep, with the task's
+    target places [m] (N, 2) when given); their paths."""
     prefix = Path(prefix)
     linkage, scene = prefix.with_name(prefix.name + ".toml"), prefix.with_name(prefix.name + "_scene.toml")
     write_whole(linkage, linkage_toml(lk, title, source))
-    write_whole(scene, scene_toml(lk, linkage.name, title))
+    write_whole(scene, scene_toml(lk, linkage.name, title, targets))
     return linkage, scene
 
 

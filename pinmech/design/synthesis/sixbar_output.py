@@ -11,6 +11,7 @@ import numpy as np
 
 from pinmech.angles import turn_degrees
 from pinmech.design.synthesis.file import SynthesisSpec
+from pinmech.design.synthesis.written import targets_text
 from pinmech.design.synthesis.result import MET, Linkage
 from pinmech.design.synthesis.written import deg_text
 from pinmech.outputs import write_whole
@@ -59,7 +60,8 @@ def scene_toml(spec: SynthesisSpec, lk: Linkage, linkage_file: str) -> str:
         "#   pinmech sweep THIS_FILE --plot fig.png",
         f"title = \"{spec.title}\"", f"linkage = \"{linkage_file}\"", "",
         f"[drivers.{driver}]", f"angle = {deg[0]}", "",
-        "[sweep]", f"from = {deg[1]}", f"to = {deg[2]}", "steps = 361", shown, "",
+        "[sweep]", f"from = {deg[1]}", f"to = {deg[2]}", "steps = 361", shown,
+        *([targets_text(spec.point, spec.targets[:, :2])] if spec.task in ("path", "motion") else []), "",
         "[report]", shown, ""])
 
 

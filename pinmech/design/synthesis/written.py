@@ -15,3 +15,11 @@ def mm_text(v: float) -> str:
 def deg_text(v: float) -> str:
     """An angle [rad] as TOML text in deg."""
     return f"{math.degrees(float(v))!r} deg"
+
+
+def targets_text(point: str, targets) -> str:
+    """A scene's `[sweep] targets` line: the task's target places of `point` [m], (N, 2) in
+    the linkage's plane, written in mm to 12 significant figures, as a user writes them (the
+    paths figure draws them on the point's path)."""
+    pairs = ", ".join(f"[\"{1e3 * float(x):.12g} mm\", \"{1e3 * float(y):.12g} mm\"]" for x, y in targets)
+    return f"targets = {{{point} = [{pairs}]}}"
