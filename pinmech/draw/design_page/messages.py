@@ -6,9 +6,12 @@
     {"type": "motion", "index": 10, "point": "P"}            -> velocity, acceleration
     {"type": "centres", "index": 10}                         -> the instant centres
     {"type": "save", "svg": "<svg...", "png": "data:..."}    -> the files written
-    {"type": "synthesise", "kind": "four-bar", "targets": [[x, y], ...], "max_crank": 0.2}
+    {"type": "synthesise", "kind": "four-bar", "task": "path", "targets": [[x, y], ...], "max_crank": 0.2,
+     "bounds": "crank = [...]\n..."}  (task "motion": "poses": [[x, y, angle], ...]; "function":
+     "pairs": [[crank turn, output turn or travel], ...], "ground": 0.1)
+    {"type": "bounds", ...the same...}                       -> the [bounds] the page proposes
     {"type": "synthesis"} (how far), {"type": "cancel"}, {"type": "adopt", "answer": 0} -> a frame
-Positions in metres, world frame; `index` a pose of the turn (0: the drawn pose).
+Positions in metres, angles in radians, world frame; `index` a pose of the turn (0: the drawn pose).
 """
 
 from __future__ import annotations
@@ -58,6 +61,10 @@ def answer(session, saving: Saving, message: dict) -> dict:
             return session.centres(int(message["index"]))
         if kind == "save":
             return saving.save(session, message)
+        if kind == "bounds":
+            from pinmech.draw.design_page.synthesis import bounds_answer
+
+            return bounds_answer(message)
         if kind in ("synthesise", "synthesis", "cancel", "adopt"):
             from pinmech.draw.design_page.synthesis import synthesis_answer
 

@@ -39,7 +39,8 @@
     else if (m.type === "centres") { state.centres = m.ok ? m : null; draw(); }
     else if (m.type === "saved") { state.saved = m; showSaved(m); }
     else if (m.type === "synthesis") { takeSynthesis(m); }
-    if (m.type === "frame" && m.ok && state.answers.length && state.adopting) { state.adopting = false; state.chosen = -1; state.targets = []; draw(); }
+    else if (m.type === "bounds") { if (m.error) message(m.error, "error"); else $("bounds").value = m.text; }
+    if (m.type === "frame" && m.ok && state.answers.length && state.adopting) { state.adopting = false; state.chosen = -1; state.targets = []; showEntries(); draw(); }
     else if (m.type === "error") {
       state.pending = false; showError(m.error);
       if (state.queued) { const next = state.queued; state.queued = null; send(next); }
@@ -245,11 +246,16 @@
     $("arrow-text").textContent = `|v| = ${norm(m.velocity).toPrecision(4)} m/s (green), ` +
       `|a| = ${norm(m.acceleration).toPrecision(4)} m/s^2 (red)`;
   }
-  function drawTargets(unit) {
-    for (const t of state.targets) {
+  function drawTargets(unit) {  // a pose's angle: a tick from its place along the coupler's direction
+    if ($("synth-task").value === "function") return;
+    state.targets.forEach((t, i) => {
       const p = mm(t);
       el("circle", { class: "target", cx: p[0], cy: p[1], r: 6 * unit, "vector-effect": "non-scaling-stroke" }, svg);
-    }
+      if (t.length > 2) el("line", { class: "target-angle", x1: p[0], y1: p[1], x2: p[0] + 24 * unit * Math.cos(t[2]),
+        y2: p[1] - 24 * unit * Math.sin(t[2]), "vector-effect": "non-scaling-stroke" }, svg);
+      const label = el("text", { class: "target-label", x: p[0] + 7 * unit, y: p[1] + 12 * unit, "font-size": 11 * unit }, svg);
+      label.textContent = String(i + 1);
+    });
   }
   function drawAnswer(unit) {
     const a = state.answers[state.chosen];
@@ -328,11 +334,26 @@
     state.dragging = null; state.phantom = null;
     if (state.frame) { state.view = fitView(state.frame); draw(); }
   });
-  svg.addEventListener("click", (event) => {
-    if (!$("targets-on").checked || state.dragging) return;
+  svg.addEventListener("click", (event) => {  // a path's target
+    if (!$("targets-on").checked || state.dragging || $("synth-task").value !== "path") return;
     const p = toWorld(event);
-    state.targets.push([p[0] / 1000, -p[1] / 1000]); draw();
+    state.targets.push([p[0] / 1000, -p[1] / 1000]); showEntries(); draw();
   });
+  svg.addEventListener("mousedown", (event) => {  // a pose: its place, then its angle dragged
+    if (!$("targets-on").checked || $("synth-task").value !== "motion") return;
+    event.preventDefault();
+    const p = toWorld(event);
+    state.targets.push([p[0] / 1000, -p[1] / 1000, 0]); state.posing = state.targets.length - 1;
+    showEntries(); draw();
+  });
+  window.addEventListener("mousemove", (event) => {
+    if (state.posing === undefined || state.posing === null) return;
+    const t = state.targets[state.posing], p = toWorld(event);
+    const dx = p[0] / 1000 - t[0], dy = -p[1] / 1000 - t[1];
+    if (Math.hypot(dx, dy) > 1e-9) t[2] = Math.atan2(dy, dx);
+    showEntries(); draw();
+  });
+  window.addEventListener("mouseup", () => { state.posing = null; });
   $("pose").addEventListener("input", () => { state.index = Number($("pose").value); draw(); requestDetails(); });
   for (const id of ["show-ghosts", "show-centres", "show-arrows", "arrow-point"])
     $(id).addEventListener("change", () => { state.arrowScale = null; draw(); requestDetails(); });
@@ -417,11 +438,49 @@
   }
 
   // ------------------------------------------------------------------ synthesis
-  $("targets-clear").addEventListener("click", () => { state.targets = []; draw(); });
+  const HELP = {
+    path: "Tick <b>place on the drawing</b> and click the coupler point's targets, in order (or type x, y in mm).",
+    motion: "Tick <b>place on the drawing</b>, press at a pose's place and drag towards its angle (or type x, y in mm, angle in deg).",
+    function: "Type the pairs: the crank's turn (deg) and the output's turn (deg; a slider's travel in mm), from the first pair.",
+  };
+  function showHelp() {
+    const task = $("synth-task").value;
+    $("synth-help").innerHTML = HELP[task];
+    $("ground-box").style.display = task === "function" && $("synth-kind").value !== "slider-crank" ? "" : "none";
+  }
+  function showEntries() {  // the targets, poses or pairs in the page's units: mm, deg
+    const d = (r) => (r * 180 / Math.PI).toFixed(3), m = (x) => (x * 1000).toFixed(3);
+    $("entries").value = state.targets.map((t) => $("synth-task").value === "function" ? t.join(", ")
+      : t.length > 2 ? `${m(t[0])}, ${m(t[1])}, ${d(t[2])}` : `${m(t[0])}, ${m(t[1])}`).join("\n");
+  }
+  function readEntries() {  // the text typed: one entry a line, numbers split by commas or spaces
+    const rows = $("entries").value.split("\n").map((l) => l.trim()).filter((l) => l)
+      .map((l) => l.split(/[\s,;]+/).map(Number));
+    const task = $("synth-task").value;
+    state.targets = task === "function" ? rows.map((r) => [r[0], r[1]])
+      : rows.map((r) => task === "motion" ? [r[0] / 1000, r[1] / 1000, (r[2] || 0) * Math.PI / 180] : [r[0] / 1000, r[1] / 1000]);
+    draw();
+  }
+  $("entries").addEventListener("change", readEntries);
+  for (const id of ["synth-task", "synth-kind"]) $(id).addEventListener("change", () => {
+    if (id === "synth-task") { state.targets = []; showEntries(); draw(); }
+    showHelp();
+  });
+  showHelp();
+  function request(type) {  // the synthesis asked for: SI (m, rad) in the message
+    const task = $("synth-task").value, rad = Math.PI / 180;
+    const m = { type, kind: $("synth-kind").value, task, max_crank: Number($("synth-max").value) / 1000,
+      ground: Number($("synth-ground").value) / 1000, bounds: $("bounds").value };
+    if (task === "function") m.pairs = state.targets.map(([a, b]) =>
+      [a * rad, $("synth-kind").value === "slider-crank" ? b / 1000 : b * rad]);
+    else if (task === "motion") m.poses = state.targets; else m.targets = state.targets;
+    return m;
+  }
+  $("bounds-propose").addEventListener("click", () => ws.send(JSON.stringify(request("bounds"))));
+  $("targets-clear").addEventListener("click", () => { state.targets = []; showEntries(); draw(); });
   $("synth-run").addEventListener("click", () => {
     state.answers = []; state.chosen = -1; $("answers").innerHTML = "";
-    ws.send(JSON.stringify({ type: "synthesise", kind: $("synth-kind").value, targets: state.targets,
-      max_crank: Number($("synth-max").value) / 1000 }));
+    ws.send(JSON.stringify(request("synthesise")));
   });
   $("synth-cancel").addEventListener("click", () => ws.send(JSON.stringify({ type: "cancel" })));
   function takeSynthesis(m) {
