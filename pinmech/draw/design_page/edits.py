@@ -54,9 +54,9 @@ def move_joint(spec: LinkageSpec, name: str, to: np.ndarray, points: dict[str, n
         offset = to - points[entry.base][:2]
         new = msgspec.structs.replace(entry, length=millimetres(float(np.hypot(*offset))),
                                       angle=degrees(math.atan2(offset[1], offset[0])))
-        return _with_joint(spec, name, new, source)
+        return with_joint(spec, name, new, source)
     if isinstance(entry, Compass):
-        return _with_joint(spec, name, _compass_to(entry, to, points, name, source), source)
+        return with_joint(spec, name, compass_to(entry, to, points, name, source), source)
     if len(entry) != 2:
         raise ModelError("a spatial joint cannot be dragged on the page (planar linkages only)", path=source,
                          element=f"[joints] {name}")
@@ -73,7 +73,7 @@ def move_joint(spec: LinkageSpec, name: str, to: np.ndarray, points: dict[str, n
     return linkage_spec(raw, source)
 
 
-def _compass_to(entry: Compass, to: np.ndarray, points: dict[str, np.ndarray], name: str, source: str) -> Compass:
+def compass_to(entry: Compass, to: np.ndarray, points: dict[str, np.ndarray], name: str, source: str) -> Compass:
     """The compass construction that draws its joint at `to`: both lengths and the side."""
     a, b = (points[base][:2] for base in entry.bases)
     r1, r2 = float(np.hypot(*(to - a))), float(np.hypot(*(to - b)))
@@ -85,7 +85,7 @@ def _compass_to(entry: Compass, to: np.ndarray, points: dict[str, np.ndarray], n
     return msgspec.structs.replace(entry, lengths=(millimetres(r1), millimetres(r2)), side=side)
 
 
-def _with_joint(spec: LinkageSpec, name: str, entry: Polar | Compass, source: str) -> LinkageSpec:
+def with_joint(spec: LinkageSpec, name: str, entry: Polar | Compass, source: str) -> LinkageSpec:
     raw = msgspec.to_builtins(spec)
     raw["joints"][name] = msgspec.to_builtins(entry)
     return linkage_spec(raw, source)

@@ -1,6 +1,7 @@
 """The page's messages, one answer each (JSON-ready dicts): what the websocket carries.
 
-    {"type": "drag", "joint": "B", "x": 0.05, "y": 0.09}    -> a frame (or its error)
+    {"type": "drag", "joint": "B", "x": 0.05, "y": 0.09, "index": 0}  -> a frame (or its error);
+        index: the pose shown (the joint put under the mouse at that crank angle)
     {"type": "param", "name": "crank", "value": 0.04}        -> a frame (or its error)
     {"type": "frame"}                                        -> the current frame
     {"type": "motion", "index": 10, "point": "P"}            -> velocity, acceleration
@@ -50,7 +51,8 @@ def answer(session, saving: Saving, message: dict) -> dict:
     kind = message.get("type") if isinstance(message, dict) else None
     try:
         if kind == "drag":
-            return session.drag(str(message["joint"]), float(message["x"]), float(message["y"]))
+            return session.drag(str(message["joint"]), float(message["x"]), float(message["y"]),
+                                int(message.get("index", 0)))
         if kind == "param":
             return session.param(str(message["name"]), float(message["value"]))
         if kind == "frame":

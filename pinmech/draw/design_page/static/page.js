@@ -120,7 +120,7 @@
     svg.setAttribute("preserveAspectRatio", "xMidYMid meet");
     const unit = Math.max(w, h) / 600;  // one screen pixel, about [mm]
     defs(unit);
-    const index = state.dragging ? 0 : state.index;
+    const index = f.solved[state.index] ? state.index : 0;
     if ($("show-ghosts").checked && f.diagnostics) drawGhosts(f, unit);
     drawPaths(f);
     drawSlides(f, w + h);
@@ -320,13 +320,13 @@
   function startDrag(event, name) {
     if ($("targets-on").checked) return;  // placing targets: a click on a joint is a target too
     event.preventDefault();
-    state.dragging = name; state.index = 0; stopPlay();
+    state.dragging = name; stopPlay();  // dragged at the pose shown: under the mouse at this crank angle
   }
   window.addEventListener("mousemove", (event) => {  // the window's: a drag may leave the drawing
     if (!state.dragging) return;
     const p = toWorld(event);
     state.phantom = state.error ? p : null;
-    send({ type: "drag", joint: state.dragging, x: p[0] / 1000, y: -p[1] / 1000 });
+    send({ type: "drag", joint: state.dragging, x: p[0] / 1000, y: -p[1] / 1000, index: state.index });
     if (state.error) draw();
   });
   window.addEventListener("mouseup", () => {
