@@ -37,6 +37,7 @@ class Turn:
         values: the driver's values [rad or m], STEPS of them.
         names: the drawn points, in the order of the arrays' axis 1.
         q: (STEPS, nq) configurations, NaN rows where a pose failed.
+        v, a: (STEPS, nv) joint rates and accelerations at the driver's speed [rad/s, m/s, /s].
         position, velocity, acceleration: (STEPS, len(names), 2) world x, y [m, m/s, m/s^2].
         errors: pose index -> the error of a pose that failed (the turn stops at the first:
             the poses after it are not solved, their rows NaN).
@@ -49,6 +50,8 @@ class Turn:
     values: np.ndarray
     names: list[str]
     q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
     position: np.ndarray
     velocity: np.ndarray
     acceleration: np.ndarray
@@ -140,7 +143,7 @@ def _turn(linkage: Linkage, sweep, values: np.ndarray) -> Turn:
         paths = frame_paths(sweep.mechanism, names, q[solved], np.nan_to_num(v[solved]), np.nan_to_num(a[solved]))
         position[solved], velocity[solved] = paths.position[..., :2], paths.velocity[..., :2]
         acceleration[solved] = paths.acceleration[..., :2]
-    return Turn(linkage, sweep, values, names, q, position, velocity, acceleration, errors, notes, folds)
+    return Turn(linkage, sweep, values, names, q, v, a, position, velocity, acceleration, errors, notes, folds)
 
 
 def _chunks(sweep, values: np.ndarray):
