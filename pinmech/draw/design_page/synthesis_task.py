@@ -22,7 +22,7 @@ from pinmech.exceptions import SceneError
 
 KINDS = ("four-bar", "slider-crank", "inverted-slider-crank")
 TASKS = ("path", "motion", "function")
-GENERATIONS = 120  # at most, on each assembly: a page's search answers in seconds
+GENERATIONS = 120  # by default, at most, on each assembly: a page's search answers in seconds
 
 
 class Request:
@@ -34,6 +34,7 @@ class Request:
         pairs: (N, 2) function pairs: crank turn [rad], output turn [rad] or travel [m].
         ground: a four-bar's or inverted slider-crank's ground for a function [m].
         max_crank: the longest crank the default bounds allow [m].
+        generations: the search's generations at most (GENERATIONS unless asked).
         bounds: the `[bounds]` table's text as the designer edited it ("" for defaults).
     """
 
@@ -48,6 +49,9 @@ class Request:
             raise SceneError(f"the crank's limit must be positive, got {self.max_crank} m", path="<page>")
         self.ground = float(message.get("ground", 0.1))
         self.bounds = str(message.get("bounds") or "").strip()
+        self.generations = int(message.get("generations", GENERATIONS))
+        if not 1 <= self.generations <= 10 * GENERATIONS:
+            raise SceneError(f"generations must be from 1 to {10 * GENERATIONS}, got {self.generations}", path="<page>")
         poses = np.asarray(message.get("poses" if self.task == "motion" else "targets", []), dtype=float)
         width = 3 if self.task == "motion" else 2
         poses = poses.reshape(-1, width) if poses.size else np.zeros((0, width))
@@ -101,7 +105,7 @@ def _function_bounds(request: Request, span_text) -> str:
 def synthesis_toml(request: Request) -> str:
     """The synthesis file of `request` (its edited bounds, or the defaults)."""
     lines = ['title = "Designed on the design page"', f'task = "{request.task}"',
-             f'topology = "{request.kind}"', "seed = 1", "population = 15", f"generations = {GENERATIONS}",
+             f'topology = "{request.kind}"', "seed = 1", "population = 15", f"generations = {request.generations}",
              "keep = 3"]
     if request.task == "function":
         output = millimetres if request.kind == "slider-crank" else degrees

@@ -470,7 +470,8 @@
   function request(type) {  // the synthesis asked for: SI (m, rad) in the message
     const task = $("synth-task").value, rad = Math.PI / 180;
     const m = { type, kind: $("synth-kind").value, task, max_crank: Number($("synth-max").value) / 1000,
-      ground: Number($("synth-ground").value) / 1000, bounds: $("bounds").value };
+      ground: Number($("synth-ground").value) / 1000, bounds: $("bounds").value,
+      generations: Number($("synth-generations").value) };
     if (task === "function") m.pairs = state.targets.map(([a, b]) =>
       [a * rad, $("synth-kind").value === "slider-crank" ? b / 1000 : b * rad]);
     else if (task === "motion") m.poses = state.targets; else m.targets = state.targets;
