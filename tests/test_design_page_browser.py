@@ -118,7 +118,7 @@ def test_synthesis_from_clicked_targets_is_adopted(page, tmp_path):
         browser.mouse("mouseReleased", sx, sy)
     assert browser.evaluate("window.pinmechPage.targets.length") == len(pts)
     browser.evaluate("document.getElementById('synthesis-box').open = true")
-    browser.evaluate("document.getElementById('synth-generations').value = 40")  # a short search: < 10 s
+    browser.evaluate("document.getElementById('synth-generations').value = 25")  # a short search: < 10 s
     browser.evaluate("document.getElementById('synth-run').click()")
     browser.wait_for("window.pinmechPage.answers.length > 0", timeout=240, every=0.5)
     browser.evaluate("document.querySelector('#answers li').click()")

@@ -106,6 +106,8 @@
       lo = [Math.min(lo[0], q[0]), Math.min(lo[1], q[1])]; hi = [Math.max(hi[0], q[0]), Math.max(hi[1], q[1])]; };
     for (const j of f.joints) add(j.at);
     for (const n in f.paths) pathPoints(f, n).forEach(add);
+    const a = state.answers[state.chosen];  // a chosen answer is drawn whole too
+    if (a) { Object.values(a.points).forEach(add); a.path.forEach(add); }
     const w = Math.max(hi[0] - lo[0], 1), h = Math.max(hi[1] - lo[1], 1), pad = 0.15 * Math.max(w, h);
     return [lo[0] - pad, lo[1] - pad, w + 2 * pad, h + 2 * pad];
   }
@@ -183,16 +185,29 @@
     const ghosts = [];
     for (const o of d.outputs || []) for (const l of o.limits) ghosts.push([`${o.name} ${l.label}`, l.points]);
     for (const x of d.folds || []) ghosts.push([`fold at ${driverText(f, x.driver)}`, x.points]);
-    ghosts.forEach((g, k) => {
+    const placed = [];
+    ghosts.forEach((g) => {
       for (const link of f.links) {
         if (link.ground) continue;
         const pts = link.points.map((n) => g[1][n]).filter((p) => p).map(mm);
         if (pts.length >= 2) polyline(pts.length > 2 ? pts.concat([pts[0]]) : pts, "ghost");
       }
-      const anyPoint = Object.values(g[1])[Object.keys(g[1]).length - 1];
-      if (anyPoint) { const p = mm(anyPoint); el("text", { class: "ghost-label", x: p[0] + 6 * unit,
-        y: p[1] - 6 * unit - 13 * unit * k, "font-size": 11 * unit }, svg).textContent = g[0]; }  // stacked: one line each
+      const away = farthest(f, g[1]);  // labelled where the ghost is farthest from the linkage shown
+      if (!away) return;
+      const p = mm(away), at = [p[0] + 6 * unit, p[1] - 6 * unit];
+      while (placed.some((q) => Math.abs(q[0] - at[0]) < 70 * unit && Math.abs(q[1] - at[1]) < 12 * unit)) at[1] -= 13 * unit;
+      placed.push(at);  // a label on another's place goes a line up
+      el("text", { class: "ghost-label", x: at[0], y: at[1], "font-size": 11 * unit }, svg).textContent = g[0];
     });
+  }
+  function farthest(f, ghost) {  // the ghost's point farthest from the same point of the linkage shown
+    let best = null, gap = -1;
+    for (const n in ghost) {
+      const now = pointAt(f, n, f.solved[state.index] ? state.index : 0);
+      const d = now ? Math.hypot(ghost[n][0] - now[0], ghost[n][1] - now[1]) : 0;
+      if (d > gap) { gap = d; best = ghost[n]; }
+    }
+    return best;
   }
   function drawSlides(f, size) {
     for (const s of f.slides) {
@@ -225,12 +240,15 @@
     }
   }
   function drawCentres(unit) {
+    const placed = [];
     for (const c of state.centres.centres) {
       if (!c.position) continue;
-      const p = mm(c.position);
+      const p = mm(c.position), text = `I(${c.links[0]},${c.links[1]})`, at = [p[0] + 4 * unit, p[1] + 10 * unit];
+      while (placed.some((q) => Math.abs(q[1] - at[1]) < 11 * unit && at[0] < q[0] + q[2] && q[0] < at[0] + 6 * unit * text.length))
+        at[1] += 11 * unit;  // a label on another's place goes a line down
+      placed.push([at[0], at[1], 6 * unit * text.length]);
       el("circle", { class: "centre", cx: p[0], cy: p[1], r: 3 * unit }, svg);
-      el("text", { class: "centre-label", x: p[0] + 4 * unit, y: p[1] + 10 * unit, "font-size": 10 * unit }, svg)
-        .textContent = `I(${c.links[0]},${c.links[1]})`;
+      el("text", { class: "centre-label", x: at[0], y: at[1], "font-size": 10 * unit }, svg).textContent = text;
     }
   }
   function drawArrows(unit, size) {
@@ -463,7 +481,10 @@
   }
   $("entries").addEventListener("change", readEntries);
   for (const id of ["synth-task", "synth-kind"]) $(id).addEventListener("change", () => {
-    if (id === "synth-task") { state.targets = []; showEntries(); draw(); }
+    if (id === "synth-task") {  // another task: its own targets, and no answers of the last
+      state.targets = []; state.answers = []; state.chosen = -1; $("answers").innerHTML = "";
+      $("synth-progress").textContent = ""; showEntries(); state.view = fitView(state.frame); draw();
+    }
     showHelp();
   });
   showHelp();
@@ -494,7 +515,8 @@
     const list = $("answers"); list.innerHTML = "";
     m.answers.forEach((a, i) => {
       const li = document.createElement("li"); li.textContent = a.summary;
-      li.addEventListener("click", () => { state.chosen = i; [...list.children].forEach((c, k) => c.className = k === i ? "chosen" : ""); draw(); });
+      li.addEventListener("click", () => { state.chosen = i; [...list.children].forEach((c, k) => c.className = k === i ? "chosen" : "");
+        state.view = fitView(state.frame); draw(); });
       const adopt = document.createElement("button"); adopt.textContent = "adopt"; adopt.type = "button";
       adopt.addEventListener("click", (e) => { e.stopPropagation(); state.adopting = true; state.view = null;
         ws.send(JSON.stringify({ type: "adopt", answer: i })); });
