@@ -60,6 +60,7 @@ class Session:
                 check(turn)
             frame = turn_frame(turn, spec)
         except PinmechError as exc:
+            self.solver.rollback()
             return {"type": "frame", "ok": False, "error": f"{type(exc).__name__}: {exc}"}
         self.spec, self.turn, self._diagnostics = spec, turn, None
         self.count += 1
