@@ -1,7 +1,8 @@
 """The design page tutorial's pictures (docs/tutorials/design_page.md), taken in headless
 chromium through its DevTools protocol from the page's own server: the bundled four-bar as
-opened, with B dragged, a drag the linkage cannot follow, instant centres and arrows on,
-targets clicked with a synthesis's answers, and a six-bar.
+opened, with B dragged, B dragged at crank 90 deg, a drag the linkage cannot follow,
+instant centres and arrows on, targets clicked with a synthesis's answers, poses placed
+for a motion synthesis, and a six-bar.
 
 Run: python scripts/design_page_pictures.py [--out docs/images]   (Debian's chromium, pinmech[page])
 """
@@ -43,6 +44,17 @@ def _joint(page, name: str) -> tuple[float, float]:
         "return [r.x + r.width / 2, r.y + r.height / 2]; })()"))
 
 
+def _pose(page, index: int) -> None:
+    """Move the crank slider to pose `index` (degrees from the drawn pose)."""
+    page.evaluate(f"document.getElementById('pose').value = {index};"
+                  "document.getElementById('pose').dispatchEvent(new Event('input'))")
+
+
+def _focus_synthesis(page) -> None:
+    """Fold the panel's other sections so that the synthesis box is in the picture."""
+    page.evaluate("for (const d of document.querySelectorAll('#panel details')) d.open = d.id === 'synthesis-box';")
+
+
 def _settled(page) -> None:
     page.wait_for(IDLE)
     page.wait_for(DIAGNOSED)
@@ -59,6 +71,12 @@ def four_bar_pictures(chromium: str, out: Path, folder: Path) -> None:
             page.drag(_joint(page, "B"), _screen(page, 0.115, 0.125), steps=6, settle=IDLE)
             _settled(page)
             page.screenshot(out / "design_page_dragged.png")
+            _pose(page, 90)
+            b = page.evaluate("window.pinmechPage.frame.paths.B.slice(180, 182)")
+            page.drag(_joint(page, "B"), _screen(page, b[0] + 0.012, b[1] + 0.006), steps=5, settle=IDLE)
+            _settled(page)
+            page.screenshot(out / "design_page_posed.png")
+            _pose(page, 0)
             page.evaluate("document.getElementById('show-centres').click(); document.getElementById('show-arrows').click();"
                           "document.getElementById('pose').value = 60;"
                           "document.getElementById('pose').dispatchEvent(new Event('input'))")
@@ -77,6 +95,8 @@ def four_bar_pictures(chromium: str, out: Path, folder: Path) -> None:
         with DevToolsPage(chromium, server.url) as page:
             _settled(page)
             _synthesis(page, out)
+            page.evaluate("document.getElementById('targets-on').click(); document.getElementById('targets-clear').click()")
+            _motion(page, out)
     finally:
         server.stop()
 
@@ -84,17 +104,36 @@ def four_bar_pictures(chromium: str, out: Path, folder: Path) -> None:
 def _synthesis(page, out: Path) -> None:
     import numpy as np
 
-    curve = np.array(page.evaluate("window.pinmechPage.frame.paths.P")).reshape(-1, 2)[::45][:8]
-    page.evaluate("document.getElementById('synthesis-box').open = true; document.getElementById('targets-on').click()")
+    curve = np.array(page.evaluate("window.pinmechPage.frame.paths.P")).reshape(-1, 2)[::36][:8]
+    _focus_synthesis(page)
+    page.evaluate("document.getElementById('targets-on').click()")
     for x, y in curve:
         sx, sy = _screen(page, x, y)
         page.mouse("mousePressed", sx, sy)
         page.mouse("mouseReleased", sx, sy)
+    page.evaluate("document.getElementById('synth-generations').value = 300")
     page.evaluate("document.getElementById('synth-run').click()")
     page.wait_for("window.pinmechPage.answers.length > 0 || document.getElementById('synth-progress')"
                   ".textContent.indexOf('pinmech synth') >= 0", timeout=300, every=0.5)
     page.evaluate("document.querySelector('#answers li').click()")
     page.screenshot(out / "design_page_synthesis.png")
+
+
+def _motion(page, out: Path) -> None:
+    """Five poses placed by mouse (press at the place, drag towards the angle), the bounds proposed."""
+    import math
+
+    _focus_synthesis(page)
+    page.evaluate("const t = document.getElementById('synth-task'); t.value = 'motion';"
+                  "t.dispatchEvent(new Event('change')); document.getElementById('targets-on').click()")
+    for k in range(5):
+        t = 0.5 + 0.45 * k
+        x, y = 0.05 + 0.05 * math.cos(t), 0.05 + 0.05 * math.sin(t)
+        start, end = _screen(page, x, y), _screen(page, x + 0.02 * math.cos(t + 1.2), y + 0.02 * math.sin(t + 1.2))
+        page.drag(start, end, steps=4)
+    page.evaluate("document.getElementById('bounds-propose').click()")
+    page.wait_for("document.getElementById('bounds').value.length > 0")
+    page.screenshot(out / "design_page_motion.png")
 
 
 def six_bar_picture(chromium: str, out: Path, folder: Path) -> None:

@@ -118,6 +118,7 @@ def test_synthesis_from_clicked_targets_is_adopted(page, tmp_path):
         browser.mouse("mouseReleased", sx, sy)
     assert browser.evaluate("window.pinmechPage.targets.length") == len(pts)
     browser.evaluate("document.getElementById('synthesis-box').open = true")
+    browser.evaluate("document.getElementById('synth-generations').value = 25")  # a short search: < 10 s
     browser.evaluate("document.getElementById('synth-run').click()")
     browser.wait_for("window.pinmechPage.answers.length > 0", timeout=240, every=0.5)
     browser.evaluate("document.querySelector('#answers li').click()")
@@ -129,3 +130,31 @@ def test_synthesis_from_clicked_targets_is_adopted(page, tmp_path):
     gaps = [np.min(np.linalg.norm(adopted - t, axis=1)) for t in pts]
     assert max(gaps) < 5e-4  # the adopted linkage's curve passes the clicked targets (within the
     # search's met error, < 0.5 mm for points on a four-bar's own curve, plus the 1-degree poses' spacing)
+
+
+def test_a_six_bar_dragged_at_another_crank_angle_puts_the_joint_under_the_mouse(tmp_path):
+    chromium = require_browser()
+    copy = tmp_path / "watt.toml"
+    shutil.copy(ROOT / "models" / "linkages" / "watt.toml", copy)
+    spec, source, driver, speed = read_design_file(copy)
+    session = Session(spec, source, driver=driver, speed=speed)
+    server = PageServer(session, Saving(copy, leading_comments(copy))).start()
+    try:
+        with DevToolsPage(chromium, server.url) as browser:
+            browser.wait_for(IDLE)
+            browser.evaluate("document.getElementById('pose').value = 90;"
+                             "document.getElementById('pose').dispatchEvent(new Event('input'))")
+            before = np.array(browser.evaluate("window.pinmechPage.frame.paths.D")).reshape(-1, 2)
+            at = before[90]
+            target = at + [0.004, 0.003]
+            browser.drag(_centre(browser, "D"), _screen(browser, *target), steps=5, settle=IDLE)
+            browser.wait_for(IDLE)
+            browser.screenshot(tmp_path / "watt_posed.png")
+            assert browser.evaluate("window.pinmechPage.index") == 90 and not browser.evaluate("window.pinmechPage.error")
+            drawn = np.array(browser.evaluate("window.pinmechPage.frame.paths.D")).reshape(-1, 2)
+    finally:
+        server.stop()
+    # the page's last drag put D under the mouse at crank 90 deg (the engine's check, edits_posed:
+    # 1e-5 m); the mouse events land on whole CSS pixels (~0.3 mm each at this scale): 1 mm
+    assert np.linalg.norm(drawn[90] - target) < 1e-3
+    assert np.linalg.norm(drawn[0] - before[0]) > 1e-4  # the drawn pose's D moved to get there

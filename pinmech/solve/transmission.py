@@ -188,7 +188,8 @@ def _end(pair: Pair, link: int) -> np.ndarray:
 
 
 def dyad_angles(linkage: PlanarLinkage, dyad: Dyad) -> DyadAngles:
-    """The dyad's angles at the pose `linkage.place` was last given."""
+    """The dyad's angles at the pose `linkage.place` was last given (of a linkage whose
+    points and directions are (2, N) arrays over N poses, the N angles of each)."""
     A = linkage.point(dyad.coupler, _end(dyad.near, dyad.coupler))
     if dyad.kind == "slot":
         return _slot_angles(linkage, dyad, A)
@@ -197,11 +198,11 @@ def dyad_angles(linkage: PlanarLinkage, dyad: Dyad) -> DyadAngles:
     if dyad.kind == "pin":
         O = linkage.point(0, _end(dyad.ground, 0))
         mu = _angle(rod, O - B)
-        acute = min(mu, 180.0 - mu)
+        acute = np.minimum(mu, 180.0 - mu)
         return DyadAngles(mu, acute, 90.0 - acute)
     u = linkage.direction(dyad.ground.links[0], dyad.ground.axis)
     phi = _angle(rod, u)
-    phi = min(phi, 180.0 - phi)
+    phi = np.minimum(phi, 180.0 - phi)
     return DyadAngles(90.0 - phi, 90.0 - phi, phi)
 
 
@@ -226,7 +227,7 @@ def _slot_angles(linkage: PlanarLinkage, dyad: Dyad, P: np.ndarray) -> DyadAngle
     """A slot dyad's angles with the block's pin at P: phi between the slot and OP."""
     O = linkage.point(0, _end(dyad.ground, 0))
     phi = _angle(linkage.direction(dyad.joint.links[0], dyad.joint.axis), P - O)
-    phi = min(phi, 180.0 - phi)
+    phi = np.minimum(phi, 180.0 - phi)
     return DyadAngles(90.0 - phi, 90.0 - phi, phi)
 
 
@@ -271,6 +272,7 @@ def toggle(linkage: PlanarLinkage, dyad: Dyad, tol: float = 1e-6) -> str:
     return "extended" if u @ w > 0 else "folded"
 
 
-def _angle(a: np.ndarray, b: np.ndarray) -> float:
-    """The angle between two plane vectors [deg], in [0, 180]."""
-    return math.degrees(math.atan2(abs(a[0] * b[1] - a[1] * b[0]), float(a @ b)))
+def _angle(a: np.ndarray, b: np.ndarray) -> float | np.ndarray:
+    """The angle between two plane vectors [deg], in [0, 180]; of (2, N) arrays of vectors
+    (x row, y row), the N angles."""
+    return np.degrees(np.arctan2(np.abs(a[0] * b[1] - a[1] * b[0]), a[0] * b[0] + a[1] * b[1]))

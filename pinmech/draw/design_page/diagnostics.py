@@ -1,9 +1,11 @@
-"""The diagnostics panel of the page, read from the sweep's own diagnostics
-(`pinmech.solve.diagnostics_sweep.DesignSweep`, the ones `pinmech sweep` prints): each
-loop's Grashof class (and a four-bar's Barker type), each dyad's transmission angle over
-the turn with its least value (located between the poses), the outputs' limit positions
-(drawn as ghosts), swing or stroke and the time ratio Q, and the folds where the turn
-stopped. Angles leave here in degrees, lengths in metres.
+"""The diagnostics panel of the page, read from the poses the turn already swept (no second
+sweep): the engine's planar linkage, dyads and outputs (`DesignSweep`, the ones `pinmech
+sweep` reports), each loop's Grashof class (and a four-bar's Barker type), each dyad's
+transmission angle at every pose (the engine's `dyad_angles` on the swept frames,
+`swept.py`) with its least and largest value located between the poses, the outputs' limit
+positions (drawn as ghosts) located from the swept rates, swing or stroke and the time ratio
+Q, and the folds where the turn stopped (`swept_extremes.py`: one closing solve each).
+Angles leave here in degrees, lengths in metres.
 """
 
 from __future__ import annotations
@@ -19,47 +21,59 @@ from pinmech.solve.limit_positions import travel
 
 def turn_diagnostics(turn) -> dict:
     """The panel's data for a solved turn (`frame.Turn`): JSON-ready."""
-    design = _design_sweep(turn.sweep)
+    from pinmech.draw.design_page.swept import SweptLinkage, unit_rates
+    from pinmech.solve.diagnostics_sweep import DesignSweep
+    from pinmech.solve.transmission import dyad_angles
+
+    design = DesignSweep(turn.sweep)
     if not design.applicable:
         return {"applicable": False, "reason": design.reason}
+    x, q, dq, ddq = unit_rates(turn)
+    swept = SweptLinkage(design.linkage, q, dq, ddq)
+    whole = turn.sweep.is_angular and len(x) == len(turn.values)  # a whole turn: its ends are one pose
+    folds = _fold_poses(design, turn, x, q)
     mu = [np.full(len(turn.values), np.nan) for _ in design.dyads]
-    for pose in sweep_poses(turn):
-        out = design.evaluate(pose)
-        for series, angles in zip(mu, out.get("angles", ())):
-            series[pose.index] = angles[1]
-    linkage = design.linkage
+    dyads = []
+    for d, series in zip(design.dyads, mu):
+        angles = dyad_angles(swept, d)
+        series[:len(x)] = angles.mu_acute
+        dyads.append(_dyad(design, d, x, q, angles.mu, series, folds, whole))
     return {
         "applicable": True,
-        "loops": [_loop(x, turn) for x in _loop_classes(linkage)],
-        "dyads": [_dyad(d, x, series, linkage) for d, x, series in zip(design.dyads, design.angle_extremes(), mu)],
-        "outputs": [_output(design, o, found, turn) for o, found in zip(design.outputs, design.limit_poses())],
-        "folds": [{"driver": x, "points": ghost_points(turn, q)} for x, q in design.fold_poses()],
+        "loops": [_loop(c, turn) for c in _loop_classes(design.linkage)],
+        "dyads": dyads,
+        "outputs": [_output(design, o, _limits(design, swept, o, x, q, whole), turn) for o in design.outputs],
+        "folds": [{"driver": fx, "points": ghost_points(turn, fq)} for fx, fq in folds],
     }
 
 
-def _design_sweep(sweep):
-    """The sweep's diagnostics (`DesignSweep`), fed poses whose motion is their configuration."""
-    from pinmech.solve.diagnostics_sweep import DesignSweep
+def _limits(design, swept, output, x, q, whole: bool) -> list:
+    """The output's limit positions over the swept poses (each once a turn), with their poses."""
+    from pinmech.draw.design_page.swept_extremes import limit_poses
+    from pinmech.solve.diagnostics_sweep import _once_a_turn
 
-    class ArrayDesign(DesignSweep):
-        def _q(self, motion) -> np.ndarray:  # the turn's q row, carried as the pose's motion
-            return motion
+    if output.kind == "pin":
+        rate, change = swept.turn_rate(output.output)
+    else:
+        slide = output.ground
+        sign = 1.0 if slide.links[1] == output.output else -1.0
+        rate, change = swept.slide_rate(output.output, swept.direction(slide.links[0], slide.axis), sign)
+    return _once_a_turn(limit_poses(design, output, x, q, rate, change), whole)
 
-    return ArrayDesign(sweep)
 
-
-def sweep_poses(turn) -> list:
-    """The turn's poses as `pinmech sweep` yields them to its diagnostics (`SweepPose`), each
-    carrying its configuration q in place of its motion (None where it failed)."""
-    from pinmech.io.sweep import SweepPose
+def _fold_poses(design, turn, x: np.ndarray, q: np.ndarray) -> list[tuple[float, np.ndarray]]:
+    """(driver value, closed q) at the fold where the turn stopped, located from the pose
+    before it (the engine's `fold_pose`); none where it cannot be located."""
+    from pinmech.solve.fold_pose import fold_pose
 
     out = []
-    for i, value in enumerate(turn.values.tolist()):
-        error = turn.errors.get(i)
-        if error is not None:  # the turn stopped here: the poses after it were not solved
-            out.append(SweepPose(i, value, None, None, f"{type(error).__name__}: {error}", fold=turn.folds.get(i)))
-            break
-        out.append(SweepPose(i, value, turn.q[i], None, note=turn.notes.get(i, "")))
+    for index, fold in turn.folds.items():
+        if index == 0 or index > len(x):
+            continue
+        try:
+            out.append(fold_pose(design.solver, design.k, design.finder.x, q[index - 1], float(x[index - 1]), fold))
+        except PinmechError:
+            continue
     return out
 
 
@@ -84,12 +98,23 @@ def _loop(loop, turn) -> dict:
     return out
 
 
-def _dyad(dyad, extremes, series: np.ndarray, linkage) -> dict:
-    """A dyad's acute transmission angle over the turn [deg] and its least value and where."""
-    return {"name": dyad.name(linkage), "pin": dyad.joint.name, "kind": dyad.kind,
-            "mu": [None if math.isnan(x) else x for x in series.tolist()],
-            "least": extremes.low, "least_at": extremes.low_at, "largest": extremes.high,
-            "largest_at": extremes.high_at, "pressure": extremes.pressure, "refined": extremes.refined}
+def _dyad(design, dyad, x, q, mu: np.ndarray, acute: np.ndarray, folds: list, whole: bool) -> dict:
+    """A dyad's acute transmission angle over the turn [deg], its least and largest value of
+    mu on [0, 180] deg and where, the largest pressure angle (the folds' poses included:
+    the ends of the motion)."""
+    from pinmech.draw.design_page.swept_extremes import Extreme, angle_extreme
+    from pinmech.solve.transmission import dyad_angles
+
+    low, high = angle_extreme(design, dyad, x, q, mu, 1.0, whole), angle_extreme(design, dyad, x, q, mu, -1.0, whole)
+    for fx, fq in folds:
+        design.linkage.place(fq)
+        at = float(dyad_angles(design.linkage, dyad).mu)
+        low = Extreme(at, fx, True) if at < low.value else low
+        high = Extreme(at, fx, True) if at > high.value else high
+    return {"name": dyad.name(design.linkage), "pin": dyad.joint.name, "kind": dyad.kind,
+            "mu": [None if math.isnan(v) else v for v in acute.tolist()],
+            "least": low.value, "least_at": low.at, "largest": high.value, "largest_at": high.at,
+            "pressure": max(90.0 - low.value, high.value - 90.0), "refined": low.refined and high.refined}
 
 
 def _output(design, output, found: list, turn) -> dict:

@@ -54,9 +54,9 @@ def move_joint(spec: LinkageSpec, name: str, to: np.ndarray, points: dict[str, n
         offset = to - points[entry.base][:2]
         new = msgspec.structs.replace(entry, length=millimetres(float(np.hypot(*offset))),
                                       angle=degrees(math.atan2(offset[1], offset[0])))
-        return _with_joint(spec, name, new, source)
+        return with_joint(spec, name, new, source)
     if isinstance(entry, Compass):
-        return _with_joint(spec, name, _compass_to(entry, to, points, name, source), source)
+        return with_joint(spec, name, compass_to(entry, to, points, name, source), source)
     if len(entry) != 2:
         raise ModelError("a spatial joint cannot be dragged on the page (planar linkages only)", path=source,
                          element=f"[joints] {name}")
@@ -73,7 +73,7 @@ def move_joint(spec: LinkageSpec, name: str, to: np.ndarray, points: dict[str, n
     return linkage_spec(raw, source)
 
 
-def _compass_to(entry: Compass, to: np.ndarray, points: dict[str, np.ndarray], name: str, source: str) -> Compass:
+def compass_to(entry: Compass, to: np.ndarray, points: dict[str, np.ndarray], name: str, source: str) -> Compass:
     """The compass construction that draws its joint at `to`: both lengths and the side."""
     a, b = (points[base][:2] for base in entry.bases)
     r1, r2 = float(np.hypot(*(to - a))), float(np.hypot(*(to - b)))
@@ -85,10 +85,43 @@ def _compass_to(entry: Compass, to: np.ndarray, points: dict[str, np.ndarray], n
     return msgspec.structs.replace(entry, lengths=(millimetres(r1), millimetres(r2)), side=side)
 
 
-def _with_joint(spec: LinkageSpec, name: str, entry: Polar | Compass, source: str) -> LinkageSpec:
+def with_joint(spec: LinkageSpec, name: str, entry: Polar | Compass, source: str) -> LinkageSpec:
+    """The spec with joint `name` built by `entry`; a length or angle the file wrote as a
+    parameter used by this joint only stays the parameter's name, the parameter set to the
+    new value (a parameter shared with other joints is not moved: the number is written)."""
     raw = msgspec.to_builtins(spec)
-    raw["joints"][name] = msgspec.to_builtins(entry)
+    old, new = raw["joints"][name], msgspec.to_builtins(entry)
+    once = {p for p in raw["params"] if _uses(raw["joints"], p) == 1}
+    for key, value in new.items():
+        before = old.get(key)
+        if isinstance(value, (list, tuple)) and isinstance(before, (list, tuple)):
+            new[key] = [_kept(b, v, once, raw["params"]) for b, v in zip(before, value)]
+        else:
+            new[key] = _kept(before, value, once, raw["params"])
+    raw["joints"][name] = new
     return linkage_spec(raw, source)
+
+
+def _kept(before, value, once: set[str], params: dict):
+    """`before` (a parameter's name, the parameter set to `value`) or `value`."""
+    if isinstance(before, str) and before.strip() in once and before != value:
+        params[before.strip()] = value
+        return before
+    return value
+
+
+def _uses(joints: dict, param: str) -> int:
+    """How many times the joints' entries name `param`."""
+    def count(value) -> int:
+        if isinstance(value, str):
+            return int(value.strip() == param)
+        if isinstance(value, (list, tuple)):
+            return sum(count(v) for v in value)
+        if isinstance(value, dict):
+            return sum(count(v) for v in value.values())
+        return 0
+
+    return sum(count(v) for v in joints.values())
 
 
 def set_param(spec: LinkageSpec, name: str, value_m: float, source: str = "<linkage>") -> LinkageSpec:

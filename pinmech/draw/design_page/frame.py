@@ -1,6 +1,7 @@
 """One turn of a drawn linkage, solved as `pinmech sweep` solves it: the data a page draws.
 
-The spec is drawn (`linkage_from_spec`, `linkage_mechanism`) and given a scene (its driver
+The spec is drawn (`linkage_from_spec`; its mechanism built once by `linkage_mechanism`,
+then written in place while drags change only dimensions, `mechanism_reuse.py`) and given a scene (its driver
 at the drawn pose's value, so the sweep starts on the drawn assembly; the one `save.py`
 writes), and `Sweep.from_scene` solves it, its poses taken as arrays (`Sweep.chunks`) and its points read by one compiled call
 (`frame_paths`, the numbers `evaluate_motion` gives `pinmech sweep`'s rows): the page's
@@ -37,6 +38,7 @@ class Turn:
         values: the driver's values [rad or m], STEPS of them.
         names: the drawn points, in the order of the arrays' axis 1.
         q: (STEPS, nq) configurations, NaN rows where a pose failed.
+        v, a: (STEPS, nv) joint rates and accelerations at the driver's speed [rad/s, m/s, /s].
         position, velocity, acceleration: (STEPS, len(names), 2) world x, y [m, m/s, m/s^2].
         errors: pose index -> the error of a pose that failed (the turn stops at the first:
             the poses after it are not solved, their rows NaN).
@@ -49,6 +51,8 @@ class Turn:
     values: np.ndarray
     names: list[str]
     q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
     position: np.ndarray
     velocity: np.ndarray
     acceleration: np.ndarray
@@ -66,10 +70,17 @@ class TurnSolver:
     at `speed` (text, e.g. "60 rpm")."""
 
     def __init__(self, driver: str | None = None, speed: str = "60 rpm") -> None:
+        from pinmech.draw.design_page.mechanism_reuse import MechanismReuse
+
         self.driver, self.speed = driver, speed
+        self._reuse = MechanismReuse()
 
     def close(self) -> None:
         return None
+
+    def rollback(self) -> None:
+        """The last turn solved is not kept: the kept turn's mechanism as it was."""
+        self._reuse.rollback()
 
     def solve(self, spec: LinkageSpec, source: str) -> Turn:
         """Draw `spec`, then sweep its driver over one turn from the drawn pose.
@@ -80,16 +91,20 @@ class TurnSolver:
         """
         from pinmech.io.scene import Scene
         from pinmech.io.sweep import Sweep
-        from pinmech.model.linkage_model import linkage_mechanism
 
+        self._reuse.keep()  # the last turn, unless rolled back, is the page's
         linkage = linkage_from_spec(spec, source)
         if linkage.spatial:
             raise ModelError("the design page draws planar linkages only", path=source)
-        mechanism = linkage_mechanism(linkage)
-        tables = scene_tables(linkage, Path(source).name, self._driver(mechanism, source), self.speed)
-        scene = Scene.from_tables(tables, Path(source).with_name("scene.toml"))
-        sweep = Sweep.from_scene(scene, mechanism=mechanism)  # the scene's linkage, drawn from `spec`
-        return _turn(linkage, sweep, np.asarray(sweep.default_values(STEPS)))
+        mechanism = self._reuse.mechanism_for(linkage)  # the last one written in place, if it can be
+        try:
+            tables = scene_tables(linkage, Path(source).name, self._driver(mechanism, source), self.speed)
+            scene = Scene.from_tables(tables, Path(source).with_name("scene.toml"))
+            sweep = Sweep.from_scene(scene, mechanism=mechanism)  # the scene's linkage, drawn from `spec`
+            return _turn(linkage, sweep, np.asarray(sweep.default_values(STEPS)))
+        except Exception:
+            self._reuse.rollback()
+            raise
 
     def _driver(self, mechanism, source: str) -> tuple[str, float]:
         """The driver's name and its value at the drawn pose [rad or m] (the reference)."""
@@ -140,7 +155,7 @@ def _turn(linkage: Linkage, sweep, values: np.ndarray) -> Turn:
         paths = frame_paths(sweep.mechanism, names, q[solved], np.nan_to_num(v[solved]), np.nan_to_num(a[solved]))
         position[solved], velocity[solved] = paths.position[..., :2], paths.velocity[..., :2]
         acceleration[solved] = paths.acceleration[..., :2]
-    return Turn(linkage, sweep, values, names, q, position, velocity, acceleration, errors, notes, folds)
+    return Turn(linkage, sweep, values, names, q, v, a, position, velocity, acceleration, errors, notes, folds)
 
 
 def _chunks(sweep, values: np.ndarray):

@@ -1,14 +1,18 @@
 """The page's messages, one answer each (JSON-ready dicts): what the websocket carries.
 
-    {"type": "drag", "joint": "B", "x": 0.05, "y": 0.09}    -> a frame (or its error)
+    {"type": "drag", "joint": "B", "x": 0.05, "y": 0.09, "index": 0}  -> a frame (or its error);
+        index: the pose shown (the joint put under the mouse at that crank angle)
     {"type": "param", "name": "crank", "value": 0.04}        -> a frame (or its error)
     {"type": "frame"}                                        -> the current frame
     {"type": "motion", "index": 10, "point": "P"}            -> velocity, acceleration
     {"type": "centres", "index": 10}                         -> the instant centres
     {"type": "save", "svg": "<svg...", "png": "data:..."}    -> the files written
-    {"type": "synthesise", "kind": "four-bar", "targets": [[x, y], ...], "max_crank": 0.2}
+    {"type": "synthesise", "kind": "four-bar", "task": "path", "targets": [[x, y], ...], "max_crank": 0.2,
+     "bounds": "crank = [...]\n..."}  (task "motion": "poses": [[x, y, angle], ...]; "function":
+     "pairs": [[crank turn, output turn or travel], ...], "ground": 0.1)
+    {"type": "bounds", ...the same...}                       -> the [bounds] the page proposes
     {"type": "synthesis"} (how far), {"type": "cancel"}, {"type": "adopt", "answer": 0} -> a frame
-Positions in metres, world frame; `index` a pose of the turn (0: the drawn pose).
+Positions in metres, angles in radians, world frame; `index` a pose of the turn (0: the drawn pose).
 """
 
 from __future__ import annotations
@@ -47,7 +51,8 @@ def answer(session, saving: Saving, message: dict) -> dict:
     kind = message.get("type") if isinstance(message, dict) else None
     try:
         if kind == "drag":
-            return session.drag(str(message["joint"]), float(message["x"]), float(message["y"]))
+            return session.drag(str(message["joint"]), float(message["x"]), float(message["y"]),
+                                int(message.get("index", 0)))
         if kind == "param":
             return session.param(str(message["name"]), float(message["value"]))
         if kind == "frame":
@@ -58,6 +63,10 @@ def answer(session, saving: Saving, message: dict) -> dict:
             return session.centres(int(message["index"]))
         if kind == "save":
             return saving.save(session, message)
+        if kind == "bounds":
+            from pinmech.draw.design_page.synthesis import bounds_answer
+
+            return bounds_answer(message)
         if kind in ("synthesise", "synthesis", "cancel", "adopt"):
             from pinmech.draw.design_page.synthesis import synthesis_answer
 

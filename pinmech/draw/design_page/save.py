@@ -1,5 +1,6 @@
-"""What the page saves: the linkage as a drawn-linkage TOML file (the file's leading
-comments kept as its header), a scene that sweeps it from the drawn pose, and the figures
+"""What the page saves: the linkage as a drawn-linkage TOML file (the values a drag changed
+rewritten in the user's file, every comment kept, where that reads back as the page's
+linkage; else the file written whole, its leading comments kept as its header), a scene that sweeps it from the drawn pose, and the figures
 of what is on screen (SVG as the page draws it, PNG as the browser rasterised it). Every
 file is written whole, through a temporary file renamed when complete.
 """
@@ -30,9 +31,27 @@ def leading_comments(path: Path) -> str:
 
 
 def save_linkage(spec: LinkageSpec, path: Path, header: str) -> Path:
-    """Write the linkage whole to `path` (its header comment lines first)."""
-    write_whole(path, linkage_toml(spec, header))
+    """Write the linkage to `path`, atomically: the file there with the changed values
+    rewritten in place (`save_inline`), or, when that cannot be, whole (its header comment
+    lines first)."""
+    write_whole(path, _kept_text(spec, path) or linkage_toml(spec, header))
     return path
+
+
+def _kept_text(spec: LinkageSpec, path: Path) -> str | None:
+    """The file at `path` with only `spec`'s changes rewritten, or None (no such file, not a
+    linkage, or changes that are not line by line)."""
+    import tomllib
+
+    from pinmech.draw.design_page.save_inline import rewritten
+    from pinmech.model.linkage_spec import linkage_spec
+
+    try:
+        text = path.read_text(encoding="utf-8")
+        old = linkage_spec(tomllib.loads(text), str(path))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, PinmechError):
+        return None
+    return rewritten(text, old, spec, str(path))
 
 
 def save_scene(tables: dict, linkage_path: Path, path: Path) -> Path:

@@ -17,7 +17,7 @@ from pinmech.model.linkage import linkage_params
 from pinmech.model.linkage_entries import Compass, Polar
 from pinmech.model.linkage_spec import GROUND, LinkageSpec
 from pinmech.draw.design_page.edits import move_joint, set_param
-from pinmech.draw.design_page.frame import Turn, TurnSolver
+from pinmech.draw.design_page.frame import Turn, TurnSolver, angle_text
 
 
 class Session:
@@ -47,13 +47,20 @@ class Session:
         self.solver.close()
 
     # ------------------------------------------------------------------ changes
-    def solve(self, spec: LinkageSpec) -> dict:
-        """The frame of `spec` (kept as the session's linkage), or its error (the last kept)."""
+    def solve(self, spec: LinkageSpec, check=None) -> dict:
+        """The frame of `spec` (kept as the session's linkage), or its error (the last kept).
+
+        Args:
+            check: called with the new turn before it is kept; raises PinmechError to refuse it.
+        """
         started = time.perf_counter()
         try:
             turn = self.solver.solve(spec, self.source)
+            if check is not None:
+                check(turn)
             frame = turn_frame(turn, spec)
         except PinmechError as exc:
+            self.solver.rollback()
             return {"type": "frame", "ok": False, "error": f"{type(exc).__name__}: {exc}"}
         self.spec, self.turn, self._diagnostics = spec, turn, None
         self.count += 1
@@ -74,13 +81,30 @@ class Session:
                                  "ms": 1e3 * (time.perf_counter() - started)}
         return self._diagnostics
 
-    def drag(self, joint: str, x: float, y: float) -> dict:
-        """Joint `joint` dragged to (x, y) [m]."""
+    def drag(self, joint: str, x: float, y: float, index: int = 0) -> dict:
+        """Joint `joint` dragged to (x, y) [m] with the linkage shown at pose `index` (0: the
+        drawn pose; another: its drawn place moved so that at that pose it is at (x, y),
+        `edits_posed`, or the drag refused saying so)."""
+        from pinmech.draw.design_page.edits_posed import landed, move_joint_posed, refusal
+
+        to = np.array([x, y], dtype=float)
+        posed = index != 0 and self._solved(index)
         try:
-            spec = move_joint(self.spec, joint, np.array([x, y], dtype=float), self.turn.linkage.points, self.source)
+            if posed:
+                spec = move_joint_posed(self.spec, self.turn, joint, index, to, self.source)
+            else:
+                spec = move_joint(self.spec, joint, to, self.turn.linkage.points, self.source)
         except PinmechError as exc:
             return {"type": "frame", "ok": False, "error": f"{type(exc).__name__}: {exc}"}
-        return self.solve(spec)
+        if not posed:
+            return self.solve(spec)
+        angle = angle_text(float(self.turn.values[index] - self.turn.values[0]), self.turn.sweep.is_angular)
+
+        def check(turn) -> None:
+            if not landed(turn, joint, index, to):
+                raise refusal(joint, f"the crank's {angle} from the drawn pose", self.source)
+
+        return self.solve(spec, check)
 
     def param(self, name: str, value_m: float) -> dict:
         """Parameter `name` set to a length [m]."""

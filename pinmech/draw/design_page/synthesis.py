@@ -1,11 +1,8 @@
-"""Synthesis from the page: targets clicked on the drawing become a path-synthesis file,
-`pinmech synth` runs it in a child process (so that cancel stops it at once, and the page
-stays live), and its answers (the linkage files it writes, each checked by the engine)
-are solved as turns and drawn; adopting one makes it the page's linkage.
-
-The search's region is set from the targets: both ground pivots within twice the targets'
-span of their centre, the crank up to the page's limit, every other length up to three
-spans.
+"""Synthesis from the page: targets, poses or input-output pairs become a synthesis file
+(`synthesis_task`, checked by the synthesis reader), `pinmech synth` runs it in a child
+process (so that cancel stops it at once, and the page stays live), and its answers (the
+linkage files it writes, each checked by the engine) are solved as turns and drawn;
+adopting one makes it the page's linkage.
 """
 
 from __future__ import annotations
@@ -19,35 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
-from pinmech.draw.design_page.edits import millimetres
+from pinmech.draw.design_page.synthesis_task import Request, checked_toml, default_bounds, describe
+from pinmech.exceptions import PinmechError
 from pinmech.outputs import write_whole
 
-KINDS = ("four-bar", "slider-crank")
-GENERATIONS = 120  # at most, on each assembly: a page's search answers in seconds
 _RUNS: dict[int, SynthesisRun] = {}  # session id -> its run
-
-
-def synthesis_toml(kind: str, targets: np.ndarray, max_crank: float) -> str:
-    """A path-synthesis file for the coupler point through `targets` [m] (N, 2) in order."""
-    centre = targets.mean(axis=0)
-    span = max(float(np.ptp(targets, axis=0).max()), 0.02)
-    box = lambda c: f'{{ x = ["{millimetres(c[0] - 2 * span)}", "{millimetres(c[0] + 2 * span)}"], ' \
-                    f'y = ["{millimetres(c[1] - 2 * span)}", "{millimetres(c[1] + 2 * span)}"] }}'
-    length = lambda low, high: f'["{millimetres(low)}", "{millimetres(high)}"]'
-    lines = ['title = "Through the targets clicked on the design page"', 'task = "path"', f'topology = "{kind}"',
-             "seed = 1", "population = 15", f"generations = {GENERATIONS}", "keep = 3", "", "targets = ["]
-    lines += [f'  ["{millimetres(x)}", "{millimetres(y)}"],' for x, y in targets] + ["]", "", "[bounds]",
-                                                                                   f"O2 = {box(centre)}"]
-    if kind == "four-bar":
-        lines += [f"O4 = {box(centre)}", f"coupler = {length(span / 5, 3 * span)}",
-                  f"rocker = {length(span / 5, 3 * span)}"]
-    else:
-        lines += [f'slide = {{ angle = ["-90 deg", "90 deg"], offset = {length(-2 * span, 2 * span)} }}',
-                  f"rod = {length(span / 5, 3 * span)}"]
-    lines += [f"crank = {length(min(span / 10, max_crank / 2), max_crank)}",
-              f"point = {{ along = {length(-2 * span, 2 * span)}, across = {length(-2 * span, 2 * span)} }}",
-              "", "[constraints]", 'transmission = "25 deg"', 'direction = "either"']
-    return "\n".join(lines) + "\n"
 
 
 class SynthesisRun:
@@ -102,19 +75,23 @@ def synthesis_answer(session, message: dict) -> dict:
 
 
 def _start(session, message: dict, run: SynthesisRun | None) -> dict:
-    targets = np.asarray(message["targets"], dtype=float).reshape(-1, 2)
-    choice = str(message.get("kind", "four-bar"))
-    if choice not in KINDS:
-        return {"type": "synthesis", "error": f"kind must be one of {', '.join(KINDS)}, got {choice!r}"}
-    if len(targets) < 3 or not np.all(np.isfinite(targets)):
-        return {"type": "synthesis", "error": f"click at least 3 targets on the drawing (now {len(targets)})"}
-    max_crank = float(message.get("max_crank", 0.2))
-    if not max_crank > 0:
-        return {"type": "synthesis", "error": f"the crank's limit must be positive, got {max_crank} m"}
+    try:
+        request = Request(message)
+        text = checked_toml(request, Path("the page's synthesis"))
+    except (PinmechError, TypeError, ValueError) as exc:
+        return {"type": "synthesis", "error": f"{type(exc).__name__}: {exc}", "running": False}
     if run is not None:
         run.close()
-    _RUNS[id(session)] = SynthesisRun(synthesis_toml(choice, targets, max_crank))
-    return {"type": "synthesis", "progress": f"searching ({len(targets)} targets)...", "running": True}
+    _RUNS[id(session)] = SynthesisRun(text)
+    return {"type": "synthesis", "progress": f"searching ({describe(request)})...", "running": True}
+
+
+def bounds_answer(message: dict) -> dict:
+    """The answer to "bounds": the `[bounds]` the page proposes for the request's targets."""
+    try:
+        return {"type": "bounds", "text": default_bounds(Request(message))}
+    except (PinmechError, ValueError) as exc:
+        return {"type": "bounds", "error": f"{type(exc).__name__}: {exc}"}
 
 
 def _progress(session, run: SynthesisRun) -> dict:
@@ -139,8 +116,6 @@ def open_synthesis(file: Path) -> tuple[SynthesisRun, list[dict]]:
     Raises:
         PinmechError: the search failed or found no linkage (pinmech synth's last line quoted).
     """
-    from pinmech.exceptions import PinmechError
-
     run = SynthesisRun(file=file)
     run.process.wait()
     answer = _progress(None, run)
@@ -165,7 +140,6 @@ def adopt_run(session, run: SynthesisRun) -> None:
 def _answers(session, run: SynthesisRun, code: int) -> list[dict]:
     """Each linkage the search wrote: its turn solved, its coupler point's curve and its drawing."""
     from pinmech.draw.design_page.frame import TurnSolver
-    from pinmech.exceptions import PinmechError
     from pinmech.model.linkage_spec import read_linkage_spec
 
     report = run.folder / "answer.json"
@@ -180,8 +154,16 @@ def _answers(session, run: SynthesisRun, code: int) -> list[dict]:
             continue
         run.specs.append(spec)
         at = {n: turn.position[0, k].tolist() for k, n in enumerate(turn.names)}
-        error = max(entry.get("errors_mm", [float("nan")]))
-        out.append({"summary": f"{i}: {entry.get('grashof', '')}, targets met within {error:.3g} mm",
-                    "path": [None if np.isnan(p[0]) else p for p in turn.path("P").tolist()],
+        traced = "P" if "P" in turn.names else turn.names[-1]  # a function's answer: its output's pin
+        out.append({"summary": f"{i}: {entry.get('grashof', '')}, {_met(entry)}", "traced": traced,
+                    "path": [None if np.isnan(p[0]) else p for p in turn.path(traced).tolist()],
                     "points": at, "links": [list(v) for k, v in turn.linkage.links.items() if k != "ground"]})
     return out
+
+
+def _met(entry: dict) -> str:
+    """How closely an answer meets its targets, in the report's own unit (mm or deg)."""
+    for key, unit in (("errors_mm", "mm"), ("errors_deg", "deg")):
+        if entry.get(key):
+            return f"targets met within {max(entry[key]):.3g} {unit}"
+    return "targets met (no error reported)"

@@ -39,7 +39,8 @@
     else if (m.type === "centres") { state.centres = m.ok ? m : null; draw(); }
     else if (m.type === "saved") { state.saved = m; showSaved(m); }
     else if (m.type === "synthesis") { takeSynthesis(m); }
-    if (m.type === "frame" && m.ok && state.answers.length && state.adopting) { state.adopting = false; state.chosen = -1; state.targets = []; draw(); }
+    else if (m.type === "bounds") { if (m.error) message(m.error, "error"); else $("bounds").value = m.text; }
+    if (m.type === "frame" && m.ok && state.answers.length && state.adopting) { state.adopting = false; state.chosen = -1; state.targets = []; showEntries(); draw(); }
     else if (m.type === "error") {
       state.pending = false; showError(m.error);
       if (state.queued) { const next = state.queued; state.queued = null; send(next); }
@@ -105,6 +106,8 @@
       lo = [Math.min(lo[0], q[0]), Math.min(lo[1], q[1])]; hi = [Math.max(hi[0], q[0]), Math.max(hi[1], q[1])]; };
     for (const j of f.joints) add(j.at);
     for (const n in f.paths) pathPoints(f, n).forEach(add);
+    const a = state.answers[state.chosen];  // a chosen answer is drawn whole too
+    if (a) { Object.values(a.points).forEach(add); a.path.forEach(add); }
     const w = Math.max(hi[0] - lo[0], 1), h = Math.max(hi[1] - lo[1], 1), pad = 0.15 * Math.max(w, h);
     return [lo[0] - pad, lo[1] - pad, w + 2 * pad, h + 2 * pad];
   }
@@ -119,7 +122,7 @@
     svg.setAttribute("preserveAspectRatio", "xMidYMid meet");
     const unit = Math.max(w, h) / 600;  // one screen pixel, about [mm]
     defs(unit);
-    const index = state.dragging ? 0 : state.index;
+    const index = f.solved[state.index] ? state.index : 0;
     if ($("show-ghosts").checked && f.diagnostics) drawGhosts(f, unit);
     drawPaths(f);
     drawSlides(f, w + h);
@@ -182,16 +185,29 @@
     const ghosts = [];
     for (const o of d.outputs || []) for (const l of o.limits) ghosts.push([`${o.name} ${l.label}`, l.points]);
     for (const x of d.folds || []) ghosts.push([`fold at ${driverText(f, x.driver)}`, x.points]);
-    ghosts.forEach((g, k) => {
+    const placed = [];
+    ghosts.forEach((g) => {
       for (const link of f.links) {
         if (link.ground) continue;
         const pts = link.points.map((n) => g[1][n]).filter((p) => p).map(mm);
         if (pts.length >= 2) polyline(pts.length > 2 ? pts.concat([pts[0]]) : pts, "ghost");
       }
-      const anyPoint = Object.values(g[1])[Object.keys(g[1]).length - 1];
-      if (anyPoint) { const p = mm(anyPoint); el("text", { class: "ghost-label", x: p[0] + 6 * unit,
-        y: p[1] - 6 * unit - 13 * unit * k, "font-size": 11 * unit }, svg).textContent = g[0]; }  // stacked: one line each
+      const away = farthest(f, g[1]);  // labelled where the ghost is farthest from the linkage shown
+      if (!away) return;
+      const p = mm(away), at = [p[0] + 6 * unit, p[1] - 6 * unit];
+      while (placed.some((q) => Math.abs(q[0] - at[0]) < 70 * unit && Math.abs(q[1] - at[1]) < 12 * unit)) at[1] -= 13 * unit;
+      placed.push(at);  // a label on another's place goes a line up
+      el("text", { class: "ghost-label", x: at[0], y: at[1], "font-size": 11 * unit }, svg).textContent = g[0];
     });
+  }
+  function farthest(f, ghost) {  // the ghost's point farthest from the same point of the linkage shown
+    let best = null, gap = -1;
+    for (const n in ghost) {
+      const now = pointAt(f, n, f.solved[state.index] ? state.index : 0);
+      const d = now ? Math.hypot(ghost[n][0] - now[0], ghost[n][1] - now[1]) : 0;
+      if (d > gap) { gap = d; best = ghost[n]; }
+    }
+    return best;
   }
   function drawSlides(f, size) {
     for (const s of f.slides) {
@@ -224,12 +240,15 @@
     }
   }
   function drawCentres(unit) {
+    const placed = [];
     for (const c of state.centres.centres) {
       if (!c.position) continue;
-      const p = mm(c.position);
+      const p = mm(c.position), text = `I(${c.links[0]},${c.links[1]})`, at = [p[0] + 4 * unit, p[1] + 10 * unit];
+      while (placed.some((q) => Math.abs(q[1] - at[1]) < 11 * unit && at[0] < q[0] + q[2] && q[0] < at[0] + 6 * unit * text.length))
+        at[1] += 11 * unit;  // a label on another's place goes a line down
+      placed.push([at[0], at[1], 6 * unit * text.length]);
       el("circle", { class: "centre", cx: p[0], cy: p[1], r: 3 * unit }, svg);
-      el("text", { class: "centre-label", x: p[0] + 4 * unit, y: p[1] + 10 * unit, "font-size": 10 * unit }, svg)
-        .textContent = `I(${c.links[0]},${c.links[1]})`;
+      el("text", { class: "centre-label", x: at[0], y: at[1], "font-size": 10 * unit }, svg).textContent = text;
     }
   }
   function drawArrows(unit, size) {
@@ -245,11 +264,16 @@
     $("arrow-text").textContent = `|v| = ${norm(m.velocity).toPrecision(4)} m/s (green), ` +
       `|a| = ${norm(m.acceleration).toPrecision(4)} m/s^2 (red)`;
   }
-  function drawTargets(unit) {
-    for (const t of state.targets) {
+  function drawTargets(unit) {  // a pose's angle: a tick from its place along the coupler's direction
+    if ($("synth-task").value === "function") return;
+    state.targets.forEach((t, i) => {
       const p = mm(t);
       el("circle", { class: "target", cx: p[0], cy: p[1], r: 6 * unit, "vector-effect": "non-scaling-stroke" }, svg);
-    }
+      if (t.length > 2) el("line", { class: "target-angle", x1: p[0], y1: p[1], x2: p[0] + 24 * unit * Math.cos(t[2]),
+        y2: p[1] - 24 * unit * Math.sin(t[2]), "vector-effect": "non-scaling-stroke" }, svg);
+      const label = el("text", { class: "target-label", x: p[0] + 7 * unit, y: p[1] + 12 * unit, "font-size": 11 * unit }, svg);
+      label.textContent = String(i + 1);
+    });
   }
   function drawAnswer(unit) {
     const a = state.answers[state.chosen];
@@ -314,13 +338,13 @@
   function startDrag(event, name) {
     if ($("targets-on").checked) return;  // placing targets: a click on a joint is a target too
     event.preventDefault();
-    state.dragging = name; state.index = 0; stopPlay();
+    state.dragging = name; stopPlay();  // dragged at the pose shown: under the mouse at this crank angle
   }
   window.addEventListener("mousemove", (event) => {  // the window's: a drag may leave the drawing
     if (!state.dragging) return;
     const p = toWorld(event);
     state.phantom = state.error ? p : null;
-    send({ type: "drag", joint: state.dragging, x: p[0] / 1000, y: -p[1] / 1000 });
+    send({ type: "drag", joint: state.dragging, x: p[0] / 1000, y: -p[1] / 1000, index: state.index });
     if (state.error) draw();
   });
   window.addEventListener("mouseup", () => {
@@ -328,11 +352,26 @@
     state.dragging = null; state.phantom = null;
     if (state.frame) { state.view = fitView(state.frame); draw(); }
   });
-  svg.addEventListener("click", (event) => {
-    if (!$("targets-on").checked || state.dragging) return;
+  svg.addEventListener("click", (event) => {  // a path's target
+    if (!$("targets-on").checked || state.dragging || $("synth-task").value !== "path") return;
     const p = toWorld(event);
-    state.targets.push([p[0] / 1000, -p[1] / 1000]); draw();
+    state.targets.push([p[0] / 1000, -p[1] / 1000]); showEntries(); draw();
   });
+  svg.addEventListener("mousedown", (event) => {  // a pose: its place, then its angle dragged
+    if (!$("targets-on").checked || $("synth-task").value !== "motion") return;
+    event.preventDefault();
+    const p = toWorld(event);
+    state.targets.push([p[0] / 1000, -p[1] / 1000, 0]); state.posing = state.targets.length - 1;
+    showEntries(); draw();
+  });
+  window.addEventListener("mousemove", (event) => {
+    if (state.posing === undefined || state.posing === null) return;
+    const t = state.targets[state.posing], p = toWorld(event);
+    const dx = p[0] / 1000 - t[0], dy = -p[1] / 1000 - t[1];
+    if (Math.hypot(dx, dy) > 1e-9) t[2] = Math.atan2(dy, dx);
+    showEntries(); draw();
+  });
+  window.addEventListener("mouseup", () => { state.posing = null; });
   $("pose").addEventListener("input", () => { state.index = Number($("pose").value); draw(); requestDetails(); });
   for (const id of ["show-ghosts", "show-centres", "show-arrows", "arrow-point"])
     $(id).addEventListener("change", () => { state.arrowScale = null; draw(); requestDetails(); });
@@ -417,11 +456,53 @@
   }
 
   // ------------------------------------------------------------------ synthesis
-  $("targets-clear").addEventListener("click", () => { state.targets = []; draw(); });
+  const HELP = {
+    path: "Tick <b>place on the drawing</b> and click the coupler point's targets, in order (or type x, y in mm).",
+    motion: "Tick <b>place on the drawing</b>, press at a pose's place and drag towards its angle (or type x, y in mm, angle in deg).",
+    function: "Type the pairs: the crank's turn (deg) and the output's turn (deg; a slider's travel in mm), from the first pair.",
+  };
+  function showHelp() {
+    const task = $("synth-task").value;
+    $("synth-help").innerHTML = HELP[task];
+    $("ground-box").style.display = task === "function" && $("synth-kind").value !== "slider-crank" ? "" : "none";
+  }
+  function showEntries() {  // the targets, poses or pairs in the page's units: mm, deg
+    const d = (r) => (r * 180 / Math.PI).toFixed(3), m = (x) => (x * 1000).toFixed(3);
+    $("entries").value = state.targets.map((t) => $("synth-task").value === "function" ? t.join(", ")
+      : t.length > 2 ? `${m(t[0])}, ${m(t[1])}, ${d(t[2])}` : `${m(t[0])}, ${m(t[1])}`).join("\n");
+  }
+  function readEntries() {  // the text typed: one entry a line, numbers split by commas or spaces
+    const rows = $("entries").value.split("\n").map((l) => l.trim()).filter((l) => l)
+      .map((l) => l.split(/[\s,;]+/).map(Number));
+    const task = $("synth-task").value;
+    state.targets = task === "function" ? rows.map((r) => [r[0], r[1]])
+      : rows.map((r) => task === "motion" ? [r[0] / 1000, r[1] / 1000, (r[2] || 0) * Math.PI / 180] : [r[0] / 1000, r[1] / 1000]);
+    draw();
+  }
+  $("entries").addEventListener("change", readEntries);
+  for (const id of ["synth-task", "synth-kind"]) $(id).addEventListener("change", () => {
+    if (id === "synth-task") {  // another task: its own targets, and no answers of the last
+      state.targets = []; state.answers = []; state.chosen = -1; $("answers").innerHTML = "";
+      $("synth-progress").textContent = ""; showEntries(); state.view = fitView(state.frame); draw();
+    }
+    showHelp();
+  });
+  showHelp();
+  function request(type) {  // the synthesis asked for: SI (m, rad) in the message
+    const task = $("synth-task").value, rad = Math.PI / 180;
+    const m = { type, kind: $("synth-kind").value, task, max_crank: Number($("synth-max").value) / 1000,
+      ground: Number($("synth-ground").value) / 1000, bounds: $("bounds").value,
+      generations: Number($("synth-generations").value) };
+    if (task === "function") m.pairs = state.targets.map(([a, b]) =>
+      [a * rad, $("synth-kind").value === "slider-crank" ? b / 1000 : b * rad]);
+    else if (task === "motion") m.poses = state.targets; else m.targets = state.targets;
+    return m;
+  }
+  $("bounds-propose").addEventListener("click", () => ws.send(JSON.stringify(request("bounds"))));
+  $("targets-clear").addEventListener("click", () => { state.targets = []; showEntries(); draw(); });
   $("synth-run").addEventListener("click", () => {
     state.answers = []; state.chosen = -1; $("answers").innerHTML = "";
-    ws.send(JSON.stringify({ type: "synthesise", kind: $("synth-kind").value, targets: state.targets,
-      max_crank: Number($("synth-max").value) / 1000 }));
+    ws.send(JSON.stringify(request("synthesise")));
   });
   $("synth-cancel").addEventListener("click", () => ws.send(JSON.stringify({ type: "cancel" })));
   function takeSynthesis(m) {
@@ -434,7 +515,8 @@
     const list = $("answers"); list.innerHTML = "";
     m.answers.forEach((a, i) => {
       const li = document.createElement("li"); li.textContent = a.summary;
-      li.addEventListener("click", () => { state.chosen = i; [...list.children].forEach((c, k) => c.className = k === i ? "chosen" : ""); draw(); });
+      li.addEventListener("click", () => { state.chosen = i; [...list.children].forEach((c, k) => c.className = k === i ? "chosen" : "");
+        state.view = fitView(state.frame); draw(); });
       const adopt = document.createElement("button"); adopt.textContent = "adopt"; adopt.type = "button";
       adopt.addEventListener("click", (e) => { e.stopPropagation(); state.adopting = true; state.view = null;
         ws.send(JSON.stringify({ type: "adopt", answer: i })); });
