@@ -22,7 +22,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.fixture
 def singular_at_zero(tmp_path, models_dir) -> Path:
-    """The R-RTR with AB = AC: singular at A = 0 deg (the block sits on C)."""
+    """The R-RTR with AB = AC: singular at A = 0 deg (the block sits on C: a change point,
+    the crossing of two branches). Swept from warm starts, where no pose is taken for a
+    change point passed on the way, that pose stops the sweep (exit 7)."""
     text = (models_dir / "r_rtr.urdf").read_text().replace('<parent_origin xyz="0.05 0 0"',
                                                             '<parent_origin xyz="0.10 0 0"')
     (tmp_path / "ab_ac.urdf").write_text(text)
@@ -40,7 +42,7 @@ def test_a_sweep_failing_at_its_first_pose_leaves_an_existing_csv_as_it_was(sing
     out = tmp_path / "a.csv"
     out.write_text("an earlier, complete result\n")
     before = _files(tmp_path)
-    assert main(["sweep", str(singular_at_zero), "--from", "0 deg", "--to", "10 deg", "--steps", "3",
+    assert main(["sweep", str(singular_at_zero), "--from", "0 deg", "--to", "10 deg", "--steps", "3", "--start", "warm",
                  "--csv", str(out)]) == 7
     assert out.read_text() == "an earlier, complete result\n"
     assert _files(tmp_path) == before  # nothing written: no partial file, no temporary left behind
@@ -49,9 +51,9 @@ def test_a_sweep_failing_at_its_first_pose_leaves_an_existing_csv_as_it_was(sing
 def test_a_sweep_failing_midway_keeps_its_rows_as_partial_files_that_agree(singular_at_zero, tmp_path, capsys):
     out, lines = tmp_path / "a.csv", tmp_path / "a.jsonl"
     out.write_text("old\n")
-    code = main(["sweep", str(singular_at_zero), "--from", "-20 deg", "--to", "0 deg", "--steps", "5",
+    code = main(["sweep", str(singular_at_zero), "--from", "-20 deg", "--to", "0 deg", "--steps", "5", "--start", "warm",
                  "--csv", str(out), "--json", str(lines)])
-    assert code == 7
+    assert code == 10  # a warm start landing on the singular pose: no assembly to keep there
     err = capsys.readouterr().err
     assert out.read_text() == "old\n" and not lines.exists()
     rows = list(csv.reader((tmp_path / "a.csv.partial").open()))
@@ -91,7 +93,7 @@ def test_an_output_over_the_scene_file_is_refused(r_rtr_scene, tmp_path, capsys)
 
 def test_an_unknown_figure_format_is_refused_before_computing(singular_at_zero, tmp_path, capsys):
     # The scene fails at 0 deg (exit 7): exit 2 shows the format was checked first.
-    code = main(["sweep", str(singular_at_zero), "--from", "0 deg", "--to", "1 deg", "--steps", "2",
+    code = main(["sweep", str(singular_at_zero), "--from", "0 deg", "--to", "1 deg", "--steps", "2", "--start", "warm",
                  "--plot", str(tmp_path / "fig.xyz")])
     assert code == 2 and "cannot draw a .xyz figure" in capsys.readouterr().err
 
@@ -171,7 +173,7 @@ def test_a_page_over_its_own_scene_or_urdf_is_refused(tmp_path, models_dir, comm
                                              ("missing/x.csv", "no such folder")])
 def test_an_output_that_cannot_be_a_file_is_refused_before_computing(singular_at_zero, tmp_path, capsys, target,
                                                                      message):
-    code = main(["sweep", str(singular_at_zero), "--from", "0 deg", "--to", "1 deg", "--steps", "2",
+    code = main(["sweep", str(singular_at_zero), "--from", "0 deg", "--to", "1 deg", "--steps", "2", "--start", "warm",
                  "--csv", str(tmp_path / target)])
     assert code == 2 and message in capsys.readouterr().err  # 2, not the pose's 7: checked first
 
@@ -209,12 +211,14 @@ def test_animate_refuses_more_frames_than_a_page_can_keep(r_rtr_scene, tmp_path,
 @pytest.mark.parametrize("target, message", [("/", "is a folder"), (".", "is a folder"), ("..", "is a folder"),
                                              ("/dev/null", "is not a regular file")])
 def test_a_figure_that_cannot_be_a_file_is_refused_in_one_line(singular_at_zero, target, message, capsys):
-    code = main(["sweep", str(singular_at_zero), "--from", "0 deg", "--to", "1 deg", "--steps", "2", "--plot", target])
+    code = main(["sweep", str(singular_at_zero), "--from", "0 deg", "--to", "1 deg", "--steps", "2", "--start", "warm", "--plot", target])
     assert code == 2 and f"--plot {target} {message}" in capsys.readouterr().err
 
 
 def test_rows_sent_to_standard_output_end_with_a_mark_when_the_run_stops(singular_at_zero, capsys):
-    assert main(["sweep", str(singular_at_zero), "--from", "-20 deg", "--to", "0 deg", "--steps", "5"]) == 7
+    # a warm start landing on the singular pose: no assembly to keep there (exit 10)
+    assert main(["sweep", str(singular_at_zero), "--from", "-20 deg", "--to", "0 deg", "--steps", "5",
+                 "--start", "warm"]) == 10
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == 1 + 4 + 1  # header, the 4 poses before 0 deg, the mark
     assert lines[-1].startswith("INCOMPLETE: pinmech stopped before the last row (sweep stopped at A = 0 deg")
