@@ -152,6 +152,7 @@ def report_picture(chromium: str, tmp: Path) -> None:
     import subprocess
 
     from pinmech.cli import main as pinmech
+    from pinmech.draw.browser import run_chromium
 
     if shutil.which("pdftoppm") is None:
         print("the report's picture needs poppler-utils: apt-get install poppler-utils")
@@ -167,9 +168,9 @@ def report_picture(chromium: str, tmp: Path) -> None:
                         encoding="utf-8")  # the reader's paper
     finally:
         os.chdir(here)
-    subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
-                    f"--user-data-dir={tmp / 'profile'}", f"--print-to-pdf={pdf}", page.resolve().as_uri()],
-                   check=True, capture_output=True, timeout=120)
+    run_chromium([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
+                  f"--user-data-dir={tmp / 'profile'}", f"--print-to-pdf={pdf}", page.resolve().as_uri()],
+                 timeout_s=120)
     subprocess.run(["pdftoppm", "-png", "-r", "90", "-f", "1", "-l", "1", "-singlefile", str(pdf),
                     str(IMAGES / "report_r_rtr_page1")], check=True)
 

@@ -106,32 +106,28 @@ def _hues(pixels: np.ndarray, value: np.ndarray, spread: np.ndarray) -> np.ndarr
 def print_pdf(html_file: Path, pdf: Path, paper: str | None = None) -> Path:
     """The page printed to PDF by headless chromium (as a reader's "print to PDF"); `paper`
     ("A4", "letter"): the paper chosen in the print dialog (else chromium's default, Letter)."""
-    import subprocess
-    import tempfile
+    from pinmech.draw.browser import chromium_profile, run_chromium
 
     if paper is not None:  # as a reader picks a paper size: a copy of the page asks for it
         text = Path(html_file).read_text(encoding="utf-8")
         html_file = Path(pdf).with_suffix(".html")
         html_file.write_text(text.replace("</style>", f"@page {{size: {paper}}}</style>", 1), encoding="utf-8")
-    with tempfile.TemporaryDirectory() as profile:
-        subprocess.run([require_browser(), "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
-                        f"--user-data-dir={profile}", f"--print-to-pdf={pdf}", Path(html_file).resolve().as_uri()],
-                       check=True, capture_output=True, timeout=120)
+    with chromium_profile() as profile:
+        run_chromium([require_browser(), "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
+                      f"--user-data-dir={profile}", f"--print-to-pdf={pdf}", Path(html_file).resolve().as_uri()],
+                     timeout_s=120)
     return pdf
 
 
 def page_dom(html_file: Path, *, fragment: str = "") -> str:
     """The page's DOM as chromium holds it once its scripts have run (`--dump-dom`)."""
-    import subprocess
-    import tempfile
 
-    from pinmech.draw.browser import chromium_command
+    from pinmech.draw.browser import chromium_command, chromium_profile, run_chromium
 
-    with tempfile.TemporaryDirectory() as profile:
-        command = [c for c in chromium_command(require_browser(), html_file, Path(profile) / "x.png", Path(profile),
+    with chromium_profile() as profile:
+        command = [c for c in chromium_command(require_browser(), html_file, profile / "x.png", profile,
                                                fragment=fragment) if not c.startswith("--screenshot")]
-        done = subprocess.run([*command[:-1], "--dump-dom", command[-1]], capture_output=True, text=True,
-                              timeout=90, check=True)
+        done = run_chromium([*command[:-1], "--dump-dom", command[-1]], timeout_s=90)
     return done.stdout
 
 

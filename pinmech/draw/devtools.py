@@ -17,7 +17,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from pinmech.draw.browser import FLAGS
+from pinmech.draw.browser import FLAGS, end_process_group, remove_profile
 from pinmech.exceptions import PinmechError
 from pinmech.outputs import write_with
 
@@ -35,11 +35,11 @@ class DevToolsPage:
     def __init__(self, chromium: str, url: str, window: tuple[int, int] = (1200, 800)) -> None:
         from websockets.sync.client import connect
 
-        self._profile = tempfile.TemporaryDirectory(prefix="pinmech-chromium-")
+        self._profile = Path(tempfile.mkdtemp(prefix="pinmech-chromium-"))
         self.process = subprocess.Popen(
             [chromium, *FLAGS, f"--window-size={window[0]},{window[1]}", "--remote-debugging-port=0",
-             f"--user-data-dir={self._profile.name}", "about:blank"],
-            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+             f"--user-data-dir={self._profile}", "about:blank"],
+            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True)
         self._connection = connect(self._browser_address(), max_size=2**26, open_timeout=START_TIMEOUT_S)
         self._socket = self._connection.__enter__()
         self._next = 0
@@ -143,13 +143,8 @@ class DevToolsPage:
             if getattr(self, "_connection", None) is not None:
                 self._connection.__exit__(None, None, None)
         finally:
-            self.process.terminate()
-            try:
-                self.process.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait(timeout=10)
-            self._profile.cleanup()
+            end_process_group(self.process)  # the browser and every helper it started
+            remove_profile(self._profile)
 
     def __enter__(self) -> DevToolsPage:
         return self
