@@ -19,6 +19,7 @@ Run: python scripts/closed_form.py   (prints the R-RTR at the textbook pose)
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -371,6 +372,42 @@ def planar_arm_forward(q: ArrayLike, q_dot: ArrayLike, q_ddot: ArrayLike, r1: fl
         acc = acc + r * (_vec(al[..., i]) * perp(e) - _vec(w[..., i] ** 2) * e)
         points.append(p), vels.append(v), accs.append(acc)
     return ArmState(*points, *vels, *accs)
+
+
+def five_bar_elbow(p: ArrayLike, base: ArrayLike, l1: float, l2: float, sign: float) -> Array:
+    """The elbow B of a five-bar's leg (motor at `base`, proximal link l1, distal link l2 [m])
+    reaching the end point p [m] with the turn base -> B -> p of the given sign
+    (cross(B - base, p - B) > 0 for +1): B at the angle phi -+ alpha of the line base -> p,
+    alpha from the law of cosines.
+
+    Raises:
+        ValueError: p outside the leg's annulus, or no elbow of that sign (p on its circles).
+    """
+    p, base = _real(p), _real(base)
+    v = p - base
+    d = float(np.hypot(v[0], v[1]))
+    cosine = (l1 * l1 + d * d - l2 * l2) / (2 * l1 * d) if d > 0 else np.inf
+    if not abs(cosine) <= 1.0 + 1e-12:  # a point on the annulus' circle, rounded: the stretched leg
+        raise ValueError(f"five-bar leg cannot reach: |p - base| = {d!r} outside [|l2 - l1|, l1 + l2]")
+    alpha = math.acos(min(1.0, max(-1.0, cosine)))
+    for angle in (math.atan2(v[1], v[0]) - alpha, math.atan2(v[1], v[0]) + alpha):
+        b = base + l1 * np.array([math.cos(angle), math.sin(angle)])
+        turn = (b - base)[0] * (p - b)[1] - (b - base)[1] * (p - b)[0]
+        if np.sign(turn) == sign:
+            return b
+    raise ValueError(f"five-bar leg has no elbow of sign {sign:+g} at p = {p!r} (a stretched or folded leg)")
+
+
+def five_bar_motors(p: ArrayLike, mode: str, bases: ArrayLike, l1: float, l2: float,
+                    zero: ArrayLike) -> Array:
+    """The motors' readings [rad] of a planar five-bar reaching the end point p [m] in the
+    working mode `mode` ("+-": each leg's elbow sign, as five_bar_elbow), each reading its
+    proximal link's angle less that motor's zero direction `zero` [rad] (a URDF's rpy)."""
+    out = []
+    for i, s in enumerate(mode):
+        b = five_bar_elbow(p, bases[i], l1, l2, 1.0 if s == "+" else -1.0)
+        out.append(math.atan2(b[1] - bases[i][1], b[0] - bases[i][0]) - zero[i])
+    return np.array(out)
 
 
 def main() -> None:

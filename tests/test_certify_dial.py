@@ -366,7 +366,8 @@ def test_a_single_pose_is_certified_at_every_level(level):
 
 def test_the_dial_benchmark_runs_and_every_level_meets_the_references(tmp_path, capsys):
     """scripts/benchmark_dial.py at small counts: its exit code is 0 when every level's
-    largest error on P1, P2 and the chain is within 1e-9 of the closed forms."""
+    largest error on P1, P2, the chain and the study's variants is within 1e-9 of the closed
+    forms, and the five-bar grid's motors within 1e-8 rad of the law-of-cosines elbows."""
     import sys
     from pathlib import Path
 
@@ -374,6 +375,7 @@ def test_the_dial_benchmark_runs_and_every_level_meets_the_references(tmp_path, 
     import benchmark_dial
 
     out = tmp_path / "dial.md"
-    assert benchmark_dial.main(["--poses", "36", "--rounds", "1", "--samples", "4", "--out", str(out)]) == 0
+    assert benchmark_dial.main(["--poses", "36", "--rounds", "1", "--samples", "4", "--grid", "7", "9",
+                                "--out", str(out)]) == 0
     text = out.read_text()
-    assert text.count("| P1 R-RTR") == 6 and "| five-bar workspace grid | any | any |" in text
+    assert text.count("| P1 R-RTR") == 6 and text.count("| five-bar workspace grid, 7 x 9 points |") == 2

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import closed_form
 import numpy as np
 import pytest
 
@@ -86,25 +87,13 @@ def near_circle(p: np.ndarray, tol: float = 1e-9) -> np.ndarray:
 
 def elbow(p: np.ndarray, leg: int, sign: float) -> np.ndarray:
     """B_i with |B - A_i| = l1, |P - B| = l2 and the turn A_i -> B -> P of the given sign
-    (cross(B - A_i, P - B) > 0 for "+", the elbow's sine): B at the angle phi -+ alpha,
-    alpha from the law of cosines."""
-    v = p - A[leg]
-    d = float(np.linalg.norm(v))
-    alpha = math.acos(min(1.0, max(-1.0, (L1**2 + d**2 - L2**2) / (2 * L1 * d))))
-    for angle in (math.atan2(v[1], v[0]) - alpha, math.atan2(v[1], v[0]) + alpha):
-        b = A[leg] + L1 * np.array([math.cos(angle), math.sin(angle)])
-        if np.sign(cross2(b - A[leg], p - b)) == sign:
-            return b
-    raise AssertionError("no elbow of that sign")
+    (the law of cosines, scripts/closed_form.py)."""
+    return closed_form.five_bar_elbow(p, A[leg], L1, L2, sign)
 
 
 def five_bar_motors(p: np.ndarray, mode: str) -> np.ndarray:
     """The motors' readings [rad] (URDF zero at 120 deg and 60 deg) reaching p in `mode`."""
-    out = []
-    for i, s in enumerate(mode):
-        b = elbow(p, i, 1.0 if s == "+" else -1.0)
-        out.append(math.atan2(b[1] - A[i][1], b[0] - A[i][0]) - ZERO[i])
-    return np.array(out)
+    return closed_form.five_bar_motors(p, mode, A, L1, L2, ZERO)
 
 
 def collinearity(p: np.ndarray, mode: str) -> float:
