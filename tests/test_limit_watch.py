@@ -314,3 +314,42 @@ def test_a_crank_rocker_driven_at_its_rocker_stops_where_crank_and_coupler_fold(
     (x,) = design.angle_extremes()
     np.testing.assert_allclose([x.low, x.pressure], [0.0, 90.0], rtol=0, atol=1e-12)
     np.testing.assert_allclose(math.degrees(x.low_at), fold, rtol=0, atol=FOLD_TOL_DEG)
+
+
+def test_an_inverted_slider_cranks_block_square_to_its_rod_reports_one_constant_angle(capsys):
+    """The R-RTR of Problem Chapter I.9 (Marghitu, Mechanisms and Robots Analysis with
+    MATLAB): the block on link 2 slides along link 3, pinned to it at the slide, so the
+    angle between them is 90 deg at every pose by construction. The summary says so once
+    ("= 90 deg at every pose"), not "from 90 deg at one pose to 90 deg at another" with the
+    pressure angle's rounding (~1e-14 deg) as its largest value."""
+    from pinmech.cli import main
+
+    from .conftest import SCENES
+
+    assert main(["sweep", str(SCENES / "r_rtr.toml")]) == 0
+    said = capsys.readouterr().err
+    line = next(x for x in said.splitlines() if "transmission angle" in x)
+    assert line.endswith("transmission angle mu = 90 deg at every pose, pressure angle |90 deg - mu| = 0 deg "
+                         "(constant to 1e-09 deg over the 361 poses)")
+    assert " from " not in line and "e-1" not in line
+
+
+def test_a_constant_transmission_angle_is_one_value_in_the_json_and_the_report_table(tmp_path):
+    """The same R-RTR: the summary's JSON says mu is constant (pi/2 to rounding), the
+    report's design table prints it once; a four-bar's mu is not constant."""
+    from pinmech.draw.report_design import design_rows
+    from pinmech.solve.design_summary import design_summary
+
+    from .conftest import SCENES
+
+    for scene, constant in (("r_rtr.toml", True), ("four_bar.toml", False)):
+        sweep = pinmech.Sweep.from_scene(pinmech.Scene.load(SCENES / scene))
+        design = design_of(sweep)
+        for pose in sweep.poses(np.linspace(0.0, 2 * np.pi, 73)):
+            design.add(pose)
+        (dyad,) = design_summary(sweep)["dyads"]
+        assert dyad["transmission_angle_constant"] is constant, scene
+        if constant:
+            assert abs(dyad["transmission_angle_least"] - math.pi / 2) < 1e-12  # rounding of unit vectors
+            rows = [cell for head, cell in design_rows(design_summary(sweep)) if head.startswith("μ at")]
+            assert rows == ['<span data-key="dyads.0.transmission_angle_least">90</span>° at every pose (constant)']

@@ -55,6 +55,9 @@ def _dyad(i: int, dyad: dict, driver: str, angular: bool) -> list[tuple[str, str
     def angle(name: str) -> str:
         return f"{_number(key + name, math.degrees(dyad[name]))}°"
 
+    if dyad.get("transmission_angle_constant"):
+        return [(f"μ at {dyad['pin']} ({dyad['coupler_output']})",
+                 f"{angle('transmission_angle_least')} at every pose (constant)")]
     rows = [(f"μ at {dyad['pin']} ({dyad['coupler_output']})",
              f"least {angle('transmission_angle_least')} at {_at(driver, dyad['transmission_angle_least_at'], angular)}; "
              f"largest {angle('transmission_angle_largest')} at "

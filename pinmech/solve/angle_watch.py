@@ -28,6 +28,12 @@ from pinmech.extremum import TOL, Tracked
 from pinmech.solve.transmission import DyadAngles, dyad_angles, dyad_side
 
 
+#: A transmission angle whose least and largest differ by no more than this [deg] is one
+#: constant value: the angles come from unit vectors rounded at ~1e-14 deg, so a spread below
+#: 1e-9 deg is rounding, and "from 90 deg at one pose to 90 deg at another" says nothing.
+CONSTANT_ANGLE_DEG = 1e-9
+
+
 @dataclass(frozen=True)
 class AngleExtremes:
     """A dyad's (named by its pin B) least and largest transmission angle mu [deg] on
@@ -51,6 +57,12 @@ class AngleExtremes:
         """The least acute transmission angle, 90 - the largest pressure angle [deg]."""
         return 90.0 - self.pressure
 
+    @property
+    def constant(self) -> bool:
+        """Whether mu is one value at every pose (an inverted slider's block square to its rod):
+        its least and largest within CONSTANT_ANGLE_DEG, rounding of unit vectors (~1e-14 deg)."""
+        return bool(self.high - self.low <= CONSTANT_ANGLE_DEG)
+
     def as_dict(self) -> dict:
         """SI: angles [rad], driver values [rad or m]."""
         rad = math.radians
@@ -58,7 +70,7 @@ class AngleExtremes:
                 "transmission_angle_largest": rad(self.high), "transmission_angle_largest_at": self.high_at,
                 "pressure_angle_largest": rad(self.pressure), "pressure_angle_largest_at": self.pressure_at,
                 "transmission_angle_acute_least": rad(self.acute_low), "in_line_at": list(self.in_line),
-                "located": self.refined}
+                "located": self.refined, "transmission_angle_constant": self.constant}
 
 
 @dataclass

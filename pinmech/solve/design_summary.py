@@ -11,7 +11,8 @@ Fields (docs/reference/outputs.md, "Design summary"):
   link as link 2);
 - dyads: per pin B, the transmission angle mu [rad] on [0, pi], least and largest, the
   largest pressure angle |pi/2 - mu| [rad], the least acute mu, each with its driver
-  value, in_line_at (coupler and output in line) and located (refined between poses);
+  value, in_line_at (coupler and output in line), located (refined between poses) and
+  transmission_angle_constant (mu one value at every pose, to 1e-9 deg);
 - folds: the driver's folds met [rad or m];
 - outputs: per output link, its limit positions (kind, label "max"/"min" with TDC/BDC,
   driver value, place [rad or m], toggle), swing [rad] or stroke [m], time ratio Q and

@@ -16,7 +16,7 @@ import numpy as np
 
 from pinmech.solve.diagnostics import _centre_dict, advantage_of, advantage_unit, barker_words
 from pinmech.exceptions import DiagnosticError, PinmechError
-from pinmech.solve.angle_watch import AngleExtremes, AngleWatch
+from pinmech.solve.angle_watch import CONSTANT_ANGLE_DEG, AngleExtremes, AngleWatch
 from pinmech.solve.change_points import BranchWatch
 from pinmech.solve.fold_pose import fold_pose
 from pinmech.solve.grashof import loop_classes
@@ -26,7 +26,6 @@ from pinmech.solve.limit_watch import RateWatch
 from pinmech.model.planar_linkage import planar_linkage
 from pinmech.solve.instant_centres import instant_centres
 from pinmech.solve.transmission import dyad_angles, find_dyads, find_outputs, input_links, output_rate
-
 
 @dataclass
 class _Extreme:
@@ -326,6 +325,12 @@ class DesignSweep:
         for d, x in zip(self.dyads, self.angle_extremes()):
             what = "transmission angle mu" if d.kind == "pin" else "transmission angle mu = 90 deg - pressure angle"
             where = "located between" if x.refined else "over"
+            if x.constant:  # an inverted slider's block square to its rod, say
+                mu = round(0.5 * (x.low + x.high), 9)  # to the constancy asked: 90.0, not 90 - 3e-14
+                lines.append(f"design: {d.name(self.linkage)}: transmission angle mu = {mu:.6g} deg at every pose, "
+                             f"pressure angle |90 deg - mu| = {abs(90.0 - mu):.6g} deg (constant to "
+                             f"{CONSTANT_ANGLE_DEG:g} deg over the {self.count} poses)")
+                continue
             lines.append(f"design: {d.name(self.linkage)}: {what} from {x.low:.6g} deg at {fmt(x.low_at)} to "
                          f"{x.high:.6g} deg at {fmt(x.high_at)}; pressure angle |90 deg - mu| up to {x.pressure:.6g} "
                          f"deg at {fmt(x.pressure_at)} (acute mu least {x.acute_low:.6g} deg) ({where} the "
