@@ -61,8 +61,7 @@ class DesignTrace:
         if not self.dyads or not self.design.count:
             return []
         return [LeastAngle(x.name, *((x.low, x.low_at) if 90.0 - x.low >= x.high - 90.0 else (x.high, x.high_at)),
-                           x.refined) for x in self.design.angle_extremes()
-                if x.high - x.low > 1e-9 * 180.0]  # below: rounding about a constant
+                           x.refined) for x in self.design.angle_extremes() if not x.constant]
 
     def limits(self) -> list[tuple[str, float, np.ndarray]]:
         """(label, driver value [rad or m], closed q) of every output's limit position."""
