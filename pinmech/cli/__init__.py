@@ -45,15 +45,43 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv and argv[0] in SUBCOMMANDS:
         try:
-            return build_parser(argv[0], parser_class=_SubcommandOnly).parse_args(argv)
+            parser = build_parser(argv[0], parser_class=_SubcommandOnly)
+            return _refuse_empty(parser, parser.parse_args(argv))
         except _ParseAgain:
             pass
-    return build_parser().parse_args(argv)
+    parser = build_parser()
+    return _refuse_empty(parser, parser.parse_args(argv))
+
+
+def _refuse_empty(parser: argparse.ArgumentParser, args: argparse.Namespace) -> argparse.Namespace:
+    """`args`, unless an option or file was given as empty text (`--plot ""`, `--from "$UNSET"`):
+    that is an OptionRefused naming it, never the option left out in silence."""
+    from pinmech.exceptions import OptionRefused
+
+    for action in _actions(parser, args.command):
+        value = getattr(args, action.dest, None)
+        values = value if isinstance(value, list) else [value]
+        if any(isinstance(v, str) and not v.strip() for v in values):
+            name = action.option_strings[-1] if action.option_strings else (action.metavar or action.dest)
+            several = isinstance(value, list) and len(value) > 1
+            what = f"{name} has an empty value in {value!r}" if several else f"{name} is empty"
+            raise OptionRefused(f"{what}: give it a value, or leave the option out", options=[name])
+    return args
+
+
+def _actions(parser: argparse.ArgumentParser, command: str) -> list[argparse.Action]:
+    """The arguments of `command`'s sub-parser."""
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return sub.choices[command]._actions
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; every pinmech error becomes one line on stderr and its exit code."""
-    args = parse_args(argv)
+    try:
+        args = parse_args(argv)
+    except PinmechError as exc:  # an empty option
+        print(f"pinmech: error: {_one_line(exc)}", file=sys.stderr)
+        return exc.exit_code
     try:
         with SIGNALS.installed():
             return args.func(args)

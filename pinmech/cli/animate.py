@@ -8,7 +8,7 @@ from pathlib import Path
 
 from pinmech.cli.arguments import add_scene_arguments
 from pinmech.cli.files import inputs_of, write_page
-from pinmech.cli.scene_args import given_text, scene_from_args
+from pinmech.cli.scene_args import scene_from_args
 from pinmech.cli.visuals import visuals
 from pinmech.exceptions import PinmechError
 
@@ -50,9 +50,9 @@ def cmd_animate(args: argparse.Namespace) -> int:
     if not args.fps > 0:
         raise PinmechError(f"--fps must be positive, got {args.fps}")
     if scene.is_task:
-        frames = task_frames(scene, given_text(args.duration, "--duration"), args.steps)
+        frames = task_frames(scene, args.duration, args.steps)
     else:
-        frames = driver_frames(scene, given_text(args.start, "--from"), given_text(args.stop, "--to"), args.steps,
+        frames = driver_frames(scene, args.start, args.stop, args.steps,
                                skip_failures=args.skip_failures)
     if args.output:
         from pinmech.draw import animation_html

@@ -10,7 +10,7 @@ from typing import Any
 from pinmech.cli.arguments import add_limits_argument, add_output_arguments, add_path_arguments
 from pinmech.cli.files import check_outputs
 from pinmech.cli.progress import LimitWatch, progress
-from pinmech.cli.scene_args import given_text, option_or_scene
+from pinmech.cli.scene_args import option_or_scene
 from pinmech.exceptions import PinmechError
 
 
@@ -80,11 +80,11 @@ def _timing(args: argparse.Namespace, scene, options: dict[str, Any]) -> tuple[f
     or the scene's key it came from."""
     from pinmech.solve.path import check_timing
 
-    duration = option_or_scene(given_text(args.duration, "--duration"), "--duration", scene, options, "duration")
+    duration = option_or_scene(args.duration, "--duration", scene, options, "duration")
     if not duration.value:
         raise PinmechError(f"{scene.path}: say how long to follow the task: --duration '0.08 s' "
                            "(or [sweep] duration = \"0.08 s\")")
-    step = option_or_scene(given_text(args.step, "--step"), "--step", scene, options, "step", "1 ms")
+    step = option_or_scene(args.step, "--step", scene, options, "step", "1 ms")
     gain = option_or_scene(args.gain, "--gain", scene, options, "gain", 0.0)
     values = {}
     for option in (duration, step):

@@ -9,16 +9,6 @@ from typing import Any, NamedTuple
 from pinmech.exceptions import PinmechError, SceneError
 
 
-def given_text(value: str | None, option: str) -> str | None:
-    """An option's text, None where it was not given; an empty one (an unset shell
-    variable) is an error, never the scene's own value in silence."""
-    if value is not None and not value.strip():
-        from pinmech.exceptions import UnitError
-
-        raise UnitError(f"{option} is empty: give a quantity such as '30 deg' (or leave the option out)")
-    return value
-
-
 class Option(NamedTuple):
     """An option's value and where it came from: its flag, or the scene's `[sweep]` key
     (`key` set), so that an error blames the one the user wrote."""
@@ -96,8 +86,6 @@ def scene_from_args(args: argparse.Namespace):
     if getattr(args, "certify", None):
         overrides.append(f'solver.certify="{certify_argument(args.certify)}"')
     shortcuts = {"angle": args.angle, "speed": args.speed, "acceleration": args.acceleration}
-    for key, value in shortcuts.items():
-        given_text(value, f"--{key}")
     if any(shortcuts.values()):
         scene = Scene.load(args.scene)
         drivers = list(scene.file.drivers)

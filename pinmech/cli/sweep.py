@@ -18,7 +18,7 @@ from pinmech.cli.arguments import (
 from pinmech.cli.files import check_outputs
 from pinmech.cli.path import follow_task
 from pinmech.cli.progress import LimitWatch, progress
-from pinmech.cli.scene_args import given_text, option_or_scene, scene_from_args
+from pinmech.cli.scene_args import option_or_scene, scene_from_args
 from pinmech.counts import checked_count
 from pinmech.exceptions import PinmechError
 from pinmech.solve.certify import dial_note
@@ -132,8 +132,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     checked_count(steps, given_steps.where, f"steps = {steps}")
     sweep = Sweep.from_scene(scene, args.driver)
     kind = "angle" if sweep.is_angular else "length"
-    first = option_or_scene(given_text(args.first, "--from"), "--from", scene, options, "from")
-    last = option_or_scene(given_text(args.last, "--to"), "--to", scene, options, "to")
+    first = option_or_scene(args.first, "--from", scene, options, "from")
+    last = option_or_scene(args.last, "--to", scene, options, "to")
     start = first.quantity(kind) if first.value else sweep.start
     stop = last.quantity(kind) if last.value else start + (sweep.default_values(2)[1] - sweep.start)
     if args.tol is not None:
