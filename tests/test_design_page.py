@@ -119,6 +119,46 @@ def test_saved_linkage_reads_back_as_the_page_holds_it(tmp_path):
     assert not list(tmp_path.glob("*.partial")) and not list(tmp_path.glob(".*tmp*"))
 
 
+@pytest.mark.parametrize("figure, said", [
+    ({"svg": "<svg/>", "png": "data:image/png;base64,!!!!"}, "base64 data is malformed"),
+    ({"svg": "<svg/>", "png": "data:image/png;base64,R0lGODlh"}, "not a PNG"),
+    ({"svg": "<svg/>", "png": "http://example.com/a.png"}, "not a data:image/png;base64 URL"),
+    ({"svg": 12}, "SVG that is not text (a int)"),
+    ({"svg": "<svg/>", "png": ["x"]}, "PNG that is not a data URL (a list)"),
+])
+def test_a_save_with_a_bad_figure_writes_no_file_and_says_why(tmp_path, figure, said):
+    """The figure is checked before the linkage, its scene or the SVG are written: a save
+    refused half-way left three files of four, and the user's linkage rewritten."""
+    copy = tmp_path / "four_bar.toml"
+    shutil.copy(FOUR_BAR, copy)
+    before = copy.read_bytes()
+    spec, source, _, _ = read_design_file(copy)
+    session = Session(spec, source)
+    session.drag("B", 0.0712345, 0.0934567)
+    answer = Saving(copy, leading_comments(copy)).save(session, {"type": "save", **figure})
+    assert not answer["ok"] and answer["error"].startswith("PinmechError") and said in answer["error"], answer
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["four_bar.toml"] and copy.read_bytes() == before
+
+
+@pytest.mark.parametrize("index", [-1, 361, 10**30])  # a turn of 1-degree poses, both ends: 0 to 360
+def test_a_drag_at_a_pose_the_turn_has_not_is_refused_not_taken_at_the_drawn_pose(index):
+    spec, source, _, _ = read_design_file(FOUR_BAR)
+    session = Session(spec, source)
+    before = session.spec
+    answer = session.drag("B", 0.0712345, 0.0934567, index=index)
+    assert not answer["ok"] and f"at pose {index}: the turn's poses are 0 to 360" in answer["error"]
+    assert session.spec is before
+
+
+def test_a_drag_at_a_pose_past_the_fold_is_refused():
+    """A non-Grashof drawing's turn stops at its fold: the poses past it are not drawn."""
+    spec, source, driver, speed = read_design_file(ROOT / "models" / "linkages" / "stephenson.toml")
+    session = Session(spec, source, driver=driver, speed=speed)
+    past = session.first["stopped"]["index"] + 1
+    answer = session.drag(session.turn.names[-1], 0.01, 0.02, index=past)
+    assert not answer["ok"] and "drawn only where it was solved" in answer["error"]
+
+
 # ---------------------------------------------------------------- the server
 @pytest.fixture
 def server(tmp_path):

@@ -32,15 +32,16 @@ class Saving:
 
     def save(self, session, message: dict) -> dict:
         from pinmech.draw.design_page.frame import scene_tables
-        from pinmech.draw.design_page.save import save_figure, save_linkage, save_scene
+        from pinmech.draw.design_page.save import figure_contents, save_figure, save_linkage, save_scene
 
         turn = session.turn
         sweep = turn.sweep
         driver = (sweep.driver, float(sweep.start))
         try:
+            figure = figure_contents(message.get("svg"), message.get("png"))  # checked before any file is written
             files = [save_linkage(session.spec, self.linkage, self.header),
                      save_scene(scene_tables(turn.linkage, "", driver, session.solver.speed), self.linkage, self.scene)]
-            files += save_figure(message.get("svg"), message.get("png"), self.figure)
+            files += save_figure(figure, self.figure)
         except (PinmechError, OSError, ValueError) as exc:
             return {"type": "saved", "ok": False, "error": f"{type(exc).__name__}: {exc}"}
         return {"type": "saved", "ok": True, "files": [str(f) for f in files]}

@@ -78,29 +78,40 @@ def save_scene(tables: dict, linkage_path: Path, path: Path) -> Path:
     return path
 
 
-def save_figure(svg: str | None, png_data_url: str | None, stem: Path) -> list[Path]:
-    """The page's figure as `stem`.svg and `stem`.png (either may be absent).
+def figure_contents(svg: object, png_data_url: object) -> dict[str, bytes]:
+    """The page's figure checked before anything is saved: {".svg": ..., ".png": ...} (either
+    may be absent), so that a bad figure leaves no file of the save written.
 
     Raises:
-        PinmechError: a PNG that is not a base64 data URL of a PNG.
+        PinmechError: an SVG that is not text, a PNG that is not a base64 data URL of a PNG.
     """
-    written = []
+    import binascii
+
+    contents = {}
+    if svg is not None and not isinstance(svg, str):
+        raise PinmechError(f"the page sent an SVG that is not text (a {type(svg).__name__})")
     if svg:
-        written.append(_write_text(stem.with_suffix(".svg"), svg))
+        contents[".svg"] = svg.encode("utf-8")
+    if png_data_url is not None and not isinstance(png_data_url, str):
+        raise PinmechError(f"the page sent a PNG that is not a data URL (a {type(png_data_url).__name__})")
     if png_data_url:
         prefix = "data:image/png;base64,"
         if not png_data_url.startswith(prefix):
             raise PinmechError("the page sent a PNG that is not a data:image/png;base64 URL")
-        data = base64.b64decode(png_data_url[len(prefix):], validate=True)
+        try:
+            data = base64.b64decode(png_data_url[len(prefix):], validate=True)
+        except binascii.Error as exc:
+            raise PinmechError(f"the page sent a PNG whose base64 data is malformed ({exc})") from None
         if not data.startswith(b"\x89PNG"):
             raise PinmechError("the page sent a PNG whose data is not a PNG")
-        written.append(write_with(stem.with_suffix(".png"), lambda temporary: Path(temporary).write_bytes(data)))
-    return written
+        contents[".png"] = data
+    return contents
 
 
-def _write_text(path: Path, text: str) -> Path:
-    write_whole(path, text)
-    return path
+def save_figure(contents: dict[str, bytes], stem: Path) -> list[Path]:
+    """Write `figure_contents` as `stem`.svg and `stem`.png, each whole."""
+    return [write_with(stem.with_suffix(suffix), lambda temporary, data=data: Path(temporary).write_bytes(data))
+            for suffix, data in contents.items()]
 
 
 def _string(text: str) -> str:

@@ -88,7 +88,12 @@ class Session:
         from pinmech.draw.design_page.edits_posed import landed, move_joint_posed, refusal
 
         to = np.array([x, y], dtype=float)
-        posed = index != 0 and self._solved(index)
+        posed = index != 0
+        if posed and not self._solved(index):  # never taken as a drag at the drawn pose in silence
+            count = 0 if self.turn is None else len(self.turn.values)
+            return {"type": "frame", "ok": False,
+                    "error": f"AssemblyError: {self.source}: {joint} cannot be dragged at pose {index}: the turn's "
+                             f"poses are 0 to {count - 1} and the linkage is drawn only where it was solved"}
         try:
             if posed:
                 spec = move_joint_posed(self.spec, self.turn, joint, index, to, self.source)

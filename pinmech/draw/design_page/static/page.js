@@ -344,7 +344,8 @@
     if (!state.dragging) return;
     const p = toWorld(event);
     state.phantom = state.error ? p : null;
-    send({ type: "drag", joint: state.dragging, x: p[0] / 1000, y: -p[1] / 1000, index: state.index });
+    const shown = state.frame.solved[state.index] ? state.index : 0;  // an unsolved pose is drawn at the drawn one
+    send({ type: "drag", joint: state.dragging, x: p[0] / 1000, y: -p[1] / 1000, index: shown });
     if (state.error) draw();
   });
   window.addEventListener("mouseup", () => {
