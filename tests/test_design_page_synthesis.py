@@ -51,6 +51,13 @@ def test_each_task_of_each_kind_is_a_file_the_synthesis_reader_reads_back(kind, 
     ({"bounds": "crank = [\"10 mm\", \"80 mm\"]"}, "missing"),
     ({"bounds": "crank = [10 mm"}, "the bounds are not TOML"),
     ({"kind": "watt"}, "kind must be one of"),
+    # rows of the wrong length were reshaped into other targets in silence (6 numbers: 3 points)
+    ({"targets": [[0.0, 0.0, 0.0], [0.01, 0.01, 0.0]]}, "targets must be rows of 2 numbers, got of shape (2, 3)"),
+    ({"targets": [0.0, 0.0, 0.01, 0.01, 0.02, 0.0]}, "targets must be rows of 2 numbers, got of shape (6,)"),
+    ({"targets": [[0.0, 0.0], [0.01], [0.02, 0.0]]}, "targets must be rows of 2 numbers, got not numbers in rows"),
+    ({"targets": "0,0 1,1 2,0"}, "targets must be rows of 2 numbers"),
+    ({"task": "motion", "poses": [[0.0, 0.0], [0.01, 0.01], [0.02, 0.0]]}, "poses must be rows of 3 numbers"),
+    ({"task": "function", "pairs": [[0.1, 0.2, 0.3]] * 3}, "pairs must be rows of 2 numbers"),
 ])
 def test_a_request_the_reader_refuses_is_its_named_error_on_the_page(change, said):
     spec, source, _, _ = read_design_file(ROOT / "models" / "linkages" / "four_bar.toml")

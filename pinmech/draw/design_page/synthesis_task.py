@@ -52,18 +52,31 @@ class Request:
         self.generations = int(message.get("generations", GENERATIONS))
         if not 1 <= self.generations <= 10 * GENERATIONS:
             raise SceneError(f"generations must be from 1 to {10 * GENERATIONS}, got {self.generations}", path="<page>")
-        poses = np.asarray(message.get("poses" if self.task == "motion" else "targets", []), dtype=float)
-        width = 3 if self.task == "motion" else 2
-        poses = poses.reshape(-1, width) if poses.size else np.zeros((0, width))
+        key = "poses" if self.task == "motion" else "targets"
+        poses = _rows(message.get(key, []), 3 if self.task == "motion" else 2, key)
         self.places, self.angles = poses[:, :2], poses[:, 2] if self.task == "motion" else None
-        pairs = np.asarray(message.get("pairs", []), dtype=float)
-        self.pairs = pairs.reshape(-1, 2) if pairs.size else np.zeros((0, 2))
+        self.pairs = _rows(message.get("pairs", []), 2, "pairs")
         if not (np.all(np.isfinite(poses)) and np.all(np.isfinite(self.pairs))):
             raise SceneError("the targets, poses and pairs must be finite numbers", path="<page>")
 
     @property
     def count(self) -> int:
         return len(self.pairs) if self.task == "function" else len(self.places)
+
+
+def _rows(value, width: int, key: str) -> np.ndarray:
+    """`value` as rows of `width` numbers, (n, width); anything else (a flat list, rows of
+    another length, text) a SceneError naming `key`, never reshaped into other rows."""
+    try:
+        rows = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        rows = None
+    if rows is not None and rows.size == 0:
+        return np.zeros((0, width))
+    if rows is None or rows.ndim != 2 or rows.shape[1] != width:
+        shape = "not numbers in rows" if rows is None else f"of shape {rows.shape}"
+        raise SceneError(f"{key} must be rows of {width} numbers, got {shape}", path="<page>")
+    return rows
 
 
 def default_bounds(request: Request) -> str:
