@@ -24,6 +24,7 @@ from tests.tolerance import STATED_SWEEP, rounding
         ("benchmark_study", ["--samples", "40", "--rounds", "1"]),
         ("benchmark_drawn_study", ["--samples", "10", "--steps", "13", "--rounds", "1"]),
         ("benchmark_synthesis", ["--six-bar", "--rounds", "1"]),
+        ("benchmark_synthesis", ["--seeds", "1", "--generations", "3"]),
         ("benchmark_design_page", ["--drags", "1"]),
     ],
 )

@@ -82,27 +82,37 @@ def nearest_angles(z: np.ndarray, s: np.ndarray, targets: np.ndarray, angles: np
     grid = np.arange(SAMPLES) * step
     thetas = np.broadcast_to(grid, (len(z), SAMPLES))
     p = kinematics(topology).pose(z, s, thetas)
-    P = p.P  # (n, M, 2)
-    dx = P[:, None, :, 0] - targets[None, :, None, 0]
-    dy = P[:, None, :, 1] - targets[None, :, None, 1]
-    d2 = dx * dx + dy * dy  # (n, N, M)
+    px, py = p.P[..., 0], p.P[..., 1]  # (n, M)
     if angles is not None:
-        phi = carried_angle(topology, p, z, s, thetas)  # (n, M)
-        turn = phi[:, None, :] + gamma[:, None, None] - angles[None, :, None]
-        d2 = d2 + 2 * extent(targets) ** 2 * (1 - np.cos(turn))
-    d2 = np.where(np.isnan(d2), np.inf, d2)
-    k = np.argmin(d2, axis=2)
-    rows = np.arange(len(z))[:, None]
-    cols = np.arange(len(targets))[None, :]
-    f0, fm, fp = d2[rows, cols, k], d2[rows, cols, (k - 1) % SAMPLES], d2[rows, cols, (k + 1) % SAMPLES]
+        lead = carried_angle(topology, p, z, s, thetas) + gamma[:, None]  # (n, M)
+        weight = 2 * extent(targets) ** 2
+    # One target at a time: (n, M) arrays, where (n, N, M) ones were allocated and faulted
+    # in afresh at every call (the same arithmetic, element by element).
+    theta = np.empty((len(z), len(targets)))
+    for j, (tx, ty) in enumerate(targets):
+        dx, dy = px - tx, py - ty
+        d2 = dx * dx + dy * dy  # (n, M)
+        if angles is not None:
+            d2 += weight * (1 - np.cos(lead - angles[j]))
+        d2[np.isnan(d2)] = np.inf
+        theta[:, j] = _nearest_sample(d2) * step
+    return theta
+
+
+def _nearest_sample(d2: np.ndarray) -> np.ndarray:
+    """Each row's least entry of squared distances d2 (n, M) over a closed turn of M samples,
+    as a fractional sample index (n,): the parabola through it and its two neighbours (where
+    all three are finite and curve upwards, the shift clipped to half a sample), NaN for a
+    row with none finite."""
+    k, rows, m = np.argmin(d2, axis=1), np.arange(len(d2)), d2.shape[1]
+    f0, fm, fp = d2[rows, k], d2[rows, (k - 1) % m], d2[rows, (k + 1) % m]
     found = np.isfinite(f0)
     ok = np.isfinite(fm) & np.isfinite(fp) & found
     fm, f0, fp = (np.where(ok, f, 0.0) for f in (fm, f0, fp))
     curve = fm - 2 * f0 + fp
     ok &= curve > 0
     shift = np.where(ok, 0.5 * (fm - fp) / np.where(ok, curve, 1.0), 0.0)
-    theta = (k + np.clip(shift, -0.5, 0.5)) * step
-    return np.where(found, theta, np.nan)
+    return np.where(found, k + np.clip(shift, -0.5, 0.5), np.nan)
 
 
 def evaluate_path(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchValues:

@@ -39,12 +39,24 @@ def search_bounds(spec: SynthesisSpec) -> list[tuple[float, float]]:
             "six-bar": sixbar_bounds}.get(_task(spec), path_bounds)(spec)
 
 
+#: Rows evaluated at once: a block's arrays (rows x 180 crank angles: 92 kB at 64 rows) stay
+#: in the CPU's caches, where a whole population's were allocated and faulted in afresh at
+#: every call, three times slower. Every row is evaluated on its own arithmetic, so the
+#: blocks change no bit of the values.
+BLOCK = 64
+
+
 def evaluate(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> BatchValues:
-    """The task's objective of rows x on one assembly (a Dask task)."""
-    return {"function": evaluate_function, "motion": evaluate_poses,
-            "slider function": evaluate_slider_function,
-            "inverted function": evaluate_inverted_function,
-            "six-bar": evaluate_sixbar}.get(_task(spec), evaluate_path)(spec, assembly, x)
+    """The task's objective of rows x on one assembly (a Dask task), BLOCK rows at a time."""
+    function = {"function": evaluate_function, "motion": evaluate_poses,
+                "slider function": evaluate_slider_function,
+                "inverted function": evaluate_inverted_function,
+                "six-bar": evaluate_sixbar}.get(_task(spec), evaluate_path)
+    if len(x) <= BLOCK:
+        return function(spec, assembly, x)
+    parts = [function(spec, assembly, x[i:i + BLOCK]) for i in range(0, len(x), BLOCK)]
+    return BatchValues(np.concatenate([p.values for p in parts]), [c for p in parts for c in p.causes],
+                       np.concatenate([p.theta for p in parts]))
 
 
 def refined(spec: SynthesisSpec, assembly: float, x: np.ndarray) -> Linkage | None:
