@@ -160,6 +160,19 @@ def test_a_change_point_at_a_sweeps_first_or_last_pose_is_a_row_not_a_failure(tm
         assert (f"the sweep's {which} pose is a change point" in err) == ((0 if which == "first" else 1) in on_change_point)
 
 
+@pytest.mark.parametrize("last", [360.0, -360.0])
+def test_a_change_point_a_turn_on_is_named_at_its_angle_not_rounding(tmp_path, capsys, last):
+    """The SCRR's change point a turn (or two) from 0, the sweep's last pose: the failed
+    row's error names O2 = 0 deg (its position a turn on), as the driver read back from its
+    cos and sin, not "-1.4e-14 deg" (the noise of that reading)."""
+    lines = tmp_path / "s.jsonl"
+    assert main(["sweep", str(scrr_scene(tmp_path)), "--from", "90 deg", "--to", f"{last} deg", "--steps", "37",
+                 "--csv", str(tmp_path / "s.csv"), "--json", str(lines)]) == 0
+    capsys.readouterr()
+    (row,) = [json.loads(x) for x in lines.read_text().splitlines() if '"solved"' not in x]
+    assert "singular at O2 = 0 deg (" in row["error"] and "e-1" not in row["error"].split("(")[0], row["error"]
+
+
 @pytest.mark.parametrize("last", [450.5, -269.5], ids=["forwards", "backwards"])
 @pytest.mark.parametrize("steps", [361, 100, 37])
 def test_an_scrr_swept_off_the_grid_passes_its_change_point_either_way(tmp_path, capsys, last, steps):

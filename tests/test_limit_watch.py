@@ -353,3 +353,28 @@ def test_a_constant_transmission_angle_is_one_value_in_the_json_and_the_report_t
             assert abs(dyad["transmission_angle_least"] - math.pi / 2) < 1e-12  # rounding of unit vectors
             rows = [cell for head, cell in design_rows(design_summary(sweep)) if head.startswith("μ at")]
             assert rows == ['<span data-key="dyads.0.transmission_angle_least">90</span>° at every pose (constant)']
+
+
+@pytest.mark.parametrize("side, constant", [("left", True), ("right", False)],
+                         ids=["parallelogram", "antiparallelogram"])
+def test_a_parallelograms_mechanical_advantage_is_one_value_not_a_least_at_a_pose(tmp_path, side, constant):
+    """A four-bar of two equal pairs (ground = coupler 100 mm, crank = rocker 40 mm) drawn
+    at 30 deg on its parallelogram branch: the rocker stays parallel to the crank, so it
+    turns with it, omega4 = omega2 at every pose, through both change points, and the
+    mechanical advantage |omega2 / omega4| is 1 (the summary said "least 1 at O2 = 110.282
+    deg", a pose rounding chose). On the antiparallelogram branch it varies."""
+    from pinmech.solve.design_summary import design_summary
+
+    scene = four_bar_files(tmp_path, 100, 40, 100, 40, drawn=30, side=side)
+    sweep, design = swept(scene, 30, 390 - 1, 73)  # no pose exactly on a change point (180, 360 deg)
+    (stat,) = design.advantages
+    (entry,) = design_summary(sweep)["outputs"]
+    line = next(x for x in design.summary() if "mechanical advantage" in x)
+    assert entry["mechanical_advantage_constant"] is constant and stat.constant is constant
+    if constant:
+        assert abs(stat.low - 1) < 1e-12 and abs(stat.high - 1) < 1e-12  # rates solved to ~1e-15 relative
+        assert line.endswith("mechanical advantage |driver rate / rocker's rate| 1 [1] at every pose "
+                             "(constant to 1e-09 of it over the 73 poses)")
+    else:
+        assert stat.high - stat.low > 0.1 and " least " in line
+    assert "limit positions" not in line  # neither rocker has one: it never stops

@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from pinmech.solve.continuation import Route
+from pinmech.solve.closure_check import value_text
 from pinmech.solve.core import core_for
 from pinmech.exceptions import AssemblyError, PinmechError
 
@@ -109,4 +110,4 @@ def _joint_value(solver, name: str, q: np.ndarray) -> str:
     if joint.nv != 1:
         return str(np.round(q[joint.idx_q:joint.idx_q + joint.nq], 6).tolist())
     value = solver.mechanism.coordinate(q, name)
-    return f"{math.degrees(value):.10g} deg" if joint.is_angular else f"{value:.10g} m"
+    return value_text(joint.is_angular, value)

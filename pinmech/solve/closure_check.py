@@ -17,14 +17,19 @@ ROUNDING_LEVEL = 1e-14
 
 def describe_joint_values(mechanism: Mechanism, names: Sequence[str], values: Sequence[float]) -> str:
     """One-dof joints' values as a user reads them in an error: angles in degrees, lengths
-    in metres ("O2 = 90 deg, slide = 0.15 m")."""
-    out = []
-    for name, value in zip(names, values):
-        if mechanism.joint(name).is_angular:
-            out.append(f"{name} = {math.degrees(value):.10g} deg")
-        else:
-            out.append(f"{name} = {value:.10g} m")
-    return ", ".join(out)
+    in metres ("O2 = 90 deg, slide = 0.15 m"), each rounded to 1e-9 deg or 1e-12 m first:
+    a driver a turn on at 360 deg, read back from its cos and sin as -1.4e-16 rad, is
+    "0 deg", not "-1.40334186e-14 deg"."""
+    return ", ".join(f"{name} = {value_text(mechanism.joint(name).is_angular, value)}"
+                     for name, value in zip(names, values))
+
+
+def value_text(angular: bool, value: float) -> str:
+    """A one-dof joint's value [rad or m] as an error prints it: "90 deg" or "0.15 m", to
+    10 significant figures after rounding to 1e-9 deg or 1e-12 m (describe_joint_values)."""
+    if angular:
+        return f"{round(math.degrees(value), 9) + 0.0:.10g} deg"
+    return f"{round(value, 12) + 0.0:.10g} m"
 
 
 def is_closed(independent, full, tol: float):

@@ -58,7 +58,8 @@ def design_summary(sweep, span: float | None = None) -> dict:
                  "quick_stroke_driver_angle": t.beta if t else None,
                  "mechanical_advantage_least_over_the_poses": stat.low if math.isfinite(stat.low) else None,
                  "mechanical_advantage_least_over_the_poses_at": stat.low_at if math.isfinite(stat.low) else None,
-                 "mechanical_advantage_unit": design._unit(output)}
+                 "mechanical_advantage_unit": design._unit(output),
+                 "mechanical_advantage_constant": stat.constant}
         outputs.append(entry)
     return {**out, "planar": True, "poses": design.count, "fold_end": sweep.fold_end,
             "loops": [x.as_dict(design.input_link) for x in loop_classes(design.linkage)],

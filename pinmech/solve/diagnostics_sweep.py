@@ -27,6 +27,12 @@ from pinmech.model.planar_linkage import planar_linkage
 from pinmech.solve.instant_centres import instant_centres
 from pinmech.solve.transmission import dyad_angles, find_dyads, find_outputs, input_links, output_rate
 
+#: A ratio of rates (a mechanical advantage) whose spread over the poses is below this share
+#: of it is one value: rates come from solves rounded at ~1e-15 relative (times the
+#: Jacobian's condition number, under 1e3 away from toggles).
+CONSTANT_RELATIVE = 1e-9
+
+
 @dataclass
 class _Extreme:
     """The least and largest of a quantity over the poses, and the driver values there."""
@@ -41,6 +47,13 @@ class _Extreme:
             self.low, self.low_at = value, at
         if value > self.high:
             self.high, self.high_at = value, at
+
+    @property
+    def constant(self) -> bool:
+        """Whether the quantity is one value at every pose (a parallelogram's rocker turning
+        with its crank): its least and largest within CONSTANT_RELATIVE of it, so that the
+        pose "where" it is least would be rounding's choice."""
+        return bool(math.isfinite(self.low) and self.high - self.low <= CONSTANT_RELATIVE * abs(self.high))
 
 
 class DesignSweep:
@@ -343,10 +356,15 @@ class DesignSweep:
         for output, found, stat in zip(self.outputs, self.limits(), self.advantages):
             name = self.linkage.names[output.output]
             lines += self._travel_lines(name, found, span)
-            if math.isfinite(stat.low):
+            infinite = " (infinite at its limit positions)" if found else ""
+            if stat.constant:
+                lines.append(f"design: {name}: mechanical advantage |driver rate / {name}'s rate| "
+                             f"{stat.low:.6g} [{self._unit(output)}] at every pose (constant to {CONSTANT_RELATIVE:g} "
+                             f"of it over the {self.count} poses){infinite}")
+            elif math.isfinite(stat.low):
                 lines.append(f"design: {name}: mechanical advantage |driver rate / {name}'s rate| least "
-                             f"{stat.low:.6g} [{self._unit(output)}] at {self._driver(stat.low_at)} over the poses "
-                             "(infinite at its limit positions)")
+                             f"{stat.low:.6g} [{self._unit(output)}] at {self._driver(stat.low_at)} over the poses"
+                             f"{infinite}")
         return lines
 
     def _travel_lines(self, name: str, found: list[LimitPosition], span: float | None) -> list[str]:
