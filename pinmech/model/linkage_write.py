@@ -31,8 +31,8 @@ def linkage_toml(spec: LinkageSpec, header: str = "") -> str:
         if getattr(spec, key):
             lines.append(f"{key} = {_array(getattr(spec, key))}")
     tables = {
-        "params": {n: _value(v) for n, v in spec.params.items()},
-        "joints": {n: _joint(j) for n, j in spec.joints.items()},
+        "params": {n: value_toml(v) for n, v in spec.params.items()},
+        "joints": {n: joint_toml(j) for n, j in spec.joints.items()},
         "links": {n: _array(names) for n, names in spec.links.items()},
         "sliders": {n: _entry(s) for n, s in spec.sliders.items()},
         "slots": {n: _entry(s) for n, s in spec.slots.items()},
@@ -46,7 +46,8 @@ def linkage_toml(spec: LinkageSpec, header: str = "") -> str:
     return "\n".join(lines) + "\n"
 
 
-def _joint(joint: tuple | Polar | Compass | Bearing) -> str:
+def joint_toml(joint: tuple | Polar | Compass | Bearing) -> str:
+    """A drawn joint's TOML value: an array of coordinates, or an inline table of its construction."""
     if isinstance(joint, (Polar, Compass, Bearing)):
         return _entry(joint)
     return _array(joint)
@@ -55,10 +56,11 @@ def _joint(joint: tuple | Polar | Compass | Bearing) -> str:
 def _entry(entry: Polar | Compass | Bearing | Slider | Slot | MassSpec) -> str:
     """An inline table of the entry's given fields, by their file names (`from`)."""
     fields = given_fields(entry)
-    return "{ " + ", ".join(f"{_key(k)} = {_value(v)}" for k, v in fields.items()) + " }"
+    return "{ " + ", ".join(f"{_key(k)} = {value_toml(v)}" for k, v in fields.items()) + " }"
 
 
-def _value(value: str | int | float | tuple | list) -> str:
+def value_toml(value: str | int | float | tuple | list) -> str:
+    """A TOML value: a basic string, a number, or an array of them."""
     if isinstance(value, str):
         return _string(value)
     if isinstance(value, (tuple, list)):
@@ -69,7 +71,7 @@ def _value(value: str | int | float | tuple | list) -> str:
 
 
 def _array(values: tuple | list) -> str:
-    return "[" + ", ".join(_value(v) for v in values) + "]"
+    return "[" + ", ".join(value_toml(v) for v in values) + "]"
 
 
 def _key(name: str) -> str:

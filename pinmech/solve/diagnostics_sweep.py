@@ -285,7 +285,7 @@ class DesignSweep:
                 found.append((self.finder.limit(output, q, x, extreme_label(b.r0, b.x1 - b.x0)), q))
             found += [(self.finder.limit(output, e.q, e.x, e.label), e.q) for e in at_poses]
             along = sorted(found, key=lambda f: abs(f[0].driver - self._first))  # in the sweep's order
-            out.append(_once_a_turn(along, self.sweep.is_angular))
+            out.append(once_a_turn(along, self.sweep.is_angular))
         self._limits = (self.count, out)
         return out
 
@@ -393,7 +393,7 @@ class DesignSweep:
         return f"{self.sweep.driver} = {unit}"
 
 
-def _once_a_turn(found: list[tuple], angular: bool) -> list[tuple]:
+def once_a_turn(found: list[tuple], angular: bool) -> list[tuple]:
     """The limits, each once: a sweep of a whole turn that begins on a limit ends on it too
     (the same pose of the mechanism, the driver a turn on: the same limit)."""
     out: list[tuple] = []

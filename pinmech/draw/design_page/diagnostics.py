@@ -50,7 +50,7 @@ def turn_diagnostics(turn) -> dict:
 def _limits(design, swept, output, x, q, whole: bool) -> list:
     """The output's limit positions over the swept poses (each once a turn), with their poses."""
     from pinmech.draw.design_page.swept_extremes import limit_poses
-    from pinmech.solve.diagnostics_sweep import _once_a_turn
+    from pinmech.solve.diagnostics_sweep import once_a_turn
 
     if output.kind == "pin":
         rate, change = swept.turn_rate(output.output)
@@ -58,7 +58,7 @@ def _limits(design, swept, output, x, q, whole: bool) -> list:
         slide = output.ground
         sign = 1.0 if slide.links[1] == output.output else -1.0
         rate, change = swept.slide_rate(output.output, swept.direction(slide.links[0], slide.axis), sign)
-    return _once_a_turn(limit_poses(design, output, x, q, rate, change), whole)
+    return once_a_turn(limit_poses(design, output, x, q, rate, change), whole)
 
 
 def _fold_poses(design, turn, x: np.ndarray, q: np.ndarray) -> list[tuple[float, np.ndarray]]:

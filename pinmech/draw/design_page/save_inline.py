@@ -11,7 +11,7 @@ import re
 import tomllib
 
 from pinmech.model.linkage_spec import LinkageSpec, linkage_spec
-from pinmech.model.linkage_write import _joint, _value
+from pinmech.model.linkage_write import joint_toml, value_toml
 
 #: The tables whose entries a page's edit changes: their values are rewritten line by line.
 EDITED = ("params", "joints")
@@ -53,7 +53,7 @@ def _changes(old: LinkageSpec, new: LinkageSpec) -> dict[tuple[str, str], str] |
         if name not in EDITED and getattr(old, name) != getattr(new, name):
             return None
     out = {}
-    for table, text in (("params", _value), ("joints", _joint)):
+    for table, text in (("params", value_toml), ("joints", joint_toml)):
         before, after = getattr(old, table), getattr(new, table)
         if list(before) != list(after):
             return None
