@@ -26,6 +26,7 @@ distributed = pytest.importorskip("distributed")
 psutil = pytest.importorskip("psutil")
 ROOT = Path(__file__).resolve().parents[1]
 STUDY = ROOT / "models" / "studies" / "four_bar_tolerance.toml"
+SYNTHESIS = ROOT / "models" / "synthesis" / "four_bar_path.toml"
 
 
 def _spec(samples: int = 120, batch: int = 10, steps: int = 19):
@@ -48,9 +49,11 @@ def _free_port() -> int:
     ("tcp://127.0.0.1:{free}", "cannot reach"),
     ("tcp://{http}", "did not answer as a Dask scheduler"),
 ])
-def test_a_bad_or_unreachable_scheduler_is_one_line_in_seconds(address, said, capsys):
+@pytest.mark.parametrize("command", ["study", "synth"])
+def test_a_bad_or_unreachable_scheduler_is_one_line_in_seconds(address, said, command, capsys):
     """Before: 20 s of waiting ('Timed out trying to connect'), or a traceback (a ValueError
-    for 'nonsense', numpy's 3 EiB MemoryError for a server that is no scheduler)."""
+    for 'nonsense', numpy's 3 EiB MemoryError for a server that is no scheduler); `synth`
+    had its own connection, without the study's checks, until round 4's last stop."""
     import http.server
     import threading
 
@@ -63,7 +66,8 @@ def test_a_bad_or_unreachable_scheduler_is_one_line_in_seconds(address, said, ca
     try:
         address = address.format(free=_free_port(), http=f"127.0.0.1:{server.server_address[1]}")
         began = time.monotonic()
-        code = main(["study", str(STUDY), "--scheduler", address, "--quiet"])
+        argv = [str(STUDY), "--quiet"] if command == "study" else [str(SYNTHESIS)]
+        code = main([command, *argv, "--scheduler", address])
         seconds = time.monotonic() - began
     finally:
         server.shutdown()
@@ -132,3 +136,48 @@ def test_the_scheduler_lost_mid_run_is_one_line_and_no_output(tmp_path):
     finally:
         cluster.close()
     assert time.monotonic() - began[0] < CONNECT_SECONDS + 20
+
+
+@pytest.mark.parametrize("workers", ["100000000000", "-1", str(4 * (os.cpu_count() or 1) + 1)])
+@pytest.mark.parametrize("command", ["study", "synth"])
+def test_a_worker_count_the_machine_cannot_hold_is_refused_before_anything_starts(workers, command, capsys):
+    """--workers 100000000000 started a LocalCluster of that many processes (killed after a
+    minute of forking); now refused in one line, before the file is read: at most four
+    worker processes a core (cluster.WORKERS_PER_CORE), a scheduler's address for more."""
+    with pytest.raises(SystemExit) as stop:
+        main([command, str(STUDY if command == "study" else SYNTHESIS), "--workers", workers])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and f"--workers: {workers}: give a whole number of worker processes" in err
+
+
+@pytest.mark.parametrize("workers", [10**11, -1, 2.5, True, "2"])
+def test_the_api_refuses_the_same_worker_counts(workers):
+    import pinmech
+    from pinmech.exceptions import OptionError
+
+    for run, path in ((pinmech.study, STUDY), (pinmech.synthesise, SYNTHESIS)):
+        with pytest.raises(OptionError, match=r"workers = .*: give a whole number of worker processes from 0"):
+            run(path, workers=workers)
+
+
+def test_a_synthesis_whose_scheduler_is_lost_is_a_cluster_error_naming_how_far_it_got():
+    """The population's evaluation on a cluster gone away: one ClusterError ("lost during the
+    run after N candidates"), as a study's, not Dask's CommClosedError or a 20 s timeout."""
+    from pinmech.design.synthesis.file import load_synthesis
+    from pinmech.design.synthesis.search import PopulationMap
+
+    spec = load_synthesis(SYNTHESIS)
+    cluster = local_cluster(1, silence_logs=50)
+    client = distributed.Client(cluster)
+    try:
+        mapper = PopulationMap(spec, client, 1, cluster.scheduler_address)
+        rows = np.tile((spec.lower + spec.upper) / 2, (4, 1))
+        assert len(mapper(None, rows)) == 4
+        cluster.close()
+        began = time.monotonic()
+        with pytest.raises(ClusterError, match="lost during the run after 4 candidates"):
+            mapper(None, rows)
+        assert time.monotonic() - began < CONNECT_SECONDS + 30
+    finally:
+        client.close()
+        cluster.close()

@@ -23,7 +23,7 @@ from contextlib import contextmanager
 
 from pinmech.design.study.file import StudySpec
 from pinmech.design.study.tolerance import Batch, BatchResult, run_batch
-from pinmech.exceptions import ClusterError, PinmechError
+from pinmech.exceptions import ClusterError, OptionError, PinmechError
 
 _EXTRA = 'pip install "pinmech[study]"'
 #: Seconds a scheduler given by its address has to answer (Dask's own default waits 30 s).
@@ -171,11 +171,37 @@ def _host_port(address: str) -> tuple[str, int]:
     return host, int(port)
 
 
+#: The most worker processes a LocalCluster starts, per core of this machine: more only queue
+#: for the cores, and each holds its own mechanism and Python (about 100 MB).
+WORKERS_PER_CORE = 4
+
+
+def checked_workers(workers: object) -> int:
+    """`workers` as a number of local worker processes: a whole number from 0 (this process)
+    to WORKERS_PER_CORE x the machine's cores, else an OptionError naming both (a count of
+    1e11 started processes until the run was killed).
+
+    A scheduler's address takes its workers from the cluster behind it, whatever this is."""
+    import operator
+
+    most = WORKERS_PER_CORE * (os.cpu_count() or 1)
+    try:
+        count = None if isinstance(workers, bool) else operator.index(workers)  # an int, numpy's too
+    except TypeError:
+        count = None
+    if count is None or not 0 <= count <= most:
+        raise OptionError(f"workers = {workers!r}: give a whole number of worker processes from 0 (this process) "
+                          f"to {most} ({WORKERS_PER_CORE} per core of this machine's {os.cpu_count() or 1}), or "
+                          "a running scheduler's address for more", option="workers", value=workers)
+    return count
+
+
 def local_cluster(workers: int, **options):
     """A LocalCluster of `workers` processes of one thread each on 127.0.0.1, its workers
     quiet (QUIET_WORKERS); `options` go to LocalCluster (e.g. silence_logs)."""
     import dask
 
+    checked_workers(workers)
     distributed = require_dask()
     with dask.config.set(QUIET_WORKERS):  # a worker process takes the config it is started with
         return distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
@@ -201,7 +227,7 @@ def _gathered(client, spec: StudySpec, batches: list[Batch], progress, distribut
     """The batches' results in batch order; the scheduler lost on the way is a ClusterError
     (the batches' own errors pass as they are)."""
     results: list[BatchResult | None] = [None] * len(batches)
-    try:
+    with lost_as_cluster_error(address, lambda: f"{sum(r is not None for r in results)} of {len(batches)} batches"):
         futures = client.map(solve_batch, [spec] * len(batches), batches, pure=False)
         index = {f.key: i for i, f in enumerate(futures)}
         for future in distributed.as_completed(futures):
@@ -209,16 +235,24 @@ def _gathered(client, spec: StudySpec, batches: list[Batch], progress, distribut
             results[i] = future.result()
             if progress:
                 progress(batches[i])
+    return results
+
+
+@contextmanager
+def lost_as_cluster_error(address: str, done: Callable[[], str]) -> Iterator[None]:
+    """Dask's errors for a scheduler or connection gone away, inside the block, as one
+    ClusterError naming `address` and how far the run got (`done()`); pinmech's own errors
+    and a task's own failure pass as they are."""
+    try:
+        yield
     except PinmechError:
         raise
-    except Exception as exc:  # noqa: BLE001 - sorted below: Dask's losses, else the batch's own error
+    except Exception as exc:  # noqa: BLE001 - sorted by _lost: Dask's losses, else the task's own error
         if not _lost(exc):
             raise
-        done = sum(r is not None for r in results)
         said = " ".join(str(exc).split())[:200] or type(exc).__name__
-        raise ClusterError(f"lost during the run after {done} of {len(batches)} batches ({type(exc).__name__}: "
-                           f"{said}); nothing was written", address=address) from exc
-    return results
+        raise ClusterError(f"lost during the run after {done()} ({type(exc).__name__}: {said}); nothing was written",
+                           address=address) from exc
 
 
 def _lost(error: BaseException) -> bool:

@@ -10,14 +10,16 @@ from pinmech.solve.kernels import KERNELS
 
 
 def _workers(text: str) -> int:
-    """--workers: a whole number >= 0 (argparse type)."""
+    """--workers: a whole number of worker processes, 0 to cluster.checked_workers' most (argparse type)."""
+    from pinmech.design.cluster import checked_workers
+    from pinmech.exceptions import OptionError
+
     try:
-        value = int(text)
+        return checked_workers(int(text))
     except ValueError:
-        value = -1
-    if value < 0:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number of worker processes (0 runs in this process)")
-    return value
+    except OptionError as exc:
+        raise argparse.ArgumentTypeError(str(exc).replace("workers = ", "", 1))
 
 
 class ProgressBar:

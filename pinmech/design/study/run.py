@@ -107,6 +107,9 @@ def study(path: str | Path | StudySpec | WorkspaceSpec, *, workers: int = 0, sch
         SweepError: the nominal's cycle fails.
         ImportError: naming `pinmech[study]`, without Dask.
     """
+    from pinmech.design.cluster import checked_workers
+
+    checked_workers(workers)  # before the file is read: a count that would fork the machine to a halt
     spec = path if isinstance(path, (StudySpec, WorkspaceSpec)) else load_any_study(Path(path))
     if certify is not None:
         spec = _with_certify(spec, certify)

@@ -36,8 +36,8 @@ class PopulationMap:
     """The `workers` of differential_evolution: evaluates a whole population at once, in
     this process or as `chunks` Dask tasks, and counts the rejected candidates by cause."""
 
-    def __init__(self, spec: SynthesisSpec, client=None, chunks: int = 1) -> None:
-        self.spec, self.client, self.chunks = spec, client, chunks
+    def __init__(self, spec: SynthesisSpec, client=None, chunks: int = 1, address: str = "local") -> None:
+        self.spec, self.client, self.chunks, self.address = spec, client, chunks, address
         self.assembly = 1.0
         self.rejected: Counter = Counter()
         self.evaluations = 0
@@ -47,9 +47,12 @@ class PopulationMap:
         if self.client is None:
             parts = [evaluate(self.spec, self.assembly, x)]
         else:
-            futures = self.client.map(evaluate, [self.spec] * self.chunks, [self.assembly] * self.chunks,
-                                      np.array_split(x, self.chunks), pure=False)
-            parts = self.client.gather(futures)
+            from pinmech.design.cluster import lost_as_cluster_error
+
+            with lost_as_cluster_error(self.address, lambda: f"{self.evaluations} candidates"):
+                futures = self.client.map(evaluate, [self.spec] * self.chunks, [self.assembly] * self.chunks,
+                                          np.array_split(x, self.chunks), pure=False)
+                parts = self.client.gather(futures)
         self.evaluations += len(x)
         values = []
         for part in parts:
@@ -70,22 +73,23 @@ def synthesise(spec: SynthesisSpec | str | Path, *, workers: int = 0, scheduler:
             "generated": one kernel for the whole search); None: the template scene's. The
             four-bar and slider-crank topologies are solved in closed form and run no passes.
     """
+    from pinmech.design.cluster import checked_workers
+
+    checked_workers(workers)
     if not isinstance(spec, SynthesisSpec):
         spec = load_synthesis(spec)
     if kernel is not None:
         spec = dataclasses.replace(spec, kernel=checked_kernel(kernel))
     if scheduler is None and workers == 0:
         return _run(spec, PopulationMap(spec))
-    from pinmech.design.cluster import require_dask
+    from pinmech.design.cluster import connected, local_cluster, require_dask
 
     distributed = require_dask()
-    if scheduler is not None:
-        with distributed.Client(scheduler, timeout="20s") as client:
-            return _run(spec, PopulationMap(spec, client, max(workers, 1)))
-    with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                  dashboard_address="127.0.0.1:0", host="127.0.0.1") as cluster, \
-            distributed.Client(cluster) as client:
-        return _run(spec, PopulationMap(spec, client, workers))
+    if scheduler is not None:  # the study's checks: the address, a TCP connection, Dask's handshake
+        with connected(scheduler, distributed) as client:
+            return _run(spec, PopulationMap(spec, client, max(workers, 1), scheduler))
+    with local_cluster(workers) as cluster, distributed.Client(cluster) as client:
+        return _run(spec, PopulationMap(spec, client, workers, "local"))
 
 
 def _run(spec: SynthesisSpec, mapper: PopulationMap) -> SynthesisResult:
