@@ -58,6 +58,30 @@ def test_solver_options_out_of_range_are_refused(four_bar, option, value):
         setattr(solver, option, value)  # set later, as a user's script may
 
 
+@pytest.mark.parametrize("option, value", [
+    ("tol", float("nan")), ("tol", 1.0), ("max_condition", float("nan")), ("max_condition", 0.5),
+    ("kernel", "GENERATED"), ("kernel", "fast"), ("kernel", None), ("certify", "often"), ("certify", 10),
+])
+def test_a_rate_solvers_options_are_checked_when_set_later_too(option, value):
+    """A RateSolver checked its options in its constructor only: `rates.tol = nan` after it
+    turned the residual check off, and `kernel = "GENERATED"` ran the generic passes in
+    silence (a LoopSolver's kernel too). Both now refuse them when set, also later."""
+    from pinmech import RateSolver, Task
+    from tests.conftest import MODELS
+
+    arm = Mechanism.from_urdf(MODELS / "planar_arm.urdf")
+    rates = RateSolver(arm, [Task("D", ("x", "y"), np.array([1.0, 0.0]), np.zeros(2)),
+                             Task("CD", ("wz",), np.zeros(1), np.zeros(1))])
+    before = getattr(rates, option)
+    with pytest.raises(OptionError, match=option):
+        setattr(rates, option, value)
+    assert getattr(rates, option) == before
+    if option in ("kernel", "certify"):
+        loop = LoopSolver(Mechanism.from_urdf(MODELS / "r_rtr.urdf"), ["A"])
+        with pytest.raises(OptionError, match=option):
+            setattr(loop, option, value)
+
+
 def test_options_at_the_ends_of_their_ranges_work(four_bar):
     solver = LoopSolver(four_bar, ["O2"], tol=1e-3, max_iterations=1000, max_condition=float("inf"))
     assert solver.solve([1.0]).accuracy.residual <= 1e-3

@@ -38,13 +38,12 @@ from pinmech.model.mechanism import Mechanism
 from pinmech.seeded import Seeded
 from pinmech.solve import core
 from pinmech.solve.core import _core
-from pinmech.solve.certify import checked_certify
-from pinmech.solve.kernels import checked_kernel, kept
+from pinmech.solve.kernels import kept
 from pinmech.solve.results import RateSolution, frozen
+from pinmech.solve.solver_options import SolverOptions
 from pinmech.solve.loops import (
     DEFAULT_MAX_CONDITION,
     DEFAULT_TOL,
-    checked_option,
     describe_joint_values,
     is_closed,
     open_loops_error,
@@ -128,7 +127,7 @@ class RateBatch:
     closure_residual: np.ndarray
 
 
-class RateSolver:
+class RateSolver(SolverOptions):
     """Solves task-space rate problems pose after pose, keeping one `pin.Data`.
 
     Args:
@@ -178,10 +177,10 @@ class RateSolver:
         self.frames = [mechanism.frame_id(t.frame) for t in self.tasks]
         self.method = method
         self.damping = float(damping)
-        self.max_condition = checked_option("max_condition", max_condition)  # NaN would turn the check off
-        self.tol = checked_option("tol", tol)
-        self.kernel = checked_kernel(kernel)
-        self.certify = checked_certify(certify)
+        self.max_condition = max_condition  # checked when set, also later (SolverOptions): NaN would turn the check off
+        self.tol = tol
+        self.kernel = kernel
+        self.certify = certify
         self.x_dot = np.concatenate([t.velocity for t in self.tasks])
         self.x_ddot = np.concatenate([t.acceleration for t in self.tasks])
         self.row_names = [f"{t.frame}.{c}" for t in self.tasks for c in t.components]

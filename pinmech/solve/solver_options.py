@@ -91,7 +91,8 @@ class Reference:
 
 
 class SolverOptions:
-    """A loop solver's options, each checked against SOLVER_RANGES when set (also later)."""
+    """A solver's options (a loop solver's, a rate solver's), each checked when set, also
+    later: the numbers against SOLVER_RANGES, the dial and the kernel against their names."""
 
     @property
     def tol(self) -> float:
@@ -130,3 +131,14 @@ class SolverOptions:
         from pinmech.solve.certify import checked_certify
 
         self._certify = checked_certify(value)
+
+    @property
+    def kernel(self) -> str:
+        """The kinematic passes (kernels.py): "generic", "generated" or "auto"."""
+        return self._kernel
+
+    @kernel.setter
+    def kernel(self, value: str) -> None:  # "GENERATED" ran the generic passes in silence
+        from pinmech.solve.kernels import checked_kernel
+
+        self._kernel = checked_kernel(value)
