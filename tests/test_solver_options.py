@@ -23,6 +23,7 @@ from pinmech import (
     OptionError,
     RateOverflowError,
     Scene,
+    TaskError,
 )
 from pinmech.solve.batch import BatchSolver
 from pinmech.solve.cycle import solve_range
@@ -61,11 +62,13 @@ def test_solver_options_out_of_range_are_refused(four_bar, option, value):
 @pytest.mark.parametrize("option, value", [
     ("tol", float("nan")), ("tol", 1.0), ("max_condition", float("nan")), ("max_condition", 0.5),
     ("kernel", "GENERATED"), ("kernel", "fast"), ("kernel", None), ("certify", "often"), ("certify", 10),
+    ("damping", float("nan")), ("damping", -1.0), ("method", "bogus"),
 ])
 def test_a_rate_solvers_options_are_checked_when_set_later_too(option, value):
     """A RateSolver checked its options in its constructor only: `rates.tol = nan` after it
-    turned the residual check off, and `kernel = "GENERATED"` ran the generic passes in
-    silence (a LoopSolver's kernel too). Both now refuse them when set, also later."""
+    turned the residual check off, `damping = nan` gave NaN rates, `method = "bogus"` a
+    KeyError, and `kernel = "GENERATED"` ran the generic passes in silence (a LoopSolver's
+    kernel too). Both now refuse them when set, also later."""
     from pinmech import RateSolver, Task
     from tests.conftest import MODELS
 
@@ -73,8 +76,8 @@ def test_a_rate_solvers_options_are_checked_when_set_later_too(option, value):
     rates = RateSolver(arm, [Task("D", ("x", "y"), np.array([1.0, 0.0]), np.zeros(2)),
                              Task("CD", ("wz",), np.zeros(1), np.zeros(1))])
     before = getattr(rates, option)
-    with pytest.raises(OptionError, match=option):
-        setattr(rates, option, value)
+    with pytest.raises(TaskError if option in ("damping", "method") else OptionError, match=option):
+        setattr(rates, option, value)  # damping = nan gave NaN rates, method = "bogus" a KeyError
     assert getattr(rates, option) == before
     if option in ("kernel", "certify"):
         loop = LoopSolver(Mechanism.from_urdf(MODELS / "r_rtr.urdf"), ["A"])

@@ -158,25 +158,18 @@ class RateSolver(SolverOptions):
     def __init__(self, mechanism: Mechanism, tasks: Sequence[Task], *, method: str = "exact",
                  damping: float = 1e-3, max_condition: float = DEFAULT_MAX_CONDITION,
                  tol: float = DEFAULT_TOL, kernel: str = "generic", certify: str = "every-pose") -> None:
-        if method not in METHODS:
-            raise TaskError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+        self.method = method  # checked first: a TaskError before anything is built
         if not isinstance(tasks, (list, tuple)) or not all(isinstance(t, Task) for t in tasks):
             raise TaskError(f"tasks must be a list of pinmech.Task, got {tasks!r:.80}")
         if not tasks:
             raise TaskError("no task given: add a [[task]] with frame, components, velocity, acceleration")
-        low, high = DAMPING_RANGE
-        number = damping if isinstance(damping, (int, float, np.number)) and not isinstance(damping, bool) else None
-        if number is None or not low <= number <= high:  # NaN is in no range
-            raise TaskError(f"damping must be a positive number in [{low:g}, {high:g}] (dimensionless: below, "
-                            f"its square drowns in rounding; above, it overflows), got {damping!r}")
+        self.damping = damping
         self.mechanism = mechanism
         self.model = mechanism.model
         self.lock = threading.RLock()  # one Data: threads sharing the solver take turns
         self.data = self.model.createData()
         self.tasks = tuple(tasks)
         self.frames = [mechanism.frame_id(t.frame) for t in self.tasks]
-        self.method = method
-        self.damping = float(damping)
         self.max_condition = max_condition  # checked when set, also later (SolverOptions): NaN would turn the check off
         self.tol = tol
         self.kernel = kernel
@@ -292,6 +285,31 @@ class RateSolver(SolverOptions):
                 condition=condition, sigma_min=sigma_min, partial=q,
             )
         return values
+
+    @property
+    def method(self) -> str:
+        """"exact", "least_squares" or "damped" (checked when set, also later)."""
+        return self._method
+
+    @method.setter
+    def method(self, value: str) -> None:  # an unknown one set later was a KeyError at the next solve
+        if value not in METHODS:
+            raise TaskError(f"method must be one of {', '.join(METHODS)}, got {value!r}")
+        self._method = value
+
+    @property
+    def damping(self) -> float:
+        """Lambda of the damped least squares (dimensionless), in DAMPING_RANGE (checked when set, also later)."""
+        return self._damping
+
+    @damping.setter
+    def damping(self, value: float) -> None:  # NaN set later gave NaN rates
+        low, high = DAMPING_RANGE
+        number = value if isinstance(value, (int, float, np.number)) and not isinstance(value, bool) else None
+        if number is None or not low <= number <= high:  # NaN is in no range
+            raise TaskError(f"damping must be a positive number in [{low:g}, {high:g}] (dimensionless: below, "
+                            f"its square drowns in rounding; above, it overflows), got {value!r}")
+        self._damping = float(value)
 
     def _compiled(self):
         """The core with this solver's loops, task and options (built once per model tree:
