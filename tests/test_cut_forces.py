@@ -271,3 +271,28 @@ def test_every_cut_type_gives_the_torque_of_the_energy_rate(tmp_path, name):
     np.testing.assert_allclose(f.effort[0] * omega, rate, rtol=0, atol=1e-7 * scale)
     assert f.power.residual < rounding(1.0, f.condition) and f.equation_residual < 1e-11
     assert any(r.is_cut for r in f.reactions.values())
+
+
+def test_gravity_and_max_condition_set_later_are_the_solvers_own(tmp_path):
+    """A ForceSolver built without gravity and given it afterwards (`f.gravity = ...`): the
+    slotted lever's driver torque and pin forces are Newton-Euler's by hand with that gravity
+    (the set gravity reached the loads' part of the solve and not the model's), and a bad
+    gravity or max_condition set later is refused as at construction."""
+    phi, omega, alpha = math.radians(250.0), 120.0 * math.pi / 30, -15.0
+    mech = pinmech.Mechanism.from_urdf(_r_rtr_cut_at_slide(tmp_path))
+    k = cff.cf.r_rtr(phi, 0.0, 0.0)
+    guess = mech.neutral()
+    mech.set_coordinate(guess, "B", float(k.phi3) - phi + 0.05)
+    mech.set_coordinate(guess, "C", float(k.phi3) - 0.05)
+    sol = pinmech.LoopSolver(mech, ["A"]).solve([phi], [omega], [alpha], guess=guess)
+    solver = ForceSolver(mech, ["A"])
+    solver.gravity = (0, -G, 0)
+    f = solver.solve(sol.q, sol.v, sol.a)
+    hand = cff.r_rtr_forces(phi, omega, alpha, *R_RTR_BODIES, gravity=(0.0, -G))
+    scale = max(np.abs(np.concatenate([hand.F12, hand.F23, hand.F14])).max(), abs(hand.N34))
+    np.testing.assert_allclose(f.effort[0], hand.T, rtol=0, atol=RTOL * scale * 0.2)  # lever arms below 0.2 m
+    np.testing.assert_allclose(f.reactions["A"].force[:2], hand.F12, rtol=0, atol=RTOL * scale)
+    for option, value in (("gravity", (0, float("nan"), 0)), ("gravity", (1, 2)), ("max_condition", float("nan"))):
+        with pytest.raises(pinmech.OptionError, match=option):
+            setattr(solver, option, value)
+    assert solver.gravity.tolist() == [0.0, -G, 0.0]

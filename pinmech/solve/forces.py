@@ -42,7 +42,8 @@ from pinmech.exceptions import BalanceError, IndeterminateForcesError, ModelErro
 from pinmech.model.mechanism import Mechanism
 from pinmech.solve.force_results import (ForceSolution, Load, PowerBalance, Reaction, advantage_unit,
                                          mechanical_advantage)
-from pinmech.solve.loops import checked_option, describe_joint_values, serialized
+from pinmech.solve.loops import describe_joint_values, serialized
+from pinmech.solve.solver_options import SolverOptions
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 #: Default largest condition number of the (dimensionless) force equations: as for velocities.
@@ -52,7 +53,7 @@ __all__ = ["DEFAULT_MAX_CONDITION", "ForceSolution", "ForceSolver", "Load", "Pow
            "advantage_unit", "mechanical_advantage"]
 
 
-class ForceSolver:
+class ForceSolver(SolverOptions):
     """Inverse dynamics of one mechanism, pose after pose (keeps its own `pin.Data`).
 
     Args:
@@ -83,12 +84,7 @@ class ForceSolver:
     ) -> None:
         self.mechanism = mechanism
         self.model = pin.Model(mechanism.model)  # a copy: its gravity is ours, not the user's
-        try:
-            self.gravity = float_array(gravity, "gravity", (3,))
-        except ModelError:
-            raise OptionError(f"gravity = {gravity!r:.80} must be three finite numbers [m/s^2]",
-                              option="gravity", value=gravity) from None
-        self.model.gravity = pin.Motion(self.gravity, np.zeros(3))
+        self.gravity = gravity
         self.lock = threading.RLock()  # one Data: threads sharing the solver take turns
         self.data = self.model.createData()
         self.drivers = names(drivers, "drivers")
@@ -101,10 +97,27 @@ class ForceSolver:
                                   f"three finite numbers [N, N m], got frame {load.frame!r}, force {load.force!r}, "
                                   f"torque {load.torque!r}", option="loads", value=load)
         self.minimum_norm = minimum_norm
-        self.max_condition = checked_option("max_condition", max_condition)
+        self.max_condition = max_condition  # checked when set, also later (SolverOptions)
         self._drv_v = np.array([self.mechanism.driver_index(n) for n in self.drivers], dtype=int)
         self._scale = mechanism.velocity_scale()
         self._check_masses(set(massless))
+
+    @property
+    def gravity(self) -> np.ndarray:
+        """Gravity [m/s^2], world frame (a read-only copy; set it whole)."""
+        return self._gravity
+
+    @gravity.setter
+    def gravity(self, value) -> None:  # set later, it reached the loads' part and not the model's
+        try:
+            g = float_array(value, "gravity", (3,))
+        except ModelError:
+            raise OptionError(f"gravity = {value!r:.80} must be three finite numbers [m/s^2]",
+                              option="gravity", value=value) from None
+        g = np.array(g, dtype=float)
+        g.flags.writeable = False
+        self._gravity = g
+        self.model.gravity = pin.Motion(g, np.zeros(3))
 
     def _check_masses(self, massless: set[str]) -> None:
         """The file's masses are the model's (no `force_caveats`), and every moving body
