@@ -134,6 +134,18 @@ R_RTR_BODIES = (cff.Body(0.1, 1e-4, (0.05, 0.004)), cff.Body(0.05, 1e-6, (0.01, 
                 cff.Body(0.15, 3e-4, (0.075, -0.002)))
 
 
+def _slotted_lever_pose(tmp_path, phi: float, omega: float, alpha: float):
+    """The slotted lever cut at its slide, its closed form at crank angle phi [rad], and the
+    pose solved there at crank rate omega [rad/s] and acceleration alpha [rad/s^2], seeded
+    near the closed form's branch."""
+    mech = pinmech.Mechanism.from_urdf(_r_rtr_cut_at_slide(tmp_path))
+    k = cff.cf.r_rtr(phi, 0.0, 0.0)
+    guess = mech.neutral()
+    mech.set_coordinate(guess, "B", float(k.phi3) - phi + 0.05)
+    mech.set_coordinate(guess, "C", float(k.phi3) - 0.05)
+    return mech, k, pinmech.LoopSolver(mech, ["A"]).solve([phi], [omega], [alpha], guess=guess)
+
+
 @pytest.mark.parametrize(("deg", "rpm", "alpha", "gravity"), [
     (30.0, -50.0, 0.0, G),
     (135.0, 300.0, 40.0, 0.0),
@@ -145,12 +157,7 @@ def test_a_slotted_lever_cut_at_its_slide_matches_newton_euler_by_hand(tmp_path,
     the block pushes the turning guide with a normal force N34 and a moment M34 about B,
     where the guide's cut frame (its origin C) is 0.05-0.15 m away."""
     phi, omega = math.radians(deg), rpm * math.pi / 30
-    mech = pinmech.Mechanism.from_urdf(_r_rtr_cut_at_slide(tmp_path))
-    k = cff.cf.r_rtr(phi, 0.0, 0.0)
-    guess = mech.neutral()
-    mech.set_coordinate(guess, "B", float(k.phi3) - phi + 0.05)
-    mech.set_coordinate(guess, "C", float(k.phi3) - 0.05)
-    sol = pinmech.LoopSolver(mech, ["A"]).solve([phi], [omega], [alpha], guess=guess)
+    mech, k, sol = _slotted_lever_pose(tmp_path, phi, omega, alpha)
     data = mech.model.createData()
     pin.framesForwardKinematics(mech.model, data, sol.q)
     np.testing.assert_allclose(data.oMf[mech.frame_id("D")].translation[:2], k.D, atol=closure(0.2, sol.accuracy.condition))  # same branch
@@ -279,12 +286,7 @@ def test_gravity_and_max_condition_set_later_are_the_solvers_own(tmp_path):
     (the set gravity reached the loads' part of the solve and not the model's), and a bad
     gravity or max_condition set later is refused as at construction."""
     phi, omega, alpha = math.radians(250.0), 120.0 * math.pi / 30, -15.0
-    mech = pinmech.Mechanism.from_urdf(_r_rtr_cut_at_slide(tmp_path))
-    k = cff.cf.r_rtr(phi, 0.0, 0.0)
-    guess = mech.neutral()
-    mech.set_coordinate(guess, "B", float(k.phi3) - phi + 0.05)
-    mech.set_coordinate(guess, "C", float(k.phi3) - 0.05)
-    sol = pinmech.LoopSolver(mech, ["A"]).solve([phi], [omega], [alpha], guess=guess)
+    mech, _, sol = _slotted_lever_pose(tmp_path, phi, omega, alpha)
     solver = ForceSolver(mech, ["A"])
     solver.gravity = (0, -G, 0)
     f = solver.solve(sol.q, sol.v, sol.a)
