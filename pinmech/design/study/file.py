@@ -261,7 +261,6 @@ def _grid(raw: dict[str, Any], kind: str, params: tuple[Parameter, ...], where: 
     table = raw.get("grid")
     if not isinstance(table, dict):
         raise where.error("grid", "a grid study needs [grid.NAME] tables: from = \"30 mm\", to = \"60 mm\", count = 7")
-    names = [p.name for p in params]
     if not 1 <= len(table) <= 3:
         raise where.error("grid", f"give 1 to 3 [grid.NAME] tables, got {len(table)}")
     axes = tuple(_axis(name, entry, params, where) for name, entry in table.items())

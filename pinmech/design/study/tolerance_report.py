@@ -59,7 +59,7 @@ def tolerance_lines(s: dict, driver: str) -> list[str]:
     over = s["sigma_over"]
     failed = f", {over['failed']} failed" if over["failed"] else ""
     lines = [f"Monte Carlo sigma over the {over['solved']} of {over['samples']} variants that solved{failed}",
-             f"stack-up at each output's pose of largest sigma (t: a uniform's half width, else 3 sigma):",
+             "stack-up at each output's pose of largest sigma (t: a uniform's half width, else 3 sigma):",
              f"{'output':<18}{driver + ' [deg]':>12}{'worst case':>12}{'RSS':>10}{'3s linear':>11}{'3s MC':>10}"
              "  largest shares of the variance"]
     for name, e in s["stackup"].items():

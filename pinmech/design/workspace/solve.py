@@ -31,7 +31,6 @@ from pinmech.design.study.file import spec_scene
 from pinmech.design.workspace.file import WorkspaceSpec
 from pinmech.design.workspace.legs import Leg, angles, find_legs, mode_sign, passive_conditioning, set_angles
 from pinmech.exceptions import SceneError
-from pinmech.io.scene import Scene
 from pinmech.io.scene_model import load_mechanism, scene_drivers
 from pinmech.model.closure_core import closure_rows
 from pinmech.solve.kernels import attach, resolved

@@ -6,7 +6,6 @@ valid linkage stays the session's.
 
 from __future__ import annotations
 
-import math
 import time
 from pathlib import Path
 
