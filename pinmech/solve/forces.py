@@ -53,7 +53,7 @@ __all__ = ["DEFAULT_MAX_CONDITION", "ForceSolution", "ForceSolver", "Load", "Pow
            "advantage_unit", "mechanical_advantage"]
 
 
-class ForceSolver(SolverOptions):
+class ForceSolver:
     """Inverse dynamics of one mechanism, pose after pose (keeps its own `pin.Data`).
 
     Args:
@@ -70,6 +70,10 @@ class ForceSolver(SolverOptions):
         ModelError: a moving body without mass (naming its links), or a driver with
             more than one degree of freedom.
     """
+
+    #: Checked when set, also later (a NaN would turn the dead-centre check off): the
+    #: loop and rate solvers' own property, not a copy of it.
+    max_condition = SolverOptions.max_condition
 
     def __init__(
         self,

@@ -33,7 +33,6 @@ from pinmech.solve.closure_check import (  # noqa: F401  (importers of these nam
     not_closed_error,
     open_loops_error,
 )
-from pinmech.solve.kernels import checked_kernel
 from pinmech.solve.driver_values import check_mobility, index_view, one_coordinate, ordered_values, turn_remainder
 from pinmech.solve.results import Accuracy, LoopSolution
 from pinmech.solve.solver_options import (  # noqa: F401  (names users and other modules import from here)
@@ -99,7 +98,7 @@ class LoopSolver(SolverOptions):
         certify: str = "every-pose",
     ) -> None:
         self.mechanism = mechanism
-        self.kernel = checked_kernel(kernel)
+        self.kernel = kernel  # checked when set, also later (SolverOptions)
         self.certify = certify
         self.model = mechanism.model
         self.data = self.model.createData()
